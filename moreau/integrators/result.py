@@ -1,0 +1,106 @@
+"""The result object shared by every integration scheme.
+
+Event-driven and time-stepping runs return the same :class:`SimulationResult`
+so that their time histories plot and compare the same way.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..regimes import REGIME_LETTERS, Regime
+
+__all__ = ["SimulationResult", "Event", "STATUS_MESSAGES"]
+
+#: status codes and their meaning (scipy.integrate style: 0 finished,
+#: 1 a terminal event stopped the run, < 0 failure)
+STATUS_MESSAGES = {
+    0: "The run reached the end of the time interval.",
+    1: "A terminal event occurred.",
+    -1: "The contact problem became ill-posed (Painlevé condition violated).",
+    -2: "Contact was lost where the method assumes permanent contact.",
+    -3: "A contact problem (LCP) could not be solved.",
+    -4: "The run was interrupted; the result holds what was finished.",
+    -5: "A numerical failure occurred.",
+}
+
+
+@dataclass
+class Event:
+    """One located regime change or impact.
+
+    Attributes
+    ----------
+    t : float
+        Dimensionless time of the event.
+    kind : str
+        ``"transition"``, ``"impact"``, ``"liftoff"`` or ``"painleve"``.
+    before, after : Regime
+        Regimes before and after the event.
+    contact : int
+        Index of the contact concerned.
+    """
+
+    t: float
+    kind: str
+    before: Regime
+    after: Regime
+    contact: int = 0
+
+    def __repr__(self):
+        return (f"Event(t={self.t:.12g}, {self.kind}, "
+                f"{REGIME_LETTERS[self.before]}->{REGIME_LETTERS[self.after]})")
+
+
+@dataclass
+class SimulationResult:
+    """Time history of a run, in the scene's dimensionless units.
+
+    Attributes
+    ----------
+    t : ndarray, shape (n,)
+        Sample times.
+    q, v : ndarray, shape (n, ndof)
+        Generalized coordinates and velocities at the samples.
+    regime : ndarray of int, shape (n, ncontacts)
+        :class:`~moreau.regimes.Regime` code of each contact at each sample.
+    force_N, force_T : ndarray, shape (n, ncontacts)
+        Contact forces (time-stepping schemes report impulse / step).
+    slip_velocity : ndarray, shape (n, ncontacts)
+        Tangential relative velocity of each contact.
+    gap : ndarray, shape (n, ncontacts)
+        Normal gap of each contact.
+    events : list of Event
+        Located events (empty for schemes that do not locate events).
+    status : int
+        See :data:`STATUS_MESSAGES`.
+    message : str
+        Human-readable reason for termination.
+    scheme : str
+        Name of the integration scheme.
+    stats : dict
+        Counters: steps, LCP solves, pivots, fallbacks, residuals, penetration.
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    v: np.ndarray
+    regime: np.ndarray
+    force_N: np.ndarray
+    force_T: np.ndarray
+    slip_velocity: np.ndarray
+    gap: np.ndarray
+    events: list = field(default_factory=list)
+    status: int = 0
+    message: str = STATUS_MESSAGES[0]
+    scheme: str = ""
+    stats: dict = field(default_factory=dict)
+
+    @property
+    def success(self):
+        """True when the run ended normally (status 0 or a terminal event)."""
+        return self.status >= 0
+
+    def regime_letters(self, contact=0):
+        """Regime of one contact at each sample as a string of letters."""
+        return "".join(REGIME_LETTERS[Regime(int(r))] for r in self.regime[:, contact])

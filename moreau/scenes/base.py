@@ -1,0 +1,100 @@
+"""The scene interface: what a mechanical system tells an integrator.
+
+A scene works in its own dimensionless variables (time ``t``, coordinates
+``q``, velocities ``v``). It declares only what it has: a frictionless contact
+contributes no tangential row, a scene without contacts reports ``ncontacts == 0``.
+
+Contact kinematics, for contact ``i``::
+
+    g_i(q, t)                      gap, >= 0 admissible
+    dg_i/dt   = WN[i] @ v + wN[i]  normal relative velocity
+    gammaT_j  = WT[j] @ v + wT[j]  tangential relative (slip) velocity
+    d2g_i/dt2 = WN[i] @ a + wNbar[i]
+    dgammaT_j = WT[j] @ a + wTbar[j]
+
+where ``j`` runs over the frictional contacts only (``mu > 0``), in the order
+of ``frictional_index``. The contact reactions enter the equations of motion as::
+
+    M(q) a = h(q, v, t) + WN.T @ lambdaN + WT.T @ lambdaT
+
+so ``lambdaN >= 0`` pushes the gap open, and in positive slip
+(``gammaT > 0``) Coulomb friction gives ``lambdaT = -mu * lambdaN``.
+"""
+
+import numpy as np
+
+__all__ = ["Scene"]
+
+
+class Scene:
+    """Base class of all scenes.
+
+    Subclasses set ``ndof``, ``mu`` (array over contacts) and ``restitution``
+    (array over contacts), and implement the methods below. Arrays are plain
+    ``numpy`` float arrays in the scene's dimensionless units.
+    """
+
+    #: number of generalized coordinates
+    ndof = 0
+    #: friction coefficient of each contact, shape (ncontacts,)
+    mu = np.zeros(0)
+    #: Newton restitution coefficient of each contact, shape (ncontacts,)
+    restitution = np.zeros(0)
+    #: short name used in reports
+    name = "scene"
+
+    @property
+    def ncontacts(self):
+        return len(self.mu)
+
+    @property
+    def frictional_index(self):
+        """Indices of the contacts with ``mu > 0`` (the only ones with tangential rows)."""
+        return np.flatnonzero(np.asarray(self.mu) > 0.0)
+
+    # -- dynamics ---------------------------------------------------------
+    def mass(self, q):
+        """Mass matrix ``M(q)``, shape (ndof, ndof), symmetric positive definite."""
+        raise NotImplementedError
+
+    def forces(self, q, v, t):
+        """Generalized non-contact forces ``h(q, v, t)``, including gyroscopic terms."""
+        raise NotImplementedError
+
+    def force_jacobians(self, q, v, t):
+        """``(dh/dq, dh/dv)``, each (ndof, ndof); used by implicit schemes.
+
+        The default is zero, which makes implicit schemes treat ``h`` explicitly.
+        """
+        n = self.ndof
+        return np.zeros((n, n)), np.zeros((n, n))
+
+    # -- contacts ---------------------------------------------------------
+    def gaps(self, q, t):
+        """Gap of every contact, shape (ncontacts,)."""
+        raise NotImplementedError
+
+    def contact_jacobians(self, q, t):
+        """Return ``(WN, wN, WT, wT)``.
+
+        ``WN`` (ncontacts, ndof) and ``wN`` (ncontacts,) give the normal relative
+        velocity; ``WT`` (nfrictional, ndof) and ``wT`` (nfrictional,) the slip
+        velocity of the frictional contacts.
+        """
+        raise NotImplementedError
+
+    def contact_drift(self, q, v, t):
+        """Return ``(wNbar, wTbar)``, the velocity-dependent parts of the contact accelerations."""
+        raise NotImplementedError
+
+    # -- conveniences shared by all scenes --------------------------------
+    def contact_velocities(self, q, v, t):
+        """Normal and tangential relative velocities ``(gN_dot, gammaT)``."""
+        WN, wN, WT, wT = self.contact_jacobians(q, t)
+        return WN @ v + wN, WT @ v + wT
+
+    def delassus(self, q, t):
+        """Delassus blocks ``W M^-1 W^T`` over the stacked rows ``[WN; WT]``."""
+        WN, _, WT, _ = self.contact_jacobians(q, t)
+        W = np.vstack([WN, WT])
+        return W @ np.linalg.solve(self.mass(q), W.T)
