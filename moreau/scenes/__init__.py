@@ -1,0 +1,3 @@
+"""Mechanical systems ("scenes") that the integrators run."""
+
+from .base import Scene
