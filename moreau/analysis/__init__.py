@@ -1,0 +1,1 @@
+"""Analysis on top of the integrators: steady states, operation modes, sweeps."""
