@@ -51,3 +51,170 @@ class SteadyState:
     iterations: int = 0
     wall_time: float = 0.0
     stats: dict = field(default_factory=dict)
+
+
+# -- event-driven steady state of the friction drive ------------------------------
+
+import math
+import time
+
+from .._validate import positive, positive_int
+from ..errors import ConvergenceError, InputError
+from ..regimes import REGIME_LETTERS, Regime
+from .modes import mode_name
+
+TWO_PI = 2.0 * math.pi
+
+
+def _period_run(walker, state, record=False):
+    """Advance one period from ``state``; return (end_state, segments, events)."""
+    from ..integrators.event_driven import ContactState  # noqa: F401  (type of state)
+    segs, evs = [], []
+    on_seg = (lambda a, b, sol: segs.append((a, b))) if record else None
+    end = walker.advance(state, state.tau + TWO_PI, on_segment=on_seg,
+                         on_event=evs.append if record else None)
+    return end, segs, evs
+
+
+def _min_normal_force(walker, segments):
+    sc = walker.scene
+    best = math.inf
+    for a, b in segments:
+        if a.regime == Regime.FLIGHT:
+            best = min(best, 0.0)
+            continue
+        n = max(8, int(64 * (b.tau - a.tau) / TWO_PI) + 2)
+        tau = np.linspace(a.tau, b.tau, n)
+        best = min(best, float(np.min(sc.contact_forces(tau, a.regime)[0])))
+    return best
+
+
+def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
+                      **options):
+    """Periodic steady state of the friction drive, found by shooting.
+
+    The rotor position ``u2`` does not enter the dynamics, so the period map
+    acts on ``(phi, phi', u2')`` at ``tau = 0``; when the rod touches the rotor
+    there, ``phi`` and ``phi'`` are fixed by the constraint and the map is a
+    scalar map of ``u2'``. Its fixed point is found by a safeguarded secant
+    iteration (the map is contracting, often barely so at high frequency);
+    with the rod in flight at ``tau = 0`` a Newton iteration on the full
+    three-dimensional map is used.
+
+    Parameters
+    ----------
+    scene : FrictionDrive
+    scheme : str
+        ``"event-driven"`` (this function) or ``"moreau-jean"`` (delegates to
+        :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`,
+        which takes ``steps_per_period`` and ``theta`` in ``options``).
+    rtol : float
+        Tolerance on the periodic residual, relative to the tip-velocity scale.
+    v_guess : float, optional
+        Initial guess of ``u2'`` at ``tau = 0`` (dimensionless).
+    max_iter : int
+
+    Returns
+    -------
+    SteadyState
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> ss = find_steady_state(FrictionDrive(frequency=20.0))
+    >>> ss.mode
+    'NS'
+    """
+    if scheme == "moreau-jean":
+        from .mj_steady_state import moreau_jean_steady_state
+        return moreau_jean_steady_state(scene, **options)
+    if scheme != "event-driven":
+        raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {scheme!r}")
+    rtol = positive("rtol", rtol)
+    max_iter = positive_int("max_iter", max_iter)
+    from ..integrators.event_driven import ContactState, FrictionDriveWalker
+
+    t_start = time.perf_counter()
+    walker = FrictionDriveWalker(scene, rtol=min(1e-12, rtol * 1e-2), **options)
+    vs = walker.vscale
+    phi0, dphi0 = walker.manifold(0.0)
+    v0 = 0.0 if v_guess is None else float(v_guess)
+
+    def start_state(v):
+        return walker.classify(ContactState(0.0, Regime.FLIGHT, phi0, dphi0, 0.0, v))
+
+    def pmap(v):
+        end, _, _ = _period_run(walker, start_state(v))
+        return end
+
+    it = 0
+    contact_at_section = start_state(v0).regime != Regime.FLIGHT
+    x_hist = []
+    if contact_at_section:
+        end = pmap(v0)
+        ok = end.regime != Regime.FLIGHT
+        xa, fa = v0, end.du2 - v0
+        xb = end.du2
+        it = 1
+        converged = abs(fa) <= rtol * vs
+        xstar = xa
+        while not converged and ok:
+            it += 1
+            if it > max_iter:
+                raise ConvergenceError(
+                    f"shooting did not converge in `max_iter`={max_iter} period maps "
+                    f"(residual {abs(fa) / vs:.3g} relative)")
+            end = pmap(xb)
+            if end.regime == Regime.FLIGHT:
+                ok = False
+                break
+            fb = end.du2 - xb
+            if abs(fb) <= rtol * vs:
+                xstar, converged = xb, True
+                break
+            denom = fb - fa
+            if denom != 0.0:
+                xn = xb - fb * (xb - xa) / denom
+            else:
+                xn = xb + fb
+            # the map is contracting, so F(x) = P(x) - x has slope in (-2, 0):
+            # a secant step far outside that range is a kink of the map; take a
+            # fixed-point step instead
+            slope = denom / (xb - xa) if xb != xa else -1.0
+            if not (-2.5 < slope < 0.0) or not math.isfinite(xn):
+                xn = xb + fb
+            xa, fa, xb = xb, fb, xn
+        if converged:
+            x_final = xstar
+        else:
+            contact_at_section = False
+    if not contact_at_section:
+        raise ConvergenceError(
+            "the rod is in flight at tau = 0 in the steady state; shooting on the full "
+            "(phi, phi', u2') map is not implemented for this case")
+    st0 = start_state(x_final)
+    end, segs, evs = _period_run(walker, st0, record=True)
+    residual = abs(end.du2 - st0.du2) / vs
+    regimes = []
+    for a, b in segs:
+        if b.tau - a.tau <= 0.0:
+            continue
+        letter = REGIME_LETTERS[a.regime]
+        if regimes and regimes[-1][1] == letter:
+            continue
+        regimes.append([a.tau % TWO_PI, letter])
+    impact_at = {round(e.t, 12) for e in evs if e.kind == "impact"}
+    flags = [round(t, 12) in impact_at for t, _ in regimes]
+    mode = mode_name([r[1] for r in regimes], flags)
+    return SteadyState(
+        scheme="event-driven",
+        displacement_per_period=float(end.u2 - st0.u2),
+        state0=np.array([st0.phi, st0.dphi, st0.du2]),
+        mode=mode,
+        regimes=regimes,
+        min_normal_force=_min_normal_force(walker, segs),
+        periodic_residual=float(residual),
+        iterations=it,
+        wall_time=time.perf_counter() - t_start,
+        stats=dict(walker.counters),
+    )

@@ -1,0 +1,583 @@
+"""Event-driven reference integrator for the friction drive.
+
+The run is split into smooth segments, one contact regime each (flight,
+positive slip, negative slip, stick). Every regime change and impact is
+located with a root finder (Brent's method) to near machine precision; the
+regime after a slip velocity reaches zero comes from the exact
+acceleration-level contact problem (Baraff's case analysis of
+``g_N'' = A f_N - B f_T + D``, ``g_T'' = -B f_N + C f_T + E``).
+
+While the tip touches the rotor the rod is fixed by the constraint
+``sin phi = sin phi0 - u1(tau)``, so the contact forces of each regime are
+explicit, ``2 pi``-periodic functions of ``tau``. The rotor acceleration of
+each slip regime is expanded once in a Fourier series whose truncation error
+is below round-off; its first and second antiderivatives are then exact, so
+slip segments are integrated in closed form. Flight segments (the rod swings
+freely) are integrated with DOP853 at tight tolerance; re-contact is an
+impact with Newton's restitution coefficient and Coulomb friction.
+"""
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+from scipy.optimize import brentq, minimize_scalar
+
+from .._validate import positive, positive_int
+from ..errors import ContactLostError, InputError, MoreauError, PainleveError
+from ..regimes import Regime
+from .base import Integrator, register_integrator
+from .result import Event
+
+__all__ = ["EventDriven", "ContactState", "FrictionDriveWalker"]
+
+TWO_PI = 2.0 * math.pi
+_F, _P, _N, _S = Regime.FLIGHT, Regime.POSITIVE, Regime.NEGATIVE, Regime.STICK
+
+
+class ContactState:
+    """Mutable state of the walk: time, regime and ``(phi, phi', u2, u2')``."""
+
+    __slots__ = ("tau", "regime", "phi", "dphi", "u2", "du2")
+
+    def __init__(self, tau, regime, phi, dphi, u2, du2):
+        self.tau, self.regime = float(tau), Regime(regime)
+        self.phi, self.dphi, self.u2, self.du2 = float(phi), float(dphi), float(u2), float(du2)
+
+    def copy(self):
+        return ContactState(self.tau, self.regime, self.phi, self.dphi, self.u2, self.du2)
+
+    def __repr__(self):
+        return (f"ContactState(tau={self.tau:.15g}, {self.regime.letter}, phi={self.phi:.15g}, "
+                f"dphi={self.dphi:.6g}, u2={self.u2:.15g}, du2={self.du2:.15g})")
+
+
+class _SlipSeries:
+    """Fourier series of a 2 pi-periodic rotor acceleration and its antiderivatives."""
+
+    def __init__(self, fun, tol=1e-13, n0=32, nmax=1 << 15):
+        n = n0
+        while True:
+            tau = TWO_PI * np.arange(n) / n
+            a = fun(tau)
+            c = np.fft.rfft(a) / n
+            scale = np.max(np.abs(a)) + 1e-300
+            tail = np.max(np.abs(c[n // 4:]))
+            if tail <= tol * scale or n >= nmax:
+                break
+            n *= 2
+        self.truncation = float(tail / scale)
+        # keep the modes that matter; the rest is below round-off
+        keep = np.flatnonzero(np.abs(c) > 5e-15 * scale)
+        K = int(keep.max()) if keep.size else 0
+        K = max(K, 1)
+        self.c0 = float(c[0].real)
+        self.k = np.arange(1, K + 1, dtype=float)
+        ck = 2.0 * c[1:K + 1]
+        self.cA = ck / (1j * self.k)          # coefficients of the first antiderivative
+        self.cAA = -ck / (self.k * self.k)    # and of the second
+        self.ck = ck
+
+    def _basis(self, tau):
+        return np.exp(1j * np.multiply.outer(np.asarray(tau, float), self.k))
+
+    def A(self, tau):
+        """Periodic part of the first antiderivative."""
+        return (self._basis(tau) @ self.cA).real
+
+    def AA(self, tau):
+        """Periodic part of the second antiderivative."""
+        return (self._basis(tau) @ self.cAA).real
+
+    def both(self, tau):
+        b = self._basis(tau)
+        return (b @ self.cA).real, (b @ self.cAA).real
+
+
+class FrictionDriveWalker:
+    """Segment-by-segment solver of the friction drive; the engine of the reference.
+
+    Parameters
+    ----------
+    scene : FrictionDrive
+    rtol : float
+        Relative tolerance of the flight integration (contact segments are
+        exact to round-off regardless).
+    grid : int
+        Samples per period used to bracket events before Brent's method.
+    max_impacts : int
+        Impacts allowed per run before an accumulation (Zeno) is declared and
+        the contact is closed.
+    """
+
+    def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000):
+        self.scene = scene
+        self.rtol = positive("rtol", rtol)
+        self.grid = positive_int("grid", grid)
+        self.max_impacts = positive_int("max_impacts", max_impacts)
+        self.mu = float(scene.mu[0])
+        self.e = float(scene.restitution[0])
+        self.n_impacts = 0
+        self.counters = {"events": 0, "impacts": 0, "flight_segments": 0, "root_solves": 0}
+        self._build_tables()
+
+    # -- tables over one period -----------------------------------------------
+    def _build_tables(self):
+        sc, mu, J, fL = self.scene, self.mu, self.scene.J, self.scene.fL
+        self.series = {}
+        for reg in (_P, _N):
+            self.series[reg] = _SlipSeries(
+                lambda t, reg=reg: (sc.contact_forces(t, reg)[1] - fL) / J)
+        n = self.grid
+        self.hg = TWO_PI / n
+        tg = self.hg * np.arange(n)
+        self.tg = tg
+        phi, dphi, ddphi = sc.contact_angle(tg)
+        self.g_phi, self.g_dphi = phi, dphi
+        self.g_vtip = -np.sin(phi) * dphi
+        self.g_A = {r: self.series[r].A(tg) for r in (_P, _N)}
+        self.g_fN = {r: sc.contact_forces(tg, r)[0] for r in (_P, _N, _S)}
+        fNs, fTs = sc.contact_forces(tg, _S)
+        self.g_stick_fT = fTs
+        self.g_painleve = np.cos(phi) - mu * np.sin(phi)
+        self.painleve_possible = bool(np.min(self.g_painleve) <= 0.0) or mu * math.tan(sc.phi0) >= 1.0
+        # scale of the slip velocity, for tolerances
+        self.vscale = float(np.max(np.abs(self.g_vtip))) + 1e-300
+        self.fscale = float(np.max(np.abs(self.g_fN[_S]))) + 1e-300
+
+    # -- explicit contact quantities ------------------------------------------
+    def vtip(self, tau):
+        phi = math.asin(self.scene.sin_phi0 - self.scene.u10 * (1.0 - math.cos(tau)))
+        dphi = -self.scene.u10 * math.sin(tau) / math.cos(phi)
+        return -math.sin(phi) * dphi
+
+    def manifold(self, tau):
+        sc = self.scene
+        phi = math.asin(sc.sin_phi0 - sc.u10 * (1.0 - math.cos(tau)))
+        return phi, -sc.u10 * math.sin(tau) / math.cos(phi)
+
+    def fN(self, tau, regime):
+        return float(self.scene.contact_forces(tau, regime)[0])
+
+    def stick_margins(self, tau):
+        fN, fT = self.scene.contact_forces(tau, _S)
+        return float(fN), float(fT + self.mu * fN), float(self.mu * fN - fT)
+
+    def slip_state(self, st, tau):
+        """``(u2, u2')`` at ``tau`` of the slip segment that starts at ``st``."""
+        ser = self.series[st.regime]
+        d = tau - st.tau
+        A1, AA1 = ser.both(np.array([tau, st.tau]))
+        du2 = st.du2 + ser.c0 * d + (A1[0] - A1[1])
+        u2 = st.u2 + st.du2 * d + 0.5 * ser.c0 * d * d + (AA1[0] - AA1[1] - A1[1] * d)
+        return u2, du2
+
+    def stick_state(self, st, tau):
+        phi, _ = self.manifold(tau)
+        return st.u2 + math.cos(phi) - math.cos(st.phi), self.vtip(tau)
+
+    # -- acceleration-level contact problem -------------------------------------
+    def decide(self, tau, phi, dphi, slip, zero_slip):
+        """Regime that follows a contact state with closed gap and zero normal velocity.
+
+        Solves the 2D frictional contact problem at acceleration level by the
+        exhaustive case analysis (flight, stick, positive slip, negative slip).
+        Raises :class:`PainleveError` where negative slip is required but
+        ``1 - mu tan(phi) <= 0``.
+        """
+        A, B, C, D, E = (float(x) for x in self.scene.coefficients(phi, dphi, tau))
+        mu = self.mu
+        AmB = A - mu * B
+        if not zero_slip:
+            if slip > 0:
+                return _P if -D / (A + mu * B) > 0 else _F
+            if AmB <= 0:
+                raise PainleveError(
+                    f"Painlevé condition violated in negative slip at tau={tau:.12g}: "
+                    f"1 - mu*tan(phi) = {1 - mu * math.tan(phi):.3g} <= 0 (mu={mu}, phi={phi:.6g})")
+            return _N if -D / AmB > 0 else _F
+        if D >= 0.0:
+            return _F
+        det = A * C - B * B
+        fN_s = -(C * D + B * E) / det
+        fT_s = -(A * E + B * D) / det
+        if fN_s >= 0 and abs(fT_s) <= mu * fN_s:
+            return _S
+        acc_p = (A * E + B * D + mu * (B * E + C * D)) / (A + mu * B)
+        if acc_p > 0:
+            return _P
+        if AmB <= 0:
+            raise PainleveError(
+                f"Painlevé condition violated at tau={tau:.12g}: 1 - mu*tan(phi) = "
+                f"{1 - mu * math.tan(phi):.3g} <= 0; the contact problem has no unique solution")
+        acc_n = (A * E + B * D - mu * (B * E + C * D)) / AmB
+        if acc_n < 0:
+            return _N
+        # exactly on a boundary of the case analysis: the stick solution is the limit of both
+        return _S
+
+    # -- event location --------------------------------------------------------
+    def _window(self, ta, tb):
+        k0 = math.floor(ta / self.hg) + 1
+        k1 = math.floor(tb / self.hg)
+        k = np.arange(k0, k1 + 1)
+        return k * self.hg, k % self.grid
+
+    def _first_root(self, f, tk, vals, ta, tb):
+        """First tau in (ta, tb] where the continuous ``f`` (positive at ta+) reaches 0.
+
+        ``vals`` are the samples of ``f`` at the grid points ``tk``. A sign
+        change is refined by Brent's method; a grid cell whose samples stay
+        positive but whose local minimum could dip below zero is checked
+        with a bounded minimisation, so double crossings inside a cell are
+        not missed.
+        """
+        tt = np.concatenate(([ta], tk, [tb])) if (tk.size == 0 or tk[-1] < tb) else np.concatenate(([ta], tk))
+        fv = np.concatenate(([max(f(ta), 0.0)], vals, [f(tb)] if tt.size > vals.size + 1 else []))
+        neg = np.flatnonzero(fv[1:] <= 0.0)
+        stop = neg[0] + 1 if neg.size else fv.size
+        # interior local minima before the first sign change
+        if stop > 2:
+            seg = fv[:stop]
+            d = np.diff(seg)
+            mins = np.flatnonzero((d[:-1] < 0) & (d[1:] >= 0)) + 1
+            for j in mins:
+                var = abs(d[j - 1]) + abs(d[j])
+                if seg[j] > var:
+                    continue
+                lo, hi = tt[j - 1], tt[min(j + 1, tt.size - 1)]
+                r = minimize_scalar(f, bounds=(lo, hi), method="bounded",
+                                    options={"xatol": 1e-14 * max(1.0, abs(hi))})
+                if r.fun <= 0.0:
+                    self.counters["root_solves"] += 1
+                    if f(lo) <= 0.0:
+                        return lo
+                    return brentq(f, lo, r.x, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+        if not neg.size:
+            return None
+        i = neg[0] + 1
+        lo, hi = tt[i - 1], tt[i]
+        self.counters["root_solves"] += 1
+        if f(lo) <= 0.0:
+            return lo
+        return brentq(f, lo, hi, xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+
+    def next_event(self, st, tau_end):
+        """Locate the first event of the contact segment that starts at ``st``.
+
+        Returns ``(tau_event, kind, new_regime)`` or ``(tau_end, None, regime)``.
+        """
+        ta = st.tau
+        tb = min(tau_end, ta + TWO_PI)
+        tk, jk = self._window(ta, tb)
+        tk_ok = tk > ta
+        tk, jk = tk[tk_ok], jk[tk_ok]
+        cands = []
+        reg = st.regime
+        if reg in (_P, _N):
+            sign = 1.0 if reg == _P else -1.0
+            ser = self.series[reg]
+            Aa = float(ser.A(ta))
+
+            def slip(t):
+                return sign * (st.du2 + ser.c0 * (t - ta) + float(ser.A(t)) - Aa - self.vtip(t))
+
+            vals = sign * (st.du2 + ser.c0 * (tk - ta) + self.g_A[reg][jk] - Aa - self.g_vtip[jk])
+            r = self._first_root(slip, tk, vals, ta, tb)
+            if r is not None:
+                cands.append((r, "slip_end", None))
+            r = self._first_root(lambda t: self.fN(t, reg), tk, self.g_fN[reg][jk], ta, tb)
+            if r is not None:
+                cands.append((r, "liftoff", _F))
+            if reg == _N and self.painleve_possible:
+                mu = self.mu
+
+                def pm(t):
+                    phi, _ = self.manifold(t)
+                    return math.cos(phi) - mu * math.sin(phi)
+
+                r = self._first_root(pm, tk, self.g_painleve[jk], ta, tb)
+                if r is not None:
+                    cands.append((r, "painleve", None))
+        elif reg == _S:
+            mu = self.mu
+            fNg, fTg = self.g_fN[_S][jk], self.g_stick_fT[jk]
+            r = self._first_root(lambda t: self.stick_margins(t)[1], tk, fTg + mu * fNg, ta, tb)
+            if r is not None:
+                cands.append((r, "stick_end", _P))
+            r = self._first_root(lambda t: self.stick_margins(t)[2], tk, mu * fNg - fTg, ta, tb)
+            if r is not None:
+                cands.append((r, "stick_end", _N))
+            r = self._first_root(lambda t: self.stick_margins(t)[0], tk, fNg, ta, tb)
+            if r is not None:
+                cands.append((r, "liftoff", _F))
+        else:
+            raise MoreauError("next_event is for contact regimes")
+        if not cands:
+            return tb, None, reg
+        return min(cands, key=lambda c: c[0])
+
+    def move_contact(self, st, tau):
+        """Return the state of the current contact segment at ``tau``."""
+        out = st.copy()
+        out.tau = tau
+        out.phi, out.dphi = self.manifold(tau)
+        if st.regime == _S:
+            out.u2, out.du2 = self.stick_state(st, tau)
+        else:
+            out.u2, out.du2 = self.slip_state(st, tau)
+        return out
+
+    # -- flight -------------------------------------------------------------------
+    def _flight_rhs(self, t, y):
+        sc = self.scene
+        phi = y[0]
+        c = math.cos(phi)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(phi)) - 0.5 * sc.u10 * math.cos(t) * c)
+        return [y[1], ddphi, y[3], -sc.fL / sc.J]
+
+    def _gap(self, t, y):
+        sc = self.scene
+        return sc.sin_phi0 - math.sin(y[0]) - sc.u10 * (1.0 - math.cos(t))
+
+    def flight(self, st, tau_end, dense=False):
+        """Integrate a flight segment up to re-contact or ``tau_end``.
+
+        Returns ``(state_at_end, recontact, sol)``; ``sol`` is the dense output
+        when requested.
+        """
+        self.counters["flight_segments"] += 1
+        gap = self._gap
+        gap.terminal = True
+        gap.direction = -1
+        y0 = [st.phi, st.dphi, st.u2, st.du2]
+        scale = np.array([1.0, 1.0, 1.0, 1.0]) * max(self.scene.u10, 1e-12)
+        sol = solve_ivp(self._flight_rhs, (st.tau, tau_end), y0, method="DOP853", events=gap,
+                        rtol=self.rtol, atol=1e-3 * self.rtol * scale, dense_output=dense)
+        if sol.status < 0:
+            raise MoreauError(f"flight integration failed: {sol.message}")
+        out = st.copy()
+        if sol.status == 1:
+            te = float(sol.t_events[0][0])
+            ye = sol.y_events[0][0]
+            out.tau, out.phi, out.dphi, out.u2, out.du2 = te, *map(float, ye)
+            return out, True, (sol.sol if dense else None)
+        out.tau = float(sol.t[-1])
+        out.phi, out.dphi, out.u2, out.du2 = map(float, sol.y[:, -1])
+        return out, False, (sol.sol if dense else None)
+
+    def impact(self, st):
+        """Apply Newton's impact law with Coulomb friction at a re-contact.
+
+        Returns the post-impact state and the impulses ``(p_N, p_T)``.
+        """
+        sc, mu, e = self.scene, self.mu, self.e
+        phi = st.phi
+        s, c = math.sin(phi), math.cos(phi)
+        vN = -c * st.dphi - sc.u10 * math.sin(st.tau)
+        vT = st.du2 + s * st.dphi
+        A, B, C = 3 * c * c, 3 * s * c, 1.0 / sc.J + 3 * s * s
+        dvN = -(1.0 + e) * vN
+        pN = pT = None
+        if mu > 0:
+            det = A * C - B * B
+            pN_s = (C * dvN - B * vT) / det
+            pT_s = (B * dvN - A * vT) / det
+            if pN_s >= 0 and abs(pT_s) <= mu * pN_s:
+                pN, pT = pN_s, pT_s
+            else:
+                p = dvN / (A + mu * B)
+                if vT - B * p - mu * C * p > 0:
+                    pN, pT = p, -mu * p
+                else:
+                    if A - mu * B <= 0:
+                        raise PainleveError(
+                            f"impact at tau={st.tau:.12g} with 1 - mu*tan(phi) = "
+                            f"{1 - mu * math.tan(phi):.3g} <= 0 has no unique solution")
+                    p = dvN / (A - mu * B)
+                    pN, pT = p, mu * p
+        else:
+            pN, pT = dvN / A, 0.0
+        out = st.copy()
+        out.dphi = st.dphi + 3.0 * (-c * pN + s * pT)
+        out.du2 = st.du2 + pT / sc.J
+        self.n_impacts += 1
+        self.counters["impacts"] += 1
+        if self.n_impacts > self.max_impacts:
+            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts")
+        return out, pN, pT
+
+    # -- entering a regime ------------------------------------------------------------
+    def classify(self, st, closing=False):
+        """Set ``st.regime`` from a state (gap, normal and slip velocities, forces).
+
+        With ``closing=True`` (right after a plastic impact) the gap and the
+        normal velocity are taken as zero and the rod is put on the contact
+        manifold.
+        """
+        sc = self.scene
+        if not closing:
+            gap = sc.sin_phi0 - math.sin(st.phi) - float(sc.u1(st.tau))
+            vN = -math.cos(st.phi) * st.dphi - float(sc.du1(st.tau))
+            tol_g = 1e-12 * max(sc.u10, 1e-300)
+            tol_v = 1e-10 * self.vscale
+            if gap < -tol_g:
+                raise InputError(f"the initial state penetrates the rotor: gap = {gap:.3g} < 0")
+            if gap > tol_g or vN > tol_v:
+                st.regime = _F
+                return st
+            if vN < -tol_v:
+                # closed gap and approaching: the state is an impact
+                st, _, _ = self.impact(st)
+        st.phi, st.dphi = self.manifold(st.tau)
+        slip = st.du2 + math.sin(st.phi) * st.dphi
+        zero = abs(slip) <= 1e-13 * self.vscale
+        st.regime = self.decide(st.tau, st.phi, st.dphi, slip, zero)
+        if st.regime == _S:
+            st.du2 = self.vtip(st.tau)
+        return st
+
+    # -- the walk ------------------------------------------------------------------------
+    def segment(self, st, tau_end, on_segment=None):
+        """Run one segment from ``st``: to its closing event or to ``tau_end``.
+
+        Returns ``(state, event)``; ``event`` is ``None`` when ``tau_end`` was
+        reached first. ``on_segment(start_state, end_state, flight_sol)``
+        receives the finished segment (``flight_sol`` is the dense output of a
+        flight segment, else ``None``).
+        """
+        if st.regime == _F:
+            end, hit, sol = self.flight(st, tau_end, dense=on_segment is not None)
+            if on_segment:
+                on_segment(st, end, sol)
+            if not hit:
+                return end, None
+            before = end.regime
+            vN = -math.cos(end.phi) * end.dphi - float(self.scene.du1(end.tau))
+            kind = "touchdown"
+            if vN < -1e-10 * self.vscale:
+                end, _, _ = self.impact(end)
+                kind = "impact"
+            vN_post = -math.cos(end.phi) * end.dphi - float(self.scene.du1(end.tau))
+            if self.e > 0 and vN_post > 1e-9 * self.vscale and self.n_impacts < self.max_impacts:
+                end.regime = _F
+            else:
+                # plastic impact, or the accumulation point of a Zeno sequence: contact closes
+                self.classify(end, closing=True)
+            self.counters["events"] += 1
+            return end, Event(end.tau, kind, before, end.regime)
+        te, kind, new = self.next_event(st, tau_end)
+        end = self.move_contact(st, te)
+        if on_segment:
+            on_segment(st, end, None)
+        if kind is None:
+            return end, None
+        self.counters["events"] += 1
+        if kind == "painleve":
+            raise PainleveError(
+                f"Painlevé condition 1 - mu*tan(phi) > 0 fails in negative slip at tau={te:.12g} "
+                f"(mu={self.mu}, phi={end.phi:.6g})")
+        if kind == "slip_end":
+            end.du2 = self.vtip(te)  # the slip velocity is exactly zero here
+            end.regime = self.decide(te, end.phi, end.dphi, 0.0, True)
+        elif kind == "liftoff":
+            end.regime = _F
+        else:
+            if new == _N and self.mu * math.tan(end.phi) >= 1.0:
+                raise PainleveError(
+                    f"stick ends towards negative slip at tau={te:.12g} where "
+                    f"1 - mu*tan(phi) = {1 - self.mu * math.tan(end.phi):.3g} <= 0")
+            end.regime = new
+        return end, Event(te, "liftoff" if kind == "liftoff" else "transition", st.regime, end.regime)
+
+    def advance(self, st, tau_end, on_segment=None, on_event=None, max_events=100000):
+        """Advance ``st`` to ``tau_end`` through all events; return the final state."""
+        st = st.copy()
+        n = 0
+        while st.tau < tau_end:
+            st, ev = self.segment(st, tau_end, on_segment)
+            if ev is not None:
+                n += 1
+                if on_event:
+                    on_event(ev)
+                if n > max_events:
+                    raise MoreauError(f"more than {max_events} events before tau={tau_end:.6g} "
+                                      "(an accumulation of events?)")
+        return st
+
+
+@register_integrator("event-driven")
+class EventDriven(Integrator):
+    """Event-driven reference integrator of the friction drive.
+
+    Each :meth:`step` advances to the next event (regime change or impact)
+    or to ``t_bound``. Samples are recorded at every event and on a uniform
+    grid of ``samples_per_period`` points per drive period.
+
+    Parameters
+    ----------
+    scene : FrictionDrive
+    t0, q0, v0, t_bound
+        See :class:`~moreau.integrators.base.Integrator`; ``q0 = (phi, u2)``,
+        ``v0 = (phi', u2')`` in the scene's dimensionless units.
+    rtol : float
+        Relative tolerance of flight segments.
+    samples_per_period : int
+        Output density.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> from moreau.integrators import simulate
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> q0, v0 = sc.rest_state()
+    >>> res = simulate(sc, (0.0, 4 * 3.141592653589793), q0, v0, "event-driven")
+    >>> res.success
+    True
+    """
+
+    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, samples_per_period=128):
+        super().__init__(scene, t0, q0, v0, t_bound)
+        if scene.ncontacts != 1 or not hasattr(scene, "contact_angle"):
+            raise InputError("`scene` must be a FrictionDrive for the event-driven reference")
+        self.walker = FrictionDriveWalker(scene, rtol=rtol)
+        self.samples_per_period = positive_int("samples_per_period", samples_per_period)
+        st = ContactState(self.t, _F, self.q[0], self.v[0], self.q[1], self.v[1])
+        self.state = self.walker.classify(st)
+        self._record_state(self.state)
+
+    def _record_state(self, st):
+        w = self.walker
+        sc = self.scene
+        if st.regime == _F:
+            fN = fT = 0.0
+        else:
+            fN, fT = (float(x) for x in sc.contact_forces(st.tau, st.regime))
+        slip = st.du2 + math.sin(st.phi) * st.dphi
+        gap = sc.sin_phi0 - math.sin(st.phi) - float(sc.u1(st.tau))
+        self._record(st.tau, (st.phi, st.u2), (st.dphi, st.du2), int(st.regime), fN, fT, slip, gap)
+        self.t, self.q, self.v = st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2])
+
+    def _on_segment(self, start, end, sol):
+        dt = TWO_PI / self.samples_per_period
+        k0 = math.floor(start.tau / dt) + 1
+        k1 = math.ceil(end.tau / dt) - 1
+        for k in range(k0, k1 + 1):
+            tau = k * dt
+            if start.regime == _F:
+                y = sol(tau)
+                s = ContactState(tau, _F, *y)
+            else:
+                s = self.walker.move_contact(start, tau)
+            self._record_state(s)
+        self._record_state(end)
+
+    def _step_impl(self):
+        w = self.walker
+        end, ev = w.segment(self.state, self.t_bound, self._on_segment)
+        if ev is not None:
+            self.events.append(ev)
+            self._record_state(end)
+        self.state = end
+        self.t = end.tau
+        self.counters.update(w.counters)

@@ -1,0 +1,318 @@
+"""The friction drive of a piezoelectric motor (Liu, Zhou, Ruan, Fu; second type).
+
+A stator moves vertically with the prescribed displacement
+``x1(t) = x10 (1 - cos w t)``. A rigid rod (mass ``m``, length ``l``) is hinged
+on the stator at angle ``phi`` from the horizontal and held by a spring ``k``
+at the initial tilt ``phi0``. Its tip presses on a rotor (mass ``m2``,
+horizontal coordinate ``x2``) through a unilateral contact with Coulomb
+friction ``mu``; a load ``F_L`` acts on the rotor.
+
+Derivation (independent of the paper's printed formulas, which have typos)
+---------------------------------------------------------------------------
+Rod centre ``(l/2 cos phi, x1 + l/2 sin phi)``, so
+
+    T = 1/2 (m + m1) x1'^2 + 1/2 m2 x2'^2 + 1/6 m l^2 phi'^2 + 1/2 m l x1' phi' cos phi
+    V = 1/2 k l^2 (sin phi0 - sin phi)^2
+
+Gap and slip (tip at ``(l cos phi, x1 + l sin phi)``, rotor surface at ``l sin phi0``):
+
+    g_N = l sin phi0 - l sin phi - x1,     g_T = x2 - l cos phi
+
+With ``tau = w t``, ``u = x / l``, forces over ``m l w^2``, ``J = m2/m``,
+``P = k/(m w^2)``, ``u1 = u10 (1 - cos tau)``, and ``q = (phi, u2)``, Lagrange's
+equations with the contact forces ``f_N`` (along ``grad g_N``) and ``f_T``
+(along ``grad g_T``) read ``M q'' = h + WN^T f_N + WT^T f_T`` with
+
+    M  = diag(1/3, J)
+    h  = (P cos phi (sin phi0 - sin phi) - 1/2 u1'' cos phi,  -f_L)
+    WN = (-cos phi, 0),   dg_N/dtau = WN q' - u1'
+    WT = ( sin phi, 1),   dg_T/dtau = WT q'
+    g_N'' = WN q'' + phi'^2 sin phi - u1'',   g_T'' = WT q'' + phi'^2 cos phi
+
+Hence the contact accelerations ``g_N'' = A f_N - B f_T + D`` and
+``g_T'' = -B f_N + C f_T + E`` with ``A = 3 cos^2 phi``,
+``B = 3 sin phi cos phi``, ``C = 1/J + 3 sin^2 phi`` and
+
+    D = phi'^2 sin phi - u1'' + 3/2 u1'' cos^2 phi - 3 P cos^2 phi (sin phi0 - sin phi)
+    E = phi'^2 cos phi - f_L/J - 3/2 u1'' sin phi cos phi + 3 P sin phi cos phi (sin phi0 - sin phi)
+
+(the paper prints the ``P`` term of ``E`` with the wrong sign). The stator
+load ``F_A`` only changes the force needed to impose ``x1`` and does not enter
+the motion of the rod or the rotor, so it is not a parameter here.
+
+In contact the constraint ``g_N = 0`` fixes the rod: ``sin phi = sin phi0 - u1``.
+Everything in contact is then an explicit function of ``tau``, which the
+event-driven reference exploits.
+"""
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from .. import _validate as V
+from ..errors import InputError
+from ..regimes import Regime
+from .base import Scene
+
+__all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
+
+
+@dataclass(frozen=True)
+class FrictionDriveParams:
+    """Physical parameters of the friction drive, in SI units.
+
+    Parameters
+    ----------
+    m : float
+        Rod mass [kg], > 0.
+    m2 : float
+        Rotor mass [kg], > 0.
+    k : float
+        Supporting spring stiffness [N/m], > 0.
+    length : float
+        Rod length [m], > 0.
+    phi0 : float
+        Initial tilt of the rod [rad], in (0, pi/2).
+    mu : float
+        Coulomb friction coefficient, >= 0.
+    x10 : float
+        Stator displacement amplitude [m], > 0 and ``2 x10 < length sin(phi0)``
+        (the rod must not pass the horizontal while in contact).
+    load : float
+        Load ``F_L`` on the rotor [N].
+    restitution : float
+        Newton restitution coefficient ``e`` of the rod-rotor impacts, in [0, 1].
+
+    Examples
+    --------
+    >>> p = FrictionDriveParams(mu=0.2)
+    >>> p.mu, p.m
+    (0.2, 2e-05)
+    """
+
+    m: float = 2.0e-5
+    m2: float = 2.0e-3
+    k: float = 1.0e4
+    length: float = 1.0e-3
+    phi0: float = math.pi / 4
+    mu: float = 0.1
+    x10: float = 2.0e-6
+    load: float = 0.0
+    restitution: float = 0.0
+
+    def __post_init__(self):
+        for name in ("m", "m2", "k", "length", "x10"):
+            object.__setattr__(self, name, V.positive(name, getattr(self, name)))
+        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
+                                                            "in the open interval (0, pi/2)"))
+        object.__setattr__(self, "mu", V.nonnegative("mu", self.mu))
+        object.__setattr__(self, "load", V.finite_scalar("load", self.load))
+        object.__setattr__(self, "restitution",
+                           V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        if not 2.0 * self.x10 < self.length * math.sin(self.phi0):
+            raise InputError(
+                f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
+                f"so that the rod stays above the horizontal in contact, got {self.x10!r}")
+
+    def with_(self, **changes):
+        """Copy with some parameters changed (validated again)."""
+        return replace(self, **changes)
+
+
+PAPER_DEFAULTS = FrictionDriveParams()
+
+
+class FrictionDrive(Scene):
+    """The paper's friction drive at one drive frequency, in dimensionless form.
+
+    Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
+    time ``tau = w t`` with ``w = 2 pi f``. One frictional contact.
+
+    Parameters
+    ----------
+    params : FrictionDriveParams, optional
+        Physical parameters; the paper's values by default.
+    frequency : float
+        Drive frequency ``f`` [Hz], > 0.
+
+    Examples
+    --------
+    >>> s = FrictionDrive(frequency=185.0)
+    >>> round(s.J), round(s.P, 1)
+    (100, 370.1)
+    >>> A, B, C, D, E = s.coefficients(s.phi0, 0.0, 0.0)
+    """
+
+    ndof = 2
+    name = "friction-drive"
+
+    def __init__(self, params=None, frequency=185.0):
+        if params is None:
+            params = PAPER_DEFAULTS
+        if not isinstance(params, FrictionDriveParams):
+            raise InputError("`params` must be a FrictionDriveParams instance")
+        self.params = params
+        self.frequency = V.positive("frequency", frequency)
+        self.omega = 2.0 * math.pi * self.frequency
+        p = params
+        self.J = p.m2 / p.m
+        self.P = p.k / (p.m * self.omega ** 2)
+        self.u10 = p.x10 / p.length
+        self.force_scale = p.m * p.length * self.omega ** 2
+        self.fL = p.load / self.force_scale
+        self.phi0 = p.phi0
+        self.sin_phi0 = math.sin(p.phi0)
+        self.mu = np.array([p.mu])
+        self.restitution = np.array([p.restitution])
+
+    def __repr__(self):
+        return f"FrictionDrive(frequency={self.frequency!r}, params={self.params!r})"
+
+    # -- prescribed stator motion -------------------------------------------
+    def u1(self, tau):
+        return self.u10 * (1.0 - np.cos(tau))
+
+    def du1(self, tau):
+        return self.u10 * np.sin(tau)
+
+    def ddu1(self, tau):
+        return self.u10 * np.cos(tau)
+
+    # -- the rod on the contact manifold ------------------------------------
+    def contact_angle(self, tau):
+        """``(phi, phi', phi'')`` of the rod while the tip touches the rotor.
+
+        From ``sin phi = sin phi0 - u1(tau)`` and its derivatives.
+        """
+        s = self.sin_phi0 - self.u1(tau)
+        phi = np.arcsin(s)
+        c = np.cos(phi)
+        dphi = -self.du1(tau) / c
+        ddphi = dphi * dphi * np.tan(phi) - self.ddu1(tau) / c
+        return phi, dphi, ddphi
+
+    def tip_velocity(self, tau):
+        """Horizontal tip velocity ``-sin(phi) phi'`` on the contact manifold."""
+        phi, dphi, _ = self.contact_angle(tau)
+        return -np.sin(phi) * dphi
+
+    def coefficients(self, phi, dphi, tau):
+        """Coefficients ``A, B, C, D, E`` of the contact accelerations (module docstring)."""
+        s, c = np.sin(phi), np.cos(phi)
+        dd1 = self.ddu1(tau)
+        spring = self.P * (self.sin_phi0 - s)
+        A = 3.0 * c * c
+        B = 3.0 * s * c
+        C = 1.0 / self.J + 3.0 * s * s
+        D = dphi * dphi * s - dd1 + 1.5 * dd1 * c * c - 3.0 * spring * c * c
+        E = dphi * dphi * c - self.fL / self.J - 1.5 * dd1 * s * c + 3.0 * spring * s * c
+        return A, B, C, D, E
+
+    def contact_forces(self, tau, regime):
+        """Dimensionless ``(f_N, f_T)`` in a contact regime, as functions of ``tau``.
+
+        Parameters
+        ----------
+        tau : float or ndarray
+        regime : Regime
+            ``POSITIVE``, ``NEGATIVE`` or ``STICK``.
+        """
+        phi, dphi, ddphi = self.contact_angle(tau)
+        s, c = np.sin(phi), np.cos(phi)
+        # F_s of the paper: rod equation with the inertia moved to one side
+        Fs = 0.5 * self.ddu1(tau) * c + ddphi / 3.0 - self.P * c * (self.sin_phi0 - s)
+        mu = float(self.mu[0])
+        if regime == Regime.POSITIVE:
+            fN = -Fs / (c + mu * s)
+            return fN, -mu * fN
+        if regime == Regime.NEGATIVE:
+            fN = -Fs / (c - mu * s)
+            return fN, mu * fN
+        if regime == Regime.STICK:
+            ddu2 = -(dphi * dphi * c + ddphi * s)
+            fT = self.J * ddu2 + self.fL
+            return fT * s / c - Fs / c, fT
+        raise InputError(f"`regime` must be POSITIVE, NEGATIVE or STICK, got {regime!r}")
+
+    def painleve_margin(self, phi):
+        """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""
+        return 1.0 - float(self.mu[0]) * np.tan(phi)
+
+    # -- Scene interface ------------------------------------------------------
+    def mass(self, q):
+        return np.diag([1.0 / 3.0, self.J])
+
+    def forces(self, q, v, t):
+        phi = q[0]
+        return np.array([self.P * math.cos(phi) * (self.sin_phi0 - math.sin(phi))
+                         - 0.5 * self.ddu1(t) * math.cos(phi), -self.fL])
+
+    def force_jacobians(self, q, v, t):
+        phi = q[0]
+        s, c = math.sin(phi), math.cos(phi)
+        K = np.zeros((2, 2))
+        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * self.ddu1(t) * s
+        return K, np.zeros((2, 2))
+
+    def gaps(self, q, t):
+        return np.array([self.sin_phi0 - math.sin(q[0]) - self.u1(t)])
+
+    def contact_jacobians(self, q, t):
+        phi = q[0]
+        WN = np.array([[-math.cos(phi), 0.0]])
+        WT = np.array([[math.sin(phi), 1.0]]) if self.mu[0] > 0 else np.zeros((0, 2))
+        wT = np.zeros(WT.shape[0])
+        return WN, np.array([-self.du1(t)]), WT, wT
+
+    def contact_drift(self, q, v, t):
+        phi, dphi = q[0], v[0]
+        wNbar = np.array([dphi * dphi * math.sin(phi) - self.ddu1(t)])
+        wTbar = np.array([dphi * dphi * math.cos(phi)]) if self.mu[0] > 0 else np.zeros(0)
+        return wNbar, wTbar
+
+    def slip_velocity(self, q, v):
+        """Tangential relative velocity ``u2' + sin(phi) phi'`` (defined also for mu = 0)."""
+        return v[1] + math.sin(q[0]) * v[0]
+
+    def rest_state(self):
+        """State at ``tau = 0`` with the rod in contact and everything at rest."""
+        return np.array([self.phi0, 0.0]), np.array([0.0, 0.0])
+
+    # -- units ------------------------------------------------------------------
+    def to_si(self, result):
+        """SI time histories of a :class:`SimulationResult` of this scene.
+
+        Returns a dict: ``t`` [s], ``x2`` rotor displacement [m], ``v2`` rotor
+        velocity [m/s], ``phi`` rod angle [rad], ``normal_force`` and
+        ``tangential_force`` [N], ``slip_velocity`` [m/s], ``regime`` codes.
+        """
+        l, w = self.params.length, self.omega
+        return {
+            "t": result.t / w,
+            "x2": result.q[:, 1] * l,
+            "v2": result.v[:, 1] * l * w,
+            "phi": result.q[:, 0].copy(),
+            "normal_force": result.force_N[:, 0] * self.force_scale,
+            "tangential_force": result.force_T[:, 0] * self.force_scale,
+            "slip_velocity": result.slip_velocity[:, 0] * l * w,
+            "regime": result.regime[:, 0].copy(),
+        }
+
+    def displacement_to_si(self, du2):
+        return du2 * self.params.length
+
+    def velocity_to_si(self, dv2):
+        return dv2 * self.params.length * self.omega
+
+    def force_to_si(self, f):
+        return f * self.force_scale
+
+
+def params_from_kwargs(**kwargs):
+    """Build :class:`FrictionDriveParams` from keyword arguments, ignoring ``None`` values."""
+    names = {f.name for f in fields(FrictionDriveParams)}
+    unknown = set(kwargs) - names
+    if unknown:
+        raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
+    return FrictionDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
