@@ -137,11 +137,18 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     t_start = time.perf_counter()
     walker = FrictionDriveWalker(scene, rtol=min(1e-12, rtol * 1e-2), **options)
     vs = walker.vscale
-    phi0, dphi0 = walker.manifold(0.0)
-    v0 = 0.0 if v_guess is None else float(v_guess)
+    # Poincare section: the phase where the rotor is pressed hardest (most
+    # negative free normal acceleration D on the contact manifold), so the
+    # rod is in contact there and the period map is a scalar map of u2'
+    tg = walker.tg
+    phig, dphig = walker.g_phi, walker.g_dphi
+    Dg = scene.coefficients(phig, dphig, tg)[3]
+    tau_s = 0.0 if Dg[0] <= 0.5 * Dg.min() else float(tg[int(np.argmin(Dg))])
+    phi_s, dphi_s = walker.manifold(tau_s)
+    v0 = walker.vtip(tau_s) if v_guess is None else float(v_guess)
 
     def start_state(v):
-        return walker.classify(ContactState(0.0, Regime.FLIGHT, phi0, dphi0, 0.0, v))
+        return walker.classify(ContactState(tau_s, Regime.FLIGHT, phi_s, dphi_s, 0.0, v))
 
     def pmap(v):
         end, _, _ = _period_run(walker, start_state(v))
@@ -190,22 +197,25 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
             contact_at_section = False
     if not contact_at_section:
         raise ConvergenceError(
-            "the rod is in flight at tau = 0 in the steady state; shooting on the full "
-            "(phi, phi', u2') map is not implemented for this case")
+            f"the rod is in flight at the Poincare section tau = {tau_s:.4g} in the steady state; "
+            "shooting on the full (phi, phi', u2') map is not implemented for this case")
     st0 = start_state(x_final)
     end, segs, evs = _period_run(walker, st0, record=True)
     residual = abs(end.du2 - st0.du2) / vs
-    regimes = []
+    runs = []  # [tau_start, letter, entered_by_impact]
+    impact_at = {e.t for e in evs if e.kind == "impact"}
     for a, b in segs:
         if b.tau - a.tau <= 0.0:
             continue
         letter = REGIME_LETTERS[a.regime]
-        if regimes and regimes[-1][1] == letter:
+        if runs and runs[-1][1] == letter:
             continue
-        regimes.append([a.tau % TWO_PI, letter])
-    impact_at = {round(e.t, 12) for e in evs if e.kind == "impact"}
-    flags = [round(t, 12) in impact_at for t, _ in regimes]
-    mode = mode_name([r[1] for r in regimes], flags)
+        runs.append([a.tau, letter, a.tau in impact_at])
+    mode = mode_name([r[1] for r in runs], [r[2] for r in runs])
+    # report over [0, 2 pi): rotate so that the list starts with the regime active at tau = 0
+    regimes = sorted(([t % TWO_PI, r] for t, r, _ in runs), key=lambda x: x[0])
+    if regimes and regimes[0][0] > 0.0:
+        regimes.insert(0, [0.0, regimes[-1][1]])
     return SteadyState(
         scheme="event-driven",
         displacement_per_period=float(end.u2 - st0.u2),

@@ -289,16 +289,6 @@ class FrictionDriveWalker:
             r = self._first_root(lambda t: self.fN(t, reg), tk, self.g_fN[reg][jk], ta, tb)
             if r is not None:
                 cands.append((r, "liftoff", _F))
-            if reg == _N and self.painleve_possible:
-                mu = self.mu
-
-                def pm(t):
-                    phi, _ = self.manifold(t)
-                    return math.cos(phi) - mu * math.sin(phi)
-
-                r = self._first_root(pm, tk, self.g_painleve[jk], ta, tb)
-                if r is not None:
-                    cands.append((r, "painleve", None))
         elif reg == _S:
             mu = self.mu
             fNg, fTg = self.g_fN[_S][jk], self.g_stick_fT[jk]
@@ -313,6 +303,16 @@ class FrictionDriveWalker:
                 cands.append((r, "liftoff", _F))
         else:
             raise MoreauError("next_event is for contact regimes")
+        if self.painleve_possible:
+            mu = self.mu
+
+            def pm(t):
+                phi, _ = self.manifold(t)
+                return math.cos(phi) - mu * math.sin(phi)
+
+            r = self._first_root(pm, tk, self.g_painleve[jk], ta, tb)
+            if r is not None:
+                cands.append((r, "painleve", None))
         if not cands:
             return tb, None, reg
         return min(cands, key=lambda c: c[0])
@@ -347,7 +347,9 @@ class FrictionDriveWalker:
         when requested.
         """
         self.counters["flight_segments"] += 1
-        gap = self._gap
+        def gap(t, y):
+            return self._gap(t, y)
+
         gap.terminal = True
         gap.direction = -1
         y0 = [st.phi, st.dphi, st.u2, st.du2]
@@ -430,6 +432,11 @@ class FrictionDriveWalker:
                 # closed gap and approaching: the state is an impact
                 st, _, _ = self.impact(st)
         st.phi, st.dphi = self.manifold(st.tau)
+        if self.mu * math.tan(st.phi) >= 1.0:
+            raise PainleveError(
+                f"Painlevé condition 1 - mu*tan(phi) > 0 fails at tau={st.tau:.12g} "
+                f"(mu={self.mu}, phi={st.phi:.6g}, 1 - mu*tan(phi) = "
+                f"{1 - self.mu * math.tan(st.phi):.3g})")
         slip = st.du2 + math.sin(st.phi) * st.dphi
         zero = abs(slip) <= 1e-13 * self.vscale
         st.regime = self.decide(st.tau, st.phi, st.dphi, slip, zero)
@@ -475,8 +482,9 @@ class FrictionDriveWalker:
         self.counters["events"] += 1
         if kind == "painleve":
             raise PainleveError(
-                f"Painlevé condition 1 - mu*tan(phi) > 0 fails in negative slip at tau={te:.12g} "
-                f"(mu={self.mu}, phi={end.phi:.6g})")
+                f"Painlevé condition 1 - mu*tan(phi) > 0 fails at tau={te:.12g} "
+                f"(mu={self.mu}, phi={end.phi:.6g}): the contact problem loses existence "
+                "or uniqueness")
         if kind == "slip_end":
             end.du2 = self.vtip(te)  # the slip velocity is exactly zero here
             end.regime = self.decide(te, end.phi, end.dphi, 0.0, True)

@@ -1,0 +1,155 @@
+"""Command line interface: ``moreau steady`` and ``moreau sweep``.
+
+Physical inputs and outputs are in SI units; the computation runs in the
+paper's dimensionless variables.
+"""
+
+import argparse
+import json
+import math
+import sys
+import time
+
+from .errors import InputError, MoreauError
+
+__all__ = ["main"]
+
+
+def _add_params(p):
+    p.add_argument("--mu", type=float, default=None, help="friction coefficient (default 0.1)")
+    p.add_argument("--phi0", type=float, default=None, help="initial rod tilt [rad] (default pi/4)")
+    p.add_argument("--x10", type=float, default=None, help="stator amplitude [m] (default 2e-6)")
+    p.add_argument("--k", dest="k", type=float, default=None, help="spring stiffness [N/m] (default 1e4)")
+    p.add_argument("--m", type=float, default=None, help="rod mass [kg] (default 2e-5)")
+    p.add_argument("--m2", type=float, default=None, help="rotor mass [kg] (default 2e-3)")
+    p.add_argument("--length", type=float, default=None, help="rod length [m] (default 1e-3)")
+    p.add_argument("--load", type=float, default=None, help="rotor load F_L [N] (default 0)")
+    p.add_argument("--restitution", type=float, default=None, help="impact restitution e (default 0)")
+    p.add_argument("--scheme", default="event-driven", choices=["event-driven", "moreau-jean"])
+    p.add_argument("--steps-per-period", type=int, default=1000,
+                   help="Moreau-Jean steps per drive period (default 1000)")
+    p.add_argument("--theta", type=float, default=1.0, help="Moreau-Jean theta in [1/2, 1] (default 1)")
+    p.add_argument("--rtol", type=float, default=1e-10, help="shooting tolerance (default 1e-10)")
+
+
+def _params(args):
+    from .scenes.friction_drive import params_from_kwargs
+    return params_from_kwargs(mu=args.mu, phi0=args.phi0, x10=args.x10, k=args.k, m=args.m,
+                              m2=args.m2, length=args.length, load=args.load,
+                              restitution=args.restitution)
+
+
+def steady_state_report(params, frequency, scheme="event-driven", steps_per_period=1000,
+                        theta=1.0, rtol=1e-10):
+    """Steady state of the friction drive as a JSON-ready dict in SI units.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> r = steady_state_report(PAPER_DEFAULTS, 20.0)
+    >>> r["mode"], r["displacement_per_period_m"] < 0
+    ('NS', True)
+    """
+    from .analysis.steady_state import find_steady_state
+    from .scenes.friction_drive import FrictionDrive
+
+    scene = FrictionDrive(params, frequency)
+    t0 = time.perf_counter()
+    if scheme == "moreau-jean":
+        ss = find_steady_state(scene, scheme=scheme, steps_per_period=steps_per_period, theta=theta)
+    else:
+        ss = find_steady_state(scene, scheme=scheme, rtol=rtol)
+    wall = time.perf_counter() - t0
+    disp = scene.displacement_to_si(ss.displacement_per_period)
+    out = {
+        "frequency_Hz": scene.frequency,
+        "scheme": ss.scheme,
+        "mode": ss.mode,
+        "displacement_per_period_m": disp,
+        "average_velocity_m_per_s": disp * scene.frequency,
+        "regimes": [[float(t), r] for t, r in ss.regimes],
+        "min_normal_force_N": scene.force_to_si(ss.min_normal_force),
+        "periodic_residual": ss.periodic_residual,
+        "shooting_iterations": ss.iterations,
+        "wall_time_s": wall,
+        "parameters": {k: getattr(params, k) for k in
+                       ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")},
+    }
+    if scheme == "moreau-jean":
+        out["steps_per_period"] = steps_per_period
+        out["theta"] = theta
+        for key in ("steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope"):
+            if key in ss.stats:
+                val = ss.stats[key]
+                out[key] = val if not hasattr(val, "tolist") else val.tolist()
+    return out
+
+
+def _cmd_steady(args):
+    params = _params(args)
+    if args.frequency is None:
+        raise InputError("`--frequency` is required (drive frequency in Hz)")
+    rep = steady_state_report(params, args.frequency, scheme=args.scheme,
+                              steps_per_period=args.steps_per_period, theta=args.theta,
+                              rtol=args.rtol)
+    if args.json:
+        print(json.dumps(rep))
+        return
+    print(f"friction drive at {rep['frequency_Hz']:g} Hz ({rep['scheme']})")
+    print(f"  operation mode            {rep['mode']}")
+    print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
+    print(f"  average rotor velocity    {rep['average_velocity_m_per_s']:.9e} m/s")
+    print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
+    print(f"  periodic residual         {rep['periodic_residual']:.2e}")
+    print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
+    print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")
+
+
+def _cmd_sweep(args):
+    from .analysis.sweeps import run_sweep
+    params = _params(args)
+    run_sweep(args.parameter, params, frequency=args.frequency, start=args.start, stop=args.stop,
+              num=args.num, log=args.log, out=args.out, progress=not args.quiet,
+              plot=not args.no_plot)
+
+
+def build_parser():
+    parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
+    p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    _add_params(p)
+    p.set_defaults(func=_cmd_steady)
+    s = sub.add_parser("sweep", help="steady states over a parameter range (data + figure)")
+    s.add_argument("parameter", choices=["frequency", "mu", "phi0"])
+    s.add_argument("--frequency", type=float, default=None,
+                   help="drive frequency [Hz] for mu/phi0 sweeps")
+    s.add_argument("--start", type=float, default=None)
+    s.add_argument("--stop", type=float, default=None)
+    s.add_argument("--num", type=int, default=None)
+    s.add_argument("--log", action="store_true", default=None, help="log-spaced values")
+    s.add_argument("--out", default="out", help="output folder (default ./out)")
+    s.add_argument("--quiet", action="store_true", help="no progress bar")
+    s.add_argument("--no-plot", action="store_true", help="skip the figure")
+    _add_params(s)
+    s.set_defaults(func=_cmd_sweep)
+    return parser
+
+
+def main(argv=None):
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        args.func(args)
+    except InputError as exc:
+        print(f"moreau: error: {exc}", file=sys.stderr)
+        return 2
+    except MoreauError as exc:
+        print(f"moreau: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
