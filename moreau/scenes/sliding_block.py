@@ -1,0 +1,263 @@
+"""A block sliding on a (possibly inclined) plane with Coulomb friction.
+
+The validation scene for friction: a block launched along the plane slides
+with constant deceleration, stops at ``t* = v0 / (mu g)`` after
+``v0^2 / (2 mu g)`` on a level plane, and then sticks if ``tan(alpha) <= mu``.
+
+Scales
+------
+Lengths in units of the reference length ``L = params.length``, time in
+``T = sqrt(L / g)``, velocities in ``sqrt(g L)``, forces in the weight
+``m g``. The dimensionless mass matrix is the identity and gravity has unit
+size, so the dimensionless motion depends on ``mu`` and ``alpha`` only.
+
+Coordinates: ``q = (x, y)`` with ``x`` along the plane, pointing downhill
+(for ``alpha > 0``), and ``y`` the height above the plane, which is the gap.
+The slip velocity is ``dx/dt``; positive slip means sliding downhill.
+"""
+
+import math
+from collections import namedtuple
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
+from ..errors import InputError
+from .base import Scene
+from .bouncing_ball import SIValues, _params_with
+
+__all__ = ["SlidingBlockParams", "SlidingBlock"]
+
+#: phases of the exact block motion: stopping time (``inf`` if it never
+#: stops), whether it sticks after stopping, and the accelerations before and
+#: after the stop
+BlockMotion = namedtuple("BlockMotion", ["t_stop", "sticks", "a_before", "a_after"])
+
+
+@dataclass(frozen=True)
+class SlidingBlockParams:
+    """SI parameters of the sliding block.
+
+    Attributes
+    ----------
+    mass : float
+        Mass of the block [kg], > 0.
+    mu : float
+        Coulomb friction coefficient, >= 0.
+    incline : float
+        Inclination ``alpha`` of the plane [rad], in (-pi/2, pi/2).
+    gravity : float
+        Gravitational acceleration [m/s^2], > 0.
+    restitution : float
+        Newton restitution of the contact, in [0, 1] (matters only if the
+        block is dropped onto the plane).
+    length : float
+        Reference length [m] that fixes the units, > 0.
+    """
+
+    mass: float = 1.0
+    mu: float = 0.3
+    incline: float = 0.0
+    gravity: float = 9.81
+    restitution: float = 0.0
+    length: float = 1.0
+
+    def __post_init__(self):
+        for name in ("mass", "gravity", "length"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        object.__setattr__(self, "incline",
+                           in_open_interval("incline", self.incline, -math.pi / 2, math.pi / 2,
+                                            "in the open interval (-pi/2, pi/2)"))
+        object.__setattr__(self, "restitution",
+                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+
+
+class SlidingBlock(Scene):
+    """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
+
+    Parameters
+    ----------
+    params : SlidingBlockParams, optional
+        SI parameters; defaults if omitted.
+    **overrides
+        Individual parameters replacing those of ``params`` (e.g. ``mu=0.5``).
+
+    Attributes
+    ----------
+    alpha : float
+        Inclination [rad].
+    length, time, force : float
+        The SI scales (m, s, N) of one dimensionless unit.
+
+    Examples
+    --------
+    >>> block = SlidingBlock(mu=0.5)
+    >>> block.stopping_time([2.0, 0.0]), block.stopping_distance([2.0, 0.0])
+    (4.0, 4.0)
+    >>> round(float(block.to_si(t=4.0).t), 4)   # seconds: T = sqrt(1 m / 9.81 m/s^2)
+    1.2771
+    """
+
+    ndof = 2
+    name = "sliding-block"
+
+    def __init__(self, params=None, **overrides):
+        p = _params_with(SlidingBlockParams, params, overrides)
+        self.params = p
+        self.alpha = p.incline
+        self.mu = np.array([p.mu])
+        self.restitution = np.array([p.restitution])
+        self.length = p.length
+        self.time = math.sqrt(p.length / p.gravity)
+        self.force = p.mass * p.gravity
+        self._h = np.array([math.sin(self.alpha), -math.cos(self.alpha)])
+
+    # -- Scene interface ----------------------------------------------------
+    def mass(self, q):
+        return np.eye(2)
+
+    def forces(self, q, v, t):
+        return self._h.copy()
+
+    def gaps(self, q, t):
+        return np.array([float(q[1])])
+
+    def contact_jacobians(self, q, t):
+        WN = np.array([[0.0, 1.0]])
+        if self.mu[0] > 0.0:
+            return WN, np.zeros(1), np.array([[1.0, 0.0]]), np.zeros(1)
+        return WN, np.zeros(1), np.zeros((0, 2)), np.zeros(0)
+
+    def contact_drift(self, q, v, t):
+        return np.zeros(1), np.zeros(1 if self.mu[0] > 0.0 else 0)
+
+    # -- units ----------------------------------------------------------------
+    def to_si(self, t=None, q=None, v=None, force=None):
+        """Convert dimensionless time, coordinates, velocities, forces to SI."""
+        L, T = self.length, self.time
+        return SIValues(None if t is None else np.asarray(t, float) * T,
+                        None if q is None else np.asarray(q, float) * L,
+                        None if v is None else np.asarray(v, float) * (L / T),
+                        None if force is None else np.asarray(force, float) * self.force)
+
+    def from_si(self, t=None, q=None, v=None, force=None):
+        """Inverse of :meth:`to_si`."""
+        L, T = self.length, self.time
+        return SIValues(None if t is None else np.asarray(t, float) / T,
+                        None if q is None else np.asarray(q, float) / L,
+                        None if v is None else np.asarray(v, float) / (L / T),
+                        None if force is None else np.asarray(force, float) / self.force)
+
+    # -- exact solution -------------------------------------------------------
+    @property
+    def sticks(self):
+        """True when a block at rest stays at rest: ``|tan(alpha)| <= mu``."""
+        return bool(abs(math.sin(self.alpha)) <= self.mu[0] * math.cos(self.alpha))
+
+    def motion(self, v0):
+        """Phases of the exact motion from a block on the plane with velocity ``v0``.
+
+        Parameters
+        ----------
+        v0 : array_like, shape (2,)
+            Initial velocity; ``v0[1]`` must be 0 (the block stays on the plane).
+
+        Returns
+        -------
+        BlockMotion
+            ``t_stop``: first time the block is at rest (0 if ``v0[0] = 0``,
+            ``inf`` if it never stops); ``sticks``: whether it stays at rest
+            afterwards; ``a_before``, ``a_after``: the constant accelerations
+            along the plane before and after ``t_stop``.
+        """
+        u0 = self._launch_speed(v0)
+        s, c, mu = math.sin(self.alpha), math.cos(self.alpha), float(self.mu[0])
+        a_after = 0.0 if self.sticks else s - mu * c * math.copysign(1.0, s)
+        if u0 == 0.0:
+            return BlockMotion(0.0, self.sticks, a_after, a_after)
+        a1 = s - mu * c * math.copysign(1.0, u0)
+        if a1 * u0 >= 0.0:
+            return BlockMotion(math.inf, False, a1, a1)
+        return BlockMotion(-u0 / a1, self.sticks, a1, a_after)
+
+    def stopping_time(self, v0):
+        """Time until the block launched with ``v0`` first comes to rest.
+
+        ``v0[0] / (mu cos(alpha) - sin(alpha))`` downhill,
+        ``|v0[0]| / (mu cos(alpha) + sin(alpha))`` uphill; ``inf`` if the
+        block never stops. On a level plane this is ``v0 / mu`` (SI:
+        ``v0 / (mu g)``).
+        """
+        return self.motion(v0).t_stop
+
+    def stopping_distance(self, v0):
+        """Signed displacement along the plane until the block first stops.
+
+        ``v0[0] * t* / 2``, i.e. ``v0^2 / (2 mu)`` on a level plane (SI:
+        ``v0^2 / (2 mu g)``); ``inf`` (with the sign of ``v0``) if it never stops.
+        """
+        u0 = self._launch_speed(v0)
+        t_stop = self.motion(v0).t_stop
+        if math.isinf(t_stop):
+            return math.copysign(math.inf, u0)
+        return 0.5 * u0 * t_stop
+
+    def exact_solution(self, t, q0, v0):
+        """Exact state at times ``t >= 0`` from ``(q0, v0)`` at ``t = 0``.
+
+        The block must start on the plane (``q0[1] = 0``, ``v0[1] = 0``); it
+        stays there because the normal force ``cos(alpha)`` is positive.
+
+        Returns
+        -------
+        q, v : ndarray, shape (len(t), 2)
+        """
+        x0, y0 = finite_array("q0", q0, shape=(2,))
+        if y0 != 0.0:
+            raise InputError(f"`q0` must put the block on the plane (q0[1] == 0), got {y0!r}")
+        u0 = self._launch_speed(v0)
+        tt = finite_array("t", t)
+        scalar = tt.ndim == 0
+        tt = np.atleast_1d(tt).astype(float)
+        if np.any(tt < 0.0):
+            raise InputError("`t` must be >= 0 (the exact solution starts at t = 0)")
+        m = self.motion(v0)
+        ts = min(m.t_stop, np.inf)
+        t1 = np.minimum(tt, ts)
+        x = x0 + u0 * t1 + 0.5 * m.a_before * t1 ** 2
+        u = u0 + m.a_before * t1
+        if math.isfinite(ts):
+            u = np.where(tt >= ts, 0.0, u)
+            t2 = np.maximum(tt - ts, 0.0)
+            x = x + 0.5 * m.a_after * t2 ** 2
+            u = u + m.a_after * t2
+        q = np.stack([x, np.zeros_like(x)], axis=-1)
+        v = np.stack([u, np.zeros_like(u)], axis=-1)
+        if scalar:
+            return q[0], v[0]
+        return q, v
+
+    def contact_forces(self, t, v0):
+        """Exact dimensionless contact forces ``(lambdaN, lambdaT)`` at times ``t``.
+
+        ``lambdaN = cos(alpha)``; ``lambdaT = -mu cos(alpha) sign(dx/dt)`` in
+        slip and ``-sin(alpha)`` in stick.
+        """
+        tt = np.atleast_1d(finite_array("t", t)).astype(float)
+        m = self.motion(v0)
+        u0 = self._launch_speed(v0)
+        s, c, mu = math.sin(self.alpha), math.cos(self.alpha), float(self.mu[0])
+        lamN = np.full_like(tt, c)
+        before = tt < m.t_stop
+        lamT = np.where(before, -mu * c * math.copysign(1.0, u0) if u0 else 0.0, 0.0)
+        after_force = -s if m.sticks else -mu * c * math.copysign(1.0, s)
+        lamT = np.where(before, lamT, after_force)
+        return lamN, lamT
+
+    def _launch_speed(self, v0):
+        u0, w0 = finite_array("v0", v0, shape=(2,))
+        if w0 != 0.0:
+            raise InputError(f"`v0` must be tangent to the plane (v0[1] == 0), got {w0!r}")
+        return float(u0)
