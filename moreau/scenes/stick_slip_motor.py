@@ -1,0 +1,399 @@
+"""Stick–slip motor: the paper's first type of friction drive (its Fig. 1a).
+
+A slider of mass ``m`` is pressed onto a stator by a constant normal force
+``N``; the stator vibrates along the direction of motion with a prescribed
+displacement ``X s(w t)``. Coulomb friction ``mu`` between them carries the
+slider along while it sticks and lets the stator slip back underneath it; an
+asymmetric drive therefore moves the slider by a net step every period.
+
+Scales
+------
+Time ``tau = w t`` (``w = 2 pi f``), so one drive period is ``2 pi``; lengths
+in units of the drive amplitude ``X``; forces in ``m X w^2``. The
+dimensionless problem has three numbers::
+
+    n  = N   / (m X w^2)    normal force
+    fL = F_L / (m X w^2)    load, opposing positive slider motion
+    mu                      friction coefficient
+
+and the drive shape ``s(tau)`` (:class:`SineDrive`, :class:`SawtoothDrive`).
+
+Coordinates: ``q = (x, y)``, the slider position along the drive and its
+height above the stator surface (the gap; the slider is pressed on by ``n``
+and never leaves). The slip velocity is that of the slider relative to the
+stator, ``gammaT = dx/dtau - s'(tau)``; positive slip gives the friction
+force ``-mu n`` on the slider. In slip the slider acceleration is
+``-fL -+ mu n``; in stick it follows the stator, ``x'' = s''``, which is
+possible while ``|s'' + fL| <= mu n``.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
+from ..errors import InputError
+from .base import Scene
+from .bouncing_ball import SIValues, _params_with
+
+__all__ = ["StickSlipMotorParams", "StickSlipMotor", "SineDrive", "SawtoothDrive"]
+
+TWO_PI = 2.0 * math.pi
+
+
+class _Drive:
+    """Shape ``s(tau)`` of the stator displacement, period ``2 pi``, unit amplitude.
+
+    Subclasses implement ``_eval(tau)`` -> ``(s, s', s'')`` on arrays, the
+    tuple ``breakpoints`` (points in ``[0, 2 pi)`` where ``s''`` jumps) and
+    ``_crossings(level)``: every ``tau`` in ``[0, 2 pi)`` where ``s''``
+    crosses or touches ``level`` (a superset is fine).
+    """
+
+    name = "drive"
+    breakpoints = ()
+
+    def __call__(self, tau):
+        """``(s, s', s'')`` at ``tau``; right-continuous where ``s''`` jumps."""
+        t = np.asarray(tau, dtype=float)
+        return self._eval(t)
+
+    def acceleration_crossings(self, level):
+        """Sorted points of ``[0, 2 pi)`` where ``s''`` crosses or touches ``level``,
+        together with the breakpoints."""
+        pts = np.concatenate([np.asarray(self._crossings(float(level)), float),
+                              np.asarray(self.breakpoints, float)])
+        pts = np.mod(pts, TWO_PI)
+        pts[pts >= TWO_PI] = 0.0
+        return np.unique(pts)
+
+    def acceleration_range(self):
+        """``(min s'', max s'')`` over a period."""
+        raise NotImplementedError
+
+
+class SineDrive(_Drive):
+    """``s(tau) = sin(tau) + b sin(2 tau + psi)``.
+
+    A pure sinusoid (``b = 0``) is symmetric under ``s(tau + pi) = -s(tau)``,
+    which maps every motion onto its mirror image half a period later; without
+    a load its periodic steady state therefore has zero net displacement. A
+    second harmonic (or a load) breaks the symmetry.
+
+    Parameters
+    ----------
+    harmonic2 : float
+        Relative amplitude ``b`` of the second harmonic, finite.
+    phase2 : float
+        Its phase ``psi`` [rad], finite.
+
+    Examples
+    --------
+    >>> d = SineDrive()
+    >>> [round(float(x), 12) for x in d(math.pi / 2)]
+    [1.0, 0.0, -1.0]
+    """
+
+    name = "sine"
+
+    def __init__(self, harmonic2=0.0, phase2=0.0):
+        self.b = finite_scalar("harmonic2", harmonic2)
+        self.psi = finite_scalar("phase2", phase2)
+
+    def _eval(self, t):
+        b, psi = self.b, self.psi
+        a2 = 2.0 * t + psi
+        s = np.sin(t) + b * np.sin(a2)
+        ds = np.cos(t) + 2.0 * b * np.cos(a2)
+        dds = -np.sin(t) - 4.0 * b * np.sin(a2)
+        return s, ds, dds
+
+    def _jerk(self, t):
+        return -np.cos(t) - 8.0 * self.b * np.cos(2.0 * t + self.psi)
+
+    def _crossings(self, level):
+        # s'' - level is a trigonometric polynomial of degree 2; with
+        # z = exp(i tau) it becomes a quartic whose unit-modulus roots are the
+        # crossings. Coefficients of z^0 .. z^4 of 2i z^2 (s'' - level):
+        b, psi = self.b, self.psi
+        ep, em = np.exp(1j * psi), np.exp(-1j * psi)
+        c = np.array([4.0 * b * em, 1.0, -2j * level, -1.0, -4.0 * b * ep], dtype=complex)
+        c = c[::-1]  # numpy.roots wants the highest power first
+        while len(c) > 1 and c[0] == 0:
+            c = c[1:]
+        z = np.roots(c) if len(c) > 1 else np.zeros(0)
+        # a tangency is a double root, perturbed off the circle by ~sqrt(eps)
+        z = z[np.abs(np.abs(z) - 1.0) < 1e-6]
+        taus = np.mod(np.angle(z), TWO_PI)
+        out = []
+        for tau in taus:
+            for _ in range(4):
+                f = self._eval(tau)[2] - level
+                fp = self._jerk(tau)
+                if fp == 0.0 or abs(f) < 1e-300:
+                    break
+                step = f / fp
+                if abs(step) > 1e-3:     # near a tangency Newton would wander
+                    break
+                tau -= step
+            out.append(tau)
+        return np.array(out, float)
+
+    def acceleration_range(self):
+        tau = np.linspace(0.0, TWO_PI, 4097)
+        a = self._eval(tau)[2]
+        ext = list(self._crossings_of_jerk())
+        if ext:
+            a = np.concatenate([a, self._eval(np.array(ext))[2]])
+        return float(a.min()), float(a.max())
+
+    def _crossings_of_jerk(self):
+        # s''' = -cos(t) - 8 b cos(2t + psi) = 0, as a quartic in z as above
+        b, psi = self.b, self.psi
+        ep, em = np.exp(1j * psi), np.exp(-1j * psi)
+        # 2 z^2 s''' = -(z^3 + z) - 8 b (ep z^4 + em)
+        c = np.array([-8.0 * b * ep, -1.0, 0.0, -1.0, -8.0 * b * em], dtype=complex)
+        while len(c) > 1 and c[0] == 0:
+            c = c[1:]
+        z = np.roots(c)
+        z = z[np.abs(np.abs(z) - 1.0) < 1e-6]
+        return np.mod(np.angle(z), TWO_PI)
+
+    def __repr__(self):
+        return f"SineDrive(harmonic2={self.b!r}, phase2={self.psi!r})"
+
+
+class SawtoothDrive(_Drive):
+    """Asymmetric sawtooth with parabolic corners: slow ramp up, fast return.
+
+    The stator velocity is trapezoidal: ``+V1`` on the ramp, ``-V2`` on the
+    return, changed linearly over a corner of duration ``Tb`` at each end.
+    The displacement is therefore piecewise quadratic with continuous slope,
+    the acceleration piecewise constant (``0`` or ``-+A``) and bounded, which
+    keeps stick–slip transitions well defined and lets a time-stepping
+    scheme converge. The displacement spans ``[-1, 1]``.
+
+    Timing over one period ``2 pi``: the ramp takes ``rise * 2 pi`` (from
+    corner centre to corner centre), the return the rest;
+    ``Tb = smoothing * 2 pi * min(rise, 1 - rise)``. At ``tau = 0`` the
+    constant-velocity ramp starts.
+
+    Parameters
+    ----------
+    rise : float
+        Fraction of the period spent ramping up, in (0, 1); > 0.5 gives the
+        usual slow-forward, fast-back sawtooth that drives the slider forward.
+    smoothing : float
+        Corner duration relative to the shorter phase, in (0, 1]; 1 leaves no
+        constant-velocity return.
+
+    Examples
+    --------
+    >>> d = SawtoothDrive(rise=0.9, smoothing=0.5)
+    >>> s, ds, dds = d(np.linspace(0.0, 2 * math.pi, 1001))
+    >>> round(float(s.min()), 12), round(float(s.max()), 12)
+    (-1.0, 1.0)
+    """
+
+    name = "sawtooth"
+
+    def __init__(self, rise=0.9, smoothing=0.5):
+        r = in_open_interval("rise", rise, 0.0, 1.0)
+        c = finite_scalar("smoothing", smoothing)
+        if not 0.0 < c <= 1.0:
+            raise InputError(f"`smoothing` must be in (0, 1], got {c!r}")
+        self.rise, self.smoothing = r, c
+        Tb = c * TWO_PI * min(r, 1.0 - r)
+        T1 = TWO_PI * r - Tb
+        T2 = TWO_PI * (1.0 - r) - Tb
+        # zero mean velocity: V1 (T1 + Tb) = V2 (T2 + Tb); stroke 2 = V1 (T1 + (1 - r) Tb)
+        V1 = 2.0 / (T1 + (1.0 - r) * Tb)
+        V2 = V1 * r / (1.0 - r)
+        A = (V1 + V2) / Tb
+        self.V1, self.V2, self.A, self.Tb = V1, V2, A, Tb
+        starts = np.array([0.0, T1, T1 + Tb, T1 + Tb + T2])
+        acc = np.array([0.0, -A, 0.0, A])
+        vel = np.array([V1, V1, -V2, -V2])
+        # the minimum -1 is where the velocity crosses zero inside the last
+        # corner, (1 - r) Tb before the end of the period
+        pos = np.empty(4)
+        pos[0] = -1.0 + 0.5 * V1 * (1.0 - r) * Tb
+        for k in range(1, 4):
+            dt = starts[k] - starts[k - 1]
+            pos[k] = pos[k - 1] + vel[k - 1] * dt + 0.5 * acc[k - 1] * dt * dt
+        if T2 <= 0.0:   # smoothing == 1 (or the mirror): the return segment is empty
+            keep = np.array([True, True, False, True])
+            starts, acc, vel, pos = starts[keep], acc[keep], vel[keep], pos[keep]
+        if T1 <= 0.0:
+            keep = np.ones(len(starts), bool)
+            keep[0] = False
+            starts, acc, vel, pos = starts[keep], acc[keep], vel[keep], pos[keep]
+        self._starts, self._acc, self._vel, self._pos = starts, acc, vel, pos
+        self.breakpoints = tuple(float(x) for x in starts)
+
+    def _eval(self, t):
+        tm = np.mod(t, TWO_PI)
+        k = np.searchsorted(self._starts, tm, side="right") - 1
+        k = np.where(k < 0, len(self._starts) - 1, k)
+        dt = np.where(tm >= self._starts[k], tm - self._starts[k], tm + TWO_PI - self._starts[k])
+        a = self._acc[k]
+        v = self._vel[k] + a * dt
+        s = self._pos[k] + self._vel[k] * dt + 0.5 * a * dt * dt
+        return s, v, a
+
+    def _crossings(self, level):
+        # s'' is piecewise constant: it can change sides only at breakpoints
+        return np.zeros(0)
+
+    def acceleration_range(self):
+        return float(self._acc.min()), float(self._acc.max())
+
+    def __repr__(self):
+        return f"SawtoothDrive(rise={self.rise!r}, smoothing={self.smoothing!r})"
+
+
+def make_drive(drive):
+    """A drive object from ``"sine"``, ``"sawtooth"`` or a drive instance."""
+    if isinstance(drive, _Drive):
+        return drive
+    if drive == "sine":
+        return SineDrive()
+    if drive == "sawtooth":
+        return SawtoothDrive()
+    raise InputError(f"`drive` must be 'sine', 'sawtooth', a SineDrive or a SawtoothDrive, "
+                     f"got {drive!r}")
+
+
+@dataclass(frozen=True)
+class StickSlipMotorParams:
+    """SI parameters of the stick–slip motor.
+
+    Attributes
+    ----------
+    mass : float
+        Slider mass [kg], > 0.
+    normal_force : float
+        Constant force pressing the slider onto the stator [N], > 0.
+    mu : float
+        Coulomb friction coefficient, > 0 (without friction nothing moves).
+    amplitude : float
+        Stator displacement amplitude ``X`` [m], > 0 (half the stroke of the
+        sawtooth, the fundamental's amplitude of the sine drive).
+    load : float
+        External force on the slider opposing positive motion [N], finite.
+    restitution : float
+        Newton restitution of the contact, in [0, 1] (irrelevant while the
+        slider stays pressed on).
+    """
+
+    mass: float = 0.01
+    normal_force: float = 1.0
+    mu: float = 0.2
+    amplitude: float = 1e-6
+    load: float = 0.0
+    restitution: float = 0.0
+
+    def __post_init__(self):
+        for name in ("mass", "normal_force", "mu", "amplitude"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "load", finite_scalar("load", self.load))
+        object.__setattr__(self, "restitution",
+                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+
+
+class StickSlipMotor(Scene):
+    """Slider pressed on a stator that vibrates along the slider's path.
+
+    Parameters
+    ----------
+    params : StickSlipMotorParams, optional
+        SI parameters; defaults if omitted.
+    frequency : float
+        Drive frequency [Hz], > 0.
+    drive : {"sawtooth", "sine"} or SineDrive or SawtoothDrive
+        Shape of the stator displacement.
+    **overrides
+        Individual parameters replacing those of ``params``.
+
+    Attributes
+    ----------
+    n, fL : float
+        Dimensionless normal force and load.
+    drive : SineDrive or SawtoothDrive
+    omega : float
+        Angular drive frequency [rad/s].
+    length, time, force : float
+        SI scales: ``X`` [m], ``1 / omega`` [s], ``m X omega^2`` [N].
+
+    Examples
+    --------
+    >>> motor = StickSlipMotor(frequency=1000.0, drive="sawtooth")
+    >>> round(motor.n, 4), round(motor.friction_level, 4)   # N / (m X w^2), mu n
+    (2.533, 0.5066)
+    >>> motor.contact_jacobians([0.0, 0.0], 0.0)[2]
+    array([[1., 0.]])
+    """
+
+    ndof = 2
+    name = "stick-slip-motor"
+
+    def __init__(self, params=None, frequency=1000.0, drive="sawtooth", **overrides):
+        p = _params_with(StickSlipMotorParams, params, overrides)
+        f = positive("frequency", frequency)
+        self.drive = make_drive(drive)
+        self.params = p
+        self.frequency = f
+        self.omega = TWO_PI * f
+        self.length = p.amplitude
+        self.time = 1.0 / self.omega
+        self.force = p.mass * p.amplitude * self.omega ** 2
+        self.n = p.normal_force / self.force
+        self.fL = p.load / self.force
+        self.mu = np.array([p.mu])
+        self.restitution = np.array([p.restitution])
+
+    @property
+    def friction_level(self):
+        """Dimensionless sliding friction force ``mu n``."""
+        return float(self.mu[0]) * self.n
+
+    def stator(self, tau):
+        """Stator displacement, velocity and acceleration ``(s, s', s'')`` at ``tau``."""
+        return self.drive(tau)
+
+    # -- Scene interface ----------------------------------------------------
+    def mass(self, q):
+        return np.eye(2)
+
+    def forces(self, q, v, t):
+        return np.array([-self.fL, -self.n])
+
+    def gaps(self, q, t):
+        return np.array([float(q[1])])
+
+    def contact_jacobians(self, q, t):
+        _, ds, _ = self.drive(t)
+        return (np.array([[0.0, 1.0]]), np.zeros(1),
+                np.array([[1.0, 0.0]]), np.array([-float(ds)]))
+
+    def contact_drift(self, q, v, t):
+        _, _, dds = self.drive(t)
+        return np.zeros(1), np.array([-float(dds)])
+
+    # -- units ----------------------------------------------------------------
+    def to_si(self, t=None, q=None, v=None, force=None):
+        """Convert dimensionless time, coordinates, velocities, forces to SI."""
+        L, T = self.length, self.time
+        return SIValues(None if t is None else np.asarray(t, float) * T,
+                        None if q is None else np.asarray(q, float) * L,
+                        None if v is None else np.asarray(v, float) * (L / T),
+                        None if force is None else np.asarray(force, float) * self.force)
+
+    def from_si(self, t=None, q=None, v=None, force=None):
+        """Inverse of :meth:`to_si`."""
+        L, T = self.length, self.time
+        return SIValues(None if t is None else np.asarray(t, float) / T,
+                        None if q is None else np.asarray(q, float) / L,
+                        None if v is None else np.asarray(v, float) / (L / T),
+                        None if force is None else np.asarray(force, float) / self.force)
