@@ -30,7 +30,6 @@ import time as _time
 import numpy as np
 from scipy.optimize import brentq
 
-from .._validate import positive
 from ..analysis.modes import mode_name
 from ..analysis.steady_state import SteadyState
 from ..errors import ConvergenceError, InputError

@@ -22,7 +22,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .._validate import finite_array, finite_scalar, in_closed_interval, positive
+from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from .base import Scene
 
@@ -81,7 +81,60 @@ def _params_with(cls, params, overrides):
     return replace(params, **overrides)
 
 
-class BouncingBall(Scene):
+
+class _SIUnits:
+    """SI conversion shared by the validation scenes of this package.
+
+    A scene using it sets ``time`` [s], ``force`` [N] and ``length`` [m] (the
+    SI size of one dimensionless unit) and may override ``_qscale`` when some
+    coordinates are angles.
+    """
+
+    def _qscale(self):
+        # one scale for all coordinates, so that scalars convert to scalars
+        return self.length
+
+    def to_si(self, result=None, *, t=None, q=None, v=None, force=None):
+        """Convert to SI units.
+
+        Parameters
+        ----------
+        result : SimulationResult, optional
+            A run of this scene. If given, a dict of SI time histories is
+            returned: ``t`` [s], ``q``, ``v`` (lengths in m, angles in rad),
+            ``force_N``, ``force_T`` [N], ``slip_velocity`` [m/s], ``gap`` [m]
+            and the ``regime`` codes.
+        t, q, v, force : array_like, optional
+            Dimensionless time, coordinates, velocities and contact forces,
+            converted individually when ``result`` is not given.
+
+        Returns
+        -------
+        dict or SIValues
+        """
+        T, F, L = self.time, self.force, self.length
+        qs = self._qscale()
+        if result is not None:
+            return {"t": result.t * T, "q": result.q * qs, "v": result.v * qs / T,
+                    "force_N": result.force_N * F, "force_T": result.force_T * F,
+                    "slip_velocity": result.slip_velocity * (L / T), "gap": result.gap * L,
+                    "regime": result.regime.copy()}
+        return SIValues(None if t is None else np.asarray(t, float) * T,
+                        None if q is None else np.asarray(q, float) * qs,
+                        None if v is None else np.asarray(v, float) * qs / T,
+                        None if force is None else np.asarray(force, float) * F)
+
+    def from_si(self, *, t=None, q=None, v=None, force=None):
+        """Inverse of :meth:`to_si` for individual quantities (SI -> dimensionless)."""
+        T, F = self.time, self.force
+        qs = self._qscale()
+        return SIValues(None if t is None else np.asarray(t, float) / T,
+                        None if q is None else np.asarray(q, float) / qs,
+                        None if v is None else np.asarray(v, float) * T / qs,
+                        None if force is None else np.asarray(force, float) / F)
+
+
+class BouncingBall(_SIUnits, Scene):
     """A ball of radius ``r`` falling on the floor ``y = 0``, restitution ``e``.
 
     Parameters
@@ -140,26 +193,6 @@ class BouncingBall(Scene):
 
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(0)
-
-    # -- units ----------------------------------------------------------------
-    def to_si(self, t=None, q=None, v=None, force=None):
-        """Convert dimensionless time, coordinates, velocities, forces to SI.
-
-        Returns an :data:`SIValues` tuple with ``None`` for the quantities not given.
-        """
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) * T,
-                        None if q is None else np.asarray(q, float) * L,
-                        None if v is None else np.asarray(v, float) * (L / T),
-                        None if force is None else np.asarray(force, float) * self.force)
-
-    def from_si(self, t=None, q=None, v=None, force=None):
-        """Inverse of :meth:`to_si`."""
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) / T,
-                        None if q is None else np.asarray(q, float) / L,
-                        None if v is None else np.asarray(v, float) / (L / T),
-                        None if force is None else np.asarray(force, float) / self.force)
 
     # -- exact solution -------------------------------------------------------
     def _initial(self, q0, v0):

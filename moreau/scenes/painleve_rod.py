@@ -42,7 +42,7 @@ import numpy as np
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from .base import Scene
-from .bouncing_ball import SIValues, _params_with
+from .bouncing_ball import _params_with, _SIUnits
 
 __all__ = ["PainleveRodParams", "PainleveRod", "painleve_critical_mu", "PAINLEVE_MU_MIN"]
 
@@ -102,7 +102,7 @@ class PainleveRodParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class PainleveRod(Scene):
+class PainleveRod(_SIUnits, Scene):
     """Uniform rod with its lower tip on a rough floor.
 
     Parameters
@@ -169,25 +169,6 @@ class PainleveRod(Scene):
     # -- units ----------------------------------------------------------------
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
-
-    def to_si(self, t=None, q=None, v=None, force=None):
-        """Convert dimensionless time, coordinates (x, y, phi), velocities, forces to SI.
-
-        Angles stay in radians; angular velocities become rad/s.
-        """
-        T = self.time
-        return SIValues(None if t is None else np.asarray(t, float) * T,
-                        None if q is None else np.asarray(q, float) * self._qscale(),
-                        None if v is None else np.asarray(v, float) * self._qscale() / T,
-                        None if force is None else np.asarray(force, float) * self.force)
-
-    def from_si(self, t=None, q=None, v=None, force=None):
-        """Inverse of :meth:`to_si`."""
-        T = self.time
-        return SIValues(None if t is None else np.asarray(t, float) / T,
-                        None if q is None else np.asarray(q, float) / self._qscale(),
-                        None if v is None else np.asarray(v, float) / self._qscale() * T,
-                        None if force is None else np.asarray(force, float) / self.force)
 
     # -- states and the paradox ---------------------------------------------
     def sliding_state(self, phi, tip_speed, dphi=0.0):

@@ -25,7 +25,7 @@ import numpy as np
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from .base import Scene
-from .bouncing_ball import SIValues, _params_with
+from .bouncing_ball import _params_with, _SIUnits
 
 __all__ = ["SlidingBlockParams", "SlidingBlock"]
 
@@ -74,7 +74,7 @@ class SlidingBlockParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class SlidingBlock(Scene):
+class SlidingBlock(_SIUnits, Scene):
     """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
 
     Parameters
@@ -132,23 +132,6 @@ class SlidingBlock(Scene):
 
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(1 if self.mu[0] > 0.0 else 0)
-
-    # -- units ----------------------------------------------------------------
-    def to_si(self, t=None, q=None, v=None, force=None):
-        """Convert dimensionless time, coordinates, velocities, forces to SI."""
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) * T,
-                        None if q is None else np.asarray(q, float) * L,
-                        None if v is None else np.asarray(v, float) * (L / T),
-                        None if force is None else np.asarray(force, float) * self.force)
-
-    def from_si(self, t=None, q=None, v=None, force=None):
-        """Inverse of :meth:`to_si`."""
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) / T,
-                        None if q is None else np.asarray(q, float) / L,
-                        None if v is None else np.asarray(v, float) / (L / T),
-                        None if force is None else np.asarray(force, float) / self.force)
 
     # -- exact solution -------------------------------------------------------
     @property

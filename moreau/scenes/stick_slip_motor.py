@@ -35,7 +35,7 @@ import numpy as np
 from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ..errors import InputError
 from .base import Scene
-from .bouncing_ball import SIValues, _params_with
+from .bouncing_ball import _params_with, _SIUnits
 
 __all__ = ["StickSlipMotorParams", "StickSlipMotor", "SineDrive", "SawtoothDrive"]
 
@@ -302,7 +302,7 @@ class StickSlipMotorParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class StickSlipMotor(Scene):
+class StickSlipMotor(_SIUnits, Scene):
     """Slider pressed on a stator that vibrates along the slider's path.
 
     Parameters
@@ -381,19 +381,3 @@ class StickSlipMotor(Scene):
         _, _, dds = self.drive(t)
         return np.zeros(1), np.array([-float(dds)])
 
-    # -- units ----------------------------------------------------------------
-    def to_si(self, t=None, q=None, v=None, force=None):
-        """Convert dimensionless time, coordinates, velocities, forces to SI."""
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) * T,
-                        None if q is None else np.asarray(q, float) * L,
-                        None if v is None else np.asarray(v, float) * (L / T),
-                        None if force is None else np.asarray(force, float) * self.force)
-
-    def from_si(self, t=None, q=None, v=None, force=None):
-        """Inverse of :meth:`to_si`."""
-        L, T = self.length, self.time
-        return SIValues(None if t is None else np.asarray(t, float) / T,
-                        None if q is None else np.asarray(q, float) / L,
-                        None if v is None else np.asarray(v, float) / (L / T),
-                        None if force is None else np.asarray(force, float) / self.force)
