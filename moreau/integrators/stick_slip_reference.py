@@ -117,6 +117,12 @@ class _Walker:
                         x += float(self.drive(b)[0]) - float(self.drive(cur)[0])
                         u, cur = float(self.drive(b)[1]), b
                         fresh = False
+                        # stick that breaks right at b is reported at b, so
+                        # that the node carries the regime that follows it
+                        new = self._decide(b, pts[i + 2])
+                        if new != "S":
+                            end_events.append((b, "S", new))
+                            reg, fresh = new, True
                         break
                     new = "N" if c > self.mun else "P"
                     yield cur, x, u, new, [(cur, reg, new)]
@@ -291,7 +297,9 @@ class StickSlipReference(Integrator):
     >>> res = simulate(StickSlipMotor(drive="sine"), (0.0, 6.0), [0.0, 0.0], [1.0, 0.0],
     ...                "stick-slip-exact")
     >>> res.status, res.regime_letters()[:2]
-    (0, 'SS')
+    (0, 'SP')
+    >>> res.events[0]       # stick breaks where sin(tau) = mu n
+    Event(t=0.531243578339, transition, S->P)
     """
 
     def __init__(self, scene, t0, q0, v0, t_bound):
