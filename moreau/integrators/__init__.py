@@ -2,3 +2,4 @@
 
 from .base import INTEGRATORS, Integrator, register_integrator, simulate
 from .result import Event, SimulationResult
+from . import event_driven  # noqa: F401  (registers "event-driven")

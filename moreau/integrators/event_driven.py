@@ -94,6 +94,16 @@ class _SlipSeries:
         return (b @ self.cA).real, (b @ self.cAA).real
 
 
+class _JoinedDense:
+    """Dense output of two consecutive flight pieces."""
+
+    def __init__(self, first, second, t_split):
+        self.first, self.second, self.t_split = first, second, t_split
+
+    def __call__(self, t):
+        return self.first(t) if t < self.t_split else self.second(t)
+
+
 class FrictionDriveWalker:
     """Segment-by-segment solver of the friction drive; the engine of the reference.
 
@@ -108,6 +118,15 @@ class FrictionDriveWalker:
     max_impacts : int
         Impacts allowed per run before an accumulation (Zeno) is declared and
         the contact is closed.
+
+    Notes
+    -----
+    With restitution ``e > 0`` the bounces of a re-contact accumulate (Zeno).
+    After each impact the remaining time of the geometric bounce sequence is
+    estimated as ``2 v_N / (|D| (1 - e))``; once it is below ``zeno_time``
+    (``1e-6`` in tau) the accumulation point is taken as reached and the
+    contact closes. The position error this makes is of order
+    ``|D| zeno_time^2``.
     """
 
     def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000):
@@ -118,6 +137,8 @@ class FrictionDriveWalker:
         self.mu = float(scene.mu[0])
         self.e = float(scene.restitution[0])
         self.n_impacts = 0
+        self.zeno_time = 1e-6
+        self._rebound_skip = None
         self.counters = {"events": 0, "impacts": 0, "flight_segments": 0, "root_solves": 0}
         self._build_tables()
 
@@ -230,10 +251,18 @@ class FrictionDriveWalker:
         change is refined by Brent's method; a grid cell whose samples stay
         positive but whose local minimum could dip below zero is checked
         with a bounded minimisation, so double crossings inside a cell are
-        not missed.
+        not missed. A segment that starts on a zero of ``f`` (slip starting
+        from zero velocity) is searched from ``ta + skip`` on, ``skip`` being
+        far below any physical time scale but above round-off.
         """
-        tt = np.concatenate(([ta], tk, [tb])) if (tk.size == 0 or tk[-1] < tb) else np.concatenate(([ta], tk))
-        fv = np.concatenate(([max(f(ta), 0.0)], vals, [f(tb)] if tt.size > vals.size + 1 else []))
+        skip = 1e-10 * max(1.0, abs(ta))
+        keep = tk > ta + skip
+        tk, vals = tk[keep], vals[keep]
+        t0 = ta + skip if f(ta) <= 0.0 else ta
+        if t0 >= tb:
+            return None
+        tt = np.concatenate(([t0], tk, [tb])) if (tk.size == 0 or tk[-1] < tb) else np.concatenate(([t0], tk))
+        fv = np.concatenate(([max(f(t0), 0.0)], vals, [f(tb)] if tt.size > vals.size + 1 else []))
         neg = np.flatnonzero(fv[1:] <= 0.0)
         stop = neg[0] + 1 if neg.size else fv.size
         # interior local minima before the first sign change
@@ -354,8 +383,21 @@ class FrictionDriveWalker:
         gap.direction = -1
         y0 = [st.phi, st.dphi, st.u2, st.du2]
         scale = np.array([1.0, 1.0, 1.0, 1.0]) * max(self.scene.u10, 1e-12)
-        sol = solve_ivp(self._flight_rhs, (st.tau, tau_end), y0, method="DOP853", events=gap,
-                        rtol=self.rtol, atol=1e-3 * self.rtol * scale, dense_output=dense)
+        opts = dict(method="DOP853", rtol=self.rtol, atol=1e-3 * self.rtol * scale)
+        t0 = st.tau
+        pre = None
+        # a flight starts on a zero of the gap (lift-off or rebound): step off it
+        # before watching for re-contact, so the start is not taken for an event
+        skip = 1e-9 * max(1.0, abs(t0))
+        if self._rebound_skip is not None:
+            skip, self._rebound_skip = self._rebound_skip, None
+        if t0 + skip < tau_end:
+            pre = solve_ivp(self._flight_rhs, (t0, t0 + skip), y0, dense_output=dense, **opts)
+            y0 = pre.y[:, -1]
+            t0 = t0 + skip
+        sol = solve_ivp(self._flight_rhs, (t0, tau_end), y0, events=gap, dense_output=dense, **opts)
+        if dense and pre is not None:
+            sol.sol = _JoinedDense(pre.sol, sol.sol, t0)
         if sol.status < 0:
             raise MoreauError(f"flight integration failed: {sol.message}")
         out = st.copy()
@@ -466,8 +508,14 @@ class FrictionDriveWalker:
                 end, _, _ = self.impact(end)
                 kind = "impact"
             vN_post = -math.cos(end.phi) * end.dphi - float(self.scene.du1(end.tau))
-            if self.e > 0 and vN_post > 1e-9 * self.vscale and self.n_impacts < self.max_impacts:
+            D = float(self.scene.coefficients(end.phi, end.dphi, end.tau)[3])
+            # remaining time of the geometric (Zeno) bounce sequence; below the
+            # threshold the accumulation point is taken as reached
+            zeno = (2.0 * vN_post / (-D * (1.0 - self.e))) if (D < 0 and self.e < 1) else math.inf
+            if (self.e > 0 and vN_post > 1e-12 * self.vscale and zeno > self.zeno_time
+                    and self.n_impacts < self.max_impacts):
                 end.regime = _F
+                self._rebound_skip = 0.5 * vN_post / -D if D < 0 else None
             else:
                 # plastic impact, or the accumulation point of a Zeno sequence: contact closes
                 self.classify(end, closing=True)
