@@ -1,0 +1,102 @@
+"""The `moreau` command and the sweep helpers."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from moreau.analysis.modes import mode_name
+from moreau.analysis.sweeps import sweep, write_csv
+from moreau.cli import main
+
+KEYS = {"displacement_per_period_m", "average_velocity_m_per_s", "mode", "regimes",
+        "min_normal_force_N", "periodic_residual", "scheme", "wall_time_s"}
+
+
+def run_json(capsys, *args):
+    rc = main(["steady", *args, "--json"])
+    out = capsys.readouterr().out
+    return rc, json.loads(out)
+
+
+def test_steady_json_keys_and_units(capsys):
+    rc, rep = run_json(capsys, "--frequency", "185")
+    assert rc == 0
+    assert KEYS <= set(rep)
+    assert rep["scheme"] == "event-driven" and rep["mode"] == "NP"
+    # SI: about -6.64 um per period, velocity = displacement * f
+    assert rep["displacement_per_period_m"] == pytest.approx(-6.639079e-6, rel=1e-6)
+    assert rep["average_velocity_m_per_s"] == pytest.approx(rep["displacement_per_period_m"] * 185)
+    assert all(0.0 <= t < 2 * math.pi for t, _ in rep["regimes"])
+    assert [r for _, r in rep["regimes"]] == ["N", "P", "N"]
+    assert rep["min_normal_force_N"] > 0 and rep["periodic_residual"] < 1e-10
+
+
+def test_steady_parameters_are_used(capsys):
+    _, a = run_json(capsys, "--frequency", "2000", "--mu", "0.95")
+    assert a["mode"] == "SP" and a["parameters"]["mu"] == 0.95
+    _, b = run_json(capsys, "--frequency", "185", "--length", "2e-3", "--x10", "4e-6")
+    assert b["parameters"]["length"] == 2e-3
+
+
+@pytest.mark.parametrize("args, match", [
+    (["--frequency", "0"], "`frequency` must be > 0"),
+    (["--frequency", "100", "--mu", "-1"], "`mu` must be >= 0"),
+    (["--frequency", "100", "--phi0", "1.7"], "`phi0` must be in the open interval"),
+    (["--frequency", "100", "--m2", "nan"], "`m2` must be finite"),
+    (["--frequency", "100", "--k", "-5"], "`k` must be > 0"),
+    ([], "`--frequency` is required"),
+])
+def test_steady_bad_input(capsys, args, match):
+    rc = main(["steady", *args, "--json"])
+    err = capsys.readouterr().err
+    assert rc == 2 and match in err and err.count("\n") == 1
+
+
+def test_steady_painleve_failure(capsys):
+    rc = main(["steady", "--frequency", "185", "--phi0", "1.5"])
+    err = capsys.readouterr().err
+    assert rc == 1 and "PainleveError" in err and "1 - mu*tan(phi)" in err
+
+
+def test_console_entry_point_human_output():
+    out = subprocess.run([sys.executable, "-m", "moreau", "steady", "--frequency", "20"],
+                         capture_output=True, text=True, check=True).stdout
+    assert "operation mode            NS" in out and "m/s" in out
+
+
+def test_sweep_rows_and_errors(tmp_path):
+    rows = sweep("phi0", [0.8, 1.5], frequency=185.0)
+    assert rows[0]["mode"] == "NP" and rows[0]["error"] == ""
+    assert rows[1]["mode"] == "" and rows[1]["error"].startswith("PainleveError")
+    assert math.isnan(rows[1]["displacement_per_period_m"])
+    path = tmp_path / "s.csv"
+    write_csv(rows, path)
+    text = path.read_text().splitlines()
+    assert len(text) == 3 and text[0].startswith("value,mode")
+
+
+def test_sweep_bad_input():
+    with pytest.raises(ValueError, match="`parameter` must be one of"):
+        sweep("k", [1.0])
+    with pytest.raises(ValueError, match="`frequency` must be"):
+        sweep("mu", [0.1])
+    with pytest.raises(ValueError, match="`values` must be"):
+        sweep("frequency", [np.nan])
+
+
+@pytest.mark.parametrize("seq, name", [
+    ("SN", "NS"), ("SPSN", "NSPS"), ("PSN", "NPS"), ("PN", "NP"), ("PNS", "NSP"), ("PS", "SP"),
+    ("NNPPN", "NP"), ("S", "S"), ("FSNF", "NFS"),
+])
+def test_mode_names(seq, name):
+    assert mode_name(seq) == name
+
+
+def test_mode_name_marks_impacts():
+    assert mode_name("NFS", impacts=[False, False, True]) == "NF!S"
+    with pytest.raises(ValueError, match="`sequence` may contain only"):
+        mode_name("NX")
