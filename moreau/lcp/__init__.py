@@ -1,0 +1,161 @@
+"""Linear complementarity problems: find ``z >= 0`` with ``w = M z + q >= 0`` and ``z.w = 0``.
+
+One entry point, :func:`solve_lcp`, reaches every method by name. Each method
+lives in its own module and exposes ``solve(M, q, *, max_iter, tol,
+check_input, friction, ...)``; :data:`METHODS` maps names to them.
+
+``"lemke"``
+    Lemke's complementary pivoting with a lexicographic ratio test
+    (:mod:`moreau.lcp.lemke`); compiled with numba, its kernel can also be
+    called from compiled code (:func:`lemke_kernel`).
+``"qp"``
+    Convex QP formulations solved by OSQP through qpsolvers
+    (:mod:`moreau.lcp.qp`); exact for symmetric PSD and monotone ``M``, a
+    Tresca fixed point for the friction LCP.
+``"auto"``
+    Lemke first; on any failure the QP method, with the path recorded in
+    ``result.path``.
+
+The 2D Coulomb friction LCP is built by :func:`build_friction_lcp` and read
+back by :func:`friction_impulses` (:mod:`moreau.lcp.friction`).
+
+Examples
+--------
+>>> import numpy as np
+>>> from moreau.lcp import solve_lcp
+>>> M = np.array([[2.0, 1.0], [1.0, 2.0]])
+>>> res = solve_lcp(M, np.array([-1.0, 1.0]))
+>>> res.success, res.z.tolist(), res.w.tolist()
+(True, [0.5, 0.0], [0.0, 1.5])
+"""
+
+from . import lemke, qp
+from ._result import (
+    BREAKDOWN,
+    INVALID_INPUT,
+    MAX_ITER,
+    NOT_APPLICABLE,
+    SECONDARY_RAY,
+    SOLVED,
+    SOLVER_FAILED,
+    STATUS_MESSAGES,
+    LCPResult,
+    lcp_residual,
+)
+from ..errors import InputError
+from .friction import (
+    FrictionLayout,
+    FrictionLCP,
+    build_friction_lcp,
+    contact_velocities,
+    friction_impulses,
+)
+from .lemke import lemke_core, lemke_kernel, lemke_workspace
+
+__all__ = [
+    "solve_lcp",
+    "METHODS",
+    "LCPResult",
+    "lcp_residual",
+    "STATUS_MESSAGES",
+    "SOLVED",
+    "SECONDARY_RAY",
+    "MAX_ITER",
+    "BREAKDOWN",
+    "INVALID_INPUT",
+    "SOLVER_FAILED",
+    "NOT_APPLICABLE",
+    "lemke_kernel",
+    "lemke_core",
+    "lemke_workspace",
+    "build_friction_lcp",
+    "friction_impulses",
+    "contact_velocities",
+    "FrictionLayout",
+    "FrictionLCP",
+]
+
+
+def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
+    # Lemke's answer is exact when it exists; the QP path is slower and
+    # less accurate, so it only runs when pivoting did not deliver.
+    first = lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
+    if first.status == SOLVED:
+        return first
+    second = qp.solve(M, q, tol=tol, check_input=check_input, friction=friction)
+    second.path = ("lemke", "qp")
+    second.detail = f"{second.detail} Lemke first: {first.message}"
+    if second.status != SOLVED and first.residual < second.residual:
+        # neither solved: keep the point closer to a solution, say so
+        first.path = ("lemke", "qp")
+        first.detail = f"{first.detail} The QP fallback failed too: {second.message}"
+        return first
+    return second
+
+
+#: method name -> solve function, all with the signature of :func:`solve_lcp`
+METHODS = {
+    "lemke": lemke.solve,
+    "qp": qp.solve,
+    "auto": _auto,
+}
+
+
+def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True, friction=None, **options):
+    """Solve the linear complementarity problem ``LCP(M, q)``.
+
+    Find ``z >= 0`` with ``w = M z + q >= 0`` and ``z.w = 0``.
+
+    Parameters
+    ----------
+    M : array_like, shape (n, n)
+    q : array_like, shape (n,)
+    method : {"lemke", "qp", "auto"}
+        See :data:`METHODS`.
+    max_iter : int, optional
+        Pivot limit (Lemke) or fixed-point iteration limit (QP, friction).
+    tol : float, optional
+        Bound on the scaled residual (:func:`lcp_residual`) for a solved
+        status; each method has its own default.
+    check_input : bool
+        Validate the data in Python. With False, ``M`` and ``q`` must be
+        float64 arrays of matching shapes; Lemke still rejects NaN and inf
+        from its compiled code, so the lean path stays safe.
+    friction : FrictionLayout, optional
+        Layout from :func:`build_friction_lcp`; lets ``"qp"`` use the Tresca
+        fixed point on the (non-monotone) friction LCP.
+    **options
+        Method-specific options, e.g. ``covering`` for ``"lemke"``.
+
+    Returns
+    -------
+    LCPResult
+        ``z``, ``w``, ``status``, ``success``, ``message``, ``pivots``,
+        ``residual``, ``method``, ``path``, ``fallback_used`` and ``ray``.
+
+    Raises
+    ------
+    InputError
+        An unknown ``method`` (the message lists the known ones), a
+        non-square ``M``, a length mismatch, NaN or inf in the data.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> res = solve_lcp(np.array([[-1.0]]), np.array([-1.0]))
+    >>> res.status == SECONDARY_RAY, res.success
+    (True, False)
+    >>> solve_lcp(np.eye(1), np.ones(1), method="simplex")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `method` must be one of 'auto', 'lemke', 'qp'; got 'simplex'
+    """
+    if method == "lemke" and not options:
+        # the per-time-step path: skip the keyword forwarding
+        return lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
+    try:
+        fn = METHODS[method]
+    except (KeyError, TypeError):
+        known = ", ".join(repr(k) for k in sorted(METHODS))
+        raise InputError(f"`method` must be one of {known}; got {method!r}") from None
+    return fn(M, q, max_iter=max_iter, tol=tol, check_input=check_input, friction=friction, **options)

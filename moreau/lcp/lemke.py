@@ -1,0 +1,681 @@
+"""Lemke's complementary pivoting method with a lexicographic ratio test.
+
+The LCP is: find ``z >= 0`` with ``w = M z + q >= 0`` and ``z.w = 0``.
+Lemke's method adds an artificial variable ``z0`` along a covering vector
+``d > 0``::
+
+    w - M z - d z0 = q,      w, z, z0 >= 0,      w_i z_i = 0,
+
+starts from the almost-complementary basis where ``z0`` is just large enough
+to make ``w >= 0``, and pivots in the complement of whichever variable left,
+until ``z0`` leaves (a solution) or the entering column has no positive
+entry (a secondary ray).
+
+Implementation
+--------------
+The work is done by :func:`lemke_core`, compiled with ``numba.njit``, on a
+condensed (Tucker) tableau: one row per basic variable, one column per
+non-basic variable, ``n x (n + 1)``, with the right-hand side kept apart in
+contiguous storage. That is half the columns of the textbook
+``[I, -M, -d, q]`` tableau, so half the work per pivot. Rows whose entry in
+the pivot column is exactly zero are skipped, which pays on the sparse
+friction LCPs.
+
+The ratio test is lexicographic: among rows tied at the minimum ratio it
+picks the lexicographic minimum of ``(b_i, (B^-1)_i) / a_i``, reading the rows
+of ``B^-1`` from the tableau columns of the original ``w`` variables. With
+this rule the basis stays lexicographically feasible and degenerate problems
+cannot cycle. If ``z0`` is among the tied rows it leaves at once, which ends
+the path on a solution.
+
+Tolerances are relative, so they follow the scale of the data: a pivot entry
+counts as positive when it exceeds ``PIVOT_TOL`` times the largest magnitude
+in its column, ratios tie within ``TIE_TOL`` relative difference, and a
+right-hand side that cancels to rounding level is set to exactly zero so
+that degenerate rows are recognised as such.
+
+A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
+the data and the scaled residual of :func:`moreau.lcp.lcp_residual` must be
+``<= tol``. If it is not, the basis found is re-solved directly
+(``M_JJ z_J = -q_J`` by Gaussian elimination with partial pivoting) and
+checked again; if that fails too the status is :data:`BREAKDOWN`.
+
+Calling from compiled code
+--------------------------
+``lemke_kernel`` and ``lemke_core`` are plain ``numba`` functions and can be
+called from other ``@njit`` code, e.g. a time-stepping loop::
+
+    status, pivots, residual = lemke_kernel(M, q, z_out, w_out, max_iter, tol)
+
+See their docstrings for the exact argument types.
+"""
+
+import numpy as np
+from numba import njit
+
+from .._validate import finite_array, positive, positive_int
+from ..errors import InputError
+from ._result import (
+    BREAKDOWN,
+    INVALID_INPUT,
+    MAX_ITER,
+    SECONDARY_RAY,
+    SOLVED,
+    LCPResult,
+)
+
+__all__ = [
+    "solve",
+    "lemke_kernel",
+    "lemke_core",
+    "lemke_workspace",
+    "default_max_iter",
+    "SOLVED",
+    "SECONDARY_RAY",
+    "MAX_ITER",
+    "BREAKDOWN",
+    "INVALID_INPUT",
+    "PIVOT_TOL",
+    "TIE_TOL",
+    "DEFAULT_TOL",
+]
+
+#: a pivot-column entry is a candidate when it exceeds this times the column's
+#: largest magnitude
+PIVOT_TOL = 1e-11
+#: two ratios (or two lexicographic entries) tie within this relative difference
+TIE_TOL = 1e-9
+#: default bound on the scaled residual for a result to count as solved
+DEFAULT_TOL = 1e-9
+
+# cancellation below this many ulps of the operands is rounding, not data
+_SNAP = 16.0 * np.finfo(float).eps
+
+
+def default_max_iter(n):
+    """Default pivot limit for an LCP of size ``n``.
+
+    Lemke's method needs ``O(n)`` pivots on practical problems; the limit is
+    generous (``max(1000, 50 n)``) but keeps a pathological case from hanging
+    a time-stepping loop. Pass ``max_iter`` explicitly for exponential
+    examples such as Murty's.
+
+    Examples
+    --------
+    >>> default_max_iter(4)
+    1000
+    """
+    return max(1000, 50 * int(n))
+
+
+@njit(cache=True)
+def lemke_workspace(n):
+    """Allocate the work arrays of :func:`lemke_core` for size ``n``.
+
+    Returns
+    -------
+    work : ndarray of float64, shape (n + 3, m)
+        ``m`` is ``n + 1`` rounded up to a multiple of 8, so that the row
+        updates run in whole SIMD blocks.
+    iwork : ndarray of int64, shape (3 n + 1,)
+    """
+    return np.empty((n + 3, _padded(n))), np.empty(3 * n + 1, dtype=np.int64)
+
+
+@njit(cache=True)
+def _padded(n):
+    return ((n + 1 + 7) // 8) * 8
+
+
+@njit(cache=True)
+def _lex_compare(T, pos, n, i, k, ai, ak):
+    # Compare rows i and k of [b | B^-1] / a lexicographically. The RHS
+    # ratios are already known to tie, so start at B^-1. Column j of B^-1 is
+    # the current tableau column of the original basic variable w_j: a unit
+    # vector if w_j is basic, else its non-basic slot.
+    for j in range(n):
+        p = pos[j]
+        if p >= 0:
+            vi = 1.0 if p == i else 0.0
+            vk = 1.0 if p == k else 0.0
+        else:
+            s = -p - 1
+            vi = T[i, s]
+            vk = T[k, s]
+        xi = vi / ai
+        xk = vk / ak
+        diff = xi - xk
+        if abs(diff) > TIE_TOL * max(abs(xi), abs(xk)):
+            return -1 if diff < 0.0 else 1
+    return 0
+
+
+@njit(cache=True)
+def _pivot(T, b, col, n, r, s):
+    # Exchange the basic variable of row r with the non-basic one of slot s
+    # in the condensed tableau x_B + T[:n, :n+1] x_N = b; col holds T[:n, s].
+    # Columns past n are zero padding, updated along (0 - f*0) so that the
+    # inner loop has no scalar remainder.
+    ncol = T.shape[1]
+    inv = 1.0 / col[r]
+    prow = T[n]  # scratch row: keeps the pivot row apart from the rows it updates
+    for k in range(ncol):
+        prow[k] = T[r, k] * inv
+    prow[s] = inv
+    b_r = b[r] * inv
+    for i in range(n):
+        f = col[i]
+        if f == 0.0 or i == r:
+            continue
+        row = T[i]
+        for k in range(ncol):
+            row[k] -= f * prow[k]
+        row[s] = -f * inv
+        b_old = b[i]
+        fb = f * b_r
+        b_new = b_old - fb
+        # a RHS that cancels to rounding level is a degenerate zero: make it
+        # exact so that ties are seen as ties. A negative value is rounding
+        # or a tolerance-level tie resolved the other way: the ratio test
+        # keeps b >= 0.
+        if b_new < 0.0 or abs(b_new) <= _SNAP * (abs(b_old) + abs(fb)):
+            b_new = 0.0
+        b[i] = b_new
+    for k in range(ncol):
+        T[r, k] = prow[k]
+    b[r] = b_r
+
+
+@njit(cache=True)
+def _extract_z(b, pos, n, z_out):
+    for j in range(n):
+        p = pos[n + j]
+        z_out[j] = b[p] if p >= 0 else 0.0
+
+
+@njit(cache=True)
+def _residual(M, q, z, w, mmax, qmax):
+    # w = M z + q from the data, and the scaled residual of lcp_residual
+    n = q.shape[0]
+    zmax = 0.0
+    for j in range(n):
+        if abs(z[j]) > zmax:
+            zmax = abs(z[j])
+    num = 0.0
+    for i in range(n):
+        acc = q[i]
+        for j in range(n):
+            zj = z[j]
+            if zj != 0.0:
+                acc += M[i, j] * zj
+        w[i] = acc
+        m = min(z[i], acc)
+        if abs(m) > num:
+            num = abs(m)
+    if not np.isfinite(num):
+        return np.inf
+    return num / (1.0 + qmax + mmax * zmax)
+
+
+@njit(cache=True)
+def _resolve_basis(M, q, pos, n, z_out):
+    # Re-solve the terminal complementary basis directly: with J the basic
+    # z variables, M_JJ z_J = -q_J. Rounding accumulated over many pivots is
+    # gone after this; returns False when M_JJ is numerically singular.
+    J = np.empty(n, dtype=np.int64)
+    m = 0
+    for j in range(n):
+        if pos[n + j] >= 0:
+            J[m] = j
+            m += 1
+    A = np.empty((m, m))
+    x = np.empty(m)
+    for a in range(m):
+        x[a] = -q[J[a]]
+        for c in range(m):
+            A[a, c] = M[J[a], J[c]]
+    amax = 0.0
+    for a in range(m):
+        for c in range(m):
+            amax = max(amax, abs(A[a, c]))
+    for c in range(m):
+        p = c
+        big = abs(A[c, c])
+        for a in range(c + 1, m):
+            if abs(A[a, c]) > big:
+                big = abs(A[a, c])
+                p = a
+        if big <= 1e3 * np.finfo(np.float64).eps * amax or big == 0.0:
+            return False
+        if p != c:
+            for k in range(m):
+                t = A[c, k]
+                A[c, k] = A[p, k]
+                A[p, k] = t
+            t = x[c]
+            x[c] = x[p]
+            x[p] = t
+        for a in range(c + 1, m):
+            f = A[a, c] / A[c, c]
+            if f != 0.0:
+                for k in range(c, m):
+                    A[a, k] -= f * A[c, k]
+                x[a] -= f * x[c]
+    for a in range(m - 1, -1, -1):
+        acc = x[a]
+        for k in range(a + 1, m):
+            acc -= A[a, k] * x[k]
+        x[a] = acc / A[a, a]
+    for j in range(n):
+        z_out[j] = 0.0
+    for a in range(m):
+        z_out[J[a]] = x[a]
+    return True
+
+
+@njit(cache=True)
+def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
+    """Lemke's method on preallocated arrays (compiled; callable from ``@njit`` code).
+
+    Parameters
+    ----------
+    M : float64[:, :], shape (n, n)
+    q : float64[:], shape (n,)
+    d : float64[:], shape (n,)
+        Covering vector, all entries finite and > 0 (``np.ones(n)`` is usual).
+    z_out, w_out : float64[:], shape (n,)
+        Receive ``z`` and ``w = M z + q``; finite on every status.
+    ray_out : float64[:], shape (n + 1,)
+        On :data:`SECONDARY_RAY`, the ray direction ``(dz, dz0)``; zero otherwise.
+    work : float64[:, :], shape (n + 3, m) with ``m >= n + 1``
+        Tableau, right-hand side and scratch storage, overwritten;
+        :func:`lemke_workspace` allocates it with ``m`` padded for SIMD.
+    iwork : int64[:], shape (3 n + 1,)
+        Basis bookkeeping, overwritten.
+    max_iter : int
+        Pivot limit, counting the first pivot on ``z0``.
+    tol : float
+        Bound on the scaled residual (:func:`moreau.lcp.lcp_residual`) for
+        the result to count as solved.
+
+    Returns
+    -------
+    status : int
+        :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1), :data:`MAX_ITER` (2),
+        :data:`BREAKDOWN` (3) or :data:`INVALID_INPUT` (4).
+    pivots : int
+        Pivots performed (0 when ``q >= 0``).
+    residual : float
+        Scaled residual of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
+    """
+    n = q.shape[0]
+    for k in range(n + 1):
+        ray_out[k] = 0.0
+    # -- data scale and validity (NaN fails every comparison, so test with `not`)
+    mmax = 0.0
+    for i in range(n):
+        for j in range(n):
+            a = abs(M[i, j])
+            if not a < np.inf:
+                for k in range(n):
+                    z_out[k] = 0.0
+                    w_out[k] = 0.0
+                return INVALID_INPUT, 0, np.inf
+            if a > mmax:
+                mmax = a
+    qmax = 0.0
+    qmin = np.inf
+    for i in range(n):
+        if not abs(q[i]) < np.inf or not (d[i] > 0.0 and d[i] < np.inf):
+            for k in range(n):
+                z_out[k] = 0.0
+                w_out[k] = 0.0
+            return INVALID_INPUT, 0, np.inf
+        qmax = max(qmax, abs(q[i]))
+        qmin = min(qmin, q[i])
+    if n == 0 or qmin >= 0.0:
+        for k in range(n):
+            z_out[k] = 0.0
+            w_out[k] = q[k]
+        return SOLVED, 0, 0.0
+
+    T = work
+    b = work[n + 1]
+    col = work[n + 2]
+    basis = iwork[:n]
+    # pos[var] = row if basic, else -(slot + 1); variables: w_j -> j,
+    # z_j -> n + j, z0 -> 2n
+    pos = iwork[n:]
+    ncol = T.shape[1]
+    if ncol < n + 1 or T.shape[0] < n + 3 or iwork.shape[0] < 3 * n + 1:
+        for k in range(n):
+            z_out[k] = 0.0
+            w_out[k] = 0.0
+        return INVALID_INPUT, 0, np.inf
+    for i in range(n):
+        for j in range(n):
+            T[i, j] = -M[i, j]
+        T[i, n] = -d[i]
+        for j in range(n + 1, ncol):
+            T[i, j] = 0.0
+        b[i] = q[i]
+        col[i] = -d[i]
+        basis[i] = i
+        pos[i] = i
+        pos[n + i] = -(i + 1)
+    pos[2 * n] = -(n + 1)
+    z0 = 2 * n
+
+    # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i
+    r = 0
+    for i in range(1, n):
+        ri = q[i] / d[i]
+        rr = q[r] / d[r]
+        if ri < rr - TIE_TOL * max(abs(ri), abs(rr)):
+            r = i
+        elif ri <= rr + TIE_TOL * max(abs(ri), abs(rr)):
+            c = _lex_compare(T, pos, n, i, r, d[i], d[r])
+            if c < 0:
+                r = i
+    _pivot(T, b, col, n, r, n)
+    leaving = basis[r]
+    basis[r] = z0
+    pos[z0] = r
+    pos[leaving] = -(n + 1)
+    pivots = 1
+    status = MAX_ITER
+    entering = leaving + n  # complement of w_r is z_r
+
+    while pivots < max_iter:
+        s = -pos[entering] - 1
+        # -- ratio test over rows with a clearly positive pivot-column entry;
+        # the column is gathered once into contiguous storage
+        cmax = 0.0
+        for i in range(n):
+            a = T[i, s]
+            col[i] = a
+            if abs(a) > cmax:
+                cmax = abs(a)
+        if not cmax < np.inf:
+            status = BREAKDOWN
+            break
+        thr = PIVOT_TOL * cmax
+        theta = np.inf
+        for i in range(n):
+            a = col[i]
+            if a > thr:
+                t = b[i] / a
+                if t < theta:
+                    theta = t
+        if theta == np.inf:
+            # secondary ray: entering variable +1, basic ones move by -a_i
+            for j in range(n):
+                p = pos[n + j]
+                if p >= 0:
+                    ray_out[j] = -col[p]
+                elif n + j == entering:
+                    ray_out[j] = 1.0
+            ray_out[n] = -col[pos[z0]]
+            status = SECONDARY_RAY
+            break
+        lim = theta + TIE_TOL * abs(theta)
+        r = -1
+        nties = 0
+        for i in range(n):
+            a = col[i]
+            if a > thr and b[i] / a <= lim:
+                nties += 1
+                if r < 0:
+                    r = i
+        if nties > 1:
+            zrow = pos[z0]
+            a_z = col[zrow]
+            if a_z > thr and b[zrow] / a_z <= lim:
+                # z0 can leave now: take the solution
+                r = zrow
+            else:
+                best = r
+                unresolved = False
+                for i in range(r + 1, n):
+                    a = col[i]
+                    if a > thr and b[i] / a <= lim:
+                        c = _lex_compare(T, pos, n, i, best, a, col[best])
+                        if c < 0:
+                            best = i
+                            unresolved = False
+                        elif c == 0:
+                            unresolved = True
+                if unresolved:
+                    status = BREAKDOWN
+                    break
+                r = best
+        _pivot(T, b, col, n, r, s)
+        pivots += 1
+        leaving = basis[r]
+        basis[r] = entering
+        pos[entering] = r
+        pos[leaving] = -(s + 1)
+        if leaving == z0:
+            status = SOLVED
+            break
+        entering = leaving + n if leaving < n else leaving - n
+
+    _extract_z(b, pos, n, z_out)
+    for j in range(n):
+        if not abs(z_out[j]) < np.inf:
+            # overflow somewhere in the tableau: report a finite point
+            for k in range(n):
+                z_out[k] = 0.0
+            status = BREAKDOWN
+            break
+    residual = _residual(M, q, z_out, w_out, mmax, qmax)
+    if status == SOLVED and not residual <= tol:
+        # accumulated rounding: re-solve the terminal basis from the data
+        zsave = z_out.copy()
+        wsave = w_out.copy()
+        ok = _resolve_basis(M, q, pos, n, z_out)
+        res2 = _residual(M, q, z_out, w_out, mmax, qmax) if ok else np.inf
+        if ok and res2 <= tol:
+            residual = res2
+        else:
+            z_out[:] = zsave
+            w_out[:] = wsave
+            status = BREAKDOWN
+    if not residual < np.inf:
+        for k in range(n):
+            z_out[k] = 0.0
+        residual = _residual(M, q, z_out, w_out, mmax, qmax)
+    return status, pivots, residual
+
+
+@njit(cache=True)
+def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
+    """Lemke's method with covering vector ``d = 1`` (compiled; callable from ``@njit`` code).
+
+    Allocates its own workspace; use :func:`lemke_core` in tight loops that
+    reuse one.
+
+    Parameters
+    ----------
+    M : float64[:, :], shape (n, n)
+    q : float64[:], shape (n,)
+    z_out, w_out : float64[:], shape (n,)
+        Receive ``z`` and ``w = M z + q``.
+    max_iter : int
+        Pivot limit.
+    tol : float
+        Bound on the scaled residual for a solved status.
+
+    Returns
+    -------
+    status : int
+    pivots : int
+    residual : float
+        As for :func:`lemke_core`.
+    """
+    n = q.shape[0]
+    d = np.ones(n)
+    ray = np.empty(n + 1)
+    work = np.empty((n + 3, _padded(n)))
+    iwork = np.empty(3 * n + 1, dtype=np.int64)
+    return lemke_core(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+
+
+@njit(cache=True)
+def _solve_packed(M, q, d, out, max_iter, tol):
+    # one compiled call per Python solve. The outputs live in one buffer
+    # (z | w | ray) allocated by the caller: returning arrays from compiled
+    # code costs more than the whole pivoting on a small LCP.
+    n = q.shape[0]
+    work = np.empty((n + 3, _padded(n)))
+    iwork = np.empty(3 * n + 1, dtype=np.int64)
+    return lemke_core(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
+
+
+_DETAIL = {
+    SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray. "
+    "For copositive-plus M this proves the LCP infeasible.",
+    MAX_ITER: "Raise `max_iter` or try method='qp'.",
+    BREAKDOWN: "The lexicographic ratio test could not separate tied rows, or the terminal "
+    "point failed the residual check.",
+}
+
+_F8 = np.dtype(np.float64)
+_NDARRAY = np.ndarray
+
+
+def _coerce(M, q):
+    # cheap when the caller already passes float64 arrays, the common case
+    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
+        M = _as_matrix(M)
+    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
+        q = _as_vector(q)
+    m0, m1 = M.shape
+    if m0 != m1:
+        raise InputError(f"`M` must be square, got shape {M.shape}")
+    if m0 != q.shape[0]:
+        raise InputError(f"`q` must have length {m0} to match `M`, got {q.shape[0]}")
+    return M, q
+
+
+def _as_matrix(M):
+    try:
+        a = np.asarray(M, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("`M` must be an array of real numbers") from None
+    if a.ndim != 2:
+        raise InputError(f"`M` must be a square 2-D array, got shape {a.shape}")
+    return a
+
+
+def _as_vector(q):
+    try:
+        a = np.asarray(q, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("`q` must be an array of real numbers") from None
+    if a.ndim != 1:
+        raise InputError(f"`q` must be a 1-D array, got shape {a.shape}")
+    return a
+
+
+def _raise_nonfinite(M, q, d):
+    finite_array("M", M)
+    finite_array("q", q)
+    if d is not None:
+        finite_array("covering", d)
+        if not np.all(d > 0):
+            raise InputError("`covering` must be strictly positive")
+    raise InputError("invalid LCP data")  # pragma: no cover - the checks above fire first
+
+
+def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, covering=None):
+    """Solve ``LCP(M, q)`` by Lemke's method.
+
+    Parameters
+    ----------
+    M : array_like, shape (n, n)
+    q : array_like, shape (n,)
+    max_iter : int, optional
+        Pivot limit; :func:`default_max_iter` when not given.
+    tol : float, optional
+        Bound on the scaled residual for a solved status
+        (default :data:`DEFAULT_TOL`).
+    covering : array_like, shape (n,), optional
+        Covering vector ``d > 0``; all ones when not given.
+    check_input : bool
+        When False, ``M`` and ``q`` must already be C-contiguous float64
+        arrays of matching shapes and no Python-side check runs (non-finite
+        data still come back as an error, detected in compiled code).
+    friction : FrictionLayout, optional
+        Accepted so that every method shares one signature; Lemke's method
+        needs no structure and ignores it.
+
+    Returns
+    -------
+    LCPResult
+
+    Raises
+    ------
+    InputError
+        ``M`` not square, ``q`` of the wrong length, NaN or inf in the data,
+        a non-positive covering vector.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> M = np.array([[1.0, 2.0, 0.0], [0.0, 1.0, 2.0], [2.0, 0.0, 1.0]])
+    >>> res = solve(M, -np.ones(3))
+    >>> res.success, np.round(res.z, 12).tolist()
+    (True, [0.333333333333, 0.333333333333, 0.333333333333])
+    """
+    if check_input:
+        # inline fast path of _coerce: float64 arrays of matching shapes
+        # pass with a handful of attribute reads
+        if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
+            M = _as_matrix(M)
+        if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
+            q = _as_vector(q)
+        m0, m1 = M.shape
+        if m0 != m1 or m0 != q.shape[0]:
+            M, q = _coerce(M, q)
+        if max_iter is not None:
+            max_iter = positive_int("max_iter", max_iter)
+        if tol is not None:
+            tol = positive("tol", tol)
+        if covering is not None:
+            covering = _as_vector(covering)
+            if covering.shape != q.shape:
+                raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
+    n = q.shape[0]
+    out = np.empty(3 * n + 1)
+    if covering is None:
+        covering_ = _ONES.get(n)
+        if covering_ is None:
+            covering_ = _ones(n)
+    else:
+        covering_ = covering
+    status, pivots, residual = _solve_packed(
+        M, q, covering_, out,
+        (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
+        DEFAULT_TOL if tol is None else tol,
+    )
+    if status == SOLVED:
+        return LCPResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+    if status == INVALID_INPUT:
+        _raise_nonfinite(M, q, covering)
+    return LCPResult(
+        out[:n], out[n:2 * n], status, pivots, residual, "lemke",
+        ray=out[2 * n:] if status == SECONDARY_RAY else None,
+        detail=_DETAIL.get(status, "") + f" (after {pivots} pivots)",
+    )
+
+
+_ONES = {}
+
+
+def _ones(n):
+    # the covering vector is read-only in the kernel, so one array per size serves all calls
+    d = _ONES.get(n)
+    if d is None:
+        d = _ONES[n] = np.ones(n)
+    return d

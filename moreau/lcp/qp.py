@@ -1,0 +1,268 @@
+"""LCP through convex quadratic programs (qpsolvers with the OSQP backend).
+
+Which QP is solved depends on what ``M`` is; the result's ``detail`` names it.
+
+``"bound"`` -- symmetric positive semidefinite ``M``
+    ``min 1/2 z.M z + q.z`` subject to ``z >= 0``. Its KKT conditions are
+    exactly the LCP (``w = M z + q`` is the multiplier of ``z >= 0``), so
+    every minimiser is an LCP solution and vice versa.
+
+``"gap"`` -- monotone ``M`` (``M + M^T`` positive semidefinite, not symmetric)
+    ``min z.(M z + q) = 1/2 z.(M + M^T) z + q.z`` subject to ``z >= 0`` and
+    ``M z + q >= 0``. The objective is the complementarity gap, convex here
+    and ``>= 0`` on the feasible set, so its minimisers with value 0 are
+    exactly the LCP solutions; a solvable monotone LCP reaches 0.
+
+``"tresca"`` -- the 2D Coulomb friction LCP (pass ``friction=layout``)
+    This LCP is not monotone (the row ``mu p_N - p_T+ - p_T-`` has no
+    symmetric partner), so no single convex QP is equivalent to it. Instead
+    the Coulomb law is reached as a fixed point of Tresca problems: with the
+    friction bound ``s = mu p_N^k`` frozen, friction is a box constraint and
+    the impulse ``p = (p_N, p_T)`` is the solution of the convex QP::
+
+        min 1/2 p.W p + p.b   subject to  p_N >= 0,  -s <= p_T <= s
+
+    with ``W`` the Delassus matrix and ``b`` the free velocity including the
+    restitution term, both read back from ``M`` and ``q``. Its KKT
+    conditions are Signorini's law for ``p_N`` and Tresca's law for ``p_T``
+    (stick inside the box, slip against ``v_T`` on its faces). The next
+    bound is ``s = mu p_N^(k+1)``, starting from the frictionless impulse.
+    A fixed point (``p_N^(k+1) = p_N^k``) is a Coulomb solution: with
+    ``p_T+ = max(p_T, 0)``, ``p_T- = max(-p_T, 0)`` and ``beta = |v_T|`` it
+    solves the friction LCP. The iteration is a contraction only for small
+    enough ``mu`` (in terms of ``W``); when it stops without converging the
+    answer is a Tresca solution with a lagged bound and the status says
+    so. ``tests/lcp/test_qp.py`` measures how far it lands from Lemke's
+    solution on random friction instances.
+
+Every answer is finished by an active-set refinement: with ``J`` the indices
+where ``z_i > w_i``, ``M_JJ z_J = -q_J`` is solved (least squares) and kept
+if it lowers the residual. OSQP, a first-order method, stops at ``eps``
+accuracy; the refinement recovers the exact vertex once the active set is
+right. A result counts as solved when the scaled residual of
+:func:`moreau.lcp.lcp_residual` is ``<= tol`` (default :data:`DEFAULT_TOL`).
+"""
+
+import warnings
+
+import numpy as np
+import scipy.sparse as sp
+
+from .._validate import positive, positive_int
+from ..errors import InputError
+from ._result import (
+    MAX_ITER,
+    NOT_APPLICABLE,
+    SOLVED,
+    SOLVER_FAILED,
+    LCPResult,
+    lcp_residual,
+)
+from .lemke import _coerce
+
+__all__ = ["solve", "DEFAULT_TOL", "qp_formulation"]
+
+#: default bound on the scaled residual for a QP answer to count as solved
+DEFAULT_TOL = 1e-6
+#: OSQP's absolute and relative tolerances
+OSQP_EPS = 1e-9
+# symmetry and semidefiniteness are judged relative to max|M|
+_STRUCT_TOL = 1e-10
+
+
+def _osqp(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None):
+    # one QP through qpsolvers; returns (x or None, iterations reported)
+    from qpsolvers import Problem, solve_problem
+
+    n = len(c)
+    Psp = sp.csc_matrix(P)
+    Gsp = None if G is None else sp.csc_matrix(G)
+    prob = Problem(Psp, c, G=Gsp, h=h, lb=lb, ub=ub)
+    opts = dict(eps_abs=OSQP_EPS, eps_rel=OSQP_EPS, polish=False, verbose=False)
+    if max_iter is not None:
+        opts["max_iter"] = max_iter
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            sol = solve_problem(prob, solver="osqp", initvals=initvals, **opts)
+        except Exception:  # the backend's own failures become a status, not a crash
+            return None
+    x = sol.x if sol.found else None
+    if x is None or x.shape != (n,) or not np.all(np.isfinite(x)):
+        return None
+    return x
+
+
+def _refine(M, q, z, res):
+    # re-solve on the active set guessed from (z, w); keep only if better
+    w = M @ z + q
+    J = np.flatnonzero(z > w)
+    if J.size == 0:
+        cand = np.zeros_like(z)
+    else:
+        cand = np.zeros_like(z)
+        sol, *_ = np.linalg.lstsq(M[np.ix_(J, J)], -q[J], rcond=None)
+        cand[J] = sol
+    r2 = lcp_residual(M, q, cand)
+    if r2 < res:
+        return cand, r2
+    return z, res
+
+
+def qp_formulation(M, friction=None):
+    """Name the QP formulation :func:`solve` would use for ``M``.
+
+    Returns
+    -------
+    str
+        ``"bound"``, ``"tresca"``, ``"gap"`` or ``"none"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> qp_formulation(np.eye(2)), qp_formulation(np.array([[1.0, 1.0], [-1.0, 1.0]]))
+    ('bound', 'gap')
+    """
+    M = np.asarray(M, dtype=float)
+    scale = max(float(np.max(np.abs(M))), 1e-300) if M.size else 1.0
+    sym = M.size == 0 or float(np.max(np.abs(M - M.T))) <= _STRUCT_TOL * scale
+    if sym and (M.size == 0 or np.linalg.eigvalsh(M)[0] >= -_STRUCT_TOL * scale * len(M)):
+        return "bound"
+    if friction is not None:
+        return "tresca"
+    S = 0.5 * (M + M.T)
+    if np.linalg.eigvalsh(S)[0] >= -_STRUCT_TOL * scale * len(M):
+        return "gap"
+    return "none"
+
+
+def _tresca(M, q, layout, max_iter, fp_tol):
+    # fixed point over Tresca QPs; returns (z, qp_solves, converged, note)
+    nc = layout.n_contacts
+    fr = layout.frictional
+    rows = np.concatenate([layout.normal, layout.tplus[fr]])
+    # rows/columns p_N and p_T+ of M hold exactly the Delassus matrix W
+    W = M[np.ix_(rows, rows)]
+    b = q[rows]
+    scale = max(float(np.max(np.abs(W))), 1e-300) if W.size else 1.0
+    if W.size and float(np.max(np.abs(W - W.T))) > 1e-8 * scale:
+        return None, 0, False, "the Delassus block read from `M` is not symmetric"
+    mu = layout.mu[fr]
+    nf = len(fr)
+    m = nc + nf
+    lb = np.concatenate([np.zeros(nc), np.zeros(nf)])
+    ub = np.concatenate([np.full(nc, np.inf), np.zeros(nf)])
+    p = None
+    solves = 0
+    pN_old = None
+    converged = False
+    for _ in range(max_iter):
+        s = mu * (p[:nc][fr] if p is not None else 0.0)
+        lb[nc:] = -s
+        ub[nc:] = s
+        x = _osqp(W, b, lb=lb, ub=ub, initvals=p)
+        solves += 1
+        if x is None:
+            return None, solves, False, "OSQP failed on a Tresca subproblem"
+        x[:nc] = np.maximum(x[:nc], 0.0)
+        x[nc:] = np.clip(x[nc:], -s, s)
+        p = x
+        pN = p[:nc]
+        if pN_old is not None and np.max(np.abs(pN - pN_old)) <= fp_tol * (1.0 + np.max(np.abs(pN))):
+            converged = True
+            break
+        if nf == 0:
+            converged = True
+            break
+        pN_old = pN.copy()
+    v = b + W @ p
+    z = np.zeros(layout.size)
+    z[layout.normal] = p[:nc]
+    pT = p[nc:]
+    z[layout.tplus[fr]] = np.maximum(pT, 0.0)
+    z[layout.tminus[fr]] = np.maximum(-pT, 0.0)
+    z[layout.beta[fr]] = np.abs(v[nc:])
+    return z, solves, converged, ""
+
+
+def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
+    """Solve ``LCP(M, q)`` through convex QPs (see the module text for the formulations).
+
+    Parameters
+    ----------
+    M : array_like, shape (n, n)
+    q : array_like, shape (n,)
+    max_iter : int, optional
+        Limit on Tresca fixed-point iterations (default 100); the other
+        formulations solve one QP.
+    tol : float, optional
+        Bound on the scaled residual for a solved status (default
+        :data:`DEFAULT_TOL`).
+    check_input : bool
+        Validate shapes and finiteness (always cheap next to a QP solve).
+    friction : FrictionLayout, optional
+        Layout of a friction LCP from :func:`moreau.lcp.build_friction_lcp`;
+        selects the Tresca fixed point when ``M`` is not symmetric.
+
+    Returns
+    -------
+    LCPResult
+        ``pivots`` counts the QP solves.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> res = solve(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]))
+    >>> res.success, np.round(res.z, 9).tolist()
+    (True, [0.333333333, 0.333333333])
+    """
+    M, q = _coerce(M, q)
+    if check_input:
+        if not (np.all(np.isfinite(M))):
+            raise InputError("`M` must contain only finite values (no NaN or inf)")
+        if not (np.all(np.isfinite(q))):
+            raise InputError("`q` must contain only finite values (no NaN or inf)")
+        if max_iter is not None:
+            max_iter = positive_int("max_iter", max_iter)
+        if tol is not None:
+            tol = positive("tol", tol)
+        if friction is not None and getattr(friction, "size", None) != len(q):
+            raise InputError(f"`friction` must be the layout of this LCP (size {len(q)})")
+    tol = DEFAULT_TOL if tol is None else tol
+    n = len(q)
+    if n == 0 or np.all(q >= 0.0):
+        z = np.zeros(n)
+        return LCPResult(z, q.copy(), SOLVED, 0, 0.0, "qp", detail="q >= 0: z = 0.")
+    form = qp_formulation(M, friction)
+    status = SOLVED
+    note = ""
+    solves = 1
+    if form == "bound":
+        z = _osqp(M, q, lb=np.zeros(n))
+    elif form == "gap":
+        z = _osqp(M + M.T, q, lb=np.zeros(n), G=-M, h=q)
+    elif form == "tresca":
+        z, solves, converged, note = _tresca(M, q, friction, 100 if max_iter is None else max_iter, 1e-10)
+        if z is not None and not converged:
+            status = MAX_ITER
+            note = f"the Tresca fixed point did not converge in {solves} QP solves"
+    else:
+        z0 = np.zeros(n)
+        return LCPResult(
+            z0, q.copy(), NOT_APPLICABLE, 0, lcp_residual(M, q, z0), "qp",
+            detail="QP formulations need a symmetric PSD `M`, a monotone `M` (M + M^T PSD), "
+            "or a friction layout (`friction=`).",
+        )
+    if z is None:
+        z0 = np.zeros(n)
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_residual(M, q, z0), "qp",
+                         detail=note or f"OSQP found no solution of the {form!r} QP.")
+    z = np.maximum(z, 0.0)
+    res = lcp_residual(M, q, z)
+    z, res = _refine(M, q, z, res)
+    w = M @ z + q
+    if status == SOLVED and not res <= tol:
+        status = SOLVER_FAILED
+        note = note or f"the {form!r} QP answer has residual {res:.2e} > tol = {tol:.1e}"
+    detail = f"formulation {form!r}" + (f"; {note}" if note else "") + "."
+    return LCPResult(z, w, status, solves, res, "qp", detail=detail)
