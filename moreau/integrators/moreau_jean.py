@@ -1,0 +1,520 @@
+r"""Moreau–Jean time stepping: the theta-scheme with velocity-level contact.
+
+The scheme
+----------
+One step goes from ``(q_k, v_k)`` at ``t_k`` to ``t_{k+1} = t_k + h``::
+
+    M (v_{k+1} - v_k) = h [theta h_{k+1} + (1 - theta) h_k] + H^T p
+    q_{k+1}           = q_k + h [theta v_{k+1} + (1 - theta) v_k]
+
+with ``theta`` in ``[1/2, 1]``, ``M = M(q_k)``, ``h_k = h(q_k, v_k, t_k)`` and
+``p`` the contact impulses over the step (``H`` stacks the normal rows ``WN``
+of the active contacts and the tangential rows ``WT`` of the active
+frictional ones). Stiff forces are made implicit by linearising ``h_{k+1}``
+about ``(q_k, v_k)`` at ``t_{k+1}``::
+
+    h_{k+1} ~ h(q_k, v_k, t_{k+1}) + K (q_{k+1} - q_k) + C (v_{k+1} - v_k),
+    K = dh/dq,  C = dh/dv   (both at (q_k, v_k, t_{k+1})).
+
+With ``q_{k+1} - q_k = h v_k + h theta (v_{k+1} - v_k)`` this gives the
+linear "iteration matrix" and the free velocity (the velocity without
+contact impulses)::
+
+    W_hat  = M - h theta C - h^2 theta^2 K
+    v_free = v_k + W_hat^-1 ( h [theta h(q_k, v_k, t_{k+1}) + (1 - theta) h_k]
+                              + h^2 theta K v_k )
+    v_{k+1} = v_free + W_hat^-1 H^T p
+
+so a stiff spring only stiffens ``W_hat`` and never forces a small step
+(``theta = 1`` damps its oscillation, ``theta = 1/2`` keeps it undamped; for a
+linear force law ``theta = 1/2`` is the trapezoidal rule and conserves the
+energy exactly).
+
+Contacts
+--------
+*Index set.* Contact ``i`` enters the step's contact problem when its
+predicted gap is closed, ``g_i(q_k, t_k) + (h/2) gdot_i(t_k) <= 0``, or when
+it carried a normal impulse in the previous step. The second clause is a
+deliberate addition: in a closed *curved or moving* contact (the friction
+drive's rod on its rotor) a velocity-level scheme lets the gap wander by
+``O(h)`` while the contact keeps pressing, and the predicted-gap test alone
+would then open it for one step, every few steps (measured on the friction
+drive at 185 Hz, 2000 steps per period: 54 spurious flight steps per
+period). A closed contact leaves the index set only through its own contact
+problem: ``p_N = 0`` with ``v_N >= 0``.
+
+*Contact problem.* With the contact Jacobians evaluated at ``q_k`` and the
+rheonomic terms ``wN, wT`` at ``t_{k+1}``, the local velocities after the
+step are ``U = U_free + W p`` with ``U_free = H v_free + w(t_{k+1})`` and the
+Delassus matrix ``W = H W_hat^-1 H^T``. Newton's impact law and 2D Coulomb
+friction hold at velocity level::
+
+    0 <= v_N,k+1 + e min(v_N,k, 0)  _|_  p_N >= 0
+    stick |p_T| <= mu p_N with v_T,k+1 = 0, or slip p_T = -mu p_N sign(v_T,k+1)
+
+where ``v_N,k = WN(q_k, t_k) v_k + wN(q_k, t_k)`` is the approach velocity
+at the start of the step. This is the LCP of
+:func:`moreau.lcp.friction.build_friction_lcp`, solved with
+:func:`moreau.lcp.solve_lcp` (Lemke, falling back to QP with
+``lcp_method="auto"``). A frictionless contact adds no tangential rows, a
+step with no active contact solves nothing, and a scene with a single
+contact is solved by exact enumeration (:func:`one_contact_impulse`).
+
+*Regimes.* Each step's regime is read from its impulses
+(:func:`classify_impulse`): flight when ``p_N = 0`` (or the contact is not
+active), positive slip when ``p_T = -mu p_N``, negative slip when
+``p_T = +mu p_N``, stick when ``|p_T| < mu p_N``. A closed frictionless
+contact has no tangential information and is reported as ``STICK``.
+
+*Drift and projection.* The gap is only controlled through velocities, so
+it drifts. With ``projection=True`` the positions are corrected after every
+step by a mass-weighted projection: every contact that carried a normal
+impulse is put back on ``g = 0`` and every penetrating contact on ``g >= 0``
+(Gauss–Newton iterations ``q += M^-1 WN^T d`` with
+``(WN M^-1 WN^T) d = -g``; velocities are left alone). It assumes ``v = dq/dt``,
+i.e. ``WN`` is the gradient of the gap, which holds for all scenes of this
+package.
+
+Statistics (``SimulationResult.stats``)
+---------------------------------------
+``steps``; ``lcp_solves`` (contact problems solved, by Lemke/QP or the
+one-contact enumeration); ``direct_solves`` (the enumeration's share);
+``pivots`` (Lemke pivots); ``fallbacks`` (solves where ``"auto"`` fell back
+to QP); ``max_residual`` (largest scaled complementarity residual,
+:func:`moreau.lcp.lcp_residual` of the friction LCP); ``max_penetration``
+(largest ``-g`` after a step, 0 if none); ``projection_iterations``.
+"""
+
+import math
+
+import numpy as np
+
+from .._validate import in_closed_interval, positive, positive_int
+from ..errors import InputError, LCPError, PainleveError
+from ..regimes import Regime
+from .base import Integrator, register_integrator
+
+__all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
+
+#: accepted values of the ``lcp_method`` option
+LCP_METHODS = ("auto", "lemke", "qp")
+
+# |p_T| within this relative distance of mu p_N counts as slip: the LCP and
+# the enumeration reach the friction-cone boundary only up to rounding
+SLIP_RTOL = 1e-10
+
+# a projection iteration stops when every corrected gap is below this (the
+# gaps of the package's scenes are O(1e-3 .. 1) in their own units)
+PROJECTION_TOL = 1e-14
+PROJECTION_MAXITER = 8
+
+def classify_impulse(pN, pT, mu):
+    """Regime of one contact from its impulses over a step.
+
+    Parameters
+    ----------
+    pN, pT : float
+        Normal and tangential impulse (``pT = 0`` for a frictionless contact).
+    mu : float
+        Friction coefficient.
+
+    Returns
+    -------
+    Regime
+        ``FLIGHT`` if ``pN <= 0``; ``POSITIVE`` if ``pT = -mu pN`` and
+        ``NEGATIVE`` if ``pT = +mu pN`` (within a relative ``1e-10``);
+        ``STICK`` otherwise, including a closed frictionless contact.
+
+    Examples
+    --------
+    >>> classify_impulse(2.0, -0.2, 0.1).name, classify_impulse(2.0, 0.05, 0.1).name
+    ('POSITIVE', 'STICK')
+    """
+    if not pN > 0.0:
+        return Regime.FLIGHT
+    if mu > 0.0:
+        bound = mu * pN * (1.0 - SLIP_RTOL)
+        if pT <= -bound:
+            return Regime.POSITIVE
+        if pT >= bound:
+            return Regime.NEGATIVE
+    return Regime.STICK
+
+
+def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
+    """Exact solution of the one-contact velocity-level Coulomb problem.
+
+    Solves the same problem as the friction LCP of
+    :func:`moreau.lcp.friction.build_friction_lcp` for a single contact by
+    enumerating its cases: no impulse, stick, positive slip, negative slip.
+
+    Parameters
+    ----------
+    W : array_like, shape (2, 2) or (1, 1)
+        Delassus matrix over the rows ``(N, T)``; ``(1, 1)`` when ``mu = 0``.
+    u_free : array_like, shape (2,) or (1,)
+        Free normal and tangential velocity at the end of the step.
+    mu : float
+        Friction coefficient, ``>= 0``.
+    e : float
+        Newton restitution coefficient.
+    vN_pre : float
+        Normal velocity before the step; the impact law uses ``min(vN_pre, 0)``.
+
+    Returns
+    -------
+    pN, pT : float
+        Normal and tangential impulse (``pT = 0`` when ``mu = 0``).
+
+    Raises
+    ------
+    PainleveError
+        The contact must act (``u_N < -e min(vN_pre, 0)``) but the discrete
+        Painlevé condition ``W_NN - mu |W_NT| > 0`` fails, so the problem may
+        have several solutions or none.
+
+    Notes
+    -----
+    For fixed ``pN`` the tangential problem has one solution ``pT(pN)``
+    (``W_TT > 0``); the normal velocity ``b + W_NN pN + W_NT pT(pN)`` then
+    grows with ``pN`` in stick (slope ``W_NN - W_NT W_TN / W_TT > 0``) and in
+    slip (slope ``W_NN -/+ mu W_NT``, positive under the Painlevé condition),
+    so exactly one case applies and the result is unique. Cases are tested in
+    the order stick, positive slip, negative slip; where two hold (on a case
+    boundary) they give the same impulse.
+
+    Examples
+    --------
+    Unit mass sliding at speed 1 onto the ground at approach speed 1, ``mu = 0.5``:
+
+    >>> one_contact_impulse([[1.0, 0.0], [0.0, 1.0]], [-1.0, 1.0], 0.5)
+    (1.0, -0.5)
+    """
+    W = np.asarray(W, dtype=float)
+    u = np.asarray(u_free, dtype=float).reshape(-1)
+    mu, e, vN_pre = float(mu), float(e), float(vN_pre)
+    if mu > 0.0:
+        pN, pT = _one_contact(*(float(x) for x in (W[0, 0], W[0, 1], W[1, 0], W[1, 1], u[0], u[1])),
+                              mu, e, vN_pre)
+        return pN, pT
+    return _one_contact_frictionless(float(W[0, 0]), float(u[0]), e, vN_pre), 0.0
+
+
+def _one_contact_frictionless(Wnn, uN, e, vN_pre):
+    b = uN + e * min(vN_pre, 0.0)
+    if b >= 0.0:
+        return 0.0
+    if not Wnn > 0.0:
+        raise PainleveError(f"the contact's Delassus entry W_NN = {Wnn!r} must be > 0")
+    return -b / Wnn
+
+
+def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
+    # kept scalar and branch-for-branch identical to the compiled kernel in
+    # _mj_kernels.py, so that the fast and the generic path agree to rounding
+    b = uN + e * min(vN_pre, 0.0)
+    if b >= 0.0:
+        return 0.0, 0.0
+    if not (Wnn - mu * abs(Wnt) > 0.0):
+        raise PainleveError(
+            f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
+            f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}): the contact problem "
+            f"has no unique solution")
+    det = Wnn * Wtt - Wnt * Wtn
+    if det > 0.0:
+        pN = (Wnt * uT - Wtt * b) / det
+        pT = (Wtn * b - Wnn * uT) / det
+        if pN >= 0.0 and abs(pT) <= mu * pN:
+            return pN, pT
+    pN = -b / (Wnn - mu * Wnt)
+    if uT + (Wtn - mu * Wtt) * pN >= 0.0:
+        return pN, -mu * pN
+    pN = -b / (Wnn + mu * Wnt)
+    return pN, mu * pN
+
+
+def one_contact_residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
+    """Scaled residual of ``(pN, pT)`` in the one-contact friction LCP.
+
+    The same number :func:`moreau.lcp.lcp_residual` gives for the LCP of
+    :func:`~moreau.lcp.friction.build_friction_lcp` at the point
+    ``z = (pN, max(pT, 0), max(-pT, 0), |u_T|)``, computed without building it.
+    """
+    b = uN + e * min(vN_pre, 0.0)
+    vN = b + Wnn * pN + Wnt * pT
+    if not mu > 0.0:
+        num = abs(min(pN, vN))
+        scale = 1.0 + abs(b) + abs(Wnn) * abs(pN)
+        return num / scale
+    vT = uT + Wtn * pN + Wtt * pT
+    tp, tm, beta = max(pT, 0.0), max(-pT, 0.0), abs(vT)
+    num = max(abs(min(pN, vN)), abs(min(tp, vT + beta)), abs(min(tm, beta - vT)),
+              abs(min(beta, mu * pN - tp - tm)))
+    mmax = max(abs(Wnn), abs(Wnt), abs(Wtn), abs(Wtt), mu, 1.0)
+    scale = 1.0 + max(abs(b), abs(uT)) + mmax * max(pN, tp, tm, beta)
+    return num / scale
+
+
+def _new_counters():
+    return {"steps": 0, "lcp_solves": 0, "direct_solves": 0, "pivots": 0, "fallbacks": 0,
+            "max_residual": 0.0, "max_penetration": 0.0, "projection_iterations": 0}
+
+
+def check_options(h, theta, projection, lcp_method, save_every=1):
+    """Validate the Moreau–Jean options; return them normalised."""
+    if h is None:
+        raise InputError("`h` (the time step) is required for the moreau-jean scheme")
+    h = positive("h", h)
+    theta = in_closed_interval("theta", theta, 0.5, 1.0)
+    if not isinstance(projection, (bool, np.bool_)):
+        raise InputError(f"`projection` must be True or False, got {projection!r}")
+    if lcp_method not in LCP_METHODS:
+        raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
+    save_every = positive_int("save_every", save_every)
+    return h, theta, bool(projection), lcp_method, save_every
+
+
+def check_scene_contacts(scene):
+    """Return ``(mu, e)`` of ``scene`` as float arrays after checking them."""
+    nc = scene.ncontacts
+    mu = np.asarray(scene.mu, dtype=float).reshape(-1)
+    e = np.asarray(scene.restitution, dtype=float).reshape(-1)
+    if e.shape != (nc,):
+        raise InputError(f"`scene.restitution` must have one entry per contact ({nc}), got shape {e.shape}")
+    if not (np.all(np.isfinite(mu)) and np.all(mu >= 0.0)):
+        raise InputError("`scene.mu` must be finite and >= 0 for every contact")
+    if not (np.all(np.isfinite(e)) and np.all((e >= 0.0) & (e <= 1.0))):
+        raise InputError("`scene.restitution` must lie in [0, 1] for every contact")
+    return mu, e
+
+
+def next_time(t0, k, h, t_bound):
+    """``(t_{k+1}, step)`` of the fixed-step grid ``t0 + k h``, the last step cut at ``t_bound``.
+
+    Shared by the generic and the compiled path so that both see the same times.
+    """
+    t1 = t0 + (k + 1) * h
+    if t1 >= t_bound - 1e-9 * h:
+        return t_bound, t_bound - (t0 + k * h)
+    return t1, h
+
+
+@register_integrator("moreau-jean")
+class MoreauJean(Integrator):
+    """Moreau–Jean theta-scheme with velocity-level Newton impacts and exact 2D Coulomb friction.
+
+    See the module docstring for the scheme, the index set, the regime
+    classification and the statistics.
+
+    Parameters
+    ----------
+    scene : Scene
+    t0, q0, v0, t_bound
+        See :class:`~moreau.integrators.base.Integrator`.
+    h : float
+        Time step (dimensionless), > 0. The grid is ``t0 + k h``; the last
+        step is shortened to end on ``t_bound``.
+    theta : float
+        In ``[1/2, 1]``; 1 is the backward-Euler-like, dissipative choice.
+    projection : bool
+        Project positions back onto the contacts after every step.
+    lcp_method : {"auto", "lemke", "qp"}
+        Method of :func:`moreau.lcp.solve_lcp` for scenes with several contacts.
+    save_every : int
+        Record one sample every ``save_every`` steps (and the last one). The
+        sample at ``t0`` is the initial state with the first step's regime and
+        forces.
+
+    Notes
+    -----
+    Recorded forces are impulse / step; the slip velocity is the one the
+    contact problem enforced (Jacobian at ``q_k``, rheonomic terms at
+    ``t_{k+1}``), 0 for a frictionless contact; the gap is ``g(q_{k+1}, t_{k+1})``.
+
+    Examples
+    --------
+    A unit point mass sliding on the ground (gravity 1, ``mu = 0.5``) from
+    speed 1 stops at ``t = 2``; with ``h = 0.01`` the discrete velocity is exact:
+
+    >>> import numpy as np
+    >>> from moreau.integrators import simulate
+    >>> from moreau.scenes.base import Scene
+    >>> class Block(Scene):
+    ...     ndof, mu, restitution = 2, np.array([0.5]), np.array([0.0])
+    ...     def mass(self, q): return np.eye(2)
+    ...     def forces(self, q, v, t): return np.array([0.0, -1.0])
+    ...     def gaps(self, q, t): return np.array([q[1]])
+    ...     def contact_jacobians(self, q, t):
+    ...         return np.array([[0.0, 1.0]]), np.zeros(1), np.array([[1.0, 0.0]]), np.zeros(1)
+    >>> res = simulate(Block(), (0.0, 1.0), [0.0, 0.0], [1.0, 0.0], "moreau-jean", h=0.01)
+    >>> round(float(res.v[-1, 0]), 12), res.regime_letters()[-1]
+    (0.5, 'P')
+    """
+
+    def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
+                 lcp_method="auto", save_every=1):
+        super().__init__(scene, t0, q0, v0, t_bound)
+        self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
+            h, theta, projection, lcp_method, save_every)
+        self.mu_c, self.e_c = check_scene_contacts(scene)
+        nc = scene.ncontacts
+        # contact -> its row in WT (frictional contacts only), -1 if frictionless
+        self._trow = np.full(nc, -1, dtype=int)
+        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
+        self._closed = np.zeros(nc, dtype=bool)
+        self._k = 0
+        self.counters = _new_counters()
+        self._pending_initial = True
+
+    # -- one step -------------------------------------------------------------
+    def _step_impl(self):
+        sc, theta = self.scene, self.theta
+        t0, q, v = self.t, self.q, self.v
+        t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
+
+        M = np.asarray(sc.mass(q), dtype=float)
+        f = np.asarray(sc.forces(q, v, t1), dtype=float)
+        K, C = (np.asarray(a, dtype=float) for a in sc.force_jacobians(q, v, t1))
+        if theta != 1.0:
+            f = theta * f + (1.0 - theta) * np.asarray(sc.forces(q, v, t0), dtype=float)
+        rhs = h * f + (h * h * theta) * (K @ v)
+        W_hat = M - (h * theta) * C - (h * h * theta * theta) * K
+        Winv = _inverse(W_hat)
+        if Winv is None:
+            self.counters["steps"] -= 1     # the base class counts this failed step
+            self._fail(-5, f"the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is "
+                           f"singular at t = {t0!r}; reduce `h` or use a smaller `theta`")
+            return
+        v_free = v + Winv @ rhs
+
+        nc = sc.ncontacts
+        pN = np.zeros(nc)
+        pT = np.zeros(nc)
+        slip = np.zeros(nc)
+        active = np.zeros(nc, dtype=bool)
+        v1 = v_free
+        if nc:
+            g0 = np.asarray(sc.gaps(q, t0), dtype=float)
+            WN0, wN0, _, _ = sc.contact_jacobians(q, t0)
+            vN0 = np.asarray(WN0, dtype=float) @ v + np.asarray(wN0, dtype=float)
+            active = (g0 + 0.5 * h * vN0 <= 0.0) | self._closed
+            if active.any():
+                v1, slip = self._contact_step(q, t1, v_free, Winv, active, vN0, pN, pT)
+
+        q1 = q + h * (theta * v1 + (1.0 - theta) * v)
+        closed = pN > 0.0
+        if self.projection and nc:
+            q1 = self._project(q1, t1, closed)
+        if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
+            # no NaN may leave the integrator: stop here, keep the last good state
+            self.counters["steps"] -= 1
+            self._fail(-5, f"non-finite state after the step at t = {t0!r} (the step `h` is "
+                           f"probably too large for an explicit part of the forces)")
+            return
+        gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
+        if nc:
+            self.counters["max_penetration"] = max(self.counters["max_penetration"],
+                                                   float(np.max(-gap, initial=0.0)))
+        regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
+        self._closed = closed
+        self._k += 1
+        self.t, self.q, self.v = t1, q1, v1
+
+        fN, fT = pN / h, pT / h
+        if self._pending_initial:
+            self._record(t0, q, v, regime, fN, fT, slip, np.asarray(sc.gaps(q, t0), float) if nc else gap)
+            self._pending_initial = False
+        last = t1 >= self.t_bound
+        if self._k % self.save_every == 0 or last:
+            self._record(t1, q1, v1, regime, fN, fT, slip, gap)
+
+    def _contact_step(self, q, t1, v_free, Winv, active, vN0, pN, pT):
+        sc = self.scene
+        WN1, wN1, WT1, wT1 = (np.asarray(a, dtype=float) for a in sc.contact_jacobians(q, t1))
+        ia = np.flatnonzero(active)
+        fa = ia[self._trow[ia] >= 0]            # active frictional contacts
+        tr = self._trow[fa]
+        H = np.vstack([WN1[ia], WT1[tr]])
+        w = np.concatenate([wN1[ia], wT1[tr]])
+        Winv_HT = Winv @ H.T
+        W = H @ Winv_HT
+        U_free = H @ v_free + w
+        mu, e = self.mu_c[ia], self.e_c[ia]
+        na = len(ia)
+        c = self.counters
+        c["lcp_solves"] += 1
+        if sc.ncontacts == 1:
+            c["direct_solves"] += 1
+            if mu[0] > 0.0:
+                pn, pt = _one_contact(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0], U_free[1],
+                                      mu[0], e[0], vN0[0])
+                res = one_contact_residual(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0],
+                                           U_free[1], mu[0], e[0], vN0[0], pn, pt)
+                p = np.array([pn, pt])
+            else:
+                pn, pt = _one_contact_frictionless(W[0, 0], U_free[0], e[0], vN0[0]), 0.0
+                res = one_contact_residual(W[0, 0], 0.0, 0.0, 0.0, U_free[0], 0.0, 0.0,
+                                           e[0], vN0[0], pn, 0.0)
+                p = np.array([pn])
+            pN[ia[0]], pT[ia[0]] = pn, pt
+        else:
+            p, res = self._solve_lcp(W, U_free, mu, e, vN0[ia], ia, pN, pT)
+        c["max_residual"] = max(c["max_residual"], float(res))
+        v1 = v_free + Winv_HT @ p
+        U = U_free + W @ p
+        slip = np.zeros(sc.ncontacts)
+        slip[fa] = U[na:]
+        return v1, slip
+
+    def _solve_lcp(self, W, U_free, mu, e, vN_pre, ia, pN, pT):
+        from ..lcp import lcp_residual, solve_lcp
+        from ..lcp.friction import build_friction_lcp, friction_impulses
+
+        Ml, ql, layout = build_friction_lcp(W, U_free, mu, e, vN_pre)
+        r = solve_lcp(Ml, ql, method=self.lcp_method, friction=layout)
+        c = self.counters
+        if r.method == "lemke":
+            c["pivots"] += int(r.pivots)
+        if r.fallback_used:
+            c["fallbacks"] += 1
+        if not r.success:
+            raise LCPError(f"contact problem at t = {self.t!r} not solved: {r.message}")
+        pn, pt = friction_impulses(r.z, layout)
+        pN[ia], pT[ia] = pn, pt
+        return friction_impulses(r.z, layout, stacked=True), lcp_residual(Ml, ql, r.z)
+
+    def _project(self, q, t, closed):
+        """Mass-weighted projection onto ``g = 0`` (closed contacts) and ``g >= 0`` (the rest)."""
+        sc = self.scene
+        M = np.asarray(sc.mass(q), dtype=float)
+        sel = closed.copy()
+        for _ in range(PROJECTION_MAXITER):
+            g = np.asarray(sc.gaps(q, t), dtype=float)
+            sel |= g < 0.0
+            if not sel.any() or np.max(np.abs(g[sel])) <= PROJECTION_TOL:
+                break
+            WN = np.asarray(sc.contact_jacobians(q, t)[0], dtype=float)[sel]
+            MinvWT = np.linalg.solve(M, WN.T)
+            d = np.linalg.solve(WN @ MinvWT, -g[sel])
+            q = q + MinvWT @ d
+            self.counters["projection_iterations"] += 1
+        return q
+
+
+def _inverse(W_hat):
+    """``W_hat^-1``, or None when ``W_hat`` is singular to working precision.
+
+    The matrices are small (``ndof`` x ``ndof``, the inverse is reused for the
+    free velocity and the Delassus matrix); the 1-norm condition number
+    decides singularity.
+    """
+    if not np.all(np.isfinite(W_hat)):
+        return None
+    try:
+        Winv = np.linalg.inv(W_hat)
+    except np.linalg.LinAlgError:
+        return None
+    cond = np.linalg.norm(W_hat, 1) * np.linalg.norm(Winv, 1)
+    if not (np.isfinite(cond) and cond < 1e14):
+        return None
+    return Winv
