@@ -219,6 +219,11 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     regimes = sorted(([t % TWO_PI, r] for t, r, _ in runs), key=lambda x: x[0])
     if regimes and regimes[0][0] > 0.0:
         regimes.insert(0, [0.0, regimes[-1][1]])
+    merged = []
+    for t, r in regimes:
+        if not merged or merged[-1][1] != r:
+            merged.append([t, r])
+    regimes = merged
     return SteadyState(
         scheme="event-driven",
         displacement_per_period=float(end.u2 - st0.u2),

@@ -93,6 +93,7 @@ from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError, LCPError, PainleveError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
+from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
 
@@ -107,6 +108,11 @@ SLIP_RTOL = 1e-10
 # gaps of the package's scenes are O(1e-3 .. 1) in their own units)
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
+
+# time steps per call of the compiled loop: large enough to hide the call,
+# small enough for a live progress bar and a prompt Ctrl-C
+FAST_BLOCK = 1 << 16
+
 
 def classify_impulse(pN, pT, mu):
     """Regime of one contact from its impulses over a step.
@@ -324,6 +330,12 @@ class MoreauJean(Integrator):
         Record one sample every ``save_every`` steps (and the last one). The
         sample at ``t0`` is the initial state with the first step's regime and
         forces.
+    fast : {"auto", True, False}
+        Use the compiled loop of :mod:`moreau.integrators._mj_kernels` (the
+        same scheme, equal to rounding). ``"auto"`` uses it for the friction
+        drive, the only scene it knows; ``True`` insists. In the compiled mode
+        one call of :meth:`step` advances a block of up to 65536 time steps
+        (``stats["steps"]`` still counts time steps).
 
     Notes
     -----
@@ -352,7 +364,7 @@ class MoreauJean(Integrator):
     """
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
-                 lcp_method="auto", save_every=1):
+                 lcp_method="auto", save_every=1, fast="auto"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
             h, theta, projection, lcp_method, save_every)
@@ -365,9 +377,24 @@ class MoreauJean(Integrator):
         self._k = 0
         self.counters = _new_counters()
         self._pending_initial = True
+        if fast not in ("auto", True, False):
+            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
+        known = is_friction_drive(scene)
+        if fast is True and not known:
+            raise InputError("`fast=True` needs a FrictionDrive scene (the only one with a "
+                             "compiled model); use fast='auto' or False")
+        self._fast = known and fast is not False
+        if self._fast:
+            from ..scenes._friction_drive_jit import pack_params
+            from ._mj_kernels import new_stats
+            self._par = pack_params(scene)
+            self._stats = new_stats()
+            self._blocks = []
 
     # -- one step -------------------------------------------------------------
     def _step_impl(self):
+        if self._fast:
+            return self._fast_block()
         sc, theta = self.scene, self.theta
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
@@ -427,6 +454,56 @@ class MoreauJean(Integrator):
         last = t1 >= self.t_bound
         if self._k % self.save_every == 0 or last:
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
+
+    def _fast_block(self):
+        from ._mj_kernels import NUMERICAL, PAINLEVE, STAT_NAMES, mj_run_fd
+
+        nmax = FAST_BLOCK
+        ns = nmax // self.save_every + 2
+        buf = (np.empty(ns), np.empty((ns, 2)), np.empty((ns, 2)), np.empty(ns, dtype=np.int64),
+               np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns))
+        q, v = self.q.copy(), self.v.copy()
+        status, k, nrec, closed = mj_run_fd(
+            self._par, self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta,
+            self.projection, bool(self._closed[0]), self.save_every, self._pending_initial,
+            *buf, self._stats)
+        ndone = k - self._k
+        if nrec:
+            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
+        if ndone:
+            self._pending_initial = False
+        self._k, self.q, self.v = k, q, v
+        self._closed[0] = closed
+        t = self.t0 + k * self.h
+        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        for name, x in zip(STAT_NAMES, self._stats):
+            self.counters[name] = float(x) if name.startswith("max_") else int(x)
+        if status == PAINLEVE:
+            self.counters["steps"] += ndone
+            raise PainleveError(f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated at "
+                                f"t = {self.t!r}: the contact problem has no unique solution")
+        self.counters["steps"] += ndone - 1     # the base class adds the last one
+        if status == NUMERICAL:
+            self._fail(-5, f"non-finite state or singular iteration matrix after t = {self.t!r}; "
+                           f"reduce `h`")
+
+    def result(self):
+        """Assemble the recorded samples into a :class:`SimulationResult`."""
+        if not self._fast:
+            return super().result()
+        if self._blocks:
+            t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*self._blocks))
+        else:
+            t, reg = np.zeros(0), np.zeros(0, dtype=np.int64)
+            q = v = np.zeros((0, 2))
+            fN = fT = slip = gap = np.zeros(0)
+        code = self.status_code
+        return SimulationResult(
+            t=t, q=q, v=v, regime=reg.reshape(-1, 1).astype(int), force_N=fN.reshape(-1, 1),
+            force_T=fT.reshape(-1, 1), slip_velocity=slip.reshape(-1, 1),
+            gap=gap.reshape(-1, 1), events=[], status=code,
+            message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
+            stats=dict(self.counters))
 
     def _contact_step(self, q, t1, v_free, Winv, active, vN0, pN, pT):
         sc = self.scene
@@ -499,6 +576,16 @@ class MoreauJean(Integrator):
             q = q + MinvWT @ d
             self.counters["projection_iterations"] += 1
         return q
+
+
+def is_friction_drive(scene):
+    """True for a plain :class:`~moreau.scenes.friction_drive.FrictionDrive` (not a subclass,
+    which might change the model the compiled kernel hard-codes)."""
+    try:
+        from ..scenes.friction_drive import FrictionDrive
+    except ImportError:      # pragma: no cover - the scene ships with the package
+        return False
+    return type(scene) is FrictionDrive
 
 
 def _inverse(W_hat):

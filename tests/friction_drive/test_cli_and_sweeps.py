@@ -36,8 +36,8 @@ def test_steady_json_keys_and_units(capsys):
 
 
 def test_steady_parameters_are_used(capsys):
-    _, a = run_json(capsys, "--frequency", "2000", "--mu", "0.95")
-    assert a["mode"] == "SP" and a["parameters"]["mu"] == 0.95
+    _, a = run_json(capsys, "--frequency", "2000", "--mu", "0.98")
+    assert a["mode"] == "SP" and a["parameters"]["mu"] == 0.98
     _, b = run_json(capsys, "--frequency", "185", "--length", "2e-3", "--x10", "4e-6")
     assert b["parameters"]["length"] == 2e-3
 

@@ -154,6 +154,8 @@ def test_registered_under_its_name():
     ({"h": 0.1, "lcp_method": "simplex"}, r"`lcp_method` must be one of \['auto', 'lemke', 'qp'\]"),
     ({"h": 0.1, "projection": "yes"}, r"`projection` must be True or False"),
     ({"h": 0.1, "save_every": 0}, r"`save_every` must be an integer >= 1"),
+    ({"h": 0.1, "fast": True}, r"`fast=True` needs a FrictionDrive scene"),
+    ({"h": 0.1, "fast": "maybe"}, r"`fast` must be 'auto', True or False"),
 ])
 def test_bad_options_are_rejected_before_any_work(opts, match):
     with pytest.raises(InputError, match=match):
