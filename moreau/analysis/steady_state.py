@@ -83,9 +83,18 @@ def _min_normal_force(walker, segments):
         if a.regime == Regime.FLIGHT:
             best = min(best, 0.0)
             continue
-        n = max(8, int(64 * (b.tau - a.tau) / TWO_PI) + 2)
+        n = max(16, int(256 * (b.tau - a.tau) / TWO_PI) + 2)
         tau = np.linspace(a.tau, b.tau, n)
-        best = min(best, float(np.min(sc.contact_forces(tau, a.regime)[0])))
+        fN = sc.contact_forces(tau, a.regime)[0]
+        i = int(np.argmin(fN))
+        best = min(best, float(fN[i]))
+        if 0 < i < n - 1:
+            # refine the sampled minimum: f_N varies fast near the stator's lowest point
+            from scipy.optimize import minimize_scalar
+            r = minimize_scalar(lambda t: float(sc.contact_forces(t, a.regime)[0]),
+                                bounds=(tau[i - 1], tau[i + 1]), method="bounded",
+                                options={"xatol": 1e-12})
+            best = min(best, float(r.fun))
     # the force at a located lift-off is zero up to round-off
     if -1e-12 * walker.fscale < best < 0.0:
         best = 0.0

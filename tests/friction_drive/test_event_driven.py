@@ -249,3 +249,12 @@ def test_simulate_bad_input():
         simulate(sc, (0.0, 1.0), q0, v0, "runge-kutta")
     with pytest.raises(InputError, match="penetrates"):
         simulate(sc, (0.0, 1.0), [sc.phi0 + 0.1, 0.0], v0, "event-driven")
+
+
+@pytest.mark.parametrize("f", [20.0, 185.0])
+def test_min_normal_force_is_the_analytic_value_at_tau_0(f):
+    # in negative slip at tau = 0 (u1 = u1' = 0, u1'' = u10): f_N = u10 (1/(3c) - c/2) / (c - mu s)
+    ss = steady(f)
+    c = s = math.cos(math.pi / 4)
+    exact = 2e-3 * (1 / (3 * c) - c / 2) / (c - 0.1 * s)
+    assert ss.min_normal_force == pytest.approx(exact, rel=1e-9)
