@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
+import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
 from moreau.errors import InputError
+from moreau.integrators import simulate
 from moreau.scenes.bouncing_ball import BouncingBall, BouncingBallParams
 
 
@@ -159,3 +161,35 @@ def test_first_impact_in_si():
     q0 = ball.from_si(q=[1.25]).q
     t1 = ball.impacts(q0, [0.0], 1).t[0]
     assert ball.to_si(t=t1).t == pytest.approx(math.sqrt(2 * 1.2 / 9.81), rel=1e-14)
+
+
+# -- Moreau–Jean against the exact solution ---------------------------------------
+def fitted_order(hs, errors):
+    return np.polyfit(np.log(hs), np.log(errors), 1)[0]
+
+
+@pytest.mark.parametrize("theta", [0.5, 1.0])
+def test_moreau_jean_converges_at_first_order(theta):
+    # Impact times 1, 2, 2.5, 2.75, ... are dyadic, so every step size 2^-k
+    # lands on them: the error then comes from the scheme alone, not from
+    # where an impact happens to fall inside a step, and the fitted slope is
+    # clean. The run ends at 2.6, after three impacts.
+    ball = BouncingBall(restitution=0.5, radius=0.1)
+    q0, v0 = [0.6], [0.0]
+    hs = [2.0 ** -k for k in range(4, 10)]
+    errors = []
+    for h in hs:
+        res = simulate(ball, (0.0, 2.6), q0, v0, "moreau-jean", h=h, theta=theta)
+        assert res.status == 0
+        q_exact, _ = ball.exact_solution(res.t, q0, v0)
+        errors.append(np.max(np.abs(res.q[:, 0] - q_exact[:, 0])))
+    assert 0.8 <= fitted_order(hs, errors) <= 1.3
+    assert errors[-1] < 5e-3
+
+
+def test_moreau_jean_ball_comes_to_rest_after_the_zeno_point():
+    ball = BouncingBall(restitution=0.5, radius=0.1)
+    res = simulate(ball, (0.0, 4.0), [0.6], [0.0], "moreau-jean", h=2.0 ** -8)
+    late = res.t > 3.1                        # past t_inf = 3
+    assert np.all(np.abs(res.v[late, 0]) < 1e-12)
+    assert np.all(np.abs(res.q[late, 0] - 0.1) < 2.0 ** -8)

@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
+import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
 from moreau.errors import InputError
+from moreau.integrators import simulate
 from moreau.scenes.sliding_block import SlidingBlock, SlidingBlockParams
 
 
@@ -123,3 +125,44 @@ def test_frictionless_block_never_stops():
     assert block.stopping_time([1.0, 0.0]) == math.inf
     q, v = block.exact_solution([2.0], [0.0, 0.0], [1.0, 0.0])
     assert q[0, 0] == 2.0 and v[0, 0] == 1.0
+
+
+# -- Moreau–Jean against the exact solution ---------------------------------------
+def fitted_order(hs, errors):
+    return np.polyfit(np.log(hs), np.log(errors), 1)[0]
+
+
+def position_errors(block, u0, t_end, hs, theta):
+    errors = []
+    for h in hs:
+        res = simulate(block, (0.0, t_end), [0.0, 0.0], [u0, 0.0], "moreau-jean", h=h,
+                       theta=theta)
+        assert res.status == 0
+        q_exact, v_exact = block.exact_solution(res.t, [0.0, 0.0], [u0, 0.0])
+        # the discrete velocity is exact at the grid points (constant
+        # deceleration, stop caught by the contact problem)
+        assert np.max(np.abs(res.v[:, 0] - v_exact[:, 0])) < 1e-12
+        errors.append(np.max(np.abs(res.q[:, 0] - q_exact[:, 0])))
+    return np.array(errors)
+
+
+@pytest.mark.parametrize("alpha, mu, u0, t_end", [
+    (0.0, 0.3, 1.0, 5.0),       # level plane, stops at 10/3
+    (0.2, 0.5, 1.5, 6.5),       # downhill on a slope it sticks to, stops at 5.148
+])
+def test_moreau_jean_converges_at_first_order(alpha, mu, u0, t_end):
+    block = SlidingBlock(mu=mu, incline=alpha)
+    hs = 0.1 * 2.0 ** -np.arange(5)
+    errors = position_errors(block, u0, t_end, hs, theta=1.0)
+    assert 0.8 <= fitted_order(hs, errors) <= 1.3
+    # theta = 1 integrates the exact (linear) velocity with the right-point
+    # rule, which lags by h v0 / 2 once the block has stopped
+    assert errors / hs == pytest.approx(np.full(len(hs), 0.5 * u0), rel=0.02)
+
+
+def test_moreau_jean_theta_half_is_second_order_on_the_level_plane():
+    # with the trapezoidal position update only the stopping step errs
+    block = SlidingBlock(mu=0.3)
+    hs = 0.1 * 2.0 ** -np.arange(4)
+    errors = position_errors(block, 1.0, 5.0, hs, theta=0.5)
+    assert 1.8 <= fitted_order(hs, errors) <= 2.2
