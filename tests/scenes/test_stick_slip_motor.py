@@ -1,10 +1,13 @@
 """Stick–slip motor: drives, scene formulas and the exact event-driven reference."""
 
 import math
+import re
 
 import numpy as np
 import pytest
 
+import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
+from moreau.analysis.modes import mode_name
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.integrators.stick_slip_reference import (_Walker, stick_slip_period_map,
@@ -257,3 +260,27 @@ def test_integrator_converges_to_the_shooting_steady_state():
     assert np.all(np.abs(res.force_T[:, 0]) <= motor.friction_level + 1e-15)
     si = motor.to_si(res)
     assert si["t"][-1] == pytest.approx(8e-3) and si["force_N"][0, 0] == pytest.approx(0.5)
+
+
+# -- Moreau–Jean against the reference ---------------------------------------------
+@pytest.mark.parametrize("kwargs", [
+    {"drive": "sawtooth", "normal_force": 0.5},     # NSP
+    {"drive": "sine", "load": 0.1},                 # NPS
+])
+def test_moreau_jean_net_displacement_matches_the_reference(kwargs):
+    # 2000 steps per period, started on the reference's periodic state; the
+    # first period absorbs the scheme's own transient, the last is measured
+    motor = StickSlipMotor(**kwargs)
+    ss = stick_slip_steady_state(motor)
+    res = simulate(motor, (0.0, 3 * TWO_PI), [0.0, 0.0], [ss.state0[0], 0.0], "moreau-jean",
+                   h=TWO_PI / 2000)
+    assert res.status == 0
+    k = np.argmin(np.abs(res.t - 2 * TWO_PI))
+    assert res.t[k] == pytest.approx(2 * TWO_PI)
+    D = res.q[-1, 0] - res.q[k, 0]
+    assert D == pytest.approx(ss.displacement_per_period, rel=1e-3)
+    # a reversal of the slip inside a step reads as one step of stick
+    letters = res.regime_letters()[k:]
+    runs = [(m.group()[0], len(m.group())) for m in re.finditer(r"(.)\1*", letters)]
+    assert mode_name([r for r, n in runs if n > 1]) == ss.mode
+    assert np.max(np.abs(res.gap)) < 1e-12          # the slider stays pressed on
