@@ -1,11 +1,15 @@
 """Painlevé rod: input checks, scene formulas, the paradox condition and its report."""
 
 import math
+import re
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
+import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
 from moreau.errors import InputError, PainleveError
+from moreau.integrators import simulate
 from moreau.scenes.painleve_rod import (PAINLEVE_MU_MIN, PainleveRod, PainleveRodParams,
                                         painleve_critical_mu)
 
@@ -155,3 +159,52 @@ def test_well_posed_states_pass_the_check(mu, tip_speed, lift):
     q, v = rod.sliding_state(PHI_STAR, tip_speed)
     q[1] += lift
     assert rod.check_well_posed(q, v, 0.0) is None
+
+
+# -- Moreau–Jean: well-posed sliding converges, the paradox is reported -----------------
+def test_moreau_jean_sliding_rod_converges_at_first_order():
+    # reference: the sliding-contact ODE a = sliding_accelerations(q, v), which
+    # holds while the normal force stays positive and the tip keeps slipping
+    rod = PainleveRod(mu=0.5)
+    q0, v0 = rod.sliding_state(0.9, -1.0, dphi=0.4)
+    t_end = 0.5
+
+    def rhs(t, y):
+        a, lamN, _ = rod.sliding_accelerations(y[:3], y[3:])
+        return np.concatenate([y[3:], a])
+
+    ref = solve_ivp(rhs, (0.0, t_end), np.concatenate([q0, v0]), method="DOP853",
+                    rtol=1e-12, atol=1e-12, dense_output=True)
+    for t in np.linspace(0.0, t_end, 6):
+        y = ref.sol(t)
+        _, lamN, _ = rod.sliding_accelerations(y[:3], y[3:])
+        assert lamN > 0.5 and rod.contact_velocities(y[:3], y[3:], t)[1][0] < -0.9
+    hs = 0.02 * 2.0 ** -np.arange(5)
+    errors = []
+    for h in hs:
+        res = simulate(rod, (0.0, t_end), q0, v0, "moreau-jean", h=h)
+        assert res.status == 0 and set(res.regime_letters()) == {"N"}
+        errors.append(np.max(np.abs(res.q - ref.sol(res.t).T[:, :3])))
+    assert 0.8 <= np.polyfit(np.log(hs), np.log(errors), 1)[0] <= 1.3
+
+
+def test_moreau_jean_stops_with_a_painleve_diagnosis():
+    rod = PainleveRod(mu=2.0)
+    q0, v0 = rod.sliding_state(PHI_STAR, -1.0)
+    res = simulate(rod, (0.0, 1.0), q0, v0, "moreau-jean", h=1e-3)
+    assert res.status == -1 and not res.success
+    assert re.search(r"Painlev[ée] condition .* violated", res.message)
+    assert re.search(r"\bmu`? = 2\b", res.message)
+    # nothing past the ill-posed state was integrated
+    assert len(res.t) == 0 or res.t[-1] == 0.0
+
+
+@pytest.mark.xfail(reason="Moreau-Jean tests W_NN - mu |W_NT| > 0 whatever the slip "
+                          "direction, so it also stops a rod sliding the harmless way "
+                          "(indicator +4); reported to the lead", strict=False)
+def test_moreau_jean_runs_the_harmless_slip_direction():
+    rod = PainleveRod(mu=2.0)
+    q0, v0 = rod.sliding_state(PHI_STAR, +1.0)
+    assert rod.painleve_indicator(q0, v0) == pytest.approx(4.0)
+    res = simulate(rod, (0.0, 0.05), q0, v0, "moreau-jean", h=1e-3)
+    assert res.status == 0
