@@ -77,6 +77,17 @@ class _SlipSeries:
         self.cA = ck / (1j * self.k)          # coefficients of the first antiderivative
         self.cAA = -ck / (self.k * self.k)    # and of the second
         self.ck = ck
+        self._cA_list = [complex(c) for c in self.cA]
+
+    def A_scalar(self, tau):
+        """``A(tau)`` for one float, without numpy overhead (the event-location hot path)."""
+        z = complex(math.cos(tau), math.sin(tau))
+        zk = z
+        acc = 0j
+        for c in self._cA_list:
+            acc += c * zk
+            zk *= z
+        return acc.real
 
     def _basis(self, tau):
         return np.exp(1j * np.multiply.outer(np.asarray(tau, float), self.k))
@@ -168,21 +179,40 @@ class FrictionDriveWalker:
 
     # -- explicit contact quantities ------------------------------------------
     def vtip(self, tau):
-        phi = math.asin(self.scene.sin_phi0 - self.scene.u10 * (1.0 - math.cos(tau)))
-        dphi = -self.scene.u10 * math.sin(tau) / math.cos(phi)
-        return -math.sin(phi) * dphi
+        sc = self.scene
+        s = sc.sin_phi0 - sc.u10 * (1.0 - math.cos(tau))
+        return s * sc.u10 * math.sin(tau) / math.sqrt((1.0 - s) * (1.0 + s))
 
     def manifold(self, tau):
         sc = self.scene
         phi = math.asin(sc.sin_phi0 - sc.u10 * (1.0 - math.cos(tau)))
         return phi, -sc.u10 * math.sin(tau) / math.cos(phi)
 
+    def _contact_scalars(self, tau):
+        # the scene's contact_forces, written with math for single floats
+        sc = self.scene
+        cu, su = math.cos(tau), math.sin(tau)
+        s = sc.sin_phi0 - sc.u10 * (1.0 - cu)
+        c = math.sqrt((1.0 - s) * (1.0 + s))
+        dd1 = sc.u10 * cu
+        dphi = -sc.u10 * su / c
+        ddphi = dphi * dphi * s / c - dd1 / c
+        Fs = 0.5 * dd1 * c + ddphi / 3.0 - sc.P * c * (sc.sin_phi0 - s)
+        return s, c, dphi, ddphi, Fs
+
     def fN(self, tau, regime):
-        return float(self.scene.contact_forces(tau, regime)[0])
+        s, c, _, _, Fs = self._contact_scalars(tau)
+        mu = self.mu
+        if regime == _P:
+            return -Fs / (c + mu * s)
+        return -Fs / (c - mu * s)
 
     def stick_margins(self, tau):
-        fN, fT = self.scene.contact_forces(tau, _S)
-        return float(fN), float(fT + self.mu * fN), float(self.mu * fN - fT)
+        s, c, dphi, ddphi, Fs = self._contact_scalars(tau)
+        sc = self.scene
+        fT = sc.J * (-(dphi * dphi * c + ddphi * s)) + sc.fL
+        fN = fT * s / c - Fs / c
+        return fN, fT + self.mu * fN, self.mu * fN - fT
 
     def slip_state(self, st, tau):
         """``(u2, u2')`` at ``tau`` of the slip segment that starts at ``st``."""
@@ -258,11 +288,28 @@ class FrictionDriveWalker:
         skip = 1e-10 * max(1.0, abs(ta))
         keep = tk > ta + skip
         tk, vals = tk[keep], vals[keep]
-        t0 = ta + skip if f(ta) <= 0.0 else ta
-        if t0 >= tb:
-            return None
-        tt = np.concatenate(([t0], tk, [tb])) if (tk.size == 0 or tk[-1] < tb) else np.concatenate(([t0], tk))
-        fv = np.concatenate(([max(f(t0), 0.0)], vals, [f(tb)] if tt.size > vals.size + 1 else []))
+        n = vals.size
+        # the start: positive by assumption, unless the grid says otherwise
+        t0 = ta
+        if n == 0 or vals[0] <= 0.0:
+            if f(ta) <= 0.0:
+                t0 = ta + skip
+            if t0 >= tb:
+                return None
+        # the end point is evaluated only where the last cell could reach zero
+        need_end = n == 0 or tk[-1] < tb and (
+            n < 2 or vals[-1] <= 2.0 * abs(vals[-1] - vals[-2]))
+        if need_end:
+            tt = np.empty(n + 2)
+            fv = np.empty(n + 2)
+            tt[1:n + 1], fv[1:n + 1] = tk, vals
+            tt[-1], fv[-1] = tb, f(tb)
+        else:
+            tt = np.empty(n + 1)
+            fv = np.empty(n + 1)
+            tt[1:], fv[1:] = tk, vals
+        tt[0] = t0
+        fv[0] = vals[0] if n and vals[0] > 0.0 else 0.0
         neg = np.flatnonzero(fv[1:] <= 0.0)
         stop = neg[0] + 1 if neg.size else fv.size
         # interior local minima before the first sign change
@@ -306,10 +353,10 @@ class FrictionDriveWalker:
         if reg in (_P, _N):
             sign = 1.0 if reg == _P else -1.0
             ser = self.series[reg]
-            Aa = float(ser.A(ta))
+            Aa = ser.A_scalar(ta)
 
             def slip(t):
-                return sign * (st.du2 + ser.c0 * (t - ta) + float(ser.A(t)) - Aa - self.vtip(t))
+                return sign * (st.du2 + ser.c0 * (t - ta) + ser.A_scalar(t) - Aa - self.vtip(t))
 
             vals = sign * (st.du2 + ser.c0 * (tk - ta) + self.g_A[reg][jk] - Aa - self.g_vtip[jk])
             r = self._first_root(slip, tk, vals, ta, tb)
