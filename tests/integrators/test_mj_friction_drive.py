@@ -60,3 +60,110 @@ def test_painleve_violation_in_the_drive(fast):
     res = mj(sc, 1, 200, fast=fast)
     assert res.status == -1 and "Painlevé" in res.message
     assert np.all(np.isfinite(res.q))
+
+
+# -- mode naming from per-step regimes ------------------------------------------------
+
+from moreau.analysis.mj_steady_state import merge_step_regimes, moreau_jean_steady_state  # noqa: E402
+from moreau.errors import ConvergenceError, InputError  # noqa: E402
+
+
+def _names(letters):
+    h = TWO_PI / len(letters)
+    runs = merge_step_regimes(letters, [k * h for k in range(len(letters))], h)
+    from moreau.analysis.modes import mode_name
+    return runs, mode_name([s for _, s in runs])
+
+
+def test_one_step_stick_between_opposite_slips_is_a_reversal():
+    runs, mode = _names("NNNNSPPPPN")
+    assert mode == "NP"
+    h = TWO_PI / 10
+    assert runs == [[0.0, "N"], [pytest.approx(4.5 * h), "P"], [pytest.approx(9 * h), "N"]]
+    assert _names("PPPSNNNN")[1] == "NP"
+
+
+def test_real_sticks_are_kept():
+    assert _names("NNNSSPPP")[1] == "NSP"      # two steps of stick
+    assert _names("NNNSNNNN")[1] == "NS"       # one-step stick between slips of equal sign
+    # the long stick stays, the reversal P -> S -> N (across the period end) goes
+    assert _names("NNSSPPSN")[1] == "NSP"
+
+
+def test_reversal_across_the_period_start():
+    runs, mode = _names("SPPPNNNN")
+    h = TWO_PI / 8
+    assert mode == "NP"
+    # the N run of the previous period reaches tau = 0, the reversal is mid-step
+    assert runs == [[0.0, "N"], [pytest.approx(0.5 * h), "P"], [pytest.approx(4 * h), "N"]]
+
+
+def test_merge_step_regimes_rejects_mismatched_times():
+    with pytest.raises(InputError, match=r"`taus` must have one entry per step"):
+        merge_step_regimes("NNP", [0.0, 1.0], 1.0)
+
+
+# -- discrete-map steady state ----------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def ss185():
+    return moreau_jean_steady_state(FrictionDrive(frequency=185.0), 1000)
+
+
+def test_steady_state_is_a_fixed_point_of_the_simulated_map(ss185):
+    sc = FrictionDrive(frequency=185.0)
+    x = ss185.state0
+    assert ss185.scheme == "moreau-jean" and ss185.periodic_residual <= 1e-12
+    res = simulate(sc, (0.0, 3 * TWO_PI), [x[0], 0.0], x[1:], "moreau-jean", h=TWO_PI / 1000,
+                   projection=True, save_every=1000)
+    # the integrator starts with the contact flag open, so compare from period 1 on
+    per = res.q[1:, 1]
+    np.testing.assert_allclose(np.diff(per), ss185.displacement_per_period, rtol=1e-10)
+    np.testing.assert_allclose(res.v[-1], x[1:], atol=1e-12 * sc.u10)
+    st = ss185.stats
+    assert st["steps"] == st["period_maps"] * 1000 and 0.9 * st["steps"] < st["lcp_solves"] <= st["steps"]
+    assert st["lcp_solves"] > 0 and st["fallbacks"] == 0 and st["max_penetration"] < 1e-14
+    assert 0.0 <= st["period_map_slope"] < 0.2
+    assert ss185.mode == "NP" and ss185.regimes[0] == [0.0, "N"]
+    assert ss185.min_normal_force > 0.0
+
+
+def test_compiled_and_generic_period_maps_give_the_same_steady_state():
+    sc = FrictionDrive(frequency=185.0)
+    a = moreau_jean_steady_state(sc, 150, fast=True)
+    b = moreau_jean_steady_state(sc, 150, fast=False)
+    assert a.mode == b.mode
+    assert a.displacement_per_period == pytest.approx(b.displacement_per_period, rel=1e-10)
+    np.testing.assert_allclose(a.state0, b.state0, rtol=0, atol=1e-12)
+
+
+def test_steady_state_argument_checks():
+    sc = FrictionDrive(frequency=185.0)
+    with pytest.raises(InputError, match=r"`steps_per_period` must be an integer >= 1"):
+        moreau_jean_steady_state(sc, 0)
+    with pytest.raises(InputError, match=r"`theta` must be in \[0.5, 1.0\]"):
+        moreau_jean_steady_state(sc, 100, theta=2.0)
+    with pytest.raises(InputError, match=r"`tol` must be > 0"):
+        moreau_jean_steady_state(sc, 100, tol=-1.0)
+    with pytest.raises(InputError, match=r"`x_guess` must have shape \(3\)"):
+        moreau_jean_steady_state(sc, 100, x_guess=[0.7, 0.0])
+
+
+def test_without_projection_the_map_has_no_fixed_point():
+    # the closed contact's gap creeps open by O(h) per period, so phi never repeats
+    with pytest.raises(ConvergenceError, match=r"try projection=True"):
+        moreau_jean_steady_state(FrictionDrive(frequency=20.0), 200, projection=False)
+
+
+def test_iteration_limit_is_reported():
+    with pytest.raises(ConvergenceError, match=r"did not converge in `max_iter`"):
+        moreau_jean_steady_state(FrictionDrive(frequency=2000.0), 500, max_iter=2)
+
+
+def test_docstring_examples_run():
+    import doctest
+
+    import moreau.analysis.mj_steady_state as mss
+    import moreau.scenes._friction_drive_jit as fdj
+    for mod in (mss, fdj):
+        assert doctest.testmod(mod, verbose=False).failed == 0
