@@ -167,3 +167,87 @@ def test_docstring_examples_run():
     import moreau.scenes._friction_drive_jit as fdj
     for mod in (mss, fdj):
         assert doctest.testmod(mod, verbose=False).failed == 0
+
+
+# -- acceptance against the event-driven reference (issue #4) ---------------------------
+
+from moreau.analysis.steady_state import find_steady_state  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def references():
+    return {f: find_steady_state(FrictionDrive(frequency=f)) for f in (20.0, 185.0, 2000.0)}
+
+
+def _rel(ss, ref):
+    return abs(ss.displacement_per_period - ref.displacement_per_period) / abs(
+        ref.displacement_per_period)
+
+
+@pytest.mark.parametrize("freq", [20.0, 185.0])
+def test_steady_state_matches_the_reference_at_2000_steps(references, freq):
+    ref = references[freq]
+    ss = moreau_jean_steady_state(FrictionDrive(frequency=freq), 2000)
+    assert ss.mode == ref.mode            # NS at 20 Hz, NP at 185 Hz
+    assert _rel(ss, ref) < 1e-3           # measured 8.2e-4 and 3.0e-4
+    # regime changes within a few steps of the reference's event times
+    assert [s for _, s in ss.regimes] == [s for _, s in ref.regimes]
+    h = TWO_PI / 2000
+    for (t, _), (tr, _) in zip(ss.regimes, ref.regimes):
+        assert abs(t - tr) < 3 * h
+
+
+def test_2000_hz_is_barely_contracting_and_converges_slowly(references):
+    ref = references[2000.0]
+    sc = FrictionDrive(frequency=2000.0)
+    errs = {}
+    for n in (2000, 4000, 8000, 16000):
+        ss = moreau_jean_steady_state(sc, n)
+        assert ss.mode == ref.mode == "NP"
+        errs[n] = _rel(ss, ref)
+        # slope of the period map on the continuous scale: about 0.987
+        assert 0.95 < ss.stats["period_map_slope"] < 1.0
+    # measured 7.1e-3, 3.4e-3, 1.8e-3, 8.1e-4
+    assert errs[2000] < 2e-2 and errs[4000] < 2e-2
+    assert errs[8000] < 5e-3 and errs[16000] < 5e-3
+
+
+def test_first_order_convergence_of_the_trajectory_at_185_hz():
+    # the displacement per period converges erratically (the O(h) error of
+    # each slip reversal depends on where it falls inside its step), so the
+    # order is fitted on the trajectory error over one period from a common
+    # start state, sampled on the coarsest grid
+    sc = FrictionDrive(frequency=185.0)
+    x0 = moreau_jean_steady_state(sc, 1000).state0
+    q0, v0 = [x0[0], 0.0], x0[1:]
+    m = 250
+    ref = simulate(sc, (0.0, TWO_PI), q0, v0, "event-driven", samples_per_period=m)
+    grid = np.arange(m + 1) * TWO_PI / m
+    idx = np.searchsorted(ref.t, grid - 1e-12)
+    np.testing.assert_allclose(ref.t[idx], grid, atol=1e-12)
+    ns = np.array([250, 500, 1000, 2000, 4000, 8000])
+    errs = []
+    for n in ns:
+        r = simulate(sc, (0.0, TWO_PI), q0, v0, "moreau-jean", h=TWO_PI / n, projection=True,
+                     save_every=n // m)
+        errs.append(np.max(np.abs(r.q[:, 1] - ref.q[idx, 1])) / sc.u10)
+    order = -np.polyfit(np.log(ns), np.log(errs), 1)[0]
+    assert 0.8 < order < 1.3              # measured 1.00
+    assert errs[-1] < 2e-3
+
+
+@pytest.mark.parametrize("theta, bound", [(1.0, 0.15), (0.5, 0.05)])
+def test_stiff_spring_at_20_hz_with_100_steps_per_period(references, theta, bound):
+    # P ~ 3.2e4: h^2 P ~ 125 per step, yet both theta stay bounded
+    sc = FrictionDrive(frequency=20.0)
+    assert sc.P > 3e4
+    res = mj(sc, 20, 100, theta=theta, projection=True)
+    assert res.success and np.all(np.isfinite(res.q)) and np.all(np.isfinite(res.v))
+    vtip = sc.u10 / math.cos(sc.phi0)
+    assert np.max(np.abs(res.v)) < 2.0 * vtip
+    ref = references[20.0]
+    ss = moreau_jean_steady_state(sc, 100, theta=theta)
+    assert ss.mode == ref.mode == "NS"
+    assert _rel(ss, ref) < bound          # measured 13 % (theta = 1) and 3.5 % (theta = 1/2)
+    per = res.q[::100, 1]
+    assert abs(per[-1] - per[-2] - ss.displacement_per_period) < 1e-9
