@@ -44,24 +44,62 @@ def new_stats():
 
 @njit(cache=True, inline="always")
 def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
-    # returns (pN, pT, ok); ok = False on a violated discrete Painlevé condition
+    # returns (pN, pT, ok); ok = False when the discrete Painlevé condition
+    # fails and the problem has no solution or several (see moreau_jean.py)
     b = uN + e * min(vN_pre, 0.0)
     if b >= 0.0:
         return 0.0, 0.0, True
     if mu > 0.0:
-        if not (Wnn - mu * abs(Wnt) > 0.0):
-            return 0.0, 0.0, False
         det = Wnn * Wtt - Wnt * Wtn
-        if det > 0.0:
-            pN = (Wnt * uT - Wtt * b) / det
-            pT = (Wtn * b - Wnn * uT) / det
-            if pN >= 0.0 and abs(pT) <= mu * pN:
-                return pN, pT, True
-        pN = -b / (Wnn - mu * Wnt)
-        if uT + (Wtn - mu * Wtt) * pN >= 0.0:
-            return pN, -mu * pN, True
-        pN = -b / (Wnn + mu * Wnt)
-        return pN, mu * pN, True
+        if Wnn - mu * abs(Wnt) > 0.0:
+            if det > 0.0:
+                pN = (Wnt * uT - Wtt * b) / det
+                pT = (Wtn * b - Wnn * uT) / det
+                if pN >= 0.0 and abs(pT) <= mu * pN:
+                    return pN, pT, True
+            pN = -b / (Wnn - mu * Wnt)
+            if uT + (Wtn - mu * Wtt) * pN >= 0.0:
+                return pN, -mu * pN, True
+            pN = -b / (Wnn + mu * Wnt)
+            return pN, mu * pN, True
+        if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
+            return 0.0, 0.0, False
+        nfound = 0
+        fN = 0.0
+        fT = 0.0
+        ok = True
+        for case in range(3):
+            valid = False
+            pN = 0.0
+            pT = 0.0
+            if case == 0:
+                if det != 0.0:
+                    pN = (Wnt * uT - Wtt * b) / det
+                    pT = (Wtn * b - Wnn * uT) / det
+                    valid = pN >= 0.0 and abs(pT) <= mu * pN
+            elif case == 1:
+                den = Wnn - mu * Wnt
+                if den != 0.0:
+                    pN = -b / den
+                    pT = -mu * pN
+                    valid = pN >= 0.0 and uT + (Wtn - mu * Wtt) * pN >= 0.0
+            else:
+                den = Wnn + mu * Wnt
+                if den != 0.0:
+                    pN = -b / den
+                    pT = mu * pN
+                    valid = pN >= 0.0 and uT + (Wtn + mu * Wtt) * pN <= 0.0
+            if valid:
+                if nfound == 0:
+                    fN = pN
+                    fT = pT
+                elif (abs(pN - fN) > 1e-9 * (1.0 + abs(fN))
+                      or abs(pT - fT) > 1e-9 * (1.0 + abs(fT))):
+                    ok = False
+                nfound += 1
+        if nfound == 0:
+            ok = False
+        return fN, fT, ok
     if not Wnn > 0.0:
         return 0.0, 0.0, False
     return -b / Wnn, 0.0, True

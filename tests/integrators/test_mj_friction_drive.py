@@ -20,14 +20,20 @@ def mj(scene, periods, steps, **opts):
 
 # -- compiled path == generic path ------------------------------------------------------
 
-@pytest.mark.parametrize("freq, theta, projection", [
-    (185.0, 1.0, False), (185.0, 0.5, True), (20.0, 1.0, True), (2000.0, 0.5, False),
+@pytest.mark.parametrize("freq, theta, projection, params", [
+    (185.0, 1.0, False, {}), (185.0, 0.5, True, {}), (20.0, 1.0, True, {}),
+    (2000.0, 0.5, False, {}), (185.0, 1.0, False, {"mu": 0.0}),
+    # a soft spring: the rod flies and comes back with restitution 0.5
+    (2000.0, 1.0, True, {"k": 10.0, "restitution": 0.5}),
 ])
-def test_compiled_path_equals_generic_path(freq, theta, projection):
-    sc = FrictionDrive(frequency=freq)
+def test_compiled_path_equals_generic_path(freq, theta, projection, params):
+    sc = FrictionDrive(FrictionDriveParams(**params), frequency=freq)
     a = mj(sc, 1, 400, theta=theta, projection=projection, fast=False)
     b = mj(sc, 1, 400, theta=theta, projection=projection, fast=True)
     assert a.status == b.status == 0 and len(a.t) == len(b.t) == 401
+    if "k" in params:
+        letters = a.regime_letters()
+        assert "F" in letters and len(set(letters)) > 1
     np.testing.assert_array_equal(a.t, b.t)
     np.testing.assert_array_equal(a.regime, b.regime)
     vs = sc.u10          # velocity and displacement scale of the drive

@@ -302,11 +302,26 @@ def test_enumeration_frictionless_and_restitution():
 
 
 def test_painleve_violation_stops_the_run_with_status_minus_one():
-    with pytest.raises(MoreauError, match=r"Painlevé condition W_NN - mu \|W_NT\| > 0 violated"):
-        one_contact_impulse([[1.0, 2.0], [2.0, 5.0]], [-1.0, 0.0], 1.0)
-    res = run(SkewContact(), 1.0, [0.0, 0.0], [0.0, 0.0], h=0.1)
+    # W_NN - mu W_NT = -1: positive slip would need a jam impulse
+    W = [[1.0, 2.0], [2.0, 5.0]]
+    with pytest.raises(MoreauError, match=r"Painlevé condition W_NN - mu \|W_NT\| > 0 "
+                                          r"violated .* sliding the paradoxical way"):
+        one_contact_impulse(W, [-1.0, 1.0], 1.0)
+    res = run(SkewContact(), 1.0, [0.0, 0.0], [0.0, 1.0], h=0.1)
     assert res.status == -1 and not res.success
-    assert "Painlevé" in res.message
+    assert "Painlevé" in res.message and len(res.t) == 0
+
+
+def test_harmless_slip_direction_runs_despite_the_painleve_condition():
+    # same W, sliding the other way (W_NN + mu W_NT = 3 > 0): one solution, stick
+    W = np.array([[1.0, 2.0], [2.0, 5.0]])
+    pN, pT = one_contact_impulse(W, [-0.1, -0.2], 1.0)
+    assert (pN, pT) == (pytest.approx(0.1), pytest.approx(0.0, abs=1e-15))
+    M, q, layout = build_friction_lcp(W, [-0.1, -0.2], [1.0], 0.0)
+    zN, zT = friction_impulses(solve_lcp(M, q, method="lemke").z, layout)
+    assert (zN[0], zT[0]) == (pytest.approx(pN), pytest.approx(pT, abs=1e-12))
+    res = run(SkewContact(), 1.0, [0.0, 0.0], [0.0, 0.0], h=0.1)
+    assert res.status == 0 and set(res.regime_letters()) == {"S"}
 
 
 def test_classification_thresholds():
