@@ -101,6 +101,56 @@ def _min_normal_force(walker, segments):
     return best
 
 
+def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
+    """Safeguarded secant iteration on the scalar period map ``u2'(tau_s) -> u2'(tau_s + 2 pi)``.
+
+    Returns ``(start_state, iterations, last_end_state)``; ``start_state`` is
+    ``None`` when the rod is in flight at the section, where the map is not
+    scalar.
+    """
+    from ..integrators.event_driven import ContactState
+
+    vs = walker.vscale
+    phi_s, dphi_s = walker.manifold(tau_s)
+
+    def start_state(v):
+        return walker.classify(ContactState(tau_s, Regime.FLIGHT, phi_s, dphi_s, 0.0, v))
+
+    st = start_state(v0)
+    if st.regime == Regime.FLIGHT:
+        return None, 0, st
+    end, _, _ = _period_run(walker, st)
+    it = 1
+    xa, fa = v0, end.du2 - v0
+    if abs(fa) <= rtol * vs:
+        return st, it, end
+    xb = end.du2
+    while True:
+        if end.regime == Regime.FLIGHT:
+            return None, it, end
+        it += 1
+        if it > max_iter:
+            raise ConvergenceError(
+                f"shooting did not converge in `max_iter`={max_iter} period maps "
+                f"(residual {abs(fa) / vs:.3g} relative)")
+        st = start_state(xb)
+        end, _, _ = _period_run(walker, st)
+        if end.regime == Regime.FLIGHT:
+            return None, it, end
+        fb = end.du2 - xb
+        if abs(fb) <= rtol * vs:
+            return st, it, end
+        denom = fb - fa
+        xn = xb - fb * (xb - xa) / denom if denom != 0.0 else xb + fb
+        # the map is contracting, so F(x) = P(x) - x has slope in (-2, 0): a
+        # secant slope far outside that range is a kink of the map; take a
+        # fixed-point step instead
+        slope = denom / (xb - xa) if xb != xa else -1.0
+        if not (-2.5 < slope < 0.0) or not math.isfinite(xn):
+            xn = xb + fb
+        xa, fa, xb = xb, fb, xn
+
+
 def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
                       **options):
     """Periodic steady state of the friction drive, found by shooting.
@@ -156,62 +206,23 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     phig, dphig = walker.g_phi, walker.g_dphi
     Dg = scene.coefficients(phig, dphig, tg)[3]
     tau_s = 0.0 if Dg[0] <= 0.5 * Dg.min() else float(tg[int(np.argmin(Dg))])
-    phi_s, dphi_s = walker.manifold(tau_s)
     v0 = walker.vtip(tau_s) if v_guess is None else float(v_guess)
-
-    def start_state(v):
-        return walker.classify(ContactState(tau_s, Regime.FLIGHT, phi_s, dphi_s, 0.0, v))
-
-    def pmap(v):
-        end, _, _ = _period_run(walker, start_state(v))
-        return end
-
-    it = 0
-    contact_at_section = start_state(v0).regime != Regime.FLIGHT
-    x_hist = []
-    if contact_at_section:
-        end = pmap(v0)
-        ok = end.regime != Regime.FLIGHT
-        xa, fa = v0, end.du2 - v0
-        xb = end.du2
-        it = 1
-        converged = abs(fa) <= rtol * vs
-        xstar = xa
-        while not converged and ok:
-            it += 1
-            if it > max_iter:
-                raise ConvergenceError(
-                    f"shooting did not converge in `max_iter`={max_iter} period maps "
-                    f"(residual {abs(fa) / vs:.3g} relative)")
-            end = pmap(xb)
-            if end.regime == Regime.FLIGHT:
-                ok = False
-                break
-            fb = end.du2 - xb
-            if abs(fb) <= rtol * vs:
-                xstar, converged = xb, True
-                break
-            denom = fb - fa
-            if denom != 0.0:
-                xn = xb - fb * (xb - xa) / denom
-            else:
-                xn = xb + fb
-            # the map is contracting, so F(x) = P(x) - x has slope in (-2, 0):
-            # a secant step far outside that range is a kink of the map; take a
-            # fixed-point step instead
-            slope = denom / (xb - xa) if xb != xa else -1.0
-            if not (-2.5 < slope < 0.0) or not math.isfinite(xn):
-                xn = xb + fb
-            xa, fa, xb = xb, fb, xn
-        if converged:
-            x_final = xstar
-        else:
-            contact_at_section = False
-    if not contact_at_section:
-        raise ConvergenceError(
-            f"the rod is in flight at the Poincare section tau = {tau_s:.4g} in the steady state; "
-            "shooting on the full (phi, phi', u2') map is not implemented for this case")
-    st0 = start_state(x_final)
+    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter)
+    if st0 is None:
+        # the rod is in flight at this section in the steady state: move the
+        # section into the longest contact segment of the settled motion
+        _, segs, _ = _period_run(walker, last, record=True)
+        contact = [(b.tau - a.tau, a.tau, b.tau) for a, b in segs if a.regime != Regime.FLIGHT]
+        if not contact:
+            raise ConvergenceError("the rod never touches the rotor: no steady contact motion")
+        _, ta, tb = max(contact)
+        tau_s = 0.5 * (ta + tb) % TWO_PI
+        st0, it2, last = _shoot_scalar(walker, tau_s, walker.vtip(tau_s), rtol, max_iter)
+        it += it2
+        if st0 is None:
+            raise ConvergenceError(
+                f"no Poincare section with the rod in contact was found (last tried tau = "
+                f"{tau_s:.4g}); the motion may not be 2 pi-periodic")
     end, segs, evs = _period_run(walker, st0, record=True)
     residual = abs(end.du2 - st0.du2) / vs
     runs = []  # [tau_start, letter, entered_by_impact]
@@ -243,5 +254,5 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         periodic_residual=float(residual),
         iterations=it,
         wall_time=time.perf_counter() - t_start,
-        stats=dict(walker.counters),
+        stats=dict(walker.counters, section_tau=float(st0.tau)),
     )

@@ -258,3 +258,21 @@ def test_min_normal_force_is_the_analytic_value_at_tau_0(f):
     c = s = math.cos(math.pi / 4)
     exact = 2e-3 * (1 / (3 * c) - c / 2) / (c - 0.1 * s)
     assert ss.min_normal_force == pytest.approx(exact, rel=1e-9)
+
+
+def test_steady_state_with_flight_at_the_first_section():
+    # at 2000 Hz and phi0 = 1.43 the rod flies at the phase of strongest pressing;
+    # the section moves into a contact segment and the orbit is still found
+    sc = FrictionDrive(FrictionDriveParams(phi0=1.43), frequency=2000.0)
+    ss = find_steady_state(sc)
+    assert "F" in ss.mode and "!" in ss.mode
+    assert ss.periodic_residual < 1e-10
+    w = FrictionDriveWalker(sc)
+    # the recorded start lies on the orbit: one more period reproduces the displacement
+    phi, dphi, du2 = ss.state0
+    t0 = ss.stats.get("section_tau", None)
+    assert t0 is not None
+    st = w.classify(ContactState(t0, Regime.FLIGHT, phi, dphi, 0.0, du2))
+    end = w.advance(st, t0 + TWO_PI)
+    assert end.u2 == pytest.approx(ss.displacement_per_period, rel=1e-9)
+    assert end.du2 == pytest.approx(du2, rel=1e-9)
