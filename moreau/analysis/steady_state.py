@@ -24,7 +24,8 @@ class SteadyState:
         Net change of the translation-invariant coordinate over one period
         (dimensionless, ``u2 = x2 / l`` for the friction drive).
     state0 : ndarray
-        The fixed point of the period map (state at ``tau = 0``).
+        The fixed point of the period map: ``(phi, phi', u2')`` at the
+        Poincaré section ``tau = section_tau``.
     mode : str
         Canonical name of the cyclic regime sequence (e.g. ``"NP"``).
     regimes : list of (float, str)
@@ -39,6 +40,8 @@ class SteadyState:
         Seconds spent.
     stats : dict
         Scheme-specific counters (steps, LCP solves, fallbacks, ...).
+    section_tau : float
+        Phase of the Poincaré section at which ``state0`` is given.
     """
 
     scheme: str
@@ -51,6 +54,7 @@ class SteadyState:
     iterations: int = 0
     wall_time: float = 0.0
     stats: dict = field(default_factory=dict)
+    section_tau: float = 0.0
 
 
 # -- event-driven steady state of the friction drive ------------------------------
@@ -254,5 +258,6 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         periodic_residual=float(residual),
         iterations=it,
         wall_time=time.perf_counter() - t_start,
-        stats=dict(walker.counters, section_tau=float(st0.tau)),
+        stats=dict(walker.counters),
+        section_tau=float(st0.tau),
     )

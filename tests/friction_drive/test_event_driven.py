@@ -270,8 +270,7 @@ def test_steady_state_with_flight_at_the_first_section():
     w = FrictionDriveWalker(sc)
     # the recorded start lies on the orbit: one more period reproduces the displacement
     phi, dphi, du2 = ss.state0
-    t0 = ss.stats.get("section_tau", None)
-    assert t0 is not None
+    t0 = ss.section_tau
     st = w.classify(ContactState(t0, Regime.FLIGHT, phi, dphi, 0.0, du2))
     end = w.advance(st, t0 + TWO_PI)
     assert end.u2 == pytest.approx(ss.displacement_per_period, rel=1e-9)
