@@ -28,11 +28,16 @@ this rule the basis stays lexicographically feasible and degenerate problems
 cannot cycle. If ``z0`` is among the tied rows it leaves at once, which ends
 the path on a solution.
 
-Tolerances are relative, so they follow the scale of the data: a pivot entry
-counts as positive when it exceeds ``PIVOT_TOL`` times the largest magnitude
-in its column, ratios tie within ``TIE_TOL`` relative difference, and a
-right-hand side that cancels to rounding level is set to exactly zero so
-that degenerate rows are recognised as such.
+Tolerances are relative, so they follow the scale of the data. A pivot
+entry counts as positive when it exceeds ``PIVOT_TOL`` times the largest
+magnitude in its column; a smaller positive entry is not thrown away (on
+badly scaled problems, e.g. a triangular P-matrix whose solution spans
+eleven orders of magnitude, it is genuine) but compared with the rounding
+level of that entry, ``NOISE_TOL * sum_j |B^-1_ij| |A_ej|`` with ``A_e`` the
+entering column of ``[I, -M, -d]``, and kept when it stands above it.
+Ratios tie within ``TIE_TOL`` relative difference, and a right-hand side
+that cancels to rounding level is set to exactly zero so that degenerate
+rows are recognised as such.
 
 A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
 the data and the scaled residual of :func:`moreau.lcp.lcp_residual` must be
@@ -76,13 +81,17 @@ __all__ = [
     "BREAKDOWN",
     "INVALID_INPUT",
     "PIVOT_TOL",
+    "NOISE_TOL",
     "TIE_TOL",
     "DEFAULT_TOL",
 ]
 
-#: a pivot-column entry is a candidate when it exceeds this times the column's
-#: largest magnitude
-PIVOT_TOL = 1e-11
+#: a pivot-column entry above this times the column's largest magnitude is a
+#: candidate without further checks
+PIVOT_TOL = 1e-9
+#: a smaller positive entry is a candidate when it exceeds this times its
+#: rounding scale sum_j |B^-1_ij| |A_ej|
+NOISE_TOL = 1e3 * np.finfo(float).eps
 #: two ratios (or two lexicographic entries) tie within this relative difference
 TIE_TOL = 1e-9
 #: default bound on the scaled residual for a result to count as solved
@@ -274,6 +283,29 @@ def _resolve_basis(M, q, pos, n, z_out):
 
 
 @njit(cache=True)
+def _noise_scale(T, pos, M, d, n, i, entering):
+    # sum_j |B^-1_ij| |A_ej|: the size of the terms that make up entry i of
+    # the entering column B^-1 A_e, hence the scale of its rounding error
+    acc = 0.0
+    for j in range(n):
+        p = pos[j]
+        if p >= 0:
+            if p != i:
+                continue
+            bij = 1.0
+        else:
+            bij = abs(T[i, -p - 1])
+        if entering < n:
+            aej = 1.0 if j == entering else 0.0
+        elif entering < 2 * n:
+            aej = abs(M[j, entering - n])
+        else:
+            aej = d[j]
+        acc += bij * aej
+    return acc
+
+
+@njit(cache=True)
 def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     """Lemke's method on preallocated arrays (compiled; callable from ``@njit`` code).
 
@@ -403,7 +435,15 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
         theta = np.inf
         for i in range(n):
             a = col[i]
-            if a > thr:
+            if a > 0.0 and a <= thr:
+                # small: keep it only if it stands above its rounding level;
+                # otherwise it is rounding of a zero, and becomes one (in the
+                # tableau too, so that the elimination agrees)
+                if not a > NOISE_TOL * _noise_scale(T, pos, M, d, n, i, entering):
+                    col[i] = 0.0
+                    T[i, s] = 0.0
+                    a = 0.0
+            if a > 0.0:
                 t = b[i] / a
                 if t < theta:
                     theta = t
@@ -423,14 +463,14 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
         nties = 0
         for i in range(n):
             a = col[i]
-            if a > thr and b[i] / a <= lim:
+            if a > 0.0 and b[i] / a <= lim:
                 nties += 1
                 if r < 0:
                     r = i
         if nties > 1:
             zrow = pos[z0]
             a_z = col[zrow]
-            if a_z > thr and b[zrow] / a_z <= lim:
+            if a_z > 0.0 and b[zrow] / a_z <= lim:
                 # z0 can leave now: take the solution
                 r = zrow
             else:
@@ -438,7 +478,7 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
                 unresolved = False
                 for i in range(r + 1, n):
                     a = col[i]
-                    if a > thr and b[i] / a <= lim:
+                    if a > 0.0 and b[i] / a <= lim:
                         c = _lex_compare(T, pos, n, i, best, a, col[best])
                         if c < 0:
                             best = i

@@ -66,29 +66,49 @@ __all__ = ["solve", "DEFAULT_TOL", "qp_formulation"]
 DEFAULT_TOL = 1e-6
 #: OSQP's absolute and relative tolerances
 OSQP_EPS = 1e-9
+#: OSQP's iteration limit (first-order: slow on rank-deficient P)
+OSQP_MAX_ITER = 20000
 # symmetry and semidefiniteness are judged relative to max|M|
 _STRUCT_TOL = 1e-10
 
 
-def _osqp(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None):
-    # one QP through qpsolvers; returns (x or None, iterations reported)
+def _osqp(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None, eps=OSQP_EPS):
+    # One QP through qpsolvers; returns x or None. OSQP's stopping rule mixes
+    # absolute and relative tolerances, so the data are first brought to
+    # unit scale (z = alpha * x_hat, alpha = max|c| / max|P|): a Delassus
+    # matrix of 1e-5 would otherwise read as "dual infeasible".
     from qpsolvers import Problem, solve_problem
 
     n = len(c)
-    Psp = sp.csc_matrix(P)
-    Gsp = None if G is None else sp.csc_matrix(G)
-    prob = Problem(Psp, c, G=Gsp, h=h, lb=lb, ub=ub)
-    opts = dict(eps_abs=OSQP_EPS, eps_rel=OSQP_EPS, polish=False, verbose=False)
-    if max_iter is not None:
-        opts["max_iter"] = max_iter
+    sP = float(np.max(np.abs(P))) if P.size else 0.0
+    sc = max(float(np.max(np.abs(c))) if n else 0.0, float(np.max(np.abs(h))) if h is not None and len(h) else 0.0)
+    sP = sP if sP > 0.0 else 1.0
+    sc = sc if sc > 0.0 else 1.0
+    alpha = sc / sP
+    if not (np.isfinite(alpha) and alpha > 0.0):
+        return None
+    Psp = sp.csc_matrix(P / sP)
+    Gsp = None if G is None else sp.csc_matrix(G / sP)
+    prob = Problem(
+        Psp, c / sc, G=Gsp, h=None if h is None else h / sc,
+        lb=None if lb is None else lb / alpha, ub=None if ub is None else ub / alpha,
+    )
+    opts = dict(eps_abs=eps, eps_rel=eps, polish=False, verbose=False,
+                max_iter=OSQP_MAX_ITER if max_iter is None else max_iter)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            sol = solve_problem(prob, solver="osqp", initvals=initvals, **opts)
+            sol = solve_problem(prob, solver="osqp", initvals=None if initvals is None else initvals / alpha, **opts)
         except Exception:  # the backend's own failures become a status, not a crash
             return None
-    x = sol.x if sol.found else None
-    if x is None or x.shape != (n,) or not np.all(np.isfinite(x)):
+    # an iterate that stopped short of OSQP's tolerance is still returned:
+    # the refinement and the residual check decide whether it solves the LCP
+    x = sol.x
+    if x is None or x.shape != (n,):
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        x = x * alpha
+    if not np.all(np.isfinite(x)):
         return None
     return x
 
@@ -185,7 +205,7 @@ def _tresca(M, q, layout, max_iter, fp_tol):
     return z, solves, converged, ""
 
 
-def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
+def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, refine=True):
     """Solve ``LCP(M, q)`` through convex QPs (see the module text for the formulations).
 
     Parameters
@@ -203,6 +223,9 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
     friction : FrictionLayout, optional
         Layout of a friction LCP from :func:`moreau.lcp.build_friction_lcp`;
         selects the Tresca fixed point when ``M`` is not symmetric.
+    refine : bool
+        Finish with the active-set refinement (see the module text). Turn
+        it off to see what OSQP alone delivers.
 
     Returns
     -------
@@ -237,10 +260,29 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
     status = SOLVED
     note = ""
     solves = 1
-    if form == "bound":
-        z = _osqp(M, q, lb=np.zeros(n))
-    elif form == "gap":
-        z = _osqp(M + M.T, q, lb=np.zeros(n), G=-M, h=q)
+    if form in ("bound", "gap"):
+        # OSQP at a tight tolerance sometimes stalls on a rank-deficient P
+        # ("dual infeasible inaccurate"); a looser solve, refined on its
+        # active set, then usually lands on the exact vertex
+        z = None
+        res = np.inf
+        for k, eps in enumerate((OSQP_EPS, 1e-6)):
+            if form == "bound":
+                x = _osqp(M, q, lb=np.zeros(n), eps=eps)
+            else:
+                x = _osqp(M + M.T, q, lb=np.zeros(n), G=-M, h=q, eps=eps)
+            solves = k + 1
+            if x is None:
+                continue
+            x = np.maximum(x, 0.0)
+            with np.errstate(over="ignore", invalid="ignore"):
+                rx = lcp_residual(M, q, x)
+            if refine and np.isfinite(rx):
+                x, rx = _refine(M, q, x, rx)
+            if rx < res:
+                z, res = x, rx
+            if res <= tol:
+                break
     elif form == "tresca":
         z, solves, converged, note = _tresca(M, q, friction, 100 if max_iter is None else max_iter, 1e-10)
         if z is not None and not converged:
@@ -258,8 +300,14 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
         return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_residual(M, q, z0), "qp",
                          detail=note or f"OSQP found no solution of the {form!r} QP.")
     z = np.maximum(z, 0.0)
-    res = lcp_residual(M, q, z)
-    z, res = _refine(M, q, z, res)
+    with np.errstate(over="ignore", invalid="ignore"):
+        res = lcp_residual(M, q, z)
+    if not np.isfinite(res):
+        z0 = np.zeros(n)
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_residual(M, q, z0), "qp",
+                         detail=f"the {form!r} QP answer overflowed.")
+    if refine:
+        z, res = _refine(M, q, z, res)
     w = M @ z + q
     if status == SOLVED and not res <= tol:
         status = SOLVER_FAILED
