@@ -78,7 +78,8 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
     if scheme == "moreau-jean":
         out["steps_per_period"] = steps_per_period
         out["theta"] = theta
-        for key in ("steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope"):
+        for key in ("steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
+                    "period_map_eigenvalues"):
             if key in ss.stats:
                 val = ss.stats[key]
                 out[key] = val if not hasattr(val, "tolist") else val.tolist()

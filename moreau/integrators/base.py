@@ -82,6 +82,10 @@ class Integrator:
             self._fail(-2, str(exc))
         except LCPError as exc:
             self._fail(-3, str(exc))
+        except InputError:
+            raise
+        except (MoreauError, FloatingPointError) as exc:
+            self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
             self.counters["steps"] += 1
             if self.t >= self.t_bound:

@@ -100,3 +100,14 @@ def test_mode_name_marks_impacts():
     assert mode_name("NFS", impacts=[False, False, True]) == "NF!S"
     with pytest.raises(ValueError, match="`sequence` may contain only"):
         mode_name("NX")
+
+
+def test_steady_moreau_jean_json(capsys):
+    rc, rep = run_json(capsys, "--frequency", "185", "--scheme", "moreau-jean",
+                       "--steps-per-period", "2000")
+    assert rc == 0
+    assert KEYS | {"steps", "lcp_solves", "fallbacks", "max_penetration"} <= set(rep)
+    assert rep["scheme"] == "moreau-jean" and rep["mode"] == "NP"
+    # within 1e-3 of the event-driven reference at 2000 steps per period
+    assert rep["displacement_per_period_m"] == pytest.approx(-6.639079e-6, rel=1e-3)
+    assert rep["steps"] > 0 and rep["fallbacks"] == 0
