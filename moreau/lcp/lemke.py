@@ -151,8 +151,10 @@ def _lex_compare(T, pos, n, i, k, ai, ak):
             s = -p - 1
             vi = T[i, s]
             vk = T[k, s]
-        xi = vi / ai
-        xk = vk / ak
+        # compare vi/ai with vk/ak through cross products (ai, ak > 0):
+        # no division in a loop that can run n times per tied row
+        xi = vi * ak
+        xk = vk * ai
         diff = xi - xk
         if abs(diff) > TIE_TOL * max(abs(xi), abs(xk)):
             return -1 if diff < 0.0 else 1
@@ -334,11 +336,18 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     -------
     status : int
         :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1), :data:`MAX_ITER` (2),
-        :data:`BREAKDOWN` (3) or :data:`INVALID_INPUT` (4).
+        :data:`BREAKDOWN` (3) or :data:`INVALID_INPUT` (4: NaN or inf in
+        ``M`` or ``q``, a covering entry that is not finite and > 0, or a
+        workspace that is too small; ``z_out`` and ``w_out`` are then zero).
     pivots : int
         Pivots performed (0 when ``q >= 0``).
     residual : float
         Scaled residual of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
+
+    Notes
+    -----
+    The arrays are not checked for shape beyond the workspace: ``M`` must
+    be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
     n = q.shape[0]
     for k in range(n + 1):
@@ -398,17 +407,17 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     pos[2 * n] = -(n + 1)
     z0 = 2 * n
 
-    # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i
+    # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i.
+    # With B^-1 = I, of two rows tied in q_i/d_i the one with the larger
+    # index is lexicographically smaller (its unit entry comes later), so a
+    # forward scan keeps the last of the tied rows.
     r = 0
+    rr = q[0] / d[0]
     for i in range(1, n):
         ri = q[i] / d[i]
-        rr = q[r] / d[r]
-        if ri < rr - TIE_TOL * max(abs(ri), abs(rr)):
+        if ri <= rr + TIE_TOL * max(abs(ri), abs(rr)):
             r = i
-        elif ri <= rr + TIE_TOL * max(abs(ri), abs(rr)):
-            c = _lex_compare(T, pos, n, i, r, d[i], d[r])
-            if c < 0:
-                r = i
+            rr = min(ri, rr)
     _pivot(T, b, col, n, r, n)
     leaving = basis[r]
     basis[r] = z0
@@ -572,6 +581,38 @@ def _solve_packed(M, q, d, out, max_iter, tol):
     return lemke_core(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
 
 
+@njit(cache=True)
+def _solve_packed_ones(M, q, out, max_iter, tol):
+    # covering vector of ones made here: one array argument less to type on
+    # every call from Python
+    return _solve_packed(M, q, np.ones(q.shape[0]), out, max_iter, tol)
+
+
+class _LemkeResult(LCPResult):
+    # the explanation of a failure is composed only when someone reads it,
+    # so that a failed solve costs no more than a successful one
+    __slots__ = ()
+
+    @property
+    def detail(self):
+        d = self.__dict__.get("_detail")
+        if d is not None:
+            return d
+        if self.status == SOLVED:
+            return ""
+        return _DETAIL.get(self.status, "") + f" (after {self.pivots} pivots)"
+
+    @detail.setter
+    def detail(self, value):
+        self.__dict__["_detail"] = value
+
+    @property
+    def ray(self):
+        if self.status != SECONDARY_RAY:
+            return None
+        return self.__dict__["_buf"][2 * len(self.z):]
+
+
 _DETAIL = {
     SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray. "
     "For copositive-plus M this proves the LCP infeasible.",
@@ -689,33 +730,20 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     n = q.shape[0]
     out = np.empty(3 * n + 1)
     if covering is None:
-        covering_ = _ONES.get(n)
-        if covering_ is None:
-            covering_ = _ones(n)
+        status, pivots, residual = _solve_packed_ones(
+            M, q, out,
+            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
+            DEFAULT_TOL if tol is None else tol,
+        )
     else:
-        covering_ = covering
-    status, pivots, residual = _solve_packed(
-        M, q, covering_, out,
-        (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
-        DEFAULT_TOL if tol is None else tol,
-    )
-    if status == SOLVED:
-        return LCPResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+        status, pivots, residual = _solve_packed(
+            M, q, covering, out,
+            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
+            DEFAULT_TOL if tol is None else tol,
+        )
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
-    return LCPResult(
-        out[:n], out[n:2 * n], status, pivots, residual, "lemke",
-        ray=out[2 * n:] if status == SECONDARY_RAY else None,
-        detail=_DETAIL.get(status, "") + f" (after {pivots} pivots)",
-    )
-
-
-_ONES = {}
-
-
-def _ones(n):
-    # the covering vector is read-only in the kernel, so one array per size serves all calls
-    d = _ONES.get(n)
-    if d is None:
-        d = _ONES[n] = np.ones(n)
-    return d
+    res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+    if status == SECONDARY_RAY:
+        res.__dict__["_buf"] = out
+    return res

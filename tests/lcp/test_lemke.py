@@ -280,3 +280,13 @@ def test_kernel_and_python_wrapper_agree_on_pivots():
         assert st == ref.status == SOLVED
         assert piv == ref.pivots
         assert res == pytest.approx(ref.residual, abs=1e-18)
+
+
+def test_badly_scaled_triangular_p_matrix_is_not_cut_off_by_the_pivot_tolerance():
+    # z_k = 17^(k-1): the pivot column spans eleven orders of magnitude and
+    # a column-relative cut-off would end on a false secondary ray
+    n = 10
+    M = np.eye(n) - 16.0 * np.tril(np.ones((n, n)), -1)
+    res = solve_lcp(M, -np.ones(n))
+    assert res.success
+    np.testing.assert_allclose(res.z, 17.0 ** np.arange(n), rtol=1e-12)
