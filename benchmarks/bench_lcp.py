@@ -131,7 +131,11 @@ def outcome(fn, M, q, feasible, max_iter=None):
 
 
 def time_per_call(fns, rounds, budget=0.02):
-    """Median CPU seconds per call of each function, measured in interleaved rounds."""
+    """CPU seconds per call of each function, one sample per interleaved round.
+
+    Returns a list (one per function) of per-round samples. A function whose
+    single call takes longer than 50 ms is sampled once.
+    """
     clock = time.process_time
     numbers = []
     for fn in fns:
@@ -139,16 +143,20 @@ def time_per_call(fns, rounds, budget=0.02):
         t0 = time.perf_counter()
         fn()
         dt = time.perf_counter() - t0
-        numbers.append(max(1, min(2000, int(budget / max(dt, 1e-7)))))
+        numbers.append(0 if dt > 0.05 else max(1, min(5000, int(budget / max(dt, 1e-7)))))
     samples = [[] for _ in fns]
-    for _ in range(rounds):
+    for r in range(rounds):
         for k, fn in enumerate(fns):
             num = numbers[k]
+            if num == 0:
+                if r > 0:
+                    continue
+                num = 1
             t0 = clock()
             for _ in range(num):
                 fn()
             samples[k].append((clock() - t0) / num)
-    return [float(np.median(s)) for s in samples]
+    return samples
 
 
 def bench_instances(quick):
@@ -180,14 +188,14 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes and fewer repeats")
     args = ap.parse_args(argv)
-    rounds = 5 if args.quick else 11
+    rounds = 7 if args.quick else 21
     n_robust = 60 if args.quick else 300
 
     names = [n for n, _ in solvers()]
     print(f"LCP benchmark ({'quick' if args.quick else 'full'}): median CPU time per solve in microseconds, "
           f"{rounds} interleaved rounds")
     print("moreau = solve_lcp(M, q); lean = check_input=False; kernel = lemke_kernel called from a compiled loop")
-    print("ratio = moreau / peer in this run (< 1: moreau faster); "
+    print("ratio = median over rounds of moreau / peer timed back to back (< 1: moreau faster); "
           "'!' marks a wrong answer, 'E' an exception\n")
     head = (f"{'instance':30s} {'n':>4s} {'moreau':>9s} {'lean':>9s} {'kernel':>9s}"
             f" {'quantecon':>10s} {'ratio':>6s} {'lemkelcp*':>10s} {'ratio':>7s}")
@@ -198,7 +206,6 @@ def main(argv=None):
         n = len(q)
         fns = dict(solvers())
         marks = {k: outcome(fn, M, q, feasible, max_iter) for k, fn in fns.items()}
-        slow = n >= 200 or name.startswith("murty")
         calls = []
         keys = []
         for k in ("moreau", "moreau-lean", "quantecon", "lemkelcp*"):
@@ -210,8 +217,17 @@ def main(argv=None):
         keys.append("kernel")
         reps = 20
         calls.append(lambda: _kernel_loop(M, q, z, w, reps))
-        times = dict(zip(keys, time_per_call(calls, 3 if slow else rounds)))
-        times["kernel"] /= reps
+        samples = dict(zip(keys, time_per_call(calls, rounds)))
+        samples["kernel"] = [t / reps for t in samples["kernel"]]
+        times = {k: float(np.median(v)) for k, v in samples.items()}
+
+        def paired_ratio(peer):
+            # median over rounds of moreau/peer measured back to back, which
+            # cancels most of the drift of a shared machine
+            a, b = samples["moreau"], samples[peer]
+            if len(b) < len(a):
+                return times["moreau"] / times[peer]
+            return float(np.median(np.array(a) / np.array(b)))
 
         def cell(k):
             t = times.get(k)
@@ -219,8 +235,8 @@ def main(argv=None):
             m = marks.get(k, "ok")
             return s + ("" if m == "ok" else ("!" if m == "FAIL" else "E"))
 
-        r_qe = times["moreau"] / times["quantecon"] if "quantecon" in times else None
-        r_lk = times["moreau"] / times["lemkelcp*"] if "lemkelcp*" in times else None
+        r_qe = paired_ratio("quantecon") if "quantecon" in times else None
+        r_lk = paired_ratio("lemkelcp*") if "lemkelcp*" in times else None
         if r_qe is not None and marks.get("quantecon") == "ok":
             worst_qe = max(worst_qe, r_qe)
         print(f"{name:30s} {n:4d} {cell('moreau'):>9s} {cell('moreau-lean'):>9s} {fmt_us(times['kernel']):>9s}"

@@ -152,7 +152,7 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     """
     if method == "lemke" and not options:
         # the per-time-step path: skip the keyword forwarding
-        return lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
+        return lemke._solve(M, q, max_iter, tol, check_input, None)
     try:
         fn = METHODS[method]
     except (KeyError, TypeError):
