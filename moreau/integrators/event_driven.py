@@ -646,7 +646,13 @@ class EventDriven(Integrator):
         self.walker = FrictionDriveWalker(scene, rtol=rtol)
         self.samples_per_period = positive_int("samples_per_period", samples_per_period)
         st = ContactState(self.t, _F, self.q[0], self.v[0], self.q[1], self.v[1])
-        self.state = self.walker.classify(st)
+        try:
+            self.state = self.walker.classify(st)
+        except PainleveError as exc:
+            # the initial state is already ill-posed: a run that stops at once, with its cause
+            self.state = st
+            self._fail(-1, str(exc))
+            return
         self._record_state(self.state)
 
     def _record_state(self, st):
