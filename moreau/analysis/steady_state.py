@@ -5,11 +5,18 @@ rotor position of the friction drive) has a period map on the remaining
 state; its fixed point is the periodic steady state, found by shooting.
 """
 
+import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-__all__ = ["SteadyState"]
+from .._validate import positive, positive_int
+from ..errors import ConvergenceError, InputError
+from ..regimes import REGIME_LETTERS, Regime
+from .modes import mode_name
+
+__all__ = ["SteadyState", "find_steady_state"]
 
 
 @dataclass
@@ -59,20 +66,11 @@ class SteadyState:
 
 # -- event-driven steady state of the friction drive ------------------------------
 
-import math
-import time
-
-from .._validate import positive, positive_int
-from ..errors import ConvergenceError, InputError
-from ..regimes import REGIME_LETTERS, Regime
-from .modes import mode_name
-
 TWO_PI = 2.0 * math.pi
 
 
 def _period_run(walker, state, record=False):
     """Advance one period from ``state``; return (end_state, segments, events)."""
-    from ..integrators.event_driven import ContactState  # noqa: F401  (type of state)
     segs, evs = [], []
     on_seg = (lambda a, b, sol: segs.append((a, b))) if record else None
     end = walker.advance(state, state.tau + TWO_PI, on_segment=on_seg,
