@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau steady`` and ``moreau sweep``.
+"""Command line interface: ``moreau steady``, ``moreau sweep`` and ``moreau run``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -114,6 +114,15 @@ def _cmd_sweep(args):
               plot=not args.no_plot)
 
 
+def _cmd_run(args):
+    from .analysis.histories import history_command
+    params = _params(args)
+    if args.frequency is None:
+        raise InputError("`--frequency` is required (drive frequency in Hz)")
+    history_command(params, args.frequency, args.periods, args.scheme, args.steps_per_period,
+                    args.theta, args.out, plot=not args.no_plot, progress=not args.quiet)
+
+
 def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -135,6 +144,14 @@ def build_parser():
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
     _add_params(s)
     s.set_defaults(func=_cmd_sweep)
+    r = sub.add_parser("run", help="time histories from rest (CSV + figure, SI units)")
+    r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
+    r.add_argument("--periods", type=float, default=10.0, help="drive periods to simulate")
+    r.add_argument("--out", default="out", help="output folder (default ./out)")
+    r.add_argument("--quiet", action="store_true", help="no progress bar")
+    r.add_argument("--no-plot", action="store_true", help="skip the figure")
+    _add_params(r)
+    r.set_defaults(func=_cmd_run)
     return parser
 
 

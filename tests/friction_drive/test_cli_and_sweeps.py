@@ -111,3 +111,27 @@ def test_steady_moreau_jean_json(capsys):
     # within 1e-3 of the event-driven reference at 2000 steps per period
     assert rep["displacement_per_period_m"] == pytest.approx(-6.639079e-6, rel=1e-3)
     assert rep["steps"] > 0 and rep["fallbacks"] == 0
+
+
+def test_run_command_writes_history(tmp_path, capsys):
+    rc = main(["run", "--frequency", "185", "--periods", "2", "--out", str(tmp_path), "--quiet",
+               "--no-plot"])
+    assert rc == 0
+    path = tmp_path / "history_185Hz_event-driven.csv"
+    data = np.genfromtxt(path, delimiter=",", names=True)
+    assert data["t"][-1] == pytest.approx(2 / 185.0)
+    assert np.all(data["normal_force"] > 0)
+    # two periods from rest: the rotor has moved backwards by a few micrometres
+    assert -2e-5 < data["x2"][-1] < -5e-6
+
+
+def test_histories_of_both_schemes_agree():
+    from moreau.analysis.histories import run_history
+    from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    ed = run_history(PAPER_DEFAULTS, 185.0, periods=3, samples_per_period=100)
+    mj = run_history(PAPER_DEFAULTS, 185.0, periods=3, scheme="moreau-jean",
+                     steps_per_period=4000, samples_per_period=100)
+    assert ed["status"] == mj["status"] == 0
+    assert mj["x2"][-1] == pytest.approx(ed["x2"][-1], rel=2e-3)
+    with pytest.raises(ValueError, match="`periods` must be > 0"):
+        run_history(PAPER_DEFAULTS, 185.0, periods=0)
