@@ -124,7 +124,7 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     end, _, _ = _period_run(walker, st)
     it = 1
     xa, fa = v0, end.du2 - v0
-    if abs(fa) <= rtol * vs:
+    if fa == 0.0:
         return st, it, end
     xb = end.du2
     while True:
@@ -140,14 +140,16 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
         if end.regime == Regime.FLIGHT:
             return None, it, end
         fb = end.du2 - xb
-        if abs(fb) <= rtol * vs:
-            return st, it, end
         denom = fb - fa
+        slope = denom / (xb - xa) if xb != xa else -1.0
+        # stop on the estimated distance to the fixed point, |F| / |F'|: near a
+        # barely contracting map (P' -> 1) the residual alone would understate it
+        if abs(fb) <= rtol * vs * min(1.0, abs(slope)):
+            return st, it, end
         xn = xb - fb * (xb - xa) / denom if denom != 0.0 else xb + fb
         # the map is contracting, so F(x) = P(x) - x has slope in (-2, 0): a
         # secant slope far outside that range is a kink of the map; take a
         # fixed-point step instead
-        slope = denom / (xb - xa) if xb != xa else -1.0
         if not (-2.5 < slope < 0.0) or not math.isfinite(xn):
             xn = xb + fb
         xa, fa, xb = xb, fb, xn
@@ -173,7 +175,9 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`,
         which takes ``steps_per_period`` and ``theta`` in ``options``).
     rtol : float
-        Tolerance on the periodic residual, relative to the tip-velocity scale.
+        Tolerance on the estimated distance of ``u2'`` from the fixed point
+        (residual over the secant slope of ``P(x) - x``), relative to the
+        tip-velocity scale.
     v_guess : float, optional
         Initial guess of ``u2'`` at ``tau = 0`` (dimensionless).
     max_iter : int
