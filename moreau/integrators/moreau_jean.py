@@ -100,6 +100,7 @@ from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError, LCPError, PainleveError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
+from . import _mj_kernels as _kernels
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
@@ -229,57 +230,23 @@ def _one_contact_frictionless(Wnn, uN, e, vN_pre):
 
 
 def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
-    # kept scalar and branch-for-branch identical to the compiled kernel in
-    # _mj_kernels.py, so that the fast and the generic path agree to rounding
-    b = uN + e * min(vN_pre, 0.0)
-    if b >= 0.0:
-        return 0.0, 0.0
-    det = Wnn * Wtt - Wnt * Wtn
-    if Wnn - mu * abs(Wnt) > 0.0:
-        # well posed: exactly one case holds (see one_contact_impulse)
-        if det > 0.0:
-            pN = (Wnt * uT - Wtt * b) / det
-            pT = (Wtn * b - Wnn * uT) / det
-            if pN >= 0.0 and abs(pT) <= mu * pN:
-                return pN, pT
-        pN = -b / (Wnn - mu * Wnt)
-        if uT + (Wtn - mu * Wtt) * pN >= 0.0:
-            return pN, -mu * pN
-        pN = -b / (Wnn + mu * Wnt)
-        return pN, mu * pN
-    # one slip branch has a non-increasing normal velocity. If the step would
-    # slide along that branch, the only way out is an impulsive jam whose size
-    # does not vanish with h: the continuous problem is paradoxical
+    # the compiled case analysis itself, so that the fast and the generic path
+    # agree to rounding; here only the failure gets its explanation
+    pN, pT, ok = _kernels._one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre)
+    if ok:
+        return pN, pT
     if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
+        # one slip branch has a non-increasing normal velocity and the step would
+        # slide along it: the only way out is an impulsive jam whose size does not
+        # vanish with h, so the continuous problem is paradoxical
         raise PainleveError(
             f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
             f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) with the contact sliding "
             f"the paradoxical way: no sliding solution exists")
-    # otherwise collect every case that holds and accept the answer only if unique
-    found = []
-    if det != 0.0:
-        pN = (Wnt * uT - Wtt * b) / det
-        pT = (Wtn * b - Wnn * uT) / det
-        if pN >= 0.0 and abs(pT) <= mu * pN:
-            found.append((pN, pT))
-    den = Wnn - mu * Wnt
-    if den != 0.0:
-        pN = -b / den
-        if pN >= 0.0 and uT + (Wtn - mu * Wtt) * pN >= 0.0:
-            found.append((pN, -mu * pN))
-    den = Wnn + mu * Wnt
-    if den != 0.0:
-        pN = -b / den
-        if pN >= 0.0 and uT + (Wtn + mu * Wtt) * pN <= 0.0:
-            found.append((pN, mu * pN))
-    if found and all(abs(p[0] - found[0][0]) <= 1e-9 * (1.0 + abs(found[0][0]))
-                     and abs(p[1] - found[0][1]) <= 1e-9 * (1.0 + abs(found[0][1]))
-                     for p in found):
-        return found[0]
     raise PainleveError(
         f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
         f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) and the contact problem has "
-        f"{'no solution' if not found else 'several solutions'}")
+        f"no unique solution")
 
 
 def one_contact_residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
@@ -289,19 +256,7 @@ def one_contact_residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
     :func:`~moreau.lcp.friction.build_friction_lcp` at the point
     ``z = (pN, max(pT, 0), max(-pT, 0), |u_T|)``, computed without building it.
     """
-    b = uN + e * min(vN_pre, 0.0)
-    vN = b + Wnn * pN + Wnt * pT
-    if not mu > 0.0:
-        num = abs(min(pN, vN))
-        scale = 1.0 + abs(b) + abs(Wnn) * abs(pN)
-        return num / scale
-    vT = uT + Wtn * pN + Wtt * pT
-    tp, tm, beta = max(pT, 0.0), max(-pT, 0.0), abs(vT)
-    num = max(abs(min(pN, vN)), abs(min(tp, vT + beta)), abs(min(tm, beta - vT)),
-              abs(min(beta, mu * pN - tp - tm)))
-    mmax = max(abs(Wnn), abs(Wnt), abs(Wtn), abs(Wtt), mu, 1.0)
-    scale = 1.0 + max(abs(b), abs(uT)) + mmax * max(pN, tp, tm, beta)
-    return num / scale
+    return _kernels._residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT)
 
 
 def _new_counters():
