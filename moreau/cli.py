@@ -50,6 +50,7 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
     >>> r["mode"], r["displacement_per_period_m"] < 0
     ('NS', True)
     """
+    from . import integrators  # noqa: F401  (load the schemes before the clock starts)
     from .analysis.steady_state import find_steady_state
     from .scenes.friction_drive import FrictionDrive
 
