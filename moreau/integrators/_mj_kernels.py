@@ -135,6 +135,21 @@ def _classify(pN, pT, mu):
     return 3
 
 
+@njit(cache=True, inline="always")
+def _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, i,
+           t, q0, q1, v0, v1, reg, fN, fT, slip, gap):
+    rec_t[i] = t
+    rec_q[i, 0] = q0
+    rec_q[i, 1] = q1
+    rec_v[i, 0] = v0
+    rec_v[i, 1] = v1
+    rec_reg[i] = reg
+    rec_fN[i] = fN
+    rec_fT[i] = fT
+    rec_slip[i] = slip
+    rec_gap[i] = gap
+
+
 @njit(cache=True)
 def mj_run_fd(par, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, save_every,
               record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
@@ -303,16 +318,8 @@ def mj_run_fd(par, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, sa
             stats[S_PEN] = -gap
         reg = _classify(pN, pT, mu)
         if record_initial:
-            rec_t[nrec] = tk
-            rec_q[nrec, 0] = q0_
-            rec_q[nrec, 1] = q1_
-            rec_v[nrec, 0] = v0_
-            rec_v[nrec, 1] = v1_
-            rec_reg[nrec] = reg
-            rec_fN[nrec] = pN / hk
-            rec_fT[nrec] = pT / hk
-            rec_slip[nrec] = slip
-            rec_gap[nrec] = b0_gap
+            _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                   tk, q0_, q1_, v0_, v1_, reg, pN / hk, pT / hk, slip, b0_gap)
             nrec += 1
             record_initial = False
         closed = is_closed
@@ -322,16 +329,8 @@ def mj_run_fd(par, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, sa
         v1_ = nv1
         k += 1
         if k % save_every == 0 or last:
-            rec_t[nrec] = t1
-            rec_q[nrec, 0] = q0_
-            rec_q[nrec, 1] = q1_
-            rec_v[nrec, 0] = v0_
-            rec_v[nrec, 1] = v1_
-            rec_reg[nrec] = reg
-            rec_fN[nrec] = pN / hk
-            rec_fT[nrec] = pT / hk
-            rec_slip[nrec] = slip
-            rec_gap[nrec] = gap
+            _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                   t1, q0_, q1_, v0_, v1_, reg, pN / hk, pT / hk, slip, gap)
             nrec += 1
         if last:
             break
