@@ -442,12 +442,17 @@ class FrictionDriveWalker:
             pre = solve_ivp(self._flight_rhs, (t0, t0 + skip), y0, dense_output=dense, **opts)
             y0 = pre.y[:, -1]
             t0 = t0 + skip
-        sol = solve_ivp(self._flight_rhs, (t0, tau_end), y0, events=gap, dense_output=dense, **opts)
-        if dense and pre is not None:
-            sol.sol = _JoinedDense(pre.sol, sol.sol, t0)
+        sol = solve_ivp(self._flight_rhs, (t0, tau_end), y0, events=gap, dense_output=True, **opts)
         if sol.status < 0:
             raise MoreauError(f"flight integration failed: {sol.message}")
+        graze = self._missed_recontact(sol)
+        if dense and pre is not None:
+            sol.sol = _JoinedDense(pre.sol, sol.sol, t0)
         out = st.copy()
+        if graze is not None:
+            te, ye = graze
+            out.tau, out.phi, out.dphi, out.u2, out.du2 = te, *map(float, ye)
+            return out, True, (sol.sol if dense else None)
         if sol.status == 1:
             te = float(sol.t_events[0][0])
             ye = sol.y_events[0][0]
@@ -456,6 +461,39 @@ class FrictionDriveWalker:
         out.tau = float(sol.t[-1])
         out.phi, out.dphi, out.u2, out.du2 = map(float, sol.y[:, -1])
         return out, False, (sol.sol if dense else None)
+
+    def _missed_recontact(self, sol, per_step=16):
+        """First re-contact inside a flight that the step-end sign test missed.
+
+        ``solve_ivp`` compares the gap at the ends of its steps only, so a
+        grazing return that dips below zero and comes back inside one step
+        goes unseen. The dense output is sampled ``per_step`` times per step;
+        a negative sample is bracketed and refined with Brent's method.
+        Returns ``(tau, y)`` or ``None``.
+        """
+        t = sol.t
+        if t.size < 2:
+            return None
+        frac = np.linspace(0.0, 1.0, per_step + 1)[1:-1]
+        ts = np.sort(np.concatenate([t, (t[:-1, None] + np.diff(t)[:, None] * frac).ravel()]))
+        if sol.status == 1:
+            ts = ts[ts < sol.t_events[0][0]]
+        if ts.size < 2:
+            return None
+        ys = sol.sol(ts)
+        sc = self.scene
+        g = sc.sin_phi0 - np.sin(ys[0]) - sc.u10 * (1.0 - np.cos(ts))
+        tol = 1e-13 * max(sc.u10, 1e-300)
+        bad = np.flatnonzero(g[1:] < -tol)
+        if not bad.size:
+            return None
+        i = bad[0] + 1
+        f = lambda tau: self._gap(tau, sol.sol(tau))  # noqa: E731
+        if f(ts[i - 1]) <= 0.0:
+            return None  # started on the surface: not a return
+        te = brentq(f, ts[i - 1], ts[i], xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
+        self.counters["root_solves"] += 1
+        return te, sol.sol(te)
 
     def impact(self, st):
         """Apply Newton's impact law with Coulomb friction at a re-contact.

@@ -280,3 +280,33 @@ def test_steady_state_with_flight_at_the_first_section():
     end = w.advance(st, t0 + TWO_PI)
     assert end.u2 == pytest.approx(ss.displacement_per_period, rel=1e-9)
     assert end.du2 == pytest.approx(du2, rel=1e-9)
+
+
+def test_grazing_return_inside_one_flight_step_is_found():
+    # a flight whose gap dips below zero between 0.4 and 0.6 and is positive at both
+    # ends of its only step: the step-end sign test sees nothing, the dense check does
+    sc = FrictionDrive(frequency=185.0)
+    w = FrictionDriveWalker(sc)
+
+    def gap_wanted(t):
+        return 1e-6 * (t - 0.4) * (t - 0.6)
+
+    class FakeSolution:
+        status = 0
+        t = np.array([0.0, 1.0])
+
+        @staticmethod
+        def sol(t):
+            t = np.asarray(t, float)
+            phi = np.arcsin(sc.sin_phi0 - sc.u1(t) - gap_wanted(t))
+            return np.array([phi, 0 * t, 0 * t, 0 * t])
+
+    te, ye = w._missed_recontact(FakeSolution)
+    # the root is as sharp as the gap's round-off (~1e-16) over its slope (2e-7)
+    assert te == pytest.approx(0.4, abs=2e-9)
+    assert abs(w._gap(te, ye)) < 1e-15
+    # no dip: nothing reported
+    FakeSolution.sol = staticmethod(lambda t: np.array(
+        [np.arcsin(sc.sin_phi0 - sc.u1(np.asarray(t, float)) - 1e-6), 0 * np.asarray(t, float),
+         0 * np.asarray(t, float), 0 * np.asarray(t, float)]))
+    assert w._missed_recontact(FakeSolution) is None
