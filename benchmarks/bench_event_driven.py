@@ -13,7 +13,6 @@ import argparse
 import math
 import os
 import sys
-import time
 
 import numpy as np
 from scipy.integrate import solve_ivp

@@ -6,7 +6,6 @@ paper's dimensionless variables.
 
 import argparse
 import json
-import math
 import sys
 import time
 

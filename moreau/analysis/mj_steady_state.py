@@ -44,7 +44,7 @@ import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError
-from ..regimes import REGIME_LETTERS, Regime
+from ..regimes import REGIME_LETTERS
 from .modes import mode_name
 from .steady_state import SteadyState
 
@@ -202,7 +202,7 @@ class PeriodMap:
         q = np.array([x[0], 0.0])
         v = np.array([x[1], x[2]])
         if self.fast:
-            from ..integrators._mj_kernels import NUMERICAL, OK, PAINLEVE, mj_run_fd
+            from ..integrators._mj_kernels import OK, PAINLEVE, mj_run_fd
             st = self._stats
             st[:] = 0.0
             status, k, nrec, closed_end = mj_run_fd(
@@ -439,7 +439,6 @@ def _bracket_u(pm, x, closed, scale, tol, max_iter):
     it = 0
     ua = x[2]
     Fa, xa, ya, ca = ev(ua)
-    best = (abs(Fa), xa, ya, ca)
 
     def done(F, xx, y):
         return float(np.max(np.abs(y - xx) / scale)) <= tol

@@ -200,7 +200,7 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {scheme!r}")
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
-    from ..integrators.event_driven import ContactState, FrictionDriveWalker
+    from ..integrators.event_driven import FrictionDriveWalker
 
     t_start = time.perf_counter()
     walker = FrictionDriveWalker(scene, rtol=min(1e-12, rtol * 1e-2), **options)

@@ -69,7 +69,6 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
         from tqdm.auto import tqdm
         it = tqdm(values, desc=f"sweep {parameter}", unit="pt")
     rows = []
-    v_guess = None
     try:
         for x in it:
             row = {"value": float(x), "mode": "", "displacement_per_period_m": math.nan,

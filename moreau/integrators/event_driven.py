@@ -24,7 +24,7 @@ from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
 from .._validate import positive, positive_int
-from ..errors import ContactLostError, InputError, MoreauError, PainleveError
+from ..errors import InputError, MoreauError, PainleveError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 from .result import Event
@@ -694,7 +694,6 @@ class EventDriven(Integrator):
         self._record_state(self.state)
 
     def _record_state(self, st):
-        w = self.walker
         sc = self.scene
         if st.regime == _F:
             fN = fT = 0.0

@@ -92,8 +92,6 @@ to QP); ``max_residual`` (largest scaled complementarity residual,
 (largest ``-g`` after a step, 0 if none); ``projection_iterations``.
 """
 
-import math
-
 import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int

@@ -169,7 +169,6 @@ def _tresca(M, q, layout, max_iter, fp_tol):
         return None, 0, False, "the Delassus block read from `M` is not symmetric"
     mu = layout.mu[fr]
     nf = len(fr)
-    m = nc + nf
     lb = np.concatenate([np.zeros(nc), np.zeros(nf)])
     ub = np.concatenate([np.full(nc, np.inf), np.zeros(nf)])
     p = None
