@@ -1,6 +1,7 @@
 """Mechanical systems ("scenes") that the integrators run."""
 
 from .base import Scene
+from .bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
 from .bouncing_ball import BouncingBall, BouncingBallParams
 from .friction_drive import FrictionDrive, FrictionDriveParams
 from .painleve_rod import PAINLEVE_MU_MIN, PainleveRod, PainleveRodParams, painleve_critical_mu

@@ -1,0 +1,325 @@
+"""Bidirectional friction drive: two mirror-image tilted rods on one rotor.
+
+The paper's conclusion proposes "adding another tilt rod with opposite
+tilting direction" so that one motor can move both ways. Rod ``a`` is the
+paper's rod (tilt ``+phi0``, tip pointing in ``+x``); rod ``b`` is its mirror
+image about the vertical (tilt ``-phi0``, tip pointing in ``-x``). Both are
+pressed by their springs on the same rotor surface, at height ``l sin phi0``
+above their hinges. Each hinge sits on its own stator group, driven
+vertically with its own amplitude and a common frequency::
+
+    x1a(t) = x10_a (1 - cos w t),    x1b(t) = x10_b (1 - cos(w t - delta))
+
+Exciting rod ``a`` alone moves the rotor as the paper's scene does (the
+direction depends on the frequency: backwards at 20 and 185 Hz, forwards at 2000 Hz with the paper's values);
+exciting rod ``b`` alone moves it the opposite way by exactly the same amount
+(mirror symmetry ``x -> -x``).
+
+Derivation
+----------
+Generalized coordinates ``(phi_a, phi_b, x2)``; each angle is measured from
+the horizontal, in the rod's own (mirrored) sense, so both rest at ``phi0``.
+The stator motions ``x1a, x1b`` are prescribed. Rod ``a`` is hinged at
+``(0, x1a)``, rod ``b`` at ``(d, x1b)`` (``d`` drops out). Rod centres and tips::
+
+    c_a = ( l/2 cos phi_a,      x1a + l/2 sin phi_a),  tip_a = ( l cos phi_a,     x1a + l sin phi_a)
+    c_b = (d - l/2 cos phi_b,   x1b + l/2 sin phi_b),  tip_b = (d - l cos phi_b,  x1b + l sin phi_b)
+
+With ``|c'|^2 = l^2/4 phi'^2 + x1'^2 + l x1' phi' cos phi`` for either rod and
+the rod's moment of inertia ``m l^2 / 12`` about its centre,
+
+    T = sum_r [1/6 m l^2 phi_r'^2 + 1/2 m l x1r' phi_r' cos phi_r + 1/2 m x1r'^2] + 1/2 m2 x2'^2
+    V = sum_r 1/2 k l^2 (sin phi0 - sin phi_r)^2
+
+(the stator masses only add terms in the prescribed ``x1r``). Gaps and
+tangential (rotor-relative-to-tip) displacements::
+
+    g_Na = l sin phi0 - l sin phi_a - x1a,   g_Ta = x2 - l cos phi_a
+    g_Nb = l sin phi0 - l sin phi_b - x1b,   g_Tb = x2 - d + l cos phi_b
+
+and the virtual work of the contact forces is ``sum_r (f_Nr dg_Nr + f_Tr dg_Tr)``.
+With ``tau = w t``, ``u = x / l``, forces over ``m l w^2``, ``J = m2/m``,
+``P = k/(m w^2)``, ``u1r = u10r (1 - cos(tau - delta_r))`` (``delta_a = 0``,
+``delta_b = delta``) and ``q = (phi_a, phi_b, u2)``, Lagrange's equations read
+``M q'' = h + WN^T f_N + WT^T f_T`` with
+
+    M  = diag(1/3, 1/3, J)
+    h  = (P cos phi_a (sin phi0 - sin phi_a) - 1/2 u1a'' cos phi_a,
+          P cos phi_b (sin phi0 - sin phi_b) - 1/2 u1b'' cos phi_b,
+          -f_L)
+    WN = [[-cos phi_a, 0, 0], [0, -cos phi_b, 0]],    wN = (-u1a', -u1b')
+    WT = [[ sin phi_a, 0, 1], [0, -sin phi_b, 1]],    wT = (0, 0)
+    wNbar = (phi_a'^2 sin phi_a - u1a'',  phi_b'^2 sin phi_b - u1b'')
+    wTbar = (phi_a'^2 cos phi_a,         -phi_b'^2 cos phi_b)
+
+(``d2 g/dtau2 = W q'' + wbar``). The ``M`` is diagonal: the rods are coupled
+only through the rotor, i.e. through the contact forces. Deleting ``phi_b``
+and contact ``b`` leaves exactly the equations of
+:class:`~moreau.scenes.friction_drive.FrictionDrive`; rod ``b`` alone is that
+scene under the mirror map ``u2 -> -u2`` (which flips the sign of its slip
+velocity, so rod ``b``'s Painlevé configuration is *positive* slip with
+``1 - mu tan(phi_b) <= 0``).
+"""
+
+import math
+from dataclasses import dataclass, fields, replace
+
+import numpy as np
+
+from .. import _validate as V
+from ..errors import InputError
+from .base import Scene
+from .friction_drive import FrictionDrive, FrictionDriveParams
+
+__all__ = ["BidirectionalDriveParams", "BidirectionalDrive"]
+
+
+@dataclass(frozen=True)
+class BidirectionalDriveParams:
+    """Physical parameters of the two-rod drive, in SI units.
+
+    The rod, spring, rotor, friction, load and restitution parameters mean
+    what they mean in :class:`~moreau.scenes.friction_drive.FrictionDriveParams`
+    and are shared by both rods (they are mirror images).
+
+    Parameters
+    ----------
+    m, m2, k, length, phi0, mu, load, restitution : float
+        As in :class:`FrictionDriveParams` (the paper's values by default).
+    x10_a, x10_b : float
+        Stator displacement amplitudes of rods ``a`` and ``b`` [m], ``>= 0``
+        (0 leaves the rod unexcited) and ``2 x10 < length sin(phi0)``.
+    phase : float
+        Phase lag ``delta`` [rad] of stator ``b`` behind stator ``a``, finite.
+
+    Examples
+    --------
+    >>> p = BidirectionalDriveParams(x10_b=0.0)
+    >>> p.x10_a, p.x10_b, p.phase
+    (2e-06, 0.0, 0.0)
+    """
+
+    m: float = 2.0e-5
+    m2: float = 2.0e-3
+    k: float = 1.0e4
+    length: float = 1.0e-3
+    phi0: float = math.pi / 4
+    mu: float = 0.1
+    x10_a: float = 2.0e-6
+    x10_b: float = 2.0e-6
+    phase: float = 0.0
+    load: float = 0.0
+    restitution: float = 0.0
+
+    def __post_init__(self):
+        for name in ("m", "m2", "k", "length"):
+            object.__setattr__(self, name, V.positive(name, getattr(self, name)))
+        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
+                                                            "in the open interval (0, pi/2)"))
+        object.__setattr__(self, "mu", V.nonnegative("mu", self.mu))
+        object.__setattr__(self, "load", V.finite_scalar("load", self.load))
+        object.__setattr__(self, "phase", V.finite_scalar("phase", self.phase))
+        object.__setattr__(self, "restitution",
+                           V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        for name in ("x10_a", "x10_b"):
+            x = V.nonnegative(name, getattr(self, name))
+            if not 2.0 * x < self.length * math.sin(self.phi0):
+                raise InputError(
+                    f"`{name}` must be < length*sin(phi0)/2 = "
+                    f"{self.length * math.sin(self.phi0) / 2!r} m so that the rod stays above "
+                    f"the horizontal in contact, got {x!r}")
+            object.__setattr__(self, name, x)
+
+    def with_(self, **changes):
+        """Copy with some parameters changed (validated again)."""
+        return replace(self, **changes)
+
+    def rod(self, which):
+        """The :class:`FrictionDriveParams` of rod ``"a"`` or ``"b"`` alone.
+
+        Raises :class:`InputError` if that rod is not excited (``x10 = 0``),
+        which the single-rod scene does not allow.
+        """
+        if which not in ("a", "b"):
+            raise InputError(f"`which` must be 'a' or 'b', got {which!r}")
+        x10 = self.x10_a if which == "a" else self.x10_b
+        if x10 <= 0.0:
+            raise InputError(f"`x10_{which}` must be > 0 for a single-rod scene, got {x10!r}")
+        return FrictionDriveParams(m=self.m, m2=self.m2, k=self.k, length=self.length,
+                                   phi0=self.phi0, mu=self.mu, x10=x10, load=self.load,
+                                   restitution=self.restitution)
+
+    @classmethod
+    def from_single(cls, params, x10_b=None, phase=0.0):
+        """Two mirror rods built from a single-rod :class:`FrictionDriveParams`.
+
+        ``x10_a = params.x10``; ``x10_b`` defaults to the same amplitude.
+        """
+        if not isinstance(params, FrictionDriveParams):
+            raise InputError("`params` must be a FrictionDriveParams instance")
+        return cls(m=params.m, m2=params.m2, k=params.k, length=params.length, phi0=params.phi0,
+                   mu=params.mu, x10_a=params.x10, x10_b=params.x10 if x10_b is None else x10_b,
+                   phase=phase, load=params.load, restitution=params.restitution)
+
+
+def params_from_kwargs(**kwargs):
+    """Build :class:`BidirectionalDriveParams` from keyword arguments, ignoring ``None`` values."""
+    names = {f.name for f in fields(BidirectionalDriveParams)}
+    unknown = set(kwargs) - names
+    if unknown:
+        raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
+    return BidirectionalDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
+
+
+class BidirectionalDrive(Scene):
+    """Two mirror-image rods driving one rotor, in the paper's dimensionless form.
+
+    Coordinates ``q = (phi_a, phi_b, u2)``, velocities their derivatives in
+    ``tau = w t``; contacts ``0`` (rod ``a``) and ``1`` (rod ``b``), both
+    frictional when ``mu > 0``. See the module docstring for the derivation.
+
+    Parameters
+    ----------
+    params : BidirectionalDriveParams, optional
+        Physical parameters; the paper's rod with both stators at its amplitude
+        and in phase by default.
+    frequency : float
+        Common drive frequency ``f`` [Hz], > 0.
+
+    Examples
+    --------
+    >>> s = BidirectionalDrive(BidirectionalDriveParams(x10_b=0.0), frequency=185.0)
+    >>> s.ndof, s.ncontacts, round(s.J)
+    (3, 2, 100)
+    >>> q0, v0 = s.rest_state()
+    >>> s.gaps(q0, 0.0).tolist()
+    [0.0, 0.0]
+    """
+
+    ndof = 3
+    name = "bidirectional-drive"
+
+    def __init__(self, params=None, frequency=185.0):
+        if params is None:
+            params = BidirectionalDriveParams()
+        if not isinstance(params, BidirectionalDriveParams):
+            raise InputError("`params` must be a BidirectionalDriveParams instance")
+        self.params = p = params
+        self.frequency = V.positive("frequency", frequency)
+        self.omega = 2.0 * math.pi * self.frequency
+        self.J = p.m2 / p.m
+        self.P = p.k / (p.m * self.omega ** 2)
+        self.u10 = np.array([p.x10_a, p.x10_b]) / p.length
+        self.delta = np.array([0.0, p.phase])
+        self.force_scale = p.m * p.length * self.omega ** 2
+        self.fL = p.load / self.force_scale
+        self.phi0 = p.phi0
+        self.sin_phi0 = math.sin(p.phi0)
+        self.mu = np.array([p.mu, p.mu])
+        self.restitution = np.array([p.restitution, p.restitution])
+        # +1 for rod a (tip towards +x), -1 for the mirrored rod b
+        self._side = np.array([1.0, -1.0])
+
+    def __repr__(self):
+        return f"BidirectionalDrive(frequency={self.frequency!r}, params={self.params!r})"
+
+    # -- prescribed stator motions, both rods at once ----------------------------
+    def u1(self, tau):
+        return self.u10 * (1.0 - np.cos(tau - self.delta))
+
+    def du1(self, tau):
+        return self.u10 * np.sin(tau - self.delta)
+
+    def ddu1(self, tau):
+        return self.u10 * np.cos(tau - self.delta)
+
+    # -- Scene interface ------------------------------------------------------
+    def mass(self, q):
+        return np.diag([1.0 / 3.0, 1.0 / 3.0, self.J])
+
+    def forces(self, q, v, t):
+        phi = np.asarray(q[:2], dtype=float)
+        c = np.cos(phi)
+        rod = self.P * c * (self.sin_phi0 - np.sin(phi)) - 0.5 * self.ddu1(t) * c
+        return np.array([rod[0], rod[1], -self.fL])
+
+    def force_jacobians(self, q, v, t):
+        K = np.zeros((3, 3))
+        dd1 = self.ddu1(t)
+        for r in range(2):
+            s, c = math.sin(q[r]), math.cos(q[r])
+            K[r, r] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * dd1[r] * s
+        return K, np.zeros((3, 3))
+
+    def gaps(self, q, t):
+        return self.sin_phi0 - np.sin(np.asarray(q[:2], dtype=float)) - self.u1(t)
+
+    def contact_jacobians(self, q, t):
+        phi = np.asarray(q[:2], dtype=float)
+        WN = np.zeros((2, 3))
+        WN[0, 0], WN[1, 1] = -math.cos(phi[0]), -math.cos(phi[1])
+        if self.params.mu > 0.0:
+            WT = np.zeros((2, 3))
+            WT[0, 0] = math.sin(phi[0])
+            WT[1, 1] = -math.sin(phi[1])
+            WT[:, 2] = 1.0
+        else:
+            WT = np.zeros((0, 3))
+        return WN, -self.du1(t), WT, np.zeros(WT.shape[0])
+
+    def contact_drift(self, q, v, t):
+        phi = np.asarray(q[:2], dtype=float)
+        w2 = np.asarray(v[:2], dtype=float) ** 2
+        wNbar = w2 * np.sin(phi) - self.ddu1(t)
+        wTbar = self._side * w2 * np.cos(phi) if self.params.mu > 0.0 else np.zeros(0)
+        return wNbar, wTbar
+
+    # -- conveniences -----------------------------------------------------------
+    def slip_velocities(self, q, v):
+        """Slip velocities ``u2' + s_r sin(phi_r) phi_r'`` of both rods (defined also for mu = 0)."""
+        return v[2] + self._side * np.sin(np.asarray(q[:2], float)) * np.asarray(v[:2], float)
+
+    def rest_state(self, tau=0.0):
+        """State at ``tau`` with both rods on their contact manifolds and the rotor at rest.
+
+        ``sin phi_r = sin phi0 - u1r(tau)``, ``phi_r' = -u1r'(tau) / cos phi_r``.
+        """
+        tau = V.finite_scalar("tau", tau)
+        phi = np.arcsin(self.sin_phi0 - self.u1(tau))
+        dphi = -self.du1(tau) / np.cos(phi)
+        return np.array([phi[0], phi[1], 0.0]), np.array([dphi[0], dphi[1], 0.0])
+
+    def single_rod(self, which):
+        """The paper's :class:`FrictionDrive` for rod ``"a"`` or ``"b"`` alone, same frequency."""
+        return FrictionDrive(self.params.rod(which), frequency=self.frequency)
+
+    # -- units ------------------------------------------------------------------
+    def to_si(self, result):
+        """SI time histories of a :class:`SimulationResult` of this scene.
+
+        Returns a dict: ``t`` [s], ``x2`` rotor displacement [m], ``v2`` rotor
+        velocity [m/s], ``phi_a``, ``phi_b`` [rad], ``normal_force`` and
+        ``tangential_force`` [N] (shape ``(n, 2)``), ``slip_velocity`` [m/s]
+        and the ``regime`` codes of both contacts.
+        """
+        l, w = self.params.length, self.omega
+        return {
+            "t": result.t / w,
+            "x2": result.q[:, 2] * l,
+            "v2": result.v[:, 2] * l * w,
+            "phi_a": result.q[:, 0].copy(),
+            "phi_b": result.q[:, 1].copy(),
+            "normal_force": result.force_N * self.force_scale,
+            "tangential_force": result.force_T * self.force_scale,
+            "slip_velocity": result.slip_velocity * l * w,
+            "regime": result.regime.copy(),
+        }
+
+    def displacement_to_si(self, du2):
+        return du2 * self.params.length
+
+    def velocity_to_si(self, dv2):
+        return dv2 * self.params.length * self.omega
+
+    def force_to_si(self, f):
+        return f * self.force_scale
