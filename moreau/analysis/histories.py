@@ -42,7 +42,7 @@ def run_history(params, frequency, periods=10.0, scheme="event-driven", steps_pe
     --------
     >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
     >>> h = run_history(PAPER_DEFAULTS, 185.0, periods=1)
-    >>> h["status"], round(h["t"][-1] * 185.0, 12)
+    >>> h["status"], round(float(h["t"][-1]) * 185.0, 12)
     (0, 1.0)
     """
     from ..integrators import simulate

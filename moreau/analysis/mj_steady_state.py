@@ -33,7 +33,10 @@ shows up as a one-step stick between slips of opposite sign; the continuous
 system has no stick there, so :func:`merge_step_regimes` drops such a
 one-step stick (the reversal time is put at the middle of that step). Any
 other run, including a one-step stick between slips of the *same* sign or a
-one-step slip, is kept. The cyclic sequence is then named by
+one-step slip, is kept. A closed frictionless contact is named by the sign of
+its slip velocity, never stick (:func:`moreau.analysis.modes.step_letters`),
+and a regime entered from flight is marked as entered through an impact, as
+the event-driven reference marks it. The cyclic sequence is then named by
 :func:`moreau.analysis.modes.mode_name`.
 """
 
@@ -44,14 +47,12 @@ import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError
-from ..regimes import REGIME_LETTERS
-from .modes import mode_name
+from .modes import impacts_after_flight, mode_name, step_letters
 from .steady_state import SteadyState
 
 __all__ = ["moreau_jean_steady_state", "merge_step_regimes", "PeriodMap"]
 
 TWO_PI = 2.0 * math.pi
-_LETTER = {int(r): s for r, s in REGIME_LETTERS.items()}
 
 
 def merge_step_regimes(letters, taus, h, period=TWO_PI):
@@ -135,7 +136,8 @@ def merge_step_regimes(letters, taus, h, period=TWO_PI):
 
 
 def _mode_of(merged):
-    return mode_name([s for _, s in merged])
+    letters = [s for _, s in merged]
+    return mode_name(letters, impacts_after_flight(letters))
 
 
 class PeriodMap:
@@ -193,6 +195,13 @@ class PeriodMap:
             self._stats = new_stats()
         self.last = None
 
+    def _slip(self, q, v, slip):
+        # a frictionless contact has no tangential row, so the scheme records
+        # no slip velocity; the mode name still needs its sign
+        if float(self.scene.mu[0]) > 0.0:
+            return np.array(slip, dtype=float)
+        return np.array([self.scene.slip_velocity(qi, vi) for qi, vi in zip(q, v)])
+
     def __call__(self, x, closed, record=False):
         """Map ``x = (phi, phi', u2')`` at ``tau = 0`` over one period.
 
@@ -218,9 +227,10 @@ class PeriodMap:
                         "period map: the contact problem has no unique solution")
                 raise MoreauError("non-finite state in the period map; increase `steps_per_period`")
             if record:
-                t, _, _, reg, fN, _, _, _ = self._buf
+                t, rq, rv, reg, fN, _, slip, _ = self._buf
                 self.last = {"tau": t[:nrec] - self.h, "regime": reg[:nrec].copy(),
-                             "force_N": fN[:nrec].copy(), "max_penetration": float(st[5]),
+                             "force_N": fN[:nrec].copy(),
+                             "slip": self._slip(rq[:nrec], rv[:nrec], slip[:nrec]), "max_penetration": float(st[5]),
                              "lcp_solves": int(st[0]), "fallbacks": 0}
         else:
             from ..integrators.moreau_jean import MoreauJean
@@ -243,6 +253,7 @@ class PeriodMap:
                 res = integ.result()
                 self.last = {"tau": res.t[1:] - self.h, "regime": res.regime[1:, 0].copy(),
                              "force_N": res.force_N[1:, 0].copy(),
+                             "slip": self._slip(res.q[1:], res.v[1:], res.slip_velocity[1:, 0]),
                              "max_penetration": c["max_penetration"],
                              "lcp_solves": c["lcp_solves"], "fallbacks": c["fallbacks"]}
         self.evaluations += 1
@@ -337,7 +348,7 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     J_loc = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
     eig = np.linalg.eigvals(J_sec)
     eig_loc = np.linalg.eigvals(J_loc)
-    letters = [_LETTER[int(c)] for c in last["regime"]]
+    letters = step_letters(last["regime"], last["slip"], float(scene.mu[0]))
     merged = merge_step_regimes(letters, last["tau"], pm.h)
     return SteadyState(
         scheme="moreau-jean",
