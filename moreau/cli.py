@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau steady``, ``moreau sweep`` and ``moreau run``.
+"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``run``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -123,6 +123,78 @@ def _cmd_run(args):
                     args.theta, args.out, plot=not args.no_plot, progress=not args.quiet)
 
 
+# -- moreau reproduce ---------------------------------------------------------------
+
+def _cmd_reproduce(args):
+    from .analysis.reproduce import reproduce
+    res = reproduce(args.out, quick=args.quick, scheduler=args.scheduler, n_jobs=args.jobs,
+                    progress=not args.quiet)
+    print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
+          f"start with {args.out}/report.md")
+
+
+def _add_reproduce(sub):
+    p = sub.add_parser("reproduce", help="the paper's section 4.3: data, figures and report.md")
+    p.add_argument("--out", default="moreau-results",
+                   help="output folder (default ./moreau-results); the cache lives in OUT/cache")
+    p.add_argument("--quick", action="store_true", help="coarse grids: a smoke run of a few seconds")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the points on this Dask scheduler (e.g. tcp://host:8786)")
+    p.add_argument("--jobs", type=int, default=-1,
+                   help="local worker processes (default -1: all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_cmd_reproduce)
+
+
+def _cmd_compare(args):
+    """``moreau compare``: work-precision of every scheme on one scene, or the stress map."""
+    from .analysis import compare as cmp
+
+    out = cmp.check_out_dir(args.out)
+    progress = not args.quiet
+    if args.stress:
+        from .analysis.stress import run_catalogue, write_stress_outputs
+        report = run_catalogue(progress=progress, full=not args.quick)
+        paths = write_stress_outputs(report, out, plot=not args.no_plot)
+        if args.json:
+            print(json.dumps(report))
+        else:
+            from .analysis.stress import format_stress_table
+            print(format_stress_table(report))
+            print("wrote " + ", ".join(p for p in paths.values() if p))
+        return
+    if args.scene is None:
+        raise InputError("`--scene` is required (one of " + ", ".join(sorted(cmp.SCENES)) +
+                         "), or give `--stress`")
+    params = {}
+    for item in args.param or []:
+        key, sep, val = item.partition("=")
+        if not sep:
+            raise InputError(f"`--param` takes KEY=VALUE, got {item!r}")
+        try:
+            params[key.strip()] = float(val)
+        except ValueError:
+            params[key.strip()] = val.strip()
+    for key in ("frequency", "mu", "phi0", "restitution", "load", "drive"):
+        if getattr(args, key) is not None:
+            params[key] = getattr(args, key)
+    tag = f"compare_{args.scene}" + (f"_{params['frequency']:g}Hz" if "frequency" in params else "")
+    partial = []
+
+    def keep(row):
+        partial.append(row)
+
+    report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep, **params)
+    paths = cmp.write_outputs(report, out, tag=tag, plot=not args.no_plot)
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print(cmp.format_table(report))
+        print("wrote " + ", ".join(p for p in paths.values() if p))
+    if report["interrupted"]:
+        raise KeyboardInterrupt
+
+
 def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True)
@@ -152,6 +224,29 @@ def build_parser():
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
     _add_params(r)
     r.set_defaults(func=_cmd_run)
+    _add_reproduce(sub)
+    c = sub.add_parser("compare", help="error against run time of every scheme on one scene "
+                                       "(table + figure), or the stiff/extreme-case map (--stress)")
+    c.add_argument("--scene", default=None,
+                   choices=["friction-drive", "stick-slip-motor", "bouncing-ball",
+                            "sliding-block", "painleve-rod"])
+    c.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
+    c.add_argument("--mu", type=float, default=None, help="friction coefficient")
+    c.add_argument("--phi0", type=float, default=None, help="friction drive: rod tilt [rad]")
+    c.add_argument("--restitution", type=float, default=None, help="impact restitution e")
+    c.add_argument("--load", type=float, default=None, help="load [N]")
+    c.add_argument("--drive", default=None, choices=["sawtooth", "sine"],
+                   help="stick-slip motor: drive shape")
+    c.add_argument("--param", action="append", metavar="KEY=VALUE",
+                   help="any other scene parameter (repeatable)")
+    c.add_argument("--stress", action="store_true",
+                   help="run the stiff and extreme case catalogue instead (stability map)")
+    c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")
+    c.add_argument("--out", default="out", help="output folder (default ./out)")
+    c.add_argument("--json", action="store_true", help="print one JSON object")
+    c.add_argument("--quiet", action="store_true", help="no progress bar")
+    c.add_argument("--no-plot", action="store_true", help="skip the figure")
+    c.set_defaults(func=_cmd_compare)
     return parser
 
 

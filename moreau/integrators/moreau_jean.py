@@ -321,7 +321,12 @@ class MoreauJean(Integrator):
     projection : bool
         Project positions back onto the contacts after every step.
     lcp_method : {"auto", "lemke", "qp"}
-        Method of :func:`moreau.lcp.solve_lcp` for scenes with several contacts.
+        Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a scene with
+        one contact is solved in closed form (and the friction drive runs
+        compiled) and several contacts go to Lemke with the QP fallback;
+        ``"lemke"`` or ``"qp"`` forces that solver on the assembled LCP of
+        every contact step, one contact included, so that solvers can be
+        compared (``moreau compare``).
     save_every : int
         Record one sample every ``save_every`` steps (and the last one). The
         sample at ``t0`` is the initial state with the first step's regime and
@@ -379,7 +384,11 @@ class MoreauJean(Integrator):
         if fast is True and not known:
             raise InputError("`fast=True` needs a FrictionDrive scene (the only one with a "
                              "compiled model); use fast='auto' or False")
-        self._fast = known and fast is not False
+        if fast is True and self.lcp_method != "auto":
+            raise InputError("`fast=True` solves the contact in closed form; a forced "
+                             "`lcp_method` needs fast='auto' or False")
+        # a forced solver is a request to run that solver, so it takes the generic path
+        self._fast = known and fast is not False and self.lcp_method == "auto"
         if self._fast:
             from ..scenes._friction_drive_jit import pack_params
             from ._mj_kernels import new_stats
@@ -516,7 +525,7 @@ class MoreauJean(Integrator):
         na = len(ia)
         c = self.counters
         c["lcp_solves"] += 1
-        if sc.ncontacts == 1:
+        if sc.ncontacts == 1 and self.lcp_method == "auto":
             c["direct_solves"] += 1
             if mu[0] > 0.0:
                 pn, pt = _one_contact(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0], U_free[1],

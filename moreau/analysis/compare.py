@@ -1,0 +1,737 @@
+"""Scheme comparison: error against run time for every shipped scene (``moreau compare``).
+
+For one scene, :func:`compare` runs
+
+- the scene's reference at several tolerances (the event-driven reference of
+  the friction drive; the exact solutions of the other scenes, which have no
+  tolerance and give one row);
+- Moreau–Jean with ``theta = 1/2`` and ``theta = 1`` at step counts spanning
+  two decades, with the scheme's own contact solve (closed form for one
+  contact; ``lcp = None`` in the table);
+- Moreau–Jean (``theta = 1``) with the contact problem of every step forced
+  through Lemke and through the QP path (``lcp = "lemke"``, ``"qp"``), so that
+  the solvers are compared as well as the schemes.
+
+Errors are measured against the reference at its tightest setting, three ways:
+
+``error``
+    the scene's headline quantity, relative (the friction drive and the
+    stick–slip motor: the displacement per period; the bouncing ball: the
+    height at the end of the window; the sliding block: the stopping
+    distance; the Painlevé rod: the horizontal position of its centre at the
+    end of the window);
+``trajectory_error``
+    the max over one period (the comparison window) of the main coordinate's
+    distance from the reference, both started from the same state (for the
+    periodic scenes the reference's periodic state), on a common grid;
+``switching_error``
+    the largest shift of a regime switching time (or an impact time), when
+    the two regime sequences agree (``None`` where they do not, or where the
+    motion has no switch).
+
+The fitted ``order`` of each Moreau–Jean series is the slope of
+``log(trajectory_error)`` against ``log(steps_per_period)``; the headline
+error converges at the same rate but erratically (each slip reversal's
+``O(h)`` error depends on where it falls inside its step), so its slope is
+given as well (``order_headline``) but not used as the order.
+
+For the friction drive, the ``lcp = None`` rows time and measure the discrete
+steady state (the fixed point of the Moreau–Jean period map); the Lemke and
+QP rows run one period from the reference's periodic state, because the QP
+path costs about 16 ms per step and a shooting would repeat that many times.
+
+Examples
+--------
+>>> rep = compare("sliding-block", steps=[20, 40, 80], lcp_steps=[], thetas=[1.0],
+...               repeat=1, progress=False)
+>>> [r["scheme"] for r in rep["rows"]][:2], rep["orders"][0]["theta"]
+(['exact', 'moreau-jean'], 1.0)
+>>> round(rep["orders"][0]["order"], 1)
+1.0
+"""
+
+import csv
+import json
+import math
+import os
+import statistics
+import time
+
+import numpy as np
+
+from .._validate import positive_int
+from ..errors import InputError, MoreauError
+
+__all__ = ["compare", "SCENES", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
+           "check_out_dir", "make_case", "fit_order"]
+
+TWO_PI = 2.0 * math.pi
+#: Moreau–Jean steps per period of the full comparison (two decades)
+DEFAULT_STEPS = (50, 100, 200, 500, 1000, 2000, 5000)
+#: the same span with fewer points, for quick runs
+QUICK_STEPS = (50, 150, 500, 1500, 5000)
+#: steps per period of the forced-Lemke / forced-QP rows (QP costs ~16 ms a step)
+DEFAULT_LCP_STEPS = (50, 100, 200)
+QUICK_LCP_STEPS = (50, 100)
+#: samples per period of the common grid of the trajectory error
+GRID = 50
+
+
+def fit_order(steps, errors):
+    """Convergence order: minus the slope of ``log(error)`` against ``log(steps)``.
+
+    Points with zero or missing error are left out; fewer than three points
+    give None.
+
+    Examples
+    --------
+    >>> round(fit_order([10, 20, 40], [1e-2, 5e-3, 2.5e-3]), 12)
+    1.0
+    """
+    pts = [(n, e) for n, e in zip(steps, errors) if e is not None and e > 0 and math.isfinite(e)]
+    if len(pts) < 3:
+        return None
+    n, e = np.array(pts, dtype=float).T
+    return float(-np.polyfit(np.log(n), np.log(e), 1)[0])
+
+
+def _median_time(fn, repeat, cheap=1.0):
+    """Median run time of ``fn()`` and its output; runs slower than ``cheap`` seconds run once."""
+    times, out = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+        if times[0] > cheap:
+            break
+    return statistics.median(times), out
+
+
+def _switches(letters, times):
+    """``[(t, letter)]`` at every change of the per-sample letter (first entry excluded)."""
+    out = []
+    for i in range(1, len(letters)):
+        if letters[i] != letters[i - 1]:
+            out.append((float(times[i]), letters[i]))
+    return out
+
+
+def _drop_reversal_sticks(sw, h):
+    # a one-step stick between slips of opposite sign is a reversal inside
+    # the step (see moreau.analysis.mj_steady_state): the continuous system
+    # has no stick there
+    out = []
+    i = 0
+    while i < len(sw):
+        if (i + 1 < len(sw) and sw[i][1] == "S" and sw[i + 1][0] - sw[i][0] <= 1.5 * h
+                and out and {out[-1][1], sw[i + 1][1]} == {"N", "P"}):
+            out.append((0.5 * (sw[i][0] + sw[i + 1][0]), sw[i + 1][1]))
+            i += 2
+            continue
+        out.append(sw[i])
+        i += 1
+    merged = []
+    for t, s in out:
+        if not merged or merged[-1][1] != s:
+            merged.append((t, s))
+    return merged
+
+
+def switching_error(ref, got):
+    """Largest shift between matched switching times, None if the sequences differ or are empty.
+
+    Examples
+    --------
+    >>> switching_error([(1.0, "P"), (2.0, "S")], [(1.1, "P"), (1.95, "S")])
+    0.1
+    >>> switching_error([(1.0, "P")], [(1.0, "S")]) is None
+    True
+    """
+    if not ref or len(ref) != len(got) or any(a[1] != b[1] for a, b in zip(ref, got)):
+        return None
+    return float(round(max(abs(a[0] - b[0]) for a, b in zip(ref, got)), 15))
+
+
+def _regime_switches(regimes):
+    """Switches of a steady state's ``[[tau, letter], ...]`` (the entry at tau = 0 dropped)."""
+    return [(float(t), s) for t, s in regimes[1:]]
+
+
+# -- the scenes -----------------------------------------------------------------------------
+class _Case:
+    """One scene set up for comparison (a subclass per scene)."""
+
+    ref_scheme = "exact"
+    ref_rtols = (None,)
+    tight_rtol = None
+    window = TWO_PI            # the "period" the steps are counted over
+    headline_name = ""
+    projection = False
+
+    def parameters(self):
+        return {}
+
+    # reference ---------------------------------------------------------------
+    def reference(self, rtol):
+        """``(headline, switches)`` of the reference at ``rtol``."""
+        raise NotImplementedError
+
+    def reference_grid(self):
+        """The main coordinate of the tight reference on the common grid."""
+        raise NotImplementedError
+
+    # Moreau–Jean ---------------------------------------------------------------
+    def start(self):
+        """``(q0, v0)`` at ``t = 0`` for the runs."""
+        raise NotImplementedError
+
+    def coordinate(self, q):
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        raise NotImplementedError
+
+    def run_mj(self, n, theta, lcp):
+        from ..integrators import simulate
+        q0, v0 = self.start()
+        # every step is kept: the switching times need each step's regime
+        opts = dict(h=self.window / n, theta=theta, projection=self.projection)
+        if lcp is not None:
+            opts["lcp_method"] = lcp
+        return simulate(self.scene, (0.0, self.window), q0, v0, "moreau-jean", **opts)
+
+    def mj(self, n, theta, lcp):
+        """``(headline, run)``: the timed work of one Moreau–Jean row."""
+        res = self.run_mj(n, theta, lcp)
+        if not res.success:
+            raise MoreauError(f"Moreau–Jean run failed: {res.message}")
+        return self.headline_of_run(res), res
+
+    def measure(self, n, theta, lcp, out):
+        """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
+        _, res = out
+        return self._trajectory_error(res), self._run_switches(res, self.window / n), None
+
+    def _trajectory_error(self, res):
+        grid = np.linspace(0.0, self.window, GRID + 1)
+        idx = np.searchsorted(res.t, grid - 1e-9 * self.window)
+        idx = np.minimum(idx, len(res.t) - 1)
+        if np.max(np.abs(res.t[idx] - grid)) > 1e-9 * self.window:
+            # the samples are not on the grid (steps not a multiple of GRID): interpolate
+            y = np.interp(grid, res.t, self.coordinate(res.q))
+        else:
+            y = self.coordinate(res.q)[idx]
+        return float(np.max(np.abs(y - self.reference_grid())) / self.trajectory_scale)
+
+    trajectory_scale = 1.0
+
+    def _run_switches(self, res, h):
+        letters = res.regime_letters()
+        # a step's regime is recorded at its end: the switch happened in that step
+        return _drop_reversal_sticks(_switches(letters, res.t - h), h)
+
+
+class _FrictionDriveCase(_Case):
+    ref_scheme = "event-driven"
+    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+    tight_rtol = 1e-13
+    headline_name = "displacement per period"
+    projection = True
+
+    def __init__(self, frequency=185.0, **params):
+        from ..scenes.friction_drive import FrictionDrive, params_from_kwargs
+        self.scene = FrictionDrive(params_from_kwargs(**params), frequency)
+        self.frequency = self.scene.frequency
+        self._params = dict(params)
+        self.trajectory_scale = self.scene.u10
+        self._ref = None
+
+    def parameters(self):
+        return dict(frequency=self.frequency, **self._params)
+
+    def reference(self, rtol):
+        from ..analysis.steady_state import find_steady_state
+        ss = find_steady_state(self.scene, rtol=rtol)
+        return ss.displacement_per_period, _regime_switches(ss.regimes)
+
+    def _tight(self):
+        if self._ref is None:
+            from ..analysis.steady_state import find_steady_state
+            from ..integrators import simulate
+            ss = find_steady_state(self.scene, rtol=self.tight_rtol)
+            q = np.array([ss.state0[0], 0.0])
+            v = np.array(ss.state0[1:])
+            tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
+            if tau_s > 0.0:
+                # carry the periodic state from the section to tau = 2 pi = 0
+                r = simulate(self.scene, (tau_s, TWO_PI), q, v, "event-driven", rtol=1e-12)
+                q, v = np.array([r.q[-1, 0], 0.0]), r.v[-1].copy()
+            grid_run = simulate(self.scene, (0.0, TWO_PI), q, v, "event-driven", rtol=1e-12,
+                                samples_per_period=GRID)
+            grid = np.linspace(0.0, TWO_PI, GRID + 1)
+            idx = np.searchsorted(grid_run.t, grid - 1e-12)
+            if np.max(np.abs(grid_run.t[idx] - grid)) > 1e-9:
+                raise MoreauError("event-driven samples are not on the comparison grid")
+            self._ref = dict(q0=q, v0=v, grid=grid_run.q[idx, 1])
+        return self._ref
+
+    def reference_grid(self):
+        return self._tight()["grid"]
+
+    def start(self):
+        r = self._tight()
+        return r["q0"].copy(), r["v0"].copy()
+
+    def coordinate(self, q):
+        return q[:, 1]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 1] - res.q[0, 1])
+
+    def mj(self, n, theta, lcp):
+        if lcp is not None:
+            return super().mj(n, theta, lcp)
+        from ..analysis.mj_steady_state import moreau_jean_steady_state
+        ss = moreau_jean_steady_state(self.scene, n, theta=theta)
+        return ss.displacement_per_period, ss
+
+    def measure(self, n, theta, lcp, out):
+        if lcp is not None:
+            return super().measure(n, theta, lcp, out)
+        _, ss = out
+        # the trajectory: one period of the same scheme from the reference's periodic state
+        res = self.run_mj(n, theta, None)
+        return self._trajectory_error(res), _regime_switches(ss.regimes), ss.mode
+
+
+class _StickSlipCase(_Case):
+    ref_scheme = "stick-slip-exact"
+    headline_name = "displacement per period"
+
+    def __init__(self, frequency=1000.0, drive="sawtooth", **params):
+        from ..scenes.stick_slip_motor import StickSlipMotor
+        self.scene = StickSlipMotor(frequency=frequency, drive=drive, **params)
+        self._params = dict(frequency=frequency, drive=drive, **params)
+        self._ss = None
+        self._grid = None
+
+    def parameters(self):
+        return dict(self._params)
+
+    def _steady(self):
+        if self._ss is None:
+            from ..integrators.stick_slip_reference import stick_slip_steady_state
+            self._ss = stick_slip_steady_state(self.scene)
+        return self._ss
+
+    def reference(self, rtol):
+        from ..integrators.stick_slip_reference import stick_slip_steady_state
+        ss = stick_slip_steady_state(self.scene)
+        return ss.displacement_per_period, _regime_switches(ss.regimes)
+
+    def start(self):
+        return np.array([0.0, 0.0]), np.array([self._steady().state0[0], 0.0])
+
+    def reference_grid(self):
+        if self._grid is None:
+            from ..integrators import simulate
+            grid = np.linspace(0.0, TWO_PI, GRID + 1)
+            q, v = self.start()
+            xs = [q[0]]
+            for a, b in zip(grid[:-1], grid[1:]):
+                r = simulate(self.scene, (a, b), q, v, "stick-slip-exact")
+                q, v = r.q[-1].copy(), r.v[-1].copy()
+                xs.append(q[0])
+            self._grid = np.array(xs)
+        return self._grid
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0] - res.q[0, 0])
+
+
+class _BouncingBallCase(_Case):
+    window = 2.6
+    headline_name = "height at the end of the window"
+
+    def __init__(self, restitution=0.5, radius=0.1, height=0.6):
+        from ..scenes.bouncing_ball import BouncingBall
+        self.scene = BouncingBall(restitution=restitution, radius=radius)
+        self._params = dict(restitution=restitution, radius=radius, height=height)
+        self.q0 = np.array([height])
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), np.zeros(1)
+
+    def reference(self, rtol):
+        q0, v0 = self.start()
+        q, _ = self.scene.exact_solution(np.array([self.window]), q0, v0)
+        imp = self.scene.impacts(q0, v0, 64).t
+        imp = [float(t) for t in imp if t < self.window]
+        return float(q[-1, 0]), [(t, "!") for t in imp]
+
+    def reference_grid(self):
+        q0, v0 = self.start()
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), q0, v0)
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+    def _run_switches(self, res, h):
+        # impacts: a contact step that follows a flight step
+        letters = res.regime_letters()
+        t = res.t - h
+        return [(float(t[i]), "!") for i in range(1, len(letters))
+                if letters[i] != "F" and letters[i - 1] == "F"]
+
+
+class _SlidingBlockCase(_Case):
+    headline_name = "stopping distance"
+
+    def __init__(self, mu=0.5, speed=2.0):
+        from ..scenes.sliding_block import SlidingBlock
+        self.scene = SlidingBlock(mu=mu)
+        self.v0 = np.array([speed, 0.0])
+        self._params = dict(mu=mu, speed=speed)
+        self.window = 1.5 * self.scene.stopping_time(self.v0)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return np.zeros(2), self.v0.copy()
+
+    def reference(self, rtol):
+        return (float(self.scene.stopping_distance(self.v0)),
+                [(float(self.scene.stopping_time(self.v0)), "S")])
+
+    def reference_grid(self):
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+
+class _PainleveRodCase(_Case):
+    ref_scheme = "sliding-ode"
+    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
+    tight_rtol = 1e-13
+    window = 0.5
+    headline_name = "centre position at the end of the window"
+
+    def __init__(self, mu=0.5, phi=0.9, tip_speed=-1.0, dphi=0.4):
+        from ..scenes.painleve_rod import PainleveRod
+        self.scene = PainleveRod(mu=mu)
+        self._params = dict(mu=mu, phi=phi, tip_speed=tip_speed, dphi=dphi)
+        self.q0, self.v0 = (np.asarray(a, dtype=float)
+                            for a in self.scene.sliding_state(phi, tip_speed, dphi=dphi))
+        self._sol = None
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), self.v0.copy()
+
+    def _ode(self, rtol):
+        from scipy.integrate import solve_ivp
+        rod = self.scene
+
+        def rhs(t, y):
+            a, lam_n, _ = rod.sliding_accelerations(y[:3], y[3:])
+            if not lam_n > 0.0:
+                raise MoreauError("the rod leaves the ground: the sliding reference does not apply")
+            return np.concatenate([y[3:], a])
+
+        return solve_ivp(rhs, (0.0, self.window), np.concatenate([self.q0, self.v0]),
+                         method="DOP853", rtol=rtol, atol=rtol, dense_output=True)
+
+    def reference(self, rtol):
+        sol = self._ode(rtol)
+        return float(sol.y[0, -1]), []
+
+    def reference_grid(self):
+        if self._sol is None:
+            self._sol = self._ode(self.tight_rtol)
+        return self._sol.sol(np.linspace(0.0, self.window, GRID + 1))[0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+
+#: scene name -> (case class, accepted parameters, one-line description)
+SCENES = {
+    "friction-drive": (_FrictionDriveCase, ("frequency", "mu", "phi0", "restitution", "load",
+                                            "x10", "k", "m", "m2", "length"),
+                       "the paper's friction drive (steady state; SI parameters)"),
+    "stick-slip-motor": (_StickSlipCase, ("frequency", "drive", "mu", "normal_force", "load"),
+                         "stick-slip motor, one period from its periodic state"),
+    "bouncing-ball": (_BouncingBallCase, ("restitution", "radius", "height"),
+                      "ball dropped from rest, window 2.6 (three impacts)"),
+    "sliding-block": (_SlidingBlockCase, ("mu", "speed"), "block sliding to rest on a level plane"),
+    "painleve-rod": (_PainleveRodCase, ("mu", "phi", "tip_speed", "dphi"),
+                     "Painlevé rod sliding on its tip, well-posed side"),
+}
+
+
+def make_case(scene, **params):
+    """Set up scene ``scene`` (a key of :data:`SCENES`) for comparison; None values are dropped."""
+    if scene not in SCENES:
+        raise InputError(f"`scene` must be one of {sorted(SCENES)}, got {scene!r}")
+    cls, allowed, _ = SCENES[scene]
+    params = {k: v for k, v in params.items() if v is not None}
+    bad = sorted(set(params) - set(allowed))
+    if bad:
+        raise InputError(f"scene {scene!r} takes the parameters {list(allowed)}; "
+                         f"`{bad[0]}` does not apply to it")
+    case = cls(**params)
+    case.name = scene
+    return case
+
+
+def _relative(value, ref):
+    return abs(value - ref) / abs(ref) if ref != 0.0 else abs(value)
+
+
+def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quick=False,
+            progress=True, on_row=None, **params):
+    """Error against run time of every scheme on one scene.
+
+    Parameters
+    ----------
+    scene : str
+        A key of :data:`SCENES`.
+    steps : sequence of int, optional
+        Moreau–Jean steps per period (per comparison window for the
+        non-periodic scenes); :data:`DEFAULT_STEPS` (two decades), or
+        :data:`QUICK_STEPS` with ``quick=True``.
+    lcp_steps : sequence of int, optional
+        Steps per period of the forced-Lemke and forced-QP rows.
+    thetas : sequence of float
+        Values of theta for the default Moreau–Jean rows.
+    repeat : int
+        Run-time samples per row (the median is reported); rows slower than
+        one second are timed once.
+    quick : bool
+        Fewer points, one timing per row.
+    progress : bool
+        Show a progress bar (tqdm, on stderr).
+    on_row : callable, optional
+        Called with each finished row (the caller can save as it goes).
+    **params
+        Scene parameters (see :data:`SCENES`).
+
+    Returns
+    -------
+    dict
+        ``scene``, ``parameters``, ``headline``, ``reference`` (scheme and
+        tightest setting), ``rows`` (one per run: ``scheme``, ``theta``,
+        ``lcp``, ``steps_per_period``, ``rtol``, ``time_s``, ``error``,
+        ``trajectory_error``, ``switching_error``, ``mode``, ``status``,
+        ``message``), ``orders`` (``scheme``, ``theta``, ``lcp``, ``order``,
+        ``order_headline``) and ``interrupted``.
+    """
+    case = make_case(scene, **params)
+    if quick:
+        steps = QUICK_STEPS if steps is None else steps
+        lcp_steps = QUICK_LCP_STEPS if lcp_steps is None else lcp_steps
+        repeat = 1
+    steps = [positive_int("steps", n) for n in (DEFAULT_STEPS if steps is None else steps)]
+    lcp_steps = [positive_int("lcp_steps", n)
+                 for n in (DEFAULT_LCP_STEPS if lcp_steps is None else lcp_steps)]
+    repeat = positive_int("repeat", repeat)
+    from .._validate import in_closed_interval
+    thetas = [in_closed_interval("theta", th, 0.5, 1.0) for th in thetas]
+
+    tight = case.tight_rtol if case.tight_rtol is not None else None
+    ref_value, ref_switches = case.reference(tight)
+    # compile (numba) and load everything once, outside the timings
+    case.mj(min(steps + lcp_steps, default=GRID), 1.0, None)
+    if lcp_steps:
+        case.mj(min(lcp_steps), 1.0, "lemke")
+    report = {
+        "scene": scene,
+        "parameters": case.parameters(),
+        "headline": case.headline_name,
+        "reference": {"scheme": case.ref_scheme, "rtol": tight, "headline_value": ref_value},
+        "rows": [],
+        "orders": [],
+        "interrupted": False,
+    }
+    jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
+    jobs += [("mj", th, None, n) for th in thetas for n in steps]
+    jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(jobs), desc=f"compare {scene}", unit="run")
+    try:
+        for kind, theta, lcp, setting in jobs:
+            row = _run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches)
+            report["rows"].append(row)
+            if on_row is not None:
+                on_row(row)
+            if bar is not None:
+                bar.update(1)
+    except KeyboardInterrupt:
+        report["interrupted"] = True
+    finally:
+        if bar is not None:
+            bar.close()
+    report["orders"] = _orders(report["rows"])
+    return report
+
+
+def _run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
+    row = {"scheme": case.ref_scheme if kind == "ref" else "moreau-jean", "theta": theta,
+           "lcp": lcp, "steps_per_period": None if kind == "ref" else int(setting),
+           "rtol": setting if kind == "ref" else None, "time_s": None, "error": None,
+           "trajectory_error": None, "switching_error": None, "mode": None, "status": 0,
+           "message": ""}
+    try:
+        if kind == "ref":
+            t, (value, sw) = _median_time(lambda: case.reference(setting), repeat)
+            row.update(time_s=t, error=_relative(value, ref_value),
+                       switching_error=switching_error(ref_switches, sw))
+        else:
+            t, out = _median_time(lambda: case.mj(setting, theta, lcp), repeat)
+            value = out[0]
+            traj, sw, mode = case.measure(setting, theta, lcp, out)
+            row.update(time_s=t, error=_relative(value, ref_value), trajectory_error=traj,
+                       switching_error=switching_error(ref_switches, sw), mode=mode)
+    except MoreauError as exc:
+        row.update(status=-1, message=f"{type(exc).__name__}: {exc}")
+    return row
+
+
+def _orders(rows):
+    series = {}
+    for r in rows:
+        if r["scheme"] == "moreau-jean" and r["status"] == 0:
+            series.setdefault((r["theta"], r["lcp"]), []).append(r)
+    out = []
+    for (theta, lcp), rs in series.items():
+        n = [r["steps_per_period"] for r in rs]
+        out.append({"scheme": "moreau-jean", "theta": theta, "lcp": lcp,
+                    "order": fit_order(n, [r["trajectory_error"] for r in rs]),
+                    "order_headline": fit_order(n, [r["error"] for r in rs])})
+    return out
+
+
+# -- output ---------------------------------------------------------------------------------
+CSV_FIELDS = ("scheme", "theta", "lcp", "steps_per_period", "rtol", "time_s", "error",
+              "trajectory_error", "switching_error", "mode", "status", "message")
+
+
+def check_out_dir(out):
+    """Create ``out`` if needed and check that files can be written there (before any work)."""
+    if os.path.exists(out) and not os.path.isdir(out):
+        raise InputError(f"`--out` must be a folder, but {out!r} is a file")
+    try:
+        os.makedirs(out, exist_ok=True)
+    except OSError as exc:
+        raise InputError(f"`--out` folder {out!r} cannot be created: {exc.strerror}") from None
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise InputError(f"`--out` folder {out!r} is not writable")
+    return out
+
+
+def write_outputs(report, out, tag=None, plot=True):
+    """Write ``<tag>.csv``, ``<tag>.json`` and (with matplotlib) ``<tag>.png``; return the paths."""
+    tag = tag or f"compare_{report['scene']}"
+    paths = {}
+    csv_path = os.path.join(out, tag + ".csv")
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=CSV_FIELDS, extrasaction="ignore")
+        w.writeheader()
+        for r in report["rows"]:
+            w.writerow(r)
+    paths["csv"] = csv_path
+    json_path = os.path.join(out, tag + ".json")
+    with open(json_path, "w") as fh:
+        json.dump(report, fh, indent=1)
+    paths["json"] = json_path
+    if plot:
+        try:
+            png = os.path.join(out, tag + ".png")
+            plot_work_precision(report, png)
+            paths["png"] = png
+        except ImportError:
+            paths["png"] = None
+    return paths
+
+
+def _label(r):
+    if r["scheme"] != "moreau-jean":
+        return r["scheme"]
+    th = "1/2" if r["theta"] == 0.5 else f"{r['theta']:g}"
+    return f"Moreau–Jean θ={th}" + (f", {r['lcp']}" if r["lcp"] else "")
+
+
+def plot_work_precision(report, path, ax=None):
+    """Log–log figure: headline error (filled) and trajectory error (open) against run time."""
+    import matplotlib
+    if ax is None:
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    own = ax is None
+    if own:
+        fig, ax = plt.subplots(figsize=(7, 5))
+    groups = {}
+    for r in report["rows"]:
+        if r["status"] == 0 and r["time_s"]:
+            groups.setdefault(_label(r), []).append(r)
+    floor = 1e-16
+    for i, (label, rs) in enumerate(groups.items()):
+        color = f"C{i}"
+        t = [r["time_s"] for r in rs]
+        ax.loglog(t, [max(r["error"], floor) for r in rs], "o-", color=color, label=label)
+        tr = [(r["time_s"], r["trajectory_error"]) for r in rs if r["trajectory_error"]]
+        if tr:
+            ax.loglog(*zip(*tr), "o:", color=color, mfc="none")
+    ax.set_xlabel("run time [s] (median)")
+    ax.set_ylabel(f"relative error: {report['headline']} (filled), trajectory (open)")
+    params = ", ".join(f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}"
+                       for k, v in report["parameters"].items())
+    ax.set_title(f"{report['scene']} ({params})", fontsize=9)
+    ax.legend(fontsize=7)
+    if own:
+        fig.tight_layout()
+        fig.savefig(path, dpi=110)
+        plt.close(fig)
+
+
+def format_table(report):
+    """The rows as a fixed-width text table."""
+    lines = [f"{report['scene']}: {report['headline']} "
+             f"(reference {report['reference']['scheme']}"
+             + (f", rtol {report['reference']['rtol']:g}" if report['reference']['rtol'] else "")
+             + ")",
+             f"{'scheme':>17} {'theta':>5} {'lcp':>5} {'steps':>6} {'rtol':>7} {'time [ms]':>10} "
+             f"{'error':>9} {'traj.':>9} {'switch':>9} mode"]
+
+    def g(x, fmt):
+        return format(x, fmt) if x is not None else "-"
+
+    for r in report["rows"]:
+        if r["status"] != 0:
+            lines.append(f"{r['scheme']:>17} {g(r['theta'], '5g')} {r['lcp'] or '-':>5} "
+                         f"{g(r['steps_per_period'], '6d')} {g(r['rtol'], '7.0e')} failed: "
+                         f"{r['message']}")
+            continue
+        lines.append(f"{r['scheme']:>17} {g(r['theta'], '5g'):>5} {r['lcp'] or '-':>5} "
+                     f"{g(r['steps_per_period'], '6d'):>6} {g(r['rtol'], '7.0e'):>7} "
+                     f"{r['time_s'] * 1e3:10.2f} {g(r['error'], '9.2e'):>9} "
+                     f"{g(r['trajectory_error'], '9.2e'):>9} {g(r['switching_error'], '9.2e'):>9} "
+                     f"{r['mode'] or ''}")
+    for o in report["orders"]:
+        th = o["theta"]
+        lines.append(f"order  theta={th:g} lcp={o['lcp'] or '-'}: "
+                     f"{g(o['order'], '.2f')} (trajectory), {g(o['order_headline'], '.2f')} "
+                     f"(headline)")
+    return "\n".join(lines)

@@ -1,0 +1,321 @@
+"""Sweep engine: steady states at many parameter points, cached on disk, in parallel.
+
+Every point is one call of :func:`evaluate_point`, a pure function of the
+friction drive's parameters, the drive frequency, the scheme settings and the
+package's code version. The calls are memoised with :class:`joblib.Memory`,
+so a finished point is never computed twice: a run that was interrupted
+resumes where it stopped, and a study that shares points with an earlier one
+reuses them. Because the code version is part of the key, editing the package
+invalidates the cache instead of serving stale numbers.
+
+The points run on local processes (joblib's loky pool, all cores by
+default) or, given a scheduler address, on a Dask distributed cluster. Both
+call the same memoised function, so they write to and read from the same
+cache and give the same rows. On a real cluster the cache folder must be on
+storage the workers can reach (a shared file system), or each worker keeps
+its own.
+
+A point that fails (ill-posed model, no convergence, anything else) becomes a
+row whose ``status`` names the cause; it never stops the run.
+"""
+
+import hashlib
+import math
+import os
+import pathlib
+import time
+
+from ..errors import InputError
+
+__all__ = ["code_version", "evaluate_point", "run_points", "check_output_dir", "Scheme",
+           "ED_REFERENCE", "mj_check_columns"]
+
+_PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
+
+
+#: modules that only present results (files, figures, text); editing them keeps the cache
+_PRESENTATION = {"cli.py", "analysis/figures.py", "analysis/report.py", "analysis/reproduce.py",
+                 "analysis/atlas.py", "analysis/sweeps.py", "analysis/histories.py"}
+
+
+def code_version():
+    """Package version plus a hash of the source files that compute results.
+
+    Used as part of the cache key: any edit of the computing code gives new
+    keys. Modules that only write files, figures or text are left out.
+
+    Examples
+    --------
+    >>> v = code_version()
+    >>> v.startswith("0.") and len(v.split("+")[1]) == 16
+    True
+    """
+    from .. import __version__
+    root = pathlib.Path(__file__).resolve().parents[1]
+    h = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        if path.relative_to(root).as_posix() in _PRESENTATION:
+            continue
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return f"{__version__}+{h.hexdigest()[:16]}"
+
+
+class Scheme(tuple):
+    """Settings of one steady-state computation: ``(name, theta, steps_per_period, rtol)``.
+
+    ``theta`` and ``steps_per_period`` are None for the event-driven scheme.
+
+    Examples
+    --------
+    >>> Scheme.moreau_jean(0.5, 2000).label
+    'mj_theta0.5'
+    """
+
+    def __new__(cls, name, theta=None, steps_per_period=None, rtol=None):
+        if name not in ("event-driven", "moreau-jean"):
+            raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {name!r}")
+        if name == "moreau-jean":
+            if theta is None or steps_per_period is None:
+                raise InputError("`theta` and `steps_per_period` are required for moreau-jean")
+            if not 0.5 <= float(theta) <= 1.0:
+                raise InputError(f"`theta` must be in [1/2, 1], got {theta!r}")
+            if int(steps_per_period) < 8:
+                raise InputError(f"`steps_per_period` must be >= 8, got {steps_per_period!r}")
+            theta, steps_per_period = float(theta), int(steps_per_period)
+        elif theta is not None or steps_per_period is not None:
+            raise InputError("`theta` and `steps_per_period` apply only to the moreau-jean scheme")
+        if rtol is not None and not (math.isfinite(rtol) and rtol > 0):
+            raise InputError(f"`rtol` must be > 0, got {rtol!r}")
+        return super().__new__(cls, (name, theta, steps_per_period,
+                                     None if rtol is None else float(rtol)))
+
+    @classmethod
+    def moreau_jean(cls, theta, steps_per_period, rtol=None):
+        return cls("moreau-jean", theta, steps_per_period, rtol)
+
+    name = property(lambda self: self[0])
+    theta = property(lambda self: self[1])
+    steps_per_period = property(lambda self: self[2])
+    rtol = property(lambda self: self[3])
+
+    @property
+    def label(self):
+        return "ed" if self.name == "event-driven" else f"mj_theta{self.theta:g}"
+
+    def __getnewargs__(self):
+        return tuple(self)
+
+
+ED_REFERENCE = Scheme("event-driven", rtol=1e-10)
+
+
+def mj_check_columns(check):
+    """CSV column names of one Moreau–Jean cross-check."""
+    p = check.label
+    return [f"{p}_displacement_per_period_m", f"{p}_relative_error", f"{p}_mode", f"{p}_status"]
+
+
+def _steady(params, frequency, scheme):
+    from .steady_state import find_steady_state
+    from ..scenes.friction_drive import FrictionDrive, FrictionDriveParams
+
+    scene = FrictionDrive(FrictionDriveParams(**params), frequency)
+    if scheme.name == "moreau-jean":
+        kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
+        ss = find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
+                               steps_per_period=scheme.steps_per_period, **kw)
+    else:
+        ss = find_steady_state(scene, rtol=1e-10 if scheme.rtol is None else scheme.rtol)
+    return scene, ss
+
+
+def _status_of(exc):
+    msg = " ".join(str(exc).split())
+    return f"{type(exc).__name__}: {msg}"
+
+
+def evaluate_point(params, frequency, scheme, checks=(), version=""):
+    """Steady state at one parameter point, as a row of SI values.
+
+    Parameters
+    ----------
+    params : dict
+        Every field of :class:`~moreau.scenes.friction_drive.FrictionDriveParams`.
+    frequency : float
+        Drive frequency [Hz].
+    scheme : Scheme
+        The scheme that gives the row's values.
+    checks : tuple of Scheme
+        Moreau–Jean cross-checks; each adds the columns of :func:`mj_check_columns`.
+    version : str
+        Code version (only a cache key here).
+
+    Returns
+    -------
+    dict
+        ``mode``, ``displacement_per_period_m``, ``average_velocity_m_per_s``,
+        ``min_normal_force_N``, ``periodic_residual``, ``shooting_iterations``,
+        ``compute_time_s``, ``status`` (``"ok"`` or the cause of the failure)
+        and the cross-check columns. Never raises for a failed point.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> from dataclasses import asdict
+    >>> row = evaluate_point(asdict(PAPER_DEFAULTS), 20.0, ED_REFERENCE)
+    >>> row["status"], row["mode"]
+    ('ok', 'NS')
+    >>> bad = evaluate_point(asdict(PAPER_DEFAULTS.with_(phi0=1.5)), 185.0, ED_REFERENCE)
+    >>> bad["status"].startswith("PainleveError")
+    True
+    """
+    t0 = time.perf_counter()
+    row = {"mode": "", "displacement_per_period_m": math.nan, "average_velocity_m_per_s": math.nan,
+           "min_normal_force_N": math.nan, "periodic_residual": math.nan,
+           "shooting_iterations": 0, "status": "ok"}
+    ref = math.nan
+    try:
+        scene, ss = _steady(params, frequency, scheme)
+        ref = scene.displacement_to_si(ss.displacement_per_period)
+        row.update(mode=ss.mode, displacement_per_period_m=ref,
+                   average_velocity_m_per_s=ref * frequency,
+                   min_normal_force_N=scene.force_to_si(ss.min_normal_force),
+                   periodic_residual=ss.periodic_residual, shooting_iterations=ss.iterations)
+    except Exception as exc:  # any failure becomes the status of this point
+        row["status"] = _status_of(exc)
+    for chk in checks:
+        d_col, e_col, m_col, s_col = mj_check_columns(chk)
+        row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: "ok"})
+        try:
+            scene, ss = _steady(params, frequency, chk)
+            d = scene.displacement_to_si(ss.displacement_per_period)
+            row.update({d_col: d, m_col: ss.mode,
+                        e_col: (d - ref) / abs(ref) if ref != 0 else math.nan})
+        except Exception as exc:  # any failure becomes the status of this point
+            row[s_col] = _status_of(exc)
+    row["compute_time_s"] = time.perf_counter() - t0
+    return row
+
+
+def check_output_dir(path):
+    """Create ``path`` if needed and make sure files can be written there.
+
+    Raises
+    ------
+    InputError
+        Naming the folder and the reason, before any work is done.
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> check_output_dir(tempfile.mkdtemp()).is_dir()
+    True
+    """
+    p = pathlib.Path(path)
+    try:
+        p.mkdir(parents=True, exist_ok=True)
+        probe = p / f".moreau-write-test-{os.getpid()}"
+        probe.write_text("ok")
+        probe.unlink()
+    except OSError as exc:
+        raise InputError(f"`--out` folder {str(p)!r} is not writable: {exc.strerror or exc}") from None
+    return p
+
+
+def _memory(cache_dir):
+    import joblib
+    return joblib.Memory(location=None if cache_dir is None else str(cache_dir), verbose=0)
+
+
+def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
+               progress=False, desc="points"):
+    """Evaluate many points, reusing cached ones, in parallel.
+
+    Parameters
+    ----------
+    points : list of (dict, float)
+        ``(params, frequency)`` pairs (see :func:`evaluate_point`).
+    scheme, checks : Scheme, tuple of Scheme
+    cache_dir : path-like, optional
+        joblib cache folder; None disables the cache.
+    n_jobs : int
+        Local processes (``-1``: all cores). Ignored with ``scheduler``.
+    scheduler : str or distributed.Client, optional
+        Address of a Dask scheduler (``"tcp://host:8786"``) or a client.
+    progress : bool
+        A tqdm bar (shown on a terminal only).
+
+    Returns
+    -------
+    rows : list of dict
+        In the order of ``points``.
+    stats : dict
+        ``cached`` (points found in the cache) and ``computed``.
+
+    Examples
+    --------
+    >>> from dataclasses import asdict
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> rows, st = run_points([(asdict(PAPER_DEFAULTS), 20.0)], n_jobs=1)
+    >>> rows[0]["mode"], st["computed"]
+    ('NS', 1)
+    """
+    version = code_version()
+    func = _memory(cache_dir).cache(evaluate_point, ignore=[])
+    args = [(dict(p), float(f), scheme, tuple(checks), version) for p, f in points]
+    rows = [None] * len(args)
+    todo = []
+    for i, a in enumerate(args):
+        if cache_dir is not None and func.check_call_in_cache(*a):
+            rows[i] = func(*a)
+        else:
+            todo.append(i)
+    bar = None
+    if progress:
+        from tqdm.auto import tqdm
+        bar = tqdm(total=len(args), initial=len(args) - len(todo), desc=desc, unit="pt",
+                   disable=None, leave=False)
+    try:
+        if todo:
+            if scheduler is not None:
+                results = _dask_results(func, [args[i] for i in todo], scheduler)
+            elif n_jobs == 1 or len(todo) == 1:
+                results = ((k, func(*args[i])) for k, i in enumerate(todo))
+            else:
+                import joblib
+                par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
+                                      batch_size=1)
+                results = par(joblib.delayed(_indexed)(func, k, args[i])
+                              for k, i in enumerate(todo))
+            for k, row in results:
+                rows[todo[k]] = row
+                if bar is not None:
+                    bar.update(1)
+    finally:
+        if bar is not None:
+            bar.close()
+    return rows, {"cached": len(args) - len(todo), "computed": len(todo)}
+
+
+def _indexed(func, k, a):
+    return k, func(*a)
+
+
+def _dask_results(func, args, scheduler):
+    from distributed import Client, as_completed
+
+    own = not hasattr(scheduler, "submit")
+    client = Client(scheduler) if own else scheduler
+    try:
+        futures = {client.submit(func, *a, pure=False): k for k, a in enumerate(args)}
+        for fut in as_completed(list(futures)):
+            k = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as exc:  # a lost worker: the point fails, the run goes on
+                row = {"status": _status_of(exc)}
+            yield k, row
+    finally:
+        if own:
+            client.close()

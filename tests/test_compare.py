@@ -1,0 +1,116 @@
+"""`moreau compare`: error against run time per scheme (issue #11)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from moreau.analysis.compare import compare, fit_order, make_case, switching_error
+from moreau.cli import main
+from moreau.errors import InputError
+
+ROW_KEYS = {"scheme", "theta", "lcp", "steps_per_period", "rtol", "time_s", "error"}
+
+
+@pytest.fixture(scope="module")
+def fd185(tmp_path_factory):
+    out = tmp_path_factory.mktemp("cmp")
+    import contextlib
+    import io
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(["compare", "--scene", "friction-drive", "--frequency", "185", "--json",
+                     "--quick", "--quiet", "--out", str(out)])
+    assert code == 0
+    return json.loads(buf.getvalue()), out
+
+
+def test_friction_drive_185_json_lists_every_scheme(fd185):
+    rep, out = fd185
+    rows = rep["rows"]
+    assert all(ROW_KEYS <= set(r) for r in rows)
+    kinds = {(r["scheme"], r["theta"], r["lcp"]) for r in rows}
+    assert ("event-driven", None, None) in kinds
+    assert {("moreau-jean", 0.5, None), ("moreau-jean", 1.0, None),
+            ("moreau-jean", 1.0, "lemke"), ("moreau-jean", 1.0, "qp")} <= kinds
+    for r in rows:
+        assert r["status"] == 0, r["message"]
+        assert (r["rtol"] is None) != (r["steps_per_period"] is None)
+        assert r["time_s"] > 0 and np.isfinite(r["error"])
+    steps = sorted({r["steps_per_period"] for r in rows if r["lcp"] is None
+                    and r["scheme"] == "moreau-jean"})
+    assert steps[-1] / steps[0] >= 100          # two decades
+    # the reference at rtol 1e-8 and tighter agrees with the tightest to 1e-12
+    ed = {r["rtol"]: r["error"] for r in rows if r["scheme"] == "event-driven"}
+    assert ed[1e-10] < 1e-11 and ed[1e-4] > ed[1e-10]
+    for f in ("csv", "json", "png"):
+        assert (out / f"compare_friction-drive_185Hz.{f}").stat().st_size > 0
+
+
+def test_friction_drive_185_moreau_jean_is_first_order(fd185):
+    rep, _ = fd185
+    orders = {(o["scheme"], o["theta"], o["lcp"]): o["order"] for o in rep["orders"]}
+    assert 0.8 <= orders[("moreau-jean", 1.0, None)] <= 1.3     # measured 1.01
+    assert 0.8 <= orders[("moreau-jean", 0.5, None)] <= 1.3     # measured 0.94
+    # finest Moreau-Jean steady state within 1e-3 of the reference
+    fine = [r for r in rep["rows"] if r["scheme"] == "moreau-jean" and r["lcp"] is None
+            and r["steps_per_period"] == 5000]
+    assert all(r["error"] < 1e-3 and r["mode"] == "NP" for r in fine)
+
+
+def test_lemke_and_qp_paths_give_the_same_steps(fd185):
+    rep, _ = fd185
+    by = {}
+    for r in rep["rows"]:
+        if r["lcp"]:
+            by.setdefault(r["steps_per_period"], {})[r["lcp"]] = r
+    assert by
+    for n, d in by.items():
+        # the same contact problems, solved by two methods, to solver precision
+        assert abs(d["lemke"]["error"] - d["qp"]["error"]) < 1e-6
+        assert abs(d["lemke"]["trajectory_error"] - d["qp"]["trajectory_error"]) < 1e-6
+
+
+@pytest.mark.parametrize("scene, order_lo", [("sliding-block", 0.95), ("painleve-rod", 0.9)])
+def test_first_order_on_exact_scenes(scene, order_lo):
+    rep = compare(scene, steps=[20, 40, 80, 160], lcp_steps=[], thetas=(1.0,), repeat=1,
+                  progress=False)
+    assert rep["rows"][0]["scheme"] in ("exact", "sliding-ode")
+    (o,) = rep["orders"]
+    assert order_lo <= o["order"] <= 1.1
+
+
+def test_bouncing_ball_impact_times_and_stick_slip_reference():
+    rep = compare("bouncing-ball", steps=[52, 104, 208], lcp_steps=[], thetas=(1.0,),
+                  repeat=1, progress=False)
+    mj = [r for r in rep["rows"] if r["scheme"] == "moreau-jean"]
+    # impacts at 1, 2, 2.5 found within a step or two
+    for r in mj:
+        assert r["switching_error"] is not None and r["switching_error"] <= 2.6 / r[
+            "steps_per_period"] * 2 + 1e-12
+    rep = compare("stick-slip-motor", steps=[100, 200, 400], lcp_steps=[100], thetas=(1.0,),
+                  repeat=1, progress=False)
+    assert rep["rows"][0]["scheme"] == "stick-slip-exact"
+    assert all(r["status"] == 0 for r in rep["rows"])
+    err = [r["trajectory_error"] for r in rep["rows"] if r["lcp"] is None
+           and r["scheme"] == "moreau-jean"]
+    assert err[0] > err[1] > err[2]
+
+
+def test_bad_input_is_refused_before_work(tmp_path, capsys):
+    with pytest.raises(InputError, match="`phi` does not apply|`restitution`"):
+        make_case("sliding-block", restitution=0.5)
+    with pytest.raises(InputError, match="`scene`"):
+        make_case("pendulum")
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["compare", "--scene", "sliding-block", "--out", str(f), "--quiet"]) == 2
+    assert "`--out`" in capsys.readouterr().err
+    assert main(["compare", "--out", str(tmp_path), "--quiet"]) == 2
+
+
+def test_helpers():
+    assert fit_order([1, 2, 4], [1.0, 0.25, 0.0625]) == pytest.approx(2.0)
+    assert fit_order([1, 2], [1.0, 0.5]) is None
+    assert switching_error([], []) is None
+    assert switching_error([(1.0, "P")], [(1.0, "P"), (2.0, "N")]) is None
