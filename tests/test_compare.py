@@ -114,3 +114,20 @@ def test_helpers():
     assert fit_order([1, 2], [1.0, 0.5]) is None
     assert switching_error([], []) is None
     assert switching_error([(1.0, "P")], [(1.0, "P"), (2.0, "N")]) is None
+
+
+@pytest.mark.parametrize("frequency, mode, fine_error", [(20.0, "NS", 5e-3), (2000.0, "NP", 1e-2)])
+def test_friction_drive_20_and_2000_hz(frequency, mode, fine_error):
+    rep = compare("friction-drive", frequency=frequency, steps=[100, 300, 1000, 3000],
+                  lcp_steps=[], repeat=1, progress=False)
+    assert all(r["status"] == 0 for r in rep["rows"]), [r["message"] for r in rep["rows"]]
+    ed = [r for r in rep["rows"] if r["scheme"] == "event-driven"]
+    assert len(ed) >= 4 and min(r["error"] for r in ed) < 1e-9
+    orders = {o["theta"]: o["order"] for o in rep["orders"]}
+    # measured: 20 Hz 1.03 (theta 1), 2000 Hz 1.00 (theta 1)
+    assert 0.8 <= orders[1.0] <= 1.3
+    for r in rep["rows"]:
+        if r["scheme"] == "moreau-jean":
+            assert r["mode"] == mode
+            if r["steps_per_period"] == 3000:
+                assert r["error"] < fine_error and r["switching_error"] < 5e-3
