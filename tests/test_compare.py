@@ -131,3 +131,20 @@ def test_friction_drive_20_and_2000_hz(frequency, mode, fine_error):
             assert r["mode"] == mode
             if r["steps_per_period"] == 3000:
                 assert r["error"] < fine_error and r["switching_error"] < 5e-3
+
+
+def test_2000_hz_plateau_is_a_grid_effect_and_is_flagged():
+    # defect 4: the slip reversal tau* = 2.98557 is pinned to the grid time
+    # 2 pi 2376/5000 = 2.98577, shared by N = 5000, 10000, 20000; N = 40000 has
+    # one 0.5e-4 after tau*, N = 4999 one 8.0e-4 after it (error -6.7 (tau_j - tau*))
+    rep = compare("friction-drive", frequency=2000.0, steps=[4999, 5000, 10000, 20000, 40000],
+                  lcp_steps=[], thetas=(0.5,), repeat=1, progress=False)
+    err = {r["steps_per_period"]: r["signed_error"] for r in rep["rows"]
+           if r["scheme"] == "moreau-jean"}
+    for n in (5000, 10000, 20000):
+        assert err[n] == pytest.approx(-1.34e-3, rel=0.01)
+    assert err[40000] == pytest.approx(-6.7 * 0.5e-4, rel=0.15)
+    assert err[4999] == pytest.approx(-6.7 * 8.0e-4, rel=0.05)
+    (note,) = rep["notes"]
+    assert note["theta"] == 0.5 and note["steps_per_period"] == [5000, 10000, 20000]
+    assert "grid time" in note["text"]
