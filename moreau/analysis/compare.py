@@ -265,8 +265,12 @@ class _Case:
 
     def _run_switches(self, res, h):
         letters = res.regime_letters()
-        # a step's regime is recorded at its end: the switch happened in that step
-        return _drop_reversal_sticks(_switches(letters, res.t - h), h)
+        t = res.t - h
+        # a step's regime is recorded at its end: the switch happened in that step.
+        # The regime in force at the start goes in front, so that a one-step
+        # stick at the first switch is recognised as a reversal too
+        sw = [(float(t[0]), letters[0])] + _switches(letters, t)
+        return _drop_reversal_sticks(sw, h)[1:]
 
 
 class _FrictionDriveCase(_Case):
