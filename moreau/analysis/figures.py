@@ -143,6 +143,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         limits.append((extra["painleve_edge"], "Painlev\u00e9 edge", "-."))
     if "contact_loss_Hz" in extra:
         limits.append((extra["contact_loss_Hz"], "lift-off limit (max D = 0)", "--"))
+    unit = {"frequency": " Hz", "phi0": " rad"}.get(parameter, "")
     lo, hi = (x.min(), x.max()) if x.size else (0, 1)
     if parameter == "phi0" and limits:
         # the valid range's edges are part of the picture
@@ -154,7 +155,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         if log or lo - 0.05 * span <= xv <= hi + 0.05 * span:
             for ax in axes:
                 h = ax.axvline(xv, color="k", ls=ls, lw=1.1)
-            limit_h[f"{lab} ({xv:.4g})"] = h
+            limit_h[f"{lab} ({xv:.4g}{unit})"] = h
     axes[1].set_xlabel(_XLABEL.get(parameter, parameter))
     lines, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(lines + list(limit_h.values()), labels + list(limit_h), fontsize=7.5,
@@ -168,7 +169,8 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         if parameter != "frequency" and frequency is not None:
             title += f" at f = {frequency:g} Hz"
     axes[0].set_title(title, fontsize=11)
-    fig.tight_layout()
+    # fixed margins: tight_layout would cost one more full draw of a dense figure
+    fig.subplots_adjust(left=0.09, right=0.98, top=0.94, bottom=0.08, hspace=0.08)
     return save(fig, stem)
 
 
@@ -290,7 +292,7 @@ def mode_figure(mode, p, f, folder):
         fig.suptitle(f"Operation mode {mode}: one steady period at f = {f:g} Hz, "
                      f"\u03bc = {p.mu:.3g}, \u03c6\u2080 = {p.phi0:.3f} rad "
                      f"(\u03c4\u2080 = {ss.section_tau:.3f})", fontsize=10.5)
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.08, right=0.99, top=0.80, bottom=0.13, wspace=0.25)
         return save(fig, folder / f"mode_{mode}")
 
 
