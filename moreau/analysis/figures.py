@@ -84,10 +84,14 @@ def _bands(ax, x, rows, others, log=False):
 
 
 _XLABEL = {"frequency": "drive frequency f [Hz]", "mu": "friction coefficient \u03bc [-]",
-           "phi0": "initial tilt angle \u03c6\u2080 [rad]"}
+           "phi0": "initial tilt angle \u03c6\u2080 [rad]", "m": "rod mass m [kg]",
+           "m2": "rotor mass m\u2082 [kg]", "k": "spring stiffness k [N/m]",
+           "length": "rod length l [m]", "x10": "stator amplitude x\u2081\u2080 [m]",
+           "load": "rotor load F_L [N]", "restitution": "restitution e [-]"}
 
 
-def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None):
+def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None, log=None,
+                 scheme_label="event-driven"):
     """Displacement per period and average velocity over a sweep (PNG + SVG).
 
     Parameters
@@ -104,6 +108,11 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         File name without suffix.
     checks : tuple of Scheme
         Moreau–Jean cross-checks whose columns are overlaid.
+    title : str, optional
+    log : bool, optional
+        Log-scaled x axis (default: for frequency sweeps over more than a decade).
+    scheme_label : str
+        Legend entry of the main curve (the scheme that computed it).
     """
     from .reproduce import PARAM_COLUMNS, SWEPT_COLUMN
     plt = _plt()
@@ -113,12 +122,14 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
     v = np.array([r["average_velocity_m_per_s"] for r in rows], float) * 1e3
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True)
     others = {}
-    log = parameter == "frequency" and x.size > 1 and x.min() > 0 and x.max() / x.min() > 20
+    if log is None:
+        log = parameter == "frequency" and x.size > 1 and x.min() > 0 and x.max() / x.min() > 20
     handles, limit_h = {}, {}
     for ax, y, lab in ((axes[0], d, "displacement per period [\u00b5m]"),
                        (axes[1], v, "average rotor velocity [mm/s]")):
         handles.update(_bands(ax, x, rows, others, log))
-        ax.plot(x, y, "k-", lw=1.3, label="event-driven")
+        # few points: show where they are
+        ax.plot(x, y, "k.-" if x.size <= 40 else "k-", lw=1.3, label=scheme_label)
         ax.axhline(0.0, color="0.5", lw=0.6)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3, lw=0.5)
@@ -156,7 +167,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
             for ax in axes:
                 h = ax.axvline(xv, color="k", ls=ls, lw=1.1)
             limit_h[f"{lab} ({xv:.4g}{unit})"] = h
-    axes[1].set_xlabel(_XLABEL.get(parameter, parameter))
+    axes[1].set_xlabel(_XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
     lines, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(lines + list(limit_h.values()), labels + list(limit_h), fontsize=7.5,
                    loc="best")
@@ -164,7 +175,8 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
                    ncol=4, loc="best", title_fontsize=8)
     if title is None:
         what = {"frequency": "drive frequency", "mu": "friction coefficient",
-                "phi0": "initial tilt angle"}.get(parameter, parameter)
+                "phi0": "initial tilt angle"}.get(parameter) or \
+            _XLABEL.get(parameter, parameter).split(" [")[0]
         title = f"Friction drive: steady state against {what}"
         if parameter != "frequency" and frequency is not None:
             title += f" at f = {frequency:g} Hz"
