@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``run``.
+"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``run``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -153,6 +153,46 @@ def _cmd_run(args):
                     args.theta, args.out, plot=not args.no_plot, progress=not args.quiet)
 
 
+def _cmd_atlas(args):
+    from .analysis.atlas import run_atlas
+    from .analysis.sweeps import make_scheme
+    params = _params(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
+    if args.quick:
+        if args.f_points is not None or args.y_points is not None:
+            raise InputError("`--quick` sets the grid; leave out `--f-points`/`--y-points`")
+        f_points, y_points = 24, 12
+    else:
+        f_points = 200 if args.f_points is None else args.f_points
+        y_points = 100 if args.y_points is None else args.y_points
+    run_atlas(planes, params, out=args.out, f_range=(args.fmin, args.fmax), f_points=f_points,
+              y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+
+
+def _add_atlas(sub):
+    p = sub.add_parser("atlas", help="operation mode and displacement over the (f, mu) and "
+                                     "(f, phi0) planes, with the lift-off, Painleve and "
+                                     "contact-loss boundaries")
+    p.add_argument("--plane", choices=["both", "f-mu", "f-phi0"], default="both")
+    p.add_argument("--f-points", type=int, default=None, help="frequencies (default 200, log-spaced)")
+    p.add_argument("--y-points", type=int, default=None, help="mu or phi0 values (default 100)")
+    p.add_argument("--fmin", type=float, default=10.0, help="lowest frequency [Hz] (default 10)")
+    p.add_argument("--fmax", type=float, default=12500.0,
+                   help="highest frequency [Hz] (default 12500)")
+    p.add_argument("--quick", action="store_true", help="a 24 x 12 grid per plane")
+    p.add_argument("--out", default="out", help="output folder (default ./out)")
+    p.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on this Dask scheduler (e.g. tcp://host:8786)")
+    p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    _add_params(p, scheme_defaults=False)
+    p.set_defaults(func=_cmd_atlas)
+
+
 # -- moreau reproduce ---------------------------------------------------------------
 
 def _cmd_reproduce(args):
@@ -269,6 +309,7 @@ def build_parser():
     _add_params(r)
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
+    _add_atlas(sub)
     c = sub.add_parser("compare", help="error against run time of every scheme on one scene "
                                        "(table + figure), or the stiff/extreme-case map (--stress)")
     c.add_argument("--scene", default=None,

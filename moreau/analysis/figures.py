@@ -308,60 +308,78 @@ def mode_figure(mode, p, f, folder):
         return save(fig, folder / f"mode_{mode}")
 
 
+#: colours of atlas points without a steady mode
+_NO_MODE_COLORS = {"no contact": "#f4f4f4", "ill-posed (Painlev\u00e9)": "#777777",
+                   "failed": "#000000"}
+
+
 def atlas_figure(atlas, stem):
     """Mode map and displacement heat map over one parameter plane (PNG + SVG).
 
     ``atlas`` is a dict from :func:`moreau.analysis.atlas.compute_atlas`.
     """
     from matplotlib.colors import ListedColormap, TwoSlopeNorm
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
     plt = _plt()
     f = np.asarray(atlas["frequency_Hz"])
     y = np.asarray(atlas["y"])
-    modes = np.asarray(atlas["mode"], dtype=object)
-    status = np.asarray(atlas["status"], dtype=object)
-    names = [m for m in PAPER_MODES if np.any(modes == m)]
-    names += sorted({m for m in modes.ravel() if m and m not in names})
+    labels = np.asarray(atlas["label"], dtype=object)
+    present = set(labels.ravel())
+    names = [m for m in PAPER_MODES if m in present]
+    names += sorted(m for m in present if m not in names and m not in _NO_MODE_COLORS)
+    names += [m for m in _NO_MODE_COLORS if m in present]
     others = {}
-    colors = [mode_color(m, others) for m in names] + ["#000000"]
-    code = np.full(modes.shape, len(names), float)
+    colors = [_NO_MODE_COLORS.get(m) or mode_color(m, others) for m in names]
+    code = np.zeros(labels.shape)
     for i, m in enumerate(names):
-        code[(modes == m) & (status == "ok")] = i
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
+        code[labels == m] = i
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.6))
     ax = axes[0]
     ax.pcolormesh(f, y, code.T, cmap=ListedColormap(colors), vmin=-0.5,
-                  vmax=len(names) + 0.5, shading="nearest", rasterized=True)
-    handles = [Patch(color=c, label=m) for m, c in zip(names, colors)]
-    if np.any(code == len(names)):
-        handles.append(Patch(color="#000000", label="failed"))
+                  vmax=len(names) - 0.5, shading="nearest", rasterized=True)
+    handles = [Patch(facecolor=c, edgecolor="0.6", lw=0.5, label=m) for m, c in zip(names, colors)]
     d = np.asarray(atlas["displacement_per_period_m"], float) * 1e6
     ax2 = axes[1]
     lim = np.nanmax(np.abs(d)) if np.any(np.isfinite(d)) else 1.0
-    pc = ax2.pcolormesh(f, y, d.T, cmap="RdBu_r", norm=TwoSlopeNorm(0.0, -lim, lim),
-                        shading="nearest", rasterized=True)
-    fig.colorbar(pc, ax=ax2, label="displacement per period [\u00b5m]")
+    # symmetric log-like scale: the displacement spans decades across the plane
+    pc = ax2.pcolormesh(f, y, np.ma.masked_invalid(d).T, cmap="RdBu_r",
+                        norm=TwoSlopeNorm(0.0, -lim, lim), shading="nearest", rasterized=True)
+    ax2.set_facecolor("#dddddd")
+    fig.colorbar(pc, ax=ax2, label="displacement per period [\u00b5m] (grey: no steady mode)")
     lines = []
     for a in axes:
         for key, style, lab in (("lift_off", dict(colors="k", linestyles="--"),
                                  "lift-off: min f_N = 0 (max D = 0)"),
                                 ("painleve", dict(colors="k", linestyles="-."),
                                  "Painlev\u00e9: 1 \u2212 \u03bc tan \u03c6\u2080 = 0"),
-                                ("contact_loss", dict(colors="#ffffff", linestyles="-"),
+                                ("contact_loss", dict(colors="#d62728", linestyles="-"),
                                  "contact loss (flight in the steady state)")):
             field = np.asarray(atlas[key + "_field"], float)
-            if np.nanmin(field) < 0 < np.nanmax(field):
+            if np.any(np.isfinite(field)) and np.nanmin(field) < 0 < np.nanmax(field) \
+                    and min(field.shape) > 1:
                 a.contour(f, y, field.T, levels=[0.0], linewidths=1.6, **style)
                 if a is axes[0]:
-                    from matplotlib.lines import Line2D
                     lines.append(Line2D([], [], color=style["colors"], ls=style["linestyles"],
                                         label=lab, lw=1.6))
+            elif a is axes[0] and key != "contact_loss":
+                # say so rather than leave the reader looking for the curve
+                vals = field[np.isfinite(field)]
+                if key == "lift_off" and np.all(vals < 0):
+                    lines.append(Line2D([], [], color="none",
+                                        label="no lift-off in this plane (max D < 0 everywhere)"))
+                if key == "painleve" and np.all(vals > 0):
+                    lines.append(Line2D([], [], color="none",
+                                        label="Painlev\u00e9 condition holds everywhere here"))
         a.set_xscale("log")
         a.set_xlabel("drive frequency f [Hz]")
         a.set_ylabel(atlas["y_label"])
     axes[0].set_title(f"Operation mode over (f, {atlas['y_name']})", fontsize=11)
     axes[1].set_title(f"Displacement per period over (f, {atlas['y_name']})", fontsize=11)
-    leg = axes[0].legend(handles=handles + lines, fontsize=7, loc="upper left", ncol=2,
-                         framealpha=0.85, title="mode / boundary", title_fontsize=7.5)
-    leg.get_frame().set_facecolor("#eeeeee")
-    fig.tight_layout()
+    fig.legend(handles=handles + lines, fontsize=8, loc="lower center",
+               ncol=min(6, len(handles) + len(lines)), title="operation mode / boundary",
+               title_fontsize=8.5, frameon=False)
+    n = len(handles) + len(lines)
+    rows = math.ceil(n / min(6, n))
+    fig.subplots_adjust(left=0.06, right=0.97, top=0.93, bottom=0.17 + 0.04 * rows, wspace=0.18)
     return save(fig, stem)
