@@ -25,7 +25,7 @@ import os
 import pathlib
 import time
 
-from ..errors import InputError
+from ..errors import ConvergenceError, InputError
 
 __all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
            "ED_REFERENCE", "mj_check_columns"]
@@ -130,6 +130,24 @@ def _steady(params, frequency, scheme):
     return scene, ss
 
 
+def _implausible(params, mode):
+    """Why a converged steady state cannot be right, or None.
+
+    Without a load the rotor is driven by friction alone, so over a period the
+    friction impulse must vanish. With only positive (or only negative) slip in
+    contact the friction force keeps one sign and cannot: such a "steady
+    state" is a runaway rotor on which the shooting stalled, not a motion.
+    """
+    if params["load"] != 0.0:
+        return None
+    contact = set(mode) & set("NSP")
+    if contact in ({"P"}, {"N"}):
+        return (f"the steady state found (mode {mode!r}) has friction of one sign all period, "
+                "which cannot be periodic without a load (the shooting converged on a "
+                "runaway rotor)")
+    return None
+
+
 def _status_of(exc):
     msg = " ".join(str(exc).split())
     return f"{type(exc).__name__}: {msg}"
@@ -189,6 +207,9 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         return row
     try:
         scene, ss = _steady(params, frequency, scheme)
+        why = _implausible(params, ss.mode)
+        if why:
+            raise ConvergenceError(why)
         ref = scene.displacement_to_si(ss.displacement_per_period)
         row.update(mode=ss.mode, displacement_per_period_m=ref,
                    average_velocity_m_per_s=ref * frequency,
@@ -201,6 +222,9 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: "ok"})
         try:
             scene, ss = _steady(params, frequency, chk)
+            why = _implausible(params, ss.mode)
+            if why:
+                raise ConvergenceError(why)
             d = scene.displacement_to_si(ss.displacement_per_period)
             row.update({d_col: d, m_col: ss.mode,
                         e_col: (d - ref) / abs(ref) if ref != 0 else math.nan})

@@ -341,12 +341,14 @@ def atlas_figure(atlas, stem):
     handles = [Patch(facecolor=c, edgecolor="0.6", lw=0.5, label=m) for m, c in zip(names, colors)]
     d = np.asarray(atlas["displacement_per_period_m"], float) * 1e6
     ax2 = axes[1]
-    lim = np.nanmax(np.abs(d)) if np.any(np.isfinite(d)) else 1.0
-    # symmetric log-like scale: the displacement spans decades across the plane
+    # a robust colour range: a few extreme points must not wash out the rest of the plane
+    lim = float(np.nanpercentile(np.abs(d), 99.5)) if np.any(np.isfinite(d)) else 1.0
+    lim = lim if lim > 0 else 1.0
     pc = ax2.pcolormesh(f, y, np.ma.masked_invalid(d).T, cmap="RdBu_r",
                         norm=TwoSlopeNorm(0.0, -lim, lim), shading="nearest", rasterized=True)
     ax2.set_facecolor("#dddddd")
-    fig.colorbar(pc, ax=ax2, label="displacement per period [\u00b5m] (grey: no steady mode)")
+    fig.colorbar(pc, ax=ax2, extend="both" if np.nanmax(np.abs(d), initial=0) > lim else "neither",
+                 label="displacement per period [\u00b5m] (grey: no steady mode)")
     lines = []
     for a in axes:
         for key, style, lab in (("lift_off", dict(colors="k", linestyles="--"),
