@@ -22,7 +22,8 @@ PAPER_MODES = ("NS", "NSPS", "NPS", "NP", "NSP", "SP")
 MODE_COLORS = {"NS": "#4477aa", "NSPS": "#66ccee", "NPS": "#228833", "NP": "#ccbb44",
                "NSP": "#ee6677", "SP": "#aa3377"}
 REGIME_COLORS = {"N": "#4477aa", "S": "#228833", "P": "#ee6677", "F": "#bbbbbb"}
-_EXTRA = ["#999933", "#882255", "#44aa99", "#117733", "#332288", "#dddddd", "#661100", "#888888"]
+# distinct from the six mode colours and from the grey/black/white of points without a mode
+_EXTRA = ["#999933", "#882255", "#44aa99", "#332288", "#e69f00", "#661100", "#cc79a7", "#56b4e9"]
 _LETTER_NAME = {"N": "negative slip", "S": "stick", "P": "positive slip", "F": "flight"}
 
 
