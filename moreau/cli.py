@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``run``.
+"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``run``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -14,7 +14,7 @@ from .errors import InputError, MoreauError
 __all__ = ["main"]
 
 
-def _add_params(p):
+def _add_params(p, scheme_defaults=True):
     p.add_argument("--mu", type=float, default=None, help="friction coefficient (default 0.1)")
     p.add_argument("--phi0", type=float, default=None, help="initial rod tilt [rad] (default pi/4)")
     p.add_argument("--x10", type=float, default=None, help="stator amplitude [m] (default 2e-6)")
@@ -25,10 +25,13 @@ def _add_params(p):
     p.add_argument("--load", type=float, default=None, help="rotor load F_L [N] (default 0)")
     p.add_argument("--restitution", type=float, default=None, help="impact restitution e (default 0)")
     p.add_argument("--scheme", default="event-driven", choices=["event-driven", "moreau-jean"])
-    p.add_argument("--steps-per-period", type=int, default=1000,
+    # without defaults a command can tell (and refuse) a setting that would not act
+    p.add_argument("--steps-per-period", type=int, default=1000 if scheme_defaults else None,
                    help="Moreau-Jean steps per drive period (default 1000)")
-    p.add_argument("--theta", type=float, default=1.0, help="Moreau-Jean theta in [1/2, 1] (default 1)")
-    p.add_argument("--rtol", type=float, default=1e-10, help="shooting tolerance (default 1e-10)")
+    p.add_argument("--theta", type=float, default=1.0 if scheme_defaults else None,
+                   help="Moreau-Jean theta in [1/2, 1] (default 1)")
+    p.add_argument("--rtol", type=float, default=1e-10 if scheme_defaults else None,
+                   help="shooting tolerance (default 1e-10 event-driven, 1e-12 Moreau-Jean)")
 
 
 def _params(args):
@@ -107,11 +110,38 @@ def _cmd_steady(args):
 
 
 def _cmd_sweep(args):
-    from .analysis.sweeps import run_sweep
+    from .analysis.sweeps import SWEEPABLE, make_scheme, run_sweep
+    settings = {}
+    for item in args.set or []:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or key not in SWEEPABLE:
+            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {list(SWEEPABLE)}, "
+                             f"got {item!r}")
+        if key == args.parameter:
+            raise InputError(f"`--set {key}` fixes the swept parameter; leave it out")
+        try:
+            settings[key] = float(val)
+        except ValueError:
+            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    frequency = settings.pop("frequency", args.frequency)
+    for key, val in settings.items():
+        if getattr(args, key, None) is not None:
+            raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
+        setattr(args, key, val)
     params = _params(args)
-    run_sweep(args.parameter, params, frequency=args.frequency, start=args.start, stop=args.stop,
-              num=args.num, log=args.log, out=args.out, progress=not args.quiet,
-              plot=not args.no_plot)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    if args.num is not None and args.points is not None:
+        raise InputError("`--num` is the old name of `--points`; give one of them")
+    scale = args.scale
+    if args.log:
+        if scale == "linear":
+            raise InputError("`--log` contradicts `--scale linear`")
+        scale = "log"
+    run_sweep(args.parameter, params, frequency=frequency, start=args.start, stop=args.stop,
+              points=args.points if args.points is not None else args.num, scale=scale,
+              scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
 
 
 def _cmd_run(args):
@@ -121,6 +151,46 @@ def _cmd_run(args):
         raise InputError("`--frequency` is required (drive frequency in Hz)")
     history_command(params, args.frequency, args.periods, args.scheme, args.steps_per_period,
                     args.theta, args.out, plot=not args.no_plot, progress=not args.quiet)
+
+
+def _cmd_atlas(args):
+    from .analysis.atlas import run_atlas
+    from .analysis.sweeps import make_scheme
+    params = _params(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
+    if args.quick:
+        if args.f_points is not None or args.y_points is not None:
+            raise InputError("`--quick` sets the grid; leave out `--f-points`/`--y-points`")
+        f_points, y_points = 24, 12
+    else:
+        f_points = 200 if args.f_points is None else args.f_points
+        y_points = 100 if args.y_points is None else args.y_points
+    run_atlas(planes, params, out=args.out, f_range=(args.fmin, args.fmax), f_points=f_points,
+              y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+
+
+def _add_atlas(sub):
+    p = sub.add_parser("atlas", help="operation mode and displacement over the (f, mu) and "
+                                     "(f, phi0) planes, with the lift-off, Painleve and "
+                                     "contact-loss boundaries")
+    p.add_argument("--plane", choices=["both", "f-mu", "f-phi0"], default="both")
+    p.add_argument("--f-points", type=int, default=None, help="frequencies (default 200, log-spaced)")
+    p.add_argument("--y-points", type=int, default=None, help="mu or phi0 values (default 100)")
+    p.add_argument("--fmin", type=float, default=10.0, help="lowest frequency [Hz] (default 10)")
+    p.add_argument("--fmax", type=float, default=12500.0,
+                   help="highest frequency [Hz] (default 12500)")
+    p.add_argument("--quick", action="store_true", help="a 24 x 12 grid per plane")
+    p.add_argument("--out", default="out", help="output folder (default ./out)")
+    p.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
+    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run on this Dask scheduler (e.g. tcp://host:8786)")
+    p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    _add_params(p, scheme_defaults=False)
+    p.set_defaults(func=_cmd_atlas)
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -203,18 +273,32 @@ def build_parser():
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p)
     p.set_defaults(func=_cmd_steady)
-    s = sub.add_parser("sweep", help="steady states over a parameter range (data + figure)")
-    s.add_argument("parameter", choices=["frequency", "mu", "phi0"])
+    s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "
+                                      "cached and in parallel")
+    s.add_argument("parameter", metavar="PARAM",
+                   choices=["frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load",
+                            "restitution"],
+                   help="parameter to sweep: frequency [Hz] or a scene parameter (SI units)")
+    s.add_argument("start", metavar="START", type=float, nargs="?", default=None,
+                   help="first value (default for frequency/mu/phi0: the paper's range)")
+    s.add_argument("stop", metavar="STOP", type=float, nargs="?", default=None, help="last value")
+    s.add_argument("--points", type=int, default=None, help="number of values")
+    s.add_argument("--num", type=int, default=None, help=argparse.SUPPRESS)  # old name of --points
+    s.add_argument("--scale", choices=["log", "linear"], default=None,
+                   help="spacing of the values (default log for frequency, else linear)")
+    s.add_argument("--log", action="store_true", help=argparse.SUPPRESS)  # old form of --scale log
+    s.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="fix another parameter (repeatable), e.g. --set mu=0.3 --set frequency=185")
     s.add_argument("--frequency", type=float, default=None,
-                   help="drive frequency [Hz] for mu/phi0 sweeps")
-    s.add_argument("--start", type=float, default=None)
-    s.add_argument("--stop", type=float, default=None)
-    s.add_argument("--num", type=int, default=None)
-    s.add_argument("--log", action="store_true", default=None, help="log-spaced values")
+                   help="drive frequency [Hz] when PARAM is not frequency")
     s.add_argument("--out", default="out", help="output folder (default ./out)")
+    s.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
+    s.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the points on this Dask scheduler (e.g. tcp://host:8786)")
+    s.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
-    _add_params(s)
+    _add_params(s, scheme_defaults=False)
     s.set_defaults(func=_cmd_sweep)
     r = sub.add_parser("run", help="time histories from rest (CSV + figure, SI units)")
     r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
@@ -225,6 +309,7 @@ def build_parser():
     _add_params(r)
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
+    _add_atlas(sub)
     c = sub.add_parser("compare", help="error against run time of every scheme on one scene "
                                        "(table + figure), or the stiff/extreme-case map (--stress)")
     c.add_argument("--scene", default=None,

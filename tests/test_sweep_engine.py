@@ -106,3 +106,27 @@ def test_output_folder_is_checked_before_work(tmp_path, capsys, monkeypatch):
     rc = cli.main(["reproduce", "--out", str(blocker / "out"), "--quick", "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and "`--out` folder" in err and "not writable" in err
+
+
+def test_runaway_rotor_is_a_status_not_a_number(monkeypatch):
+    # seen in the atlas at 2.2 kHz, mu = 0.88 (mode P) and phi0 = 1.44 (!PF): the shooting
+    # "converged" on a rotor moving 1e9 m per period
+    real = engine._steady
+
+    def steady(params, frequency, scheme):
+        scene, ss = real(params, frequency, scheme)
+        ss.displacement_per_period = 1e9
+        return scene, ss
+
+    monkeypatch.setattr(engine, "_steady", steady)
+    row = engine.evaluate_point(P, 2000.0, ED_REFERENCE, checks=(Scheme.moreau_jean(1.0, 400),))
+    assert row["status"].startswith("ConvergenceError: the steady state found (mode 'NP')")
+    assert "runaway rotor" in row["status"]
+    assert row["mj_theta1_status"].startswith("ConvergenceError")
+    assert math.isnan(row["displacement_per_period_m"])
+    # a load can push the rotor: then the bound does not apply
+    scene, ss = steady(dict(P, load=1e-3), 2000.0, ED_REFERENCE)
+    assert engine._implausible(dict(P, load=1e-3), scene, ss) is None
+    # a sound steady state passes: the rotor's average speed is below the tip's largest
+    scene, ss = real(P, 2000.0, ED_REFERENCE)
+    assert engine._implausible(P, scene, ss) is None

@@ -25,9 +25,11 @@ import os
 import pathlib
 import time
 
-from ..errors import InputError
+import numpy as np
 
-__all__ = ["code_version", "evaluate_point", "run_points", "check_output_dir", "Scheme",
+from ..errors import ConvergenceError, InputError
+
+__all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
            "ED_REFERENCE", "mj_check_columns"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -130,6 +132,28 @@ def _steady(params, frequency, scheme):
     return scene, ss
 
 
+def _implausible(params, scene, ss):
+    """Why a converged steady state cannot be right, or None.
+
+    Without a load the rotor is driven by friction alone, so over a period the
+    friction impulse must vanish: friction has to change sign, hence the
+    rotor's velocity has to meet the tip's. Its average speed therefore cannot
+    exceed the largest tip speed by much (every sound point of the atlases
+    stays below 1.0 times that speed; the runaway orbits found by a stalled
+    shooting, with one-signed friction, are 1e12 times above it).
+    """
+    if params["load"] != 0.0:
+        return None
+    tau = np.linspace(0.0, 2.0 * math.pi, 257)
+    tip = float(np.max(np.abs(scene.tip_velocity(tau))))
+    speed = abs(ss.displacement_per_period) / (2.0 * math.pi)
+    if not speed <= 2.0 * tip:
+        return (f"the steady state found (mode {ss.mode!r}) has the rotor {speed / tip:.3g} "
+                "times faster on average than the rod's tip can move, which friction alone "
+                "cannot sustain (the shooting converged on a runaway rotor)")
+    return None
+
+
 def _status_of(exc):
     msg = " ".join(str(exc).split())
     return f"{type(exc).__name__}: {msg}"
@@ -175,8 +199,23 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
            "min_normal_force_N": math.nan, "periodic_residual": math.nan,
            "shooting_iterations": 0, "status": "ok"}
     ref = math.nan
+    margin = 1.0 - params["mu"] * math.tan(params["phi0"])
+    if margin <= 0:
+        # in contact phi <= phi0 (the stator only lifts the rod's hinge), so the rest angle
+        # is the worst case; saying so here spares building an integrator for nothing
+        row["status"] = (f"PainleveError: 1 - mu*tan(phi0) = {margin:.6g} <= 0: the contact "
+                         f"problem is ill-posed at the rod's rest angle (mu={params['mu']!r}, "
+                         f"phi0={params['phi0']!r})")
+        for chk in checks:
+            d_col, e_col, m_col, s_col = mj_check_columns(chk)
+            row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: row["status"]})
+        row["compute_time_s"] = time.perf_counter() - t0
+        return row
     try:
         scene, ss = _steady(params, frequency, scheme)
+        why = _implausible(params, scene, ss)
+        if why:
+            raise ConvergenceError(why)
         ref = scene.displacement_to_si(ss.displacement_per_period)
         row.update(mode=ss.mode, displacement_per_period_m=ref,
                    average_velocity_m_per_s=ref * frequency,
@@ -189,6 +228,9 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: "ok"})
         try:
             scene, ss = _steady(params, frequency, chk)
+            why = _implausible(params, scene, ss)
+            if why:
+                raise ConvergenceError(why)
             d = scene.displacement_to_si(ss.displacement_per_period)
             row.update({d_col: d, m_col: ss.mode,
                         e_col: (d - ref) / abs(ref) if ref != 0 else math.nan})
@@ -196,6 +238,19 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
             row[s_col] = _status_of(exc)
     row["compute_time_s"] = time.perf_counter() - t0
     return row
+
+
+def evaluate_points(points, scheme, checks=(), version=""):
+    """:func:`evaluate_point` over a list of ``(params, frequency)``: one cache entry for many points.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> from dataclasses import asdict
+    >>> [r["mode"] for r in evaluate_points([(asdict(PAPER_DEFAULTS), 20.0)] * 2, ED_REFERENCE)]
+    ['NS', 'NS']
+    """
+    return [evaluate_point(p, f, scheme, checks, version) for p, f in points]
 
 
 def check_output_dir(path):
@@ -229,7 +284,7 @@ def _memory(cache_dir):
 
 
 def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
-               progress=False, desc="points"):
+               progress=False, desc="points", chunk=1):
     """Evaluate many points, reusing cached ones, in parallel.
 
     Parameters
@@ -245,6 +300,10 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         Address of a Dask scheduler (``"tcp://host:8786"``) or a client.
     progress : bool
         A tqdm bar (shown on a terminal only).
+    chunk : int
+        Points per task and per cache entry. Large grids (atlases) use a
+        chunk of a grid line: tens of thousands of single-point entries
+        would cost more in files and scheduling than in computing.
 
     Returns
     -------
@@ -262,19 +321,29 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     ('NS', 1)
     """
     version = code_version()
-    func = _memory(cache_dir).cache(evaluate_point, ignore=[])
-    args = [(dict(p), float(f), scheme, tuple(checks), version) for p, f in points]
-    rows = [None] * len(args)
+    chunk = max(1, int(chunk))
+    if chunk == 1:
+        func = _memory(cache_dir).cache(evaluate_point, ignore=[])
+        args = [(dict(p), float(f), scheme, tuple(checks), version) for p, f in points]
+        sizes = [1] * len(args)
+    else:
+        func = _memory(cache_dir).cache(evaluate_points, ignore=[])
+        groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
+        args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version)
+                for g in groups]
+        sizes = [len(g) for g in groups]
+    out = [None] * len(args)
     todo = []
     for i, a in enumerate(args):
         if cache_dir is not None and func.check_call_in_cache(*a):
-            rows[i] = func(*a)
+            out[i] = func(*a)
         else:
             todo.append(i)
+    n_cached = sum(sizes[i] for i in range(len(args)) if out[i] is not None)
     bar = None
     if progress:
         from tqdm.auto import tqdm
-        bar = tqdm(total=len(args), initial=len(args) - len(todo), desc=desc, unit="pt",
+        bar = tqdm(total=len(points), initial=n_cached, desc=desc, unit="pt",
                    disable=None, leave=False)
     try:
         if todo:
@@ -288,14 +357,18 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
                                       batch_size=1)
                 results = par(joblib.delayed(_indexed)(func, k, args[i])
                               for k, i in enumerate(todo))
-            for k, row in results:
-                rows[todo[k]] = row
+            for k, res in results:
+                i = todo[k]
+                if chunk > 1 and isinstance(res, dict):  # a lost Dask task: every point fails
+                    res = [dict(res) for _ in range(sizes[i])]
+                out[i] = res
                 if bar is not None:
-                    bar.update(1)
+                    bar.update(sizes[i])
     finally:
         if bar is not None:
             bar.close()
-    return rows, {"cached": len(args) - len(todo), "computed": len(todo)}
+    rows = out if chunk == 1 else [r for part in out for r in part]
+    return rows, {"cached": n_cached, "computed": len(points) - n_cached}
 
 
 def _indexed(func, k, a):

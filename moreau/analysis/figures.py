@@ -22,7 +22,8 @@ PAPER_MODES = ("NS", "NSPS", "NPS", "NP", "NSP", "SP")
 MODE_COLORS = {"NS": "#4477aa", "NSPS": "#66ccee", "NPS": "#228833", "NP": "#ccbb44",
                "NSP": "#ee6677", "SP": "#aa3377"}
 REGIME_COLORS = {"N": "#4477aa", "S": "#228833", "P": "#ee6677", "F": "#bbbbbb"}
-_EXTRA = ["#999933", "#882255", "#44aa99", "#117733", "#332288", "#dddddd", "#661100", "#888888"]
+# distinct from the six mode colours and from the grey/black/white of points without a mode
+_EXTRA = ["#999933", "#882255", "#44aa99", "#332288", "#e69f00", "#661100", "#cc79a7", "#56b4e9"]
 _LETTER_NAME = {"N": "negative slip", "S": "stick", "P": "positive slip", "F": "flight"}
 
 
@@ -84,10 +85,14 @@ def _bands(ax, x, rows, others, log=False):
 
 
 _XLABEL = {"frequency": "drive frequency f [Hz]", "mu": "friction coefficient \u03bc [-]",
-           "phi0": "initial tilt angle \u03c6\u2080 [rad]"}
+           "phi0": "initial tilt angle \u03c6\u2080 [rad]", "m": "rod mass m [kg]",
+           "m2": "rotor mass m\u2082 [kg]", "k": "spring stiffness k [N/m]",
+           "length": "rod length l [m]", "x10": "stator amplitude x\u2081\u2080 [m]",
+           "load": "rotor load F_L [N]", "restitution": "restitution e [-]"}
 
 
-def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None):
+def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None, log=None,
+                 scheme_label="event-driven"):
     """Displacement per period and average velocity over a sweep (PNG + SVG).
 
     Parameters
@@ -104,6 +109,11 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         File name without suffix.
     checks : tuple of Scheme
         Moreau–Jean cross-checks whose columns are overlaid.
+    title : str, optional
+    log : bool, optional
+        Log-scaled x axis (default: for frequency sweeps over more than a decade).
+    scheme_label : str
+        Legend entry of the main curve (the scheme that computed it).
     """
     from .reproduce import PARAM_COLUMNS, SWEPT_COLUMN
     plt = _plt()
@@ -113,12 +123,14 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
     v = np.array([r["average_velocity_m_per_s"] for r in rows], float) * 1e3
     fig, axes = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True)
     others = {}
-    log = parameter == "frequency" and x.size > 1 and x.min() > 0 and x.max() / x.min() > 20
+    if log is None:
+        log = parameter == "frequency" and x.size > 1 and x.min() > 0 and x.max() / x.min() > 20
     handles, limit_h = {}, {}
     for ax, y, lab in ((axes[0], d, "displacement per period [\u00b5m]"),
                        (axes[1], v, "average rotor velocity [mm/s]")):
         handles.update(_bands(ax, x, rows, others, log))
-        ax.plot(x, y, "k-", lw=1.3, label="event-driven")
+        # few points: show where they are
+        ax.plot(x, y, "k.-" if x.size <= 40 else "k-", lw=1.3, label=scheme_label)
         ax.axhline(0.0, color="0.5", lw=0.6)
         ax.set_ylabel(lab)
         ax.grid(alpha=0.3, lw=0.5)
@@ -143,6 +155,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         limits.append((extra["painleve_edge"], "Painlev\u00e9 edge", "-."))
     if "contact_loss_Hz" in extra:
         limits.append((extra["contact_loss_Hz"], "lift-off limit (max D = 0)", "--"))
+    unit = {"frequency": " Hz", "phi0": " rad"}.get(parameter, "")
     lo, hi = (x.min(), x.max()) if x.size else (0, 1)
     if parameter == "phi0" and limits:
         # the valid range's edges are part of the picture
@@ -154,8 +167,8 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
         if log or lo - 0.05 * span <= xv <= hi + 0.05 * span:
             for ax in axes:
                 h = ax.axvline(xv, color="k", ls=ls, lw=1.1)
-            limit_h[f"{lab} ({xv:.4g})"] = h
-    axes[1].set_xlabel(_XLABEL.get(parameter, parameter))
+            limit_h[f"{lab} ({xv:.4g}{unit})"] = h
+    axes[1].set_xlabel(_XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
     lines, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(lines + list(limit_h.values()), labels + list(limit_h), fontsize=7.5,
                    loc="best")
@@ -163,12 +176,14 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None)
                    ncol=4, loc="best", title_fontsize=8)
     if title is None:
         what = {"frequency": "drive frequency", "mu": "friction coefficient",
-                "phi0": "initial tilt angle"}.get(parameter, parameter)
+                "phi0": "initial tilt angle"}.get(parameter) or \
+            _XLABEL.get(parameter, parameter).split(" [")[0]
         title = f"Friction drive: steady state against {what}"
         if parameter != "frequency" and frequency is not None:
             title += f" at f = {frequency:g} Hz"
     axes[0].set_title(title, fontsize=11)
-    fig.tight_layout()
+    # fixed margins: tight_layout would cost one more full draw of a dense figure
+    fig.subplots_adjust(left=0.09, right=0.98, top=0.94, bottom=0.08, hspace=0.08)
     return save(fig, stem)
 
 
@@ -290,8 +305,13 @@ def mode_figure(mode, p, f, folder):
         fig.suptitle(f"Operation mode {mode}: one steady period at f = {f:g} Hz, "
                      f"\u03bc = {p.mu:.3g}, \u03c6\u2080 = {p.phi0:.3f} rad "
                      f"(\u03c4\u2080 = {ss.section_tau:.3f})", fontsize=10.5)
-        fig.tight_layout()
+        fig.subplots_adjust(left=0.08, right=0.99, top=0.80, bottom=0.13, wspace=0.25)
         return save(fig, folder / f"mode_{mode}")
+
+
+#: colours of atlas points without a steady mode
+_NO_MODE_COLORS = {"no contact": "#f4f4f4", "ill-posed (Painlev\u00e9)": "#777777",
+                   "failed": "#000000"}
 
 
 def atlas_figure(atlas, stem):
@@ -300,54 +320,69 @@ def atlas_figure(atlas, stem):
     ``atlas`` is a dict from :func:`moreau.analysis.atlas.compute_atlas`.
     """
     from matplotlib.colors import ListedColormap, TwoSlopeNorm
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
     plt = _plt()
     f = np.asarray(atlas["frequency_Hz"])
     y = np.asarray(atlas["y"])
-    modes = np.asarray(atlas["mode"], dtype=object)
-    status = np.asarray(atlas["status"], dtype=object)
-    names = [m for m in PAPER_MODES if np.any(modes == m)]
-    names += sorted({m for m in modes.ravel() if m and m not in names})
+    labels = np.asarray(atlas["label"], dtype=object)
+    present = set(labels.ravel())
+    names = [m for m in PAPER_MODES if m in present]
+    names += sorted(m for m in present if m not in names and m not in _NO_MODE_COLORS)
+    names += [m for m in _NO_MODE_COLORS if m in present]
     others = {}
-    colors = [mode_color(m, others) for m in names] + ["#000000"]
-    code = np.full(modes.shape, len(names), float)
+    colors = [_NO_MODE_COLORS.get(m) or mode_color(m, others) for m in names]
+    code = np.zeros(labels.shape)
     for i, m in enumerate(names):
-        code[(modes == m) & (status == "ok")] = i
-    fig, axes = plt.subplots(1, 2, figsize=(13, 5.2))
+        code[labels == m] = i
+    fig, axes = plt.subplots(1, 2, figsize=(14, 5.6))
     ax = axes[0]
     ax.pcolormesh(f, y, code.T, cmap=ListedColormap(colors), vmin=-0.5,
-                  vmax=len(names) + 0.5, shading="nearest", rasterized=True)
-    handles = [Patch(color=c, label=m) for m, c in zip(names, colors)]
-    if np.any(code == len(names)):
-        handles.append(Patch(color="#000000", label="failed"))
+                  vmax=len(names) - 0.5, shading="nearest", rasterized=True)
+    handles = [Patch(facecolor=c, edgecolor="0.6", lw=0.5, label=m) for m, c in zip(names, colors)]
     d = np.asarray(atlas["displacement_per_period_m"], float) * 1e6
     ax2 = axes[1]
-    lim = np.nanmax(np.abs(d)) if np.any(np.isfinite(d)) else 1.0
-    pc = ax2.pcolormesh(f, y, d.T, cmap="RdBu_r", norm=TwoSlopeNorm(0.0, -lim, lim),
-                        shading="nearest", rasterized=True)
-    fig.colorbar(pc, ax=ax2, label="displacement per period [\u00b5m]")
+    # a robust colour range: a few extreme points must not wash out the rest of the plane
+    lim = float(np.nanpercentile(np.abs(d), 99.5)) if np.any(np.isfinite(d)) else 1.0
+    lim = lim if lim > 0 else 1.0
+    pc = ax2.pcolormesh(f, y, np.ma.masked_invalid(d).T, cmap="RdBu_r",
+                        norm=TwoSlopeNorm(0.0, -lim, lim), shading="nearest", rasterized=True)
+    ax2.set_facecolor("#dddddd")
+    fig.colorbar(pc, ax=ax2, extend="both" if np.nanmax(np.abs(d), initial=0) > lim else "neither",
+                 label="displacement per period [\u00b5m] (grey: no steady mode)")
     lines = []
     for a in axes:
         for key, style, lab in (("lift_off", dict(colors="k", linestyles="--"),
                                  "lift-off: min f_N = 0 (max D = 0)"),
                                 ("painleve", dict(colors="k", linestyles="-."),
                                  "Painlev\u00e9: 1 \u2212 \u03bc tan \u03c6\u2080 = 0"),
-                                ("contact_loss", dict(colors="#ffffff", linestyles="-"),
+                                ("contact_loss", dict(colors="#d62728", linestyles="-"),
                                  "contact loss (flight in the steady state)")):
             field = np.asarray(atlas[key + "_field"], float)
-            if np.nanmin(field) < 0 < np.nanmax(field):
+            if np.any(np.isfinite(field)) and np.nanmin(field) < 0 < np.nanmax(field) \
+                    and min(field.shape) > 1:
                 a.contour(f, y, field.T, levels=[0.0], linewidths=1.6, **style)
                 if a is axes[0]:
-                    from matplotlib.lines import Line2D
                     lines.append(Line2D([], [], color=style["colors"], ls=style["linestyles"],
                                         label=lab, lw=1.6))
+            elif a is axes[0] and key != "contact_loss":
+                # say so rather than leave the reader looking for the curve
+                vals = field[np.isfinite(field)]
+                if key == "lift_off" and np.all(vals < 0):
+                    lines.append(Line2D([], [], color="none",
+                                        label="no lift-off in this plane (max D < 0 everywhere)"))
+                if key == "painleve" and np.all(vals > 0):
+                    lines.append(Line2D([], [], color="none",
+                                        label="Painlev\u00e9 condition holds everywhere here"))
         a.set_xscale("log")
         a.set_xlabel("drive frequency f [Hz]")
         a.set_ylabel(atlas["y_label"])
     axes[0].set_title(f"Operation mode over (f, {atlas['y_name']})", fontsize=11)
     axes[1].set_title(f"Displacement per period over (f, {atlas['y_name']})", fontsize=11)
-    leg = axes[0].legend(handles=handles + lines, fontsize=7, loc="upper left", ncol=2,
-                         framealpha=0.85, title="mode / boundary", title_fontsize=7.5)
-    leg.get_frame().set_facecolor("#eeeeee")
-    fig.tight_layout()
+    fig.legend(handles=handles + lines, fontsize=8, loc="lower center",
+               ncol=min(6, len(handles) + len(lines)), title="operation mode / boundary",
+               title_fontsize=8.5, frameon=False)
+    n = len(handles) + len(lines)
+    rows = math.ceil(n / min(6, n))
+    fig.subplots_adjust(left=0.06, right=0.97, top=0.93, bottom=0.17 + 0.04 * rows, wspace=0.18)
     return save(fig, stem)

@@ -59,29 +59,51 @@ def study_grids(params=None, quick=False):
     (250, 99, True)
     """
     from ..scenes.friction_drive import PAPER_DEFAULTS
-    from .valid_range import phi0_valid_range
 
     params = PAPER_DEFAULTS if params is None else params
-    from scipy.optimize import brentq
-
-    from .valid_range import lift_off_margin
-    # the frequency where the rod at phi0 would lift off (max D = 0), if there is one
-    f_hi = 1e3
-    while lift_off_margin(params, f_hi) < 0 and f_hi < 1e7:
-        f_hi *= 2
-    edge = {"contact_loss_Hz": brentq(lambda f: lift_off_margin(params, f), f_hi / 2, f_hi)} \
-        if f_hi < 1e7 else {}
     grids = {"frequency": ("frequency", np.geomspace(10.0, 12500.0, 12 if quick else 250), None,
-                           edge)}
+                           range_marks(params, "frequency"))}
     mus = np.array([0.05, 0.1, 0.13, 0.2, 0.5, 0.89, 0.92, 0.98]) if quick else np.round(np.arange(1, 100) / 100.0, 2)
     for f in FREQUENCIES:
-        grids[f"mu_{f:g}Hz"] = ("mu", mus, f, {"painleve_edge": 1.0 / math.tan(params.phi0)})
+        grids[f"mu_{f:g}Hz"] = ("mu", mus, f, range_marks(params, "mu", f))
     for f in FREQUENCIES:
-        vr = phi0_valid_range(params, f)
+        vr = range_marks(params, "phi0", f)
         lo, hi = vr["lift_off_edge"], vr["painleve_edge"]
         n = 7 if quick else 101
         grids[f"phi0_{f:g}Hz"] = ("phi0", np.linspace(lo, hi, n + 2)[1:-1], f, vr)
     return grids
+
+
+def range_marks(params, parameter, frequency=None):
+    """Limits of the contact model along one swept parameter, to mark on its figure.
+
+    ``{"contact_loss_Hz": f}`` for a frequency sweep (where ``max D = 0``),
+    ``{"painleve_edge": 1/tan(phi0)}`` for ``mu``, the valid range of
+    :func:`~moreau.analysis.valid_range.phi0_valid_range` for ``phi0``, and
+    ``{}`` for the other parameters.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> round(range_marks(PAPER_DEFAULTS, "mu", 185.0)["painleve_edge"], 6)
+    1.0
+    """
+    from scipy.optimize import brentq
+
+    from .valid_range import lift_off_margin, phi0_valid_range
+    if parameter == "frequency":
+        # the frequency where the rod would lift off (max D = 0), if there is one
+        f_hi = 1e3
+        while lift_off_margin(params, f_hi) < 0 and f_hi < 1e7:
+            f_hi *= 2
+        if f_hi >= 1e7:
+            return {}
+        return {"contact_loss_Hz": brentq(lambda f: lift_off_margin(params, f), f_hi / 2, f_hi)}
+    if parameter == "mu":
+        return {"painleve_edge": 1.0 / math.tan(params.phi0)}
+    if parameter == "phi0":
+        return phi0_valid_range(params, frequency)
+    return {}
 
 
 def _point(params, parameter, value, frequency):
@@ -141,7 +163,8 @@ def read_table(path):
     return rows
 
 
-def _sidecar(path, params, name, parameter, values, frequency, extra, checks, steps, stats):
+def _sidecar(path, params, name, parameter, values, frequency, extra, checks, steps, stats,
+             scheme=ED_REFERENCE):
     from .. import __version__
     meta = {
         "study": name,
@@ -150,7 +173,8 @@ def _sidecar(path, params, name, parameter, values, frequency, extra, checks, st
         "range": [float(values[0]), float(values[-1])],
         "frequency_Hz": frequency,
         "parameters_SI": asdict(params),
-        "reference_scheme": {"name": "event-driven", "rtol": ED_REFERENCE.rtol},
+        "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
+                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol},
         "cross_checks": [{"name": c.name, "theta": c.theta, "steps_per_period": c.steps_per_period}
                          for c in checks],
         "valid_range": {k: v for k, v in extra.items()},

@@ -9,14 +9,14 @@ sweep keeps the points it had finished.
 
 import csv
 import math
-import os
 
 import numpy as np
 
+from .. import _validate as _v
 from .._validate import positive, positive_int
 from ..errors import InputError, MoreauError
 
-__all__ = ["sweep", "run_sweep", "SWEEP_DEFAULTS"]
+__all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE"]
 
 #: parameter -> (start, stop, num, log)
 SWEEP_DEFAULTS = {
@@ -129,34 +129,143 @@ def plot_sweep(rows, parameter, path, title=""):
     plt.close(fig)
 
 
-def run_sweep(parameter, params, frequency=None, start=None, stop=None, num=None, log=None,
-              out="out", progress=True, plot=True):
-    """The ``moreau sweep`` command: compute, write CSV and figure, print a summary."""
-    d0, d1, dn, dlog = SWEEP_DEFAULTS[parameter]
+#: scene parameters a sweep can vary, besides ``frequency``
+SWEEPABLE = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
+
+
+def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None):
+    """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
+
+    ``theta`` and ``steps_per_period`` apply to Moreau–Jean only (defaults 1
+    and 1000 there); ``rtol`` is the shooting tolerance of either scheme.
+
+    Examples
+    --------
+    >>> make_scheme("moreau-jean", steps_per_period=500)
+    ('moreau-jean', 1.0, 500, None)
+    >>> make_scheme("event-driven", theta=0.5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
+    """
+    from .engine import Scheme
+    if scheme == "moreau-jean":
+        return Scheme.moreau_jean(1.0 if theta is None else theta,
+                                  1000 if steps_per_period is None else steps_per_period, rtol)
+    for name, val in (("--theta", theta), ("--steps-per-period", steps_per_period)):
+        if val is not None and scheme == "event-driven":
+            raise InputError(f"`{name}` applies only to `--scheme moreau-jean`")
+    return Scheme(scheme, rtol=1e-10 if rtol is None else rtol)
+
+
+def sweep_values(parameter, start, stop, points, scale="linear"):
+    """The swept values, checked: ``points`` values from ``start`` to ``stop``.
+
+    Examples
+    --------
+    >>> sweep_values("frequency", 10, 1000, 3, "log").tolist()
+    [10.0, 100.0, 1000.0]
+    """
+    if parameter not in SWEEPABLE:
+        raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
+    start = _v.finite_scalar("START", start)
+    stop = _v.finite_scalar("STOP", stop)
+    points = positive_int("points", points)
+    if scale not in ("log", "linear"):
+        raise InputError(f"`--scale` must be 'log' or 'linear', got {scale!r}")
+    if points > 1 and start == stop:
+        raise InputError("`START` and `STOP` must differ when `--points` > 1")
+    if scale == "log":
+        if start <= 0 or stop <= 0:
+            raise InputError(f"`--scale log` needs START and STOP > 0, got {start!r} and {stop!r}")
+        return np.geomspace(start, stop, points)
+    return np.linspace(start, stop, points)
+
+
+def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
+              scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
+              progress=True, plot=True, log=print):
+    """The ``moreau sweep`` command: steady states over one parameter through the sweep engine.
+
+    Every point goes through :func:`moreau.analysis.engine.run_points`: cached
+    on disk (``cache_dir``, default ``OUT/cache``), in parallel on local
+    processes or on a Dask scheduler, a failed point kept as its ``status``.
+    Writes ``OUT/sweep_TAG.csv`` (tidy, units in the column names, the same
+    columns as ``moreau reproduce``), ``sweep_TAG.json`` (parameters, scheme,
+    package version) and the figure ``sweep_TAG.png``/``.svg``.
+
+    Parameters
+    ----------
+    parameter : str
+        One of :data:`SWEEPABLE`.
+    params : FrictionDriveParams, optional
+        The fixed parameters (paper defaults).
+    frequency : float, optional
+        Drive frequency [Hz] when ``parameter`` is not ``"frequency"``.
+    start, stop, points, scale
+        The values (defaults of :data:`SWEEP_DEFAULTS` for frequency, mu, phi0).
+    scheme : Scheme, optional
+        From :func:`make_scheme` (event-driven, shooting tolerance 1e-10).
+    out : path-like
+        Output folder, checked writable before any work.
+
+    Returns
+    -------
+    list of dict
+        The tidy rows.
+    """
+    from ..scenes.friction_drive import PAPER_DEFAULTS
+    from .engine import check_output_dir, run_points
+    from .reproduce import _point, _sidecar, range_marks, tidy_rows, write_table
+
+    params = PAPER_DEFAULTS if params is None else params
+    if parameter not in SWEEPABLE:
+        raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
+    d0, d1, dn, dlog = SWEEP_DEFAULTS.get(parameter, (None, None, 50, False))
+    if (start is None or stop is None) and d0 is None:
+        raise InputError(f"`START` and `STOP` are required for a sweep of {parameter!r}")
     start = d0 if start is None else start
     stop = d1 if stop is None else stop
-    num = positive_int("num", dn if num is None else num)
-    log = dlog if log is None else log
-    if parameter != "frequency" and frequency is None:
-        raise InputError("`--frequency` is required for mu and phi0 sweeps")
-    values = np.geomspace(start, stop, num) if log else np.linspace(start, stop, num)
-    rows = sweep(parameter, values, params, frequency, progress=progress)
-    os.makedirs(out, exist_ok=True)
+    scale = ("log" if dlog else "linear") if scale is None else scale
+    values = sweep_values(parameter, start, stop, dn if points is None else points, scale)
+    if parameter == "frequency":
+        if frequency is not None:
+            raise InputError("`--frequency` is the swept parameter here; leave it out")
+    elif frequency is None:
+        raise InputError(f"`--frequency` is required for a sweep of {parameter!r} (drive frequency in Hz)")
+    else:
+        frequency = positive("frequency", frequency)
+    # every value must make a valid parameter set before any work starts
+    for x in (values[0], values[-1]):
+        _point(params, parameter, x, frequency if frequency is not None else float(x))
+    scheme = make_scheme() if scheme is None else scheme
+    out = check_output_dir(out)
+    cache_dir = out / "cache" if cache_dir is None else cache_dir
+
+    points_ = [_point(params, parameter, x, frequency) for x in values]
+    rows, stats = run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                             scheduler=scheduler, progress=progress, desc=f"sweep {parameter}")
+    table = tidy_rows(parameter, values, frequency, params, rows, ())
     tag = parameter if parameter == "frequency" else f"{parameter}_{frequency:g}Hz"
-    csv_path = os.path.join(out, f"sweep_{tag}.csv")
-    write_csv(rows, csv_path)
-    print(f"wrote {csv_path} ({len(rows)} points)")
+    stem = out / f"sweep_{tag}"
+    write_table(table, stem.with_suffix(".csv"))
+    marks = range_marks(params, parameter, frequency)
+    _sidecar(stem.with_suffix(".json"), params, f"sweep_{tag}", parameter, values, frequency,
+             marks, (), None, stats, scheme=scheme)
+    log(f"wrote {stem.with_suffix('.csv')} ({len(table)} points: {stats['computed']} computed, "
+        f"{stats['cached']} from the cache)")
     if plot:
-        try:
-            fig_path = os.path.join(out, f"sweep_{tag}.png")
-            plot_sweep(rows, parameter, fig_path, title=f"friction drive: {tag}")
-            print(f"wrote {fig_path}")
-        except ImportError:
-            print("matplotlib is not installed: no figure (pip install 'moreau[plot]')")
+        from .figures import sweep_figure
+        label = scheme.name if scheme.name == "event-driven" else \
+            f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
+        paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",
+                             scheme_label=label)
+        log(f"wrote {paths[0]}")
     prev = None
-    for r in rows:
-        label = r["mode"] or ("error: " + r["error"].split(":")[0])
+    col = list(table[0])[0] if table else None
+    for r in table:
+        label = r["mode"] if r["status"] == "ok" else "failed: " + r["status"].split(":")[0]
         if label != prev:
-            print(f"  from {r['value']:.6g}: {label}")
+            log(f"  from {r[col]:.6g}: {label}")
             prev = label
-    return rows
+    return table
