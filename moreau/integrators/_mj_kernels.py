@@ -252,18 +252,9 @@ def _solve_small(A, b, x, work, s):
 
 
 @njit(cache=True)
-def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT):
-    """Assemble the friction LCP of the active contacts and solve it by Lemke.
-
-    The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
-    the active contacts (``ia[:na]``): one variable per frictionless contact,
-    ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
-    cone rows, and the restitution term only where ``e > 0``. Writes the
-    stacked impulses ``p`` and the per-contact ``pN``, ``pT``.
-    Returns Lemke's ``(status, pivots, residual)``.
-    """
-    base = np.empty(na, dtype=np.int64)
-    trow = np.empty(na, dtype=np.int64)
+def _lcp_size(na, ia, mu, base, trow):
+    # LCP layout of the active contacts: start of each contact's block, its
+    # tangential row in the stacked W (-1 if frictionless); returns the size
     L = 0
     nf = 0
     for r in range(na):
@@ -275,8 +266,26 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT):
         else:
             trow[r] = -1
             L += 1
-    Ml = np.zeros((L, L))
-    ql = np.zeros(L)
+    return L
+
+
+@njit(cache=True)
+def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
+              work, iwork):
+    """Assemble the friction LCP of the active contacts and solve it by Lemke.
+
+    The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
+    the active contacts (``ia[:na]``): one variable per frictionless contact,
+    ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
+    cone rows, and the restitution term only where ``e > 0``. The buffers
+    have the size ``L`` of :func:`_lcp_size`. Writes the stacked impulses
+    ``p`` and the per-contact ``pN``, ``pT``.
+    Returns Lemke's ``(status, pivots, residual)``.
+    """
+    for r in range(L):
+        ql[r] = 0.0
+        for c in range(L):
+            Ml[r, c] = 0.0
     for r in range(na):
         i = ia[r]
         br = base[r]
@@ -308,12 +317,8 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT):
             Ml[br + 3, br] = mu[i]
             Ml[br + 3, br + 1] = -1.0
             Ml[br + 3, br + 2] = -1.0
-    zl = np.empty(L)
-    wl = np.empty(L)
-    rayl = np.empty(L + 1)
-    work, iwork = lemke_workspace(L)
     max_iter = 1000 if L <= 20 else 50 * L
-    status, pivots, res = lemke_core(Ml, ql, np.ones(L), zl, wl, rayl, work, iwork, max_iter,
+    status, pivots, res = lemke_core(Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter,
                                      DEFAULT_TOL)
     if status == 0:
         for r in range(na):
@@ -427,6 +432,17 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     Sw = np.zeros((ncm, ncm))
     rs = np.zeros(ncm)
     dd = np.zeros(ncm)
+    base = np.zeros(ncm, dtype=np.int64)
+    trow = np.zeros(ncm, dtype=np.int64)
+    L = 1
+    Ml = np.zeros((1, 1))
+    ql = np.zeros(1)
+    dl = np.ones(1)
+    zl = np.zeros(1)
+    wl = np.zeros(1)
+    rayl = np.zeros(2)
+    work, iwork = lemke_workspace(1)
+
     constant_W = const_mass and not has_jac
     have_Wi = False
     nrec = 0
@@ -555,7 +571,20 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 pN[i] = pn
                 pT[i] = pt
             else:
-                lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT)
+                size = _lcp_size(na, ia, mu, base, trow)
+                if size != L:
+                    # buffers follow the number of LCP variables, reallocated only when
+                    # the active set changes size
+                    L = size
+                    Ml = np.zeros((L, L))
+                    ql = np.zeros(L)
+                    dl = np.ones(L)
+                    zl = np.zeros(L)
+                    wl = np.zeros(L)
+                    rayl = np.zeros(L + 1)
+                    work, iwork = lemke_workspace(L)
+                lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
+                                          Ml, ql, dl, zl, wl, rayl, work, iwork)
                 if lst != 0:
                     status = LCP_HANDBACK
                     break
