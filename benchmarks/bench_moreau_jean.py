@@ -99,8 +99,10 @@ print(json.dumps({{"import_s": t1 - t0, "first_call_s": t3 - t2, "cache_hit": hi
 """
 
 
-def first_call(ctor, h):
+def first_call(ctor, h, cache_dir=None):
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    if cache_dir is not None:
+        env["NUMBA_CACHE_DIR"] = cache_dir
     out = subprocess.run([sys.executable, "-c", FIRST_CALL.format(ctor=ctor, h=h)],
                          capture_output=True, text=True, env=env, cwd=ROOT, timeout=900)
     if out.returncode != 0:
@@ -132,6 +134,17 @@ def main(argv=None):
     out = {"repeats": R, "scenes": {}}
 
     if not args.no_first_call:
+        import tempfile
+        print("first call in a fresh process with an empty numba cache (compilation)")
+        with tempfile.TemporaryDirectory() as tmp:
+            ctor, h = SCENES["friction-drive 185 Hz"]
+            cold = first_call(ctor, h, cache_dir=tmp)
+        out["cold_first_call"] = cold
+        if "error" in cold:
+            print(f"  failed: {cold['error']}")
+        else:
+            print(f"  friction-drive 185 Hz      import {cold['import_s']:6.2f} s   first run "
+                  f"{cold['first_call_s']:6.2f} s   (compiled; the kernel serves every scene)")
         print("first call in a fresh process (import; first 10-step run = cache load or compile)")
         for name, (ctor, h) in SCENES.items():
             fc = first_call(ctor, h)

@@ -9,6 +9,13 @@ scene. Passing the model as numba first-class functions would specialise the
 stepper per function object, and such specialisations are not found again in
 numba's on-disk cache.
 
+Adding a scene: give it a new ``kind``, add its branch to each function
+below, and a ``compiled_model()`` method returning ``CompiledModel(kind,
+par, ...)``. Numba keys the stepper's on-disk cache on its own source file
+only, so after editing this module delete
+``moreau/integrators/__pycache__/_mj_kernels*.nb*`` (or touch
+``_mj_kernels.py``); otherwise a stale compiled stepper is loaded.
+
 The Python :class:`~moreau.scenes.base.Scene` methods stay the definition;
 the formulas here are transcriptions of them, and
 ``tests/scenes/test_compiled_models.py`` checks every function against its
