@@ -1,4 +1,4 @@
-"""Periodic steady state of the *discrete* Moreau–Jean map of the friction drive.
+"""Periodic steady state of the *discrete* Moreau–Jean map of a periodic scene.
 
 The rotor position ``u2`` does not enter the dynamics, so one drive period of
 ``N`` Moreau–Jean steps maps the state ``x = (phi, phi', u2')`` at
@@ -141,33 +141,51 @@ def _mode_of(merged):
 
 
 class PeriodMap:
-    """One drive period of Moreau–Jean steps of the friction drive, as a map of ``(phi, phi', u2')``.
+    """One drive period of Moreau–Jean steps of a periodic scene, as a map of its state.
 
-    Uses the compiled loop for a :class:`~moreau.scenes.friction_drive.FrictionDrive`
-    and the generic :class:`~moreau.integrators.moreau_jean.MoreauJean` otherwise
-    (or with ``fast=False``).
+    Works through the :class:`~moreau.scenes.base.Scene` interface for any
+    scene with a periodic drive (``scene.period``): the coordinates listed in
+    ``scene.cyclic_coordinates`` (e.g. the rotor position) do not enter the
+    dynamics, so the map acts on ``x = (q without them, v)`` and reports the
+    advance of the first cyclic coordinate. For the friction drive
+    ``x = (phi, phi', u2')``. The steps run in the integrator's compiled loop
+    when the scene has a compiled model (``fast="auto"``).
 
     Parameters
     ----------
-    scene : FrictionDrive
+    scene : Scene
+        With ``scene.period`` set and at least one cyclic coordinate.
     steps_per_period : int
     theta : float
     projection : bool
     fast : bool or "auto"
+        Passed to :class:`~moreau.integrators.moreau_jean.MoreauJean`.
+
+    Raises
+    ------
+    InputError
+        A scene without a period or without a cyclic coordinate, bad options.
 
     Examples
     --------
     >>> from moreau.scenes.friction_drive import FrictionDrive
     >>> pm = PeriodMap(FrictionDrive(frequency=185.0), 200)
     >>> x1, du2, closed = pm(np.array([np.pi / 4, 0.0, 0.0]), True)
-    >>> x1.shape, closed
-    ((3,), True)
+    >>> x1.shape, closed.tolist()
+    ((3,), [True])
     """
 
     def __init__(self, scene, steps_per_period, theta=1.0, projection=True, fast="auto"):
-        from ..integrators.moreau_jean import is_friction_drive
-
+        period = getattr(scene, "period", None)
+        if period is None:
+            raise InputError(f"`scene` ({type(scene).__name__}) has no periodic drive "
+                             f"(`scene.period` is None): a period map needs one")
+        cyc = tuple(int(i) for i in getattr(scene, "cyclic_coordinates", ()))
+        if not cyc:
+            raise InputError(f"`scene` ({type(scene).__name__}) declares no cyclic coordinate "
+                             f"(`scene.cyclic_coordinates`), so a periodic state cannot advance")
         self.scene = scene
+        self.period = float(period)
         self.n = positive_int("steps_per_period", steps_per_period)
         self.theta = in_closed_interval("theta", theta, 0.5, 1.0)
         if not isinstance(projection, (bool, np.bool_)):
@@ -175,138 +193,142 @@ class PeriodMap:
         self.projection = bool(projection)
         if fast not in ("auto", True, False):
             raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
-        known = is_friction_drive(scene)
-        if fast is True and not known:
-            raise InputError("`fast=True` needs a FrictionDrive scene")
-        self.fast = known and fast is not False
-        self.h = TWO_PI / self.n
+        self.fast = fast
+        self.cyclic = cyc
+        nq = scene.ndof
+        self.kept = np.array([i for i in range(nq) if i not in cyc], dtype=int)
+        self.dim = len(self.kept) + nq
+        #: index in ``x`` of the velocity of the first cyclic coordinate
+        self.cyclic_velocity = len(self.kept) + cyc[0]
+        self.h = self.period / self.n
         self.evaluations = 0
         self.steps = 0
         self.lcp_solves = 0
         self.fallbacks = 0
-        n = self.n
-        if self.fast:
-            from ..integrators._mj_kernels import new_stats
-            from ..scenes._friction_drive_jit import pack_params
-            self._par = pack_params(scene)
-            self._buf = (np.empty(n + 1), np.empty((n + 1, 2)), np.empty((n + 1, 2)),
-                         np.empty(n + 1, dtype=np.int64), np.empty(n + 1), np.empty(n + 1),
-                         np.empty(n + 1), np.empty(n + 1))
-            self._stats = new_stats()
         self.last = None
+
+    def state(self, q, v):
+        """``x`` of a full state ``(q, v)``."""
+        return np.concatenate([np.asarray(q, float)[self.kept], np.asarray(v, float)])
+
+    def full_state(self, x):
+        """``(q, v)`` of ``x``, the cyclic coordinates at 0."""
+        q = np.zeros(self.scene.ndof)
+        q[self.kept] = x[:len(self.kept)]
+        return q, np.array(x[len(self.kept):], dtype=float)
 
     def _slip(self, q, v, slip):
         # a frictionless contact has no tangential row, so the scheme records
         # no slip velocity; the mode name still needs its sign
-        if float(self.scene.mu[0]) > 0.0:
+        sc = self.scene
+        if float(sc.mu[0]) > 0.0 or not hasattr(sc, "slip_velocity"):
             return np.array(slip, dtype=float)
-        return np.array([self.scene.slip_velocity(qi, vi) for qi, vi in zip(q, v)])
+        return np.array([sc.slip_velocity(qi, vi) for qi, vi in zip(q, v)])
 
     def __call__(self, x, closed, record=False):
-        """Map ``x = (phi, phi', u2')`` at ``tau = 0`` over one period.
+        """Map ``x`` at the section ``t = 0`` over one period.
 
-        Returns ``(x_end, displacement, closed_end)``; with ``record=True``
-        the per-step history is kept in :attr:`last` (a dict).
+        ``closed`` (a bool or one per contact) is the index-set memory at the
+        section. Returns ``(x_end, displacement, closed_end)``; with
+        ``record=True`` the per-step history of contact 0 is kept in
+        :attr:`last` (a dict).
         """
-        q = np.array([x[0], 0.0])
-        v = np.array([x[1], x[2]])
-        if self.fast:
-            from ..integrators._mj_kernels import OK, PAINLEVE, mj_run_fd
-            st = self._stats
-            st[:] = 0.0
-            status, k, nrec, closed_end = mj_run_fd(
-                self._par, 0.0, self.h, TWO_PI, 0, self.n, q, v, self.theta, self.projection,
-                bool(closed), 1, False, *self._buf, st)
-            self.steps += k
-            self.lcp_solves += int(st[0])
-            if status != OK:
-                from ..errors import PainleveError
-                if status == PAINLEVE:
-                    raise PainleveError(
-                        "discrete Painlevé condition W_NN - mu |W_NT| > 0 violated during the "
-                        "period map: the contact problem has no unique solution")
-                raise MoreauError("non-finite state in the period map; increase `steps_per_period`")
-            if record:
-                t, rq, rv, reg, fN, _, slip, _ = self._buf
-                self.last = {"tau": t[:nrec] - self.h, "regime": reg[:nrec].copy(),
-                             "force_N": fN[:nrec].copy(),
-                             "slip": self._slip(rq[:nrec], rv[:nrec], slip[:nrec]), "max_penetration": float(st[5]),
-                             "lcp_solves": int(st[0]), "fallbacks": 0}
-        else:
-            from ..integrators.moreau_jean import MoreauJean
-            integ = MoreauJean(self.scene, 0.0, q, v, TWO_PI, h=self.h, theta=self.theta,
-                               projection=self.projection, fast=False)
-            integ._closed[:] = bool(closed)
-            while integ.status == "running":
-                integ.step()
-            if integ.status != "finished":
-                if integ.status_code == -1:
-                    from ..errors import PainleveError
-                    raise PainleveError(integ.message)
-                raise MoreauError(f"period map failed: {integ.message}")
-            q, v, closed_end = integ.q, integ.v, bool(integ._closed[0])
-            c = integ.counters
-            self.steps += c["steps"]
-            self.lcp_solves += c["lcp_solves"]
-            self.fallbacks += c["fallbacks"]
-            if record:
-                res = integ.result()
-                self.last = {"tau": res.t[1:] - self.h, "regime": res.regime[1:, 0].copy(),
-                             "force_N": res.force_N[1:, 0].copy(),
-                             "slip": self._slip(res.q[1:], res.v[1:], res.slip_velocity[1:, 0]),
-                             "max_penetration": c["max_penetration"],
-                             "lcp_solves": c["lcp_solves"], "fallbacks": c["fallbacks"]}
+        from ..errors import PainleveError
+        from ..integrators.moreau_jean import MoreauJean
+
+        q, v = self.full_state(x)
+        nc = self.scene.ncontacts
+        c0 = np.broadcast_to(np.asarray(closed, dtype=bool), (nc,)).copy()
+        integ = MoreauJean(self.scene, 0.0, q, v, self.period, h=self.h, theta=self.theta,
+                           projection=self.projection, fast=self.fast, closed0=c0,
+                           save_every=1 if record else self.n)
+        while integ.status == "running":
+            integ.step()
+        if integ.status != "finished":
+            if integ.status_code == -1:
+                raise PainleveError(f"period map: {integ.message}")
+            raise MoreauError(f"period map failed: {integ.message}; increase `steps_per_period`")
+        c = integ.counters
+        self.steps += c["steps"]
+        self.lcp_solves += c["lcp_solves"]
+        self.fallbacks += c["fallbacks"]
+        if record:
+            res = integ.result()
+            self.last = {"tau": res.t[1:] - self.h, "regime": res.regime[1:, 0].copy(),
+                         "force_N": res.force_N[1:, 0].copy(),
+                         "slip": self._slip(res.q[1:], res.v[1:], res.slip_velocity[1:, 0]),
+                         "max_penetration": c["max_penetration"],
+                         "lcp_solves": c["lcp_solves"], "fallbacks": c["fallbacks"]}
         self.evaluations += 1
-        return np.array([q[0], v[0], v[1]]), float(q[1]), bool(closed_end)
+        k = self.cyclic[0]
+        return self.state(integ.q, integ.v), float(integ.q[k] - q[k]), integ.closed
+
+
+class _Stalled(ConvergenceError):
+    """Shooting found no usable derivative: worth a transient run before giving up."""
 
 
 def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_iter=50,
-                             projection=True, x_guess=None, fast="auto"):
-    """Periodic steady state of the Moreau–Jean map of the friction drive, by shooting.
+                             projection=True, x_guess=None, fast="auto", transient_periods=300):
+    """Periodic steady state of the Moreau–Jean map of a periodic scene, by shooting.
 
     Parameters
     ----------
-    scene : FrictionDrive
+    scene : Scene
+        A scene with a periodic drive (``scene.period``) and a cyclic
+        coordinate, e.g. :class:`~moreau.scenes.friction_drive.FrictionDrive`;
+        see :class:`PeriodMap` for the state ``x``.
     steps_per_period : int
-        Moreau–Jean steps per drive period, ``h = 2 pi / steps_per_period``.
+        Moreau–Jean steps per drive period, ``h = period / steps_per_period``.
     theta : float
         Scheme parameter in ``[1/2, 1]``.
     tol : float
         Bound on the periodic residual ``max_i |Phi(x)_i - x_i| / s_i`` with
-        scales ``s = (1, u10, u10)`` (radian, and the stator velocity
-        amplitude for the two rates).
+        scale 1 for coordinates and ``scene.velocity_scale`` (default 1; the
+        stator velocity amplitude ``u10`` for the drives) for velocities.
     max_iter : int
         Newton iterations.
     projection : bool
         Position projection after each step (see the module docstring for
         why the default is True).
-    x_guess : array_like, shape (3,), optional
-        Initial ``(phi, phi', u2')`` at ``tau = 0``; the rod at rest on the
-        rotor and the rotor at rest by default.
+    x_guess : array_like, optional
+        Initial ``x`` at ``t = 0``; by default the scene's ``initial_state()``.
     fast : {"auto", True, False}
-        Use the compiled loop (friction drive only).
+        Use the compiled loop (every scene with a compiled model).
+    transient_periods : int
+        When shooting stalls (e.g. the rod in flight at the section, where the
+        discrete map has no usable derivative), up to this many periods are
+        simulated from the last iterate, and shooting is tried again from
+        where they end. If the run settles on a period-1 orbit it is returned;
+        if it does not, the result says so (``stats["periodic"] = False``,
+        ``mode`` ``"no period-1 orbit"``) and reports the long-run average
+        displacement per period instead.
 
     Returns
     -------
     SteadyState
-        ``scheme="moreau-jean"``; ``stats`` holds ``steps`` and
-        ``lcp_solves`` (over all ``period_maps`` evaluated, including the
-        recorded period and the Jacobians at the fixed point), ``fallbacks``,
-        ``max_penetration`` (over the steady period), ``period_map_slope``
-        (largest ``|eigenvalue|`` of the period-map Jacobian at the fixed
-        point, from central differences over 20 steps' worth of motion, i.e.
-        the slope on the scale of the continuous system),
-        ``period_map_eigenvalues``, ``period_map_local_slope`` (the same from
-        a 1e-7 perturbation: the derivative of the piecewise-linear discrete
-        map, 0 or 1 in ``u2'`` at most points), ``steps_per_period``,
-        ``theta``, ``projection`` and ``period_maps``.
+        ``scheme="moreau-jean"``; ``stats`` holds ``periodic`` (True for a
+        fixed point), ``steps`` and ``lcp_solves`` (over all ``period_maps``
+        evaluated, including the recorded period and the Jacobians at the fixed
+        point), ``fallbacks``, ``max_penetration`` (over the steady period),
+        ``period_map_slope`` (largest ``|eigenvalue|`` of the period-map
+        Jacobian at the fixed point, from central differences over 20 steps'
+        worth of motion, i.e. the slope on the scale of the continuous
+        system), ``period_map_eigenvalues``, ``period_map_local_slope`` (the
+        same from a 1e-7 perturbation: the derivative of the piecewise-linear
+        discrete map), ``transient_periods`` (periods simulated before the
+        final shooting), ``steps_per_period``, ``theta``, ``projection`` and
+        ``period_maps``. Without a period-1 orbit: ``periodic = False``,
+        ``message``, ``average_over_periods``, ``orbit_period`` (the smallest
+        ``p <= 8`` with ``Phi^p(x) = x`` to ``sqrt(tol)``, or None).
 
     Raises
     ------
     InputError
-        Bad arguments.
+        Bad arguments, a scene without a period.
     ConvergenceError
-        No fixed point within ``max_iter`` Newton iterations.
+        No fixed point within ``max_iter`` Newton iterations, or (without
+        projection) a map that has none.
     PainleveError
         The contact problem became ill-posed along the way.
 
@@ -320,36 +342,45 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     t_start = time.perf_counter()
     tol = positive("tol", tol)
     max_iter = positive_int("max_iter", max_iter)
+    transient_periods = positive_int("transient_periods", transient_periods)
     pm = PeriodMap(scene, steps_per_period, theta, projection, fast)
-    scale = np.array([1.0, scene.u10, scene.u10])
+    vs = float(getattr(scene, "velocity_scale", 1.0))
+    nk = len(pm.kept)
+    scale = np.concatenate([np.ones(nk), np.full(scene.ndof, vs)])
     if x_guess is None:
-        x = np.array([scene.phi0, 0.0, 0.0])
+        x = pm.state(*scene.initial_state())
     else:
         from .._validate import finite_array
-        x = finite_array("x_guess", x_guess, shape=(3,)).copy()
-    closed = float(scene.gaps(np.array([x[0], 0.0]), 0.0)[0]) <= 0.0
+        x = finite_array("x_guess", x_guess, shape=(pm.dim,)).copy()
+    closed = np.asarray(scene.gaps(*pm.full_state(x)[:1], 0.0), dtype=float) <= 0.0
 
     it = 0
-    for _ in range(4):        # the contact flag must come back unchanged after one period
-        x, r, y1, closed_end, n_it = _shoot(pm, x, closed, scale, tol, max_iter - it)
-        it += n_it
-        if closed_end == closed:
-            break
-        closed = closed_end
-    else:
-        raise ConvergenceError("the contact state at tau = 0 does not settle on a periodic value")
+    transient = 0
+    try:
+        x, r, y1, closed, it = _settle(pm, x, closed, scale, tol, max_iter)
+    except _Stalled:
+        if not projection:
+            raise
+        # march the motion forward and shoot again from where it settles
+        x, closed, transient, r = _march(pm, x, closed, scale, tol, transient_periods)
+        if r > tol:
+            try:
+                x, r, y1, closed, it = _settle(pm, x, closed, scale, tol, max_iter)
+            except _Stalled:
+                return _no_orbit(pm, x, closed, scale, tol, transient, t_start)
 
     # the steady period, recorded, and the period-map Jacobian at the fixed point
-    _, disp, _ = pm(x, closed, record=True)
+    y1, disp, _ = pm(x, closed, record=True)
+    r = float(np.max(np.abs(y1 - x) / scale))
     last = pm.last
-    # perturbations on the scale of the motion (the stator amplitude), not of a radian
-    fd_scale = np.full(3, scene.u10)
+    # perturbations on the scale of the motion (the velocity scale), not of a radian
+    fd_scale = np.full(pm.dim, vs)
     J_sec = _jacobian(pm, x, closed, fd_scale, 20.0 * pm.h, central=True)
     J_loc = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
     eig = np.linalg.eigvals(J_sec)
     eig_loc = np.linalg.eigvals(J_loc)
     letters = step_letters(last["regime"], last["slip"], float(scene.mu[0]))
-    merged = merge_step_regimes(letters, last["tau"], pm.h)
+    merged = merge_step_regimes(letters, last["tau"], pm.h, period=pm.period)
     return SteadyState(
         scheme="moreau-jean",
         displacement_per_period=float(disp),
@@ -361,6 +392,7 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         iterations=it,
         wall_time=time.perf_counter() - t_start,
         stats={
+            "periodic": True,
             "steps": int(pm.steps),
             "lcp_solves": int(pm.lcp_solves),
             "fallbacks": int(pm.fallbacks),
@@ -368,12 +400,71 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
             "period_map_slope": float(np.max(np.abs(eig))),
             "period_map_eigenvalues": _plain(eig),
             "period_map_local_slope": float(np.max(np.abs(eig_loc))),
+            "transient_periods": transient,
             "steps_per_period": pm.n,
             "theta": pm.theta,
             "projection": pm.projection,
             "period_maps": pm.evaluations,
         },
     )
+
+
+def _settle(pm, x, closed, scale, tol, max_iter):
+    """Shoot with the contact flags held, until they come back unchanged after a period."""
+    it = 0
+    for _ in range(4):
+        x, r, y1, closed_end, n_it = _shoot(pm, x, closed, scale, tol, max_iter - it)
+        it += n_it
+        if np.array_equal(closed_end, closed):
+            return x, r, y1, closed, it
+        closed = closed_end
+    raise _Stalled("the contact state at the section does not settle on a periodic value")
+
+
+def _march(pm, x, closed, scale, tol, nmax):
+    """Iterate the period map (simulate) up to ``nmax`` periods or until ``x`` repeats."""
+    r = math.inf
+    for k in range(1, nmax + 1):
+        y, _, c = pm(x, closed)
+        r = float(np.max(np.abs(y - x) / scale))
+        same = np.array_equal(c, closed)
+        x, closed = y, c
+        if r <= tol and same:
+            return x, closed, k, r
+    return x, closed, nmax, r
+
+
+def _no_orbit(pm, x, closed, scale, tol, transient, t_start):
+    """No period-1 orbit: the long-run average displacement, and the orbit's period if short."""
+    navg = max(50, min(500, transient))
+    xs = [x]
+    total = 0.0
+    for _ in range(navg):
+        x, d, closed = pm(x, closed)
+        xs.append(x)
+        total += d
+    avg = total / navg
+    loose = math.sqrt(tol)
+    orbit = None
+    for p in range(2, 9):
+        if float(np.max(np.abs(xs[-1] - xs[-1 - p]) / scale)) <= loose:
+            orbit = p
+            break
+    what = (f"a period-{orbit} orbit" if orbit else "no periodic orbit of period <= 8 (the motion "
+            "may be quasi-periodic or chaotic at this step size)")
+    msg = (f"the Moreau–Jean map has no period-1 orbit here: after {transient + navg} periods "
+           f"the motion settles on {what}; displacement_per_period is the long-run average "
+           f"over the last {navg} periods")
+    r = float(np.max(np.abs(xs[-1] - xs[-2]) / scale))
+    return SteadyState(
+        scheme="moreau-jean", displacement_per_period=float(avg), state0=xs[-1].copy(),
+        mode="no period-1 orbit", regimes=[], min_normal_force=float("nan"),
+        periodic_residual=r, iterations=0, wall_time=time.perf_counter() - t_start,
+        stats={"periodic": False, "message": msg, "average_over_periods": navg,
+               "orbit_period": orbit, "transient_periods": transient,
+               "steps": int(pm.steps), "lcp_solves": int(pm.lcp_solves),
+               "fallbacks": int(pm.fallbacks), "steps_per_period": pm.n, "theta": pm.theta,
+               "projection": pm.projection, "period_maps": pm.evaluations})
 
 
 def _plain(eig):
@@ -400,7 +491,9 @@ def _shoot(pm, x, closed, scale, tol, max_iter):
     y1, _, c1 = pm(x, closed)
     F = y1 - x
     r = float(np.max(np.abs(F) / scale))
-    fd_scale = np.full(3, scale[2])
+    j = pm.cyclic_velocity
+    others = np.arange(len(x)) != j
+    fd_scale = np.full(len(x), scale[j])
     it = 0
     while r > tol:
         it += 1
@@ -409,9 +502,9 @@ def _shoot(pm, x, closed, scale, tol, max_iter):
                 f"Moreau–Jean shooting did not converge in `max_iter` Newton iterations "
                 f"(periodic residual {r:.3g} > `tol`={tol:g})")
         J = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
-        A = J - np.eye(3)
-        pinned = float(np.max(np.abs(F[:2]) / scale[:2])) <= tol
-        stalled = abs(A[2, 2]) < 1e-6
+        A = J - np.eye(len(x))
+        pinned = float(np.max(np.abs(F[others]) / scale[others])) <= tol
+        stalled = abs(A[j, j]) < 1e-6
         if not stalled:
             dx = np.linalg.lstsq(A, -F, rcond=None)[0]
             lam = 1.0
@@ -429,26 +522,30 @@ def _shoot(pm, x, closed, scale, tol, max_iter):
                 x, y1, F, r, c1 = xn, yn, Fn, rn, cn
                 continue
         if not pinned:
-            raise ConvergenceError(
+            raise _Stalled(
                 f"Moreau–Jean shooting stalled at periodic residual {r:.3g}: the period map "
                 f"has no usable derivative here and (phi, phi') are not periodic yet; "
                 f"try projection=True or another `x_guess`")
-        x, r, y1, c1, n = _bracket_u(pm, np.array([y1[0], y1[1], x[2]]), closed, scale, tol,
-                                     max_iter - it)
+        xb = y1.copy()
+        xb[j] = x[j]
+        x, r, y1, c1, n = _bracket_u(pm, xb, closed, scale, tol, max_iter - it)
         it += n
         break
     return x, r, y1, c1, it
 
 
 def _bracket_u(pm, x, closed, scale, tol, max_iter):
-    """Solve ``Phi_3(phi, phi', u) = u`` in ``u`` with ``(phi, phi')`` held (see :func:`_shoot`)."""
+    """Solve ``Phi_j(x) = x_j`` in the cyclic velocity ``x_j`` with the rest held (see :func:`_shoot`)."""
+    j = pm.cyclic_velocity
+
     def ev(u):
-        xx = np.array([x[0], x[1], u])
+        xx = x.copy()
+        xx[j] = u
         y, _, c = pm(xx, closed)
-        return y[2] - u, xx, y, c
+        return y[j] - u, xx, y, c
 
     it = 0
-    ua = x[2]
+    ua = x[j]
     Fa, xa, ya, ca = ev(ua)
 
     def done(F, xx, y):
@@ -506,8 +603,8 @@ def _jacobian(pm, x, closed, scale, rel, y1=None, central=False):
     discrete map; ``rel`` of many steps ``h`` gives its slope on the scale of
     the continuous system, which is what governs the transient.
     """
-    J = np.empty((3, 3))
-    for i in range(3):
+    J = np.empty((len(x), len(x)))
+    for i in range(len(x)):
         d = rel * max(abs(x[i]) if rel < 1e-3 else 0.0, scale[i])
         xp = x.copy()
         xp[i] += d

@@ -1,13 +1,28 @@
-"""Compiled Moreau–Jean step loop for two-dof scenes with one contact (the friction drive).
+"""Compiled Moreau–Jean step loop for any scene with a compiled model.
 
 This is the fast path of :mod:`moreau.integrators.moreau_jean`: the same
-scheme, the same index set, the same one-contact enumeration, the same
-regime classification and the same projection, written with scalars so that
-a whole run is one ``numba`` call that allocates nothing per step. The model
-is read from the buffer layout of :mod:`moreau.scenes._friction_drive_jit`.
+scheme, the same time grid, index set, contact problem, regime
+classification and projection, run as one ``numba`` call over a block of
+steps that allocates nothing per step (the LCP buffers are reallocated only
+when the number of active contacts changes). The scene's model comes from
+:mod:`moreau.scenes._compiled` as ``(kind, par)``; the loop itself knows no
+scene.
 
-Every branch mirrors the generic Python code; the two agree to rounding
-(tested to ``1e-12``). If you change one, change the other.
+The contact problem of a step is solved as the generic path solves it:
+
+* no active contact: nothing is solved;
+* one active contact: the closed-form case analysis :func:`_one_contact`
+  (stick, positive slip, negative slip; one row when ``mu = 0``);
+* several: the velocity-level friction LCP of
+  :func:`moreau.lcp.friction.build_friction_lcp`, assembled here over the
+  active contacts only (one variable per frictionless contact, four per
+  frictional one, no restitution term where ``e = 0``), solved by the
+  compiled :func:`moreau.lcp.lemke.lemke_core`. When Lemke fails the loop
+  stops *before* that step with status :data:`LCP_HANDBACK`; the caller takes
+  the step in Python (QP fallback) and calls the loop again.
+
+The generic Python step (``MoreauJean(..., fast=False)``) is kept as the
+reference; the tests hold the two to ``1e-12`` on every scene.
 """
 
 import math
@@ -15,17 +30,20 @@ import math
 import numpy as np
 from numba import njit
 
-from ..scenes._friction_drive_jit import (
-    C00, C01, C10, C11, F0, F1, GAP, K00, K01, K10, K11, M00, M01, M10, M11, NOUT,
-    P_E, P_MU, WN0, WN1, WNR, WT0, WT1, WTR, fd_eval, fd_gap,
-)
+from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
+from ..scenes._compiled import contact_fn, dynamics_fn, gaps_fn, mass_fn
 
-__all__ = ["mj_run_fd", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL"]
+__all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
+           "LCP_HANDBACK"]
 
 # status codes (those of SimulationResult where they overlap)
 OK = 0
 PAINLEVE = -1
 NUMERICAL = -5
+#: the iteration matrix was singular (reported as status -5 with its own message)
+SINGULAR = -6
+#: Lemke failed on this step: take it in Python, then resume
+LCP_HANDBACK = 7
 
 #: layout of the statistics vector
 STAT_NAMES = ("lcp_solves", "direct_solves", "pivots", "fallbacks", "max_residual",
@@ -36,6 +54,7 @@ S_LCP, S_DIRECT, S_PIVOTS, S_FALLBACKS, S_RES, S_PEN, S_PROJ = range(7)
 SLIP_RTOL = 1e-10
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
+COND_MAX = 1e14
 
 
 def new_stats():
@@ -136,74 +155,298 @@ def _classify(pN, pT, mu):
 
 
 @njit(cache=True, inline="always")
-def _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, i,
-           t, q0, q1, v0, v1, reg, fN, fT, slip, gap):
-    rec_t[i] = t
-    rec_q[i, 0] = q0
-    rec_q[i, 1] = q1
-    rec_v[i, 0] = v0
-    rec_v[i, 1] = v1
-    rec_reg[i] = reg
-    rec_fN[i] = fN
-    rec_fT[i] = fT
-    rec_slip[i] = slip
-    rec_gap[i] = gap
+def _invert(A, out, work, n):
+    """``out = A^-1``; False when ``A`` is singular to working precision (1-norm condition)."""
+    for i in range(n):
+        for j in range(n):
+            if not math.isfinite(A[i, j]):
+                return False
+    if n == 1:
+        out[0, 0] = 1.0 / A[0, 0]
+    elif n == 2:
+        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+        out[0, 0] = A[1, 1] / det
+        out[0, 1] = -A[0, 1] / det
+        out[1, 0] = -A[1, 0] / det
+        out[1, 1] = A[0, 0] / det
+    else:
+        # Gauss-Jordan with partial pivoting on a copy
+        for i in range(n):
+            for j in range(n):
+                work[i, j] = A[i, j]
+                out[i, j] = 1.0 if i == j else 0.0
+        for c in range(n):
+            piv = c
+            best = abs(work[c, c])
+            for r in range(c + 1, n):
+                if abs(work[r, c]) > best:
+                    best = abs(work[r, c])
+                    piv = r
+            if best == 0.0:
+                return False
+            if piv != c:
+                for j in range(n):
+                    tmp = work[c, j]
+                    work[c, j] = work[piv, j]
+                    work[piv, j] = tmp
+                    tmp = out[c, j]
+                    out[c, j] = out[piv, j]
+                    out[piv, j] = tmp
+            inv = 1.0 / work[c, c]
+            for j in range(n):
+                work[c, j] *= inv
+                out[c, j] *= inv
+            for r in range(n):
+                if r != c:
+                    fct = work[r, c]
+                    if fct != 0.0:
+                        for j in range(n):
+                            work[r, j] -= fct * work[c, j]
+                            out[r, j] -= fct * out[c, j]
+    na = 0.0
+    ni = 0.0
+    for j in range(n):
+        sa = 0.0
+        si = 0.0
+        for i in range(n):
+            sa += abs(A[i, j])
+            si += abs(out[i, j])
+        na = max(na, sa)
+        ni = max(ni, si)
+    return na * ni < COND_MAX
 
 
 @njit(cache=True)
-def mj_run_fd(par, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, save_every,
-              record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-              stats):
-    """Run up to ``nmax`` Moreau–Jean steps of the friction drive in one compiled call.
+def _solve_small(A, b, x, work, s):
+    """Solve ``A x = b`` (``s`` x ``s``) by Gaussian elimination with partial pivoting."""
+    for i in range(s):
+        for j in range(s):
+            work[i, j] = A[i, j]
+        x[i] = b[i]
+    for c in range(s):
+        piv = c
+        best = abs(work[c, c])
+        for r in range(c + 1, s):
+            if abs(work[r, c]) > best:
+                best = abs(work[r, c])
+                piv = r
+        if piv != c:
+            for j in range(s):
+                tmp = work[c, j]
+                work[c, j] = work[piv, j]
+                work[piv, j] = tmp
+            tmp = x[c]
+            x[c] = x[piv]
+            x[piv] = tmp
+        for r in range(c + 1, s):
+            fct = work[r, c] / work[c, c]
+            if fct != 0.0:
+                for j in range(c, s):
+                    work[r, j] -= fct * work[c, j]
+                x[r] -= fct * x[c]
+    for i in range(s - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, s):
+            acc -= work[i, j] * x[j]
+        x[i] = acc / work[i, i]
+
+
+@njit(cache=True)
+def _lcp_size(na, ia, mu, base, trow):
+    # LCP layout of the active contacts: start of each contact's block, its
+    # tangential row in the stacked W (-1 if frictionless); returns the size
+    L = 0
+    nf = 0
+    for r in range(na):
+        base[r] = L
+        if mu[ia[r]] > 0.0:
+            trow[r] = na + nf
+            nf += 1
+            L += 4
+        else:
+            trow[r] = -1
+            L += 1
+    return L
+
+
+@njit(cache=True)
+def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
+              work, iwork):
+    """Assemble the friction LCP of the active contacts and solve it by Lemke.
+
+    The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
+    the active contacts (``ia[:na]``): one variable per frictionless contact,
+    ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
+    cone rows, and the restitution term only where ``e > 0``. The buffers
+    have the size ``L`` of :func:`_lcp_size`. Writes the stacked impulses
+    ``p`` and the per-contact ``pN``, ``pT``.
+    Returns Lemke's ``(status, pivots, residual)``.
+    """
+    for r in range(L):
+        ql[r] = 0.0
+        for c in range(L):
+            Ml[r, c] = 0.0
+    for r in range(na):
+        i = ia[r]
+        br = base[r]
+        tr = trow[r]
+        ql[br] = Uf[r]
+        if e[i] > 0.0:
+            ql[br] += e[i] * min(vN0[i], 0.0)
+        if tr >= 0:
+            ql[br + 1] = Uf[tr]
+            ql[br + 2] = -Uf[tr]
+        for c in range(na):
+            bc = base[c]
+            tc = trow[c]
+            Ml[br, bc] = Wd[r, c]
+            if tc >= 0:
+                Ml[br, bc + 1] = Wd[r, tc]
+                Ml[br, bc + 2] = -Wd[r, tc]
+            if tr >= 0:
+                Ml[br + 1, bc] = Wd[tr, c]
+                Ml[br + 2, bc] = -Wd[tr, c]
+                if tc >= 0:
+                    Ml[br + 1, bc + 1] = Wd[tr, tc]
+                    Ml[br + 1, bc + 2] = -Wd[tr, tc]
+                    Ml[br + 2, bc + 1] = -Wd[tr, tc]
+                    Ml[br + 2, bc + 2] = Wd[tr, tc]
+        if tr >= 0:
+            Ml[br + 1, br + 3] = 1.0
+            Ml[br + 2, br + 3] = 1.0
+            Ml[br + 3, br] = mu[i]
+            Ml[br + 3, br + 1] = -1.0
+            Ml[br + 3, br + 2] = -1.0
+    max_iter = 1000 if L <= 20 else 50 * L
+    status, pivots, res = lemke_core(Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter,
+                                     DEFAULT_TOL)
+    if status == 0:
+        for r in range(na):
+            i = ia[r]
+            br = base[r]
+            p[r] = zl[br]
+            pN[i] = zl[br]
+            if trow[r] >= 0:
+                pt = zl[br + 1] - zl[br + 2]
+                p[trow[r]] = pt
+                pT[i] = pt
+    return status, pivots, res
+
+
+@njit(cache=True)
+def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, force_lemke,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
 
     Parameters
     ----------
-    par : float64[:]
-        From :func:`moreau.scenes._friction_drive_jit.pack_params`.
+    kind, par : int, float64[:]
+        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
+    n, nc : int
+        Degrees of freedom and contacts.
+    mu, e : float64[:]
+        Friction and restitution of each contact.
+    const_mass, has_jac : bool
+        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
     t0, h, t_bound : float
         Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
     k0 : int
         Index of the first step (``t_k0 = t0 + k0 h``).
     nmax : int
         Most steps to take in this call.
-    q, v : float64[2]
+    q, v : float64[n]
         State at ``t_k0``; overwritten with the final state.
     theta : float
     projection : bool
-    closed : bool
-        Whether the contact carried a normal impulse in the step before ``k0``.
+    closed : bool[nc]
+        Contacts that carried a normal impulse in the step before ``k0``; updated.
     save_every : int
         Record after every ``save_every``-th step (counted from ``t0``) and after the last.
     record_initial : bool
         Also record the state at ``t_k0`` (with the first step's regime and forces).
+    force_lemke : bool
+        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
     rec_* : arrays
-        Sample buffers (``rec_q``, ``rec_v`` of shape (n, 2)); must be long
-        enough for the samples of this call.
+        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
+        ones (ns, nc); long enough for this call's samples.
     stats : float64[:]
         Accumulated statistics, layout :data:`STAT_NAMES`.
 
     Returns
     -------
     status : int
-        ``OK``, ``PAINLEVE`` or ``NUMERICAL`` (the state is the last good one).
+        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
+        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
+        of the step Lemke could not solve).
     k : int
         Index of the next step (steps taken: ``k - k0``).
     nrec : int
         Samples written.
-    closed : bool
-        Contact flag after the last step.
     """
-    b0 = np.empty(NOUT)
-    b1 = np.empty(NOUT)
-    mu = par[P_MU]
-    e = par[P_E]
     th = theta
+    M = np.zeros((n, n))
+    Wh = np.empty((n, n))
+    Wi = np.empty((n, n))
+    wk = np.empty((n, n))
+    K = np.zeros((n, n))
+    C = np.zeros((n, n))
+    f = np.empty(n)
+    f0 = np.empty(n)
+    rhs = np.empty(n)
+    vf = np.empty(n)
+    v1 = np.empty(n)
+    q1 = np.empty(n)
+    ncm = max(nc, 1)
+    mrows = 2 * ncm
+    g0 = np.zeros(ncm)
+    g1 = np.zeros(ncm)
+    WN0 = np.zeros((ncm, n))
+    wN0 = np.zeros(ncm)
+    WT0 = np.zeros((ncm, n))
+    wT0 = np.zeros(ncm)
+    WN1 = np.zeros((ncm, n))
+    wN1 = np.zeros(ncm)
+    WT1 = np.zeros((ncm, n))
+    wT1 = np.zeros(ncm)
+    vN0 = np.zeros(ncm)
+    active = np.zeros(ncm, dtype=np.bool_)
+    cnew = np.zeros(ncm, dtype=np.bool_)
+    pN = np.zeros(ncm)
+    pT = np.zeros(ncm)
+    slip = np.zeros(ncm)
+    reg = np.zeros(ncm, dtype=np.int64)
+    ia = np.zeros(ncm, dtype=np.int64)
+    fa = np.zeros(ncm, dtype=np.int64)
+    H = np.zeros((mrows, n))
+    w = np.zeros(mrows)
+    WiHT = np.zeros((n, mrows))
+    Wd = np.zeros((mrows, mrows))
+    Uf = np.zeros(mrows)
+    p = np.zeros(mrows)
+    # projection buffers
+    Mi = np.empty((n, n))
+    sel = np.zeros(ncm, dtype=np.bool_)
+    X = np.zeros((n, ncm))
+    S = np.zeros((ncm, ncm))
+    Sw = np.zeros((ncm, ncm))
+    rs = np.zeros(ncm)
+    dd = np.zeros(ncm)
+    base = np.zeros(ncm, dtype=np.int64)
+    trow = np.zeros(ncm, dtype=np.int64)
+    L = 1
+    Ml = np.zeros((1, 1))
+    ql = np.zeros(1)
+    dl = np.ones(1)
+    zl = np.zeros(1)
+    wl = np.zeros(1)
+    rayl = np.zeros(2)
+    work, iwork = lemke_workspace(1)
+
+    constant_W = const_mass and not has_jac
+    have_Wi = False
     nrec = 0
     k = k0
-    q0_ = q[0]
-    q1_ = q[1]
-    v0_ = v[0]
-    v1_ = v[1]
     status = OK
     while k - k0 < nmax:
         tk = t0 + k * h
@@ -216,126 +459,251 @@ def mj_run_fd(par, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, sa
             last = True
         if tk >= t_bound:
             break
-        fd_eval(q0_, v0_, tk, par, b0)
-        fd_eval(q0_, v0_, t1, par, b1)
-        b0_gap = b0[GAP]
-        # free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
-        f0 = b1[F0]
-        f1 = b1[F1]
+        # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
+        if not (const_mass and k > k0):
+            mass_fn(kind, par, q, M)
+        dynamics_fn(kind, par, q, v, t1, f, K, C, has_jac)
         if th != 1.0:
-            f0 = th * f0 + (1.0 - th) * b0[F0]
-            f1 = th * f1 + (1.0 - th) * b0[F1]
+            dynamics_fn(kind, par, q, v, tk, f0, K, C, False)
+            for i in range(n):
+                f[i] = th * f[i] + (1.0 - th) * f0[i]
         a = hk * th
         a2 = hk * hk * th
-        r0 = hk * f0 + a2 * (b1[K00] * v0_ + b1[K01] * v1_)
-        r1 = hk * f1 + a2 * (b1[K10] * v0_ + b1[K11] * v1_)
-        a2 = a2 * th
-        w00 = b1[M00] - a * b1[C00] - a2 * b1[K00]
-        w01 = b1[M01] - a * b1[C01] - a2 * b1[K01]
-        w10 = b1[M10] - a * b1[C10] - a2 * b1[K10]
-        w11 = b1[M11] - a * b1[C11] - a2 * b1[K11]
-        det = w00 * w11 - w01 * w10
-        i00 = w11 / det
-        i01 = -w01 / det
-        i10 = -w10 / det
-        i11 = w00 / det
-        n1 = max(abs(w00) + abs(w10), abs(w01) + abs(w11))
-        ni = max(abs(i00) + abs(i10), abs(i01) + abs(i11))
-        if not (n1 * ni < 1e14):
-            status = NUMERICAL
-            break
-        vf0 = v0_ + (i00 * r0 + i01 * r1)
-        vf1 = v1_ + (i10 * r0 + i11 * r1)
-
-        # index set: predicted gap, or closed in the previous step
-        vN0 = b0[WN0] * v0_ + b0[WN1] * v1_ + b0[WNR]
-        active = (b0_gap + 0.5 * hk * vN0 <= 0.0) or closed
-        pN = 0.0
-        pT = 0.0
-        slip = 0.0
-        nv0 = vf0
-        nv1 = vf1
-        if active:
-            # W_hat^-1 H^T columns and the Delassus entries
-            an0 = i00 * b1[WN0] + i01 * b1[WN1]
-            an1 = i10 * b1[WN0] + i11 * b1[WN1]
-            Wnn = b1[WN0] * an0 + b1[WN1] * an1
-            uN = b1[WN0] * vf0 + b1[WN1] * vf1 + b1[WNR]
-            if mu > 0.0:
-                at0 = i00 * b1[WT0] + i01 * b1[WT1]
-                at1 = i10 * b1[WT0] + i11 * b1[WT1]
-                Wnt = b1[WN0] * at0 + b1[WN1] * at1
-                Wtn = b1[WT0] * an0 + b1[WT1] * an1
-                Wtt = b1[WT0] * at0 + b1[WT1] * at1
-                uT = b1[WT0] * vf0 + b1[WT1] * vf1 + b1[WTR]
-            else:
-                at0 = 0.0
-                at1 = 0.0
-                Wnt = 0.0
-                Wtn = 0.0
-                Wtt = 0.0
-                uT = 0.0
-            pN, pT, ok = _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN0)
-            if not ok:
-                status = PAINLEVE
+        if has_jac:
+            for i in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += K[i, j] * v[j]
+                rhs[i] = hk * f[i] + a2 * acc
+            a2 = a2 * th
+            for i in range(n):
+                for j in range(n):
+                    Wh[i, j] = M[i, j] - a * C[i, j] - a2 * K[i, j]
+        else:
+            for i in range(n):
+                rhs[i] = hk * f[i]
+                for j in range(n):
+                    Wh[i, j] = M[i, j]
+        if not (constant_W and have_Wi):
+            if not _invert(Wh, Wi, wk, n):
+                status = SINGULAR
                 break
-            stats[S_LCP] += 1.0
-            stats[S_DIRECT] += 1.0
-            res = _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN0, pN, pT)
+            have_Wi = True
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Wi[i, j] * rhs[j]
+            vf[i] = v[i] + acc
+            v1[i] = vf[i]
+
+        # -- contacts
+        na = 0
+        nfa = 0
+        for i in range(nc):
+            pN[i] = 0.0
+            pT[i] = 0.0
+            slip[i] = 0.0
+        if nc > 0:
+            contact_fn(kind, par, q, tk, g0, WN0, wN0, WT0, wT0, True, False)
+            for i in range(nc):
+                acc = wN0[i]
+                for j in range(n):
+                    acc += WN0[i, j] * v[j]
+                vN0[i] = acc
+                active[i] = (g0[i] + 0.5 * hk * acc <= 0.0) or closed[i]
+                if active[i]:
+                    ia[na] = i
+                    na += 1
+                    if mu[i] > 0.0:
+                        fa[nfa] = i
+                        nfa += 1
+        if na > 0:
+            contact_fn(kind, par, q, t1, g1, WN1, wN1, WT1, wT1, False)
+            m = na + nfa
+            for r in range(na):
+                i = ia[r]
+                for j in range(n):
+                    H[r, j] = WN1[i, j]
+                w[r] = wN1[i]
+            for r in range(nfa):
+                i = fa[r]
+                for j in range(n):
+                    H[na + r, j] = WT1[i, j]
+                w[na + r] = wT1[i]
+            for c in range(m):
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(n):
+                        acc += Wi[i, j] * H[c, j]
+                    WiHT[i, c] = acc
+            for r in range(m):
+                acc = w[r]
+                for j in range(n):
+                    acc += H[r, j] * vf[j]
+                Uf[r] = acc
+                for c in range(m):
+                    acc = 0.0
+                    for j in range(n):
+                        acc += H[r, j] * WiHT[j, c]
+                    Wd[r, c] = acc
+            if na == 1 and not force_lemke:
+                i = ia[0]
+                stats[S_LCP] += 1.0
+                stats[S_DIRECT] += 1.0
+                if nfa == 1:
+                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                              Uf[1], mu[i], e[i], vN0[i])
+                    if not ok:
+                        status = PAINLEVE
+                        break
+                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1],
+                                    mu[i], e[i], vN0[i], pn, pt)
+                    p[1] = pt
+                else:
+                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0,
+                                              e[i], vN0[i])
+                    if not ok:
+                        status = PAINLEVE
+                        break
+                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i],
+                                    pn, 0.0)
+                p[0] = pn
+                pN[i] = pn
+                pT[i] = pt
+            else:
+                size = _lcp_size(na, ia, mu, base, trow)
+                if size != L:
+                    # buffers follow the number of LCP variables, reallocated only when
+                    # the active set changes size
+                    L = size
+                    Ml = np.zeros((L, L))
+                    ql = np.zeros(L)
+                    dl = np.ones(L)
+                    zl = np.zeros(L)
+                    wl = np.zeros(L)
+                    rayl = np.zeros(L + 1)
+                    work, iwork = lemke_workspace(L)
+                lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
+                                          Ml, ql, dl, zl, wl, rayl, work, iwork)
+                if lst != 0:
+                    status = LCP_HANDBACK
+                    break
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
-            nv0 = vf0 + (an0 * pN + at0 * pT)
-            nv1 = vf1 + (an1 * pN + at1 * pT)
-            if mu > 0.0:
-                slip = uT + (Wtn * pN + Wtt * pT)
+            for i in range(n):
+                acc = vf[i]
+                for c in range(m):
+                    acc += WiHT[i, c] * p[c]
+                v1[i] = acc
+            for r in range(nfa):
+                tr = na + r
+                acc = Uf[tr]
+                for c in range(m):
+                    acc += Wd[tr, c] * p[c]
+                slip[fa[r]] = acc
 
-        nq0 = q0_ + hk * (th * nv0 + (1.0 - th) * v0_)
-        nq1 = q1_ + hk * (th * nv1 + (1.0 - th) * v1_)
-        is_closed = pN > 0.0
-        if projection:
-            sel = is_closed
+        for i in range(n):
+            q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
+        for i in range(nc):
+            cnew[i] = pN[i] > 0.0
+        if projection and nc > 0:
+            if not const_mass:
+                mass_fn(kind, par, q1, M)
+            for i in range(nc):
+                sel[i] = cnew[i]
+            pinv = False
             for _ in range(PROJECTION_MAXITER):
-                fd_eval(nq0, nv0, t1, par, b0)
-                g = b0[GAP]
-                if g < 0.0:
-                    sel = True
-                if (not sel) or abs(g) <= PROJECTION_TOL:
+                gaps_fn(kind, par, q1, t1, g1)
+                anysel = False
+                gmax = 0.0
+                for i in range(nc):
+                    if g1[i] < 0.0:
+                        sel[i] = True
+                    if sel[i]:
+                        anysel = True
+                        gmax = max(gmax, abs(g1[i]))
+                if (not anysel) or gmax <= PROJECTION_TOL:
                     break
-                # q += M^-1 WN^T d with (WN M^-1 WN^T) d = -g
-                dm = b0[M00] * b0[M11] - b0[M01] * b0[M10]
-                m0 = (b0[M11] * b0[WN0] - b0[M01] * b0[WN1]) / dm
-                m1 = (-b0[M10] * b0[WN0] + b0[M00] * b0[WN1]) / dm
-                d = -g / (b0[WN0] * m0 + b0[WN1] * m1)
-                nq0 = nq0 + m0 * d
-                nq1 = nq1 + m1 * d
+                if not pinv:
+                    if not _invert(M, Mi, wk, n):
+                        status = NUMERICAL
+                        break
+                    pinv = True
+                contact_fn(kind, par, q1, t1, g1, WN1, wN1, WT1, wT1, False, False)
+                s = 0
+                for i in range(nc):
+                    if sel[i]:
+                        ia[s] = i
+                        s += 1
+                # X = M^-1 WN_sel^T, S = WN_sel X, S d = -g_sel, q += X d
+                for c in range(s):
+                    for i in range(n):
+                        acc = 0.0
+                        for j in range(n):
+                            acc += Mi[i, j] * WN1[ia[c], j]
+                        X[i, c] = acc
+                    rs[c] = -g1[ia[c]]
+                for r in range(s):
+                    for c in range(s):
+                        acc = 0.0
+                        for j in range(n):
+                            acc += WN1[ia[r], j] * X[j, c]
+                        S[r, c] = acc
+                _solve_small(S, rs, dd, Sw, s)
+                for i in range(n):
+                    acc = 0.0
+                    for c in range(s):
+                        acc += X[i, c] * dd[c]
+                    q1[i] += acc
                 stats[S_PROJ] += 1.0
-        if not (math.isfinite(nq0) and math.isfinite(nq1) and math.isfinite(nv0)
-                and math.isfinite(nv1)):
+            if status != OK:
+                break
+        finite = True
+        for i in range(n):
+            if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
+                finite = False
+        if not finite:
             status = NUMERICAL
             break
-        gap = fd_gap(nq0, t1, par)
-        if -gap > stats[S_PEN]:
-            stats[S_PEN] = -gap
-        reg = _classify(pN, pT, mu)
+        if nc > 0:
+            gaps_fn(kind, par, q1, t1, g1)
+            for i in range(nc):
+                if -g1[i] > stats[S_PEN]:
+                    stats[S_PEN] = -g1[i]
+                reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
-            _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                   tk, q0_, q1_, v0_, v1_, reg, pN / hk, pT / hk, slip, b0_gap)
+            rec_t[nrec] = tk
+            for j in range(n):
+                rec_q[nrec, j] = q[j]
+                rec_v[nrec, j] = v[j]
+            for i in range(nc):
+                rec_reg[nrec, i] = reg[i]
+                rec_fN[nrec, i] = pN[i] / hk
+                rec_fT[nrec, i] = pT[i] / hk
+                rec_slip[nrec, i] = slip[i]
+                rec_gap[nrec, i] = g0[i]
             nrec += 1
             record_initial = False
-        closed = is_closed
-        q0_ = nq0
-        q1_ = nq1
-        v0_ = nv0
-        v1_ = nv1
+        for i in range(nc):
+            closed[i] = cnew[i]
+        for j in range(n):
+            q[j] = q1[j]
+            v[j] = v1[j]
         k += 1
         if k % save_every == 0 or last:
-            _store(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                   t1, q0_, q1_, v0_, v1_, reg, pN / hk, pT / hk, slip, gap)
+            rec_t[nrec] = t1
+            for j in range(n):
+                rec_q[nrec, j] = q[j]
+                rec_v[nrec, j] = v[j]
+            for i in range(nc):
+                rec_reg[nrec, i] = reg[i]
+                rec_fN[nrec, i] = pN[i] / hk
+                rec_fT[nrec, i] = pT[i] / hk
+                rec_slip[nrec, i] = slip[i]
+                rec_gap[nrec, i] = g1[i]
             nrec += 1
         if last:
             break
-    q[0] = q0_
-    q[1] = q1_
-    v[0] = v0_
-    v[1] = v1_
-    return status, k, nrec, closed
+    return status, k, nrec

@@ -93,6 +93,13 @@ class Integrator:
                 self.message = STATUS_MESSAGES[0]
         return self.status
 
+    def interrupt(self, message=None):
+        """Stop the run as interrupted (status ``-4``); what was recorded is kept.
+
+        For drivers such as :func:`simulate` that catch ``KeyboardInterrupt``.
+        """
+        self._fail(-4, message or STATUS_MESSAGES[-4])
+
     def _fail(self, code, message):
         self.status = "failed"
         self.status_code = code
@@ -179,7 +186,7 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
                 bar.update(integ.t - last)
                 last = integ.t
     except KeyboardInterrupt:
-        integ._fail(-4, STATUS_MESSAGES[-4])
+        integ.interrupt()
     finally:
         if bar is not None:
             bar.close()

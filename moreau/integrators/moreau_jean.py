@@ -58,8 +58,15 @@ at the start of the step. This is the LCP of
 :func:`moreau.lcp.friction.build_friction_lcp`, solved with
 :func:`moreau.lcp.solve_lcp` (Lemke, falling back to QP with
 ``lcp_method="auto"``). A frictionless contact adds no tangential rows, a
-step with no active contact solves nothing, and a scene with a single
-contact is solved by exact enumeration (:func:`one_contact_impulse`).
+step with no active contact solves nothing, a step with a single active
+contact is solved by exact enumeration (:func:`one_contact_impulse`), and
+no restitution term enters where ``e = 0``.
+
+*Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
+the same step in the compiled loop of :mod:`moreau.integrators._mj_kernels`,
+Lemke included (:func:`moreau.lcp.lemke.lemke_core`); a step on which Lemke
+fails is handed back to this module's generic step (QP fallback) and the
+loop resumes. The generic step stays as the reference (``fast=False``).
 
 *Regimes.* Each step's regime is read from its impulses
 (:func:`classify_impulse`): flight when ``p_N = 0`` (or the contact is not
@@ -321,9 +328,9 @@ class MoreauJean(Integrator):
     projection : bool
         Project positions back onto the contacts after every step.
     lcp_method : {"auto", "lemke", "qp"}
-        Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a scene with
-        one contact is solved in closed form (and the friction drive runs
-        compiled) and several contacts go to Lemke with the QP fallback;
+        Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
+        one active contact is solved in closed form and several active
+        contacts go to Lemke with the QP fallback;
         ``"lemke"`` or ``"qp"`` forces that solver on the assembled LCP of
         every contact step, one contact included, so that solvers can be
         compared (``moreau compare``).
@@ -333,10 +340,17 @@ class MoreauJean(Integrator):
         forces.
     fast : {"auto", True, False}
         Use the compiled loop of :mod:`moreau.integrators._mj_kernels` (the
-        same scheme, equal to rounding). ``"auto"`` uses it for the friction
-        drive, the only scene it knows; ``True`` insists. In the compiled mode
+        same scheme, equal to rounding). ``"auto"`` uses it for every scene
+        whose ``compiled_model()`` returns a model (all shipped scenes) unless
+        ``lcp_method="qp"``; ``True`` insists; ``False`` takes the generic
+        Python step through the :class:`Scene` interface. In the compiled mode
         one call of :meth:`step` advances a block of up to 65536 time steps
         (``stats["steps"]`` still counts time steps).
+    closed0 : bool or array_like of bool, optional
+        Contacts to treat as closed in the step before ``t0`` (the index-set
+        memory; see the module docstring). Default: none. Lets a run continue
+        another one exactly (:class:`moreau.analysis.mj_steady_state.PeriodMap`);
+        the final flags are :attr:`closed`.
 
     Notes
     -----
@@ -365,7 +379,7 @@ class MoreauJean(Integrator):
     """
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
-                 lcp_method="auto", save_every=1, fast="auto"):
+                 lcp_method="auto", save_every=1, fast="auto", closed0=None):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
             h, theta, projection, lcp_method, save_every)
@@ -375,31 +389,46 @@ class MoreauJean(Integrator):
         self._trow = np.full(nc, -1, dtype=int)
         self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
         self._closed = np.zeros(nc, dtype=bool)
+        if closed0 is not None:
+            c0 = np.asarray(closed0)
+            if c0.dtype != bool or c0.size not in (1, nc):
+                raise InputError(f"`closed0` must be a bool or {nc} bools (one per contact), "
+                                 f"got {closed0!r}")
+            self._closed[:] = c0.reshape(-1)
         self._k = 0
         self.counters = _new_counters()
         self._pending_initial = True
         if fast not in ("auto", True, False):
             raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
-        known = is_friction_drive(scene)
-        if fast is True and not known:
-            raise InputError("`fast=True` needs a FrictionDrive scene (the only one with a "
-                             "compiled model); use fast='auto' or False")
-        if fast is True and self.lcp_method != "auto":
-            raise InputError("`fast=True` solves the contact in closed form; a forced "
-                             "`lcp_method` needs fast='auto' or False")
-        # a forced solver is a request to run that solver, so it takes the generic path
-        self._fast = known and fast is not False and self.lcp_method == "auto"
+        model = compiled_model_of(scene)
+        if fast is True and model is None:
+            raise InputError(f"`fast=True` needs a scene with a compiled model "
+                             f"(`compiled_model()`); {type(scene).__name__} has none, or a "
+                             f"subclass changed its equations; use fast='auto' or False")
+        if fast is True and self.lcp_method == "qp":
+            raise InputError("`fast=True` solves contacts in closed form or by Lemke; "
+                             "`lcp_method='qp'` needs fast='auto' or False")
+        # a forced QP solver is a request to run that solver, so it takes the generic path
+        self._fast = model is not None and fast is not False and self.lcp_method != "qp"
         if self._fast:
-            from ..scenes._friction_drive_jit import pack_params
             from ._mj_kernels import new_stats
-            self._par = pack_params(scene)
+            self._model = model
             self._stats = new_stats()
             self._blocks = []
+
+    @property
+    def closed(self):
+        """Contacts that carried a normal impulse in the last step (the index-set memory), a copy."""
+        return self._closed.copy()
 
     # -- one step -------------------------------------------------------------
     def _step_impl(self):
         if self._fast:
             return self._fast_block()
+        return self._generic_step()
+
+    def _generic_step(self):
+        """One step through the :class:`Scene` interface (the reference of the compiled loop)."""
         sc, theta = self.scene, self.theta
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
@@ -461,52 +490,78 @@ class MoreauJean(Integrator):
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
     def _fast_block(self):
-        from ._mj_kernels import NUMERICAL, PAINLEVE, STAT_NAMES, mj_run_fd
+        from ._mj_kernels import LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, mj_run
 
+        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
         nmax = FAST_BLOCK
         ns = nmax // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, 2)), np.empty((ns, 2)), np.empty(ns, dtype=np.int64),
-               np.empty(ns), np.empty(ns), np.empty(ns), np.empty(ns))
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+               np.empty((ns, nc)), np.empty((ns, nc)))
         q, v = self.q.copy(), self.v.copy()
-        status, k, nrec, closed = mj_run_fd(
-            self._par, self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta,
-            self.projection, bool(self._closed[0]), self.save_every, self._pending_initial,
-            *buf, self._stats)
+        closed = self._closed.copy()
+        st = self._stats
+        st[:] = 0.0
+        status, k, nrec = mj_run(
+            m.kind, m.par, n, nc, self.mu_c, self.e_c, m.const_mass, m.has_jacobians,
+            self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta, self.projection,
+            closed, self.save_every, self._pending_initial, self.lcp_method == "lemke",
+            *buf, st)
         ndone = k - self._k
         if nrec:
             self._blocks.append(tuple(b[:nrec].copy() for b in buf))
         if ndone:
             self._pending_initial = False
-        self._k, self.q, self.v = k, q, v
-        self._closed[0] = closed
+        self._k, self.q, self.v, self._closed = k, q, v, closed
         t = self.t0 + k * self.h
         self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
-        for name, x in zip(STAT_NAMES, self._stats):
-            self.counters[name] = float(x) if name.startswith("max_") else int(x)
-        if status == PAINLEVE:
-            self.counters["steps"] += ndone
-            raise PainleveError(f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated at "
-                                f"t = {self.t!r}: the contact problem has no unique solution")
-        self.counters["steps"] += ndone - 1     # the base class adds the last one
-        if status == NUMERICAL:
-            self._fail(-5, f"non-finite state or singular iteration matrix after t = {self.t!r}; "
-                           f"reduce `h`")
+        c = self.counters
+        for name, x in zip(STAT_NAMES, st):
+            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
+        # the base class counts one step per call of _step_impl
+        c["steps"] += ndone - 1
+        if status in (LCP_HANDBACK, PAINLEVE):
+            # Lemke failed on this step: the generic step solves it (QP fallback with
+            # lcp_method="auto", an LCPError with "lemke"), then the loop resumes.
+            # Painlevé: the generic step meets the same case and raises with the
+            # full diagnosis (the state is the start of that step).
+            c["steps"] += 1
+            self._generic_step()
+            return
+        if status == SINGULAR:
+            self._fail(-5, f"the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is "
+                           f"singular at t = {self.t!r}; reduce `h` or use a smaller `theta`")
+        elif status == NUMERICAL:
+            self._fail(-5, f"non-finite state after the step at t = {self.t!r} (the step `h` is "
+                           f"probably too large for an explicit part of the forces)")
+
+    def _record(self, t, q, v, regime, force_N, force_T, slip, gap):
+        if not self._fast:
+            return super()._record(t, q, v, regime, force_N, force_T, slip, gap)
+        # a step taken in Python inside a compiled run: a one-sample block
+        nc = self.scene.ncontacts
+        self._blocks.append((np.array([t], float), np.array(q, float).reshape(1, -1),
+                             np.array(v, float).reshape(1, -1),
+                             np.asarray(regime, np.int64).reshape(1, nc),
+                             *(np.asarray(a, float).reshape(1, nc)
+                               for a in (force_N, force_T, slip, gap))))
 
     def result(self):
         """Assemble the recorded samples into a :class:`SimulationResult`."""
         if not self._fast:
             return super().result()
+        n, nc = self.scene.ndof, self.scene.ncontacts
         if self._blocks:
             t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*self._blocks))
         else:
-            t, reg = np.zeros(0), np.zeros(0, dtype=np.int64)
-            q = v = np.zeros((0, 2))
-            fN = fT = slip = gap = np.zeros(0)
+            t = np.zeros(0)
+            q = v = np.zeros((0, n))
+            reg = np.zeros((0, nc), dtype=np.int64)
+            fN = fT = slip = gap = np.zeros((0, nc))
         code = self.status_code
         return SimulationResult(
-            t=t, q=q, v=v, regime=reg.reshape(-1, 1).astype(int), force_N=fN.reshape(-1, 1),
-            force_T=fT.reshape(-1, 1), slip_velocity=slip.reshape(-1, 1),
-            gap=gap.reshape(-1, 1), events=[], status=code,
+            t=t, q=q, v=v, regime=reg.astype(int), force_N=fN, force_T=fT,
+            slip_velocity=slip, gap=gap, events=[], status=code,
             message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
             stats=dict(self.counters))
 
@@ -525,7 +580,7 @@ class MoreauJean(Integrator):
         na = len(ia)
         c = self.counters
         c["lcp_solves"] += 1
-        if sc.ncontacts == 1 and self.lcp_method == "auto":
+        if na == 1 and self.lcp_method == "auto":
             c["direct_solves"] += 1
             if mu[0] > 0.0:
                 pn, pt = _one_contact(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0], U_free[1],
@@ -583,14 +638,33 @@ class MoreauJean(Integrator):
         return q
 
 
-def is_friction_drive(scene):
-    """True for a plain :class:`~moreau.scenes.friction_drive.FrictionDrive` (not a subclass,
-    which might change the model the compiled kernel hard-codes)."""
-    try:
-        from ..scenes.friction_drive import FrictionDrive
-    except ImportError:      # pragma: no cover - the scene ships with the package
-        return False
-    return type(scene) is FrictionDrive
+def compiled_model_of(scene):
+    """The scene's :class:`~moreau.scenes._compiled.CompiledModel`, or None.
+
+    None when the scene has no ``compiled_model()``, or when a subclass
+    overrides one of the model methods (``mass``, ``forces``,
+    ``force_jacobians``, ``gaps``, ``contact_jacobians``) below the class that
+    defined ``compiled_model``: its compiled form would then describe other
+    equations than the Python ones.
+    """
+    get = getattr(scene, "compiled_model", None)
+    if get is None:
+        return None
+    cls = type(scene)
+    owner = next((k for k in cls.__mro__ if "compiled_model" in vars(k)), None)
+    if owner is None:
+        return None
+    above = cls.__mro__[:cls.__mro__.index(owner)]
+    for name in ("mass", "forces", "force_jacobians", "gaps", "contact_jacobians"):
+        if any(name in vars(k) for k in above):
+            return None
+    model = get()
+    if model is None:
+        return None
+    if model.ndof != scene.ndof or model.ncontacts != scene.ncontacts:
+        raise InputError(f"`scene.compiled_model()` describes {model.ndof} dof and "
+                         f"{model.ncontacts} contacts, the scene {scene.ndof} and {scene.ncontacts}")
+    return model
 
 
 def _inverse(W_hat):

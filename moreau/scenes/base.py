@@ -42,6 +42,11 @@ class Scene:
     restitution = np.zeros(0)
     #: short name used in reports
     name = "scene"
+    #: period of the drive in the scene's time, or None for a scene without a periodic drive
+    period = None
+    #: coordinates that do not enter the dynamics (e.g. the rotor position): a
+    #: periodic steady state repeats everything else and advances these
+    cyclic_coordinates = ()
 
     @property
     def ncontacts(self):
@@ -86,6 +91,19 @@ class Scene:
     def contact_drift(self, q, v, t):
         """Return ``(wNbar, wTbar)``, the velocity-dependent parts of the contact accelerations."""
         raise NotImplementedError
+
+    # -- defaults and compiled form ---------------------------------------
+    def initial_state(self):
+        """A sensible default ``(q0, v0)``: the rest state or the scene's documented start."""
+        raise NotImplementedError(f"{type(self).__name__} defines no initial_state()")
+
+    def compiled_model(self):
+        """The model in compiled form (:class:`moreau.scenes._compiled.CompiledModel`), or None.
+
+        Scenes that return one run Moreau–Jean in the compiled loop of
+        :mod:`moreau.integrators._mj_kernels`; the others take the generic path.
+        """
+        return None
 
     # -- conveniences shared by all scenes --------------------------------
     def contact_velocities(self, q, v, t):

@@ -198,6 +198,8 @@ class BidirectionalDrive(Scene):
 
     ndof = 3
     name = "bidirectional-drive"
+    period = 2.0 * math.pi
+    cyclic_coordinates = (2,)
 
     def __init__(self, params=None, frequency=185.0):
         if params is None:
@@ -219,6 +221,8 @@ class BidirectionalDrive(Scene):
         self.restitution = np.array([p.restitution, p.restitution])
         # +1 for rod a (tip towards +x), -1 for the mirrored rod b
         self._side = np.array([1.0, -1.0])
+        #: velocity scale of the motion (the larger stator velocity amplitude), for tolerances
+        self.velocity_scale = float(np.max(self.u10)) if np.max(self.u10) > 0 else 1.0
 
     def __repr__(self):
         return f"BidirectionalDrive(frequency={self.frequency!r}, params={self.params!r})"
@@ -288,6 +292,17 @@ class BidirectionalDrive(Scene):
         phi = np.arcsin(self.sin_phi0 - self.u1(tau))
         dphi = -self.du1(tau) / np.cos(phi)
         return np.array([phi[0], phi[1], 0.0]), np.array([dphi[0], dphi[1], 0.0])
+
+    def initial_state(self):
+        """The rest state at ``tau = 0`` (:meth:`rest_state`)."""
+        return self.rest_state()
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import BIDIRECTIONAL_DRIVE, CompiledModel
+        par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.u10[0], self.u10[1],
+                        self.delta[0], self.delta[1]], dtype=np.float64)
+        return CompiledModel(BIDIRECTIONAL_DRIVE, par, 3, 2, True, True)
 
     def single_rod(self, which):
         """The paper's :class:`FrictionDrive` for rod ``"a"`` or ``"b"`` alone, same frequency."""

@@ -194,6 +194,16 @@ class BouncingBall(_SIUnits, Scene):
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(0)
 
+    def initial_state(self):
+        """The ball at rest with its lowest point one length unit above the floor."""
+        return np.array([self.r + 1.0]), np.zeros(1)
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import BOUNCING_BALL, CompiledModel
+        return CompiledModel(BOUNCING_BALL, np.array([self.r], dtype=np.float64), 1, 1,
+                             True, False)
+
     # -- exact solution -------------------------------------------------------
     def _initial(self, q0, v0):
         y0 = float(finite_array("q0", q0, shape=(1,))[0])

@@ -146,6 +146,8 @@ class FrictionDrive(Scene):
 
     ndof = 2
     name = "friction-drive"
+    period = 2.0 * math.pi
+    cyclic_coordinates = (1,)
 
     def __init__(self, params=None, frequency=185.0):
         if params is None:
@@ -165,6 +167,8 @@ class FrictionDrive(Scene):
         self.sin_phi0 = math.sin(p.phi0)
         self.mu = np.array([p.mu])
         self.restitution = np.array([p.restitution])
+        #: velocity scale of the motion (the stator velocity amplitude), for tolerances
+        self.velocity_scale = self.u10
 
     def __repr__(self):
         return f"FrictionDrive(frequency={self.frequency!r}, params={self.params!r})"
@@ -278,6 +282,16 @@ class FrictionDrive(Scene):
     def rest_state(self):
         """State at ``tau = 0`` with the rod in contact and everything at rest."""
         return np.array([self.phi0, 0.0]), np.array([0.0, 0.0])
+
+    def initial_state(self):
+        """The rest state :meth:`rest_state` (rod on the rotor at ``phi0``, all at rest)."""
+        return self.rest_state()
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import FRICTION_DRIVE, CompiledModel
+        par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0], dtype=np.float64)
+        return CompiledModel(FRICTION_DRIVE, par, 2, 1, True, True)
 
     # -- units ------------------------------------------------------------------
     def to_si(self, result):

@@ -166,6 +166,15 @@ class PainleveRod(_SIUnits, Scene):
         wT = np.array([c * w2]) if self.mu[0] > 0.0 else np.zeros(0)
         return np.array([s * w2]), wT
 
+    def initial_state(self):
+        """Tip on the floor at 45 degrees, sliding at unit speed the well-posed way (away from the rod)."""
+        return self.sliding_state(phi=math.pi / 4, tip_speed=1.0)
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import PAINLEVE_ROD, CompiledModel
+        return CompiledModel(PAINLEVE_ROD, np.zeros(1), 3, 1, True, False)
+
     # -- units ----------------------------------------------------------------
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])

@@ -133,6 +133,16 @@ class SlidingBlock(_SIUnits, Scene):
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(1 if self.mu[0] > 0.0 else 0)
 
+    def initial_state(self):
+        """On the plane at the origin, launched along it at unit speed."""
+        return np.zeros(2), np.array([1.0, 0.0])
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import SLIDING_BLOCK, CompiledModel
+        par = np.array([math.sin(self.alpha), math.cos(self.alpha)], dtype=np.float64)
+        return CompiledModel(SLIDING_BLOCK, par, 2, 1, True, False)
+
     # -- exact solution -------------------------------------------------------
     @property
     def sticks(self):

@@ -337,6 +337,8 @@ class StickSlipMotor(_SIUnits, Scene):
 
     ndof = 2
     name = "stick-slip-motor"
+    period = TWO_PI
+    cyclic_coordinates = (0,)
 
     def __init__(self, params=None, frequency=1000.0, drive="sawtooth", **overrides):
         p = _params_with(StickSlipMotorParams, params, overrides)
@@ -381,3 +383,26 @@ class StickSlipMotor(_SIUnits, Scene):
         _, _, dds = self.drive(t)
         return np.zeros(1), np.array([-float(dds)])
 
+    def initial_state(self):
+        """Slider on the stator at ``x = 0``, moving with it (sticking) at ``tau = 0``."""
+        _, ds, _ = self.drive(0.0)
+        return np.zeros(2), np.array([float(ds), 0.0])
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import STICK_SLIP_MOTOR, CompiledModel
+        par = np.zeros(22)
+        par[0], par[1] = self.fL, self.n
+        d = self.drive
+        if isinstance(d, SineDrive):
+            par[2], par[3], par[4] = 0.0, d.b, d.psi
+        elif isinstance(d, SawtoothDrive):
+            m = len(d._starts)
+            par[2], par[5] = 1.0, m
+            par[6:6 + m], par[10:10 + m] = d._starts, d._acc
+            par[14:14 + m], par[18:18 + m] = d._vel, d._pos
+        else:
+            return None
+        if type(d) not in (SineDrive, SawtoothDrive):
+            return None     # a drive subclass may change s(tau)
+        return CompiledModel(STICK_SLIP_MOTOR, par, 2, 1, True, False)

@@ -170,8 +170,8 @@ def test_docstring_examples_run():
     import doctest
 
     import moreau.analysis.mj_steady_state as mss
-    import moreau.scenes._friction_drive_jit as fdj
-    for mod in (mss, fdj):
+    import moreau.scenes._compiled as cm
+    for mod in (mss, cm):
         assert doctest.testmod(mod, verbose=False).failed == 0
 
 

@@ -154,7 +154,8 @@ def test_registered_under_its_name():
     ({"h": 0.1, "lcp_method": "simplex"}, r"`lcp_method` must be one of \['auto', 'lemke', 'qp'\]"),
     ({"h": 0.1, "projection": "yes"}, r"`projection` must be True or False"),
     ({"h": 0.1, "save_every": 0}, r"`save_every` must be an integer >= 1"),
-    ({"h": 0.1, "fast": True}, r"`fast=True` needs a FrictionDrive scene"),
+    ({"h": 0.1, "fast": True}, r"`fast=True` needs a scene with a compiled model"),
+    ({"h": 0.1, "closed0": [True, False]}, r"`closed0` must be a bool or 1 bools"),
     ({"h": 0.1, "fast": "maybe"}, r"`fast` must be 'auto', True or False"),
 ])
 def test_bad_options_are_rejected_before_any_work(opts, match):
@@ -253,12 +254,17 @@ def test_lcp_path_with_a_frictionless_contact():
 
 
 def test_lcp_path_matches_the_one_contact_path():
-    # the second contact never closes, so both scenes move alike; the first
-    # runs the LCP every step, the second the enumeration
+    # the second contact never closes, so both scenes move alike; forced to
+    # Lemke, the first runs the LCP every step, the second the enumeration
+    # (with "auto" a step with one active contact takes the enumeration too)
     h = 1.0 / 32
-    two = run(TwoPoints(mu=(0.5, 0.3), far=10.0), 3.0, [0, 0, 0, 0], [1, 0, 0, 0], h=h)
+    two = run(TwoPoints(mu=(0.5, 0.3), far=10.0), 3.0, [0, 0, 0, 0], [1, 0, 0, 0], h=h,
+              lcp_method="lemke")
     one = run(PointOnGround(mu=0.5), 3.0, [0, 0], [1, 0], h=h)
     assert two.stats["direct_solves"] == 0 and two.stats["lcp_solves"] == len(one.t) - 1
+    auto = run(TwoPoints(mu=(0.5, 0.3), far=10.0), 3.0, [0, 0, 0, 0], [1, 0, 0, 0], h=h)
+    assert auto.stats["direct_solves"] == auto.stats["lcp_solves"] == len(one.t) - 1
+    np.testing.assert_allclose(auto.q[:, :2], one.q, atol=1e-13)
     np.testing.assert_allclose(two.q[:, :2], one.q, atol=1e-13)
     np.testing.assert_allclose(two.v[:, :2], one.v, atol=1e-13)
     np.testing.assert_array_equal(two.regime[:, 0], one.regime[:, 0])

@@ -1,0 +1,338 @@
+"""Compiled (numba) form of every shipped scene's model, for the compiled Moreau–Jean loop.
+
+A scene hands its model to compiled code as a :class:`CompiledModel`: an
+integer ``kind`` naming its equations below and a float vector ``par`` of its
+parameters. One compiled time stepper then serves every scene
+(:mod:`moreau.integrators._mj_kernels`): the few functions here dispatch on
+``kind``, so the stepper is compiled (and cached on disk) once, not once per
+scene. Passing the model as numba first-class functions would specialise the
+stepper per function object, and such specialisations are not found again in
+numba's on-disk cache.
+
+Adding a scene: give it a new ``kind``, add its branch to each function
+below, and a ``compiled_model()`` method returning ``CompiledModel(kind,
+par, ...)``. Numba keys the stepper's on-disk cache on its own source file
+only, so after editing this module delete
+``moreau/integrators/__pycache__/_mj_kernels*.nb*`` (or touch
+``_mj_kernels.py``); otherwise a stale compiled stepper is loaded.
+
+The Python :class:`~moreau.scenes.base.Scene` methods stay the definition;
+the formulas here are transcriptions of them, and
+``tests/scenes/test_compiled_models.py`` checks every function against its
+Python counterpart to ``1e-12``. Layout of the outputs (the caller zero-fills them once; a model writes the
+same entries on every call and leaves the structural zeros alone, so that the
+stepper does not clear arrays on every step):
+
+* ``mass_fn(kind, par, q, M)``: ``M`` (ndof, ndof).
+* ``dynamics_fn(kind, par, q, v, t, f, K, C, need_jac)``: forces ``h`` and,
+  when ``need_jac``, ``K = dh/dq`` and ``C = dh/dv`` (left untouched otherwise;
+  scenes with ``has_jacobians = False`` never write them).
+* ``contact_fn(kind, par, q, t, g, WN, wN, WT, wT, need_gap, need_T=True)``:
+  gaps (when ``need_gap``), the normal rows ``WN`` (nc, ndof), ``wN`` (nc,) and one
+  tangential row *per contact* ``WT`` (nc, ndof), ``wT`` (nc,), written for
+  every contact; the stepper reads a contact's tangential row only when its
+  ``mu > 0``. (The Python interface returns tangential rows of the frictional
+  contacts only.) With ``need_T=False`` only the normal rows are written.
+* ``gaps_fn(kind, par, q, t, g)``.
+* ``drift_fn(kind, par, q, v, t, wNbar, wTbar)``: one entry per contact, as ``WT``.
+"""
+
+import math
+from collections import namedtuple
+
+import numpy as np
+from numba import njit
+
+__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn",
+           "FRICTION_DRIVE", "BOUNCING_BALL", "SLIDING_BLOCK", "PAINLEVE_ROD",
+           "STICK_SLIP_MOTOR", "BIDIRECTIONAL_DRIVE", "SLIDING_BOX", "check_compiled_model"]
+
+#: the model of a scene for compiled code. ``kind``: which equations;
+#: ``par``: float64 parameters; ``const_mass``: ``M`` does not depend on ``q``;
+#: ``has_jacobians``: ``dh/dq`` or ``dh/dv`` is not identically zero.
+CompiledModel = namedtuple("CompiledModel", ["kind", "par", "ndof", "ncontacts", "const_mass",
+                                             "has_jacobians"])
+
+FRICTION_DRIVE = 1
+BOUNCING_BALL = 2
+SLIDING_BLOCK = 3
+PAINLEVE_ROD = 4
+STICK_SLIP_MOTOR = 5
+BIDIRECTIONAL_DRIVE = 6
+SLIDING_BOX = 7
+
+TWO_PI = 2.0 * math.pi
+
+
+# -- stick-slip motor drives -------------------------------------------------------------
+# par: [fL, n, drive (0 sine, 1 sawtooth), b, psi, nseg, starts[4], acc[4], vel[4], pos[4]]
+
+@njit(cache=True, inline="always")
+def _motor_drive(par, t):
+    if par[2] == 0.0:
+        b = par[3]
+        a2 = 2.0 * t + par[4]
+        return (math.sin(t) + b * math.sin(a2), math.cos(t) + 2.0 * b * math.cos(a2),
+                -math.sin(t) - 4.0 * b * math.sin(a2))
+    nseg = int(par[5])
+    # Python's float modulo, as np.mod in the Python model
+    tm = t % TWO_PI
+    k = -1
+    for i in range(nseg):
+        if par[6 + i] <= tm:
+            k = i
+    if k < 0:
+        k = nseg - 1
+    st = par[6 + k]
+    dt = tm - st if tm >= st else tm + TWO_PI - st
+    a = par[10 + k]
+    v0 = par[14 + k]
+    return par[18 + k] + v0 * dt + 0.5 * a * dt * dt, v0 + a * dt, a
+
+
+# -- dispatchers -------------------------------------------------------------------------
+
+@njit(cache=True, inline="always")
+def mass_fn(kind, par, q, M):
+    if kind == FRICTION_DRIVE:
+        M[0, 0] = 1.0 / 3.0
+        M[1, 1] = par[0]
+    elif kind == BIDIRECTIONAL_DRIVE:
+        M[0, 0] = 1.0 / 3.0
+        M[1, 1] = 1.0 / 3.0
+        M[2, 2] = par[0]
+    elif kind == PAINLEVE_ROD:
+        M[0, 0] = 1.0
+        M[1, 1] = 1.0
+        M[2, 2] = 1.0 / 3.0
+    elif kind == SLIDING_BOX:
+        M[0, 0] = 1.0
+        M[1, 1] = 1.0
+        M[2, 2] = par[2]
+    else:
+        for i in range(M.shape[0]):
+            M[i, i] = 1.0
+
+
+@njit(cache=True, inline="always")
+def dynamics_fn(kind, par, q, v, t, f, K, C, need_jac):
+    if kind == FRICTION_DRIVE:
+        # par: J, P, u10, fL, sin_phi0
+        s = math.sin(q[0])
+        c = math.cos(q[0])
+        spring = par[4] - s
+        ddu1 = par[2] * math.cos(t)
+        f[0] = par[1] * c * spring - 0.5 * ddu1 * c
+        f[1] = -par[3]
+        if need_jac:
+            K[0, 0] = par[1] * (-s * spring - c * c) + 0.5 * ddu1 * s
+    elif kind == BIDIRECTIONAL_DRIVE:
+        # par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b
+        for r in range(2):
+            s = math.sin(q[r])
+            c = math.cos(q[r])
+            dd1 = par[4 + r] * math.cos(t - par[6 + r])
+            f[r] = par[1] * c * (par[2] - s) - 0.5 * dd1 * c
+            if need_jac:
+                K[r, r] = par[1] * (-s * (par[2] - s) - c * c) + 0.5 * dd1 * s
+        f[2] = -par[3]
+    elif kind == BOUNCING_BALL:
+        f[0] = -1.0
+    elif kind == SLIDING_BLOCK:
+        # par: sin(alpha), cos(alpha)
+        f[0] = par[0]
+        f[1] = -par[1]
+    elif kind == PAINLEVE_ROD or kind == SLIDING_BOX:
+        f[0] = 0.0
+        f[1] = -1.0
+        f[2] = 0.0
+    elif kind == STICK_SLIP_MOTOR:
+        f[0] = -par[0]
+        f[1] = -par[1]
+
+
+@njit(cache=True, inline="always")
+def gaps_fn(kind, par, q, t, g):
+    if kind == FRICTION_DRIVE:
+        g[0] = par[4] - math.sin(q[0]) - par[2] * (1.0 - math.cos(t))
+    elif kind == BIDIRECTIONAL_DRIVE:
+        for r in range(2):
+            g[r] = par[2] - math.sin(q[r]) - par[4 + r] * (1.0 - math.cos(t - par[6 + r]))
+    elif kind == BOUNCING_BALL:
+        g[0] = q[0] - par[0]
+    elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
+        g[0] = q[1]
+    elif kind == PAINLEVE_ROD:
+        g[0] = q[1] - math.sin(q[2])
+    elif kind == SLIDING_BOX:
+        # par: a, b, inertia; corners at body coordinates (-a, -b), (+a, -b)
+        s = math.sin(q[2])
+        c = math.cos(q[2])
+        g[0] = q[1] - par[0] * s - par[1] * c
+        g[1] = q[1] + par[0] * s - par[1] * c
+
+
+@njit(cache=True, inline="always")
+def _normal_rows(kind, par, q, t, WN, wN):
+    # the normal rows only (the stepper's index-set test needs no tangential ones)
+    if kind == FRICTION_DRIVE:
+        WN[0, 0] = -math.cos(q[0])
+        wN[0] = -par[2] * math.sin(t)
+    elif kind == BIDIRECTIONAL_DRIVE:
+        WN[0, 0] = -math.cos(q[0])
+        WN[1, 1] = -math.cos(q[1])
+        wN[0] = -par[4] * math.sin(t - par[6])
+        wN[1] = -par[5] * math.sin(t - par[7])
+    elif kind == BOUNCING_BALL:
+        WN[0, 0] = 1.0
+    elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
+        WN[0, 1] = 1.0
+    elif kind == PAINLEVE_ROD:
+        WN[0, 1] = 1.0
+        WN[0, 2] = -math.cos(q[2])
+    elif kind == SLIDING_BOX:
+        s = math.sin(q[2])
+        c = math.cos(q[2])
+        for i in range(2):
+            WN[i, 1] = 1.0
+            WN[i, 2] = (2.0 * i - 1.0) * par[0] * c + par[1] * s
+
+
+@njit(cache=True, inline="always")
+def contact_fn(kind, par, q, t, g, WN, wN, WT, wT, need_gap, need_T=True):
+    if need_gap:
+        gaps_fn(kind, par, q, t, g)
+    if not need_T:
+        _normal_rows(kind, par, q, t, WN, wN)
+        return
+    if kind == FRICTION_DRIVE:
+        WN[0, 0] = -math.cos(q[0])
+        wN[0] = -par[2] * math.sin(t)
+        WT[0, 0] = math.sin(q[0])
+        WT[0, 1] = 1.0
+    elif kind == BIDIRECTIONAL_DRIVE:
+        WN[0, 0] = -math.cos(q[0])
+        WN[1, 1] = -math.cos(q[1])
+        wN[0] = -par[4] * math.sin(t - par[6])
+        wN[1] = -par[5] * math.sin(t - par[7])
+        WT[0, 0] = math.sin(q[0])
+        WT[1, 1] = -math.sin(q[1])
+        WT[0, 2] = 1.0
+        WT[1, 2] = 1.0
+    elif kind == BOUNCING_BALL:
+        WN[0, 0] = 1.0
+    elif kind == SLIDING_BLOCK:
+        WN[0, 1] = 1.0
+        WT[0, 0] = 1.0
+    elif kind == STICK_SLIP_MOTOR:
+        WN[0, 1] = 1.0
+        WT[0, 0] = 1.0
+        wT[0] = -_motor_drive(par, t)[1]
+    elif kind == PAINLEVE_ROD:
+        WN[0, 1] = 1.0
+        WN[0, 2] = -math.cos(q[2])
+        WT[0, 0] = 1.0
+        WT[0, 2] = math.sin(q[2])
+    elif kind == SLIDING_BOX:
+        s = math.sin(q[2])
+        c = math.cos(q[2])
+        a = par[0]
+        b = par[1]
+        for i in range(2):
+            sg = 2.0 * i - 1.0
+            WN[i, 1] = 1.0
+            WN[i, 2] = sg * a * c + b * s
+            WT[i, 0] = 1.0
+            WT[i, 2] = -sg * a * s + b * c
+
+
+@njit(cache=True)
+def drift_fn(kind, par, q, v, t, wNbar, wTbar):
+    if kind == FRICTION_DRIVE:
+        w2 = v[0] * v[0]
+        wNbar[0] = w2 * math.sin(q[0]) - par[2] * math.cos(t)
+        wTbar[0] = w2 * math.cos(q[0])
+    elif kind == BIDIRECTIONAL_DRIVE:
+        for r in range(2):
+            w2 = v[r] * v[r]
+            wNbar[r] = w2 * math.sin(q[r]) - par[4 + r] * math.cos(t - par[6 + r])
+            wTbar[r] = (1.0 - 2.0 * r) * w2 * math.cos(q[r])
+    elif kind == STICK_SLIP_MOTOR:
+        wTbar[0] = -_motor_drive(par, t)[2]
+    elif kind == PAINLEVE_ROD:
+        w2 = v[2] * v[2]
+        wNbar[0] = math.sin(q[2]) * w2
+        wTbar[0] = math.cos(q[2]) * w2
+    elif kind == SLIDING_BOX:
+        s = math.sin(q[2])
+        c = math.cos(q[2])
+        w2 = v[2] * v[2]
+        for i in range(2):
+            sg = 2.0 * i - 1.0
+            wNbar[i] = w2 * (-sg * par[0] * s + par[1] * c)
+            wTbar[i] = w2 * (-sg * par[0] * c - par[1] * s)
+
+
+# -- checking a compiled model against its Python scene ----------------------------------
+
+def evaluate_compiled(model, q, v, t):
+    """All compiled model outputs at ``(q, v, t)`` as a dict of arrays (for checks and tests)."""
+    n, nc = model.ndof, model.ncontacts
+    q = np.ascontiguousarray(q, dtype=float)
+    v = np.ascontiguousarray(v, dtype=float)
+    t = float(t)
+    M = np.zeros((n, n))
+    f = np.zeros(n)
+    K = np.zeros((n, n))
+    C = np.zeros((n, n))
+    g = np.zeros(nc)
+    WN, WT = np.zeros((nc, n)), np.zeros((nc, n))
+    wN, wT, wNb, wTb = (np.zeros(nc) for _ in range(4))
+    mass_fn(model.kind, model.par, q, M)
+    dynamics_fn(model.kind, model.par, q, v, t, f, K, C, True)
+    contact_fn(model.kind, model.par, q, t, g, WN, wN, WT, wT, True)
+    drift_fn(model.kind, model.par, q, v, t, wNb, wTb)
+    WN2, WT2, wN2, wT2 = np.zeros((nc, n)), np.zeros((nc, n)), np.zeros(nc), np.zeros(nc)
+    contact_fn(model.kind, model.par, q, t, g, WN2, wN2, WT2, wT2, False, False)
+    return {"WN_normal_only": WN2, "wN_normal_only": wN2, "mass": M, "forces": f, "K": K, "C": C, "gaps": g, "WN": WN, "wN": wN,
+            "WT": WT, "wT": wT, "wNbar": wNb, "wTbar": wTb}
+
+
+def check_compiled_model(scene, q, v, t):
+    """Largest difference between ``scene``'s compiled model and its Python methods at ``(q, v, t)``.
+
+    Compares ``M``, ``h``, ``dh/dq``, ``dh/dv``, gaps, ``WN``, ``wN``, the
+    tangential rows of the frictional contacts, and the drift terms, each
+    relative to ``max(1, |Python value|)``.
+
+    Returns
+    -------
+    float
+        The largest scaled difference; the caller decides what is acceptable.
+
+    Examples
+    --------
+    >>> from moreau.scenes import BouncingBall
+    >>> ball = BouncingBall()
+    >>> check_compiled_model(ball, [1.0], [-0.5], 0.3) <= 1e-12
+    True
+    """
+    model = scene.compiled_model()
+    c = evaluate_compiled(model, q, v, t)
+    q = np.asarray(q, dtype=float)
+    v = np.asarray(v, dtype=float)
+    fr = scene.frictional_index
+    K, Cj = scene.force_jacobians(q, v, t)
+    WN, wN, WT, wT = scene.contact_jacobians(q, t)
+    wNb, wTb = scene.contact_drift(q, v, t)
+    pairs = [(c["mass"], scene.mass(q)), (c["forces"], scene.forces(q, v, t)),
+             (c["K"], K), (c["C"], Cj), (c["gaps"], scene.gaps(q, t)),
+             (c["WN"], WN), (c["wN"], wN), (c["WN_normal_only"], WN), (c["wN_normal_only"], wN), (c["WT"][fr], WT), (c["wT"][fr], wT),
+             (c["wNbar"], wNb), (c["wTbar"][fr], wTb)]
+    worst = 0.0
+    for a, b in pairs:
+        b = np.asarray(b, dtype=float)
+        a = np.asarray(a, dtype=float).reshape(b.shape)
+        if b.size:
+            worst = max(worst, float(np.max(np.abs(a - b) / np.maximum(1.0, np.abs(b)))))
+    return worst

@@ -1,0 +1,220 @@
+"""A rigid box sliding on a level floor on its two bottom corners: two frictional contacts.
+
+The multi-contact validation scene. Launched along the floor, the box slides
+on both corners, decelerates at ``mu g`` and stops at ``t* = v0 / (mu g)``
+after ``v0^2 / (2 mu g)``, like a point mass, but the weight is shared
+unequally: friction acting below the centre of mass tips the box forward,
+so the leading corner carries more. Every Moreau–Jean step with the box on
+the floor solves a two-contact frictional LCP (Lemke).
+
+Derivation
+----------
+Box of half-width ``a``, half-height ``b``, mass ``m``, centroidal inertia
+``m (a^2 + b^2) / 3``; coordinates ``q = (x, y, theta)`` of the centre and the
+rotation (counter-clockwise). Corner ``i`` (``s_i = -1`` rear-left, ``+1``
+right) sits at body coordinates ``(s_i a, -b)``, i.e. at
+``(x + s_i a cos(theta) + b sin(theta),  y + s_i a sin(theta) - b cos(theta))``. Its gap and
+horizontal (slip) velocity are::
+
+    g_i      = y + s_i a sin(theta) - b cos(theta)
+    WN_i     = (0, 1, s_i a cos(theta) + b sin(theta)),   wN_i = 0
+    WT_i     = (1, 0, b cos(theta) - s_i a sin(theta)),   wT_i = 0
+    wNbar_i  = theta'^2 (b cos(theta) - s_i a sin(theta))
+    wTbar_i  = -theta'^2 (s_i a cos(theta) + b sin(theta))
+
+(second derivatives of the corner coordinates). Lengths in units of
+``L = params.length``, time in ``sqrt(L / g)``, forces in ``m g``: ``M = diag(1,
+1, (a^2 + b^2) / 3)``, ``h = (0, -1, 0)``.
+
+Exact motion from ``theta = 0``, ``y = b``, speed ``v0 > 0`` along ``+x``: with
+``theta'' = 0`` and ``y'' = 0`` the contact forces are
+``lambda_N,i = (1 + s_i mu b / a) / 2`` and ``lambda_T,i = -mu lambda_N,i`` (moment
+balance about the centre: ``a (N_+ - N_-) = mu b (N_+ + N_-)``), valid while
+``mu b < a`` (otherwise the rear corner lifts and the box tips). Then
+``x'' = -mu`` until ``t* = v0 / mu``, and rest after that.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import finite_array, in_closed_interval, nonnegative, positive
+from ..errors import InputError
+from .base import Scene
+from .bouncing_ball import _params_with, _SIUnits
+
+__all__ = ["SlidingBoxParams", "SlidingBox"]
+
+
+@dataclass(frozen=True)
+class SlidingBoxParams:
+    """SI parameters of the sliding box.
+
+    Attributes
+    ----------
+    mass : float
+        Mass [kg], > 0.
+    half_width, half_height : float
+        Half the box's width and height [m], > 0.
+    mu : float
+        Coulomb friction at both corners, >= 0; ``mu * half_height < half_width``
+        keeps both corners on the floor while sliding.
+    gravity : float
+        [m/s^2], > 0.
+    restitution : float
+        Newton restitution at the corners, in [0, 1].
+    length : float
+        Reference length [m] that fixes the units, > 0.
+    """
+
+    mass: float = 1.0
+    half_width: float = 0.5
+    half_height: float = 0.25
+    mu: float = 0.4
+    gravity: float = 9.81
+    restitution: float = 0.0
+    length: float = 1.0
+
+    def __post_init__(self):
+        for name in ("mass", "half_width", "half_height", "gravity", "length"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        object.__setattr__(self, "restitution",
+                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+
+
+class SlidingBox(_SIUnits, Scene):
+    """Rigid box on a level floor, two frictional corner contacts.
+
+    Parameters
+    ----------
+    params : SlidingBoxParams, optional
+    **overrides
+        Individual parameters replacing those of ``params``.
+
+    Examples
+    --------
+    >>> box = SlidingBox(mu=0.5)
+    >>> q0, v0 = box.initial_state()
+    >>> box.gaps(q0, 0.0).tolist(), box.stopping_time(v0)
+    ([0.0, 0.0], 2.0)
+    >>> [round(x, 12) for x in box.normal_forces()]      # rear, front
+    [0.375, 0.625]
+    """
+
+    ndof = 3
+    name = "sliding-box"
+
+    def __init__(self, params=None, **overrides):
+        p = _params_with(SlidingBoxParams, params, overrides)
+        self.params = p
+        self.a = p.half_width / p.length
+        self.b = p.half_height / p.length
+        self.inertia = (self.a ** 2 + self.b ** 2) / 3.0
+        self.mu = np.array([p.mu, p.mu])
+        self.restitution = np.array([p.restitution, p.restitution])
+        self.length = p.length
+        self.time = math.sqrt(p.length / p.gravity)
+        self.force = p.mass * p.gravity
+        self._side = np.array([-1.0, 1.0])
+
+    # -- Scene interface ----------------------------------------------------
+    def mass(self, q):
+        return np.diag([1.0, 1.0, self.inertia])
+
+    def forces(self, q, v, t):
+        return np.array([0.0, -1.0, 0.0])
+
+    def gaps(self, q, t):
+        s, c = math.sin(q[2]), math.cos(q[2])
+        return q[1] + self._side * self.a * s - self.b * c
+
+    def contact_jacobians(self, q, t):
+        s, c = math.sin(q[2]), math.cos(q[2])
+        WN = np.zeros((2, 3))
+        WN[:, 1] = 1.0
+        WN[:, 2] = self._side * self.a * c + self.b * s
+        if self.params.mu > 0.0:
+            WT = np.zeros((2, 3))
+            WT[:, 0] = 1.0
+            WT[:, 2] = self.b * c - self._side * self.a * s
+        else:
+            WT = np.zeros((0, 3))
+        return WN, np.zeros(2), WT, np.zeros(WT.shape[0])
+
+    def contact_drift(self, q, v, t):
+        s, c = math.sin(q[2]), math.cos(q[2])
+        w2 = v[2] * v[2]
+        wNbar = w2 * (self.b * c - self._side * self.a * s)
+        wTbar = -w2 * (self._side * self.a * c + self.b * s)
+        return wNbar, (wTbar if self.params.mu > 0.0 else np.zeros(0))
+
+    def initial_state(self):
+        """Flat on the floor at ``x = 0``, launched along ``+x`` at unit speed."""
+        return np.array([0.0, self.b, 0.0]), np.array([1.0, 0.0, 0.0])
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
+        from ._compiled import SLIDING_BOX, CompiledModel
+        return CompiledModel(SLIDING_BOX, np.array([self.a, self.b, self.inertia]), 3, 2,
+                             True, False)
+
+    def _qscale(self):
+        return np.array([self.length, self.length, 1.0])
+
+    # -- exact solution -------------------------------------------------------
+    def _check_flat(self):
+        mu = float(self.mu[0])
+        if not mu * self.b < self.a:
+            raise InputError(f"`mu` * half_height must be < half_width for the box to slide on "
+                             f"both corners (mu b / a = {mu * self.b / self.a:.6g}); it tips")
+        if mu == 0.0:
+            raise InputError("`mu` must be > 0 for the box to stop")
+
+    def _speed(self, v0):
+        v0 = finite_array("v0", v0, shape=(3,))
+        if v0[1] != 0.0 or v0[2] != 0.0:
+            raise InputError("`v0` must be a pure slide along the floor: v0[1] == v0[2] == 0")
+        if not v0[0] > 0.0:
+            raise InputError(f"`v0[0]` must be > 0 (sliding along +x), got {v0[0]!r}")
+        return float(v0[0])
+
+    def stopping_time(self, v0):
+        """``v0 / mu`` (SI: ``v0 / (mu g)``)."""
+        self._check_flat()
+        return self._speed(v0) / float(self.mu[0])
+
+    def stopping_distance(self, v0):
+        """``v0^2 / (2 mu)`` (SI: ``v0^2 / (2 mu g)``)."""
+        self._check_flat()
+        u = self._speed(v0)
+        return u * u / (2.0 * float(self.mu[0]))
+
+    def normal_forces(self):
+        """Exact normal forces ``(rear, front)`` while sliding along ``+x``: ``(1 -+ mu b / a) / 2``."""
+        self._check_flat()
+        r = float(self.mu[0]) * self.b / self.a
+        return 0.5 * (1.0 - r), 0.5 * (1.0 + r)
+
+    def exact_solution(self, t, q0, v0):
+        """Exact ``(q, v)`` at times ``t >= 0`` from a flat sliding start ``(q0, v0)``.
+
+        Returns arrays of shape ``(len(t), 3)``.
+        """
+        self._check_flat()
+        q0 = finite_array("q0", q0, shape=(3,))
+        if q0[2] != 0.0 or q0[1] != self.b:
+            raise InputError("`q0` must be flat on the floor: q0[1] == half_height, q0[2] == 0")
+        u = self._speed(v0)
+        tt = np.atleast_1d(finite_array("t", t)).astype(float)
+        if np.any(tt < 0.0):
+            raise InputError("`t` must be >= 0")
+        mu = float(self.mu[0])
+        ts = np.minimum(tt, u / mu)
+        q = np.zeros((len(tt), 3))
+        v = np.zeros((len(tt), 3))
+        q[:, 0] = q0[0] + u * ts - 0.5 * mu * ts ** 2
+        q[:, 1] = self.b
+        v[:, 0] = u - mu * ts
+        return q, v
