@@ -6,6 +6,7 @@ paper's dimensionless variables.
 
 import argparse
 import json
+import math
 import sys
 import time
 
@@ -71,7 +72,10 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
         "displacement_per_period_m": disp,
         "average_velocity_m_per_s": disp * scene.frequency,
         "regimes": [[float(t), r] for t, r in ss.regimes],
-        "min_normal_force_N": scene.force_to_si(ss.min_normal_force),
+        # None, not NaN, where no period-1 orbit exists: JSON has no NaN
+        "min_normal_force_N": (scene.force_to_si(ss.min_normal_force)
+                               if math.isfinite(ss.min_normal_force) else None),
+        "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
         "periodic_residual": ss.periodic_residual,
         "shooting_iterations": ss.iterations,
         "wall_time_s": wall,
@@ -81,7 +85,7 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
     if scheme == "moreau-jean":
         out["steps_per_period"] = steps_per_period
         out["theta"] = theta
-        for key in ("steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
+        for key in ("message", "steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
                     "period_map_eigenvalues"):
             if key in ss.stats:
                 val = ss.stats[key]
@@ -103,7 +107,10 @@ def _cmd_steady(args):
     print(f"  operation mode            {rep['mode']}")
     print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
     print(f"  average rotor velocity    {rep['average_velocity_m_per_s']:.9e} m/s")
-    print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
+    if not rep["periodic"]:
+        print(f"  note                      {rep['message']}")
+    if rep["min_normal_force_N"] is not None:
+        print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     print(f"  periodic residual         {rep['periodic_residual']:.2e}")
     print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
     print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")

@@ -113,6 +113,33 @@ def test_steady_moreau_jean_json(capsys):
     assert rep["steps"] > 0 and rep["fallbacks"] == 0
 
 
+def test_steady_moreau_jean_without_period_one_orbit_says_so(capsys):
+    # above the contact-loss limit with restitution the Moreau-Jean map has no
+    # period-1 orbit: the report says so, gives the long-run average, and its
+    # JSON holds no NaN (the min normal force is unknown, so null)
+    rc = main(["steady", "--frequency", "15000", "--restitution", "0.5", "--scheme",
+               "moreau-jean", "--steps-per-period", "2000", "--json"])
+    out = capsys.readouterr().out
+    assert rc == 0 and "NaN" not in out
+    rep = json.loads(out)
+    assert rep["periodic"] is False and rep["mode"] == "no period-1 orbit"
+    assert rep["min_normal_force_N"] is None
+    assert "long-run average" in rep["message"]
+    assert math.isfinite(rep["displacement_per_period_m"]) and rep["displacement_per_period_m"] > 0
+
+
+def test_steady_moreau_jean_finds_flight_orbit(capsys):
+    # issue 11, defect 1: at 15 kHz the event-driven reference finds NF!P; so must Moreau-Jean
+    # (1.2 % off at N = 8000: first order, the impact is located to a step)
+    rc, rep = run_json(capsys, "--frequency", "15000", "--scheme", "moreau-jean",
+                       "--steps-per-period", "8000")
+    assert rc == 0 and rep["periodic"] is True and rep["mode"] == "NF!P"
+    rc, ref = run_json(capsys, "--frequency", "15000")
+    assert ref["mode"] == "NF!P"
+    assert rep["displacement_per_period_m"] == pytest.approx(ref["displacement_per_period_m"],
+                                                             rel=2e-2)
+
+
 def test_run_command_writes_history(tmp_path, capsys):
     rc = main(["run", "--frequency", "185", "--periods", "2", "--out", str(tmp_path), "--quiet",
                "--no-plot"])
