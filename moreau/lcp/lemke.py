@@ -40,10 +40,17 @@ that cancels to rounding level is set to exactly zero so that degenerate
 rows are recognised as such.
 
 A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
-the data and the scaled residual of :func:`moreau.lcp.lcp_residual` must be
-``<= tol``. If it is not, the basis found is re-solved directly
-(``M_JJ z_J = -q_J`` by Gaussian elimination with partial pivoting) and
-checked again; if that fails too the status is :data:`BREAKDOWN`.
+the data (one matrix-vector product) and the violation of
+:func:`moreau.lcp.lcp_violation`, whose tolerances are fixed by ``max|q|``
+and ``max|M|`` and not by the size of ``z``, must be ``<= tol``. If it is
+not, the basis found is re-solved directly (``M_JJ z_J = -q_J`` by Gaussian
+elimination with partial pivoting) and checked again; if that fails too the
+status is :data:`BREAKDOWN`.
+
+A secondary ray is turned into a proof of infeasibility when it is one
+(:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
+:data:`INFEASIBLE`, with the Farkas vector in ``certificate``. Otherwise it
+stays :data:`SECONDARY_RAY`, which proves nothing.
 
 Calling from compiled code
 --------------------------
@@ -60,8 +67,10 @@ from numba import njit
 
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
+from .certify import infeasibility_from_ray
 from ._result import (
     BREAKDOWN,
+    INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
     SECONDARY_RAY,
@@ -94,8 +103,12 @@ PIVOT_TOL = 1e-9
 NOISE_TOL = 1e3 * np.finfo(float).eps
 #: two ratios (or two lexicographic entries) tie within this relative difference
 TIE_TOL = 1e-9
-#: default bound on the scaled residual for a result to count as solved
+#: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+#: result to count as solved
 DEFAULT_TOL = 1e-9
+#: work budget of the default pivot limit: pivots times n (n + 1) tableau
+#: updates, about a second of pivoting
+WORK_BUDGET = 2**30
 
 # cancellation below this many ulps of the operands is rounding, not data
 _SNAP = 16.0 * np.finfo(float).eps
@@ -104,17 +117,36 @@ _SNAP = 16.0 * np.finfo(float).eps
 def default_max_iter(n):
     """Default pivot limit for an LCP of size ``n``.
 
-    Lemke's method needs ``O(n)`` pivots on practical problems; the limit is
-    generous (``max(1000, 50 n)``) but keeps a pathological case from hanging
-    a time-stepping loop. Pass ``max_iter`` explicitly for exponential
-    examples such as Murty's.
+    ``max(1000, 50 n, min(2^(n+1), 2^30 // (n (n + 1))))``.
+
+    Lemke's method needs ``O(n)`` pivots on practical problems, but
+    ``2^n`` on Murty's exponential examples; ``2^(n+1)`` lets those finish
+    (n = 12: 8192, n = 16: 131072, n = 20: 2097152). The second term caps
+    the work, pivots times the ``n (n + 1)`` tableau entries each one
+    updates, at :data:`WORK_BUDGET` = 2^30 (about a second), so that a
+    pathological problem cannot hang a time-stepping loop: the bound is
+    ``2^(n+1)`` up to n = 20, then falls to ``50 n`` (from n = 278 on).
+
+    Parameters
+    ----------
+    n : int
+
+    Returns
+    -------
+    int
 
     Examples
     --------
-    >>> default_max_iter(4)
-    1000
+    >>> default_max_iter(4), default_max_iter(12), default_max_iter(16), default_max_iter(100)
+    (1000, 8192, 131072, 106311)
     """
-    return max(1000, 50 * int(n))
+    n = int(n)
+    exp = 2 ** (n + 1) if n < 62 else 2**62
+    return max(1000, 50 * n, min(exp, WORK_BUDGET // max(n * (n + 1), 1)))
+
+
+# the default limits of small sizes, looked up on the per-time-step path
+_MAX_ITER_TABLE = tuple(default_max_iter(n) for n in range(512))
 
 
 @njit(cache=True)
@@ -206,12 +238,11 @@ def _extract_z(b, pos, n, z_out):
 
 @njit(cache=True)
 def _residual(M, q, z, w, mmax, qmax):
-    # w = M z + q from the data, and the scaled residual of lcp_residual
+    # w = M z + q from the data, and the violation of lcp_violation:
+    # max |min(mmax z_i, w_i)| / qmax, scaled by the data only
     n = q.shape[0]
-    zmax = 0.0
-    for j in range(n):
-        if abs(z[j]) > zmax:
-            zmax = abs(z[j])
+    ms = mmax if mmax > 0.0 else 1.0
+    qs = qmax if qmax > 0.0 else 1.0
     num = 0.0
     for i in range(n):
         acc = q[i]
@@ -220,12 +251,12 @@ def _residual(M, q, z, w, mmax, qmax):
             if zj != 0.0:
                 acc += M[i, j] * zj
         w[i] = acc
-        m = min(z[i], acc)
+        m = min(ms * z[i], acc)
         if abs(m) > num:
             num = abs(m)
     if not np.isfinite(num):
         return np.inf
-    return num / (1.0 + qmax + mmax * zmax)
+    return num / qs
 
 
 @njit(cache=True)
@@ -329,20 +360,22 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     max_iter : int
         Pivot limit, counting the first pivot on ``z0``.
     tol : float
-        Bound on the scaled residual (:func:`moreau.lcp.lcp_residual`) for
-        the result to count as solved.
+        Bound on the violation (:func:`moreau.lcp.lcp_violation`) for the
+        result to count as solved.
 
     Returns
     -------
     status : int
-        :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1), :data:`MAX_ITER` (2),
+        :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1; the kernel does not
+        tell a proof of infeasibility from a failure, see
+        :func:`moreau.lcp.certify.infeasibility_from_ray`), :data:`MAX_ITER` (2),
         :data:`BREAKDOWN` (3) or :data:`INVALID_INPUT` (4: NaN or inf in
         ``M`` or ``q``, a covering entry that is not finite and > 0, or a
         workspace that is too small; ``z_out`` and ``w_out`` are then zero).
     pivots : int
         Pivots performed (0 when ``q >= 0``).
     residual : float
-        Scaled residual of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
+        Violation of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
 
     Notes
     -----
@@ -553,7 +586,7 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     max_iter : int
         Pivot limit.
     tol : float
-        Bound on the scaled residual for a solved status.
+        Bound on the violation for a solved status.
 
     Returns
     -------
@@ -608,14 +641,14 @@ class _LemkeResult(LCPResult):
 
     @property
     def ray(self):
-        if self.status != SECONDARY_RAY:
+        buf = self.__dict__.get("_buf")
+        if buf is None:
             return None
-        return self.__dict__["_buf"][2 * len(self.z):]
+        return buf[2 * len(self.z):]
 
 
 _DETAIL = {
-    SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray. "
-    "For copositive-plus M this proves the LCP infeasible.",
+    SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray.",
     MAX_ITER: "Raise `max_iter` or try method='qp'.",
     BREAKDOWN: "The lexicographic ratio test could not separate tied rows, or the terminal "
     "point failed the residual check.",
@@ -677,10 +710,12 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     M : array_like, shape (n, n)
     q : array_like, shape (n,)
     max_iter : int, optional
-        Pivot limit; :func:`default_max_iter` when not given.
+        Pivot limit; :func:`default_max_iter` when not given (``max(1000,
+        50 n, min(2^(n+1), 2^30 // (n (n + 1))))``: enough for Murty's
+        exponential examples up to n = 20).
     tol : float, optional
-        Bound on the scaled residual for a solved status
-        (default :data:`DEFAULT_TOL`).
+        Bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+        solved status (default :data:`DEFAULT_TOL`).
     covering : array_like, shape (n,), optional
         Covering vector ``d > 0``; all ones when not given.
     check_input : bool
@@ -694,6 +729,11 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     Returns
     -------
     LCPResult
+        On a secondary ray, status :data:`INFEASIBLE` with the Farkas vector
+        in ``certificate`` when the ray proves infeasibility (``M``
+        copositive-plus, or the ray itself a Farkas vector, see
+        :func:`moreau.lcp.certify.infeasibility_from_ray`), else
+        :data:`SECONDARY_RAY`; ``ray`` holds the ray in both cases.
 
     Raises
     ------
@@ -735,21 +775,26 @@ def _solve(M, q, max_iter, tol, check_input, covering):
                 raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
     n = q.shape[0]
     out = np.empty(3 * n + 1)
+    if max_iter is None:
+        max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
     if covering is None:
         status, pivots, residual = _solve_packed_ones(
-            M, q, out,
-            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
-            DEFAULT_TOL if tol is None else tol,
+            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
     else:
         status, pivots, residual = _solve_packed(
-            M, q, covering, out,
-            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
-            DEFAULT_TOL if tol is None else tol,
+            M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
+    if status == SOLVED:
+        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == SECONDARY_RAY:
         res.__dict__["_buf"] = out
+        y, why = infeasibility_from_ray(M, q, out[2 * n:])
+        if y is not None:
+            res.status = INFEASIBLE
+            res.certificate = y
+        res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res

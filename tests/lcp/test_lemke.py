@@ -7,6 +7,7 @@ from numba import njit
 from moreau.errors import InputError, MoreauError
 from moreau.lcp import (
     BREAKDOWN,
+    INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
     SECONDARY_RAY,
@@ -19,7 +20,7 @@ from moreau.lcp import (
 )
 from moreau.lcp.instances import murty, random_p_matrix
 
-from .conftest import assert_complementary
+from .conftest import assert_complementary, assert_farkas
 
 
 def test_murty_takes_exactly_two_to_the_n_pivots():
@@ -68,8 +69,10 @@ def test_no_solution_ends_on_a_secondary_ray_with_a_certificate():
     M = np.array([[-1.0]])
     q = np.array([-1.0])
     res = solve_lcp(M, q)
-    assert res.status == SECONDARY_RAY and not res.success
-    assert "ray" in res.message
+    # M = -1 is not copositive, but the ray is a Farkas vector by itself
+    assert res.status == INFEASIBLE and not res.success
+    assert "ray" in res.message and "Farkas" in res.message
+    assert res.certificate.tolist() == [1.0]
     assert np.isfinite(res.residual) and res.residual > 0.1
     dz, dz0 = res.ray[:1], res.ray[1]
     # along (dz, dz0) the augmented w = M z + q + d z0 keeps its value
@@ -82,7 +85,9 @@ def test_secondary_ray_direction_is_feasible_for_the_augmented_problem():
     M = np.array([[-1.0, 0, -3], [1, -2, -5], [-2, -1, -2]])
     q = np.array([-3.0, -2, -1])
     res = solve_lcp(M, q)
-    assert res.status == SECONDARY_RAY
+    # row 1 reads w1 = -z1 - 3 z3 - 3 < 0: infeasible, and the ray says so
+    assert res.status == INFEASIBLE
+    assert_farkas(M, q, res.certificate)
     dz, dz0 = res.ray[:3], res.ray[3]
     assert np.all(dz >= -1e-12) and dz0 >= -1e-12
     dw = M @ dz + dz0 * np.ones(3)
@@ -95,6 +100,9 @@ def test_covering_vector_changes_the_path():
     M = np.array([[-1.5, 2], [-4, 4]])
     q = np.array([-5.0, 17])
     assert solve_lcp(M, q, covering=np.array([5.0, 16.0])).status == SECONDARY_RAY
+    ray = solve_lcp(M, q, covering=np.array([5.0, 16.0]))
+    # M is not copositive-plus and the ray is no Farkas vector: no claim of infeasibility
+    assert ray.certificate is None and "proves nothing" in ray.message
     res = solve_lcp(M, q)
     assert res.success
     assert_complementary(M, q, res.z, 1e-12)
