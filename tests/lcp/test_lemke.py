@@ -19,6 +19,7 @@ from moreau.lcp import (
     solve_lcp,
 )
 from moreau.lcp.instances import murty, random_p_matrix
+from moreau.lcp.lemke import default_max_iter
 
 from .conftest import assert_complementary, assert_farkas
 
@@ -32,11 +33,31 @@ def test_murty_takes_exactly_two_to_the_n_pivots():
         np.testing.assert_array_equal(res.z, inst.z)
 
 
-def test_murty_16_runs_its_65536_pivots_and_stays_exact():
-    inst = murty(16)
-    res = solve_lcp(inst.M, inst.q, max_iter=2**16)
-    assert res.success and res.pivots == 2**16
+@pytest.mark.parametrize("n", [12, 16])
+def test_murty_12_and_16_finish_within_the_default_pivot_limit(n):
+    # 4096 and 65536 pivots: QuantEcon's and Siconos's Lemke solve these
+    # with their defaults, so must ours
+    inst = murty(n)
+    res = solve_lcp(inst.M, inst.q)
+    assert res.success and res.pivots == 2**n
     np.testing.assert_array_equal(res.z, inst.z)
+    assert default_max_iter(n) == 2 ** (n + 1)
+
+
+def test_default_pivot_limit_is_bounded_by_the_work_budget():
+    assert default_max_iter(1) == 1000
+    assert default_max_iter(20) == 2**21
+    for n in (21, 50, 100, 200, 277):
+        # pivots times the n (n + 1) entries each updates stays within 2^30
+        assert default_max_iter(n) * n * (n + 1) <= 2**30
+    assert default_max_iter(278) == 50 * 278
+    assert default_max_iter(1000) == 50000
+
+
+def test_the_default_pivot_limit_stops_an_exponential_run():
+    inst = murty(11)
+    res = solve_lcp(inst.M, inst.q, max_iter=default_max_iter(9))
+    assert res.status == MAX_ITER and res.pivots == 1024
 
 
 def test_pivot_limit_gives_max_iter_with_a_finite_point():
