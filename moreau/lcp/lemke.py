@@ -62,6 +62,8 @@ called from other ``@njit`` code, e.g. a time-stepping loop::
 See their docstrings for the exact argument types.
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
@@ -318,8 +320,13 @@ def _resolve_basis(M, q, pos, n, z_out):
 @njit(cache=True)
 def _noise_scale(T, pos, M, d, n, i, entering):
     # sum_j |B^-1_ij| |A_ej|: the size of the terms that make up entry i of
-    # the entering column B^-1 A_e, hence the scale of its rounding error
+    # the entering column B^-1 A_e, hence the scale of its rounding error.
+    # When a slack w_k enters, A_e = e_k and that sum is the entry itself,
+    # B^-1_ik, which measures nothing: an exact zero that pivoting left at
+    # 1e-17 would pass as genuine. The entry was then formed by eliminations
+    # on row i of B^-1, so its rounding is relative to that row's size.
     acc = 0.0
+    rowmax = 0.0
     for j in range(n):
         p = pos[j]
         if p >= 0:
@@ -328,6 +335,8 @@ def _noise_scale(T, pos, M, d, n, i, entering):
             bij = 1.0
         else:
             bij = abs(T[i, -p - 1])
+        if bij > rowmax:
+            rowmax = bij
         if entering < n:
             aej = 1.0 if j == entering else 0.0
         elif entering < 2 * n:
@@ -335,6 +344,14 @@ def _noise_scale(T, pos, M, d, n, i, entering):
         else:
             aej = d[j]
         acc += bij * aej
+    if entering < n:
+        acc = rowmax
+    # the entry itself was made by eliminations on the whole tableau row:
+    # its rounding is relative to the largest entry of that row too
+    for k in range(n + 1):
+        t = abs(T[i, k])
+        if t > acc:
+            acc = t
     return acc
 
 
@@ -574,8 +591,11 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
 def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     """Lemke's method with covering vector ``d = 1`` (compiled; callable from ``@njit`` code).
 
-    Allocates its own workspace; use :func:`lemke_core` in tight loops that
-    reuse one.
+    Allocates its own workspace, and brings data whose largest entry lies
+    outside ``[2^-64, 2^64]`` (e.g. subnormal numbers, on which the
+    tableau's arithmetic keeps only a few bits) to unit scale by exact
+    powers of two first; use :func:`lemke_core`, which does neither, in
+    tight loops that reuse one workspace on data of sane scale.
 
     Parameters
     ----------
@@ -600,7 +620,71 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     ray = np.empty(n + 1)
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return lemke_core(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+
+
+# data whose largest entry lies outside [2^-64, 2^64] are brought to unit
+# scale before pivoting (see _lemke_scaled)
+_SCALE_LO = 2.0**-64
+_SCALE_HI = 2.0**64
+
+
+@njit(cache=True)
+def _exponent_to_unit(x):
+    # k with 2^k x in [0.5, 1) when x is finite, > 0 and outside the safe
+    # range; 0 otherwise (no scaling)
+    if not (x > 0.0 and x < np.inf) or (x >= _SCALE_LO and x <= _SCALE_HI):
+        return 0
+    return -math.frexp(x)[1]
+
+
+@njit(cache=True)
+def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
+    # lemke_core on (2^a M, 2^b q) when the data are extreme, e.g. subnormal
+    # entries, on which the tableau's arithmetic keeps only a few bits. The
+    # scaled LCP has the solutions 2^(b-a) z and the same pivoting path (the
+    # artificial level scales by 2^b); powers of two make both maps exact.
+    # The violation is invariant under the scaling, so the residual stands.
+    n = q.shape[0]
+    mmax = 0.0
+    for i in range(n):
+        for j in range(n):
+            a = abs(M[i, j])
+            if a > mmax:
+                mmax = a
+    qmax = 0.0
+    for i in range(n):
+        a = abs(q[i])
+        if a > qmax:
+            qmax = a
+    ka = _exponent_to_unit(mmax)
+    kb = _exponent_to_unit(qmax)
+    if ka == 0 and kb == 0:
+        return lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    Ms = np.empty((n, n))
+    qs = np.empty(n)
+    for i in range(n):
+        qs[i] = math.ldexp(q[i], kb)
+        for j in range(n):
+            Ms[i, j] = math.ldexp(M[i, j], ka)
+    status, pivots, residual = lemke_core(Ms, qs, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    for j in range(n):
+        z_out[j] = math.ldexp(z_out[j], ka - kb)
+        w_out[j] = math.ldexp(w_out[j], -kb)
+    # the ray is a direction: (dz, dz0) = (2^(a-b) dz', 2^-b dz0') times the
+    # positive 2^(b-a), which keeps dz at the size it has in the tableau
+    ray_out[n] = math.ldexp(ray_out[n], -ka)
+    ok = True
+    for j in range(n):
+        if not (abs(z_out[j]) < np.inf and abs(w_out[j]) < np.inf):
+            ok = False
+    if not ok:
+        # the answer is outside the range of doubles at the data's scale
+        for j in range(n):
+            z_out[j] = 0.0
+            w_out[j] = q[j]
+        return BREAKDOWN, pivots, _residual(M, q, z_out, w_out, mmax, qmax)
+    return status, pivots, residual
 
 
 @njit(cache=True)
@@ -611,7 +695,7 @@ def _solve_packed(M, q, d, out, max_iter, tol):
     n = q.shape[0]
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return lemke_core(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
 
 
 @njit(cache=True)
