@@ -319,3 +319,35 @@ def test_badly_scaled_triangular_p_matrix_is_not_cut_off_by_the_pivot_tolerance(
     res = solve_lcp(M, -np.ones(n))
     assert res.success
     np.testing.assert_allclose(res.z, 17.0 ** np.arange(n), rtol=1e-12)
+
+
+def test_an_exact_zero_left_by_rounding_is_not_taken_as_a_pivot():
+    # copositive-plus (symmetric part PSD) and infeasible: y = (1, 1, 0).
+    # After four pivots w_2 enters with the entry 5.55e-17 where exact
+    # arithmetic has 0; pivoting on it ran z to 4.5e15 and broke down.
+    M = np.array([[0.25, -0.25, -2.0], [-0.25, 0.25, 0.0], [2.0, 0.0, 1.0]])
+    q = np.array([-0.5, -0.5, -1.0])
+    res = solve_lcp(M, q)
+    assert res.status == INFEASIBLE and res.pivots == 4
+    assert_farkas(M, q, res.certificate)
+
+
+def test_subnormal_data_are_pivoted_at_unit_scale():
+    # entries 2^-1070: without rescaling the tableau keeps a few bits
+    M = np.ldexp(np.array([[2.0, 1.0], [1.0, 2.0]]), -1070)
+    q = np.ldexp(np.array([-1.0, 1.0]), -1000)
+    res = solve_lcp(M, q)
+    assert res.success
+    np.testing.assert_array_equal(res.z, [2.0**69, 0.0])
+    M = 5e-324 * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    res = solve_lcp(M, np.array([-0.01, -0.01]))
+    assert res.status == INFEASIBLE
+    np.testing.assert_array_equal(res.certificate, [1.0, 1.0])
+    assert np.all(np.isfinite(res.ray))
+
+
+def test_an_answer_beyond_the_range_of_doubles_is_a_breakdown_not_a_nan():
+    M = 1e-310 * np.array([[2.0, 1.0], [1.0, 2.0]])
+    res = solve_lcp(M, np.array([-1.0, 1.0]))  # z1 = 5e309
+    assert res.status == BREAKDOWN
+    assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w)) and np.isfinite(res.residual)
