@@ -69,7 +69,7 @@ from numba import njit
 
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
-from .certify import infeasibility_from_ray
+from .certify import FARKAS_TOL, infeasibility_from_ray
 from ._result import (
     BREAKDOWN,
     INFEASIBLE,
@@ -688,6 +688,45 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
 
 
 @njit(cache=True)
+def _ray_is_farkas(M, q, y, tol):
+    # moreau.lcp.certify.farkas_vector(M, q, y, tol) is not None, compiled:
+    # y >= 0 (to -tol after scaling to max 1), q.y < 0 and
+    # max(M^T y) <= tol max|M| |q.y| / max|q|
+    n = q.shape[0]
+    top = 0.0
+    for i in range(n):
+        if not abs(y[i]) < np.inf:
+            return False
+        if y[i] > top:
+            top = y[i]
+    if not top > 0.0:
+        return False
+    qy = 0.0
+    qmax = 0.0
+    for i in range(n):
+        yi = y[i] / top
+        if yi < -tol:
+            return False
+        if yi > 0.0:
+            qy += q[i] * yi
+        qmax = max(qmax, abs(q[i]))
+    if not qy < 0.0:
+        return False
+    mmax = 0.0
+    g = -np.inf
+    for j in range(n):
+        acc = 0.0
+        for i in range(n):
+            a = M[i, j]
+            mmax = max(mmax, abs(a))
+            yi = y[i] / top
+            if yi > 0.0:
+                acc += a * yi
+        g = max(g, acc)
+    return g <= tol * mmax * (-qy) / qmax
+
+
+@njit(cache=True)
 def _solve_packed(M, q, d, out, max_iter, tol):
     # one compiled call per Python solve. The outputs live in one buffer
     # (z | w | ray) allocated by the caller: returning arrays from compiled
@@ -717,6 +756,14 @@ class _LemkeResult(LCPResult):
             return d
         if self.status == SOLVED:
             return ""
+        if self.status == INFEASIBLE:
+            # proven in compiled code; the words (and the matrix class they
+            # name, an eigenvalue computation) only when someone reads them
+            M, q = self.__dict__["_data"]
+            why = infeasibility_from_ray(M, q, self.ray)[1]
+            d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
+            self.__dict__["_detail"] = d
+            return d
         return _DETAIL.get(self.status, "") + f" (after {self.pivots} pivots)"
 
     @detail.setter
@@ -729,6 +776,20 @@ class _LemkeResult(LCPResult):
         if buf is None:
             return None
         return buf[2 * len(self.z):]
+
+    @property
+    def certificate(self):
+        if self.status != INFEASIBLE:
+            return None
+        y = self.__dict__.get("_cert")
+        if y is None:
+            y = np.maximum(self.ray[:len(self.z)], 0.0)
+            y = self.__dict__["_cert"] = y / np.max(y)
+        return y
+
+    @certificate.setter
+    def certificate(self, value):
+        self.__dict__["_cert"] = value
 
 
 _DETAIL = {
@@ -876,9 +937,17 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == SECONDARY_RAY:
         res.__dict__["_buf"] = out
-        y, why = infeasibility_from_ray(M, q, out[2 * n:])
-        if y is not None:
+        if _ray_is_farkas(M, q, out[2 * n:3 * n], FARKAS_TOL):
+            # the ray's dz is a Farkas vector by itself, checked in compiled
+            # code so that proving infeasibility costs about what the
+            # pivoting did
             res.status = INFEASIBLE
-            res.certificate = y
-        res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
+            res.__dict__["_data"] = (M, q)
+        else:
+            # no direct proof: try Lemke's theorem (is M copositive-plus?)
+            y, why = infeasibility_from_ray(M, q, out[2 * n:])
+            if y is not None:
+                res.status = INFEASIBLE
+                res.certificate = y
+            res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res
