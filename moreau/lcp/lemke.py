@@ -611,6 +611,10 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     Returns
     -------
     status : int
+        As for :func:`lemke_core`, except that a secondary ray whose ``dz``
+        is a Farkas vector (``dz >= 0``, ``M^T dz <= 0``, ``q.dz < 0``, to
+        :data:`moreau.lcp.certify.FARKAS_TOL`) comes back as
+        :data:`INFEASIBLE` (7): a proof that the LCP has no solution.
     pivots : int
     residual : float
         As for :func:`lemke_core`.
@@ -660,7 +664,10 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     ka = _exponent_to_unit(mmax)
     kb = _exponent_to_unit(qmax)
     if ka == 0 and kb == 0:
-        return lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+        status, pivots, residual = lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+        if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+            status = INFEASIBLE
+        return status, pivots, residual
     Ms = np.empty((n, n))
     qs = np.empty(n)
     for i in range(n):
@@ -684,6 +691,8 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
             z_out[j] = 0.0
             w_out[j] = q[j]
         return BREAKDOWN, pivots, _residual(M, q, z_out, w_out, mmax, qmax)
+    if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+        status = INFEASIBLE
     return status, pivots, residual
 
 
@@ -759,7 +768,7 @@ class _LemkeResult(LCPResult):
         if self.status == INFEASIBLE:
             # proven in compiled code; the words (and the matrix class they
             # name, an eigenvalue computation) only when someone reads them
-            M, q = self.__dict__["_data"]
+            _, M, q = self.__dict__["_ray"]
             why = infeasibility_from_ray(M, q, self.ray)[1]
             d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
             self.__dict__["_detail"] = d
@@ -772,10 +781,12 @@ class _LemkeResult(LCPResult):
 
     @property
     def ray(self):
-        buf = self.__dict__.get("_buf")
-        if buf is None:
+        # _ray = (output buffer, M, q), set on the ray statuses in one go:
+        # the first write to an instance's __dict__ is what costs
+        packed = self.__dict__.get("_ray")
+        if packed is None:
             return None
-        return buf[2 * len(self.z):]
+        return packed[0][2 * len(self.z):]
 
     @property
     def certificate(self):
@@ -935,19 +946,16 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
-    if status == SECONDARY_RAY:
-        res.__dict__["_buf"] = out
-        if _ray_is_farkas(M, q, out[2 * n:3 * n], FARKAS_TOL):
-            # the ray's dz is a Farkas vector by itself, checked in compiled
-            # code so that proving infeasibility costs about what the
-            # pivoting did
+    if status == INFEASIBLE:
+        # the ray's dz is a Farkas vector by itself, checked in compiled code
+        # so that proving infeasibility costs about what the pivoting did
+        res.__dict__["_ray"] = (out, M, q)
+    elif status == SECONDARY_RAY:
+        res.__dict__["_ray"] = (out, M, q)
+        # no direct proof: try Lemke's theorem (is M copositive-plus?)
+        y, why = infeasibility_from_ray(M, q, out[2 * n:])
+        if y is not None:
             res.status = INFEASIBLE
-            res.__dict__["_data"] = (M, q)
-        else:
-            # no direct proof: try Lemke's theorem (is M copositive-plus?)
-            y, why = infeasibility_from_ray(M, q, out[2 * n:])
-            if y is not None:
-                res.status = INFEASIBLE
-                res.certificate = y
-            res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
+            res.certificate = y
+        res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res
