@@ -114,6 +114,11 @@ WORK_BUDGET = 2**30
 
 # cancellation below this many ulps of the operands is rounding, not data
 _SNAP = 16.0 * np.finfo(float).eps
+# data whose largest entry lies outside [2^-64, 2^64] are brought to unit
+# scale before pivoting (see _lemke_scaled); _core asks for it with this code
+_SCALE_LO = 2.0**-64
+_SCALE_HI = 2.0**64
+_RESCALE = -1
 
 
 def default_max_iter(n):
@@ -399,6 +404,14 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
+    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
+
+
+@njit(cache=True)
+def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, rescale):
+    # lemke_core; with `rescale`, data whose largest entry lies outside
+    # [2^-64, 2^64] return _RESCALE before any pivoting, found by the scan
+    # for non-finite entries that runs anyway
     n = q.shape[0]
     for k in range(n + 1):
         ray_out[k] = 0.0
@@ -429,6 +442,9 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
             z_out[k] = 0.0
             w_out[k] = q[k]
         return SOLVED, 0, 0.0
+    if rescale and (_exponent_to_unit(mmax) != 0 or _exponent_to_unit(qmax) != 0):
+        # extreme data: the caller brings them to unit scale and calls again
+        return _RESCALE, 0, 0.0
 
     T = work
     b = work[n + 1]
@@ -627,10 +643,6 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
 
 
-# data whose largest entry lies outside [2^-64, 2^64] are brought to unit
-# scale before pivoting (see _lemke_scaled)
-_SCALE_LO = 2.0**-64
-_SCALE_HI = 2.0**64
 
 
 @njit(cache=True)
@@ -649,32 +661,28 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     # scaled LCP has the solutions 2^(b-a) z and the same pivoting path (the
     # artificial level scales by 2^b); powers of two make both maps exact.
     # The violation is invariant under the scaling, so the residual stands.
+    status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, True)
+    if status != _RESCALE:
+        if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+            status = INFEASIBLE
+        return status, pivots, residual
     n = q.shape[0]
     mmax = 0.0
     for i in range(n):
         for j in range(n):
-            a = abs(M[i, j])
-            if a > mmax:
-                mmax = a
+            mmax = max(mmax, abs(M[i, j]))
     qmax = 0.0
     for i in range(n):
-        a = abs(q[i])
-        if a > qmax:
-            qmax = a
+        qmax = max(qmax, abs(q[i]))
     ka = _exponent_to_unit(mmax)
     kb = _exponent_to_unit(qmax)
-    if ka == 0 and kb == 0:
-        status, pivots, residual = lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
-        if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
-            status = INFEASIBLE
-        return status, pivots, residual
     Ms = np.empty((n, n))
     qs = np.empty(n)
     for i in range(n):
         qs[i] = math.ldexp(q[i], kb)
         for j in range(n):
             Ms[i, j] = math.ldexp(M[i, j], ka)
-    status, pivots, residual = lemke_core(Ms, qs, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    status, pivots, residual = _core(Ms, qs, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
     for j in range(n):
         z_out[j] = math.ldexp(z_out[j], ka - kb)
         w_out[j] = math.ldexp(w_out[j], -kb)
