@@ -13,8 +13,18 @@ check_input, friction, ...)``; :data:`METHODS` maps names to them.
     (:mod:`moreau.lcp.qp`); exact for symmetric PSD and monotone ``M``, a
     Tresca fixed point for the friction LCP.
 ``"auto"``
-    Lemke first; on any failure the QP method, with the path recorded in
-    ``result.path``.
+    Lemke first. When Lemke proves the LCP infeasible (a secondary ray with
+    ``M`` copositive-plus, or a ray that is itself a Farkas vector) that is
+    the answer: status :data:`INFEASIBLE`, no QP. On any other failure the
+    QP method, with the path recorded in ``result.path``.
+
+Success means the same for every method: ``z`` passed
+:func:`lcp_violation` ``<= tol`` (``z >= -tol_z``, ``w = M z + q >=
+-tol_w`` and ``|min(z_i / tol_z, w_i / tol_w)| <= 1`` with ``tol_w = tol
+max|q|``, ``tol_z = tol_w / max|M|``), checked against the data after the
+backend has finished, whatever the backend reported. Infeasibility is a
+status too, :data:`INFEASIBLE`, and carries its proof, a Farkas vector, in
+``result.certificate``.
 
 The 2D Coulomb friction LCP is built by :func:`build_friction_lcp` and read
 back by :func:`friction_impulses` (:mod:`moreau.lcp.friction`).
@@ -32,6 +42,7 @@ Examples
 from . import lemke, qp
 from ._result import (
     BREAKDOWN,
+    INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
     NOT_APPLICABLE,
@@ -41,6 +52,7 @@ from ._result import (
     STATUS_MESSAGES,
     LCPResult,
     lcp_residual,
+    lcp_violation,
 )
 from ..errors import InputError
 from .friction import (
@@ -57,6 +69,7 @@ __all__ = [
     "METHODS",
     "LCPResult",
     "lcp_residual",
+    "lcp_violation",
     "STATUS_MESSAGES",
     "SOLVED",
     "SECONDARY_RAY",
@@ -65,6 +78,7 @@ __all__ = [
     "INVALID_INPUT",
     "SOLVER_FAILED",
     "NOT_APPLICABLE",
+    "INFEASIBLE",
     "lemke_kernel",
     "lemke_core",
     "lemke_workspace",
@@ -78,14 +92,15 @@ __all__ = [
 
 def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
     # Lemke's answer is exact when it exists; the QP path is slower and
-    # less accurate, so it only runs when pivoting did not deliver.
+    # less accurate, so it only runs when pivoting did not deliver. A proof
+    # of infeasibility is an answer too: no QP can overturn it.
     first = lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
-    if first.status == SOLVED:
+    if first.status == SOLVED or first.status == INFEASIBLE:
         return first
     second = qp.solve(M, q, tol=tol, check_input=check_input, friction=friction)
     second.path = ("lemke", "qp")
     second.detail = f"{second.detail} Lemke first: {first.message}"
-    if second.status != SOLVED and first.residual < second.residual:
+    if second.status not in (SOLVED, INFEASIBLE) and first.residual < second.residual:
         # neither solved: keep the point closer to a solution, say so
         first.path = ("lemke", "qp")
         first.detail = f"{first.detail} The QP fallback failed too: {second.message}"
@@ -115,8 +130,8 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     max_iter : int, optional
         Pivot limit (Lemke) or fixed-point iteration limit (QP, friction).
     tol : float, optional
-        Bound on the scaled residual (:func:`lcp_residual`) for a solved
-        status; each method has its own default.
+        Bound on the violation (:func:`lcp_violation`) for a solved status;
+        each method has its own default (Lemke 1e-9, QP 1e-6).
     check_input : bool
         Validate the data in Python. With False, ``M`` and ``q`` must be
         float64 arrays of matching shapes; Lemke still rejects NaN and inf
@@ -131,7 +146,8 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     -------
     LCPResult
         ``z``, ``w``, ``status``, ``success``, ``message``, ``pivots``,
-        ``residual``, ``method``, ``path``, ``fallback_used`` and ``ray``.
+        ``residual``, ``method``, ``path``, ``fallback_used``, ``ray`` and
+        ``certificate``.
 
     Raises
     ------
@@ -143,8 +159,8 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     --------
     >>> import numpy as np
     >>> res = solve_lcp(np.array([[-1.0]]), np.array([-1.0]))
-    >>> res.status == SECONDARY_RAY, res.success
-    (True, False)
+    >>> res.status == INFEASIBLE, res.success, res.certificate.tolist()
+    (True, False, [1.0])
     >>> solve_lcp(np.eye(1), np.ones(1), method="simplex")
     Traceback (most recent call last):
     ...

@@ -18,7 +18,9 @@ __all__ = [
     "INVALID_INPUT",
     "SOLVER_FAILED",
     "NOT_APPLICABLE",
+    "INFEASIBLE",
     "lcp_residual",
+    "lcp_violation",
 ]
 
 #: a solution was found and passed the residual check
@@ -38,6 +40,9 @@ SOLVER_FAILED = 5
 #: the method has no formulation for this matrix (e.g. ``"qp"`` on a
 #: non-monotone LCP without a friction layout)
 NOT_APPLICABLE = 6
+#: the LCP has no solution and the result carries the proof: a Farkas vector
+#: ``y >= 0`` with ``M^T y <= 0`` and ``q.y < 0`` in ``certificate``
+INFEASIBLE = 7
 
 STATUS_MESSAGES = {
     SOLVED: "Solution found.",
@@ -47,11 +52,12 @@ STATUS_MESSAGES = {
     INVALID_INPUT: "Invalid input: non-finite data or a non-positive covering vector.",
     SOLVER_FAILED: "The QP backend returned no usable solution.",
     NOT_APPLICABLE: "The method has no formulation for this problem.",
+    INFEASIBLE: "Infeasible: no z >= 0 has M z + q >= 0, so the LCP has no solution.",
 }
 
 
 def lcp_residual(M, q, z, w=None):
-    """Scaled complementarity residual of a candidate solution.
+    """Complementarity residual relative to the size of the answer (a diagnostic).
 
     Parameters
     ----------
@@ -68,11 +74,11 @@ def lcp_residual(M, q, z, w=None):
 
     Notes
     -----
-    ``|min(z_i, w_i)|`` vanishes exactly when ``z_i >= 0``, ``w_i >= 0`` and
-    ``z_i w_i = 0``, so the numerator catches a negative ``z``, a negative
-    ``w`` and a complementarity violation alike. The denominator is the size
-    of the terms summed into ``w``: rounding in ``M @ z + q`` is relative to
-    it, so the same tolerance serves problems of any scale.
+    The denominator grows with ``z``, so this number is small for any point
+    far enough out, solution or not (on ``M = [[1, -1], [-1, 1]]``, ``q =
+    -1``, ``z = (2e9, 2e9)`` gives 2.3e-10 while ``w = -1``). It measures
+    the rounding in ``M @ z + q`` and is kept as a diagnostic (the time
+    stepper reports it); success is decided by :func:`lcp_violation`.
 
     Examples
     --------
@@ -94,6 +100,69 @@ def lcp_residual(M, q, z, w=None):
     return num / scale
 
 
+def lcp_violation(M, q, z, w=None):
+    """How far ``z`` is from solving ``LCP(M, q)``, in units fixed by the data alone.
+
+    This is the number every method's success is certified with: a result
+    counts as solved only when ``lcp_violation(M, q, z) <= tol``.
+
+    Parameters
+    ----------
+    M : array_like, shape (n, n)
+    q : array_like, shape (n,)
+    z : array_like, shape (n,)
+    w : array_like, shape (n,), optional
+        ``M @ z + q``; computed (one matrix-vector product) when not given.
+
+    Returns
+    -------
+    float
+        ``max_i |min(m z_i, w_i)| / s`` with ``s = max|q|`` and ``m =
+        max|M|`` (each replaced by 1 when it is 0); ``inf`` when ``z`` or
+        ``w`` is not finite.
+
+    Notes
+    -----
+    With ``tol_w = tol s`` and ``tol_z = tol s / m``, ``lcp_violation <=
+    tol`` holds exactly when
+
+    * ``z >= -tol_z``,
+    * ``w = M z + q >= -tol_w``, and
+    * for every ``i``, ``z_i <= tol_z`` or ``w_i <= tol_w``
+      (``|min(z_i / tol_z, w_i / tol_w)| <= 1``: complementarity).
+
+    ``s`` is the scale of ``w`` and ``s / m`` the natural scale of ``z``, so
+    both tolerances are absolute and follow the data: the measure is
+    invariant under ``(M, q) -> (a M, b q)`` (whose solutions are ``(b / a)
+    z``) and never grows with the candidate ``z``. A point with ``w_i = -1``
+    fails by ``1 / max|q|`` however large ``z`` is.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> M = np.array([[1.0, -1.0], [-1.0, 1.0]])
+    >>> q = np.array([-1.0, -1.0])
+    >>> float(lcp_violation(M, q, np.array([2e9, 2e9])))  # w = (-1, -1)
+    1.0
+    >>> float(lcp_violation(np.eye(2), q, np.array([1.0, 1.0])))
+    0.0
+    """
+    M = np.asarray(M, dtype=float)
+    q = np.asarray(q, dtype=float)
+    z = np.asarray(z, dtype=float)
+    if z.size == 0:
+        return 0.0
+    with np.errstate(over="ignore", invalid="ignore"):
+        if w is None:
+            w = M @ z + q
+        m = float(np.max(np.abs(M)))
+        s = float(np.max(np.abs(q)))
+        m = m if m > 0.0 else 1.0
+        s = s if s > 0.0 else 1.0
+        v = float(np.max(np.abs(np.minimum(m * z, w)))) / s
+    return v if np.isfinite(v) else np.inf
+
+
 class LCPResult:
     """Outcome of one LCP solve: find ``z >= 0`` with ``w = M z + q >= 0``, ``z.w = 0``.
 
@@ -111,7 +180,8 @@ class LCPResult:
     pivots : int
         Pivots (Lemke) or QP solves (QP methods) performed.
     residual : float
-        Scaled complementarity residual, see :func:`lcp_residual`.
+        The certified violation :func:`lcp_violation` of ``z``: a solved
+        status means ``residual <= tol``.
     method : str
         The method that produced ``z`` (``"lemke"`` or ``"qp"``).
     path : tuple of str
@@ -122,6 +192,10 @@ class LCPResult:
         along which ``(z, z0)`` leaves: ``z + t dz`` with artificial level
         ``z0 + t dz0`` stays feasible and complementary for all ``t >= 0``
         in the augmented problem ``w = M z + q + d z0``.
+    certificate : ndarray or None
+        With status :data:`INFEASIBLE`, a Farkas vector ``y``: ``y >= 0``,
+        ``M^T y <= 0``, ``q.y < 0``, ``max(y) = 1``. For any ``z >= 0``,
+        ``y.(M z + q) = (M^T y).z + q.y < 0``, so some ``w_i`` is negative.
 
     Examples
     --------
@@ -138,6 +212,7 @@ class LCPResult:
     __slots__ = ("z", "w", "status", "pivots", "residual", "method", "__dict__")
 
     ray = None
+    certificate = None
     detail = ""
     _path = None
 
@@ -180,21 +255,21 @@ class LCPResult:
         return text
 
     def check(self, M, q, tol=1e-9):
-        """Recompute the residual against ``(M, q)`` and compare it with ``tol``.
+        """Certify ``z`` against ``(M, q)`` afresh: :func:`lcp_violation` ``<= tol``.
 
         Parameters
         ----------
         M : array_like, shape (n, n)
         q : array_like, shape (n,)
         tol : float
-            Bound on the scaled residual of :func:`lcp_residual`.
+            Bound on the violation.
 
         Returns
         -------
         bool
             True when ``z`` solves the LCP to within ``tol``.
         """
-        return lcp_residual(M, q, self.z) <= tol
+        return lcp_violation(M, q, self.z) <= tol
 
     def __repr__(self):
         return (

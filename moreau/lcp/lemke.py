@@ -40,10 +40,17 @@ that cancels to rounding level is set to exactly zero so that degenerate
 rows are recognised as such.
 
 A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
-the data and the scaled residual of :func:`moreau.lcp.lcp_residual` must be
-``<= tol``. If it is not, the basis found is re-solved directly
-(``M_JJ z_J = -q_J`` by Gaussian elimination with partial pivoting) and
-checked again; if that fails too the status is :data:`BREAKDOWN`.
+the data (one matrix-vector product) and the violation of
+:func:`moreau.lcp.lcp_violation`, whose tolerances are fixed by ``max|q|``
+and ``max|M|`` and not by the size of ``z``, must be ``<= tol``. If it is
+not, the basis found is re-solved directly (``M_JJ z_J = -q_J`` by Gaussian
+elimination with partial pivoting) and checked again; if that fails too the
+status is :data:`BREAKDOWN`.
+
+A secondary ray is turned into a proof of infeasibility when it is one
+(:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
+:data:`INFEASIBLE`, with the Farkas vector in ``certificate``. Otherwise it
+stays :data:`SECONDARY_RAY`, which proves nothing.
 
 Calling from compiled code
 --------------------------
@@ -55,13 +62,17 @@ called from other ``@njit`` code, e.g. a time-stepping loop::
 See their docstrings for the exact argument types.
 """
 
+import math
+
 import numpy as np
 from numba import njit
 
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
+from .certify import FARKAS_TOL, infeasibility_from_ray
 from ._result import (
     BREAKDOWN,
+    INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
     SECONDARY_RAY,
@@ -94,27 +105,55 @@ PIVOT_TOL = 1e-9
 NOISE_TOL = 1e3 * np.finfo(float).eps
 #: two ratios (or two lexicographic entries) tie within this relative difference
 TIE_TOL = 1e-9
-#: default bound on the scaled residual for a result to count as solved
+#: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+#: result to count as solved
 DEFAULT_TOL = 1e-9
+#: work budget of the default pivot limit: pivots times n (n + 1) tableau
+#: updates, about a second of pivoting
+WORK_BUDGET = 2**30
 
 # cancellation below this many ulps of the operands is rounding, not data
 _SNAP = 16.0 * np.finfo(float).eps
+# data whose largest entry lies outside [2^-64, 2^64] are brought to unit
+# scale before pivoting (see _lemke_scaled); _core asks for it with this code
+_SCALE_LO = 2.0**-64
+_SCALE_HI = 2.0**64
+_RESCALE = -1
 
 
 def default_max_iter(n):
     """Default pivot limit for an LCP of size ``n``.
 
-    Lemke's method needs ``O(n)`` pivots on practical problems; the limit is
-    generous (``max(1000, 50 n)``) but keeps a pathological case from hanging
-    a time-stepping loop. Pass ``max_iter`` explicitly for exponential
-    examples such as Murty's.
+    ``max(1000, 50 n, min(2^(n+1), 2^30 // (n (n + 1))))``.
+
+    Lemke's method needs ``O(n)`` pivots on practical problems, but
+    ``2^n`` on Murty's exponential examples; ``2^(n+1)`` lets those finish
+    (n = 12: 8192, n = 16: 131072, n = 20: 2097152). The second term caps
+    the work, pivots times the ``n (n + 1)`` tableau entries each one
+    updates, at :data:`WORK_BUDGET` = 2^30 (about a second), so that a
+    pathological problem cannot hang a time-stepping loop: the bound is
+    ``2^(n+1)`` up to n = 20, then falls to ``50 n`` (from n = 278 on).
+
+    Parameters
+    ----------
+    n : int
+
+    Returns
+    -------
+    int
 
     Examples
     --------
-    >>> default_max_iter(4)
-    1000
+    >>> default_max_iter(4), default_max_iter(12), default_max_iter(16), default_max_iter(100)
+    (1000, 8192, 131072, 106311)
     """
-    return max(1000, 50 * int(n))
+    n = int(n)
+    exp = 2 ** (n + 1) if n < 62 else 2**62
+    return max(1000, 50 * n, min(exp, WORK_BUDGET // max(n * (n + 1), 1)))
+
+
+# the default limits of small sizes, looked up on the per-time-step path
+_MAX_ITER_TABLE = tuple(default_max_iter(n) for n in range(512))
 
 
 @njit(cache=True)
@@ -206,12 +245,11 @@ def _extract_z(b, pos, n, z_out):
 
 @njit(cache=True)
 def _residual(M, q, z, w, mmax, qmax):
-    # w = M z + q from the data, and the scaled residual of lcp_residual
+    # w = M z + q from the data, and the violation of lcp_violation:
+    # max |min(mmax z_i, w_i)| / qmax, scaled by the data only
     n = q.shape[0]
-    zmax = 0.0
-    for j in range(n):
-        if abs(z[j]) > zmax:
-            zmax = abs(z[j])
+    ms = mmax if mmax > 0.0 else 1.0
+    qs = qmax if qmax > 0.0 else 1.0
     num = 0.0
     for i in range(n):
         acc = q[i]
@@ -220,12 +258,12 @@ def _residual(M, q, z, w, mmax, qmax):
             if zj != 0.0:
                 acc += M[i, j] * zj
         w[i] = acc
-        m = min(z[i], acc)
+        m = min(ms * z[i], acc)
         if abs(m) > num:
             num = abs(m)
     if not np.isfinite(num):
         return np.inf
-    return num / (1.0 + qmax + mmax * zmax)
+    return num / qs
 
 
 @njit(cache=True)
@@ -287,8 +325,13 @@ def _resolve_basis(M, q, pos, n, z_out):
 @njit(cache=True)
 def _noise_scale(T, pos, M, d, n, i, entering):
     # sum_j |B^-1_ij| |A_ej|: the size of the terms that make up entry i of
-    # the entering column B^-1 A_e, hence the scale of its rounding error
+    # the entering column B^-1 A_e, hence the scale of its rounding error.
+    # When a slack w_k enters, A_e = e_k and that sum is the entry itself,
+    # B^-1_ik, which measures nothing: an exact zero that pivoting left at
+    # 1e-17 would pass as genuine. The entry was then formed by eliminations
+    # on row i of B^-1, so its rounding is relative to that row's size.
     acc = 0.0
+    rowmax = 0.0
     for j in range(n):
         p = pos[j]
         if p >= 0:
@@ -297,6 +340,8 @@ def _noise_scale(T, pos, M, d, n, i, entering):
             bij = 1.0
         else:
             bij = abs(T[i, -p - 1])
+        if bij > rowmax:
+            rowmax = bij
         if entering < n:
             aej = 1.0 if j == entering else 0.0
         elif entering < 2 * n:
@@ -304,6 +349,14 @@ def _noise_scale(T, pos, M, d, n, i, entering):
         else:
             aej = d[j]
         acc += bij * aej
+    if entering < n:
+        acc = rowmax
+    # the entry itself was made by eliminations on the whole tableau row:
+    # its rounding is relative to the largest entry of that row too
+    for k in range(n + 1):
+        t = abs(T[i, k])
+        if t > acc:
+            acc = t
     return acc
 
 
@@ -329,26 +382,36 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     max_iter : int
         Pivot limit, counting the first pivot on ``z0``.
     tol : float
-        Bound on the scaled residual (:func:`moreau.lcp.lcp_residual`) for
-        the result to count as solved.
+        Bound on the violation (:func:`moreau.lcp.lcp_violation`) for the
+        result to count as solved.
 
     Returns
     -------
     status : int
-        :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1), :data:`MAX_ITER` (2),
+        :data:`SOLVED` (0), :data:`SECONDARY_RAY` (1; the kernel does not
+        tell a proof of infeasibility from a failure, see
+        :func:`moreau.lcp.certify.infeasibility_from_ray`), :data:`MAX_ITER` (2),
         :data:`BREAKDOWN` (3) or :data:`INVALID_INPUT` (4: NaN or inf in
         ``M`` or ``q``, a covering entry that is not finite and > 0, or a
         workspace that is too small; ``z_out`` and ``w_out`` are then zero).
     pivots : int
         Pivots performed (0 when ``q >= 0``).
     residual : float
-        Scaled residual of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
+        Violation of ``z_out``; ``inf`` on :data:`INVALID_INPUT`.
 
     Notes
     -----
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
+    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
+
+
+@njit(cache=True)
+def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, rescale):
+    # lemke_core; with `rescale`, data whose largest entry lies outside
+    # [2^-64, 2^64] return _RESCALE before any pivoting, found by the scan
+    # for non-finite entries that runs anyway
     n = q.shape[0]
     for k in range(n + 1):
         ray_out[k] = 0.0
@@ -379,6 +442,9 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
             z_out[k] = 0.0
             w_out[k] = q[k]
         return SOLVED, 0, 0.0
+    if rescale and (_exponent_to_unit(mmax) != 0 or _exponent_to_unit(qmax) != 0):
+        # extreme data: the caller brings them to unit scale and calls again
+        return _RESCALE, 0, 0.0
 
     T = work
     b = work[n + 1]
@@ -541,8 +607,11 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
 def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     """Lemke's method with covering vector ``d = 1`` (compiled; callable from ``@njit`` code).
 
-    Allocates its own workspace; use :func:`lemke_core` in tight loops that
-    reuse one.
+    Allocates its own workspace, and brings data whose largest entry lies
+    outside ``[2^-64, 2^64]`` (e.g. subnormal numbers, on which the
+    tableau's arithmetic keeps only a few bits) to unit scale by exact
+    powers of two first; use :func:`lemke_core`, which does neither, in
+    tight loops that reuse one workspace on data of sane scale.
 
     Parameters
     ----------
@@ -553,11 +622,15 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     max_iter : int
         Pivot limit.
     tol : float
-        Bound on the scaled residual for a solved status.
+        Bound on the violation for a solved status.
 
     Returns
     -------
     status : int
+        As for :func:`lemke_core`, except that a secondary ray whose ``dz``
+        is a Farkas vector (``dz >= 0``, ``M^T dz <= 0``, ``q.dz < 0``, to
+        :data:`moreau.lcp.certify.FARKAS_TOL`) comes back as
+        :data:`INFEASIBLE` (7): a proof that the LCP has no solution.
     pivots : int
     residual : float
         As for :func:`lemke_core`.
@@ -567,7 +640,107 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     ray = np.empty(n + 1)
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return lemke_core(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+
+
+
+
+@njit(cache=True)
+def _exponent_to_unit(x):
+    # k with 2^k x in [0.5, 1) when x is finite, > 0 and outside the safe
+    # range; 0 otherwise (no scaling)
+    if not (x > 0.0 and x < np.inf) or (x >= _SCALE_LO and x <= _SCALE_HI):
+        return 0
+    return -math.frexp(x)[1]
+
+
+@njit(cache=True)
+def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
+    # lemke_core on (2^a M, 2^b q) when the data are extreme, e.g. subnormal
+    # entries, on which the tableau's arithmetic keeps only a few bits. The
+    # scaled LCP has the solutions 2^(b-a) z and the same pivoting path (the
+    # artificial level scales by 2^b); powers of two make both maps exact.
+    # The violation is invariant under the scaling, so the residual stands.
+    status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, True)
+    if status != _RESCALE:
+        if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+            status = INFEASIBLE
+        return status, pivots, residual
+    n = q.shape[0]
+    mmax = 0.0
+    for i in range(n):
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+    ka = _exponent_to_unit(mmax)
+    kb = _exponent_to_unit(qmax)
+    Ms = np.empty((n, n))
+    qs = np.empty(n)
+    for i in range(n):
+        qs[i] = math.ldexp(q[i], kb)
+        for j in range(n):
+            Ms[i, j] = math.ldexp(M[i, j], ka)
+    status, pivots, residual = _core(Ms, qs, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
+    for j in range(n):
+        z_out[j] = math.ldexp(z_out[j], ka - kb)
+        w_out[j] = math.ldexp(w_out[j], -kb)
+    # the ray is a direction: (dz, dz0) = (2^(a-b) dz', 2^-b dz0') times the
+    # positive 2^(b-a), which keeps dz at the size it has in the tableau
+    ray_out[n] = math.ldexp(ray_out[n], -ka)
+    ok = True
+    for j in range(n):
+        if not (abs(z_out[j]) < np.inf and abs(w_out[j]) < np.inf):
+            ok = False
+    if not ok:
+        # the answer is outside the range of doubles at the data's scale
+        for j in range(n):
+            z_out[j] = 0.0
+            w_out[j] = q[j]
+        return BREAKDOWN, pivots, _residual(M, q, z_out, w_out, mmax, qmax)
+    if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+        status = INFEASIBLE
+    return status, pivots, residual
+
+
+@njit(cache=True)
+def _ray_is_farkas(M, q, y, tol):
+    # moreau.lcp.certify.farkas_vector(M, q, y, tol) is not None, compiled:
+    # y >= 0 (to -tol after scaling to max 1), q.y < 0 and
+    # max(M^T y) <= tol max|M| |q.y| / max|q|
+    n = q.shape[0]
+    top = 0.0
+    for i in range(n):
+        if not abs(y[i]) < np.inf:
+            return False
+        if y[i] > top:
+            top = y[i]
+    if not top > 0.0:
+        return False
+    qy = 0.0
+    qmax = 0.0
+    for i in range(n):
+        yi = y[i] / top
+        if yi < -tol:
+            return False
+        if yi > 0.0:
+            qy += q[i] * yi
+        qmax = max(qmax, abs(q[i]))
+    if not qy < 0.0:
+        return False
+    mmax = 0.0
+    g = -np.inf
+    for j in range(n):
+        acc = 0.0
+        for i in range(n):
+            a = M[i, j]
+            mmax = max(mmax, abs(a))
+            yi = y[i] / top
+            if yi > 0.0:
+                acc += a * yi
+        g = max(g, acc)
+    return g <= tol * mmax * (-qy) / qmax
 
 
 @njit(cache=True)
@@ -578,7 +751,7 @@ def _solve_packed(M, q, d, out, max_iter, tol):
     n = q.shape[0]
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return lemke_core(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
 
 
 @njit(cache=True)
@@ -600,6 +773,14 @@ class _LemkeResult(LCPResult):
             return d
         if self.status == SOLVED:
             return ""
+        if self.status == INFEASIBLE:
+            # proven in compiled code; the words (and the matrix class they
+            # name, an eigenvalue computation) only when someone reads them
+            _, M, q = self.__dict__["_ray"]
+            why = infeasibility_from_ray(M, q, self.ray)[1]
+            d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
+            self.__dict__["_detail"] = d
+            return d
         return _DETAIL.get(self.status, "") + f" (after {self.pivots} pivots)"
 
     @detail.setter
@@ -608,14 +789,30 @@ class _LemkeResult(LCPResult):
 
     @property
     def ray(self):
-        if self.status != SECONDARY_RAY:
+        # _ray = (output buffer, M, q), set on the ray statuses in one go:
+        # the first write to an instance's __dict__ is what costs
+        packed = self.__dict__.get("_ray")
+        if packed is None:
             return None
-        return self.__dict__["_buf"][2 * len(self.z):]
+        return packed[0][2 * len(self.z):]
+
+    @property
+    def certificate(self):
+        if self.status != INFEASIBLE:
+            return None
+        y = self.__dict__.get("_cert")
+        if y is None:
+            y = np.maximum(self.ray[:len(self.z)], 0.0)
+            y = self.__dict__["_cert"] = y / np.max(y)
+        return y
+
+    @certificate.setter
+    def certificate(self, value):
+        self.__dict__["_cert"] = value
 
 
 _DETAIL = {
-    SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray. "
-    "For copositive-plus M this proves the LCP infeasible.",
+    SECONDARY_RAY: "No solution was found; `ray` holds the direction of the ray.",
     MAX_ITER: "Raise `max_iter` or try method='qp'.",
     BREAKDOWN: "The lexicographic ratio test could not separate tied rows, or the terminal "
     "point failed the residual check.",
@@ -677,10 +874,12 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     M : array_like, shape (n, n)
     q : array_like, shape (n,)
     max_iter : int, optional
-        Pivot limit; :func:`default_max_iter` when not given.
+        Pivot limit; :func:`default_max_iter` when not given (``max(1000,
+        50 n, min(2^(n+1), 2^30 // (n (n + 1))))``: enough for Murty's
+        exponential examples up to n = 20).
     tol : float, optional
-        Bound on the scaled residual for a solved status
-        (default :data:`DEFAULT_TOL`).
+        Bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+        solved status (default :data:`DEFAULT_TOL`).
     covering : array_like, shape (n,), optional
         Covering vector ``d > 0``; all ones when not given.
     check_input : bool
@@ -694,6 +893,11 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     Returns
     -------
     LCPResult
+        On a secondary ray, status :data:`INFEASIBLE` with the Farkas vector
+        in ``certificate`` when the ray proves infeasibility (``M``
+        copositive-plus, or the ray itself a Farkas vector, see
+        :func:`moreau.lcp.certify.infeasibility_from_ray`), else
+        :data:`SECONDARY_RAY`; ``ray`` holds the ray in both cases.
 
     Raises
     ------
@@ -735,21 +939,31 @@ def _solve(M, q, max_iter, tol, check_input, covering):
                 raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
     n = q.shape[0]
     out = np.empty(3 * n + 1)
+    if max_iter is None:
+        max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
     if covering is None:
         status, pivots, residual = _solve_packed_ones(
-            M, q, out,
-            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
-            DEFAULT_TOL if tol is None else tol,
+            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
     else:
         status, pivots, residual = _solve_packed(
-            M, q, covering, out,
-            (1000 if n <= 20 else 50 * n) if max_iter is None else max_iter,
-            DEFAULT_TOL if tol is None else tol,
+            M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
+    if status == SOLVED:
+        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
-    if status == SECONDARY_RAY:
-        res.__dict__["_buf"] = out
+    if status == INFEASIBLE:
+        # the ray's dz is a Farkas vector by itself, checked in compiled code
+        # so that proving infeasibility costs about what the pivoting did
+        res.__dict__["_ray"] = (out, M, q)
+    elif status == SECONDARY_RAY:
+        res.__dict__["_ray"] = (out, M, q)
+        # no direct proof: try Lemke's theorem (is M copositive-plus?)
+        y, why = infeasibility_from_ray(M, q, out[2 * n:])
+        if y is not None:
+            res.status = INFEASIBLE
+            res.certificate = y
+        res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res

@@ -37,10 +37,28 @@ Which QP is solved depends on what ``M`` is; the result's ``detail`` names it.
 
 Every answer is finished by an active-set refinement: with ``J`` the indices
 where ``z_i > w_i``, ``M_JJ z_J = -q_J`` is solved (least squares) and kept
-if it lowers the residual. OSQP, a first-order method, stops at ``eps``
+if it lowers the violation. OSQP, a first-order method, stops at ``eps``
 accuracy; the refinement recovers the exact vertex once the active set is
-right. A result counts as solved when the scaled residual of
-:func:`moreau.lcp.lcp_residual` is ``<= tol`` (default :data:`DEFAULT_TOL`).
+right. Whatever OSQP reports, a result counts as solved only when the
+violation of :func:`moreau.lcp.lcp_violation` (tolerances fixed by the
+data, not by the size of ``z``) is ``<= tol`` (default :data:`DEFAULT_TOL`).
+
+Infeasibility
+-------------
+OSQP detects infeasible and unbounded QPs and returns a certificate. On
+``"bound"`` the QP is unbounded below ("dual infeasible") exactly when the
+LCP is infeasible: the certificate is a direction ``d >= 0`` with ``M d =
+0`` and ``q.d < 0``, a Farkas vector. On ``"gap"`` the constraints ``z >=
+0``, ``M z + q >= 0`` have no solution ("primal infeasible"; the
+multipliers of ``M z + q >= 0`` in the certificate are a Farkas vector),
+and OSQP may see first that the objective falls without bound along a
+direction ``d >= 0``, ``M d >= 0``, ``(M + M^T) d = 0``, ``q.d < 0`` ("dual
+infeasible"; ``d`` is a Farkas vector). OSQP's infeasibility tolerances
+are set to its ``eps`` so that these certificates come out accurate. In
+either case the vector is checked (:func:`moreau.lcp.certify.farkas_vector`)
+and the status is :data:`~moreau.lcp.INFEASIBLE`, the message naming which
+of OSQP's certificates it came from. A certificate that does not check out
+gives :data:`~moreau.lcp.SOLVER_FAILED`.
 """
 
 import warnings
@@ -51,19 +69,25 @@ import scipy.sparse as sp
 from .._validate import positive, positive_int
 from ..errors import InputError
 from ._result import (
+    INFEASIBLE,
     MAX_ITER,
     NOT_APPLICABLE,
     SOLVED,
     SOLVER_FAILED,
     LCPResult,
-    lcp_residual,
+    lcp_violation,
 )
+from .certify import farkas_vector
 from .lemke import _coerce
 
 __all__ = ["solve", "DEFAULT_TOL", "qp_formulation"]
 
-#: default bound on the scaled residual for a QP answer to count as solved
+#: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+#: QP answer to count as solved
 DEFAULT_TOL = 1e-6
+#: relative accuracy asked of a Farkas vector read from OSQP's certificates
+#: (no feasible point within ``||z||_1 < 1e6 max|q| / max|M|``)
+OSQP_FARKAS_TOL = 1e-6
 #: OSQP's absolute and relative tolerances
 OSQP_EPS = 1e-9
 #: OSQP's iteration limit (first-order: slow on rank-deficient P)
@@ -73,7 +97,19 @@ _STRUCT_TOL = 1e-10
 
 
 def _osqp(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None, eps=OSQP_EPS):
-    # One QP through qpsolvers; returns x or None. OSQP's stopping rule mixes
+    # One QP through qpsolvers; returns x or None
+    return _osqp_run(P, c, lb, ub, G, h, initvals, max_iter, eps)[0]
+
+
+# OSQP's infeasibility verdicts (qpsolvers passes OSQP's status string
+# through in `extras["info"]`)
+_PRIMAL_INF = ("primal infeasible", "primal infeasible inaccurate")
+_DUAL_INF = ("dual infeasible", "dual infeasible inaccurate")
+
+
+def _osqp_run(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None, eps=OSQP_EPS):
+    # One QP through qpsolvers; returns (x or None, OSQP status text, primal
+    # infeasibility certificate, dual infeasibility certificate). OSQP's stopping rule mixes
     # absolute and relative tolerances, so the data are first brought to
     # unit scale (z = alpha * x_hat, alpha = max|c| / max|P|): a Delassus
     # matrix of 1e-5 would otherwise read as "dual infeasible".
@@ -86,44 +122,68 @@ def _osqp(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=None, 
     sc = sc if sc > 0.0 else 1.0
     alpha = sc / sP
     if not (np.isfinite(alpha) and alpha > 0.0):
-        return None
+        return None, "bad scale", None, None
     Psp = sp.csc_matrix(P / sP)
     Gsp = None if G is None else sp.csc_matrix(G / sP)
     prob = Problem(
         Psp, c / sc, G=Gsp, h=None if h is None else h / sc,
         lb=None if lb is None else lb / alpha, ub=None if ub is None else ub / alpha,
     )
-    opts = dict(eps_abs=eps, eps_rel=eps, polish=False, verbose=False,
+    opts = dict(eps_abs=eps, eps_rel=eps, eps_prim_inf=eps, eps_dual_inf=eps, polish=False, verbose=False,
                 max_iter=OSQP_MAX_ITER if max_iter is None else max_iter)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
             sol = solve_problem(prob, solver="osqp", initvals=None if initvals is None else initvals / alpha, **opts)
         except Exception:  # the backend's own failures become a status, not a crash
-            return None
+            return None, "exception", None, None
+    extras = getattr(sol, "extras", None) or {}
+    info = extras.get("info")
+    text = str(getattr(info, "status", "unknown"))
+    pcert = extras.get("prim_inf_cert")
+    dcert = extras.get("dual_inf_cert")
     # an iterate that stopped short of OSQP's tolerance is still returned:
-    # the refinement and the residual check decide whether it solves the LCP
+    # the refinement and the certification decide whether it solves the LCP
     x = sol.x
     if x is None or x.shape != (n,):
-        return None
+        return None, text, pcert, dcert
     with np.errstate(over="ignore", invalid="ignore"):
         x = x * alpha
     if not np.all(np.isfinite(x)):
-        return None
-    return x
+        return None, text, pcert, dcert
+    return x, text, pcert, dcert
+
+
+def _infeasibility(M, q, form, text, pcert, dcert):
+    # OSQP's verdict turned into a checked Farkas vector, or None. The
+    # certificates are those of the scaled QP; positive scalings of the
+    # rows and columns do not change the signs a Farkas vector needs.
+    n = len(q)
+    if text in _DUAL_INF and dcert is not None and len(dcert) == n:
+        # d >= 0 along which the objective falls without bound: on "bound"
+        # M d = 0 and q.d < 0; on "gap" (M + M^T) d = 0, M d >= 0, hence
+        # M^T d = -M d <= 0: a Farkas vector either way
+        y = farkas_vector(M, q, np.asarray(dcert, dtype=float), OSQP_FARKAS_TOL)
+        return y, "OSQP: dual infeasible (the QP is unbounded below along a Farkas direction)"
+    if text in _PRIMAL_INF and pcert is not None and form == "gap" and len(pcert) == 2 * n:
+        # rows: -M z <= q first (multipliers >= 0), then the bounds z >= 0
+        y = farkas_vector(M, q, np.asarray(pcert, dtype=float)[:n], OSQP_FARKAS_TOL)
+        return y, "OSQP: primal infeasible (no z >= 0 with M z + q >= 0)"
+    return None, ""
 
 
 def _refine(M, q, z, res):
     # re-solve on the active set guessed from (z, w); keep only if better
     w = M @ z + q
-    J = np.flatnonzero(z > w)
+    m = float(np.max(np.abs(M))) if M.size else 1.0
+    J = np.flatnonzero(m * z > w)
     if J.size == 0:
         cand = np.zeros_like(z)
     else:
         cand = np.zeros_like(z)
         sol, *_ = np.linalg.lstsq(M[np.ix_(J, J)], -q[J], rcond=None)
         cand[J] = sol
-    r2 = lcp_residual(M, q, cand)
+    r2 = lcp_violation(M, q, cand)
     if r2 < res:
         return cand, r2
     return z, res
@@ -215,8 +275,8 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
         Limit on Tresca fixed-point iterations (default 100); the other
         formulations solve one QP.
     tol : float, optional
-        Bound on the scaled residual for a solved status (default
-        :data:`DEFAULT_TOL`).
+        Bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
+        solved status (default :data:`DEFAULT_TOL`).
     check_input : bool
         Validate shapes and finiteness (always cheap next to a QP solve).
     friction : FrictionLayout, optional
@@ -229,7 +289,11 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
     Returns
     -------
     LCPResult
-        ``pivots`` counts the QP solves.
+        ``pivots`` counts the QP solves. Status :data:`~moreau.lcp.SOLVED`
+        only when the answer passes :func:`moreau.lcp.lcp_violation`;
+        :data:`~moreau.lcp.INFEASIBLE` with a checked Farkas vector in
+        ``certificate`` when OSQP proved the QP infeasible or unbounded
+        (the message says which).
 
     Examples
     --------
@@ -265,23 +329,35 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
         # active set, then usually lands on the exact vertex
         z = None
         res = np.inf
+        unverified = ""
         for k, eps in enumerate((OSQP_EPS, 1e-6)):
             if form == "bound":
-                x = _osqp(M, q, lb=np.zeros(n), eps=eps)
+                x, text, pcert, dcert = _osqp_run(M, q, lb=np.zeros(n), eps=eps)
             else:
-                x = _osqp(M + M.T, q, lb=np.zeros(n), G=-M, h=q, eps=eps)
+                x, text, pcert, dcert = _osqp_run(M + M.T, q, lb=np.zeros(n), G=-M, h=q, eps=eps)
             solves = k + 1
+            if text in _PRIMAL_INF or text in _DUAL_INF:
+                y, which = _infeasibility(M, q, form, text, pcert, dcert)
+                if y is not None:
+                    z0 = np.zeros(n)
+                    out = LCPResult(z0, q.copy(), INFEASIBLE, solves, lcp_violation(M, q, z0), "qp",
+                                    detail=f"{which}, formulation {form!r}; `certificate` holds the "
+                                    f"Farkas vector y: y >= 0, M^T y <= 0, q.y = {float(q @ y):.3g} < 0.")
+                    out.certificate = y
+                    return out
+                unverified = f"OSQP reported {text!r} but its certificate does not check out"
             if x is None:
                 continue
             x = np.maximum(x, 0.0)
-            with np.errstate(over="ignore", invalid="ignore"):
-                rx = lcp_residual(M, q, x)
+            rx = lcp_violation(M, q, x)
             if refine and np.isfinite(rx):
                 x, rx = _refine(M, q, x, rx)
             if rx < res:
                 z, res = x, rx
             if res <= tol:
                 break
+        if res > tol and unverified:
+            note = unverified
     elif form == "tresca":
         z, solves, converged, note = _tresca(M, q, friction, 100 if max_iter is None else max_iter, 1e-10)
         if z is not None and not converged:
@@ -290,26 +366,28 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
     else:
         z0 = np.zeros(n)
         return LCPResult(
-            z0, q.copy(), NOT_APPLICABLE, 0, lcp_residual(M, q, z0), "qp",
+            z0, q.copy(), NOT_APPLICABLE, 0, lcp_violation(M, q, z0), "qp",
             detail="QP formulations need a symmetric PSD `M`, a monotone `M` (M + M^T PSD), "
             "or a friction layout (`friction=`).",
         )
     if z is None:
         z0 = np.zeros(n)
-        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_residual(M, q, z0), "qp",
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_violation(M, q, z0), "qp",
                          detail=note or f"OSQP found no solution of the {form!r} QP.")
     z = np.maximum(z, 0.0)
     with np.errstate(over="ignore", invalid="ignore"):
-        res = lcp_residual(M, q, z)
+        w = M @ z + q
+    res = lcp_violation(M, q, z, w)
     if not np.isfinite(res):
         z0 = np.zeros(n)
-        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_residual(M, q, z0), "qp",
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, solves, lcp_violation(M, q, z0), "qp",
                          detail=f"the {form!r} QP answer overflowed.")
     if refine:
         z, res = _refine(M, q, z, res)
-    w = M @ z + q
+        w = M @ z + q
     if status == SOLVED and not res <= tol:
+        # whatever OSQP said: a point that fails the certification is no solution
         status = SOLVER_FAILED
-        note = note or f"the {form!r} QP answer has residual {res:.2e} > tol = {tol:.1e}"
+        note = note or f"the {form!r} QP answer fails the certification: violation {res:.2e} > tol = {tol:.1e}"
     detail = f"formulation {form!r}" + (f"; {note}" if note else "") + "."
     return LCPResult(z, w, status, solves, res, "qp", detail=detail)

@@ -27,6 +27,39 @@ def assert_complementary(M, q, z, tol):
         assert abs(z @ w) <= tol * scale * max(zs, ws, 1.0) * len(z)
 
 
+def assert_certified(M, q, z, tol):
+    """The certification of issue 7, written out: tolerances fixed by the data only.
+
+    ``z >= -tol_z``, ``w >= -tol_w`` and, for every ``i``, ``z_i <= tol_z``
+    or ``w_i <= tol_w``, with ``tol_w = tol max|q|`` and ``tol_z = tol_w /
+    max|M|``. Nothing here grows with ``z``.
+    """
+    M = np.asarray(M, dtype=float)
+    q = np.asarray(q, dtype=float)
+    z = np.asarray(z, dtype=float)
+    w = M @ z + q
+    assert np.all(np.isfinite(z)) and np.all(np.isfinite(w))
+    tol_w = tol * (np.max(np.abs(q), initial=0.0) or 1.0)
+    tol_z = tol_w / (np.max(np.abs(M), initial=0.0) or 1.0)
+    assert np.all(z >= -tol_z), f"z has a negative entry {np.min(z)} < -{tol_z:.3g}"
+    assert np.all(w >= -tol_w), f"w has a negative entry {np.min(w)} < -{tol_w:.3g}"
+    both = (z > tol_z) & (w > tol_w)
+    assert not np.any(both), f"complementarity violated at {np.flatnonzero(both)}: z = {z[both]}, w = {w[both]}"
+
+
+def assert_farkas(M, q, y, rtol=1e-9):
+    """``y`` proves ``LCP(M, q)`` infeasible: ``y >= 0``, ``M^T y <= 0``, ``q.y < 0`` (to rounding)."""
+    M = np.asarray(M, dtype=float)
+    q = np.asarray(q, dtype=float)
+    assert y is not None, "no certificate"
+    y = np.asarray(y, dtype=float)
+    assert np.all(np.isfinite(y)) and np.all(y >= 0) and np.max(y) > 0
+    qy = q @ y
+    assert qy < 0, f"q.y = {qy} is not negative"
+    g = np.max(M.T @ y)
+    assert g <= rtol * np.max(np.abs(M)) * abs(qy) / np.max(np.abs(q)), f"max(M^T y) = {g} > 0"
+
+
 _CACHE = {}
 
 

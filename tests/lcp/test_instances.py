@@ -4,15 +4,15 @@ import numpy as np
 import pytest
 
 from moreau.lcp import (
+    INFEASIBLE,
     NOT_APPLICABLE,
-    SECONDARY_RAY,
     SOLVED,
     lcp_residual,
     solve_lcp,
 )
 from moreau.lcp.qp import qp_formulation
 
-from .conftest import TOL, assert_complementary, instances
+from .conftest import TOL, assert_complementary, assert_farkas, instances
 
 INSTANCES = instances()
 IDS = [i.name for i in INSTANCES]
@@ -42,9 +42,12 @@ def test_lemke(inst):
     res = solve_lcp(inst.M, inst.q, method="lemke", max_iter=inst.max_iter)
     assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w))
     if inst.expect == "ray":
-        assert res.status == SECONDARY_RAY
+        # both "ray" instances have a row with M_i <= 0 and q_i < 0, so
+        # the ray must come back as a proof of infeasibility
+        assert res.status == INFEASIBLE
         assert not res.success
         assert res.ray is not None and np.all(np.isfinite(res.ray))
+        assert_farkas(inst.M, inst.q, res.certificate)
         return
     assert res.status == SOLVED, res.message
     assert res.residual <= TOL["lemke"]
@@ -88,9 +91,10 @@ def test_auto(inst):
     res = solve_lcp(inst.M, inst.q, method="auto", max_iter=inst.max_iter, friction=inst.layout)
     assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w))
     if inst.expect == "ray":
-        assert not res.success
-        assert res.path == ("lemke", "qp")
-        assert res.fallback_used
+        # Lemke's proof stands: no QP is asked
+        assert res.status == INFEASIBLE and not res.success
+        assert res.path == ("lemke",) and not res.fallback_used
+        assert_farkas(inst.M, inst.q, res.certificate)
         return
     assert res.success, res.message
     assert res.residual <= TOL["auto"]

@@ -7,6 +7,7 @@ from numba import njit
 from moreau.errors import InputError, MoreauError
 from moreau.lcp import (
     BREAKDOWN,
+    INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
     SECONDARY_RAY,
@@ -18,8 +19,9 @@ from moreau.lcp import (
     solve_lcp,
 )
 from moreau.lcp.instances import murty, random_p_matrix
+from moreau.lcp.lemke import default_max_iter
 
-from .conftest import assert_complementary
+from .conftest import assert_complementary, assert_farkas
 
 
 def test_murty_takes_exactly_two_to_the_n_pivots():
@@ -31,11 +33,31 @@ def test_murty_takes_exactly_two_to_the_n_pivots():
         np.testing.assert_array_equal(res.z, inst.z)
 
 
-def test_murty_16_runs_its_65536_pivots_and_stays_exact():
-    inst = murty(16)
-    res = solve_lcp(inst.M, inst.q, max_iter=2**16)
-    assert res.success and res.pivots == 2**16
+@pytest.mark.parametrize("n", [12, 16])
+def test_murty_12_and_16_finish_within_the_default_pivot_limit(n):
+    # 4096 and 65536 pivots: QuantEcon's and Siconos's Lemke solve these
+    # with their defaults, so must ours
+    inst = murty(n)
+    res = solve_lcp(inst.M, inst.q)
+    assert res.success and res.pivots == 2**n
     np.testing.assert_array_equal(res.z, inst.z)
+    assert default_max_iter(n) == 2 ** (n + 1)
+
+
+def test_default_pivot_limit_is_bounded_by_the_work_budget():
+    assert default_max_iter(1) == 1000
+    assert default_max_iter(20) == 2**21
+    for n in (21, 50, 100, 200, 277):
+        # pivots times the n (n + 1) entries each updates stays within 2^30
+        assert default_max_iter(n) * n * (n + 1) <= 2**30
+    assert default_max_iter(278) == 50 * 278
+    assert default_max_iter(1000) == 50000
+
+
+def test_the_default_pivot_limit_stops_an_exponential_run():
+    inst = murty(11)
+    res = solve_lcp(inst.M, inst.q, max_iter=default_max_iter(9))
+    assert res.status == MAX_ITER and res.pivots == 1024
 
 
 def test_pivot_limit_gives_max_iter_with_a_finite_point():
@@ -68,8 +90,10 @@ def test_no_solution_ends_on_a_secondary_ray_with_a_certificate():
     M = np.array([[-1.0]])
     q = np.array([-1.0])
     res = solve_lcp(M, q)
-    assert res.status == SECONDARY_RAY and not res.success
-    assert "ray" in res.message
+    # M = -1 is not copositive, but the ray is a Farkas vector by itself
+    assert res.status == INFEASIBLE and not res.success
+    assert "ray" in res.message and "Farkas" in res.message
+    assert res.certificate.tolist() == [1.0]
     assert np.isfinite(res.residual) and res.residual > 0.1
     dz, dz0 = res.ray[:1], res.ray[1]
     # along (dz, dz0) the augmented w = M z + q + d z0 keeps its value
@@ -82,7 +106,9 @@ def test_secondary_ray_direction_is_feasible_for_the_augmented_problem():
     M = np.array([[-1.0, 0, -3], [1, -2, -5], [-2, -1, -2]])
     q = np.array([-3.0, -2, -1])
     res = solve_lcp(M, q)
-    assert res.status == SECONDARY_RAY
+    # row 1 reads w1 = -z1 - 3 z3 - 3 < 0: infeasible, and the ray says so
+    assert res.status == INFEASIBLE
+    assert_farkas(M, q, res.certificate)
     dz, dz0 = res.ray[:3], res.ray[3]
     assert np.all(dz >= -1e-12) and dz0 >= -1e-12
     dw = M @ dz + dz0 * np.ones(3)
@@ -95,6 +121,9 @@ def test_covering_vector_changes_the_path():
     M = np.array([[-1.5, 2], [-4, 4]])
     q = np.array([-5.0, 17])
     assert solve_lcp(M, q, covering=np.array([5.0, 16.0])).status == SECONDARY_RAY
+    ray = solve_lcp(M, q, covering=np.array([5.0, 16.0]))
+    # M is not copositive-plus and the ray is no Farkas vector: no claim of infeasibility
+    assert ray.certificate is None and "proves nothing" in ray.message
     res = solve_lcp(M, q)
     assert res.success
     assert_complementary(M, q, res.z, 1e-12)
@@ -290,3 +319,35 @@ def test_badly_scaled_triangular_p_matrix_is_not_cut_off_by_the_pivot_tolerance(
     res = solve_lcp(M, -np.ones(n))
     assert res.success
     np.testing.assert_allclose(res.z, 17.0 ** np.arange(n), rtol=1e-12)
+
+
+def test_an_exact_zero_left_by_rounding_is_not_taken_as_a_pivot():
+    # copositive-plus (symmetric part PSD) and infeasible: y = (1, 1, 0).
+    # After four pivots w_2 enters with the entry 5.55e-17 where exact
+    # arithmetic has 0; pivoting on it ran z to 4.5e15 and broke down.
+    M = np.array([[0.25, -0.25, -2.0], [-0.25, 0.25, 0.0], [2.0, 0.0, 1.0]])
+    q = np.array([-0.5, -0.5, -1.0])
+    res = solve_lcp(M, q)
+    assert res.status == INFEASIBLE and res.pivots == 4
+    assert_farkas(M, q, res.certificate)
+
+
+def test_subnormal_data_are_pivoted_at_unit_scale():
+    # entries 2^-1070: without rescaling the tableau keeps a few bits
+    M = np.ldexp(np.array([[2.0, 1.0], [1.0, 2.0]]), -1070)
+    q = np.ldexp(np.array([-1.0, 1.0]), -1000)
+    res = solve_lcp(M, q)
+    assert res.success
+    np.testing.assert_array_equal(res.z, [2.0**69, 0.0])
+    M = 5e-324 * np.array([[1.0, -1.0], [-1.0, 1.0]])
+    res = solve_lcp(M, np.array([-0.01, -0.01]))
+    assert res.status == INFEASIBLE
+    np.testing.assert_array_equal(res.certificate, [1.0, 1.0])
+    assert np.all(np.isfinite(res.ray))
+
+
+def test_an_answer_beyond_the_range_of_doubles_is_a_breakdown_not_a_nan():
+    M = 1e-310 * np.array([[2.0, 1.0], [1.0, 2.0]])
+    res = solve_lcp(M, np.array([-1.0, 1.0]))  # z1 = 5e309
+    assert res.status == BREAKDOWN
+    assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w)) and np.isfinite(res.residual)

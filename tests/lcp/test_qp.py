@@ -53,7 +53,7 @@ def test_non_monotone_without_layout_is_not_applicable():
 
 
 def test_osqp_failure_becomes_a_status(monkeypatch):
-    monkeypatch.setattr(qp_module, "_osqp", lambda *a, **k: None)
+    monkeypatch.setattr(qp_module, "_osqp_run", lambda *a, **k: (None, "exception", None, None))
     res = solve_lcp(np.eye(3), -np.ones(3), method="qp")
     assert res.status == SOLVER_FAILED
     assert np.all(np.isfinite(res.z)) and not np.any(np.isnan(res.w))
@@ -132,7 +132,8 @@ def test_auto_without_fallback_is_plain_lemke():
 
 
 def test_auto_when_both_fail_keeps_both_messages():
-    res = solve_lcp(np.array([[-1.0]]), np.array([-1.0]), method="auto")
+    # Lemke stopped by the pivot limit, and no QP formulation for an indefinite M
+    res = solve_lcp(np.array([[0.0, 1.0], [2.0, 0.0]]), -np.ones(2), method="auto", max_iter=1)
     assert not res.success
     assert res.path == ("lemke", "qp")
-    assert "Secondary ray" in res.message and "QP" in res.message
+    assert "Iteration limit" in res.message and "QP" in res.message
