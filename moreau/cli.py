@@ -79,7 +79,7 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
         out["steps_per_period"] = steps_per_period
         out["theta"] = theta
         for key in ("steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
-                    "period_map_eigenvalues"):
+                    "period_map_eigenvalues", "periodic", "message"):
             if key in ss.stats:
                 val = ss.stats[key]
                 out[key] = val if not hasattr(val, "tolist") else val.tolist()
@@ -98,6 +98,8 @@ def _cmd_steady(args):
         return
     print(f"friction drive at {rep['frequency_Hz']:g} Hz ({rep['scheme']})")
     print(f"  operation mode            {rep['mode']}")
+    if rep.get("periodic") is False:
+        print(f"  NOTE: {rep['message']}")
     print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
     print(f"  average rotor velocity    {rep['average_velocity_m_per_s']:.9e} m/s")
     print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
