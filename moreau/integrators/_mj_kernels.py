@@ -438,6 +438,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
 
     constant_W = const_mass and not has_jac
     have_Wi = False
+    have_Mi = False
     nrec = 0
     k = k0
     status = OK
@@ -606,7 +607,8 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 mass_fn(kind, par, q1, M)
             for i in range(nc):
                 sel[i] = cnew[i]
-            pinv = False
+            # M^-1 of a constant mass matrix is kept from the last projection
+            pinv = const_mass and have_Mi
             for _ in range(PROJECTION_MAXITER):
                 gaps_fn(kind, par, q1, t1, Gq)
                 anysel = False
@@ -624,6 +626,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                         status = NUMERICAL
                         break
                     pinv = True
+                    have_Mi = True
                 contact_fn(kind, par, q1, t1, Gq, False, False)
                 s = 0
                 for i in range(nc):
