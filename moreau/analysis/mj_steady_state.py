@@ -302,7 +302,8 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         where they end. If the run settles on a period-1 orbit it is returned;
         if it does not, the result says so (``stats["periodic"] = False``,
         ``mode`` ``"no period-1 orbit"``) and reports the long-run average
-        displacement per period instead.
+        displacement per period instead (``min_normal_force`` is then that of
+        the last period simulated).
 
     Returns
     -------
@@ -439,8 +440,8 @@ def _no_orbit(pm, x, closed, scale, tol, transient, t_start):
     navg = max(50, min(500, transient))
     xs = [x]
     total = 0.0
-    for _ in range(navg):
-        x, d, closed = pm(x, closed)
+    for i in range(navg):
+        x, d, closed = pm(x, closed, record=i == navg - 1)
         xs.append(x)
         total += d
     avg = total / navg
@@ -458,7 +459,7 @@ def _no_orbit(pm, x, closed, scale, tol, transient, t_start):
     r = float(np.max(np.abs(xs[-1] - xs[-2]) / scale))
     return SteadyState(
         scheme="moreau-jean", displacement_per_period=float(avg), state0=xs[-1].copy(),
-        mode="no period-1 orbit", regimes=[], min_normal_force=float("nan"),
+        mode="no period-1 orbit", regimes=[], min_normal_force=float(np.min(pm.last["force_N"])),
         periodic_residual=r, iterations=0, wall_time=time.perf_counter() - t_start,
         stats={"periodic": False, "message": msg, "average_over_periods": navg,
                "orbit_period": orbit, "transient_periods": transient,

@@ -389,26 +389,19 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     Wh = np.empty((n, n))
     Wi = np.empty((n, n))
     wk = np.empty((n, n))
-    K = np.zeros((n, n))
-    C = np.zeros((n, n))
-    f = np.empty(n)
-    f0 = np.empty(n)
+    # model outputs, packed (see moreau.scenes._compiled): D = [h | K | C]
+    D = np.zeros((n, 1 + 2 * n))
+    D0 = np.zeros((n, 1 + 2 * n))
     rhs = np.empty(n)
     vf = np.empty(n)
     v1 = np.empty(n)
     q1 = np.empty(n)
     ncm = max(nc, 1)
     mrows = 2 * ncm
-    g0 = np.zeros(ncm)
-    g1 = np.zeros(ncm)
-    WN0 = np.zeros((ncm, n))
-    wN0 = np.zeros(ncm)
-    WT0 = np.zeros((ncm, n))
-    wT0 = np.zeros(ncm)
-    WN1 = np.zeros((ncm, n))
-    wN1 = np.zeros(ncm)
-    WT1 = np.zeros((ncm, n))
-    wT1 = np.zeros(ncm)
+    # contact rows (g, wN, wT, WN, WT): at (q_k, t_k), at (q_k, t_k+1), at (q_k+1, t_k+1)
+    G0 = np.zeros((ncm, 3 + 2 * n))
+    G1 = np.zeros((ncm, 3 + 2 * n))
+    Gq = np.zeros((ncm, 3 + 2 * n))
     vN0 = np.zeros(ncm)
     active = np.zeros(ncm, dtype=np.bool_)
     cnew = np.zeros(ncm, dtype=np.bool_)
@@ -445,6 +438,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
 
     constant_W = const_mass and not has_jac
     have_Wi = False
+    have_Mi = False
     nrec = 0
     k = k0
     status = OK
@@ -462,26 +456,26 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
         # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
         if not (const_mass and k > k0):
             mass_fn(kind, par, q, M)
-        dynamics_fn(kind, par, q, v, t1, f, K, C, has_jac)
+        dynamics_fn(kind, par, q, v, t1, D, has_jac)
         if th != 1.0:
-            dynamics_fn(kind, par, q, v, tk, f0, K, C, False)
+            dynamics_fn(kind, par, q, v, tk, D0, False)
             for i in range(n):
-                f[i] = th * f[i] + (1.0 - th) * f0[i]
+                D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
         a = hk * th
         a2 = hk * hk * th
         if has_jac:
             for i in range(n):
                 acc = 0.0
                 for j in range(n):
-                    acc += K[i, j] * v[j]
-                rhs[i] = hk * f[i] + a2 * acc
+                    acc += D[i, 1 + j] * v[j]
+                rhs[i] = hk * D[i, 0] + a2 * acc
             a2 = a2 * th
             for i in range(n):
                 for j in range(n):
-                    Wh[i, j] = M[i, j] - a * C[i, j] - a2 * K[i, j]
+                    Wh[i, j] = M[i, j] - a * D[i, 1 + n + j] - a2 * D[i, 1 + j]
         else:
             for i in range(n):
-                rhs[i] = hk * f[i]
+                rhs[i] = hk * D[i, 0]
                 for j in range(n):
                     Wh[i, j] = M[i, j]
         if not (constant_W and have_Wi):
@@ -504,13 +498,13 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
             pT[i] = 0.0
             slip[i] = 0.0
         if nc > 0:
-            contact_fn(kind, par, q, tk, g0, WN0, wN0, WT0, wT0, True, False)
+            contact_fn(kind, par, q, tk, G0, True, False)
             for i in range(nc):
-                acc = wN0[i]
+                acc = G0[i, 1]
                 for j in range(n):
-                    acc += WN0[i, j] * v[j]
+                    acc += G0[i, 3 + j] * v[j]
                 vN0[i] = acc
-                active[i] = (g0[i] + 0.5 * hk * acc <= 0.0) or closed[i]
+                active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
                 if active[i]:
                     ia[na] = i
                     na += 1
@@ -518,18 +512,18 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                         fa[nfa] = i
                         nfa += 1
         if na > 0:
-            contact_fn(kind, par, q, t1, g1, WN1, wN1, WT1, wT1, False)
+            contact_fn(kind, par, q, t1, G1, False, True)
             m = na + nfa
             for r in range(na):
                 i = ia[r]
                 for j in range(n):
-                    H[r, j] = WN1[i, j]
-                w[r] = wN1[i]
+                    H[r, j] = G1[i, 3 + j]
+                w[r] = G1[i, 1]
             for r in range(nfa):
                 i = fa[r]
                 for j in range(n):
-                    H[na + r, j] = WT1[i, j]
-                w[na + r] = wT1[i]
+                    H[na + r, j] = G1[i, 3 + n + j]
+                w[na + r] = G1[i, 2]
             for c in range(m):
                 for i in range(n):
                     acc = 0.0
@@ -613,17 +607,18 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 mass_fn(kind, par, q1, M)
             for i in range(nc):
                 sel[i] = cnew[i]
-            pinv = False
+            # M^-1 of a constant mass matrix is kept from the last projection
+            pinv = const_mass and have_Mi
             for _ in range(PROJECTION_MAXITER):
-                gaps_fn(kind, par, q1, t1, g1)
+                gaps_fn(kind, par, q1, t1, Gq)
                 anysel = False
                 gmax = 0.0
                 for i in range(nc):
-                    if g1[i] < 0.0:
+                    if Gq[i, 0] < 0.0:
                         sel[i] = True
                     if sel[i]:
                         anysel = True
-                        gmax = max(gmax, abs(g1[i]))
+                        gmax = max(gmax, abs(Gq[i, 0]))
                 if (not anysel) or gmax <= PROJECTION_TOL:
                     break
                 if not pinv:
@@ -631,7 +626,8 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                         status = NUMERICAL
                         break
                     pinv = True
-                contact_fn(kind, par, q1, t1, g1, WN1, wN1, WT1, wT1, False, False)
+                    have_Mi = True
+                contact_fn(kind, par, q1, t1, Gq, False, False)
                 s = 0
                 for i in range(nc):
                     if sel[i]:
@@ -642,14 +638,14 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                     for i in range(n):
                         acc = 0.0
                         for j in range(n):
-                            acc += Mi[i, j] * WN1[ia[c], j]
+                            acc += Mi[i, j] * Gq[ia[c], 3 + j]
                         X[i, c] = acc
-                    rs[c] = -g1[ia[c]]
+                    rs[c] = -Gq[ia[c], 0]
                 for r in range(s):
                     for c in range(s):
                         acc = 0.0
                         for j in range(n):
-                            acc += WN1[ia[r], j] * X[j, c]
+                            acc += Gq[ia[r], 3 + j] * X[j, c]
                         S[r, c] = acc
                 _solve_small(S, rs, dd, Sw, s)
                 for i in range(n):
@@ -668,10 +664,10 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
             status = NUMERICAL
             break
         if nc > 0:
-            gaps_fn(kind, par, q1, t1, g1)
+            gaps_fn(kind, par, q1, t1, Gq)
             for i in range(nc):
-                if -g1[i] > stats[S_PEN]:
-                    stats[S_PEN] = -g1[i]
+                if -Gq[i, 0] > stats[S_PEN]:
+                    stats[S_PEN] = -Gq[i, 0]
                 reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
             rec_t[nrec] = tk
@@ -683,7 +679,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 rec_fN[nrec, i] = pN[i] / hk
                 rec_fT[nrec, i] = pT[i] / hk
                 rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = g0[i]
+                rec_gap[nrec, i] = G0[i, 0]
             nrec += 1
             record_initial = False
         for i in range(nc):
@@ -702,7 +698,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 rec_fN[nrec, i] = pN[i] / hk
                 rec_fT[nrec, i] = pT[i] / hk
                 rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = g1[i]
+                rec_gap[nrec, i] = Gq[i, 0]
             nrec += 1
         if last:
             break

@@ -18,23 +18,29 @@ only, so after editing this module delete
 
 The Python :class:`~moreau.scenes.base.Scene` methods stay the definition;
 the formulas here are transcriptions of them, and
-``tests/scenes/test_compiled_models.py`` checks every function against its
-Python counterpart to ``1e-12``. Layout of the outputs (the caller zero-fills them once; a model writes the
-same entries on every call and leaves the structural zeros alone, so that the
-stepper does not clear arrays on every step):
+``tests/integrators/test_compiled_engine.py`` checks every function against
+its Python counterpart to ``1e-12``. Layout of the outputs (the caller
+zero-fills them once; a model writes the same entries on every call and
+leaves the structural zeros alone, so that the stepper does not clear arrays
+on every step):
 
 * ``mass_fn(kind, par, q, M)``: ``M`` (ndof, ndof).
-* ``dynamics_fn(kind, par, q, v, t, f, K, C, need_jac)``: forces ``h`` and,
-  when ``need_jac``, ``K = dh/dq`` and ``C = dh/dv`` (left untouched otherwise;
-  scenes with ``has_jacobians = False`` never write them).
-* ``contact_fn(kind, par, q, t, g, WN, wN, WT, wT, need_gap, need_T=True)``:
-  gaps (when ``need_gap``), the normal rows ``WN`` (nc, ndof), ``wN`` (nc,) and one
-  tangential row *per contact* ``WT`` (nc, ndof), ``wT`` (nc,), written for
-  every contact; the stepper reads a contact's tangential row only when its
-  ``mu > 0``. (The Python interface returns tangential rows of the frictional
-  contacts only.) With ``need_T=False`` only the normal rows are written.
-* ``gaps_fn(kind, par, q, t, g)``.
-* ``drift_fn(kind, par, q, v, t, wNbar, wTbar)``: one entry per contact, as ``WT``.
+* ``dynamics_fn(kind, par, q, v, t, D, need_jac)``: ``D`` (ndof, 1 + 2 ndof)
+  holds the forces ``h`` in column 0 and, when ``need_jac``, ``K = dh/dq`` in
+  columns ``1 .. ndof`` and ``C = dh/dv`` after them (scenes with
+  ``has_jacobians = False`` never write them).
+* ``contact_fn(kind, par, q, t, G, need_gap, need_T=True)``: row ``i`` of ``G``
+  (nc, 3 + 2 ndof) is ``(g_i, wN_i, wT_i, WN_i, WT_i)``: the gap (when
+  ``need_gap``), the rheonomic terms, the normal row and one tangential row
+  *per contact*; the stepper reads a contact's tangential entries only when
+  its ``mu > 0``. (The Python interface returns tangential rows of the
+  frictional contacts only.) With ``need_T=False`` only ``wN`` and ``WN`` are
+  written.
+* ``gaps_fn(kind, par, q, t, G)``: column 0 of ``G``.
+* ``drift_fn(kind, par, q, v, t, Dr)``: ``Dr`` (nc, 2) = ``(wNbar, wTbar)``.
+
+The outputs are packed into one array per function so that each inlined
+call carries few array arguments (numba reference-counts them).
 """
 
 import math
@@ -115,124 +121,127 @@ def mass_fn(kind, par, q, M):
 
 
 @njit(cache=True, inline="always")
-def dynamics_fn(kind, par, q, v, t, f, K, C, need_jac):
+def dynamics_fn(kind, par, q, v, t, D, need_jac):
+    # D[i, 0] = h_i, D[i, 1 + j] = dh_i/dq_j, D[i, 1 + n + j] = dh_i/dv_j
     if kind == FRICTION_DRIVE:
         # par: J, P, u10, fL, sin_phi0
         s = math.sin(q[0])
         c = math.cos(q[0])
         spring = par[4] - s
         ddu1 = par[2] * math.cos(t)
-        f[0] = par[1] * c * spring - 0.5 * ddu1 * c
-        f[1] = -par[3]
+        D[0, 0] = par[1] * c * spring - 0.5 * ddu1 * c
+        D[1, 0] = -par[3]
         if need_jac:
-            K[0, 0] = par[1] * (-s * spring - c * c) + 0.5 * ddu1 * s
+            D[0, 1] = par[1] * (-s * spring - c * c) + 0.5 * ddu1 * s
     elif kind == BIDIRECTIONAL_DRIVE:
         # par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b
         for r in range(2):
             s = math.sin(q[r])
             c = math.cos(q[r])
             dd1 = par[4 + r] * math.cos(t - par[6 + r])
-            f[r] = par[1] * c * (par[2] - s) - 0.5 * dd1 * c
+            D[r, 0] = par[1] * c * (par[2] - s) - 0.5 * dd1 * c
             if need_jac:
-                K[r, r] = par[1] * (-s * (par[2] - s) - c * c) + 0.5 * dd1 * s
-        f[2] = -par[3]
+                D[r, 1 + r] = par[1] * (-s * (par[2] - s) - c * c) + 0.5 * dd1 * s
+        D[2, 0] = -par[3]
     elif kind == BOUNCING_BALL:
-        f[0] = -1.0
+        D[0, 0] = -1.0
     elif kind == SLIDING_BLOCK:
         # par: sin(alpha), cos(alpha)
-        f[0] = par[0]
-        f[1] = -par[1]
+        D[0, 0] = par[0]
+        D[1, 0] = -par[1]
     elif kind == PAINLEVE_ROD or kind == SLIDING_BOX:
-        f[0] = 0.0
-        f[1] = -1.0
-        f[2] = 0.0
+        D[0, 0] = 0.0
+        D[1, 0] = -1.0
+        D[2, 0] = 0.0
     elif kind == STICK_SLIP_MOTOR:
-        f[0] = -par[0]
-        f[1] = -par[1]
+        D[0, 0] = -par[0]
+        D[1, 0] = -par[1]
 
 
 @njit(cache=True, inline="always")
-def gaps_fn(kind, par, q, t, g):
+def gaps_fn(kind, par, q, t, G):
+    # G[i, 0] = g_i
     if kind == FRICTION_DRIVE:
-        g[0] = par[4] - math.sin(q[0]) - par[2] * (1.0 - math.cos(t))
+        G[0, 0] = par[4] - math.sin(q[0]) - par[2] * (1.0 - math.cos(t))
     elif kind == BIDIRECTIONAL_DRIVE:
         for r in range(2):
-            g[r] = par[2] - math.sin(q[r]) - par[4 + r] * (1.0 - math.cos(t - par[6 + r]))
+            G[r, 0] = par[2] - math.sin(q[r]) - par[4 + r] * (1.0 - math.cos(t - par[6 + r]))
     elif kind == BOUNCING_BALL:
-        g[0] = q[0] - par[0]
+        G[0, 0] = q[0] - par[0]
     elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
-        g[0] = q[1]
+        G[0, 0] = q[1]
     elif kind == PAINLEVE_ROD:
-        g[0] = q[1] - math.sin(q[2])
+        G[0, 0] = q[1] - math.sin(q[2])
     elif kind == SLIDING_BOX:
         # par: a, b, inertia; corners at body coordinates (-a, -b), (+a, -b)
         s = math.sin(q[2])
         c = math.cos(q[2])
-        g[0] = q[1] - par[0] * s - par[1] * c
-        g[1] = q[1] + par[0] * s - par[1] * c
+        G[0, 0] = q[1] - par[0] * s - par[1] * c
+        G[1, 0] = q[1] + par[0] * s - par[1] * c
 
 
 @njit(cache=True, inline="always")
-def _normal_rows(kind, par, q, t, WN, wN):
+def _normal_rows(kind, par, q, t, G):
     # the normal rows only (the stepper's index-set test needs no tangential ones)
     if kind == FRICTION_DRIVE:
-        WN[0, 0] = -math.cos(q[0])
-        wN[0] = -par[2] * math.sin(t)
+        G[0, 3] = -math.cos(q[0])
+        G[0, 1] = -par[2] * math.sin(t)
     elif kind == BIDIRECTIONAL_DRIVE:
-        WN[0, 0] = -math.cos(q[0])
-        WN[1, 1] = -math.cos(q[1])
-        wN[0] = -par[4] * math.sin(t - par[6])
-        wN[1] = -par[5] * math.sin(t - par[7])
+        G[0, 3] = -math.cos(q[0])
+        G[1, 4] = -math.cos(q[1])
+        G[0, 1] = -par[4] * math.sin(t - par[6])
+        G[1, 1] = -par[5] * math.sin(t - par[7])
     elif kind == BOUNCING_BALL:
-        WN[0, 0] = 1.0
+        G[0, 3] = 1.0
     elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
-        WN[0, 1] = 1.0
+        G[0, 4] = 1.0
     elif kind == PAINLEVE_ROD:
-        WN[0, 1] = 1.0
-        WN[0, 2] = -math.cos(q[2])
+        G[0, 4] = 1.0
+        G[0, 5] = -math.cos(q[2])
     elif kind == SLIDING_BOX:
         s = math.sin(q[2])
         c = math.cos(q[2])
         for i in range(2):
-            WN[i, 1] = 1.0
-            WN[i, 2] = (2.0 * i - 1.0) * par[0] * c + par[1] * s
+            G[i, 4] = 1.0
+            G[i, 5] = (2.0 * i - 1.0) * par[0] * c + par[1] * s
 
 
 @njit(cache=True, inline="always")
-def contact_fn(kind, par, q, t, g, WN, wN, WT, wT, need_gap, need_T=True):
+def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
+    # G[i] = (g_i, wN_i, wT_i, WN_i (n), WT_i (n))
     if need_gap:
-        gaps_fn(kind, par, q, t, g)
+        gaps_fn(kind, par, q, t, G)
     if not need_T:
-        _normal_rows(kind, par, q, t, WN, wN)
+        _normal_rows(kind, par, q, t, G)
         return
     if kind == FRICTION_DRIVE:
-        WN[0, 0] = -math.cos(q[0])
-        wN[0] = -par[2] * math.sin(t)
-        WT[0, 0] = math.sin(q[0])
-        WT[0, 1] = 1.0
+        G[0, 3] = -math.cos(q[0])
+        G[0, 1] = -par[2] * math.sin(t)
+        G[0, 5] = math.sin(q[0])
+        G[0, 6] = 1.0
     elif kind == BIDIRECTIONAL_DRIVE:
-        WN[0, 0] = -math.cos(q[0])
-        WN[1, 1] = -math.cos(q[1])
-        wN[0] = -par[4] * math.sin(t - par[6])
-        wN[1] = -par[5] * math.sin(t - par[7])
-        WT[0, 0] = math.sin(q[0])
-        WT[1, 1] = -math.sin(q[1])
-        WT[0, 2] = 1.0
-        WT[1, 2] = 1.0
+        G[0, 3] = -math.cos(q[0])
+        G[1, 4] = -math.cos(q[1])
+        G[0, 1] = -par[4] * math.sin(t - par[6])
+        G[1, 1] = -par[5] * math.sin(t - par[7])
+        G[0, 6] = math.sin(q[0])
+        G[1, 7] = -math.sin(q[1])
+        G[0, 8] = 1.0
+        G[1, 8] = 1.0
     elif kind == BOUNCING_BALL:
-        WN[0, 0] = 1.0
+        G[0, 3] = 1.0
     elif kind == SLIDING_BLOCK:
-        WN[0, 1] = 1.0
-        WT[0, 0] = 1.0
+        G[0, 4] = 1.0
+        G[0, 5] = 1.0
     elif kind == STICK_SLIP_MOTOR:
-        WN[0, 1] = 1.0
-        WT[0, 0] = 1.0
-        wT[0] = -_motor_drive(par, t)[1]
+        G[0, 4] = 1.0
+        G[0, 5] = 1.0
+        G[0, 2] = -_motor_drive(par, t)[1]
     elif kind == PAINLEVE_ROD:
-        WN[0, 1] = 1.0
-        WN[0, 2] = -math.cos(q[2])
-        WT[0, 0] = 1.0
-        WT[0, 2] = math.sin(q[2])
+        G[0, 4] = 1.0
+        G[0, 5] = -math.cos(q[2])
+        G[0, 6] = 1.0
+        G[0, 8] = math.sin(q[2])
     elif kind == SLIDING_BOX:
         s = math.sin(q[2])
         c = math.cos(q[2])
@@ -240,37 +249,38 @@ def contact_fn(kind, par, q, t, g, WN, wN, WT, wT, need_gap, need_T=True):
         b = par[1]
         for i in range(2):
             sg = 2.0 * i - 1.0
-            WN[i, 1] = 1.0
-            WN[i, 2] = sg * a * c + b * s
-            WT[i, 0] = 1.0
-            WT[i, 2] = -sg * a * s + b * c
+            G[i, 4] = 1.0
+            G[i, 5] = sg * a * c + b * s
+            G[i, 6] = 1.0
+            G[i, 8] = -sg * a * s + b * c
 
 
 @njit(cache=True)
-def drift_fn(kind, par, q, v, t, wNbar, wTbar):
+def drift_fn(kind, par, q, v, t, Dr):
+    # Dr[i] = (wNbar_i, wTbar_i)
     if kind == FRICTION_DRIVE:
         w2 = v[0] * v[0]
-        wNbar[0] = w2 * math.sin(q[0]) - par[2] * math.cos(t)
-        wTbar[0] = w2 * math.cos(q[0])
+        Dr[0, 0] = w2 * math.sin(q[0]) - par[2] * math.cos(t)
+        Dr[0, 1] = w2 * math.cos(q[0])
     elif kind == BIDIRECTIONAL_DRIVE:
         for r in range(2):
             w2 = v[r] * v[r]
-            wNbar[r] = w2 * math.sin(q[r]) - par[4 + r] * math.cos(t - par[6 + r])
-            wTbar[r] = (1.0 - 2.0 * r) * w2 * math.cos(q[r])
+            Dr[r, 0] = w2 * math.sin(q[r]) - par[4 + r] * math.cos(t - par[6 + r])
+            Dr[r, 1] = (1.0 - 2.0 * r) * w2 * math.cos(q[r])
     elif kind == STICK_SLIP_MOTOR:
-        wTbar[0] = -_motor_drive(par, t)[2]
+        Dr[0, 1] = -_motor_drive(par, t)[2]
     elif kind == PAINLEVE_ROD:
         w2 = v[2] * v[2]
-        wNbar[0] = math.sin(q[2]) * w2
-        wTbar[0] = math.cos(q[2]) * w2
+        Dr[0, 0] = math.sin(q[2]) * w2
+        Dr[0, 1] = math.cos(q[2]) * w2
     elif kind == SLIDING_BOX:
         s = math.sin(q[2])
         c = math.cos(q[2])
         w2 = v[2] * v[2]
         for i in range(2):
             sg = 2.0 * i - 1.0
-            wNbar[i] = w2 * (-sg * par[0] * s + par[1] * c)
-            wTbar[i] = w2 * (-sg * par[0] * c - par[1] * s)
+            Dr[i, 0] = w2 * (-sg * par[0] * s + par[1] * c)
+            Dr[i, 1] = w2 * (-sg * par[0] * c - par[1] * s)
 
 
 # -- checking a compiled model against its Python scene ----------------------------------
@@ -282,20 +292,19 @@ def evaluate_compiled(model, q, v, t):
     v = np.ascontiguousarray(v, dtype=float)
     t = float(t)
     M = np.zeros((n, n))
-    f = np.zeros(n)
-    K = np.zeros((n, n))
-    C = np.zeros((n, n))
-    g = np.zeros(nc)
-    WN, WT = np.zeros((nc, n)), np.zeros((nc, n))
-    wN, wT, wNb, wTb = (np.zeros(nc) for _ in range(4))
+    D = np.zeros((n, 1 + 2 * n))
+    G = np.zeros((nc, 3 + 2 * n))
+    G2 = np.zeros((nc, 3 + 2 * n))
+    Dr = np.zeros((nc, 2))
     mass_fn(model.kind, model.par, q, M)
-    dynamics_fn(model.kind, model.par, q, v, t, f, K, C, True)
-    contact_fn(model.kind, model.par, q, t, g, WN, wN, WT, wT, True)
-    drift_fn(model.kind, model.par, q, v, t, wNb, wTb)
-    WN2, WT2, wN2, wT2 = np.zeros((nc, n)), np.zeros((nc, n)), np.zeros(nc), np.zeros(nc)
-    contact_fn(model.kind, model.par, q, t, g, WN2, wN2, WT2, wT2, False, False)
-    return {"WN_normal_only": WN2, "wN_normal_only": wN2, "mass": M, "forces": f, "K": K, "C": C, "gaps": g, "WN": WN, "wN": wN,
-            "WT": WT, "wT": wT, "wNbar": wNb, "wTbar": wTb}
+    dynamics_fn(model.kind, model.par, q, v, t, D, True)
+    contact_fn(model.kind, model.par, q, t, G, True, True)
+    contact_fn(model.kind, model.par, q, t, G2, False, False)
+    drift_fn(model.kind, model.par, q, v, t, Dr)
+    return {"mass": M, "forces": D[:, 0], "K": D[:, 1:1 + n], "C": D[:, 1 + n:],
+            "gaps": G[:, 0], "wN": G[:, 1], "wT": G[:, 2], "WN": G[:, 3:3 + n],
+            "WT": G[:, 3 + n:], "WN_normal_only": G2[:, 3:3 + n], "wN_normal_only": G2[:, 1],
+            "wNbar": Dr[:, 0], "wTbar": Dr[:, 1]}
 
 
 def check_compiled_model(scene, q, v, t):

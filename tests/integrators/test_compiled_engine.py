@@ -232,3 +232,16 @@ def test_steady_state_with_flight_and_impacts_at_15_khz():
     rel = abs(ss.displacement_per_period / ref.displacement_per_period - 1.0)
     assert rel < 2e-2                       # measured 1.2e-2
     assert ss.min_normal_force == 0.0       # flight inside the period
+
+
+def test_no_period_one_orbit_is_said_plainly():
+    # elastic impacts at 15 kHz: the discrete motion does not settle on a
+    # period-1 orbit; the answer says so and reports a long-run average
+    from moreau.analysis.mj_steady_state import moreau_jean_steady_state
+    sc = FrictionDrive(FrictionDriveParams(restitution=1.0), frequency=15000.0)
+    ss = moreau_jean_steady_state(sc, 2000)
+    assert ss.stats["periodic"] is False and ss.mode == "no period-1 orbit"
+    assert "no period-1 orbit" in ss.stats["message"]
+    assert "long-run average" in ss.stats["message"]
+    assert math.isfinite(ss.displacement_per_period) and ss.displacement_per_period > 0.0
+    assert ss.periodic_residual > 1e-6 and ss.regimes == []
