@@ -146,6 +146,9 @@ class FrictionDrive(Scene):
 
     ndof = 2
     name = "friction-drive"
+    #: the scene's own high-precision event-driven scheme, which
+    #: ``simulate(..., "event-driven")`` selects for it
+    reference_integrator = "friction-drive-walker"
 
     def __init__(self, params=None, frequency=185.0):
         if params is None:
