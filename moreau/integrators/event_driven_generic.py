@@ -16,7 +16,7 @@ Smooth phases
 
     with ``H`` the rows ``[WN_closed; WT_stick]`` and ``G`` the same rows
     except that a sliding contact's normal row is ``WN_i - mu_i s_i WT_i``.
-    The state is integrated by DOP853 (``method="Radau"`` for stiff scenes)
+    The state is integrated by DOP853 (``ode_method="Radau"`` for stiff scenes)
     at a tight tolerance.
 
 Events (terminal event functions of ``solve_ivp``, refined by its Brent
@@ -218,7 +218,7 @@ class GenericEventDriven(Integrator):
     rtol, atol : float
         Tolerances of the smooth-phase integrator (``atol`` absolute, per
         state component).
-    method : {"DOP853", "Radau"}
+    ode_method : {"DOP853", "Radau"}
         Smooth-phase integrator; Radau for stiff scenes.
     max_step : float
         Largest integrator step; bounds the time in which a gap could dip
@@ -248,15 +248,15 @@ class GenericEventDriven(Integrator):
     [1.0, 2.0]
     """
 
-    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, method="DOP853",
+    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
                  max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
                  max_impacts=10000, lcp_method="lemke"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.rtol = positive("rtol", rtol)
         self.atol = positive("atol", atol)
-        if method not in ("DOP853", "Radau"):
-            raise InputError(f"`method` must be 'DOP853' or 'Radau', got {method!r}")
-        self.method = method
+        if ode_method not in ("DOP853", "Radau"):
+            raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")
+        self.ode_method = ode_method
         self.max_step = positive("max_step", max_step)
         self.sample_dt = (positive("sample_dt", sample_dt) if sample_dt is not None
                           else (self.t_bound - self.t0) / 256.0)
@@ -627,7 +627,7 @@ class GenericEventDriven(Integrator):
         rhs, events, meta, evaluate = self._phase_functions()
         y0 = np.concatenate([self.q, self.v])
         self.counters["segments"] += 1
-        sol = solve_ivp(rhs, (self.t, self.t_bound), y0, method=self.method, rtol=self.rtol,
+        sol = solve_ivp(rhs, (self.t, self.t_bound), y0, method=self.ode_method, rtol=self.rtol,
                         atol=self.atol, events=events or None, dense_output=True,
                         max_step=self.max_step)
         if sol.status < 0:
