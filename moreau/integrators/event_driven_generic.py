@@ -270,6 +270,7 @@ class GenericEventDriven(Integrator):
         self.mode = np.zeros(nc, dtype=int)
         self._vscale = 0.0
         self._approach = np.zeros(nc)
+        self._last_event_t, self._stalled = None, 0
         self.counters.update({"events": 0, "impacts": 0, "lcp_solves": 0, "rhs": 0,
                               "segments": 0})
         self._next_sample = self.t0 + self.sample_dt
@@ -310,6 +311,9 @@ class GenericEventDriven(Integrator):
         slip = ms.slip_velocities(q, v, t, kin)
         gap = self.scene.gaps(q, t)
         self._record(t, q, v, self.mode.copy(), lamN, lamT, slip, gap)
+        # the velocity scale of the tolerances also learns from the samples:
+        # events may all fall where the scene is momentarily at rest
+        self._update_vscale(q, v, t)
 
     # -- projection onto the closed contacts' constraints ----------------------
     def _project_positions(self, t, q, contacts):
@@ -463,8 +467,61 @@ class GenericEventDriven(Integrator):
                     mode[i] = _S
                 else:
                     mode[i] = _P if acc[kk] > 0 else _N
+        if not self._consistent(t, q, v, mode, cand, sign, cone):
+            # a degenerate LCP (simultaneous events, redundant contacts) can
+            # return a mode whose own dynamics leaves it at once; the case
+            # analysis over the candidates' regimes finds the consistent one
+            mode = self._enumerate(t, q, v, mode, cand, sign, cone)
         self._check_well_posed(t, q, v, mode)
         return mode
+
+    def _consistent(self, t, q, v, mode, cand, sign, cone):
+        """Whether ``mode`` satisfies its own sign conditions at ``(t, q, v)``."""
+        ms = self.ms
+        try:
+            a, lamN, lamT, _, _, kin = ms.solve(t, q, v, mode)
+        except PainleveError:
+            return False
+        WN, WT, wNb, wTb = kin[2], kin[4], kin[6], kin[7]
+        scale = max(float(np.max(np.abs(lamN), initial=0.0)), float(np.max(np.abs(a))), 1e-300)
+        tol = 1e-10 * scale
+        for i in cand:
+            j = ms.trow[i]
+            if mode[i] == _F:
+                if WN[i] @ a + wNb[i] < -tol:
+                    return False
+                continue
+            if lamN[i] < -tol:
+                return False
+            if j < 0:
+                continue
+            if mode[i] == _S:
+                if abs(lamT[i]) > ms.mu[i] * lamN[i] + tol:
+                    return False
+            elif i in cone and _SIGN[mode[i]] * (WT[j] @ a + wTb[j]) < -tol:
+                return False
+        return True
+
+    def _enumerate(self, t, q, v, first, cand, sign, cone):
+        from itertools import product
+
+        ms = self.ms
+        choices = []
+        for i in cand:
+            if ms.trow[i] < 0:
+                choices.append((_P, _F))
+            elif i in sign:
+                choices.append((_P if sign[i] > 0 else _N, _F))
+            else:
+                choices.append((_S, _P, _N, _F))
+        for combo in product(*choices):
+            mode = first.copy()
+            mode[list(cand)] = combo
+            if self._consistent(t, q, v, mode, cand, sign, cone):
+                return mode
+        raise PainleveError(
+            f"no contact mode is consistent at t = {t:.12g} (contacts {list(cand)}): the "
+            "acceleration-level contact problem has no solution")
 
     def _check_well_posed(self, t, q, v, mode):
         """Raise PainleveError unless the mode's normal-force matrix is a P-matrix."""
@@ -624,6 +681,13 @@ class GenericEventDriven(Integrator):
         return rhs, events, meta, evaluate
 
     def _step_impl(self):
+        if self.t == self._last_event_t:
+            self._stalled += 1
+            if self._stalled > 50:
+                raise MoreauError(f"more than 50 events at t = {self.t:.15g} without progress "
+                                  f"(contact modes {self.ms.letters(self.mode)})")
+        else:
+            self._last_event_t, self._stalled = self.t, 0
         rhs, events, meta, evaluate = self._phase_functions()
         y0 = np.concatenate([self.q, self.v])
         self.counters["segments"] += 1
