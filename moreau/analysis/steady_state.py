@@ -126,7 +126,10 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
 
     Parameters
     ----------
-    scene : FrictionDrive
+    scene : FrictionDrive or a scene with a ``cyclic_coordinate``
+        Scenes with a ``cyclic_coordinate`` (the bidirectional drive) are
+        handed to :func:`moreau.analysis.periodic_shooting.shoot_periodic`
+        with ``scheme`` and ``options``.
     scheme : str
         ``"event-driven"`` (this function) or ``"moreau-jean"`` (delegates to
         :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`,
@@ -150,6 +153,11 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     >>> ss.mode
     'NS'
     """
+    if getattr(scene, "cyclic_coordinate", None) is not None:
+        # scenes beyond the single-rod drive: generic shooting on the period
+        # map of either scheme
+        from .periodic_shooting import shoot_periodic
+        return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     if scheme == "moreau-jean":
         from .mj_steady_state import moreau_jean_steady_state
         return moreau_jean_steady_state(scene, **options)

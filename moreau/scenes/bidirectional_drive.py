@@ -198,6 +198,8 @@ class BidirectionalDrive(Scene):
 
     ndof = 3
     name = "bidirectional-drive"
+    #: the rotor position u2 does not enter the dynamics (period maps reset it)
+    cyclic_coordinate = 2
 
     def __init__(self, params=None, frequency=185.0):
         if params is None:
