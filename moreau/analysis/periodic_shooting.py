@@ -180,8 +180,11 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         vn = vb + Bv @ z[nz_q:]
         return _project(scene, ts, qn, vn, touching)
 
+    vmax = [0.0]
+
     def residual(qs, vs):
         res = period(qs, vs)
+        vmax[0] = max(vmax[0], float(np.max(np.abs(res.v))))
         qe, ve = res.q[-1].copy(), res.v[-1].copy()
         disp = qe[cyclic] - qs[cyclic]
         qe[cyclic] = qs[cyclic]
@@ -193,7 +196,13 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     base = (q, v)
     z = np.zeros(nz_q + Bv.shape[1])
     r, disp = residual(q, v)
-    vscale = max(float(np.max(np.abs(v))), float(np.max(np.abs(r))), 1e-300)
+    # the velocity scale of the motion over the period (the section may
+    # catch the scene at rest)
+    for tk in np.linspace(ts, ts + TWO_PI, 33):
+        _, wN, _, wT = scene.contact_jacobians(q, tk)
+        vmax[0] = max(vmax[0], float(np.max(np.abs(wN), initial=0.0)),
+                      float(np.max(np.abs(wT), initial=0.0)))
+    vscale = max(vmax[0], float(np.max(np.abs(r))), 1e-300)
     it = 0
     while np.max(np.abs(r)) > rtol * vscale:
         it += 1

@@ -280,6 +280,12 @@ class GenericEventDriven(Integrator):
                 i = int(np.argmin(g))
                 raise InputError(f"`q0` penetrates contact {i}: gap = {g[i]:.3g} < 0")
             self._update_vscale(self.q, self.v, self.t)
+            # a driven scene may start at rest: its rheonomic contact
+            # velocities over the run set the scale then
+            for tk in np.linspace(self.t0, self.t_bound, 17):
+                _, wN, _, wT = scene.contact_jacobians(self.q, tk)
+                self._vscale = max(self._vscale, float(np.max(np.abs(wN), initial=0.0)),
+                                   float(np.max(np.abs(wT), initial=0.0)))
             self._resolve(kind="start")
         except PainleveError as exc:
             self._fail(-1, str(exc))
