@@ -67,6 +67,9 @@ def direction_sweep(knob, values, frequency=185.0, base=None, scheme="event-driv
 
     Examples
     --------
+    >>> p = bidirectional_params("balance", 0.5)      # rod b at full, rod a at half amplitude
+    >>> p.x10_a, p.x10_b
+    (1e-06, 2e-06)
     >>> rows = direction_sweep("balance", [-1.0], frequency=2000.0)   # doctest: +SKIP
     >>> rows[0]["mode"]                                                # doctest: +SKIP
     'NP|F'

@@ -113,8 +113,10 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     --------
     >>> from moreau.scenes import BidirectionalDrive, BidirectionalDriveParams
     >>> sc = BidirectionalDrive(BidirectionalDriveParams(x10_b=0.0), frequency=2000.0)
-    >>> ss = shoot_periodic(sc, "event-driven")                     # doctest: +SKIP
-    >>> ss.mode                                                     # doctest: +SKIP
+    >>> sc.cyclic_coordinate                     # the rotor position
+    2
+    >>> ss = shoot_periodic(sc, "event-driven")  # doctest: +SKIP
+    >>> ss.mode                                  # doctest: +SKIP
     'NP|F'
     """
     if cyclic is None:

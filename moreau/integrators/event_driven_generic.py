@@ -228,8 +228,10 @@ class GenericEventDriven(Integrator):
     gap_tol : float
         Gap at or below which a contact counts as touching.
     vel_tol : float
-        Relative velocity (scaled by the largest contact velocity met so far)
-        below which a normal or slip velocity counts as zero at an event.
+        Relative velocity below which a normal or slip velocity counts as
+        zero at an event. The scale is the largest term of the contact
+        velocities (``|W| |v| + |w|``) met so far, including the scene's
+        rheonomic terms over the run, so a scene at rest still has one.
     zeno_rtol : float
         Rebound velocity, relative to the contact's largest approach speed,
         below which an impact sequence is taken as accumulated (contact closes).
