@@ -94,6 +94,9 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
 
 
 def _cmd_steady(args):
+    if getattr(args, "scene", "friction-drive") == "bidirectional":
+        from .cli_bidirectional import cmd_steady_bidirectional
+        return cmd_steady_bidirectional(args)
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
@@ -279,6 +282,8 @@ def build_parser():
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p)
+    from .cli_bidirectional import add_scene_options
+    add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "
                                       "cached and in parallel")

@@ -7,61 +7,18 @@ state; its fixed point is the periodic steady state, found by shooting.
 
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from .._validate import positive, positive_int
 from ..errors import ConvergenceError, InputError
+# SteadyState is defined with the other scheme results (below this layer)
+# and re-exported here, where callers have always found it
+from ..integrators.result import SteadyState
+from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
-from .modes import mode_name
 
 __all__ = ["SteadyState", "find_steady_state"]
-
-
-@dataclass
-class SteadyState:
-    """A periodic steady state, in the scene's dimensionless units.
-
-    Attributes
-    ----------
-    scheme : str
-        ``"event-driven"`` or ``"moreau-jean"``.
-    displacement_per_period : float
-        Net change of the translation-invariant coordinate over one period
-        (dimensionless, ``u2 = x2 / l`` for the friction drive).
-    state0 : ndarray
-        The fixed point of the period map: ``(phi, phi', u2')`` at the
-        Poincaré section ``tau = section_tau``.
-    mode : str
-        Canonical name of the cyclic regime sequence (e.g. ``"NP"``).
-    regimes : list of (float, str)
-        ``[tau_start, letter]`` of each regime over one period, tau in [0, 2 pi).
-    min_normal_force : float
-        Smallest dimensionless normal force over the period.
-    periodic_residual : float
-        ``|P(x*) - x*|`` of the period map at the returned fixed point.
-    iterations : int
-        Shooting iterations.
-    wall_time : float
-        Seconds spent.
-    stats : dict
-        Scheme-specific counters (steps, LCP solves, fallbacks, ...).
-    section_tau : float
-        Phase of the Poincaré section at which ``state0`` is given.
-    """
-
-    scheme: str
-    displacement_per_period: float
-    state0: np.ndarray
-    mode: str
-    regimes: list
-    min_normal_force: float
-    periodic_residual: float
-    iterations: int = 0
-    wall_time: float = 0.0
-    stats: dict = field(default_factory=dict)
-    section_tau: float = 0.0
 
 
 # -- event-driven steady state of the friction drive ------------------------------
@@ -169,7 +126,13 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
 
     Parameters
     ----------
-    scene : FrictionDrive
+    scene : Scene
+        A ``2 pi``-periodic scene with ``cyclic_coordinates``. The friction
+        drive's event-driven steady state uses its walker (below); other
+        scenes' event-driven steady states are found by
+        :func:`moreau.analysis.periodic_shooting.shoot_periodic`, and every
+        scene's Moreau–Jean steady state by the compiled period map of
+        :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`.
     scheme : str
         ``"event-driven"`` (this function) or ``"moreau-jean"`` (delegates to
         :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`,
@@ -198,6 +161,10 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         return moreau_jean_steady_state(scene, **options)
     if scheme != "event-driven":
         raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {scheme!r}")
+    if getattr(scene, "reference_integrator", None) != "friction-drive-walker":
+        # any other periodic scene: Newton shooting on the generic event-driven period map
+        from .periodic_shooting import shoot_periodic
+        return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
     from ..integrators.event_driven import FrictionDriveWalker

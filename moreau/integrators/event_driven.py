@@ -647,9 +647,16 @@ class FrictionDriveWalker:
         return st
 
 
-@register_integrator("event-driven")
+@register_integrator("friction-drive-walker")
 class EventDriven(Integrator):
-    """Event-driven reference integrator of the friction drive.
+    """Event-driven reference integrator of the friction drive (``"friction-drive-walker"``).
+
+    The high-precision path for :class:`~moreau.scenes.friction_drive.FrictionDrive`:
+    contact segments are integrated in closed form, so they are exact to
+    round-off. ``simulate(..., "event-driven")`` selects it for that scene
+    (the scene names it in ``reference_integrator``); the scene-independent
+    scheme, :class:`~moreau.integrators.event_driven_generic.GenericEventDriven`
+    (``"event-driven-generic"``), cross-checks it.
 
     Each :meth:`step` advances to the next event (regime change or impact)
     or to ``t_bound``. Samples are recorded at every event and on a uniform

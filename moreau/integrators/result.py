@@ -10,7 +10,7 @@ import numpy as np
 
 from ..regimes import REGIME_LETTERS, Regime
 
-__all__ = ["SimulationResult", "Event", "STATUS_MESSAGES"]
+__all__ = ["SimulationResult", "Event", "STATUS_MESSAGES", "SteadyState"]
 
 #: status codes and their meaning (scipy.integrate style: 0 finished,
 #: 1 a terminal event stopped the run, < 0 failure)
@@ -104,3 +104,48 @@ class SimulationResult:
     def regime_letters(self, contact=0):
         """Regime of one contact at each sample as a string of letters."""
         return "".join(REGIME_LETTERS[Regime(int(r))] for r in self.regime[:, contact])
+
+
+@dataclass
+class SteadyState:
+    """A periodic steady state, in the scene's dimensionless units.
+
+    Attributes
+    ----------
+    scheme : str
+        ``"event-driven"`` or ``"moreau-jean"``.
+    displacement_per_period : float
+        Net change of the translation-invariant coordinate over one period
+        (dimensionless, ``u2 = x2 / l`` for the friction drive).
+    state0 : ndarray
+        The fixed point of the period map: ``(phi, phi', u2')`` at the
+        Poincaré section ``tau = section_tau``.
+    mode : str
+        Canonical name of the cyclic regime sequence (e.g. ``"NP"``).
+    regimes : list of (float, str)
+        ``[tau_start, letter]`` of each regime over one period, tau in [0, 2 pi).
+    min_normal_force : float
+        Smallest dimensionless normal force over the period.
+    periodic_residual : float
+        ``|P(x*) - x*|`` of the period map at the returned fixed point.
+    iterations : int
+        Shooting iterations.
+    wall_time : float
+        Seconds spent.
+    stats : dict
+        Scheme-specific counters (steps, LCP solves, fallbacks, ...).
+    section_tau : float
+        Phase of the Poincaré section at which ``state0`` is given.
+    """
+
+    scheme: str
+    displacement_per_period: float
+    state0: np.ndarray
+    mode: str
+    regimes: list
+    min_normal_force: float
+    periodic_residual: float
+    iterations: int = 0
+    wall_time: float = 0.0
+    stats: dict = field(default_factory=dict)
+    section_tau: float = 0.0

@@ -30,13 +30,12 @@ import time as _time
 import numpy as np
 from scipy.optimize import brentq
 
-from ..analysis.modes import mode_name
-from ..analysis.steady_state import SteadyState
 from ..errors import ConvergenceError, InputError
+from ..modes import mode_name
 from ..regimes import Regime
 from ..scenes.stick_slip_motor import TWO_PI, StickSlipMotor
 from .base import Integrator, register_integrator
-from .result import Event
+from .result import Event, SteadyState
 
 __all__ = ["StickSlipReference", "stick_slip_steady_state", "stick_slip_period_map"]
 

@@ -148,6 +148,9 @@ class FrictionDrive(Scene):
     name = "friction-drive"
     period = 2.0 * math.pi
     cyclic_coordinates = (1,)
+    #: the scene's own high-precision event-driven scheme, which
+    #: ``simulate(..., "event-driven")`` selects for it
+    reference_integrator = "friction-drive-walker"
 
     def __init__(self, params=None, frequency=185.0):
         if params is None:

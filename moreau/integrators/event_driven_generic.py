@@ -1,0 +1,770 @@
+"""Event-driven integration of any scene, through the :class:`~moreau.scenes.base.Scene` interface.
+
+The scheme follows the classical event-driven treatment of unilateral
+contact with Coulomb friction (Pfeiffer and Glocker): the motion is cut into
+smooth phases, each with a fixed *contact mode* (every contact open, sliding
+one way, sliding the other way, or sticking), and the phases are joined at
+events located to near machine precision.
+
+Smooth phases
+    With the mode fixed, the closed contacts' normal accelerations and the
+    sticking contacts' slip accelerations are held at zero; sliding contacts
+    carry the friction force ``lambdaT = -mu sign(gammaT) lambdaN``. That is
+    one linear system per right-hand-side evaluation::
+
+        M a = h + G^T lam,    H a + wbar = 0
+
+    with ``H`` the rows ``[WN_closed; WT_stick]`` and ``G`` the same rows
+    except that a sliding contact's normal row is ``WN_i - mu_i s_i WT_i``.
+    The state is integrated by DOP853 (``ode_method="Radau"`` for stiff scenes)
+    at a tight tolerance.
+
+Events (terminal event functions of ``solve_ivp``, refined by its Brent
+root finder to a few ulps of time)
+    * an open contact's gap closing;
+    * a closed contact's normal force vanishing (lift-off);
+    * a sliding contact's slip velocity vanishing;
+    * a sticking contact's friction force reaching the cone ``|lambdaT| = mu lambdaN``;
+    * a sliding contact's normal-force coefficient ``(H M^-1 G^T)_ii``
+      vanishing, which is the Painlevé condition failing
+      (:class:`~moreau.errors.PainleveError`).
+
+Deciding the next mode
+    At an event the state is projected back onto the closed contacts'
+    constraints (gap and normal velocity zero, slip velocity zero for
+    sticking contacts, in the metric of ``M``), then the frictional LCP at
+    acceleration level is solved by Lemke's method over the closed
+    contacts: contacts with zero slip get the full friction-cone variables
+    (stick or slip in the direction the LCP picks), contacts with nonzero
+    slip keep their sliding friction. The event itself settles the cases the
+    LCP cannot decide at the event instant: a lift-off opens its contact, a
+    saturated cone starts slip in the direction of the friction force's
+    reaction. The new mode is then checked for well-posedness: the matrix
+    of the normal forces (stick rows eliminated) must be a P-matrix, else
+    :class:`~moreau.errors.PainleveError` is raised.
+
+Impacts
+    A gap closing with an approach velocity is an impact: Newton's
+    restitution law with Coulomb friction, as the velocity-level LCP of
+    :func:`moreau.lcp.build_friction_lcp` over every contact whose gap is
+    closed, solved by Lemke's method.
+
+Accumulation of impacts (Zeno) policy
+    A contact whose rebound velocity after an impact is below
+    ``zeno_rtol`` times the largest approach speed seen at that contact is
+    treated as having reached the accumulation point: the impact is
+    repeated as a plastic one (``e = 0``) for that contact and the contact
+    closes. For a ball under gravity with restitution ``e`` and first impact
+    speed ``V`` the remaining bounce time thus cut off is below
+    ``2 zeno_rtol V / (1 - e)`` (``zeno_rtol = 1e-10`` by default). Independently,
+    more than ``max_impacts`` impacts in one run stop it with a
+    :class:`~moreau.errors.MoreauError` (status ``-5``).
+
+Known limits: a gap that dips below zero and comes back inside one
+integrator step is not seen (``max_step`` bounds the step); scenes with
+discontinuous forcing (a sawtooth drive) are integrated across the jumps by
+step-size control, which costs steps and some accuracy.
+"""
+
+import math
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from .._validate import nonnegative, positive, positive_int
+from ..errors import InputError, LCPError, MoreauError, PainleveError
+from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
+from ..regimes import Regime
+from .base import INTEGRATORS, Integrator, register_integrator
+from .result import Event
+
+__all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference"]
+
+_F, _P, _N, _S = int(Regime.FLIGHT), int(Regime.POSITIVE), int(Regime.NEGATIVE), int(Regime.STICK)
+_SIGN = {_P: 1.0, _N: -1.0}
+
+
+class ContactModeSolver:
+    """Contact-mode dynamics of a scene: accelerations, forces, event functions.
+
+    Parameters
+    ----------
+    scene : Scene
+
+    Notes
+    -----
+    ``mode`` is an int array over contacts of :class:`~moreau.regimes.Regime`
+    codes. A closed frictionless contact is coded ``POSITIVE`` (it has no
+    tangential row, so the sign is immaterial).
+    """
+
+    def __init__(self, scene):
+        self.scene = scene
+        self.nc = scene.ncontacts
+        self.ndof = scene.ndof
+        self.mu = np.asarray(scene.mu, dtype=float).copy()
+        self.e = np.asarray(scene.restitution, dtype=float).copy()
+        # row of each frictional contact in WT (-1 for frictionless contacts)
+        self.trow = np.full(self.nc, -1, dtype=int)
+        self.trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
+
+    def kinematics(self, t, q, v):
+        sc = self.scene
+        M = sc.mass(q)
+        h = sc.forces(q, v, t)
+        WN, wN, WT, wT = sc.contact_jacobians(q, t)
+        wNb, wTb = sc.contact_drift(q, v, t)
+        return M, h, WN, wN, WT, wT, wNb, wTb
+
+    def _rows(self, mode, WN, WT, wNb, wTb):
+        """Rows ``H`` (measured accelerations), ``G`` (force directions) and drift."""
+        closed = np.flatnonzero(mode != _F)
+        stick = [i for i in closed if mode[i] == _S and self.trow[i] >= 0]
+        nrow = len(closed) + len(stick)
+        H = np.empty((nrow, self.ndof))
+        G = np.empty((nrow, self.ndof))
+        wbar = np.empty(nrow)
+        for k, i in enumerate(closed):
+            H[k] = WN[i]
+            wbar[k] = wNb[i]
+            j = self.trow[i]
+            if j >= 0 and mode[i] in (_P, _N):
+                G[k] = WN[i] - self.mu[i] * _SIGN[mode[i]] * WT[j]
+            else:
+                G[k] = WN[i]
+        for k, i in enumerate(stick):
+            j = self.trow[i]
+            H[len(closed) + k] = WT[j]
+            G[len(closed) + k] = WT[j]
+            wbar[len(closed) + k] = wTb[j]
+        return closed, stick, H, G, wbar
+
+    def solve(self, t, q, v, mode):
+        """Accelerations and contact forces of ``mode`` at ``(t, q, v)``.
+
+        Returns
+        -------
+        a : ndarray (ndof,)
+        lamN, lamT : ndarray (nc,)
+            Normal and friction force of every contact (0 where open).
+        A : ndarray
+            The mode matrix ``H M^-1 G^T`` (closed normal rows, then stick rows).
+        closed : ndarray of int
+        kin : tuple
+            The scene quantities at this state (see :meth:`kinematics`).
+        """
+        kin = self.kinematics(t, q, v)
+        M, h, WN, wN, WT, wT, wNb, wTb = kin
+        closed, stick, H, G, wbar = self._rows(mode, WN, WT, wNb, wTb)
+        lamN = np.zeros(self.nc)
+        lamT = np.zeros(self.nc)
+        if H.shape[0] == 0:
+            return np.linalg.solve(M, h), lamN, lamT, np.zeros((0, 0)), closed, kin
+        X = np.linalg.solve(M, np.column_stack([h, G.T]))
+        Mih, MiG = X[:, 0], X[:, 1:]
+        A = H @ MiG
+        try:
+            lam = np.linalg.solve(A, -(H @ Mih + wbar))
+        except np.linalg.LinAlgError:
+            raise PainleveError(
+                f"the contact problem of mode {self.letters(mode)} is singular at t = {t:.12g}: "
+                "the normal forces are not determined (Painlevé configuration or "
+                "redundant contacts)") from None
+        a = Mih + MiG @ lam
+        nclosed = len(closed)
+        lamN[closed] = lam[:nclosed]
+        for k, i in enumerate(closed):
+            if mode[i] in (_P, _N) and self.trow[i] >= 0:
+                lamT[i] = -self.mu[i] * _SIGN[mode[i]] * lam[k]
+        for k, i in enumerate(stick):
+            lamT[i] = lam[nclosed + k]
+        return a, lamN, lamT, A, closed, kin
+
+    @staticmethod
+    def letters(mode):
+        return "".join(Regime(int(m)).letter for m in mode)
+
+    def slip_velocities(self, q, v, t, kin=None):
+        """Slip velocity of every contact (0 for frictionless ones)."""
+        if kin is None:
+            kin = self.kinematics(t, q, v)
+        _, _, _, _, WT, wT, _, _ = kin
+        out = np.zeros(self.nc)
+        fr = self.trow >= 0
+        out[fr] = WT[self.trow[fr]] @ v + wT[self.trow[fr]]
+        return out
+
+    def normal_velocities(self, q, v, t, kin=None):
+        if kin is None:
+            kin = self.kinematics(t, q, v)
+        _, _, WN, wN, _, _, _, _ = kin
+        return WN @ v + wN
+
+
+@register_integrator("event-driven-generic")
+class GenericEventDriven(Integrator):
+    """Event-driven reference for any :class:`~moreau.scenes.base.Scene`.
+
+    Each :meth:`step` runs one smooth phase to its first event (or to
+    ``t_bound``) and resolves the event. Samples are recorded at every event
+    and every ``sample_dt`` of time. See the module docstring for the method
+    and the impact-accumulation policy.
+
+    Parameters
+    ----------
+    scene : Scene
+    t0, q0, v0, t_bound
+        See :class:`~moreau.integrators.base.Integrator`.
+    rtol, atol : float
+        Tolerances of the smooth-phase integrator (``atol`` absolute, per
+        state component).
+    ode_method : {"DOP853", "Radau"}
+        Smooth-phase integrator; Radau for stiff scenes.
+    max_step : float
+        Largest integrator step; bounds the time in which a gap could dip
+        below zero and come back unseen.
+    sample_dt : float, optional
+        Output interval; ``(t_bound - t0) / 256`` by default.
+    gap_tol : float
+        Gap at or below which a contact counts as touching.
+    vel_tol : float
+        Relative velocity below which a normal or slip velocity counts as
+        zero at an event. The scale is the largest term of the contact
+        velocities (``|W| |v| + |w|``) met so far, including the scene's
+        rheonomic terms over the run, so a scene at rest still has one.
+    zeno_rtol : float
+        Rebound velocity, relative to the contact's largest approach speed,
+        below which an impact sequence is taken as accumulated (contact closes).
+    max_impacts : int
+        Impacts allowed in one run.
+    lcp_method : str
+        LCP solver for the contact problems (see :func:`moreau.lcp.solve_lcp`).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> from moreau.integrators import simulate
+    >>> ball = BouncingBall(restitution=0.5, radius=0.1)
+    >>> res = simulate(ball, (0.0, 2.4), [0.6], [0.0], "event-driven-generic")
+    >>> [round(ev.t, 12) for ev in res.events if ev.kind == "impact"]
+    [1.0, 2.0]
+    """
+
+    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
+                 max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
+                 max_impacts=10000, lcp_method="lemke"):
+        super().__init__(scene, t0, q0, v0, t_bound)
+        self.rtol = positive("rtol", rtol)
+        self.atol = positive("atol", atol)
+        if ode_method not in ("DOP853", "Radau"):
+            raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")
+        self.ode_method = ode_method
+        self.max_step = positive("max_step", max_step)
+        self.sample_dt = (positive("sample_dt", sample_dt) if sample_dt is not None
+                          else (self.t_bound - self.t0) / 256.0)
+        self.gap_tol = nonnegative("gap_tol", gap_tol)
+        self.vel_tol = nonnegative("vel_tol", vel_tol)
+        self.zeno_rtol = nonnegative("zeno_rtol", zeno_rtol)
+        self.max_impacts = positive_int("max_impacts", max_impacts)
+        self.lcp_method = lcp_method
+        self.ms = ContactModeSolver(scene)
+        nc = scene.ncontacts
+        self.mode = np.zeros(nc, dtype=int)
+        self._vscale = 0.0
+        self._approach = np.zeros(nc)
+        self._last_event_t, self._stalled = None, 0
+        self.counters.update({"events": 0, "impacts": 0, "lcp_solves": 0, "rhs": 0,
+                              "segments": 0})
+        self._next_sample = self.t0 + self.sample_dt
+        try:
+            g = scene.gaps(self.q, self.t)
+            if np.any(g < -self.gap_tol):
+                i = int(np.argmin(g))
+                raise InputError(f"`q0` penetrates contact {i}: gap = {g[i]:.3g} < 0")
+            self._update_vscale(self.q, self.v, self.t)
+            # a driven scene may start at rest: its rheonomic contact
+            # velocities over the run set the scale then
+            for tk in np.linspace(self.t0, self.t_bound, 17):
+                _, wN, _, wT = scene.contact_jacobians(self.q, tk)
+                self._vscale = max(self._vscale, float(np.max(np.abs(wN), initial=0.0)),
+                                   float(np.max(np.abs(wT), initial=0.0)))
+            self._resolve(kind="start")
+        except PainleveError as exc:
+            self._fail(-1, str(exc))
+            return
+        except LCPError as exc:
+            self._fail(-3, str(exc))
+            return
+        self._record_state(self.t, self.q, self.v)
+
+    # -- scales and tolerances ------------------------------------------------
+    def _update_vscale(self, q, v, t):
+        # the scale of the terms that make up the contact velocities, not of
+        # the relative velocities themselves (zero in stick)
+        kin = self.ms.kinematics(t, q, v)
+        WN, wN, WT, wT = kin[2], kin[3], kin[4], kin[5]
+        av = np.abs(v)
+        terms = [np.abs(WN) @ av + np.abs(wN), np.abs(WT) @ av + np.abs(wT)]
+        vel = np.concatenate(terms)
+        if vel.size:
+            self._vscale = max(self._vscale, float(vel.max()))
+
+    def _vtol(self):
+        return self.vel_tol * max(self._vscale, 1e-300)
+
+    # -- recording ---------------------------------------------------------------
+    def _record_state(self, t, q, v):
+        ms = self.ms
+        a, lamN, lamT, _, _, kin = ms.solve(t, q, v, self.mode)
+        slip = ms.slip_velocities(q, v, t, kin)
+        gap = self.scene.gaps(q, t)
+        self._record(t, q, v, self.mode.copy(), lamN, lamT, slip, gap)
+        # the velocity scale of the tolerances also learns from the samples:
+        # events may all fall where the scene is momentarily at rest
+        self._update_vscale(q, v, t)
+
+    # -- projection onto the closed contacts' constraints ----------------------
+    def _project_positions(self, t, q, contacts):
+        """``q`` moved (in the metric of ``M``) onto ``g = 0`` for ``contacts``."""
+        sc = self.scene
+        M = sc.mass(q)
+        for _ in range(4):
+            g = sc.gaps(q, t)[contacts]
+            if np.max(np.abs(g)) == 0.0:
+                break
+            WN = sc.contact_jacobians(q, t)[0][contacts]
+            MiW = np.linalg.solve(M, WN.T)
+            dq = MiW @ np.linalg.solve(WN @ MiW, g)
+            q = q - dq
+            if np.max(np.abs(dq)) <= 4e-16 * max(1.0, float(np.max(np.abs(q)))):
+                break
+        return q
+
+    def _project(self, t, q, v, mode):
+        closed = np.flatnonzero(mode != _F)
+        if closed.size == 0:
+            return q, v
+        sc = self.scene
+        q = self._project_positions(t, q, closed)
+        WN, wN, WT, wT = sc.contact_jacobians(q, t)
+        stick = [i for i in closed if mode[i] == _S and self.ms.trow[i] >= 0]
+        H = np.vstack([WN[closed]] + ([WT[self.ms.trow[stick]]] if stick else []))
+        w = np.concatenate([wN[closed]] + ([wT[self.ms.trow[stick]]] if stick else []))
+        MiH = np.linalg.solve(sc.mass(q), H.T)
+        v = v - MiH @ np.linalg.solve(H @ MiH, H @ v + w)
+        return q, v
+
+    # -- impacts ---------------------------------------------------------------------
+    def _impact(self, t, q, v, touching):
+        """Velocity jump of Newton's impact law with Coulomb friction over ``touching``."""
+        ms, sc = self.ms, self.scene
+        kin = ms.kinematics(t, q, v)
+        M, _, WN, wN, WT, wT, _, _ = kin
+        rows = [WN[touching]]
+        fr = [i for i in touching if ms.trow[i] >= 0]
+        if fr:
+            rows.append(WT[ms.trow[fr]])
+        J = np.vstack(rows)
+        w = np.concatenate([wN[touching]] + ([wT[ms.trow[fr]]] if fr else []))
+        MiJ = np.linalg.solve(M, J.T)
+        W = J @ MiJ
+        vrel = J @ v + w
+        mu = ms.mu[touching]
+        e = ms.e[touching].copy()
+        vN_pre = vrel[:len(touching)]
+        self._approach[touching] = np.maximum(self._approach[touching], -vN_pre)
+        for attempt in range(2):
+            lcp = build_friction_lcp(W, vrel, mu, e, vN_pre)
+            res = solve_lcp(lcp.M, lcp.q, self.lcp_method)
+            self.counters["lcp_solves"] += 1
+            if not res.success:
+                if np.any(mu > 0):
+                    raise PainleveError(
+                        f"the frictional impact problem at t = {t:.12g} has no solution "
+                        f"(Lemke: {res.message}); a Painlevé-type impact configuration")
+                raise LCPError(f"impact LCP at t = {t:.12g} not solved: {res.message}")
+            p = friction_impulses(res.z, lcp.layout, stacked=True)
+            vN_post = (vrel + W @ p)[:len(touching)]
+            # Zeno policy: a rebound far below the contact's approach speeds is
+            # the accumulation point of a bounce sequence; close the contact
+            weak = (e > 0) & (vN_post > 0) & (vN_post <= self.zeno_rtol * self._approach[touching])
+            if attempt == 0 and np.any(weak):
+                e[weak] = 0.0
+                self.counters["zeno_closures"] = self.counters.get("zeno_closures", 0) + int(weak.sum())
+                continue
+            break
+        self.counters["impacts"] += 1
+        if self.counters["impacts"] > self.max_impacts:
+            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts "
+                              f"(an accumulation the Zeno policy did not end?)")
+        return v + MiJ @ p
+
+    # -- mode decision ------------------------------------------------------------------
+    def _decide(self, t, q, v, forced):
+        """New contact mode from the acceleration-level frictional LCP.
+
+        ``forced`` maps a contact to the regime its event imposes (lift-off ->
+        FLIGHT, cone saturation -> slip direction).
+        """
+        ms, sc = self.ms, self.scene
+        kin = ms.kinematics(t, q, v)
+        M, h, WN, wN, WT, wT, wNb, wTb = kin
+        g = sc.gaps(q, t)
+        vN = WN @ v + wN
+        vT = ms.slip_velocities(q, v, t, kin)
+        vtol = self._vtol()
+        mode = np.full(ms.nc, _F, dtype=int)
+        cand = [i for i in range(ms.nc)
+                if g[i] <= self.gap_tol and vN[i] <= vtol and forced.get(i) != _F]
+        if not cand:
+            return mode
+        # friction model of each candidate in the LCP: full cone (zero slip) or
+        # sliding with a fixed sign (nonzero slip, or a saturated cone)
+        sign = {}
+        cone = []
+        for i in cand:
+            if ms.trow[i] < 0:
+                continue
+            if i in forced:
+                sign[i] = _SIGN[forced[i]]
+            elif abs(vT[i]) > vtol:
+                sign[i] = math.copysign(1.0, vT[i])
+            else:
+                cone.append(i)
+        nC = len(cand)
+        H = np.empty((nC + len(cone), ms.ndof))
+        G = np.empty_like(H)
+        wbar = np.empty(nC + len(cone))
+        for k, i in enumerate(cand):
+            H[k] = WN[i]
+            G[k] = WN[i] - ms.mu[i] * sign[i] * WT[ms.trow[i]] if i in sign else WN[i]
+            wbar[k] = wNb[i]
+        for k, i in enumerate(cone):
+            H[nC + k] = G[nC + k] = WT[ms.trow[i]]
+            wbar[nC + k] = wTb[ms.trow[i]]
+        X = np.linalg.solve(M, np.column_stack([h, G.T]))
+        A = H @ X[:, 1:]
+        b = H @ X[:, 0] + wbar
+        mu_eff = np.array([ms.mu[i] if i in cone else 0.0 for i in cand])
+        lcp = build_friction_lcp(A, b, mu_eff, 0.0, np.zeros(nC))
+        res = solve_lcp(lcp.M, lcp.q, self.lcp_method)
+        self.counters["lcp_solves"] += 1
+        if not res.success:
+            if sign or cone:
+                raise PainleveError(
+                    f"the acceleration-level contact problem at t = {t:.12g} has no solution "
+                    f"(Lemke: {res.message}); a Painlevé configuration (friction "
+                    f"coefficients {ms.mu[cand].tolist()}, sliding contacts {sorted(sign)})")
+            raise LCPError(f"acceleration-level contact LCP at t = {t:.12g} not solved: "
+                           f"{res.message}")
+        lam = friction_impulses(res.z, lcp.layout, stacked=True)
+        acc = A @ lam + b
+        lamN = lam[:nC]
+        fscale = max(float(np.max(np.abs(lam))), float(np.max(np.abs(b))), 1e-300)
+        ftol = 1e-12 * fscale
+        for k, i in enumerate(cand):
+            if lamN[k] <= ftol and acc[k] >= -ftol:
+                continue     # leaves (or grazes): open
+            if ms.trow[i] < 0:
+                mode[i] = _P
+            elif i in sign:
+                mode[i] = _P if sign[i] > 0 else _N
+            else:
+                kk = nC + cone.index(i)
+                if abs(acc[kk]) <= ftol:
+                    mode[i] = _S
+                else:
+                    mode[i] = _P if acc[kk] > 0 else _N
+        if not self._consistent(t, q, v, mode, cand, sign, cone):
+            # a degenerate LCP (simultaneous events, redundant contacts) can
+            # return a mode whose own dynamics leaves it at once; the case
+            # analysis over the candidates' regimes finds the consistent one
+            mode = self._enumerate(t, q, v, mode, cand, sign, cone)
+        self._check_well_posed(t, q, v, mode)
+        return mode
+
+    def _consistent(self, t, q, v, mode, cand, sign, cone):
+        """Whether ``mode`` satisfies its own sign conditions at ``(t, q, v)``."""
+        ms = self.ms
+        try:
+            a, lamN, lamT, _, _, kin = ms.solve(t, q, v, mode)
+        except PainleveError:
+            return False
+        WN, WT, wNb, wTb = kin[2], kin[4], kin[6], kin[7]
+        scale = max(float(np.max(np.abs(lamN), initial=0.0)), float(np.max(np.abs(a))), 1e-300)
+        tol = 1e-10 * scale
+        for i in cand:
+            j = ms.trow[i]
+            if mode[i] == _F:
+                if WN[i] @ a + wNb[i] < -tol:
+                    return False
+                continue
+            if lamN[i] < -tol:
+                return False
+            if j < 0:
+                continue
+            if mode[i] == _S:
+                if abs(lamT[i]) > ms.mu[i] * lamN[i] + tol:
+                    return False
+            elif i in cone and _SIGN[mode[i]] * (WT[j] @ a + wTb[j]) < -tol:
+                return False
+        return True
+
+    def _enumerate(self, t, q, v, first, cand, sign, cone):
+        from itertools import product
+
+        ms = self.ms
+        choices = []
+        for i in cand:
+            if ms.trow[i] < 0:
+                choices.append((_P, _F))
+            elif i in sign:
+                choices.append((_P if sign[i] > 0 else _N, _F))
+            else:
+                choices.append((_S, _P, _N, _F))
+        for combo in product(*choices):
+            mode = first.copy()
+            mode[list(cand)] = combo
+            if self._consistent(t, q, v, mode, cand, sign, cone):
+                return mode
+        raise PainleveError(
+            f"no contact mode is consistent at t = {t:.12g} (contacts {list(cand)}): the "
+            "acceleration-level contact problem has no solution")
+
+    def _check_well_posed(self, t, q, v, mode):
+        """Raise PainleveError unless the mode's normal-force matrix is a P-matrix."""
+        closed = np.flatnonzero(mode != _F)
+        if closed.size == 0 or not np.any(np.isin(mode[closed], (_P, _N)) & (self.ms.mu[closed] > 0)):
+            return
+        _, _, _, A, closed, _ = self.ms.solve(t, q, v, mode)
+        n = len(closed)
+        K = A[:n, :n]
+        if A.shape[0] > n:       # eliminate the stick rows (Schur complement)
+            K = K - A[:n, n:] @ np.linalg.solve(A[n:, n:], A[n:, :n])
+        scale = max(float(np.max(np.abs(K))), 1e-300)
+        for r in range(1, min(n, 8) + 1):
+            from itertools import combinations
+            for idx in combinations(range(n), r):
+                d = np.linalg.det(K[np.ix_(idx, idx)])
+                if d <= 1e-13 * scale ** r:
+                    names = ", ".join(f"{int(closed[i])} ({Regime(int(mode[closed[i]])).letter})"
+                                      for i in idx)
+                    raise PainleveError(
+                        f"Painlevé configuration at t = {t:.12g}: the normal-force matrix of "
+                        f"the sliding contacts [{names}] has a principal minor {d:.3g} <= 0 "
+                        f"(friction coefficients {self.ms.mu[closed].tolist()}); the contact "
+                        "problem has no solution or several")
+
+    def _resolve(self, kind, forced=None, contact=None):
+        """Impacts, projection and the new mode at the current state."""
+        forced = forced or {}
+        t, q, v = self.t, self.q, self.v
+        sc, ms = self.scene, self.ms
+        before = self.mode.copy()
+        impacted = False
+        if kind != "start":
+            # remove the drift of the phase that just ended, so that a closed
+            # contact's residual normal velocity is not taken for an impact
+            q, v = self._project(t, q, v, before)
+        for _ in range(ms.nc + 2):
+            kin = ms.kinematics(t, q, v)
+            g = sc.gaps(q, t)
+            vN = ms.normal_velocities(q, v, t, kin)
+            touching = np.flatnonzero(g <= self.gap_tol)
+            if not np.any(vN[touching] < -self._vtol()):
+                break
+            q = self._project_positions(t, q, touching)
+            self._update_vscale(q, v, t)
+            v = self._impact(t, q, v, touching)
+            impacted = True
+        mode = self._decide(t, q, v, forced)
+        q, v = self._project(t, q, v, mode)
+        self.q, self.v, self.mode = q, v, mode
+        self._update_vscale(q, v, t)
+        if kind != "start":
+            changed = np.flatnonzero(mode != before)
+            evkind = "impact" if impacted else kind
+            if contact is None and changed.size:
+                contact = int(changed[0])
+            c = 0 if contact is None else int(contact)
+            self.events.append(Event(t=t, kind=evkind, before=Regime(int(before[c])),
+                                     after=Regime(int(mode[c])), contact=c))
+            self.counters["events"] += 1
+
+    # -- smooth phase ---------------------------------------------------------------------
+    def _phase_functions(self):
+        """RHS and event functions of the current mode (with a one-entry cache)."""
+        ms, sc, mode = self.ms, self.scene, self.mode.copy()
+        n = sc.ndof
+        cache = {}
+        counters = self.counters
+
+        def evaluate(t, y):
+            key = (t, y.tobytes())
+            hit = cache.get("key")
+            if hit == key:
+                return cache["val"]
+            q, v = y[:n], y[n:]
+            a, lamN, lamT, A, closed, kin = ms.solve(t, q, v, mode)
+            counters["rhs"] += 1
+            val = (a, lamN, lamT, A, closed, kin, q, v)
+            cache["key"], cache["val"] = key, val
+            return val
+
+        def rhs(t, y):
+            a = evaluate(t, y)[0]
+            return np.concatenate([y[n:], a])
+
+        y0 = np.concatenate([self.q, self.v])
+        t0 = self.t
+        a0, lamN0, lamT0, A0, closed0, kin0 = evaluate(t0, y0)[:6]
+        fscale = max(float(np.max(np.abs(lamN0), initial=0.0)), 1e-300)
+        g0 = sc.gaps(self.q, t0)
+        vN0 = ms.normal_velocities(self.q, self.v, t0, kin0)
+        vT0 = ms.slip_velocities(self.q, self.v, t0, kin0)
+        vtol = self._vtol()
+        # a function that starts on its zero (a phase begun by that very
+        # event) is held positive for a short skip, so the start is not taken
+        # for an event; later roots are found without bias
+        skip = 1e-10 * max(1.0, abs(t0))
+        events, meta = [], []
+
+        def make(fun, start_zero=False, span=skip):
+            if start_zero:
+                t_on = t0 + span
+
+                def ev(t, y, f=fun):
+                    return 1.0 if t < t_on else f(t, y)
+            else:
+                ev = fun
+            ev.terminal = True
+            ev.direction = -1.0
+            return ev
+
+        for i in range(ms.nc):
+            j = ms.trow[i]
+            if mode[i] == _F:
+                gap = (lambda t, y, i=i: sc.gaps(y[:n], t)[i])
+                if g0[i] > self.gap_tol:
+                    events.append(make(gap))
+                elif vN0[i] > vtol:
+                    # a rebound: skip a small part of its flight
+                    gdd = float(kin0[2][i] @ a0 + kin0[6][i])
+                    span = 1e-3 * 2.0 * vN0[i] / -gdd if gdd < 0 else skip
+                    events.append(make(gap, True, max(span, skip)))
+                else:
+                    # lift-off with zero normal velocity: the gap grows like a
+                    # power of the time and stays below round-off for a while,
+                    # so re-contact is watched at -gap_tol
+                    events.append(make(lambda t, y, i=i: sc.gaps(y[:n], t)[i] + self.gap_tol))
+                meta.append(("gap", i))
+                continue
+            zf = lamN0[i] <= 1e-12 * fscale
+            events.append(make(lambda t, y, i=i: evaluate(t, y)[1][i], zf))
+            meta.append(("liftoff", i))
+            if j < 0:
+                continue
+            if mode[i] == _S:
+                mu = ms.mu[i]
+                zc = mu * lamN0[i] - abs(lamT0[i]) <= 1e-12 * fscale
+                events.append(make(lambda t, y, i=i, mu=mu:
+                                   mu * evaluate(t, y)[1][i] - evaluate(t, y)[2][i], zc))
+                meta.append(("cone", i, _N))     # friction at +mu lamN: slip turns negative
+                events.append(make(lambda t, y, i=i, mu=mu:
+                                   mu * evaluate(t, y)[1][i] + evaluate(t, y)[2][i], zc))
+                meta.append(("cone", i, _P))
+            else:
+                s = _SIGN[mode[i]]
+
+                def slip(t, y, j=j, s=s):
+                    kin = evaluate(t, y)[5]
+                    WT, wT = kin[4], kin[5]
+                    return s * (WT[j] @ y[n:] + wT[j])
+
+                events.append(make(slip, abs(vT0[i]) <= vtol))
+                meta.append(("slip", i))
+                k = int(np.flatnonzero(closed0 == i)[0])
+                events.append(make(lambda t, y, k=k: evaluate(t, y)[3][k, k]))
+                meta.append(("painleve", i))
+        return rhs, events, meta, evaluate
+
+    def _step_impl(self):
+        if self.t == self._last_event_t:
+            self._stalled += 1
+            if self._stalled > 50:
+                raise MoreauError(f"more than 50 events at t = {self.t:.15g} without progress "
+                                  f"(contact modes {self.ms.letters(self.mode)})")
+        else:
+            self._last_event_t, self._stalled = self.t, 0
+        rhs, events, meta, evaluate = self._phase_functions()
+        y0 = np.concatenate([self.q, self.v])
+        self.counters["segments"] += 1
+        sol = solve_ivp(rhs, (self.t, self.t_bound), y0, method=self.ode_method, rtol=self.rtol,
+                        atol=self.atol, events=events or None, dense_output=True,
+                        max_step=self.max_step)
+        if sol.status < 0:
+            raise MoreauError(f"smooth-phase integration failed at t = {sol.t[-1]:.12g}: "
+                              f"{sol.message}")
+        n = self.scene.ndof
+        t_end = float(sol.t[-1])
+        # samples of the smooth phase
+        while self._next_sample < t_end:
+            ys = sol.sol(self._next_sample)
+            self._record_state(self._next_sample, ys[:n], ys[n:])
+            self._next_sample += self.sample_dt
+        self.t = t_end
+        y1 = sol.y[:, -1]
+        self.q, self.v = y1[:n].copy(), y1[n:].copy()
+        if sol.status != 1:
+            self.q, self.v = self._project(self.t, self.q, self.v, self.mode)
+            self._record_state(self.t, self.q, self.v)
+            return
+        fired = [k for k, te in enumerate(sol.t_events) if len(te)]
+        kinds = [meta[k] for k in fired]
+        forced = {}
+        contact = kinds[0][1] if kinds else None
+        label = "transition"
+        for kd in kinds:
+            if kd[0] == "painleve":
+                raise PainleveError(
+                    f"Painlevé condition fails at t = {self.t:.12g}: contact {kd[1]} slides "
+                    f"({Regime(int(self.mode[kd[1]])).letter}) with a normal-force coefficient "
+                    f"WN M^-1 (WN - mu s WT)^T that reaches 0 (mu = {self.ms.mu[kd[1]]:.6g}); "
+                    "the contact problem loses existence or uniqueness")
+            if kd[0] == "liftoff":
+                forced[kd[1]] = _F
+                label = "liftoff"
+            elif kd[0] == "cone":
+                forced[kd[1]] = kd[2]
+        self._resolve(kind=label, forced=forced, contact=contact)
+        self._record_state(self.t, self.q, self.v)
+
+
+@register_integrator("event-driven")
+class EventDrivenReference(Integrator):
+    """The event-driven reference of any scene (``"event-driven"``).
+
+    A scene that has its own high-precision event-driven scheme names it in
+    its ``reference_integrator`` attribute (the friction drive:
+    ``"friction-drive-walker"``); every other scene gets
+    :class:`GenericEventDriven`. Constructing this class returns an instance
+    of the selected scheme, so ``result.scheme`` names the scheme that ran.
+    To force one, use ``"event-driven-generic"`` or the scene's own name.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> type(EventDrivenReference(BouncingBall(), 0.0, [1.0], [0.0], 1.0)).__name__
+    'GenericEventDriven'
+    >>> sc = FrictionDrive()
+    >>> type(EventDrivenReference(sc, 0.0, *sc.rest_state(), 1.0)).__name__
+    'EventDriven'
+    """
+
+    def __new__(cls, scene, *args, **options):
+        name = getattr(scene, "reference_integrator", None)
+        target = INTEGRATORS.get(name, GenericEventDriven) if name else GenericEventDriven
+        obj = target(scene, *args, **options)
+        obj.scheme = "event-driven"
+        return obj
