@@ -201,6 +201,7 @@ def _cmd_reproduce(args):
                     progress=not args.quiet)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
           f"start with {args.out}/report.md")
+    print("  " + ", ".join(f"{k[:-2].replace('_', ' ')} {v:.1f} s" for k, v in res["_timings"].items()))
 
 
 def _add_reproduce(sub):
