@@ -124,6 +124,8 @@ def _cmd_sweep(args):
             settings[key] = float(val)
         except ValueError:
             raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    if args.parameter != "frequency" and getattr(args, args.parameter, None) is not None:
+        raise InputError(f"`--{args.parameter}` fixes the swept parameter; leave it out")
     frequency = settings.pop("frequency", args.frequency)
     for key, val in settings.items():
         if getattr(args, key, None) is not None:
