@@ -134,6 +134,8 @@ def _cmd_sweep(args):
             settings[key] = float(val)
         except ValueError:
             raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    if args.parameter != "frequency" and getattr(args, args.parameter, None) is not None:
+        raise InputError(f"`--{args.parameter}` fixes the swept parameter; leave it out")
     frequency = settings.pop("frequency", args.frequency)
     for key, val in settings.items():
         if getattr(args, key, None) is not None:
@@ -211,6 +213,7 @@ def _cmd_reproduce(args):
                     progress=not args.quiet)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
           f"start with {args.out}/report.md")
+    print("  " + ", ".join(f"{k[:-2].replace('_', ' ')} {v:.1f} s" for k, v in res["_timings"].items()))
 
 
 def _add_reproduce(sub):

@@ -53,6 +53,16 @@ def test_quick_run_writes_every_file(quick_run):
     assert "| 180 Hz |" in report and "| 0.13 |" in report and "| 0.89 |" in report
     assert "| 1.42 |" in report and "| 0.84 |" in report
     assert "figures/frequency.png" in report and "Typos" in report
+    # every row of a table has as many cells as its header (a bare "|" in "|d|" would split one)
+    import re
+    width = None
+    for line in report.splitlines():
+        if not line.startswith("|"):
+            width = None
+            continue
+        n = len(re.findall(r"(?<!\\)\|", line))
+        width = n if width is None else width
+        assert n == width, line
 
 
 def test_second_run_comes_from_the_cache(quick_run):

@@ -56,6 +56,7 @@ def test_scheme_options_change_the_computation(tmp_path):
     (["--rtol", "0"], "`rtol` must be > 0"),
     (["--set", "frequency=185"], "fixes the swept parameter"),
     (["--set", "zeta=1"], "`--set` takes NAME=VALUE"),
+    (["--frequency", "185"], "`--frequency` is the swept parameter"),
     (["--scale", "log", "--points", "3"], None),
 ])
 def test_refused_options(tmp_path, capsys, monkeypatch, args, match):
@@ -70,6 +71,12 @@ def test_refused_options(tmp_path, capsys, monkeypatch, args, match):
     rc = cli.main(["sweep", *ARGS, *args, "--out", str(tmp_path), "--quiet"])
     err = capsys.readouterr().err
     assert rc == 2 and match in err
+
+
+def test_fixing_the_swept_parameter_is_refused(tmp_path, capsys):
+    rc = cli.main(["sweep", "mu", "0.1", "0.5", "--points", "2", "--frequency", "185",
+                   "--mu", "0.3", "--out", str(tmp_path), "--quiet"])
+    assert rc == 2 and "`--mu` fixes the swept parameter" in capsys.readouterr().err
 
 
 def test_unwritable_output_folder_fails_before_work(tmp_path, capsys, monkeypatch):

@@ -275,13 +275,18 @@ TYPOS = [
 ]
 
 
+def _cell(text):
+    """Table-cell text: a bare ``|`` (as in ``|d|``) would end the cell."""
+    return str(text).replace("|", "\\|")
+
+
 def _md_table(rows, link):
     lines = ["| # | claim (section 4.3 unless noted) | paper | ours | verdict | why / note |",
              "|---|---|---|---|---|---|"]
     for i, r in enumerate(rows, 1):
         fig = f" [fig]({link(r['figure'])})" if r["figure"] else ""
-        lines.append(f"| {i} | {r['claim']}{fig} | {r['paper']} | {r['ours']} | "
-                     f"**{r['verdict']}** | {r['note']} |")
+        lines.append(f"| {i} | {_cell(r['claim'])}{fig} | {_cell(r['paper'])} | "
+                     f"{_cell(r['ours'])} | **{r['verdict']}** | {_cell(r['note'])} |")
     return "\n".join(lines)
 
 
@@ -317,12 +322,12 @@ def write_report(results, grids, params, out, checks, wall_time=None, quick=Fals
         "| where | printed | correct | evidence |",
         "|---|---|---|---|",
     ]
-    parts += [f"| {a} | {b} | {c} | {d} |" for a, b, c, d in TYPOS]
+    parts += [f"| {_cell(a)} | {_cell(b)} | {_cell(c)} | {_cell(d)} |" for a, b, c, d in TYPOS]
     parts += ["", "## Moreau\u2013Jean cross-check", "",
               "Largest relative difference from the event-driven value, over the points where "
               "both succeeded and the event-driven value is not near zero "
               "(|d| > 1 % of the study's largest |d|).", "",
-              "| study | " + " | ".join(f"\u03b8 = {c.theta:g}: max / median |rel. error|"
+              "| study | " + " | ".join(f"\u03b8 = {c.theta:g}: max / median \\|rel. error\\|"
                                       for c in checks) + " | failed points |",
               "|---|" + "---|" * len(checks) + "---|"]
     for name, table in results.items():

@@ -230,6 +230,7 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         for x in values:
             points.append(_point(params, parameter, x, frequency))
             owner.append(name)
+    timings = {"grids_s": time.perf_counter() - t0}
     rows, stats = run_points(points, ED_REFERENCE, checks, cache_dir=out / "cache", n_jobs=n_jobs,
                              scheduler=scheduler, progress=progress, desc="reproduce")
     log(f"{len(points)} points: {stats['computed']} computed, {stats['cached']} from the cache")
@@ -243,6 +244,7 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         _sidecar(path.with_suffix(".json"), params, name, parameter, values, frequency, extra,
                  checks, steps, stats)
         paths += [path, path.with_suffix(".json")]
+    timings["points_and_tables_s"] = time.perf_counter() - t0 - timings["grids_s"]
     if figures:
         from .figures import mode_figure_jobs, sweep_figure
         (out / "figures").mkdir(exist_ok=True)
@@ -252,9 +254,12 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         jobs += mode_figure_jobs(results, params, out / "figures")
         paths += run_jobs(jobs, n_jobs)
     wall = time.perf_counter() - t0
+    timings["figures_s"] = wall - sum(timings.values())
     if report:
         from .report import write_report
         paths.append(write_report(results, grids, params, out, checks, wall_time=wall, quick=quick))
     results["_paths"] = [pathlib.Path(p) for p in paths]
     results["_wall_time_s"] = time.perf_counter() - t0
+    timings["report_s"] = results["_wall_time_s"] - wall
+    results["_timings"] = timings
     return results
