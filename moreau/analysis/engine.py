@@ -133,25 +133,9 @@ def _steady(params, frequency, scheme):
 
 
 def _implausible(params, scene, ss):
-    """Why a converged steady state cannot be right, or None.
-
-    Without a load the rotor is driven by friction alone, so over a period the
-    friction impulse must vanish: friction has to change sign, hence the
-    rotor's velocity has to meet the tip's. Its average speed therefore cannot
-    exceed the largest tip speed by much (every sound point of the atlases
-    stays below 1.0 times that speed; the runaway orbits found by a stalled
-    shooting, with one-signed friction, are 1e12 times above it).
-    """
-    if params["load"] != 0.0:
-        return None
-    tau = np.linspace(0.0, 2.0 * math.pi, 257)
-    tip = float(np.max(np.abs(scene.tip_velocity(tau))))
-    speed = abs(ss.displacement_per_period) / (2.0 * math.pi)
-    if not speed <= 2.0 * tip:
-        return (f"the steady state found (mode {ss.mode!r}) has the rotor {speed / tip:.3g} "
-                "times faster on average than the rod's tip can move, which friction alone "
-                "cannot sustain (the shooting converged on a runaway rotor)")
-    return None
+    """Why a converged steady state cannot be right, or None (any scheme)."""
+    from .steady_state import implausible_steady_state
+    return implausible_steady_state(scene, ss)
 
 
 def _status_of(exc):

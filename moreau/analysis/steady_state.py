@@ -217,7 +217,7 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         if not merged or merged[-1][1] != r:
             merged.append([t, r])
     regimes = merged
-    return SteadyState(
+    ss = SteadyState(
         scheme="event-driven",
         displacement_per_period=float(end.u2 - st0.u2),
         state0=np.array([st0.phi, st0.dphi, st0.du2]),
@@ -230,3 +230,37 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         stats=dict(walker.counters),
         section_tau=float(st0.tau),
     )
+    why = implausible_steady_state(scene, ss)
+    if why:
+        raise ConvergenceError(why)
+    return ss
+
+
+def implausible_steady_state(scene, ss):
+    """Why a converged friction-drive steady state cannot be right, or None.
+
+    Without a load the rotor is driven by friction alone, so over a period
+    the friction impulse must vanish: friction has to change sign, hence the
+    rotor's velocity has to meet the tip's, and its average speed cannot
+    exceed the largest tip speed by much. Every sound point of the atlases
+    stays below 1.0 times that speed; the runaway orbits a stalled shooting
+    can settle on, with one-signed friction, are up to 1e12 times above it.
+    With a load the bound does not hold and nothing is checked.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> implausible_steady_state(sc, find_steady_state(sc)) is None
+    True
+    """
+    if scene.params.load != 0.0:
+        return None
+    tau = np.linspace(0.0, TWO_PI, 257)
+    tip = float(np.max(np.abs(scene.tip_velocity(tau))))
+    speed = abs(ss.displacement_per_period) / TWO_PI
+    if not speed <= 2.0 * tip:
+        return (f"the steady state found (mode {ss.mode!r}) has the rotor {speed / tip:.3g} "
+                "times faster on average than the rod's tip can move, which friction alone "
+                "cannot sustain (the shooting converged on a runaway rotor)")
+    return None
