@@ -336,11 +336,18 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
             elif n_jobs == 1 or len(todo) == 1:
                 results = ((k, func(*args[i])) for k, i in enumerate(todo))
             else:
+                import itertools
+
                 import joblib
+                # the first task runs here: it compiles (or loads) the numba kernels
+                # once and writes numba's on-disk cache, which the workers then load
+                # instead of each compiling the same kernels at the same time
+                first = (0, func(*args[todo[0]]))
                 par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
                                       batch_size=1)
-                results = par(joblib.delayed(_indexed)(func, k, args[i])
-                              for k, i in enumerate(todo))
+                rest = par(joblib.delayed(_indexed)(func, k, args[i])
+                           for k, i in enumerate(todo) if k > 0)
+                results = itertools.chain([first], rest)
             for k, res in results:
                 i = todo[k]
                 if chunk > 1 and isinstance(res, dict):  # a lost Dask task: every point fails
