@@ -68,6 +68,7 @@ import numpy as np
 
 from .. import _validate as V
 from ..errors import InputError
+from ._units import DriveUnits
 from .base import Scene
 from .friction_drive import FrictionDrive, FrictionDriveParams
 
@@ -171,7 +172,7 @@ def params_from_kwargs(**kwargs):
     return BidirectionalDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
 
 
-class BidirectionalDrive(Scene):
+class BidirectionalDrive(DriveUnits, Scene):
     """Two mirror-image rods driving one rotor, in the paper's dimensionless form.
 
     Coordinates ``q = (phi_a, phi_b, u2)``, velocities their derivatives in
@@ -329,12 +330,3 @@ class BidirectionalDrive(Scene):
             "slip_velocity": result.slip_velocity * l * w,
             "regime": result.regime.copy(),
         }
-
-    def displacement_to_si(self, du2):
-        return du2 * self.params.length
-
-    def velocity_to_si(self, dv2):
-        return dv2 * self.params.length * self.omega
-
-    def force_to_si(self, f):
-        return f * self.force_scale

@@ -53,6 +53,7 @@ import numpy as np
 from .. import _validate as V
 from ..errors import InputError
 from ..regimes import Regime
+from ._units import DriveUnits
 from .base import Scene
 
 __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
@@ -123,7 +124,7 @@ class FrictionDriveParams:
 PAPER_DEFAULTS = FrictionDriveParams()
 
 
-class FrictionDrive(Scene):
+class FrictionDrive(DriveUnits, Scene):
     """The paper's friction drive at one drive frequency, in dimensionless form.
 
     Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
@@ -315,15 +316,6 @@ class FrictionDrive(Scene):
             "slip_velocity": result.slip_velocity[:, 0] * l * w,
             "regime": result.regime[:, 0].copy(),
         }
-
-    def displacement_to_si(self, du2):
-        return du2 * self.params.length
-
-    def velocity_to_si(self, dv2):
-        return dv2 * self.params.length * self.omega
-
-    def force_to_si(self, f):
-        return f * self.force_scale
 
 
 def params_from_kwargs(**kwargs):
