@@ -339,7 +339,8 @@ def build_parser():
                                        "(table + figure), or the stiff/extreme-case map (--stress)")
     c.add_argument("--scene", default=None,
                    choices=["friction-drive", "stick-slip-motor", "bouncing-ball",
-                            "sliding-block", "painleve-rod"])
+                            "sliding-block", "painleve-rod", "sliding-box",
+                            "bidirectional-drive"])
     c.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     c.add_argument("--mu", type=float, default=None, help="friction coefficient")
     c.add_argument("--phi0", type=float, default=None, help="friction drive: rod tilt [rad]")
