@@ -19,7 +19,9 @@ Errors are measured against the reference at its tightest setting, three ways:
     stick–slip motor: the displacement per period; the bouncing ball: the
     height at the end of the window; the sliding block: the stopping
     distance; the Painlevé rod: the horizontal position of its centre at the
-    end of the window);
+    end of the window; the sliding box (two contacts): its exact stopping
+    distance; the bidirectional drive (two contacts): the displacement per
+    period against the generic event-driven steady state);
 ``trajectory_error``
     the max over one period (the comparison window) of the main coordinate's
     distance from the reference, both started from the same state (for the
@@ -27,7 +29,8 @@ Errors are measured against the reference at its tightest setting, three ways:
 ``switching_error``
     the largest shift of a regime switching time (or an impact time), when
     the two regime sequences agree (``None`` where they do not, or where the
-    motion has no switch).
+    motion has no switch); on the two-contact scenes each contact's switches
+    are matched separately.
 
 The fitted ``order`` of each Moreau–Jean series is the slope of
 ``log(trajectory_error)`` against ``log(steps_per_period)``; the headline
