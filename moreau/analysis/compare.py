@@ -7,7 +7,7 @@ For one scene, :func:`compare` runs
   tolerance and give one row);
 - Moreau–Jean with ``theta = 1/2`` and ``theta = 1`` at step counts spanning
   two decades, with the scheme's own contact solve (closed form for one
-  contact; ``lcp = None`` in the table);
+  contact, the compiled Lemke for two; ``lcp = None`` in the table);
 - Moreau–Jean (``theta = 1``) with the contact problem of every step forced
   through Lemke and through the QP path (``lcp = "lemke"``, ``"qp"``), so that
   the solvers are compared as well as the schemes.
