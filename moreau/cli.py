@@ -97,6 +97,9 @@ def _cmd_steady(args):
     if getattr(args, "scene", "friction-drive") == "bidirectional":
         from .cli_bidirectional import cmd_steady_bidirectional
         return cmd_steady_bidirectional(args)
+    for opt in ("x10_a", "x10_b", "phase"):
+        if getattr(args, opt, None) is not None:
+            raise InputError(f"`--{opt.replace('_', '-')}` applies only to `--scene bidirectional`")
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")

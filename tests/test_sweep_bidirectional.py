@@ -91,6 +91,8 @@ def test_failed_point_is_a_status(tmp_path):
     (["sweep", "x10_a", "0", "1e-6", "--frequency", "185"], "applies only to `--scene bidirectional`"),
     (["sweep", "mu", "0.1", "0.2", "--frequency", "185", "--phase", "1"],
      "`--phase` applies only to `--scene bidirectional`"),
+    (["steady", "--frequency", "185", "--x10-b", "1e-6"],
+     "`--x10-b` applies only to `--scene bidirectional`"),
     (["sweep", "--scene", "bidirectional", "x10", "0", "1e-6", "--frequency", "185"],
      "`x10` sets both rods"),
     (["sweep", "--scene", "bidirectional", "x10_b", "0", "1e-6", "--frequency", "185",
@@ -110,5 +112,6 @@ def test_refused_before_work(tmp_path, capsys, monkeypatch, args, match):
         raise AssertionError("work started before the options were checked")
 
     monkeypatch.setattr(engine, "run_points", no_work)
-    rc = cli.main([*args, "--out", str(tmp_path), "--quiet"])
+    extra = ["--out", str(tmp_path), "--quiet"] if args[0] == "sweep" else []
+    rc = cli.main([*args, *extra])
     assert rc == 2 and match in capsys.readouterr().err
