@@ -109,3 +109,19 @@ def test_two_contact_scenes_refuse_bad_input():
         make_case("sliding-box", mu=3.0)
     with pytest.raises(InputError, match="`x10_b` must be < length"):
         make_case("bidirectional-drive", x10_b=1e-3)
+
+
+@pytest.mark.parametrize("frequency", [185.0, 2000.0])
+def test_rod_b_unexcited_moreau_jean_equals_the_single_rod(frequency):
+    # the 2000 Hz Moreau-Jean errors of the two-rod compare are the single rod's
+    # grid plateaus (moreau.analysis.compare, "Plateaus"), not a two-contact effect
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.scenes.bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
+    from moreau.scenes.friction_drive import FrictionDrive
+
+    two = BidirectionalDrive(BidirectionalDriveParams(x10_b=0.0), frequency)
+    one = FrictionDrive(frequency=frequency)
+    for theta in (0.5, 1.0):
+        d2 = find_steady_state(two, "moreau-jean", steps_per_period=500, theta=theta)
+        d1 = find_steady_state(one, "moreau-jean", steps_per_period=500, theta=theta)
+        assert d2.displacement_per_period == pytest.approx(d1.displacement_per_period, rel=1e-12)
