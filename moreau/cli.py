@@ -97,6 +97,9 @@ def _cmd_steady(args):
     if getattr(args, "scene", "friction-drive") == "bidirectional":
         from .cli_bidirectional import cmd_steady_bidirectional
         return cmd_steady_bidirectional(args)
+    for opt in ("x10_a", "x10_b", "phase"):
+        if getattr(args, opt, None) is not None:
+            raise InputError(f"`--{opt.replace('_', '-')}` applies only to `--scene bidirectional`")
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
@@ -121,6 +124,14 @@ def _cmd_steady(args):
 
 def _cmd_sweep(args):
     from .analysis.sweeps import SWEEPABLE, make_scheme, run_sweep
+    if args.scene == "bidirectional":
+        from .cli_bidirectional import cmd_sweep_bidirectional
+        return cmd_sweep_bidirectional(args)
+    if args.parameter not in SWEEPABLE:
+        raise InputError(f"`PARAM` {args.parameter!r} applies only to `--scene bidirectional`")
+    for opt in ("x10_a", "x10_b", "phase"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"`--{opt.replace('_', '-')}` applies only to `--scene bidirectional`")
     settings = {}
     for item in args.set or []:
         key, sep, val = item.partition("=")
@@ -292,8 +303,9 @@ def build_parser():
                                       "cached and in parallel")
     s.add_argument("parameter", metavar="PARAM",
                    choices=["frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load",
-                            "restitution"],
-                   help="parameter to sweep: frequency [Hz] or a scene parameter (SI units)")
+                            "restitution", "x10_a", "x10_b", "phase", "balance"],
+                   help="parameter to sweep: frequency [Hz] or a scene parameter (SI units); "
+                        "x10_a, x10_b, phase and balance with --scene bidirectional")
     s.add_argument("start", metavar="START", type=float, nargs="?", default=None,
                    help="first value (default for frequency/mu/phi0: the paper's range)")
     s.add_argument("stop", metavar="STOP", type=float, nargs="?", default=None, help="last value")
@@ -314,6 +326,7 @@ def build_parser():
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
     _add_params(s, scheme_defaults=False)
+    add_scene_options(s)
     s.set_defaults(func=_cmd_sweep)
     r = sub.add_parser("run", help="time histories from rest (CSV + figure, SI units)")
     r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
@@ -329,7 +342,8 @@ def build_parser():
                                        "(table + figure), or the stiff/extreme-case map (--stress)")
     c.add_argument("--scene", default=None,
                    choices=["friction-drive", "stick-slip-motor", "bouncing-ball",
-                            "sliding-block", "painleve-rod"])
+                            "sliding-block", "painleve-rod", "sliding-box",
+                            "bidirectional-drive"])
     c.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     c.add_argument("--mu", type=float, default=None, help="friction coefficient")
     c.add_argument("--phi0", type=float, default=None, help="friction drive: rod tilt [rad]")

@@ -1,4 +1,4 @@
-"""``moreau steady --scene bidirectional``: the two-rod drive from the command line.
+"""``moreau steady`` and ``moreau sweep`` with ``--scene bidirectional``: the two-rod drive.
 
 Kept apart from :mod:`moreau.cli` so that the shared CLI module only gains
 the hooks. The rod, spring, rotor, friction, load and restitution options
@@ -11,7 +11,8 @@ import time
 
 from .errors import InputError
 
-__all__ = ["add_scene_options", "bidirectional_report", "cmd_steady_bidirectional"]
+__all__ = ["add_scene_options", "bidirectional_report", "cmd_steady_bidirectional",
+           "cmd_sweep_bidirectional"]
 
 
 def add_scene_options(p):
@@ -102,3 +103,56 @@ def cmd_steady_bidirectional(args):
     print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     print(f"  periodic residual         {rep['periodic_residual']:.2e}")
     print(f"  wall time                 {rep['wall_time_s']:.2f} s")
+
+
+def cmd_sweep_bidirectional(args):
+    """``moreau sweep --scene bidirectional PARAM START STOP ...``; every option is checked first."""
+    from .analysis.bidirectional_sweep import BIDIRECTIONAL_SWEEPABLE, run_bidirectional_sweep
+    from .analysis.sweeps import make_scheme
+
+    param = args.parameter
+    if param not in BIDIRECTIONAL_SWEEPABLE:
+        raise InputError(f"`PARAM` must be one of {list(BIDIRECTIONAL_SWEEPABLE)} for "
+                         f"`--scene bidirectional`, got {param!r} (`x10` sets both rods: "
+                         "sweep `x10_a`, `x10_b` or `balance`)")
+    settable = [p for p in BIDIRECTIONAL_SWEEPABLE if p != "balance"] + ["x10"]
+    settings = {}
+    for item in args.set or []:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or key not in settable:
+            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {settable}, got {item!r}")
+        try:
+            settings[key] = float(val)
+        except ValueError:
+            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    # the stator amplitudes a balance point sets, and the parameter swept, cannot also be fixed
+    fixed_by_sweep = {"balance": ("x10_a", "x10_b")}.get(param, (param,))
+    for key in fixed_by_sweep:
+        if key in settings:
+            raise InputError(f"`--set {key}` fixes what the sweep of {param!r} varies; leave it out")
+        if key != "frequency" and getattr(args, key, None) is not None:
+            raise InputError(f"`--{key.replace('_', '-')}` fixes what the sweep of {param!r} "
+                             "varies; leave it out")
+    frequency = settings.pop("frequency", args.frequency)
+    if "frequency" in fixed_by_sweep and args.frequency is not None:
+        raise InputError("`--frequency` is the swept parameter here; leave it out")
+    for key, val in settings.items():
+        if getattr(args, key, None) is not None:
+            raise InputError(f"`{key}` is given twice (`--{key.replace('_', '-')}` and "
+                             f"`--set {key}=...`)")
+        setattr(args, key, val)
+    params = _params(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    if args.num is not None and args.points is not None:
+        raise InputError("`--num` is the old name of `--points`; give one of them")
+    scale = args.scale or "linear"
+    if args.log:
+        if args.scale == "linear":
+            raise InputError("`--log` contradicts `--scale linear`")
+        scale = "log"
+    run_bidirectional_sweep(param, params, frequency=frequency, start=args.start, stop=args.stop,
+                            points=args.points if args.points is not None else args.num,
+                            scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
+                            n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
+                            plot=not args.no_plot)

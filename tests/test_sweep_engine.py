@@ -32,11 +32,11 @@ def test_interrupted_run_resumes_without_recomputing(tmp_path, monkeypatch):
     calls = {"n": 0}
     real = engine._steady
 
-    def steady(*a):
+    def steady(*a, **kw):
         calls["n"] += 1
         if calls["n"] == 3:
             raise KeyboardInterrupt
-        return real(*a)
+        return real(*a, **kw)
 
     monkeypatch.setattr(engine, "_steady", steady)
     with pytest.raises(KeyboardInterrupt):
@@ -50,10 +50,10 @@ def test_interrupted_run_resumes_without_recomputing(tmp_path, monkeypatch):
 def test_failing_point_becomes_a_status(monkeypatch):
     real = engine._steady
 
-    def steady(params, frequency, scheme):
+    def steady(params, frequency, scheme, **kw):
         if frequency == 2000.0:
             raise RuntimeError("numerical trouble\n on two lines")
-        return real(params, frequency, scheme)
+        return real(params, frequency, scheme, **kw)
 
     monkeypatch.setattr(engine, "_steady", steady)
     pts = POINTS[:3] + [(asdict(PAPER_DEFAULTS.with_(phi0=1.5)), 185.0)]
@@ -113,8 +113,8 @@ def test_runaway_rotor_is_a_status_not_a_number(monkeypatch):
     # "converged" on a rotor moving 1e9 m per period
     real = engine._steady
 
-    def steady(params, frequency, scheme):
-        scene, ss = real(params, frequency, scheme)
+    def steady(params, frequency, scheme, **kw):
+        scene, ss = real(params, frequency, scheme, **kw)
         ss.displacement_per_period = 1e9
         return scene, ss
 

@@ -7,7 +7,7 @@ For one scene, :func:`compare` runs
   tolerance and give one row);
 - Moreau–Jean with ``theta = 1/2`` and ``theta = 1`` at step counts spanning
   two decades, with the scheme's own contact solve (closed form for one
-  contact; ``lcp = None`` in the table);
+  contact, the compiled Lemke for two; ``lcp = None`` in the table);
 - Moreau–Jean (``theta = 1``) with the contact problem of every step forced
   through Lemke and through the QP path (``lcp = "lemke"``, ``"qp"``), so that
   the solvers are compared as well as the schemes.
@@ -19,7 +19,9 @@ Errors are measured against the reference at its tightest setting, three ways:
     stick–slip motor: the displacement per period; the bouncing ball: the
     height at the end of the window; the sliding block: the stopping
     distance; the Painlevé rod: the horizontal position of its centre at the
-    end of the window);
+    end of the window; the sliding box (two contacts): its exact stopping
+    distance; the bidirectional drive (two contacts): the displacement per
+    period against the generic event-driven steady state);
 ``trajectory_error``
     the max over one period (the comparison window) of the main coordinate's
     distance from the reference, both started from the same state (for the
@@ -27,7 +29,8 @@ Errors are measured against the reference at its tightest setting, three ways:
 ``switching_error``
     the largest shift of a regime switching time (or an impact time), when
     the two regime sequences agree (``None`` where they do not, or where the
-    motion has no switch).
+    motion has no switch); on the two-contact scenes each contact's switches
+    are matched separately.
 
 The fitted ``order`` of each Moreau–Jean series is the slope of
 ``log(trajectory_error)`` against ``log(steps_per_period)``; the headline
@@ -264,7 +267,10 @@ class _Case:
     trajectory_scale = 1.0
 
     def _run_switches(self, res, h):
-        letters = res.regime_letters()
+        return self._run_switches_of(res, h, 0)
+
+    def _run_switches_of(self, res, h, contact):
+        letters = res.regime_letters(contact)
         t = res.t - h
         # a step's regime is recorded at its end: the switch happened in that step.
         # The regime in force at the start goes in front, so that a one-step
@@ -507,6 +513,150 @@ class _PainleveRodCase(_Case):
         return float(res.q[-1, 0])
 
 
+class _SlidingBoxCase(_Case):
+    headline_name = "stopping distance"
+
+    def __init__(self, mu=0.4, speed=1.0, half_width=0.5, half_height=0.25):
+        from ..scenes.sliding_box import SlidingBox
+        self.scene = SlidingBox(mu=mu, half_width=half_width, half_height=half_height)
+        self.q0, _ = self.scene.initial_state()
+        self.v0 = np.array([speed, 0.0, 0.0])
+        self._params = dict(mu=mu, speed=speed, half_width=half_width, half_height=half_height)
+        # checks mu b < a (both corners stay down) and mu > 0, before any work
+        self.window = 1.5 * self.scene.stopping_time(self.v0)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), self.v0.copy()
+
+    def reference(self, rtol):
+        # both corners stop sliding together, at t* = v0 / mu
+        t_stop = float(self.scene.stopping_time(self.v0))
+        return (float(self.scene.stopping_distance(self.v0)),
+                _flatten([[(t_stop, "S")], [(t_stop, "S")]]))
+
+    def reference_grid(self):
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+    def _run_switches(self, res, h):
+        # each corner's stop is measured: Moreau–Jean may stop them a step apart
+        return _flatten([self._run_switches_of(res, h, c) for c in (0, 1)])
+
+
+def _contact_switches(regimes, tau_s, contact, h=0.0):
+    """Switches ``[(tau, letter)]`` of one contact over ``[0, 2 pi)`` from a steady state's regimes.
+
+    ``regimes`` holds ``[tau - tau_s, key]`` with one letter per contact in
+    ``key``; one-step sticks at a slip reversal (``h`` > 0) are dropped as in
+    the single-contact case.
+    """
+    pts = sorted(((float(t) + tau_s) % TWO_PI, k[contact]) for t, k in regimes)
+    sw = [(0.0, pts[-1][1] if pts[0][0] > 1e-12 else pts[0][1])]
+    for t, letter in pts:
+        if letter != sw[-1][1]:
+            sw.append((t, letter))
+    return _drop_reversal_sticks(sw, h)[1:]
+
+
+class _BidirectionalDriveCase(_Case):
+    """The two-rod drive's steady state; Moreau–Jean against the generic event-driven reference."""
+
+    ref_scheme = "event-driven"
+    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
+    tight_rtol = 1e-12
+    headline_name = "displacement per period"
+    projection = True
+
+    def __init__(self, frequency=185.0, **params):
+        from ..scenes.bidirectional_drive import BidirectionalDrive, params_from_kwargs
+        # default: rod a at full and rod b at half amplitude, so that both
+        # contacts carry load and slip both ways (mode NSP|NP at 185 Hz)
+        params.setdefault("x10_b", 1.0e-6)
+        self.scene = BidirectionalDrive(params_from_kwargs(**params), frequency)
+        self.frequency = self.scene.frequency
+        self._params = dict(params)
+        self.trajectory_scale = float(np.max(self.scene.u10))
+        self._ref = None
+
+    def parameters(self):
+        return dict(frequency=self.frequency, **self._params)
+
+    def _switches_of_steady(self, ss, h=0.0):
+        tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
+        return [_contact_switches(ss.regimes, tau_s, c, h) for c in range(self.scene.ncontacts)]
+
+    def reference(self, rtol):
+        from ..analysis.steady_state import find_steady_state
+        ss = find_steady_state(self.scene, "event-driven", rtol=rtol)
+        return ss.displacement_per_period, _flatten(self._switches_of_steady(ss))
+
+    def _tight(self):
+        if self._ref is None:
+            from ..analysis.steady_state import find_steady_state
+            from ..integrators import simulate
+            ss = find_steady_state(self.scene, "event-driven", rtol=self.tight_rtol)
+            n = self.scene.ndof
+            q, v = ss.state0[:n].copy(), ss.state0[n:].copy()
+            tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
+            if tau_s > 0.0:
+                # carry the periodic state from the section to tau = 2 pi = 0
+                r = simulate(self.scene, (tau_s, TWO_PI), q, v, "event-driven", rtol=1e-12)
+                q, v = r.q[-1].copy(), r.v[-1].copy()
+            q[2] = 0.0
+            run = simulate(self.scene, (0.0, TWO_PI), q, v, "event-driven", rtol=1e-12,
+                           sample_dt=TWO_PI / (8 * GRID))
+            grid = np.linspace(0.0, TWO_PI, GRID + 1)
+            self._ref = dict(q0=q, v0=v, grid=np.interp(grid, run.t, run.q[:, 2]))
+        return self._ref
+
+    def reference_grid(self):
+        return self._tight()["grid"]
+
+    def start(self):
+        r = self._tight()
+        return r["q0"].copy(), r["v0"].copy()
+
+    def coordinate(self, q):
+        return q[:, 2]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 2] - res.q[0, 2])
+
+    def mj(self, n, theta, lcp):
+        if lcp is not None:
+            return super().mj(n, theta, lcp)
+        from ..analysis.mj_steady_state import moreau_jean_steady_state
+        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
+        return ss.displacement_per_period, ss
+
+    def measure(self, n, theta, lcp, out):
+        # the trajectory and the switching times: one period of the same scheme
+        # from the reference's periodic state (the Moreau–Jean steady state names
+        # the regimes of the first contact only)
+        res = out[1] if lcp is not None else self.run_mj(n, theta, None)
+        h = self.window / n
+        sw = [self._run_switches_of(res, h, c) for c in range(self.scene.ncontacts)]
+        mode = out[1].mode if lcp is None else None
+        return self._trajectory_error(res), _flatten(sw), mode
+
+
+def _flatten(per_contact):
+    """One switch list from per-contact lists: ``(tau, "c:letter")``, contact by contact.
+
+    Examples
+    --------
+    >>> _flatten([[(2.0, "S")], [(1.0, "P"), (3.0, "N")]])
+    [(2.0, '0:S'), (1.0, '1:P'), (3.0, '1:N')]
+    """
+    return [(t, f"{c}:{s}") for c, sw in enumerate(per_contact) for t, s in sw]
+
+
 #: scene name -> (case class, accepted parameters, one-line description)
 SCENES = {
     "friction-drive": (_FrictionDriveCase, ("frequency", "mu", "phi0", "restitution", "load",
@@ -519,6 +669,13 @@ SCENES = {
     "sliding-block": (_SlidingBlockCase, ("mu", "speed"), "block sliding to rest on a level plane"),
     "painleve-rod": (_PainleveRodCase, ("mu", "phi", "tip_speed", "dphi"),
                      "Painlevé rod sliding on its tip, well-posed side"),
+    "sliding-box": (_SlidingBoxCase, ("mu", "speed", "half_width", "half_height"),
+                    "box sliding to rest on its two corners (two frictional contacts)"),
+    "bidirectional-drive": (_BidirectionalDriveCase,
+                            ("frequency", "mu", "phi0", "restitution", "load", "x10_a",
+                             "x10_b", "phase", "k", "m", "m2", "length"),
+                            "two-rod bidirectional drive (steady state; SI parameters; "
+                            "default x10_b = 1e-6)"),
 }
 
 

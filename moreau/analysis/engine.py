@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import ConvergenceError, InputError
 
 __all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
-           "ED_REFERENCE", "mj_check_columns"]
+           "ED_REFERENCE", "mj_check_columns", "SCENES"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
 
@@ -118,11 +118,24 @@ def mj_check_columns(check):
     return [f"{p}_displacement_per_period_m", f"{p}_relative_error", f"{p}_mode", f"{p}_status"]
 
 
-def _steady(params, frequency, scheme):
-    from .steady_state import find_steady_state
-    from ..scenes.friction_drive import FrictionDrive, FrictionDriveParams
+#: scenes the engine can evaluate, by the name :func:`evaluate_point` takes
+SCENES = ("friction-drive", "bidirectional")
 
-    scene = FrictionDrive(FrictionDriveParams(**params), frequency)
+
+def _make_scene(params, frequency, scene):
+    if scene == "bidirectional":
+        from ..scenes.bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
+        return BidirectionalDrive(BidirectionalDriveParams(**params), frequency)
+    if scene != "friction-drive":
+        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
+    from ..scenes.friction_drive import FrictionDrive, FrictionDriveParams
+    return FrictionDrive(FrictionDriveParams(**params), frequency)
+
+
+def _steady(params, frequency, scheme, scene="friction-drive"):
+    from .steady_state import find_steady_state
+
+    scene = _make_scene(params, frequency, scene)
     if scheme.name == "moreau-jean":
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
         ss = find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
@@ -135,7 +148,29 @@ def _steady(params, frequency, scheme):
 def _implausible(params, scene, ss):
     """Why a converged steady state cannot be right, or None (any scheme)."""
     from .steady_state import implausible_steady_state
-    return implausible_steady_state(scene, ss)
+    if hasattr(scene, "tip_velocity"):
+        return implausible_steady_state(scene, ss)
+    return _implausible_two_rods(scene, ss)
+
+
+def _implausible_two_rods(scene, ss):
+    # the single-rod argument holds for each rod: without a load the rotor is
+    # driven by friction alone, so its average speed cannot exceed by much the
+    # fastest tip speed of the two rods on their contact manifolds
+    if scene.params.load != 0.0:
+        return None
+    tip = 0.0
+    for tau in np.linspace(0.0, 2.0 * math.pi, 257):
+        q, v = scene.rest_state(tau)
+        tip = max(tip, float(np.max(np.abs(np.sin(q[:2]) * v[:2]))))
+    if tip == 0.0:
+        return None
+    speed = abs(ss.displacement_per_period) / (2.0 * math.pi)
+    if not speed <= 2.0 * tip:
+        return (f"the steady state found (mode {ss.mode!r}) has the rotor {speed / tip:.3g} "
+                "times faster on average than the rods' tips can move, which friction alone "
+                "cannot sustain (the shooting converged on a runaway rotor)")
+    return None
 
 
 def _status_of(exc):
@@ -143,13 +178,15 @@ def _status_of(exc):
     return f"{type(exc).__name__}: {msg}"
 
 
-def evaluate_point(params, frequency, scheme, checks=(), version=""):
+def evaluate_point(params, frequency, scheme, checks=(), version="", scene="friction-drive"):
     """Steady state at one parameter point, as a row of SI values.
 
     Parameters
     ----------
     params : dict
-        Every field of :class:`~moreau.scenes.friction_drive.FrictionDriveParams`.
+        Every field of :class:`~moreau.scenes.friction_drive.FrictionDriveParams`
+        (or, with ``scene="bidirectional"``, of
+        :class:`~moreau.scenes.bidirectional_drive.BidirectionalDriveParams`).
     frequency : float
         Drive frequency [Hz].
     scheme : Scheme
@@ -158,6 +195,9 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         Moreau–Jean cross-checks; each adds the columns of :func:`mj_check_columns`.
     version : str
         Code version (only a cache key here).
+    scene : str
+        One of :data:`SCENES`: the paper's single-rod drive or the two-rod
+        bidirectional drive (Moreau–Jean with projection in either case).
 
     Returns
     -------
@@ -177,12 +217,20 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
     >>> bad = evaluate_point(asdict(PAPER_DEFAULTS.with_(phi0=1.5)), 185.0, ED_REFERENCE)
     >>> bad["status"].startswith("PainleveError")
     True
+    >>> from moreau.scenes.bidirectional_drive import BidirectionalDriveParams
+    >>> two = evaluate_point(asdict(BidirectionalDriveParams(x10_b=0.0)), 2000.0,
+    ...                      Scheme.moreau_jean(1.0, 200), scene="bidirectional")
+    >>> two["status"], two["displacement_per_period_m"] > 0     # rod a alone: forward at 2 kHz
+    ('ok', True)
     """
     t0 = time.perf_counter()
     row = {"mode": "", "displacement_per_period_m": math.nan, "average_velocity_m_per_s": math.nan,
            "min_normal_force_N": math.nan, "periodic_residual": math.nan,
            "shooting_iterations": 0, "status": "ok"}
     ref = math.nan
+    if scene not in SCENES:
+        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
+    # both rods of the bidirectional drive share mu and phi0: one margin for either scene
     margin = 1.0 - params["mu"] * math.tan(params["phi0"])
     if margin <= 0:
         # in contact phi <= phi0 (the stator only lifts the rod's hinge), so the rest angle
@@ -196,14 +244,14 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         row["compute_time_s"] = time.perf_counter() - t0
         return row
     try:
-        scene, ss = _steady(params, frequency, scheme)
-        why = _implausible(params, scene, ss)
+        sc, ss = _steady(params, frequency, scheme, scene=scene)
+        why = _implausible(params, sc, ss)
         if why:
             raise ConvergenceError(why)
-        ref = scene.displacement_to_si(ss.displacement_per_period)
+        ref = sc.displacement_to_si(ss.displacement_per_period)
         row.update(mode=ss.mode, displacement_per_period_m=ref,
                    average_velocity_m_per_s=ref * frequency,
-                   min_normal_force_N=scene.force_to_si(ss.min_normal_force),
+                   min_normal_force_N=sc.force_to_si(ss.min_normal_force),
                    periodic_residual=ss.periodic_residual, shooting_iterations=ss.iterations)
     except Exception as exc:  # any failure becomes the status of this point
         row["status"] = _status_of(exc)
@@ -211,11 +259,11 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
         d_col, e_col, m_col, s_col = mj_check_columns(chk)
         row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: "ok"})
         try:
-            scene, ss = _steady(params, frequency, chk)
-            why = _implausible(params, scene, ss)
+            sc, ss = _steady(params, frequency, chk, scene=scene)
+            why = _implausible(params, sc, ss)
             if why:
                 raise ConvergenceError(why)
-            d = scene.displacement_to_si(ss.displacement_per_period)
+            d = sc.displacement_to_si(ss.displacement_per_period)
             row.update({d_col: d, m_col: ss.mode,
                         e_col: (d - ref) / abs(ref) if ref != 0 else math.nan})
         except Exception as exc:  # any failure becomes the status of this point
@@ -224,7 +272,7 @@ def evaluate_point(params, frequency, scheme, checks=(), version=""):
     return row
 
 
-def evaluate_points(points, scheme, checks=(), version=""):
+def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive"):
     """:func:`evaluate_point` over a list of ``(params, frequency)``: one cache entry for many points.
 
     Examples
@@ -234,7 +282,7 @@ def evaluate_points(points, scheme, checks=(), version=""):
     >>> [r["mode"] for r in evaluate_points([(asdict(PAPER_DEFAULTS), 20.0)] * 2, ED_REFERENCE)]
     ['NS', 'NS']
     """
-    return [evaluate_point(p, f, scheme, checks, version) for p, f in points]
+    return [evaluate_point(p, f, scheme, checks, version, scene) for p, f in points]
 
 
 def check_output_dir(path):
@@ -268,7 +316,7 @@ def _memory(cache_dir):
 
 
 def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
-               progress=False, desc="points", chunk=1):
+               progress=False, desc="points", chunk=1, scene="friction-drive"):
     """Evaluate many points, reusing cached ones, in parallel.
 
     Parameters
@@ -284,6 +332,8 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         Address of a Dask scheduler (``"tcp://host:8786"``) or a client.
     progress : bool
         A tqdm bar (shown on a terminal only).
+    scene : str
+        One of :data:`SCENES`; ``params`` are that scene's parameters.
     chunk : int
         Points per task and per cache entry. Large grids (atlases) use a
         chunk of a grid line: tens of thousands of single-point entries
@@ -304,16 +354,18 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     >>> rows[0]["mode"], st["computed"]
     ('NS', 1)
     """
+    if scene not in SCENES:
+        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
         func = _memory(cache_dir).cache(evaluate_point, ignore=[])
-        args = [(dict(p), float(f), scheme, tuple(checks), version) for p, f in points]
+        args = [(dict(p), float(f), scheme, tuple(checks), version, scene) for p, f in points]
         sizes = [1] * len(args)
     else:
         func = _memory(cache_dir).cache(evaluate_points, ignore=[])
         groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
-        args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version)
+        args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene)
                 for g in groups]
         sizes = [len(g) for g in groups]
     out = [None] * len(args)

@@ -88,7 +88,11 @@ _XLABEL = {"frequency": "drive frequency f [Hz]", "mu": "friction coefficient \u
            "phi0": "initial tilt angle \u03c6\u2080 [rad]", "m": "rod mass m [kg]",
            "m2": "rotor mass m\u2082 [kg]", "k": "spring stiffness k [N/m]",
            "length": "rod length l [m]", "x10": "stator amplitude x\u2081\u2080 [m]",
-           "load": "rotor load F_L [N]", "restitution": "restitution e [-]"}
+           "load": "rotor load F_L [N]", "restitution": "restitution e [-]",
+           "x10_a": "stator amplitude of rod a x\u2081\u2080\u1d43 [m]",
+           "x10_b": "stator amplitude of rod b x\u2081\u2080\u1d47 [m]",
+           "phase": "phase lag of stator b \u03b4 [rad]",
+           "balance": "balance \u03b2 [-] (\u22121 rod a alone, +1 rod b alone)"}
 
 
 def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None, log=None,

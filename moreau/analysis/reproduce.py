@@ -36,7 +36,10 @@ FREQUENCIES = (20.0, 185.0, 2000.0)
 SWEPT_COLUMN = {"frequency": "frequency_Hz", "mu": "mu", "phi0": "phi0_rad"}
 PARAM_COLUMNS = {"frequency": "frequency_Hz", "m": "m_kg", "m2": "m2_kg", "k": "k_N_per_m",
                  "length": "length_m", "phi0": "phi0_rad", "mu": "mu", "x10": "x10_m",
-                 "load": "load_N", "restitution": "restitution"}
+                 "load": "load_N", "restitution": "restitution",
+                 # the bidirectional drive's own parameters (moreau.analysis.bidirectional_sweep)
+                 "x10_a": "x10_a_m", "x10_b": "x10_b_m", "phase": "phase_rad",
+                 "balance": "balance"}
 VALUE_COLUMNS = ["mode", "displacement_per_period_m", "average_velocity_m_per_s",
                  "min_normal_force_N", "painleve_margin", "lift_off_margin", "periodic_residual",
                  "shooting_iterations", "status"]
