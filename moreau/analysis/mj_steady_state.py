@@ -257,6 +257,9 @@ class PeriodMap:
             self.last = {"tau": res.t[1:] - self.h, "regime": res.regime[1:, 0].copy(),
                          "force_N": res.force_N[1:, 0].copy(),
                          "slip": self._slip(res.q[1:], res.v[1:], res.slip_velocity[1:, 0]),
+                         "regime_all": res.regime[1:].copy(),
+                         "slip_all": res.slip_velocity[1:].copy(),
+                         "force_all": res.force_N[1:].copy(),
                          "max_penetration": c["max_penetration"],
                          "lcp_solves": c["lcp_solves"], "fallbacks": c["fallbacks"]}
         self.evaluations += 1
@@ -380,15 +383,14 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     J_loc = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
     eig = np.linalg.eigvals(J_sec)
     eig_loc = np.linalg.eigvals(J_loc)
-    letters = step_letters(last["regime"], last["slip"], float(scene.mu[0]))
-    merged = merge_step_regimes(letters, last["tau"], pm.h, period=pm.period)
+    mode, merged, fmin = _modes_of_run(scene, pm, last)
     return SteadyState(
         scheme="moreau-jean",
         displacement_per_period=float(disp),
         state0=x.copy(),
-        mode=_mode_of(merged),
+        mode=mode,
         regimes=merged,
-        min_normal_force=float(np.min(last["force_N"])),
+        min_normal_force=fmin,
         periodic_residual=r,
         iterations=it,
         wall_time=time.perf_counter() - t_start,
@@ -466,6 +468,30 @@ def _no_orbit(pm, x, closed, scale, tol, transient, t_start):
                "steps": int(pm.steps), "lcp_solves": int(pm.lcp_solves),
                "fallbacks": int(pm.fallbacks), "steps_per_period": pm.n, "theta": pm.theta,
                "projection": pm.projection, "period_maps": pm.evaluations})
+
+
+def _modes_of_run(scene, pm, last):
+    """Mode name, regimes over the period and min normal force of a recorded period.
+
+    One contact: the canonical mode (``"NP"``) and its merged regimes. Several:
+    each contact's mode joined by ``"|"`` (``"NSP|NP"``, as the event-driven
+    shooting names them), and regimes keyed by one letter per contact.
+    """
+    nc = last["regime_all"].shape[1]
+    if nc == 1:
+        letters = step_letters(last["regime"], last["slip"], float(scene.mu[0]))
+        merged = merge_step_regimes(letters, last["tau"], pm.h, period=pm.period)
+        return _mode_of(merged), merged, float(np.min(last["force_N"]))
+    per = [step_letters(last["regime_all"][:, c], last["slip_all"][:, c], float(scene.mu[c]))
+           for c in range(nc)]
+    mode = "|".join(_mode_of(merge_step_regimes(p, last["tau"], pm.h, period=pm.period))
+                    for p in per)
+    merged = []
+    for k, tau in enumerate(last["tau"]):
+        key = "".join(p[k] for p in per)
+        if not merged or merged[-1][1] != key:
+            merged.append([float(tau % pm.period), key])
+    return mode, merged, float(np.min(last["force_all"]))
 
 
 def _plain(eig):

@@ -80,3 +80,14 @@ def test_moreau_jean_agrees_with_the_event_driven_reference():
 def test_shooting_needs_a_cyclic_coordinate():
     with pytest.raises(InputError, match="`cyclic`"):
         shoot_periodic(BouncingBall(), "event-driven")
+
+
+@pytest.mark.parametrize("kw", [{"phase": 1.0}, {"x10_b": 1e-6}, {"x10_b": 0.0}])
+def test_moreau_jean_names_every_contact_like_the_reference(kw):
+    # both rods' regimes, in the same canonical form as the event-driven shooting
+    sc = BidirectionalDrive(BidirectionalDriveParams(**kw), frequency=185.0)
+    ed = find_steady_state(sc)
+    mj = find_steady_state(sc, "moreau-jean", steps_per_period=2000)
+    assert mj.mode == ed.mode and mj.mode.count("|") == 1
+    assert all(len(key) == 2 for _, key in mj.regimes)
+    assert mj.min_normal_force >= 0.0
