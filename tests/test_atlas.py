@@ -39,8 +39,9 @@ def test_phi0_plane_marks_ill_posed_and_flight(tmp_path):
     assert math.isnan(a["contact_loss_field"][0, 2])
     # at 2000 Hz, phi0 = 1.14: still in contact (the contact-loss edge is at 1.367)
     assert a["label"][1, 1] == "NP" and a["contact_loss_field"][1, 1] == -1.0
-    assert point_label({"status": "ConvergenceError: the rod never touches the rotor"}) == \
-        "no contact"
+    assert point_label({"status": "ConvergenceError: the rod does not touch the rotor in 50 "
+                                  "periods after the shooting's last state"}) == "no contact"
+    assert point_label({"status": "ConvergenceError: shooting did not converge"}) == "failed"
 
 
 def test_dask_local_cluster_gives_the_same_atlas(tmp_path):

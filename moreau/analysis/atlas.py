@@ -58,7 +58,7 @@ def point_label(row):
         return row["mode"]
     if status.startswith("PainleveError"):
         return ILL_POSED
-    if "never touches" in status:
+    if "does not touch the rotor" in status:
         return NO_CONTACT
     return FAILED
 

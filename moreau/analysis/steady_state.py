@@ -60,6 +60,10 @@ def _min_normal_force(walker, segments):
     return best
 
 
+#: periods run from a state in flight before the rod is declared never to touch
+_FLIGHT_SEARCH_PERIODS = 50
+
+
 def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     """Safeguarded secant iteration on the scalar period map ``u2'(tau_s) -> u2'(tau_s + 2 pi)``.
 
@@ -184,10 +188,19 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     if st0 is None:
         # the rod is in flight at this section in the steady state: move the
         # section into the longest contact segment of the settled motion
-        _, segs, _ = _period_run(walker, last, record=True)
-        contact = [(b.tau - a.tau, a.tau, b.tau) for a, b in segs if a.regime != Regime.FLIGHT]
+        # (with restitution the rod may fly through whole periods between
+        # impacts, so look over several periods before concluding)
+        contact = []
+        for _ in range(_FLIGHT_SEARCH_PERIODS):
+            last, segs, _ = _period_run(walker, last, record=True)
+            contact = [(b.tau - a.tau, a.tau, b.tau) for a, b in segs
+                       if a.regime != Regime.FLIGHT]
+            if contact:
+                break
         if not contact:
-            raise ConvergenceError("the rod never touches the rotor: no steady contact motion")
+            raise ConvergenceError(
+                f"the rod does not touch the rotor in {_FLIGHT_SEARCH_PERIODS} periods after the "
+                "shooting's last state: no steady contact motion was found")
         _, ta, tb = max(contact)
         tau_s = 0.5 * (ta + tb) % TWO_PI
         st0, it2, last = _shoot_scalar(walker, tau_s, walker.vtip(tau_s), rtol, max_iter)
