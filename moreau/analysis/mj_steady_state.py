@@ -48,7 +48,7 @@ import numpy as np
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError
 from .modes import impacts_after_flight, mode_name, step_letters
-from .steady_state import SteadyState
+from ..integrators.result import SteadyState
 
 __all__ = ["moreau_jean_steady_state", "merge_step_regimes", "PeriodMap"]
 
