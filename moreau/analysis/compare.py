@@ -370,12 +370,12 @@ class _StickSlipCase(_Case):
 
     def _steady(self):
         if self._ss is None:
-            from ..integrators.stick_slip_reference import stick_slip_steady_state
+            from ..scenes.stick_slip_exact import stick_slip_steady_state
             self._ss = stick_slip_steady_state(self.scene)
         return self._ss
 
     def reference(self, rtol):
-        from ..integrators.stick_slip_reference import stick_slip_steady_state
+        from ..scenes.stick_slip_exact import stick_slip_steady_state
         ss = stick_slip_steady_state(self.scene)
         return ss.displacement_per_period, _regime_switches(ss.regimes)
 

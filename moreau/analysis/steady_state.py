@@ -71,7 +71,7 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     ``None`` when the rod is in flight at the section, where the map is not
     scalar.
     """
-    from ..integrators.event_driven import ContactState
+    from ..scenes.friction_drive_walker import ContactState
 
     vs = walker.vscale
     phi_s, dphi_s = walker.manifold(tau_s)
@@ -171,7 +171,7 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
-    from ..integrators.event_driven import FrictionDriveWalker
+    from ..scenes.friction_drive_walker import FrictionDriveWalker
 
     t_start = time.perf_counter()
     walker = FrictionDriveWalker(scene, rtol=min(1e-12, rtol * 1e-2), **options)

@@ -8,7 +8,7 @@ import pytest
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import PainleveError, InputError
 from moreau.integrators import simulate
-from moreau.integrators.event_driven import ContactState, FrictionDriveWalker
+from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
 

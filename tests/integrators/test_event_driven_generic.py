@@ -8,7 +8,7 @@ import pytest
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
 from moreau.integrators import INTEGRATORS, simulate, stick_slip_steady_state
-from moreau.integrators.event_driven import EventDriven
+from moreau.scenes.friction_drive_walker import EventDriven
 from moreau.integrators.event_driven_generic import EventDrivenReference, GenericEventDriven
 from moreau.regimes import Regime
 from moreau.scenes import (BouncingBall, FrictionDrive, PainleveRod, SawtoothDrive, SineDrive,

@@ -27,6 +27,8 @@ Four generated families, each run through every method:
 every family; on the infeasible families success itself is the failure.
 """
 
+from pathlib import Path
+
 import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -209,11 +211,29 @@ def test_psd_family(prob):
     assert broken == []
     infeasibility_claims_carry_a_proof(M, q, results)
     # Lemke's secondary ray with a certified PSD M is a proof, and auto
-    # takes it without asking the QP
-    for method in ("lemke", "auto"):
-        res = results[method]
-        assert res.status == lcp.INFEASIBLE, f"{method}: {res.message}"
-        assert res.path == ("lemke",) and "copositive-plus" in res.message
+    # takes it without asking the QP. About 1 case in 2000 Lemke breaks down
+    # before the ray instead (an honest failure status, see
+    # test_psd_breakdown_is_caught_by_the_certified_qp); auto then proves
+    # infeasibility through the QP's checked certificate.
+    lem, auto = results["lemke"], results["auto"]
+    assert lem.status in (lcp.INFEASIBLE, lcp.BREAKDOWN), lem.message
+    assert auto.status == lcp.INFEASIBLE, auto.message
+    if lem.status == lcp.INFEASIBLE:
+        for res in (lem, auto):
+            assert res.path == ("lemke",) and "copositive-plus" in res.message
+
+
+def test_psd_breakdown_is_caught_by_the_certified_qp():
+    # an 8 x 8 member of the PSD family (found by Hypothesis) on which Lemke's
+    # lexicographic pivoting breaks down after 9 pivots: no false success, and
+    # auto still reports infeasible, with OSQP's certificate checked
+    data = np.load(Path(__file__).parents[1] / "data" / "psd_lemke_breakdown.npz")
+    M, q = data["M"], data["q"]
+    lem = lcp.solve_lcp(M, q, method="lemke")
+    assert not lem.success and lem.status in (lcp.INFEASIBLE, lcp.BREAKDOWN)
+    auto = lcp.solve_lcp(M, q, method="auto")
+    assert auto.status == lcp.INFEASIBLE and not auto.success
+    assert_farkas(M, q, auto.certificate, rtol=1e-6)
 
 
 @_settings("copositive")

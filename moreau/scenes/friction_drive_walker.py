@@ -26,8 +26,8 @@ from scipy.optimize import brentq, minimize_scalar
 from .._validate import positive, positive_int
 from ..errors import InputError, MoreauError, PainleveError
 from ..regimes import Regime
-from .base import Integrator, register_integrator
-from .result import Event
+from ..integrators.base import Integrator, register_integrator
+from ..integrators.result import Event
 
 __all__ = ["EventDriven", "ContactState", "FrictionDriveWalker"]
 
