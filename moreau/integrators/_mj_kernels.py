@@ -30,7 +30,11 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import _jit_cache
+from ..lcp import certify as _certify
+from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
+from ..scenes import _compiled
 from ..scenes._compiled import contact_fn, dynamics_fn, gaps_fn, mass_fn
 
 __all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
@@ -703,3 +707,15 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
         if last:
             break
     return status, k, nrec
+
+
+#: every source whose compiled code ends up in this module's functions (the
+#: scene models and Lemke are inlined or linked in; globals are frozen in)
+KERNEL_SOURCES = (__file__, _compiled.__file__, _lemke.__file__, _certify.__file__)
+
+# numba checks a cached kernel against this file only: tie it to all of them so
+# that editing a scene model or Lemke cannot leave stale machine code in use
+CACHE_MODE = _jit_cache.bind_cache_to_sources(
+    [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
+     and getattr(f.py_func, "__module__", None) == __name__],
+    KERNEL_SOURCES)

@@ -11,10 +11,10 @@ numba's on-disk cache.
 
 Adding a scene: give it a new ``kind``, add its branch to each function
 below, and a ``compiled_model()`` method returning ``CompiledModel(kind,
-par, ...)``. Numba keys the stepper's on-disk cache on its own source file
-only, so after editing this module delete
-``moreau/integrators/__pycache__/_mj_kernels*.nb*`` (or touch
-``_mj_kernels.py``); otherwise a stale compiled stepper is loaded.
+par, ...)``. The stepper's on-disk cache is tied to the contents of this
+module (:data:`moreau.integrators._mj_kernels.KERNEL_SOURCES`), so an edit
+here recompiles it on the next run; a scene model kept in another file must
+be added to that list.
 
 The Python :class:`~moreau.scenes.base.Scene` methods stay the definition;
 the formulas here are transcriptions of them, and
