@@ -26,6 +26,8 @@ import time
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
 from moreau.integrators import _mj_kernels as mk
 from moreau.scenes import FrictionDrive
 
