@@ -34,7 +34,7 @@ from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
 from ..scenes import _compiled
-from ..scenes._compiled import contact_fn, dynamics_fn, gaps_fn, mass_fn
+from ..scenes._compiled import FRICTION_DRIVE, contact_fn, dynamics_fn, gaps_fn, mass_fn
 
 __all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
            "LCP_HANDBACK"]
@@ -403,60 +403,11 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
     return status, pivots, res
 
 
-# error_model="numpy": a division by zero gives inf/nan, which the loop's own
-# tests turn into SINGULAR or NUMERICAL, instead of a raise branch after every
-# division, whose clean-up path kept numba from pruning reference counts
-@njit(cache=True, error_model="numpy")
-def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, force_lemke,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
-
-    Parameters
-    ----------
-    kind, par : int, float64[:]
-        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
-    n, nc : int
-        Degrees of freedom and contacts.
-    mu, e : float64[:]
-        Friction and restitution of each contact.
-    const_mass, has_jac : bool
-        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
-    t0, h, t_bound : float
-        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
-    k0 : int
-        Index of the first step (``t_k0 = t0 + k0 h``).
-    nmax : int
-        Most steps to take in this call.
-    q, v : float64[n]
-        State at ``t_k0``; overwritten with the final state.
-    theta : float
-    projection : bool
-    closed : bool[nc]
-        Contacts that carried a normal impulse in the step before ``k0``; updated.
-    save_every : int
-        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
-    record_initial : bool
-        Also record the state at ``t_k0`` (with the first step's regime and forces).
-    force_lemke : bool
-        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
-    rec_* : arrays
-        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
-        ones (ns, nc); long enough for this call's samples.
-    stats : float64[:]
-        Accumulated statistics, layout :data:`STAT_NAMES`.
-
-    Returns
-    -------
-    status : int
-        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
-        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
-        of the step Lemke could not solve).
-    k : int
-        Index of the next step (steps taken: ``k - k0``).
-    nrec : int
-        Samples written.
-    """
+@njit(cache=True, inline="always")
+def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+             theta, projection, closed, save_every, record_initial, force_lemke,
+             rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    # the loop of mj_run, inlined there twice (see mj_run)
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -776,6 +727,75 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
         if last:
             break
     return status, k, nrec
+
+
+# error_model="numpy": a division by zero gives inf/nan, which the loop's own
+# tests turn into SINGULAR or NUMERICAL, instead of a raise branch after every
+# division, whose clean-up path kept numba from pruning reference counts
+@njit(cache=True, error_model="numpy")
+def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, force_lemke,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
+
+    Parameters
+    ----------
+    kind, par : int, float64[:]
+        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
+    n, nc : int
+        Degrees of freedom and contacts.
+    mu, e : float64[:]
+        Friction and restitution of each contact.
+    const_mass, has_jac : bool
+        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
+    t0, h, t_bound : float
+        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
+    k0 : int
+        Index of the first step (``t_k0 = t0 + k0 h``).
+    nmax : int
+        Most steps to take in this call.
+    q, v : float64[n]
+        State at ``t_k0``; overwritten with the final state.
+    theta : float
+    projection : bool
+    closed : bool[nc]
+        Contacts that carried a normal impulse in the step before ``k0``; updated.
+    save_every : int
+        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
+    record_initial : bool
+        Also record the state at ``t_k0`` (with the first step's regime and forces).
+    force_lemke : bool
+        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
+    rec_* : arrays
+        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
+        ones (ns, nc); long enough for this call's samples.
+    stats : float64[:]
+        Accumulated statistics, layout :data:`STAT_NAMES`.
+
+    Returns
+    -------
+    status : int
+        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
+        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
+        of the step Lemke could not solve).
+    k : int
+        Index of the next step (steps taken: ``k - k0``).
+    nrec : int
+        Samples written.
+    """
+    # The same loop twice: once with the friction drive's kind and sizes as
+    # constants, once for any model. With constants, the compiler drops the
+    # other scenes' branches, unrolls the small-matrix loops and evaluates the
+    # sines and cosines shared by the model functions once per step; that
+    # keeps the paper's scene as fast as its former hand-written kernel.
+    if kind == FRICTION_DRIVE and n == 2 and nc == 1:
+        return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, const_mass, has_jac, t0, h, t_bound,
+                        k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
+                        force_lemke, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
+                        rec_gap, stats)
+    return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
+                    v, theta, projection, closed, save_every, record_initial, force_lemke,
+                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
 
 
 #: every source whose compiled code ends up in this module's functions (the
