@@ -29,6 +29,9 @@ import time
 
 import numpy as np
 
+# runnable from a checkout without installing the package
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
 from moreau.integrators import simulate
 from moreau.scenes import (BidirectionalDrive, BouncingBall, FrictionDrive, PainleveRod,

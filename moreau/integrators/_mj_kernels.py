@@ -3,8 +3,7 @@
 This is the fast path of :mod:`moreau.integrators.moreau_jean`: the same
 scheme, the same time grid, index set, contact problem, regime
 classification and projection, run as one ``numba`` call over a block of
-steps that allocates nothing per step (the LCP buffers are reallocated only
-when the number of active contacts changes). The scene's model comes from
+steps that allocates nothing per step. The scene's model comes from
 :mod:`moreau.scenes._compiled` as ``(kind, par)``; the loop itself knows no
 scene.
 
@@ -30,8 +29,12 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import _jit_cache
+from ..lcp import certify as _certify
+from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
-from ..scenes._compiled import contact_fn, dynamics_fn, gaps_fn, mass_fn
+from ..scenes import _compiled
+from ..scenes._compiled import FRICTION_DRIVE, contact_fn, dynamics_fn, gaps_fn, mass_fn
 
 __all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
            "LCP_HANDBACK"]
@@ -155,54 +158,119 @@ def _classify(pN, pT, mu):
 
 
 @njit(cache=True, inline="always")
-def _invert(A, out, work, n):
-    """``out = A^-1``; False when ``A`` is singular to working precision (1-norm condition)."""
+def _invert_small(A, out, n):
+    """``out = A^-1`` for ``n <= 3`` in closed form; False when ``A`` is singular.
+
+    Singular means to working precision: a 1-norm condition number of 1e14 or
+    more, or a non-finite entry. Loop-free and call-free on purpose: numba
+    reference-counts the arrays of an inlined function, and LLVM prunes those
+    counts only around straight-line code (see moreau.scenes._compiled).
+    """
+    ok = True
+    na = 0.0
+    ni = 0.0
+    if n == 1:
+        a = A[0, 0]
+        ok = math.isfinite(a)
+        out[0, 0] = 1.0 / a
+        na = abs(a)
+        ni = abs(out[0, 0])
+    elif n == 2:
+        a = A[0, 0]
+        b = A[0, 1]
+        c = A[1, 0]
+        d = A[1, 1]
+        ok = math.isfinite(a) and math.isfinite(b) and math.isfinite(c) and math.isfinite(d)
+        det = a * d - b * c
+        out[0, 0] = d / det
+        out[0, 1] = -b / det
+        out[1, 0] = -c / det
+        out[1, 1] = a / det
+        na = max(abs(a) + abs(c), abs(b) + abs(d))
+        ni = max(abs(out[0, 0]) + abs(out[1, 0]), abs(out[0, 1]) + abs(out[1, 1]))
+    else:
+        a00 = A[0, 0]
+        a01 = A[0, 1]
+        a02 = A[0, 2]
+        a10 = A[1, 0]
+        a11 = A[1, 1]
+        a12 = A[1, 2]
+        a20 = A[2, 0]
+        a21 = A[2, 1]
+        a22 = A[2, 2]
+        ok = (math.isfinite(a00) and math.isfinite(a01) and math.isfinite(a02)
+              and math.isfinite(a10) and math.isfinite(a11) and math.isfinite(a12)
+              and math.isfinite(a20) and math.isfinite(a21) and math.isfinite(a22))
+        # adjugate over the determinant
+        c00 = a11 * a22 - a12 * a21
+        c01 = a02 * a21 - a01 * a22
+        c02 = a01 * a12 - a02 * a11
+        c10 = a12 * a20 - a10 * a22
+        c11 = a00 * a22 - a02 * a20
+        c12 = a02 * a10 - a00 * a12
+        c20 = a10 * a21 - a11 * a20
+        c21 = a01 * a20 - a00 * a21
+        c22 = a00 * a11 - a01 * a10
+        det = a00 * c00 + a01 * c10 + a02 * c20
+        out[0, 0] = c00 / det
+        out[0, 1] = c01 / det
+        out[0, 2] = c02 / det
+        out[1, 0] = c10 / det
+        out[1, 1] = c11 / det
+        out[1, 2] = c12 / det
+        out[2, 0] = c20 / det
+        out[2, 1] = c21 / det
+        out[2, 2] = c22 / det
+        na = max(abs(a00) + abs(a10) + abs(a20),
+                 max(abs(a01) + abs(a11) + abs(a21), abs(a02) + abs(a12) + abs(a22)))
+        ni = max(abs(out[0, 0]) + abs(out[1, 0]) + abs(out[2, 0]),
+                 max(abs(out[0, 1]) + abs(out[1, 1]) + abs(out[2, 1]),
+                     abs(out[0, 2]) + abs(out[1, 2]) + abs(out[2, 2])))
+    # the arrays' last use, on the path where all branches have merged
+    touched = A.size + out.size
+    # `na * ni < COND_MAX` is False for nan too
+    return ok and na * ni < COND_MAX and touched > 0
+
+
+@njit(cache=True, error_model="numpy")
+def _invert_gj(A, out, work, n):
+    """``out = A^-1`` by Gauss-Jordan with partial pivoting (any ``n``); False when singular."""
     for i in range(n):
         for j in range(n):
             if not math.isfinite(A[i, j]):
                 return False
-    if n == 1:
-        out[0, 0] = 1.0 / A[0, 0]
-    elif n == 2:
-        det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        out[0, 0] = A[1, 1] / det
-        out[0, 1] = -A[0, 1] / det
-        out[1, 0] = -A[1, 0] / det
-        out[1, 1] = A[0, 0] / det
-    else:
-        # Gauss-Jordan with partial pivoting on a copy
-        for i in range(n):
+    for i in range(n):
+        for j in range(n):
+            work[i, j] = A[i, j]
+            out[i, j] = 1.0 if i == j else 0.0
+    for c in range(n):
+        piv = c
+        best = abs(work[c, c])
+        for r in range(c + 1, n):
+            if abs(work[r, c]) > best:
+                best = abs(work[r, c])
+                piv = r
+        if best == 0.0:
+            return False
+        if piv != c:
             for j in range(n):
-                work[i, j] = A[i, j]
-                out[i, j] = 1.0 if i == j else 0.0
-        for c in range(n):
-            piv = c
-            best = abs(work[c, c])
-            for r in range(c + 1, n):
-                if abs(work[r, c]) > best:
-                    best = abs(work[r, c])
-                    piv = r
-            if best == 0.0:
-                return False
-            if piv != c:
-                for j in range(n):
-                    tmp = work[c, j]
-                    work[c, j] = work[piv, j]
-                    work[piv, j] = tmp
-                    tmp = out[c, j]
-                    out[c, j] = out[piv, j]
-                    out[piv, j] = tmp
-            inv = 1.0 / work[c, c]
-            for j in range(n):
-                work[c, j] *= inv
-                out[c, j] *= inv
-            for r in range(n):
-                if r != c:
-                    fct = work[r, c]
-                    if fct != 0.0:
-                        for j in range(n):
-                            work[r, j] -= fct * work[c, j]
-                            out[r, j] -= fct * out[c, j]
+                tmp = work[c, j]
+                work[c, j] = work[piv, j]
+                work[piv, j] = tmp
+                tmp = out[c, j]
+                out[c, j] = out[piv, j]
+                out[piv, j] = tmp
+        inv = 1.0 / work[c, c]
+        for j in range(n):
+            work[c, j] *= inv
+            out[c, j] *= inv
+        for r in range(n):
+            if r != c:
+                fct = work[r, c]
+                if fct != 0.0:
+                    for j in range(n):
+                        work[r, j] -= fct * work[c, j]
+                        out[r, j] -= fct * out[c, j]
     na = 0.0
     ni = 0.0
     for j in range(n):
@@ -278,7 +346,8 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
     the active contacts (``ia[:na]``): one variable per frictionless contact,
     ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
     cone rows, and the restitution term only where ``e > 0``. The buffers
-    have the size ``L`` of :func:`_lcp_size`. Writes the stacked impulses
+    are at least the size ``L`` of :func:`_lcp_size`; their leading ``L``
+    entries are used. Writes the stacked impulses
     ``p`` and the per-contact ``pN``, ``pT``.
     Returns Lemke's ``(status, pivots, residual)``.
     """
@@ -318,7 +387,8 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
             Ml[br + 3, br + 1] = -1.0
             Ml[br + 3, br + 2] = -1.0
     max_iter = 1000 if L <= 20 else 50 * L
-    status, pivots, res = lemke_core(Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter,
+    # lemke_core takes the size from q; M, d and the outputs may be larger
+    status, pivots, res = lemke_core(Ml, ql[:L], dl, zl, wl, rayl, work, iwork, max_iter,
                                      DEFAULT_TOL)
     if status == 0:
         for r in range(na):
@@ -333,57 +403,11 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
     return status, pivots, res
 
 
-@njit(cache=True)
-def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, force_lemke,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
-
-    Parameters
-    ----------
-    kind, par : int, float64[:]
-        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
-    n, nc : int
-        Degrees of freedom and contacts.
-    mu, e : float64[:]
-        Friction and restitution of each contact.
-    const_mass, has_jac : bool
-        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
-    t0, h, t_bound : float
-        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
-    k0 : int
-        Index of the first step (``t_k0 = t0 + k0 h``).
-    nmax : int
-        Most steps to take in this call.
-    q, v : float64[n]
-        State at ``t_k0``; overwritten with the final state.
-    theta : float
-    projection : bool
-    closed : bool[nc]
-        Contacts that carried a normal impulse in the step before ``k0``; updated.
-    save_every : int
-        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
-    record_initial : bool
-        Also record the state at ``t_k0`` (with the first step's regime and forces).
-    force_lemke : bool
-        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
-    rec_* : arrays
-        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
-        ones (ns, nc); long enough for this call's samples.
-    stats : float64[:]
-        Accumulated statistics, layout :data:`STAT_NAMES`.
-
-    Returns
-    -------
-    status : int
-        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
-        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
-        of the step Lemke could not solve).
-    k : int
-        Index of the next step (steps taken: ``k - k0``).
-    nrec : int
-        Samples written.
-    """
+@njit(cache=True, inline="always")
+def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+             theta, projection, closed, save_every, record_initial, force_lemke,
+             rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    # the loop of mj_run, inlined there twice (see mj_run)
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -427,14 +451,17 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     dd = np.zeros(ncm)
     base = np.zeros(ncm, dtype=np.int64)
     trow = np.zeros(ncm, dtype=np.int64)
-    L = 1
-    Ml = np.zeros((1, 1))
-    ql = np.zeros(1)
-    dl = np.ones(1)
-    zl = np.zeros(1)
-    wl = np.zeros(1)
-    rayl = np.zeros(2)
-    work, iwork = lemke_workspace(1)
+    # LCP buffers at the largest size (four variables per contact), allocated
+    # once: arrays reassigned inside the loop would be reference-counted on
+    # every step, contact or not; _lcp_step uses their leading L x L block
+    Lmax = 4 * ncm
+    Ml = np.zeros((Lmax, Lmax))
+    ql = np.zeros(Lmax)
+    dl = np.ones(Lmax)
+    zl = np.zeros(Lmax)
+    wl = np.zeros(Lmax)
+    rayl = np.zeros(Lmax + 1)
+    work, iwork = lemke_workspace(Lmax)
 
     constant_W = const_mass and not has_jac
     have_Wi = False
@@ -479,7 +506,11 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 for j in range(n):
                     Wh[i, j] = M[i, j]
         if not (constant_W and have_Wi):
-            if not _invert(Wh, Wi, wk, n):
+            if n <= 3:
+                ok = _invert_small(Wh, Wi, n)
+            else:
+                ok = _invert_gj(Wh, Wi, wk, n)
+            if not ok:
                 status = SINGULAR
                 break
             have_Wi = True
@@ -565,18 +596,7 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 pN[i] = pn
                 pT[i] = pt
             else:
-                size = _lcp_size(na, ia, mu, base, trow)
-                if size != L:
-                    # buffers follow the number of LCP variables, reallocated only when
-                    # the active set changes size
-                    L = size
-                    Ml = np.zeros((L, L))
-                    ql = np.zeros(L)
-                    dl = np.ones(L)
-                    zl = np.zeros(L)
-                    wl = np.zeros(L)
-                    rayl = np.zeros(L + 1)
-                    work, iwork = lemke_workspace(L)
+                L = _lcp_size(na, ia, mu, base, trow)
                 lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
                                           Ml, ql, dl, zl, wl, rayl, work, iwork)
                 if lst != 0:
@@ -622,7 +642,11 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
                 if (not anysel) or gmax <= PROJECTION_TOL:
                     break
                 if not pinv:
-                    if not _invert(M, Mi, wk, n):
+                    if n <= 3:
+                        ok = _invert_small(M, Mi, n)
+                    else:
+                        ok = _invert_gj(M, Mi, wk, n)
+                    if not ok:
                         status = NUMERICAL
                         break
                     pinv = True
@@ -703,3 +727,84 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
         if last:
             break
     return status, k, nrec
+
+
+# error_model="numpy": a division by zero gives inf/nan, which the loop's own
+# tests turn into SINGULAR or NUMERICAL, instead of a raise branch after every
+# division, whose clean-up path kept numba from pruning reference counts
+@njit(cache=True, error_model="numpy")
+def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, force_lemke,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
+
+    Parameters
+    ----------
+    kind, par : int, float64[:]
+        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
+    n, nc : int
+        Degrees of freedom and contacts.
+    mu, e : float64[:]
+        Friction and restitution of each contact.
+    const_mass, has_jac : bool
+        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
+    t0, h, t_bound : float
+        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
+    k0 : int
+        Index of the first step (``t_k0 = t0 + k0 h``).
+    nmax : int
+        Most steps to take in this call.
+    q, v : float64[n]
+        State at ``t_k0``; overwritten with the final state.
+    theta : float
+    projection : bool
+    closed : bool[nc]
+        Contacts that carried a normal impulse in the step before ``k0``; updated.
+    save_every : int
+        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
+    record_initial : bool
+        Also record the state at ``t_k0`` (with the first step's regime and forces).
+    force_lemke : bool
+        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
+    rec_* : arrays
+        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
+        ones (ns, nc); long enough for this call's samples.
+    stats : float64[:]
+        Accumulated statistics, layout :data:`STAT_NAMES`.
+
+    Returns
+    -------
+    status : int
+        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
+        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
+        of the step Lemke could not solve).
+    k : int
+        Index of the next step (steps taken: ``k - k0``).
+    nrec : int
+        Samples written.
+    """
+    # The same loop twice: once with the friction drive's kind and sizes as
+    # constants, once for any model. With constants, the compiler drops the
+    # other scenes' branches, unrolls the small-matrix loops and evaluates the
+    # sines and cosines shared by the model functions once per step; that
+    # keeps the paper's scene as fast as its former hand-written kernel.
+    if kind == FRICTION_DRIVE and n == 2 and nc == 1:
+        return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, const_mass, has_jac, t0, h, t_bound,
+                        k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
+                        force_lemke, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
+                        rec_gap, stats)
+    return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
+                    v, theta, projection, closed, save_every, record_initial, force_lemke,
+                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
+
+
+#: every source whose compiled code ends up in this module's functions (the
+#: scene models and Lemke are inlined or linked in; globals are frozen in)
+KERNEL_SOURCES = (__file__, _compiled.__file__, _lemke.__file__, _certify.__file__)
+
+# numba checks a cached kernel against this file only: tie it to all of them so
+# that editing a scene model or Lemke cannot leave stale machine code in use
+CACHE_MODE = _jit_cache.bind_cache_to_sources(
+    [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
+     and getattr(f.py_func, "__module__", None) == __name__],
+    KERNEL_SOURCES)

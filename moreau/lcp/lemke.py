@@ -967,3 +967,17 @@ def _solve(M, q, max_iter, tol, check_input, covering):
             res.certificate = y
         res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res
+
+
+# the compiled functions freeze FARKAS_TOL from certify.py: their on-disk cache
+# must follow that file too (numba only checks this one)
+def _bind_cache():
+    from .. import _jit_cache
+    from . import certify
+    _jit_cache.bind_cache_to_sources(
+        [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
+         and getattr(f.py_func, "__module__", None) == __name__],
+        (__file__, certify.__file__))
+
+
+_bind_cache()

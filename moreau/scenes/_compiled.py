@@ -11,10 +11,10 @@ numba's on-disk cache.
 
 Adding a scene: give it a new ``kind``, add its branch to each function
 below, and a ``compiled_model()`` method returning ``CompiledModel(kind,
-par, ...)``. Numba keys the stepper's on-disk cache on its own source file
-only, so after editing this module delete
-``moreau/integrators/__pycache__/_mj_kernels*.nb*`` (or touch
-``_mj_kernels.py``); otherwise a stale compiled stepper is loaded.
+par, ...)``. The stepper's on-disk cache is tied to the contents of this
+module (:data:`moreau.integrators._mj_kernels.KERNEL_SOURCES`), so an edit
+here recompiles it on the next run; a scene model kept in another file must
+be added to that list.
 
 The Python :class:`~moreau.scenes.base.Scene` methods stay the definition;
 the formulas here are transcriptions of them, and
@@ -97,6 +97,19 @@ def _motor_drive(par, t):
 
 
 # -- dispatchers -------------------------------------------------------------------------
+#
+# Each function below ends by "touching" its array arguments (their sizes are
+# returned and ignored). Numba inlines these functions into the stepper and
+# reference-counts every array argument there; without a use after the
+# ``kind`` branches merge, each branch releases the arrays separately and
+# LLVM's reference-count pruning cannot pair those releases with the single
+# acquire, which left ~20 atomic increments and decrements in every step.
+
+
+@njit(cache=True, inline="always")
+def _touch3(a, b, c):
+    return a.size + b.size + c.size
+
 
 @njit(cache=True, inline="always")
 def mass_fn(kind, par, q, M):
@@ -118,6 +131,7 @@ def mass_fn(kind, par, q, M):
     else:
         for i in range(M.shape[0]):
             M[i, i] = 1.0
+    return _touch3(par, q, M)
 
 
 @njit(cache=True, inline="always")
@@ -156,6 +170,7 @@ def dynamics_fn(kind, par, q, v, t, D, need_jac):
     elif kind == STICK_SLIP_MOTOR:
         D[0, 0] = -par[0]
         D[1, 0] = -par[1]
+    return _touch3(par, q, D) + v.size
 
 
 @njit(cache=True, inline="always")
@@ -178,6 +193,7 @@ def gaps_fn(kind, par, q, t, G):
         c = math.cos(q[2])
         G[0, 0] = q[1] - par[0] * s - par[1] * c
         G[1, 0] = q[1] + par[0] * s - par[1] * c
+    return _touch3(par, q, G)
 
 
 @njit(cache=True, inline="always")
@@ -204,6 +220,7 @@ def _normal_rows(kind, par, q, t, G):
         for i in range(2):
             G[i, 4] = 1.0
             G[i, 5] = (2.0 * i - 1.0) * par[0] * c + par[1] * s
+    return _touch3(par, q, G)
 
 
 @njit(cache=True, inline="always")
@@ -213,8 +230,7 @@ def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
         gaps_fn(kind, par, q, t, G)
     if not need_T:
         _normal_rows(kind, par, q, t, G)
-        return
-    if kind == FRICTION_DRIVE:
+    elif kind == FRICTION_DRIVE:
         G[0, 3] = -math.cos(q[0])
         G[0, 1] = -par[2] * math.sin(t)
         G[0, 5] = math.sin(q[0])
@@ -253,6 +269,7 @@ def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
             G[i, 5] = sg * a * c + b * s
             G[i, 6] = 1.0
             G[i, 8] = -sg * a * s + b * c
+    return _touch3(par, q, G)
 
 
 @njit(cache=True)

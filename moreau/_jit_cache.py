@@ -1,0 +1,108 @@
+"""Key numba's on-disk cache of a module's functions on every source they compile in.
+
+Numba validates a cached function against the modification time and size of
+the one file that defines it (a documented limitation: "changes in symbols
+defined in another file are not detected"). A stepper that inlines or links
+compiled functions from other modules would therefore keep running stale
+machine code after one of those modules is edited, and give silently wrong
+answers. :func:`bind_cache_to_sources` adds a digest of the contents of all
+the files the functions depend on to the stamp that numba stores in each
+cache index and compares on load: when any of them changes, the index no
+longer matches, numba compiles again and overwrites the stale entry.
+
+Nothing is written or removed here, so a read-only install is unaffected. If
+numba's cache internals are not what this module expects (another numba
+version), the functions fall back to compiling in memory each process:
+slower, never stale.
+"""
+
+import hashlib
+import os
+
+__all__ = ["sources_digest", "bind_cache_to_sources"]
+
+
+def sources_digest(paths):
+    """SHA-256 of the contents of ``paths``, in order (unreadable files count as missing).
+
+    Examples
+    --------
+    >>> import moreau._jit_cache as jc
+    >>> len(sources_digest([jc.__file__]))
+    64
+    """
+    hasher = hashlib.sha256()
+    for path in paths:
+        hasher.update(os.path.basename(path).encode())
+        try:
+            with open(path, "rb") as fh:
+                hasher.update(fh.read())
+        except OSError:
+            hasher.update(b"<missing>")
+    return hasher.hexdigest()
+
+
+def bind_cache_to_sources(dispatchers, paths):
+    """Make the on-disk cache of ``dispatchers`` valid only for the current ``paths``.
+
+    Parameters
+    ----------
+    dispatchers : iterable of numba dispatchers
+        Functions compiled with ``cache=True``, before their first call.
+    paths : sequence of str
+        Every source file whose compiled code ends up in them (their own
+        module included).
+
+    Returns
+    -------
+    str
+        ``"bound"`` when the cache stamps carry the digest, ``"memory"`` when
+        caching had to be turned off for at least one function.
+
+    Examples
+    --------
+    >>> from numba import njit
+    >>> @njit
+    ... def f(x):
+    ...     return x + 1
+    >>> bind_cache_to_sources([f], [__file__]) in ("bound", "memory")
+    True
+    """
+    digest = sources_digest(paths)
+    mode = "bound"
+    for disp in dispatchers:
+        cache = getattr(disp, "_cache", None)
+        cache_file = getattr(cache, "_cache_file", None)
+        if cache_file is None:
+            # not cached on disk (cache=False or a null cache): nothing can go stale
+            continue
+        stamp = getattr(cache_file, "_source_stamp", None)
+        if stamp is None:
+            _disable_disk_cache(disp)
+            mode = "memory"
+            continue
+        if isinstance(stamp, tuple) and len(stamp) == 2 and stamp[0] == "moreau-deps":
+            # bound already (module reloaded): rebind to the current digest
+            stamp = stamp[1][0]
+        cache_file._source_stamp = ("moreau-deps", (stamp, digest))
+    return mode
+
+
+def _disable_disk_cache(disp):
+    try:
+        from numba.core.caching import NullCache
+        disp._cache = NullCache()
+    except Exception:
+        # last resort: a dispatcher without a usable cache object compiles in memory
+        disp._cache = _NoCache()
+
+
+class _NoCache:
+    def load_overload(self, sig, target_context):
+        return None
+
+    def save_overload(self, sig, data):
+        pass
+
+    def flush(self):
+        pass

@@ -1,0 +1,123 @@
+"""The compiled kernel's on-disk cache follows every source compiled into it."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+import moreau
+from moreau import _jit_cache
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(moreau.__file__)))
+
+KERNEL = textwrap.dedent("""
+    import os
+    from numba import njit
+    from toypkg import dep
+
+    @njit(cache=True)
+    def f(x):
+        return dep.g(x)
+
+    if os.environ.get("TOY_BIND") == "1":
+        from moreau._jit_cache import bind_cache_to_sources
+        MODE = bind_cache_to_sources([f], [__file__, dep.__file__])
+    """)
+
+DEP = "from numba import njit\n\n\n@njit(cache=True, inline='always')\ndef g(x):\n    return x + {}.0\n"
+
+
+def _toy(tmp_path, name):
+    pkg = tmp_path / name / "toypkg"
+    pkg.mkdir(parents=True)
+    (pkg / "__init__.py").write_text("")
+    (pkg / "kern.py").write_text(KERNEL)
+    (pkg / "dep.py").write_text(DEP.format(1))
+    return pkg
+
+
+def _run(pkg, bind):
+    env = dict(os.environ)
+    env.pop("NUMBA_CACHE_DIR", None)
+    env["PYTHONPATH"] = os.pathsep.join([str(pkg.parent), ROOT])
+    env["TOY_BIND"] = "1" if bind else "0"
+    out = subprocess.run([sys.executable, "-c", "from toypkg import kern; print(kern.f(1.0))"],
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr
+    return float(out.stdout.split()[-1])
+
+
+def _edit_dep(pkg):
+    # same size, same file for the kernel: only the dependency's content changes
+    st = os.stat(pkg / "kern.py")
+    (pkg / "dep.py").write_text(DEP.format(2))
+    os.utime(pkg / "kern.py", ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
+def test_unbound_cache_goes_stale(tmp_path):
+    # the hazard itself, so that the next test proves something: numba alone
+    # keeps the old machine code after the dependency changes
+    pkg = _toy(tmp_path, "plain")
+    assert _run(pkg, bind=False) == 2.0
+    _edit_dep(pkg)
+    assert _run(pkg, bind=False) == 2.0
+
+
+def test_bound_cache_recompiles_when_a_dependency_changes(tmp_path):
+    pkg = _toy(tmp_path, "bound")
+    assert _run(pkg, bind=True) == 2.0
+    assert any(p.suffix == ".nbi" for p in (pkg / "__pycache__").iterdir())
+    assert _run(pkg, bind=True) == 2.0
+    _edit_dep(pkg)
+    assert _run(pkg, bind=True) == 3.0
+    assert _run(pkg, bind=True) == 3.0
+
+
+@pytest.mark.skipif(hasattr(os, "geteuid") and os.geteuid() == 0,
+                    reason="root ignores read-only permissions")
+def test_read_only_install_still_runs(tmp_path):
+    pkg = _toy(tmp_path, "readonly")
+    assert _run(pkg, bind=True) == 2.0
+    _edit_dep(pkg)
+    for p in [pkg, pkg / "__pycache__"]:
+        os.chmod(p, 0o555)
+    try:
+        assert _run(pkg, bind=True) == 3.0
+    finally:
+        for p in [pkg, pkg / "__pycache__"]:
+            os.chmod(p, 0o755)
+
+
+def test_kernel_stamps_carry_the_digest_of_all_kernel_sources():
+    from moreau.integrators import _mj_kernels as mk
+    from moreau.lcp import lemke
+
+    names = {os.path.basename(p) for p in mk.KERNEL_SOURCES}
+    assert {"_mj_kernels.py", "_compiled.py", "lemke.py", "certify.py"} <= names
+    assert mk.CACHE_MODE == "bound"
+    digest = _jit_cache.sources_digest(mk.KERNEL_SOURCES)
+    for disp in (mk.mj_run, mk._lcp_step, mk._one_contact):
+        stamp = disp._cache._cache_file._source_stamp
+        assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
+    assert lemke.lemke_core._cache._cache_file._source_stamp[0] == "moreau-deps"
+
+
+def test_digest_changes_with_content(tmp_path):
+    a = tmp_path / "a.py"
+    a.write_text("x = 1\n")
+    d1 = _jit_cache.sources_digest([str(a)])
+    a.write_text("x = 2\n")
+    assert _jit_cache.sources_digest([str(a)]) != d1
+    assert _jit_cache.sources_digest([str(tmp_path / "missing.py")]) != d1
+
+
+def test_unknown_cache_internals_fall_back_to_memory():
+    from types import SimpleNamespace
+
+    from numba.core.caching import NullCache
+
+    disp = SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace()))
+    assert _jit_cache.bind_cache_to_sources([disp], [__file__]) == "memory"
+    assert isinstance(disp._cache, NullCache)
