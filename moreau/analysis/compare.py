@@ -279,7 +279,36 @@ class _Case:
         return _drop_reversal_sticks(sw, h)[1:]
 
 
-class _FrictionDriveCase(_Case):
+class _DriveCase(_Case):
+    """A periodically driven scene whose headline is the displacement of its
+    cyclic coordinate ``cyclic`` over one steady period; ``_tight()`` gives the
+    reference's periodic state and its trajectory on the comparison grid."""
+
+    cyclic = 1
+    projection = True
+
+    def reference_grid(self):
+        return self._tight()["grid"]
+
+    def start(self):
+        r = self._tight()
+        return r["q0"].copy(), r["v0"].copy()
+
+    def coordinate(self, q):
+        return q[:, self.cyclic]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, self.cyclic] - res.q[0, self.cyclic])
+
+    def mj(self, n, theta, lcp):
+        if lcp is not None:
+            return super().mj(n, theta, lcp)
+        from ..analysis.mj_steady_state import moreau_jean_steady_state
+        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
+        return ss.displacement_per_period, ss
+
+
+class _FrictionDriveCase(_DriveCase):
     ref_scheme = "event-driven"
     # the compiled steady state is cheap: go far enough to show the plateaus
     default_steps = DEFAULT_STEPS + (10000, 20000)
@@ -325,25 +354,6 @@ class _FrictionDriveCase(_Case):
             self._ref = dict(q0=q, v0=v, grid=grid_run.q[idx, 1])
         return self._ref
 
-    def reference_grid(self):
-        return self._tight()["grid"]
-
-    def start(self):
-        r = self._tight()
-        return r["q0"].copy(), r["v0"].copy()
-
-    def coordinate(self, q):
-        return q[:, 1]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 1] - res.q[0, 1])
-
-    def mj(self, n, theta, lcp):
-        if lcp is not None:
-            return super().mj(n, theta, lcp)
-        from ..analysis.mj_steady_state import moreau_jean_steady_state
-        ss = moreau_jean_steady_state(self.scene, n, theta=theta)
-        return ss.displacement_per_period, ss
 
     def measure(self, n, theta, lcp, out):
         if lcp is not None:
@@ -564,14 +574,14 @@ def _contact_switches(regimes, tau_s, contact, h=0.0):
     return _drop_reversal_sticks(sw, h)[1:]
 
 
-class _BidirectionalDriveCase(_Case):
+class _BidirectionalDriveCase(_DriveCase):
     """The two-rod drive's steady state; Moreau–Jean against the generic event-driven reference."""
 
     ref_scheme = "event-driven"
     ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
     tight_rtol = 1e-12
     headline_name = "displacement per period"
-    projection = True
+    cyclic = 2
 
     def __init__(self, frequency=185.0, **params):
         from ..scenes.bidirectional_drive import BidirectionalDrive, params_from_kwargs
@@ -615,25 +625,6 @@ class _BidirectionalDriveCase(_Case):
             self._ref = dict(q0=q, v0=v, grid=np.interp(grid, run.t, run.q[:, 2]))
         return self._ref
 
-    def reference_grid(self):
-        return self._tight()["grid"]
-
-    def start(self):
-        r = self._tight()
-        return r["q0"].copy(), r["v0"].copy()
-
-    def coordinate(self, q):
-        return q[:, 2]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 2] - res.q[0, 2])
-
-    def mj(self, n, theta, lcp):
-        if lcp is not None:
-            return super().mj(n, theta, lcp)
-        from ..analysis.mj_steady_state import moreau_jean_steady_state
-        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
-        return ss.displacement_per_period, ss
 
     def measure(self, n, theta, lcp, out):
         # the trajectory and the switching times: one period of the same scheme
