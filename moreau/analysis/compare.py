@@ -814,26 +814,37 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
     jobs += [("mj", th, None, n) for th in thetas for n in steps]
     jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(jobs), desc=f"compare {scene}", unit="run")
-    try:
-        for kind, theta, lcp, setting in jobs:
-            row = _run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches)
-            report["rows"].append(row)
-            if on_row is not None:
-                on_row(row)
-            if bar is not None:
-                bar.update(1)
-    except KeyboardInterrupt:
-        report["interrupted"] = True
-    finally:
-        if bar is not None:
-            bar.close()
+    report["interrupted"] = collect_rows(
+        jobs, lambda job: [_run_row(case, *job, repeat, ref_value, ref_switches)],
+        report["rows"], on_row, progress, desc=f"compare {scene}", unit="run")
     report["orders"] = _orders(report["rows"])
     report["notes"] = plateaus(report["rows"])
     return report
+
+
+def collect_rows(items, run, rows, on_row=None, progress=False, desc="", unit="item"):
+    """Append ``run(item)``'s rows for each item, with a progress bar; keep them on Ctrl-C.
+
+    Returns True when interrupted: the rows finished so far stay in ``rows``.
+    """
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(items), desc=desc, unit=unit)
+    try:
+        for item in items:
+            for row in run(item):
+                rows.append(row)
+                if on_row is not None:
+                    on_row(row)
+            if bar is not None:
+                bar.update(1)
+    except KeyboardInterrupt:
+        return True
+    finally:
+        if bar is not None:
+            bar.close()
+    return False
 
 
 def _run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):

@@ -40,17 +40,9 @@ TWO_PI = 2.0 * math.pi
 def _project(scene, t, q, v, touching):
     if not len(touching):
         return q, v
-    M = scene.mass(q)
-    for _ in range(5):
-        g = scene.gaps(q, t)[touching]
-        if np.max(np.abs(g)) == 0.0:
-            break
-        WN = scene.contact_jacobians(q, t)[0][touching]
-        MiW = np.linalg.solve(M, WN.T)
-        dq = MiW @ np.linalg.solve(WN @ MiW, g)
-        q = q - dq
-        if np.max(np.abs(dq)) <= 4e-16 * max(1.0, float(np.max(np.abs(q)))):
-            break
+    from ..integrators.event_driven_generic import project_positions
+
+    q = project_positions(scene, t, q, touching, max_iter=5)
     WN, wN, _, _ = scene.contact_jacobians(q, t)
     WN, wN = WN[touching], wN[touching]
     MiW = np.linalg.solve(scene.mass(q), WN.T)

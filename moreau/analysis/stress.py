@@ -382,23 +382,10 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None):
         if c not in CASES:
             raise InputError(f"`cases` must hold keys of CASES ({list(CASES)}), got {c!r}")
     report = {"full": bool(full), "bound": BOUND, "rows": [], "interrupted": False}
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = tqdm(total=len(cases), desc="stress catalogue", unit="case")
-    try:
-        for c in cases:
-            for r in run_case(c, full):
-                report["rows"].append(r)
-                if on_row is not None:
-                    on_row(r)
-            if bar is not None:
-                bar.update(1)
-    except KeyboardInterrupt:
-        report["interrupted"] = True
-    finally:
-        if bar is not None:
-            bar.close()
+    from .compare import collect_rows
+
+    report["interrupted"] = collect_rows(cases, lambda c: run_case(c, full), report["rows"],
+                                         on_row, progress, desc="stress catalogue", unit="case")
     return report
 
 

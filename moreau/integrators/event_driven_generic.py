@@ -201,6 +201,25 @@ class ContactModeSolver:
         return WN @ v + wN
 
 
+def project_positions(scene, t, q, contacts, max_iter=4):
+    """``q`` moved, in the metric of ``M``, onto ``g = 0`` for ``contacts`` (Newton steps).
+
+    Stops when the gaps are exactly zero or the step is at round-off.
+    """
+    M = scene.mass(q)
+    for _ in range(max_iter):
+        g = scene.gaps(q, t)[contacts]
+        if np.max(np.abs(g)) == 0.0:
+            break
+        WN = scene.contact_jacobians(q, t)[0][contacts]
+        MiW = np.linalg.solve(M, WN.T)
+        dq = MiW @ np.linalg.solve(WN @ MiW, g)
+        q = q - dq
+        if np.max(np.abs(dq)) <= 4e-16 * max(1.0, float(np.max(np.abs(q)))):
+            break
+    return q
+
+
 @register_integrator("event-driven-generic")
 class GenericEventDriven(Integrator):
     """Event-driven reference for any :class:`~moreau.scenes.base.Scene`.
@@ -325,20 +344,7 @@ class GenericEventDriven(Integrator):
 
     # -- projection onto the closed contacts' constraints ----------------------
     def _project_positions(self, t, q, contacts):
-        """``q`` moved (in the metric of ``M``) onto ``g = 0`` for ``contacts``."""
-        sc = self.scene
-        M = sc.mass(q)
-        for _ in range(4):
-            g = sc.gaps(q, t)[contacts]
-            if np.max(np.abs(g)) == 0.0:
-                break
-            WN = sc.contact_jacobians(q, t)[0][contacts]
-            MiW = np.linalg.solve(M, WN.T)
-            dq = MiW @ np.linalg.solve(WN @ MiW, g)
-            q = q - dq
-            if np.max(np.abs(dq)) <= 4e-16 * max(1.0, float(np.max(np.abs(q)))):
-                break
-        return q
+        return project_positions(self.scene, t, q, contacts, max_iter=4)
 
     def _project(self, t, q, v, mode):
         closed = np.flatnonzero(mode != _F)
