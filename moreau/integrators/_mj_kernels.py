@@ -34,7 +34,7 @@ from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
 from ..scenes import _compiled
-from ..scenes._compiled import FRICTION_DRIVE, contact_fn, dynamics_fn, gaps_fn, mass_fn
+from ..scenes._compiled import FRICTION_DRIVE, contact_fn, gaps_fn, mass_fn, step_fn
 
 __all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
            "LCP_HANDBACK"]
@@ -481,11 +481,10 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
         if tk >= t_bound:
             break
         # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
-        if not (const_mass and k > k0):
-            mass_fn(kind, par, q, M)
-        dynamics_fn(kind, par, q, v, t1, D, has_jac)
+        # the gaps at (q_k, t_k) were computed at the end of the step before
+        step_fn(kind, par, q, v, tk, t1, not (const_mass and k > k0), k == k0, th != 1.0,
+                has_jac, M, D, D0, G0, G1)
         if th != 1.0:
-            dynamics_fn(kind, par, q, v, tk, D0, False)
             for i in range(n):
                 D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
         a = hk * th
@@ -529,7 +528,6 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             pT[i] = 0.0
             slip[i] = 0.0
         if nc > 0:
-            contact_fn(kind, par, q, tk, G0, True, False)
             for i in range(nc):
                 acc = G0[i, 1]
                 for j in range(n):
@@ -542,8 +540,56 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     if mu[i] > 0.0:
                         fa[nfa] = i
                         nfa += 1
-        if na > 0:
-            contact_fn(kind, par, q, t1, G1, False, True)
+        if na == 1 and not force_lemke:
+            # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
+            # matrix, built from the contact's two rows only; loops over n alone, so
+            # that with the sizes known at compile time it is straight-line code
+            i = ia[0]
+            fr = nfa == 1
+            for j in range(n):
+                acc = 0.0
+                acc2 = 0.0
+                for l in range(n):
+                    acc += Wi[j, l] * G1[i, 3 + l]
+                    acc2 += Wi[j, l] * G1[i, 3 + n + l]
+                WiHT[j, 0] = acc
+                WiHT[j, 1] = acc2
+            Wnn = 0.0
+            uN = G1[i, 1]
+            for j in range(n):
+                Wnn += G1[i, 3 + j] * WiHT[j, 0]
+                uN += G1[i, 3 + j] * vf[j]
+            stats[S_LCP] += 1.0
+            stats[S_DIRECT] += 1.0
+            if fr:
+                Wnt = 0.0
+                Wtn = 0.0
+                Wtt = 0.0
+                uT = G1[i, 2]
+                for j in range(n):
+                    Wnt += G1[i, 3 + j] * WiHT[j, 1]
+                    Wtn += G1[i, 3 + n + j] * WiHT[j, 0]
+                    Wtt += G1[i, 3 + n + j] * WiHT[j, 1]
+                    uT += G1[i, 3 + n + j] * vf[j]
+                pn, pt, ok = _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
+                if not ok:
+                    status = PAINLEVE
+                    break
+                res = _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i], pn, pt)
+                slip[i] = uT + Wtn * pn + Wtt * pt
+            else:
+                pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i])
+                if not ok:
+                    status = PAINLEVE
+                    break
+                res = _residual(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i], pn, 0.0)
+            pN[i] = pn
+            pT[i] = pt
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+            for j in range(n):
+                v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
+        elif na > 0:
             m = na + nfa
             for r in range(na):
                 i = ia[r]
@@ -571,39 +617,14 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     for j in range(n):
                         acc += H[r, j] * WiHT[j, c]
                     Wd[r, c] = acc
-            if na == 1 and not force_lemke:
-                i = ia[0]
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-                if nfa == 1:
-                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                              Uf[1], mu[i], e[i], vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1],
-                                    mu[i], e[i], vN0[i], pn, pt)
-                    p[1] = pt
-                else:
-                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0,
-                                              e[i], vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i],
-                                    pn, 0.0)
-                p[0] = pn
-                pN[i] = pn
-                pT[i] = pt
-            else:
-                L = _lcp_size(na, ia, mu, base, trow)
-                lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
-                                          Ml, ql, dl, zl, wl, rayl, work, iwork)
-                if lst != 0:
-                    status = LCP_HANDBACK
-                    break
-                stats[S_PIVOTS] += piv
-                stats[S_LCP] += 1.0
+            L = _lcp_size(na, ia, mu, base, trow)
+            lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
+                                      Ml, ql, dl, zl, wl, rayl, work, iwork)
+            if lst != 0:
+                status = LCP_HANDBACK
+                break
+            stats[S_PIVOTS] += piv
+            stats[S_LCP] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
             for i in range(n):
@@ -622,6 +643,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
         for i in range(nc):
             cnew[i] = pN[i] > 0.0
+        gaps_current = False
         if projection and nc > 0:
             if not const_mass:
                 mass_fn(kind, par, q1, M)
@@ -631,6 +653,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             pinv = const_mass and have_Mi
             for _ in range(PROJECTION_MAXITER):
                 gaps_fn(kind, par, q1, t1, Gq)
+                gaps_current = True
                 anysel = False
                 gmax = 0.0
                 for i in range(nc):
@@ -677,6 +700,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     for c in range(s):
                         acc += X[i, c] * dd[c]
                     q1[i] += acc
+                gaps_current = False
                 stats[S_PROJ] += 1.0
             if status != OK:
                 break
@@ -688,7 +712,8 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             status = NUMERICAL
             break
         if nc > 0:
-            gaps_fn(kind, par, q1, t1, Gq)
+            if not gaps_current:
+                gaps_fn(kind, par, q1, t1, Gq)
             for i in range(nc):
                 if -Gq[i, 0] > stats[S_PEN]:
                     stats[S_PEN] = -Gq[i, 0]
@@ -708,6 +733,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             record_initial = False
         for i in range(nc):
             closed[i] = cnew[i]
+            G0[i, 0] = Gq[i, 0]
         for j in range(n):
             q[j] = q1[j]
             v[j] = v1[j]

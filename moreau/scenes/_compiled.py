@@ -38,6 +38,8 @@ on every step):
   written.
 * ``gaps_fn(kind, par, q, t, G)``: column 0 of ``G``.
 * ``drift_fn(kind, par, q, v, t, Dr)``: ``Dr`` (nc, 2) = ``(wNbar, wTbar)``.
+* ``step_fn(...)``: all that one Moreau–Jean step reads at its start state,
+  in one call (the time stepper uses this one).
 
 The outputs are packed into one array per function so that each inlined
 call carries few array arguments (numba reference-counts them).
@@ -49,7 +51,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn",
+__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn", "step_fn",
            "FRICTION_DRIVE", "BOUNCING_BALL", "SLIDING_BLOCK", "PAINLEVE_ROD",
            "STICK_SLIP_MOTOR", "BIDIRECTIONAL_DRIVE", "SLIDING_BOX", "check_compiled_model"]
 
@@ -68,6 +70,43 @@ BIDIRECTIONAL_DRIVE = 6
 SLIDING_BOX = 7
 
 TWO_PI = 2.0 * math.pi
+
+
+# -- the rod of a friction drive ----------------------------------------------------------
+# Both drives are built from one rod pressed by its spring on the rotor (the paper's model;
+# the two-rod drive mirrors the second rod). These scalar pieces take the sines and cosines
+# already evaluated, so that a caller evaluating several outputs at one state (step_fn)
+# computes each transcendental once, and each formula is written once for both drives.
+# Rod j at angle phi (s = sin phi, c = cos phi), base motion u1 = u10 (1 - cos tau') with
+# tau' = tau - delta (st = sin tau', ct = cos tau'), rotor coordinate `rotor`:
+#   h_j = P c (sin phi0 - s) - u1''/2 c,   dh_j/dphi = P (-s (sin phi0 - s) - c^2) + u1''/2 s
+#   g = sin phi0 - s - u1,   WN = -c e_j,   wN = -u1',   WT = sgn s e_j + e_rotor,   wT = 0
+
+
+@njit(cache=True, inline="always")
+def _rod_gap(sphi0, u10, s, ct):
+    return sphi0 - s - u10 * (1.0 - ct)
+
+
+@njit(cache=True, inline="always")
+def _rod_forces(D, j, P, sphi0, u10, s, c, ct, need_jac):
+    ddu1 = u10 * ct
+    spring = sphi0 - s
+    D[j, 0] = P * c * spring - 0.5 * ddu1 * c
+    if need_jac:
+        D[j, 1 + j] = P * (-s * spring - c * c) + 0.5 * ddu1 * s
+    return D.size
+
+
+@njit(cache=True, inline="always")
+def _rod_rows(G, r, j, rotor, n, sgn, u10, s, c, st, need_T):
+    # contact row r of the rod with angle q[j] (layout of contact_fn)
+    G[r, 1] = -u10 * st
+    G[r, 3 + j] = -c
+    if need_T:
+        G[r, 3 + n + j] = sgn * s
+        G[r, 3 + n + rotor] = 1.0
+    return G.size
 
 
 # -- stick-slip motor drives -------------------------------------------------------------
@@ -139,23 +178,14 @@ def dynamics_fn(kind, par, q, v, t, D, need_jac):
     # D[i, 0] = h_i, D[i, 1 + j] = dh_i/dq_j, D[i, 1 + n + j] = dh_i/dv_j
     if kind == FRICTION_DRIVE:
         # par: J, P, u10, fL, sin_phi0
-        s = math.sin(q[0])
-        c = math.cos(q[0])
-        spring = par[4] - s
-        ddu1 = par[2] * math.cos(t)
-        D[0, 0] = par[1] * c * spring - 0.5 * ddu1 * c
+        _rod_forces(D, 0, par[1], par[4], par[2], math.sin(q[0]), math.cos(q[0]), math.cos(t),
+                    need_jac)
         D[1, 0] = -par[3]
-        if need_jac:
-            D[0, 1] = par[1] * (-s * spring - c * c) + 0.5 * ddu1 * s
     elif kind == BIDIRECTIONAL_DRIVE:
         # par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b
         for r in range(2):
-            s = math.sin(q[r])
-            c = math.cos(q[r])
-            dd1 = par[4 + r] * math.cos(t - par[6 + r])
-            D[r, 0] = par[1] * c * (par[2] - s) - 0.5 * dd1 * c
-            if need_jac:
-                D[r, 1 + r] = par[1] * (-s * (par[2] - s) - c * c) + 0.5 * dd1 * s
+            _rod_forces(D, r, par[1], par[2], par[4 + r], math.sin(q[r]), math.cos(q[r]),
+                        math.cos(t - par[6 + r]), need_jac)
         D[2, 0] = -par[3]
     elif kind == BOUNCING_BALL:
         D[0, 0] = -1.0
@@ -177,10 +207,10 @@ def dynamics_fn(kind, par, q, v, t, D, need_jac):
 def gaps_fn(kind, par, q, t, G):
     # G[i, 0] = g_i
     if kind == FRICTION_DRIVE:
-        G[0, 0] = par[4] - math.sin(q[0]) - par[2] * (1.0 - math.cos(t))
+        G[0, 0] = _rod_gap(par[4], par[2], math.sin(q[0]), math.cos(t))
     elif kind == BIDIRECTIONAL_DRIVE:
         for r in range(2):
-            G[r, 0] = par[2] - math.sin(q[r]) - par[4 + r] * (1.0 - math.cos(t - par[6 + r]))
+            G[r, 0] = _rod_gap(par[2], par[4 + r], math.sin(q[r]), math.cos(t - par[6 + r]))
     elif kind == BOUNCING_BALL:
         G[0, 0] = q[0] - par[0]
     elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
@@ -200,13 +230,11 @@ def gaps_fn(kind, par, q, t, G):
 def _normal_rows(kind, par, q, t, G):
     # the normal rows only (the stepper's index-set test needs no tangential ones)
     if kind == FRICTION_DRIVE:
-        G[0, 3] = -math.cos(q[0])
-        G[0, 1] = -par[2] * math.sin(t)
+        _rod_rows(G, 0, 0, 1, 2, 1.0, par[2], 0.0, math.cos(q[0]), math.sin(t), False)
     elif kind == BIDIRECTIONAL_DRIVE:
-        G[0, 3] = -math.cos(q[0])
-        G[1, 4] = -math.cos(q[1])
-        G[0, 1] = -par[4] * math.sin(t - par[6])
-        G[1, 1] = -par[5] * math.sin(t - par[7])
+        for r in range(2):
+            _rod_rows(G, r, r, 2, 3, 1.0 - 2.0 * r, par[4 + r], 0.0, math.cos(q[r]),
+                      math.sin(t - par[6 + r]), False)
     elif kind == BOUNCING_BALL:
         G[0, 3] = 1.0
     elif kind == SLIDING_BLOCK or kind == STICK_SLIP_MOTOR:
@@ -231,19 +259,11 @@ def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
     if not need_T:
         _normal_rows(kind, par, q, t, G)
     elif kind == FRICTION_DRIVE:
-        G[0, 3] = -math.cos(q[0])
-        G[0, 1] = -par[2] * math.sin(t)
-        G[0, 5] = math.sin(q[0])
-        G[0, 6] = 1.0
+        _rod_rows(G, 0, 0, 1, 2, 1.0, par[2], math.sin(q[0]), math.cos(q[0]), math.sin(t), True)
     elif kind == BIDIRECTIONAL_DRIVE:
-        G[0, 3] = -math.cos(q[0])
-        G[1, 4] = -math.cos(q[1])
-        G[0, 1] = -par[4] * math.sin(t - par[6])
-        G[1, 1] = -par[5] * math.sin(t - par[7])
-        G[0, 6] = math.sin(q[0])
-        G[1, 7] = -math.sin(q[1])
-        G[0, 8] = 1.0
-        G[1, 8] = 1.0
+        for r in range(2):
+            _rod_rows(G, r, r, 2, 3, 1.0 - 2.0 * r, par[4 + r], math.sin(q[r]), math.cos(q[r]),
+                      math.sin(t - par[6 + r]), True)
     elif kind == BOUNCING_BALL:
         G[0, 3] = 1.0
     elif kind == SLIDING_BLOCK:
@@ -270,6 +290,69 @@ def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
             G[i, 6] = 1.0
             G[i, 8] = -sg * a * s + b * c
     return _touch3(par, q, G)
+
+
+@njit(cache=True, inline="always")
+def step_fn(kind, par, q, v, tk, t1, need_mass, need_gap0, need_f0, need_jac, M, D, D0, G0, G1):
+    """Every model output one Moreau–Jean step needs at its start state ``(q_k, v_k)``, in one call.
+
+    Writes ``M`` (when ``need_mass``), ``D`` at ``t1`` (Jacobians when
+    ``need_jac``), ``D0`` at ``tk`` (forces only, when ``need_f0``), the
+    normal rows ``G0`` at ``tk`` (and its gaps when ``need_gap0``) and the
+    full contact rows ``G1`` at ``t1``; the same values as the separate
+    functions above. For the drives it evaluates each sine and cosine once:
+    the separate calls read ``q`` from memory after writing their outputs,
+    which the compiler must assume may alias ``q``, so it could not share
+    them.
+    """
+    if kind == FRICTION_DRIVE:
+        s = math.sin(q[0])
+        c = math.cos(q[0])
+        sk = math.sin(tk)
+        ck = math.cos(tk)
+        s1 = math.sin(t1)
+        c1 = math.cos(t1)
+        if need_mass:
+            mass_fn(kind, par, q, M)
+        _rod_forces(D, 0, par[1], par[4], par[2], s, c, c1, need_jac)
+        D[1, 0] = -par[3]
+        if need_f0:
+            _rod_forces(D0, 0, par[1], par[4], par[2], s, c, ck, False)
+            D0[1, 0] = -par[3]
+        if need_gap0:
+            G0[0, 0] = _rod_gap(par[4], par[2], s, ck)
+        _rod_rows(G0, 0, 0, 1, 2, 1.0, par[2], s, c, sk, False)
+        _rod_rows(G1, 0, 0, 1, 2, 1.0, par[2], s, c, s1, True)
+    elif kind == BIDIRECTIONAL_DRIVE:
+        if need_mass:
+            mass_fn(kind, par, q, M)
+        for r in range(2):
+            s = math.sin(q[r])
+            c = math.cos(q[r])
+            sk = math.sin(tk - par[6 + r])
+            ck = math.cos(tk - par[6 + r])
+            s1 = math.sin(t1 - par[6 + r])
+            c1 = math.cos(t1 - par[6 + r])
+            sgn = 1.0 - 2.0 * r
+            _rod_forces(D, r, par[1], par[2], par[4 + r], s, c, c1, need_jac)
+            if need_f0:
+                _rod_forces(D0, r, par[1], par[2], par[4 + r], s, c, ck, False)
+            if need_gap0:
+                G0[r, 0] = _rod_gap(par[2], par[4 + r], s, ck)
+            _rod_rows(G0, r, r, 2, 3, sgn, par[4 + r], s, c, sk, False)
+            _rod_rows(G1, r, r, 2, 3, sgn, par[4 + r], s, c, s1, True)
+        D[2, 0] = -par[3]
+        if need_f0:
+            D0[2, 0] = -par[3]
+    else:
+        if need_mass:
+            mass_fn(kind, par, q, M)
+        dynamics_fn(kind, par, q, v, t1, D, need_jac)
+        if need_f0:
+            dynamics_fn(kind, par, q, v, tk, D0, False)
+        contact_fn(kind, par, q, tk, G0, need_gap0, False)
+        contact_fn(kind, par, q, t1, G1, False, True)
+    return _touch3(par, q, M) + _touch3(D, D0, G0) + G1.size + v.size
 
 
 @njit(cache=True)
