@@ -681,25 +681,39 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                         ia[s] = i
                         s += 1
                 # X = M^-1 WN_sel^T, S = WN_sel X, S d = -g_sel, q += X d
-                for c in range(s):
+                if s == 1:
+                    # one contact (the common case): a scalar division, no solver call
+                    i0 = ia[0]
+                    sc = 0.0
                     for i in range(n):
                         acc = 0.0
                         for j in range(n):
-                            acc += Mi[i, j] * Gq[ia[c], 3 + j]
-                        X[i, c] = acc
-                    rs[c] = -Gq[ia[c], 0]
-                for r in range(s):
+                            acc += Mi[i, j] * Gq[i0, 3 + j]
+                        X[i, 0] = acc
+                        sc += Gq[i0, 3 + i] * acc
+                    d0 = -Gq[i0, 0] / sc
+                    for i in range(n):
+                        q1[i] += X[i, 0] * d0
+                else:
                     for c in range(s):
+                        for i in range(n):
+                            acc = 0.0
+                            for j in range(n):
+                                acc += Mi[i, j] * Gq[ia[c], 3 + j]
+                            X[i, c] = acc
+                        rs[c] = -Gq[ia[c], 0]
+                    for r in range(s):
+                        for c in range(s):
+                            acc = 0.0
+                            for j in range(n):
+                                acc += Gq[ia[r], 3 + j] * X[j, c]
+                            S[r, c] = acc
+                    _solve_small(S, rs, dd, Sw, s)
+                    for i in range(n):
                         acc = 0.0
-                        for j in range(n):
-                            acc += Gq[ia[r], 3 + j] * X[j, c]
-                        S[r, c] = acc
-                _solve_small(S, rs, dd, Sw, s)
-                for i in range(n):
-                    acc = 0.0
-                    for c in range(s):
-                        acc += X[i, c] * dd[c]
-                    q1[i] += acc
+                        for c in range(s):
+                            acc += X[i, c] * dd[c]
+                        q1[i] += acc
                 gaps_current = False
                 stats[S_PROJ] += 1.0
             if status != OK:
@@ -814,8 +828,8 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     # other scenes' branches, unrolls the small-matrix loops and evaluates the
     # sines and cosines shared by the model functions once per step; that
     # keeps the paper's scene as fast as its former hand-written kernel.
-    if kind == FRICTION_DRIVE and n == 2 and nc == 1:
-        return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, const_mass, has_jac, t0, h, t_bound,
+    if kind == FRICTION_DRIVE and n == 2 and nc == 1 and const_mass and has_jac:
+        return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
                         k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
                         force_lemke, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
                         rec_gap, stats)
