@@ -113,16 +113,60 @@ def first_call(ctor, h, cache_dir=None):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def siconos_peer(repeats):
+def siconos_peer(repeats, extra=()):
     exe = "/usr/bin/python3"
     if not os.path.exists(exe):
         return {"available": False, "reason": f"{exe} not found"}
     try:
         out = subprocess.run([exe, os.path.join(HERE, "siconos_peer.py"), "--repeats",
-                              str(repeats)], capture_output=True, text=True, timeout=600)
+                              str(repeats), *extra], capture_output=True, text=True, timeout=900)
+        if out.returncode != 0:
+            # a negative code is the signal that killed it (-11: segmentation fault)
+            tail = out.stderr.strip().splitlines()[-1:] or [""]
+            return {"available": False, "reason": f"peer exited with code {out.returncode} "
+                                                  f"{tail[0]}".strip()}
         return json.loads(out.stdout.strip().splitlines()[-1])
     except Exception as exc:  # a broken peer must not stop the benchmark
         return {"available": False, "reason": f"{type(exc).__name__}: {exc}"}
+
+
+# the friction-drive rows compared with Siconos: label -> scene of SCENES
+FD_PEER = {"185 Hz": "friction-drive 185 Hz", "2000 Hz": "friction-drive 2000 Hz"}
+FD_PEER_STEPS = 20_000
+
+
+def siconos_friction_drive(repeats):
+    """Siconos's Moreau–Jean on the friction drive: ``{label: {...}}`` or ``{"reason": ...}``."""
+    params = []
+    for label, name in FD_PEER.items():
+        sc = eval(SCENES[name][0], NAMESPACE)
+        q0, v0 = sc.initial_state()
+        params.append({"label": label, "J": sc.J, "P": sc.P, "u10": sc.u10, "fL": sc.fL,
+                       "sin_phi0": sc.sin_phi0, "mu": float(sc.mu[0]),
+                       "e": float(sc.restitution[0]), "q0": [float(x) for x in q0],
+                       "v0": [float(x) for x in v0]})
+    peer = siconos_peer(repeats, ("--case", "friction-drive", "--steps", str(FD_PEER_STEPS),
+                                  "--fd-params", json.dumps(params)))
+    if not peer.get("available"):
+        return {"reason": peer.get("reason", "Siconos not available")}
+    fd = peer.get("friction_drive", {})
+    if fd.get("measured") is False:
+        return {"reason": fd.get("reason", "unknown")}
+    return fd
+
+
+def fd_agreement(name, ref):
+    """Our compiled run over the peer's steps; differences of the final state to Siconos's."""
+    ctor, h = SCENES[name]
+    sc = eval(ctor, NAMESPACE)
+    q0, v0 = sc.initial_state()
+    n = ref["steps"]
+    res = simulate(sc, (0.0, n * h), q0, v0, "moreau-jean", h=h, theta=1.0, save_every=n)
+    q = res.q[-1]
+    qs = np.asarray(ref["q_end"])
+    return {"u2_ours": float(q[1]), "u2_siconos": float(qs[1]),
+            "u2_rel_diff": float(abs(qs[1] - q[1]) / abs(q[1])),
+            "phi_abs_diff": float(abs(qs[0] - q[0])), "flight_steps_siconos": ref["flight_steps"]}
 
 
 def main(argv=None):
@@ -167,6 +211,15 @@ def main(argv=None):
     else:
         sic = None
         print(f"Siconos not available, peer skipped: {peer.get('reason')}")
+    sic_fd = siconos_friction_drive(R) if peer.get("available") else {
+        "reason": "Siconos not available"}
+    out["siconos_friction_drive"] = sic_fd
+    if "reason" in sic_fd:
+        print(f"Siconos Moreau-Jean, friction drive: not measured: {sic_fd['reason']}")
+    else:
+        for label, r in sic_fd.items():
+            print(f"Siconos {peer['version']} Moreau-Jean, friction drive {label}: "
+                  f"{r['steps_per_s']:.3e} steps/s")
     print()
     print(f"{'scene':26s} {'compiled/s':>11s} {'generic/s':>10s} {'x generic':>9s} "
           f"{'x Siconos BB':>12s} {'LCP solves':>10s} {'Lemke':>6s}")
@@ -191,6 +244,31 @@ def main(argv=None):
         out["goal_10x_siconos_met"] = bool(met)
         print(f"\ngoal: every scene >= 10x Siconos's bouncing-ball rate: "
               f"{'met' if met else 'MISSED'} (worst ratio {worst:.1f})")
+
+    print()
+    print(f"friction drive vs Siconos's friction drive (h = 2 pi/1000, theta = 1, "
+          f"{FD_PEER_STEPS} steps)")
+    if "reason" in sic_fd:
+        print(f"  not measured: {sic_fd['reason']}")
+    else:
+        print(f"  {'case':10s} {'Siconos/s':>10s} {'compiled/s':>11s} {'ratio':>7s}   "
+              f"agreement of the final state (u2 rel, phi abs; Siconos p_N = 0 steps)")
+        fd_ratios = []
+        for label, r in sic_fd.items():
+            name = FD_PEER[label]
+            ours = out["scenes"][name]["steps_per_s"]
+            ratio = ours / r["steps_per_s"]
+            fd_ratios.append(ratio)
+            agree = fd_agreement(name, r)
+            out["scenes"][name].update({"siconos_fd_steps_per_s": r["steps_per_s"],
+                                        "ratio_to_siconos_fd": ratio, "siconos_agreement": agree})
+            print(f"  {label:10s} {r['steps_per_s']:10.3e} {ours:11.3e} {ratio:7.1f}   "
+                  f"{agree['u2_rel_diff']:.1e}, {agree['phi_abs_diff']:.1e}; "
+                  f"{agree['flight_steps_siconos']}")
+        met_fd = min(fd_ratios) >= 10.0
+        out["goal_fd_10x_siconos_fd_met"] = bool(met_fd)
+        print(f"goal: friction drive >= 10x Siconos's friction drive per step: "
+              f"{'met' if met_fd else 'MISSED'} (worst ratio {min(fd_ratios):.1f})")
 
     print()
     print("steady state of the discrete map, friction drive, 1000 steps/period")
