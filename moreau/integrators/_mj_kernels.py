@@ -469,6 +469,9 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
     nrec = 0
     k = k0
     status = OK
+    # steps left until the next sample (k % save_every == 0 after the step): a
+    # countdown, because an integer division per step costs as much as a sine
+    to_save = save_every - k0 % save_every
     while k - k0 < nmax:
         tk = t0 + k * h
         t1 = t0 + (k + 1) * h
@@ -752,7 +755,10 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             q[j] = q1[j]
             v[j] = v1[j]
         k += 1
-        if k % save_every == 0 or last:
+        to_save -= 1
+        if to_save == 0:
+            to_save = save_every
+        if to_save == save_every or last:
             rec_t[nrec] = t1
             for j in range(n):
                 rec_q[nrec, j] = q[j]
