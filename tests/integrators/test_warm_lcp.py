@@ -110,38 +110,49 @@ def test_warm_start_option_is_checked():
 
 # -- Lemke failing inside the compiled loop: the step goes back to Python --------------------
 
-def test_lemke_failure_is_handed_back_to_the_qp_fallback():
+@pytest.mark.parametrize("limit, warm", [(1, False), (3, False), (3, True)])
+def test_lemke_failure_is_handed_back_to_the_qp_fallback(limit, warm):
     box = SlidingBox(mu=0.4)
     q0, v0 = box.initial_state()
     ts = box.stopping_time(v0)
     T = 1.6 * ts
     n = 100
     h = T / n
-    # one pivot is Lemke's first (z0 entering): no step with an impulse can
-    # finish, so every contact step fails in the kernel and is handed back
-    opts = dict(h=h, save_every=1, lemke_max_iter=1, lcp_warm_start=False)
+    # one pivot is Lemke's first (z0 entering): no contact step can finish, so
+    # every one fails in the kernel and is taken by the generic step. Three
+    # pivots finish the resting steps but not the sliding ones (measured: 4 to
+    # 7 pivots): then kernel steps and handed-back steps alternate
+    opts = dict(h=h, save_every=1, lemke_max_iter=limit, lcp_warm_start=warm)
     gen = simulate(box, (0.0, T), q0, v0, "moreau-jean", fast=False, **opts)
     comp = simulate(box, (0.0, T), q0, v0, "moreau-jean", fast=True, **opts)
     lemke = simulate(box, (0.0, T), q0, v0, "moreau-jean", h=h, save_every=1)
     for r in (gen, comp):
         assert r.success, r.message
-        assert r.stats["lcp_solves"] == n and r.stats["fallbacks"] == n
-        assert r.stats["warm_starts"] == 0
+        assert r.stats["lcp_solves"] == n
+    nfall = comp.stats["fallbacks"]
+    assert nfall == gen.stats["fallbacks"]
+    if limit == 1:
+        assert nfall == n and comp.stats["warm_starts"] == 0
+    else:
+        # the sliding steps (62 of them) and the first resting one
+        assert 0.5 * n < nfall < n
+        assert comp.stats["pivots"] > 0 and (comp.stats["warm_starts"] > 0) == warm
     assert lemke.stats["fallbacks"] == 0
-    # each handed-back step is the generic step itself, so the two runs solve
-    # the same QPs; their data differ by rounding only (measured difference
-    # 0.0), but OSQP is iterative, and where rounding moves an iterate across
-    # its stopping test the answers differ within the QP tolerance, not 1e-12
+    # the handed-back steps are the generic step itself and the kernel's steps
+    # agree with it to rounding; measured difference 6e-16. Not held to 1e-12:
+    # OSQP is iterative, and where rounding moves an iterate across its
+    # stopping test the answer moves within the QP tolerance
     _assert_same_run(gen, comp, 1e-9)
     # the QP answers are accurate to its tolerance (1e-6), far below the
-    # scheme's O(h) error: the trajectory still matches the exact motion as
-    # well as the Lemke run does
+    # scheme's O(h) error: the trajectory matches the exact motion as well as
+    # the Lemke run does (measured: equal errors, 0.0199)
     qe, ve = box.exact_solution(comp.t, q0, v0)
     err = max(np.max(np.abs(comp.q - qe)), np.max(np.abs(comp.v - ve)))
     qe, ve = box.exact_solution(lemke.t, q0, v0)
     err_lemke = max(np.max(np.abs(lemke.q - qe)), np.max(np.abs(lemke.v - ve)))
     assert err == pytest.approx(err_lemke, rel=1e-3)
     assert err < 0.02 * box.stopping_distance(v0)
+    np.testing.assert_allclose(comp.v, lemke.v, rtol=0, atol=1e-9)
 
 
 def test_warm_start_resumes_after_a_handback():
