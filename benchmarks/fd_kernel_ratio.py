@@ -101,7 +101,7 @@ def main(argv=None):
         closed = np.zeros(1, dtype=np.bool_)
         out = mk.mj_run(m.kind, m.par, m.ndof, m.ncontacts, mu, e, m.const_mass,
                         m.has_jacobians, 0.0, h, t_bound, 0, N, q, v, 1.0, projection, closed,
-                        N, False, False, *bufs(1), st)
+                        N, False, mk.new_lcp_control(1), *bufs(1), st)
         return out[1], q, v
 
     print(f"friction drive {args.frequency:g} Hz, h = 2 pi/1000, {N} steps, "

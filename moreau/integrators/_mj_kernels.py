@@ -19,6 +19,15 @@ The contact problem of a step is solved as the generic path solves it:
   compiled :func:`moreau.lcp.lemke.lemke_core`. When Lemke fails the loop
   stops *before* that step with status :data:`LCP_HANDBACK`; the caller takes
   the step in Python (QP fallback) and calls the loop again.
+* warm start (``lcp_method="auto"``): before Lemke, the support of the last
+  LCP solved with the same active contacts is tried, i.e. the principal
+  subsystem ``M_BB z_B = -q_B`` with ``z = 0`` off it. Its solution is taken
+  only when it passes Lemke's own certification
+  (:func:`moreau.lcp.lcp_violation` at Lemke's tolerance) and the subsystem
+  is well conditioned; where the LCP's solution is unique the answer is
+  then Lemke's to rounding. Between contact events the support does not
+  change, so most multi-contact steps skip pivoting
+  (``stats["warm_starts"]``).
 
 The generic Python step (``MoreauJean(..., fast=False)``) is kept as the
 reference; the tests hold the two to ``1e-12`` on every scene.
@@ -36,8 +45,8 @@ from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
 from ..scenes import _compiled
 from ..scenes._compiled import FRICTION_DRIVE, contact_fn, gaps_fn, mass_fn, step_fn
 
-__all__ = ["mj_run", "new_stats", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR",
-           "LCP_HANDBACK"]
+__all__ = ["mj_run", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
+           "SINGULAR", "LCP_HANDBACK"]
 
 # status codes (those of SimulationResult where they overlap)
 OK = 0
@@ -50,14 +59,31 @@ LCP_HANDBACK = 7
 
 #: layout of the statistics vector
 STAT_NAMES = ("lcp_solves", "direct_solves", "pivots", "fallbacks", "max_residual",
-              "max_penetration", "projection_iterations")
-S_LCP, S_DIRECT, S_PIVOTS, S_FALLBACKS, S_RES, S_PEN, S_PROJ = range(7)
+              "max_penetration", "projection_iterations", "warm_starts")
+S_LCP, S_DIRECT, S_PIVOTS, S_FALLBACKS, S_RES, S_PEN, S_PROJ, S_WARM = range(8)
 
 # shared with moreau_jean.py (kept as literals so that numba freezes them)
 SLIP_RTOL = 1e-10
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
 COND_MAX = 1e14
+
+# warm start of the contact LCP (see _lcp_step): a solution on the previous
+# step's support is accepted only when every pivot of its subsystem's
+# elimination exceeds this times its column's largest entry (a singular
+# M_BB, e.g. two sticking contacts on fewer degrees of freedom, gives pivots
+# at rounding level), and then under the violation bound a Lemke solution
+# must meet (DEFAULT_TOL). A tighter bound was tried: Lemke's own answers
+# on a resting box violate by 1e-11 (it snaps a tangential impulse of
+# rounding size to zero), and the warm start must accept those too.
+WARM_PIVOT_RTOL = 1e-8
+# ... and only when it is clear of a change of support: every z_j on it and
+# every w_j of a normal row (and of the cone row of a loaded contact) off it
+# above this times its natural scale (max|q| / max|M| for z, max|q| for w).
+# Near such a tie (a slip that ends within the step, a contact about to
+# lift off) two solutions lie within rounding of each other; Lemke decides
+# there, as the generic step does.
+WARM_MARGIN = 1e-8
 
 
 def new_stats():
@@ -337,24 +363,149 @@ def _lcp_size(na, ia, mu, base, trow):
     return L
 
 
+# layout of the contact-problem control array (new_lcp_control)
+CTL_FORCE, CTL_WARM, CTL_MAXIT, CTL_L, CTL_NA, CTL_IA = range(6)
+
+
+def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
+    """Options and warm-start memory of the loop's contact problems, one int64 array.
+
+    Layout: ``[force_lemke, warm_start, max_iter, L, na, ia (max(nc, 1)
+    slots), support flags (4 max(nc, 1) slots)]``. The first three are the
+    options (see :func:`mj_run`); the rest is the warm start's memory, the
+    last contact LCP solved in the loop (``L = -1``: none), which the caller
+    keeps from one call of :func:`mj_run` to the next. (One array rather than
+    separate arguments: the loop already takes the thirty arguments beyond
+    which CPython passes a call's arguments as a tuple, which numba cannot
+    inline.)
+    """
+    ncm = max(nc, 1)
+    ctl = np.zeros(CTL_IA + 5 * ncm, dtype=np.int64)
+    ctl[CTL_FORCE] = bool(force_lemke)
+    ctl[CTL_WARM] = bool(warm_start)
+    ctl[CTL_MAXIT] = int(max_iter)
+    ctl[CTL_L] = -1
+    return ctl
+
+
+@njit(cache=True)
+def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, trow):
+    """Solve ``LCP(Ml, qv)`` on the remembered support; the violation, or inf if refused.
+
+    With ``B`` the remembered support (flags ``memo[off:off + L]``), solves
+    ``M_BB z_B = -q_B`` by Gaussian elimination with partial pivoting, sets
+    ``z_N = 0`` and returns Lemke's own measure of the result
+    (:func:`moreau.lcp.lemke._residual`, which also writes ``w = M z + q``
+    into ``wl``). A pivot below :data:`WARM_PIVOT_RTOL` times the largest
+    entry of its column of ``M_BB`` refuses the subsystem as ill conditioned
+    (a singular one included), and so is a solution near a change of
+    support (see :data:`WARM_MARGIN`); the caller then runs Lemke.
+    """
+    s = 0
+    for j in range(L):
+        if memo[off + j] != 0:
+            idx[s] = j
+            s += 1
+    for a in range(s):
+        x[a] = -qv[idx[a]]
+        for c in range(s):
+            A[a, c] = Ml[idx[a], idx[c]]
+    for c in range(s):
+        # the column's scale before elimination: the test is then invariant
+        # under a change of units of one variable (impulses vs beta)
+        cmax = 0.0
+        for a in range(s):
+            cmax = max(cmax, abs(A[a, c]))
+        piv = c
+        best = abs(A[c, c])
+        for r in range(c + 1, s):
+            if abs(A[r, c]) > best:
+                best = abs(A[r, c])
+                piv = r
+        # `not >` refuses NaN too
+        if not best > WARM_PIVOT_RTOL * cmax:
+            return np.inf
+        if piv != c:
+            for j in range(c, s):
+                tmp = A[c, j]
+                A[c, j] = A[piv, j]
+                A[piv, j] = tmp
+            tmp = x[c]
+            x[c] = x[piv]
+            x[piv] = tmp
+        for r in range(c + 1, s):
+            fct = A[r, c] / A[c, c]
+            if fct != 0.0:
+                for j in range(c + 1, s):
+                    A[r, j] -= fct * A[c, j]
+                x[r] -= fct * x[c]
+    for a in range(s - 1, -1, -1):
+        acc = x[a]
+        for j in range(a + 1, s):
+            acc -= A[a, j] * x[j]
+        x[a] = acc / A[a, a]
+    for j in range(L):
+        zl[j] = 0.0
+    for a in range(s):
+        zl[idx[a]] = x[a]
+    res = _lemke._residual(Ml, qv, zl, wl, mmax, qmax)
+    dw = WARM_MARGIN * (qmax if qmax > 0.0 else 1.0)
+    dz = dw / (mmax if mmax > 0.0 else 1.0)
+    for a in range(s):
+        if not zl[idx[a]] > dz:
+            return np.inf
+    for r in range(na):
+        j = base[r]
+        loaded = memo[off + j] != 0
+        if not loaded and not wl[j] > dw:
+            return np.inf
+        # the cone row mu pN - pT+ - pT- of an unloaded contact is 0 by nature;
+        # the tangential rows vT +- beta of a sticking one too
+        if loaded and trow[r] >= 0 and memo[off + j + 3] == 0 and not wl[j + 3] > dw:
+            return np.inf
+    return res
+
+
 @njit(cache=True)
 def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
-              work, iwork):
-    """Assemble the friction LCP of the active contacts and solve it by Lemke.
+              work, iwork, lay, ctl, Ab, xb, idx):
+    """Assemble the friction LCP of the active contacts and solve it (warm start, else Lemke).
 
     The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
     the active contacts (``ia[:na]``): one variable per frictionless contact,
     ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
     cone rows, and the restitution term only where ``e > 0``. The buffers
     are at least the size ``L`` of :func:`_lcp_size`; their leading ``L``
-    entries are used. Writes the stacked impulses
-    ``p`` and the per-contact ``pN``, ``pT``.
-    Returns Lemke's ``(status, pivots, residual)``.
+    entries are used. ``lay`` (``[na, ia...]``) holds the layout ``Ml`` was
+    last assembled in: with the same layout the matrix's zero pattern is the
+    same and only its nonzero entries are rewritten.
+
+    With the warm start on (``ctl``, see :func:`new_lcp_control`), and when
+    the last LCP in its memory had the same active contacts, that solution's
+    support ``B = {j : z_j > 0}`` is tried first (:func:`_warm_solve`); the
+    result is accepted only when it passes the check a Lemke solution must
+    pass (violation at most ``DEFAULT_TOL``).
+    Otherwise Lemke runs, with the pivot limit of ``ctl`` (``<= 0``: the
+    default). After a success the memory takes the new support.
+
+    Writes the stacked impulses ``p`` and the per-contact ``pN``, ``pT``.
+    Returns ``(status, pivots, residual, warm_used)``, status and residual
+    as Lemke's (:func:`moreau.lcp.lemke.lemke_core`).
     """
-    for r in range(L):
-        ql[r] = 0.0
-        for c in range(L):
-            Ml[r, c] = 0.0
+    same = lay[0] == na
+    if same:
+        for r in range(na):
+            if lay[1 + r] != ia[r]:
+                same = False
+    if not same:
+        # a new layout: clear the block; with the old one every entry that is
+        # not rewritten below is still zero
+        for r in range(L):
+            for c in range(L):
+                Ml[r, c] = 0.0
+        lay[0] = na
+        for r in range(na):
+            lay[1 + r] = ia[r]
     for r in range(na):
         i = ia[r]
         br = base[r]
@@ -365,6 +516,7 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
         if tr >= 0:
             ql[br + 1] = Uf[tr]
             ql[br + 2] = -Uf[tr]
+            ql[br + 3] = 0.0
         for c in range(na):
             bc = base[c]
             tc = trow[c]
@@ -386,10 +538,41 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
             Ml[br + 3, br] = mu[i]
             Ml[br + 3, br + 1] = -1.0
             Ml[br + 3, br + 2] = -1.0
-    max_iter = 1000 if L <= 20 else 50 * L
-    # lemke_core takes the size from q; M, d and the outputs may be larger
-    status, pivots, res = lemke_core(Ml, ql[:L], dl, zl, wl, rayl, work, iwork, max_iter,
-                                     DEFAULT_TOL)
+    qv = ql[:L]
+    off = CTL_IA + ia.shape[0]
+    warm = ctl[CTL_WARM] != 0
+    status = -1
+    pivots = 0
+    res = np.inf
+    used = False
+    if warm and ctl[CTL_L] == L and ctl[CTL_NA] == na:
+        same = True
+        for r in range(na):
+            if ctl[CTL_IA + r] != ia[r]:
+                same = False
+        qmin = 0.0
+        qmax = 0.0
+        for r in range(L):
+            qmin = min(qmin, qv[r])
+            qmax = max(qmax, abs(qv[r]))
+        # q >= 0: Lemke returns z = 0 without a pivot, nothing to gain
+        if same and qmin < 0.0:
+            mmax = 0.0
+            for r in range(L):
+                for c in range(L):
+                    mmax = max(mmax, abs(Ml[r, c]))
+            res = _warm_solve(Ml, qv, L, ctl, off, Ab, xb, idx, zl, wl, mmax, qmax, na, base,
+                              trow)
+            if res <= DEFAULT_TOL:
+                status = 0
+                used = True
+    if not used:
+        max_iter = ctl[CTL_MAXIT]
+        if max_iter <= 0:
+            max_iter = 1000 if L <= 20 else 50 * L
+        # lemke_core takes the size from q; M, d and the outputs may be larger
+        status, pivots, res = lemke_core(Ml, qv, dl, zl, wl, rayl, work, iwork, max_iter,
+                                         DEFAULT_TOL)
     if status == 0:
         for r in range(na):
             i = ia[r]
@@ -400,14 +583,33 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
                 pt = zl[br + 1] - zl[br + 2]
                 p[trow[r]] = pt
                 pT[i] = pt
-    return status, pivots, res
+        if warm:
+            ctl[CTL_L] = L
+            ctl[CTL_NA] = na
+            for r in range(na):
+                ctl[CTL_IA + r] = ia[r]
+            for j in range(L):
+                ctl[off + j] = 1 if zl[j] > 0.0 else 0
+            for r in range(na):
+                br = base[r]
+                if (trow[r] >= 0 and ctl[off + br + 1] != 0 and ctl[off + br + 2] != 0
+                        and ctl[off + br + 3] == 0):
+                    # stick with both p_T+ and p_T- > 0 (beta = 0): their columns
+                    # are opposite on the rows of B, so M_BB is singular; keep
+                    # the one that carries the net tangential impulse
+                    if zl[br + 1] >= zl[br + 2]:
+                        ctl[off + br + 2] = 0
+                    else:
+                        ctl[off + br + 1] = 0
+    return status, pivots, res, used
 
 
 @njit(cache=True, inline="always")
 def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-             theta, projection, closed, save_every, record_initial, force_lemke,
+             theta, projection, closed, save_every, record_initial, lcp_ctl,
              rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
     # the loop of mj_run, inlined there twice (see mj_run)
+    force_lemke = lcp_ctl[CTL_FORCE] != 0
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -462,6 +664,12 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
     wl = np.zeros(Lmax)
     rayl = np.zeros(Lmax + 1)
     work, iwork = lemke_workspace(Lmax)
+    # the layout Ml holds (na, ia...), and the warm start's subsystem
+    lay = np.zeros(1 + ncm, dtype=np.int64)
+    lay[0] = -1
+    Ab = np.zeros((Lmax, Lmax))
+    xb = np.zeros(Lmax)
+    idx = np.zeros(Lmax, dtype=np.int64)
 
     constant_W = const_mass and not has_jac
     have_Wi = False
@@ -621,13 +829,16 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                         acc += H[r, j] * WiHT[j, c]
                     Wd[r, c] = acc
             L = _lcp_size(na, ia, mu, base, trow)
-            lst, piv, res = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow,
-                                      Ml, ql, dl, zl, wl, rayl, work, iwork)
+            lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base,
+                                            trow, Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                            lcp_ctl, Ab, xb, idx)
             if lst != 0:
                 status = LCP_HANDBACK
                 break
             stats[S_PIVOTS] += piv
             stats[S_LCP] += 1.0
+            if warm:
+                stats[S_WARM] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
             for i in range(n):
@@ -780,7 +991,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
 # division, whose clean-up path kept numba from pruning reference counts
 @njit(cache=True, error_model="numpy")
 def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, force_lemke,
+           theta, projection, closed, save_every, record_initial, lcp_ctl,
            rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
     """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
 
@@ -810,8 +1021,13 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
         Record after every ``save_every``-th step (counted from ``t0``) and after the last.
     record_initial : bool
         Also record the state at ``t_k0`` (with the first step's regime and forces).
-    force_lemke : bool
-        Solve a single active contact by Lemke too (``lcp_method="lemke"``).
+    lcp_ctl : int64[:]
+        From :func:`new_lcp_control`: ``force_lemke`` (solve a single active
+        contact by Lemke too, ``lcp_method="lemke"``), ``warm_start`` (try
+        the last contact LCP's support before Lemke, see :func:`_lcp_step`),
+        ``max_iter`` (Lemke's pivot limit; ``<= 0``: the default, 1000, or
+        ``50 L`` above ``L = 20``), then the warm start's memory, read and
+        updated; the caller keeps the array from one call to the next.
     rec_* : arrays
         Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
         ones (ns, nc); long enough for this call's samples.
@@ -837,10 +1053,10 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     if kind == FRICTION_DRIVE and n == 2 and nc == 1 and const_mass and has_jac:
         return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
                         k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
-                        force_lemke, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
+                        lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
                         rec_gap, stats)
     return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
-                    v, theta, projection, closed, save_every, record_initial, force_lemke,
+                    v, theta, projection, closed, save_every, record_initial, lcp_ctl,
                     rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
 
 

@@ -114,7 +114,8 @@ def test_forced_lemke_runs_compiled_and_agrees():
 
 def test_multi_contact_steps_go_through_lemke_in_the_compiled_loop():
     sc = SCENES["bidirectional-drive"]
-    a, b = _pair(sc, 400)
+    # without the warm start (tests/integrators/test_warm_lcp.py) every step pivots
+    a, b = _pair(sc, 400, lcp_warm_start=False)
     assert b.stats["lcp_solves"] == 400 and b.stats["direct_solves"] == 0
     assert b.stats["pivots"] > 400 and b.stats["fallbacks"] == 0
     assert b.stats["max_residual"] < 1e-12
@@ -165,9 +166,11 @@ def test_sliding_box_converges_at_first_order_through_lemke():
         h = T / n
         res = simulate(box, (0.0, T), q0, v0, "moreau-jean", h=h, save_every=1)
         st = res.stats
-        # two active contacts on every step: each one an LCP solved by compiled Lemke
+        # two active contacts on every step: each one an LCP solved in the compiled
+        # loop, by Lemke where the support changes (first step, stop; measured 3
+        # steps) and by the certified warm start on the previous support elsewhere
         assert res.success and st["lcp_solves"] == n and st["direct_solves"] == 0
-        assert st["pivots"] >= 2 * n and st["fallbacks"] == 0
+        assert st["pivots"] >= 2 and st["warm_starts"] >= n - 5 and st["fallbacks"] == 0
         qe, ve = box.exact_solution(res.t, q0, v0)
         errs.append(max(np.max(np.abs(res.q - qe)), np.max(np.abs(res.v - ve))))
         hs.append(h)
