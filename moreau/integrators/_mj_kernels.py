@@ -43,7 +43,8 @@ from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
 from ..scenes import _compiled
-from ..scenes._compiled import FRICTION_DRIVE, contact_fn, gaps_fn, mass_fn, step_fn
+from ..scenes._compiled import (FRICTION_DRIVE, contact_fn, dynamics_fn, fused, gaps_fn, mass_fn,
+                                step_fn)
 
 __all__ = ["mj_run", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
@@ -467,6 +468,168 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
 
 
 @njit(cache=True)
+def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, vel, pcol):
+    """Solve the active contacts' problem in the regimes of the step before; the violation, or inf.
+
+    Each active contact keeps its last regime (``reg``, as :func:`_classify`:
+    0 open, 1 and 2 slipping with ``p_T = -/+ mu p_N``, 3 sticking, or loaded
+    without friction). The unknowns are the normal impulses of the loaded
+    contacts and the tangential ones of the sticking contacts; the equations
+    are their zero normal and (sticking) tangential velocities, on the
+    Delassus matrix ``Wd`` itself: 2 x 2 for two sliding contacts, against
+    the 8 x 8 friction LCP of the same step.
+
+    Where sticking contacts are statically indeterminate (the box resting on
+    two corners: four impulse rows on three degrees of freedom, its two
+    tangential rows equal), the elimination finds a column without a pivot
+    (below :data:`WARM_PIVOT_RTOL` times the column's scale) and sets that
+    impulse to zero: a vertex of the solution set, as Lemke's basic
+    solutions are. An inconsistent system fails the velocity check below.
+
+    The answer is accepted only as a solution of the friction LCP it stands
+    for: every inequality of the regimes holds clear of its bound
+    (:data:`WARM_MARGIN`, so that near a change of regime Lemke decides, as
+    in the generic step) and the violation of the LCP, measured as
+    :func:`moreau.lcp.lemke._residual` measures Lemke's (the LCP's ``max|q|``
+    and ``max|M|``), is at most ``DEFAULT_TOL``. Writes ``p``, ``pN``, ``pT``
+    only when accepted. Returns the violation when accepted, ``inf`` when
+    refused.
+    """
+    m = na
+    for r in range(na):
+        if trow[r] >= 0:
+            m += 1
+    # scales of the LCP this stands for: q = (b, +-uT, 0), M's entries Wd, +-1, mu
+    qmax = 0.0
+    mmax = 1.0
+    for r in range(m):
+        b = Uf[r]
+        if r < na:
+            i = ia[r]
+            if e[i] > 0.0:
+                b += e[i] * min(vN0[i], 0.0)
+            if trow[r] >= 0:
+                mmax = max(mmax, mu[i])
+        qmax = max(qmax, abs(b))
+        for c in range(m):
+            mmax = max(mmax, abs(Wd[r, c]))
+    qs = qmax if qmax > 0.0 else 1.0
+    dw = WARM_MARGIN * qs
+    dz = dw / mmax
+    s = 0
+    for r in range(na):
+        g = reg[ia[r]]
+        if g != 0:
+            uidx[s] = r
+            s += 1
+            if g == 3 and trow[r] >= 0:
+                uidx[s] = trow[r]
+                s += 1
+    for a in range(s):
+        row = uidx[a]
+        b = Uf[row]
+        if row < na and e[ia[row]] > 0.0:
+            b += e[ia[row]] * min(vN0[ia[row]], 0.0)
+        x[a] = -b
+        for c in range(s):
+            col = uidx[c]
+            val = Wd[row, col]
+            if col < na:
+                g = reg[ia[col]]
+                tc = trow[col]
+                if tc >= 0 and (g == 1 or g == 2):
+                    # a sliding contact's tangential impulse rides on its normal one
+                    val += (2.0 * g - 3.0) * mu[ia[col]] * Wd[row, tc]
+            A[a, c] = val
+    # Gaussian elimination with partial pivoting; a column without a pivot is
+    # a free impulse, set to zero (pcol[row] = the pivot column of that row)
+    prow = 0
+    for c in range(s):
+        cmax = 0.0
+        for a in range(s):
+            cmax = max(cmax, abs(A[a, c]))
+        piv = prow
+        best = 0.0
+        for r in range(prow, s):
+            if abs(A[r, c]) > best:
+                best = abs(A[r, c])
+                piv = r
+        # `not >` takes NaN for no pivot too; a zero column is free as well
+        if not best > WARM_PIVOT_RTOL * cmax:
+            continue
+        if piv != prow:
+            for j in range(s):
+                tmp = A[prow, j]
+                A[prow, j] = A[piv, j]
+                A[piv, j] = tmp
+            tmp = x[prow]
+            x[prow] = x[piv]
+            x[piv] = tmp
+        for r in range(prow + 1, s):
+            fct = A[r, c] / A[prow, c]
+            if fct != 0.0:
+                for j in range(c + 1, s):
+                    A[r, j] -= fct * A[prow, j]
+                x[r] -= fct * x[prow]
+        pcol[prow] = c
+        prow += 1
+    # vel holds the impulses: zero, then the pivoted ones by back substitution
+    for r in range(m):
+        vel[r] = 0.0
+    for r in range(prow - 1, -1, -1):
+        c = pcol[r]
+        acc = x[r]
+        for j in range(c + 1, s):
+            acc -= A[r, j] * vel[uidx[j]]
+        vel[uidx[c]] = acc / A[r, c]
+    for r in range(na):
+        tr = trow[r]
+        g = reg[ia[r]]
+        if tr >= 0 and (g == 1 or g == 2):
+            vel[tr] = (2.0 * g - 3.0) * mu[ia[r]] * vel[r]
+    # x takes the contact velocities; then the regimes' inequalities
+    num = 0.0
+    for r in range(m):
+        acc = Uf[r]
+        if r < na and e[ia[r]] > 0.0:
+            acc += e[ia[r]] * min(vN0[ia[r]], 0.0)
+        for c in range(m):
+            acc += Wd[r, c] * vel[c]
+        x[r] = acc
+    for r in range(na):
+        i = ia[r]
+        tr = trow[r]
+        g = reg[i]
+        if g == 0:
+            if not x[r] > dw:
+                return np.inf
+            continue
+        if not vel[r] > dz:
+            return np.inf
+        num = max(num, abs(x[r]))
+        if tr >= 0:
+            if g == 3:
+                if not mu[i] * vel[r] - abs(vel[tr]) > dz:
+                    return np.inf
+                num = max(num, abs(x[tr]))
+            elif g == 1:
+                if not x[tr] > dw:
+                    return np.inf
+            elif not x[tr] < -dw:
+                return np.inf
+    res = num / qs
+    if not res <= DEFAULT_TOL:
+        return np.inf
+    for r in range(m):
+        p[r] = vel[r]
+    for r in range(na):
+        i = ia[r]
+        pN[i] = vel[r]
+        pT[i] = vel[trow[r]] if trow[r] >= 0 else 0.0
+    return res
+
+
+@njit(cache=True)
 def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
               work, iwork, lay, ctl, Ab, xb, idx):
     """Assemble the friction LCP of the active contacts and solve it (warm start, else Lemke).
@@ -610,6 +773,9 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
              rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
     # the loop of mj_run, inlined there twice (see mj_run)
     force_lemke = lcp_ctl[CTL_FORCE] != 0
+    warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
+    rvel = np.zeros(2 * max(nc, 1))
+    pcol = np.zeros(2 * max(nc, 1), dtype=np.int64)
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -693,8 +859,18 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             break
         # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
         # the gaps at (q_k, t_k) were computed at the end of the step before
-        step_fn(kind, par, q, v, tk, t1, not (const_mass and k > k0), k == k0, th != 1.0,
-                has_jac, M, D, D0, G0, G1)
+        drive = fused(kind)
+        if drive:
+            step_fn(kind, par, q, v, tk, t1, not (const_mass and k > k0), k == k0, th != 1.0,
+                    has_jac, M, D, D0, G0, G1)
+        else:
+            if not (const_mass and k > k0):
+                mass_fn(kind, par, q, M)
+            dynamics_fn(kind, par, q, v, t1, D, has_jac)
+            if th != 1.0:
+                dynamics_fn(kind, par, q, v, tk, D0, False)
+            if nc > 0:
+                contact_fn(kind, par, q, tk, G0, k == k0, False)
         if th != 1.0:
             for i in range(n):
                 D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
@@ -751,6 +927,8 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     if mu[i] > 0.0:
                         fa[nfa] = i
                         nfa += 1
+        if na > 0 and not drive:
+            contact_fn(kind, par, q, t1, G1, False, True)
         if na == 1 and not force_lemke:
             # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
             # matrix, built from the contact's two rows only; loops over n alone, so
@@ -829,16 +1007,34 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                         acc += H[r, j] * WiHT[j, c]
                     Wd[r, c] = acc
             L = _lcp_size(na, ia, mu, base, trow)
-            lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base,
-                                            trow, Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                            lcp_ctl, Ab, xb, idx)
-            if lst != 0:
-                status = LCP_HANDBACK
-                break
-            stats[S_PIVOTS] += piv
-            stats[S_LCP] += 1.0
-            if warm:
+            res = np.inf
+            # the regimes of the step before (known from the second step of a call on)
+            regimes = warm_on and k > k0
+            if regimes:
+                res = _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, Ab, xb,
+                                    idx, rvel, pcol)
+            if 0.0 <= res <= DEFAULT_TOL:
+                stats[S_LCP] += 1.0
                 stats[S_WARM] += 1.0
+            else:
+                # refused: a regime changes in this step (or lies within the
+                # margin of changing) and Lemke decides, from scratch, since the
+                # remembered support is that of the old regimes. On the first
+                # step of a call the regimes are unknown: the support may serve
+                if regimes:
+                    lcp_ctl[CTL_WARM] = 0
+                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base,
+                                                trow, Ml, ql, dl, zl, wl, rayl, work, iwork,
+                                                lay, lcp_ctl, Ab, xb, idx)
+                if regimes:
+                    lcp_ctl[CTL_WARM] = 1
+                if lst != 0:
+                    status = LCP_HANDBACK
+                    break
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
+                if warm:
+                    stats[S_WARM] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
             for i in range(n):

@@ -51,7 +51,7 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn", "step_fn",
+__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn", "step_fn", "fused",
            "FRICTION_DRIVE", "BOUNCING_BALL", "SLIDING_BLOCK", "PAINLEVE_ROD",
            "STICK_SLIP_MOTOR", "BIDIRECTIONAL_DRIVE", "SLIDING_BOX", "check_compiled_model"]
 
@@ -293,8 +293,18 @@ def contact_fn(kind, par, q, t, G, need_gap, need_T=True):
 
 
 @njit(cache=True, inline="always")
+def fused(kind):
+    """Whether :func:`step_fn` evaluates this model (the friction drives)."""
+    return kind == FRICTION_DRIVE or kind == BIDIRECTIONAL_DRIVE
+
+
+@njit(cache=True, inline="always")
 def step_fn(kind, par, q, v, tk, t1, need_mass, need_gap0, need_f0, need_jac, M, D, D0, G0, G1):
     """Every model output one Moreau–Jean step needs at its start state ``(q_k, v_k)``, in one call.
+
+    Only for the models where that pays (:func:`fused`); the stepper calls
+    the separate functions for the others (nesting their ``kind`` dispatch
+    in here cost reference counts on every step).
 
     Writes ``M`` (when ``need_mass``), ``D`` at ``t1`` (Jacobians when
     ``need_jac``), ``D0`` at ``tk`` (forces only, when ``need_f0``), the
@@ -344,14 +354,6 @@ def step_fn(kind, par, q, v, tk, t1, need_mass, need_gap0, need_f0, need_jac, M,
         D[2, 0] = -par[3]
         if need_f0:
             D0[2, 0] = -par[3]
-    else:
-        if need_mass:
-            mass_fn(kind, par, q, M)
-        dynamics_fn(kind, par, q, v, t1, D, need_jac)
-        if need_f0:
-            dynamics_fn(kind, par, q, v, tk, D0, False)
-        contact_fn(kind, par, q, tk, G0, need_gap0, False)
-        contact_fn(kind, par, q, t1, G1, False, True)
     return _touch3(par, q, M) + _touch3(D, D0, G0) + G1.size + v.size
 
 

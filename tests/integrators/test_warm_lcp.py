@@ -13,6 +13,8 @@ from moreau.lcp import lcp_violation
 from moreau.lcp.friction import build_friction_lcp
 from moreau.scenes import BidirectionalDrive, BidirectionalDriveParams, SlidingBox
 
+from _agreement import assert_forces_agree
+
 TWO_PI = 2.0 * math.pi
 
 # the two shipped scenes with two frictional contacts, as the compiled-vs-generic
@@ -28,17 +30,15 @@ def _run(sc, h, nsteps, **opts):
     return simulate(sc, (0.0, nsteps * h), q0, v0, "moreau-jean", h=h, **opts)
 
 
-def _assert_same_run(a, b, tol):
+def _assert_same_run(a, b, tol, h):
     np.testing.assert_array_equal(a.t, b.t)
     np.testing.assert_array_equal(a.regime, b.regime)
     qs = max(1.0, float(np.max(np.abs(a.q))))
     vs = max(1.0, float(np.max(np.abs(a.v))))
-    fs = max(1.0, float(np.max(np.abs(a.force_N))))
     np.testing.assert_allclose(b.q, a.q, rtol=0, atol=tol * qs)
     np.testing.assert_allclose(b.v, a.v, rtol=0, atol=tol * vs)
     np.testing.assert_allclose(b.slip_velocity, a.slip_velocity, rtol=0, atol=tol * vs)
-    np.testing.assert_allclose(b.force_N, a.force_N, rtol=0, atol=tol * fs)
-    np.testing.assert_allclose(b.force_T, a.force_T, rtol=0, atol=tol * fs)
+    assert_forces_agree(a, b, h, vs, tol)
 
 
 @pytest.mark.parametrize("name", sorted(CASES))
@@ -59,7 +59,7 @@ def test_warm_start_skips_pivoting_and_changes_nothing(name):
     # the certification of an accepted warm solution is Lemke's (<= 1e-9);
     # what they reach is rounding level, as Lemke's do
     assert warm.stats["max_residual"] <= 1e-10
-    _assert_same_run(cold, warm, 1e-12)
+    _assert_same_run(cold, warm, 1e-12, h)
 
 
 def _lcps_of_generic_run(sc, h, nsteps):
@@ -142,7 +142,7 @@ def test_lemke_failure_is_handed_back_to_the_qp_fallback(limit, warm):
     # agree with it to rounding; measured difference 6e-16. Not held to 1e-12:
     # OSQP is iterative, and where rounding moves an iterate across its
     # stopping test the answer moves within the QP tolerance
-    _assert_same_run(gen, comp, 1e-9)
+    _assert_same_run(gen, comp, 1e-9, h)
     # the QP answers are accurate to its tolerance (1e-6), far below the
     # scheme's O(h) error: the trajectory matches the exact motion as well as
     # the Lemke run does (measured: equal errors, 0.0199)
