@@ -19,18 +19,28 @@ The contact problem of a step is solved as the generic path solves it:
   compiled :func:`moreau.lcp.lemke.lemke_core`. When Lemke fails the loop
   stops *before* that step with status :data:`LCP_HANDBACK`; the caller takes
   the step in Python (QP fallback) and calls the loop again.
-* warm start (``lcp_method="auto"``): before Lemke, the support of the last
-  LCP solved with the same active contacts is tried, i.e. the principal
-  subsystem ``M_BB z_B = -q_B`` with ``z = 0`` off it. Its solution is taken
-  only when it passes Lemke's own certification
-  (:func:`moreau.lcp.lcp_violation` at Lemke's tolerance) and the subsystem
-  is well conditioned; where the LCP's solution is unique the answer is
-  then Lemke's to rounding. Between contact events the support does not
-  change, so most multi-contact steps skip pivoting
-  (``stats["warm_starts"]``).
+* warm start (``lcp_method="auto"``), two levels, both certified as Lemke's
+  answer would be (:func:`moreau.lcp.lcp_violation` at Lemke's tolerance,
+  every inequality clear of its bound) and refused otherwise:
+
+  - from the second step of a call on, :func:`_regime_solve` solves the step
+    in the regimes of the step before (open, slipping either way, sticking)
+    on the Delassus matrix itself: the normal impulses of the loaded
+    contacts and the tangential ones of the sticking contacts, 2 x 2 for two
+    sliding contacts instead of the 8 x 8 LCP;
+  - on the first step of a call, the support of the last LCP solved with the
+    same active contacts (:func:`_warm_solve`: the principal subsystem
+    ``M_BB z_B = -q_B``, ``z = 0`` off it).
+
+  Where the LCP's solution is unique the answer is then Lemke's to rounding.
+  Between contact events nothing changes, so most multi-contact steps skip
+  pivoting (``stats["warm_starts"]``); where a regime changes within the
+  step (or within the margin of changing), Lemke runs from scratch.
 
 The generic Python step (``MoreauJean(..., fast=False)``) is kept as the
-reference; the tests hold the two to ``1e-12`` on every scene.
+reference; the tests hold the two to ``1e-12`` on every scene (the forces of
+sticking contacts to the velocities' difference over ``h``, see
+``tests/integrators/_agreement.py``).
 """
 
 import math
@@ -1241,16 +1251,24 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     nrec : int
         Samples written.
     """
-    # The same loop twice: once with the friction drive's kind and sizes as
-    # constants, once for any model. With constants, the compiler drops the
-    # other scenes' branches, unrolls the small-matrix loops and evaluates the
-    # sines and cosines shared by the model functions once per step; that
-    # keeps the paper's scene as fast as its former hand-written kernel.
+    # The same loop three times: with the friction drive's kind and sizes as
+    # constants, with the sizes of the two-contact scenes, and for any model.
+    # With constants, the compiler drops the other scenes' branches, unrolls
+    # the small-matrix loops and evaluates the sines and cosines shared by the
+    # model functions once per step; that keeps the paper's scene as fast as
+    # its former hand-written kernel.
     if kind == FRICTION_DRIVE and n == 2 and nc == 1 and const_mass and has_jac:
         return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
                         k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
                         lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
                         rec_gap, stats)
+    if n == 3 and nc == 2:
+        # three degrees of freedom on two contacts (the two-rod drive, the box):
+        # with the sizes constant, the Delassus products and the contact rows'
+        # loops unroll
+        return _mj_loop(kind, par, 3, 2, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax,
+                        q, v, theta, projection, closed, save_every, record_initial, lcp_ctl,
+                        rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
     return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
                     v, theta, projection, closed, save_every, record_initial, lcp_ctl,
                     rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
