@@ -90,34 +90,41 @@ i.e. ``WN`` is the gradient of the gap, which holds for all scenes of this
 package.
 
 *Warm start.* On the compiled path with ``lcp_method="auto"``, a
-multi-contact LCP is first solved on the support of the previous one
-(same active contacts): the principal subsystem ``M_BB z_B = -q_B`` with
-``z = 0`` off ``B``. That solution is kept only when it passes the check
-a Lemke solution must pass (:func:`moreau.lcp.lcp_violation` to Lemke's
-tolerance) and the subsystem is well conditioned; otherwise Lemke runs.
-While the contacts keep their regimes the support does not change and no
-pivot is needed (``lcp_warm_start=False`` turns it off; the generic step
-never uses it). A warm solution near a change of support (a slip ending
-within the step, a contact about to lift off) is refused too, so that the
-choice between two solutions within rounding of each other is Lemke's, as
-on the generic path. Where the contact problem has a unique solution the
-answer is then Lemke's to rounding. Where it has several, in a statically
-indeterminate configuration (two contacts sticking on fewer degrees of
-freedom than contact rows, e.g. both rods of
-:class:`~moreau.scenes.BidirectionalDrive` sticking on the rotor at once),
-the motion is the same to rounding but the split of the impulses between
-the contacts is not determined by the model, and the warm start could keep
-another vertex than Lemke picks; on the shipped scenes the recorded forces
-agree to 1.2e-12 (without the refusal near a change of support they
-differed by 0.16 on a few steps of ``BidirectionalDrive()`` at
-``h = 2 pi / 1000``).
+multi-contact step is first solved without pivoting. From the second step
+of a run on, the contacts keep the regimes of the step before (open,
+slipping either way, sticking): the normal impulses of the loaded contacts
+and the tangential ones of the sticking contacts solve their zero-velocity
+equations on the Delassus matrix (2 x 2 for two sliding contacts; where
+sticking contacts are statically indeterminate, one impulse of the
+dependent set is set to zero, a vertex of the solution set). On the first
+step, the support of the last LCP with the same active contacts is tried
+(the principal subsystem ``M_BB z_B = -q_B``, ``z = 0`` off ``B``). Either
+answer is kept only when it passes the check a Lemke solution must pass
+(:func:`moreau.lcp.lcp_violation` to Lemke's tolerance) with every
+inequality clear of its bound; otherwise Lemke runs, from scratch. While
+the contacts keep their regimes no pivot is needed
+(``lcp_warm_start=False`` turns it off; the generic step never uses it). A
+solution near a change of regime (a slip ending within the step, a contact
+about to lift off) is refused, so that the choice between two solutions
+within rounding of each other is Lemke's, as on the generic path. Where the
+contact problem has a unique solution the answer is Lemke's to Lemke's
+accuracy, and on nearly dependent contact rows more accurate: on a box
+tumbling onto both corners Lemke's sliding friction is off the cone by up
+to 1.3e-7 of ``mu f_N`` (inside its certification), the warm answer by
+3e-12. Where the problem has several solutions (statically indeterminate
+sticking, e.g. both rods of :class:`~moreau.scenes.BidirectionalDrive`
+sticking on the rotor at once, or the box resting on both corners) the
+motion is the same to rounding but the split of the impulses is not
+determined by the model, and the warm start may keep another vertex than
+Lemke picks; the normal forces and the total friction agree.
 
 Statistics (``SimulationResult.stats``)
 ---------------------------------------
 ``steps``; ``lcp_solves`` (contact problems solved, by Lemke/QP, the
 one-contact enumeration or a warm start); ``direct_solves`` (the
-enumeration's share); ``warm_starts`` (the share solved on the previous
-support without pivoting, compiled path only); ``pivots`` (Lemke pivots);
+enumeration's share); ``warm_starts`` (the share solved without pivoting,
+in the regimes of the step before or on the previous support, compiled
+path only); ``pivots`` (Lemke pivots);
 ``fallbacks`` (solves where ``"auto"`` fell back to QP); ``max_residual``
 (largest scaled complementarity residual, :func:`moreau.lcp.lcp_residual`
 of the friction LCP; on the compiled path Lemke's measure,
