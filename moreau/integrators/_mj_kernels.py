@@ -322,41 +322,6 @@ def _invert_gj(A, out, work, n):
 
 
 @njit(cache=True)
-def _solve_small(A, b, x, work, s):
-    """Solve ``A x = b`` (``s`` x ``s``) by Gaussian elimination with partial pivoting."""
-    for i in range(s):
-        for j in range(s):
-            work[i, j] = A[i, j]
-        x[i] = b[i]
-    for c in range(s):
-        piv = c
-        best = abs(work[c, c])
-        for r in range(c + 1, s):
-            if abs(work[r, c]) > best:
-                best = abs(work[r, c])
-                piv = r
-        if piv != c:
-            for j in range(s):
-                tmp = work[c, j]
-                work[c, j] = work[piv, j]
-                work[piv, j] = tmp
-            tmp = x[c]
-            x[c] = x[piv]
-            x[piv] = tmp
-        for r in range(c + 1, s):
-            fct = work[r, c] / work[c, c]
-            if fct != 0.0:
-                for j in range(c, s):
-                    work[r, j] -= fct * work[c, j]
-                x[r] -= fct * x[c]
-    for i in range(s - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, s):
-            acc -= work[i, j] * x[j]
-        x[i] = acc / work[i, i]
-
-
-@njit(cache=True)
 def _lcp_size(na, ia, mu, base, trow):
     # LCP layout of the active contacts: start of each contact's block, its
     # tangential row in the stacked W (-1 if frictionless); returns the size
@@ -399,8 +364,61 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
     return ctl
 
 
+@njit(cache=True, inline="always")
+def _eliminate(A, x, s, rtol, pcol, sol, cols):
+    """Solve the ``s x s`` system ``A y = x`` by Gaussian elimination with partial pivoting.
+
+    A column whose best pivot is not above ``rtol`` times the column's
+    largest entry (before elimination, so that the test does not depend on
+    the units of one unknown) has no pivot: its unknown is set to zero, a
+    vertex of the solution set where the system is singular but consistent.
+    ``A`` and ``x`` are overwritten; ``pcol`` receives each pivot row's
+    column. Writes ``sol[cols[c]] = y[c]`` and returns the number of pivots
+    (``s`` when the system is regular).
+    """
+    prow = 0
+    for c in range(s):
+        cmax = 0.0
+        for a in range(s):
+            cmax = max(cmax, abs(A[a, c]))
+        piv = prow
+        best = 0.0
+        for r in range(prow, s):
+            if abs(A[r, c]) > best:
+                best = abs(A[r, c])
+                piv = r
+        # `not >` takes NaN as no pivot too
+        if not best > rtol * cmax:
+            continue
+        if piv != prow:
+            for j in range(s):
+                tmp = A[prow, j]
+                A[prow, j] = A[piv, j]
+                A[piv, j] = tmp
+            tmp = x[prow]
+            x[prow] = x[piv]
+            x[piv] = tmp
+        for r in range(prow + 1, s):
+            fct = A[r, c] / A[prow, c]
+            if fct != 0.0:
+                for j in range(c + 1, s):
+                    A[r, j] -= fct * A[prow, j]
+                x[r] -= fct * x[prow]
+        pcol[prow] = c
+        prow += 1
+    for c in range(s):
+        sol[cols[c]] = 0.0
+    for r in range(prow - 1, -1, -1):
+        c = pcol[r]
+        acc = x[r]
+        for j in range(c + 1, s):
+            acc -= A[r, j] * sol[cols[j]]
+        sol[cols[c]] = acc / A[r, c]
+    return prow
+
+
 @njit(cache=True)
-def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, trow):
+def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, trow, pcol):
     """Solve ``LCP(Ml, qv)`` on the remembered support; the violation, or inf if refused.
 
     With ``B`` the remembered support (flags ``memo[off:off + L]``), solves
@@ -421,44 +439,10 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
         x[a] = -qv[idx[a]]
         for c in range(s):
             A[a, c] = Ml[idx[a], idx[c]]
-    for c in range(s):
-        # the column's scale before elimination: the test is then invariant
-        # under a change of units of one variable (impulses vs beta)
-        cmax = 0.0
-        for a in range(s):
-            cmax = max(cmax, abs(A[a, c]))
-        piv = c
-        best = abs(A[c, c])
-        for r in range(c + 1, s):
-            if abs(A[r, c]) > best:
-                best = abs(A[r, c])
-                piv = r
-        # `not >` refuses NaN too
-        if not best > WARM_PIVOT_RTOL * cmax:
-            return np.inf
-        if piv != c:
-            for j in range(c, s):
-                tmp = A[c, j]
-                A[c, j] = A[piv, j]
-                A[piv, j] = tmp
-            tmp = x[c]
-            x[c] = x[piv]
-            x[piv] = tmp
-        for r in range(c + 1, s):
-            fct = A[r, c] / A[c, c]
-            if fct != 0.0:
-                for j in range(c + 1, s):
-                    A[r, j] -= fct * A[c, j]
-                x[r] -= fct * x[c]
-    for a in range(s - 1, -1, -1):
-        acc = x[a]
-        for j in range(a + 1, s):
-            acc -= A[a, j] * x[j]
-        x[a] = acc / A[a, a]
     for j in range(L):
         zl[j] = 0.0
-    for a in range(s):
-        zl[idx[a]] = x[a]
+    if _eliminate(A, x, s, WARM_PIVOT_RTOL, pcol, zl, idx) < s:
+        return np.inf
     res = _lemke._residual(Ml, qv, zl, wl, mmax, qmax)
     dw = WARM_MARGIN * (qmax if qmax > 0.0 else 1.0)
     dz = dw / (mmax if mmax > 0.0 else 1.0)
@@ -551,47 +535,10 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
                     # a sliding contact's tangential impulse rides on its normal one
                     val += (2.0 * g - 3.0) * mu[ia[col]] * Wd[row, tc]
             A[a, c] = val
-    # Gaussian elimination with partial pivoting; a column without a pivot is
-    # a free impulse, set to zero (pcol[row] = the pivot column of that row)
-    prow = 0
-    for c in range(s):
-        cmax = 0.0
-        for a in range(s):
-            cmax = max(cmax, abs(A[a, c]))
-        piv = prow
-        best = 0.0
-        for r in range(prow, s):
-            if abs(A[r, c]) > best:
-                best = abs(A[r, c])
-                piv = r
-        # `not >` takes NaN for no pivot too; a zero column is free as well
-        if not best > WARM_PIVOT_RTOL * cmax:
-            continue
-        if piv != prow:
-            for j in range(s):
-                tmp = A[prow, j]
-                A[prow, j] = A[piv, j]
-                A[piv, j] = tmp
-            tmp = x[prow]
-            x[prow] = x[piv]
-            x[piv] = tmp
-        for r in range(prow + 1, s):
-            fct = A[r, c] / A[prow, c]
-            if fct != 0.0:
-                for j in range(c + 1, s):
-                    A[r, j] -= fct * A[prow, j]
-                x[r] -= fct * x[prow]
-        pcol[prow] = c
-        prow += 1
-    # vel holds the impulses: zero, then the pivoted ones by back substitution
+    # vel takes the impulses: the pivoted ones, zero for a column without a pivot
     for r in range(m):
         vel[r] = 0.0
-    for r in range(prow - 1, -1, -1):
-        c = pcol[r]
-        acc = x[r]
-        for j in range(c + 1, s):
-            acc -= A[r, j] * vel[uidx[j]]
-        vel[uidx[c]] = acc / A[r, c]
+    _eliminate(A, x, s, WARM_PIVOT_RTOL, pcol, vel, uidx)
     for r in range(na):
         tr = trow[r]
         g = reg[ia[r]]
@@ -641,7 +588,7 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
 
 @njit(cache=True)
 def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
-              work, iwork, lay, ctl, Ab, xb, idx):
+              work, iwork, lay, ctl, Ab, xb, idx, pcol):
     """Assemble the friction LCP of the active contacts and solve it (warm start, else Lemke).
 
     The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
@@ -735,7 +682,7 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
                 for c in range(L):
                     mmax = max(mmax, abs(Ml[r, c]))
             res = _warm_solve(Ml, qv, L, ctl, off, Ab, xb, idx, zl, wl, mmax, qmax, na, base,
-                              trow)
+                              trow, pcol)
             if res <= DEFAULT_TOL:
                 status = 0
                 used = True
@@ -785,7 +732,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     rvel = np.zeros(2 * max(nc, 1))
-    pcol = np.zeros(2 * max(nc, 1), dtype=np.int64)
+    pcol = np.zeros(4 * max(nc, 1), dtype=np.int64)
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -824,8 +771,8 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
     sel = np.zeros(ncm, dtype=np.bool_)
     X = np.zeros((n, ncm))
     S = np.zeros((ncm, ncm))
-    Sw = np.zeros((ncm, ncm))
     rs = np.zeros(ncm)
+    ident = np.arange(ncm)
     dd = np.zeros(ncm)
     base = np.zeros(ncm, dtype=np.int64)
     trow = np.zeros(ncm, dtype=np.int64)
@@ -1035,7 +982,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     lcp_ctl[CTL_WARM] = 0
                 lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base,
                                                 trow, Ml, ql, dl, zl, wl, rayl, work, iwork,
-                                                lay, lcp_ctl, Ab, xb, idx)
+                                                lay, lcp_ctl, Ab, xb, idx, pcol)
                 if regimes:
                     lcp_ctl[CTL_WARM] = 1
                 if lst != 0:
@@ -1128,7 +1075,11 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                             for j in range(n):
                                 acc += Gq[ia[r], 3 + j] * X[j, c]
                             S[r, c] = acc
-                    _solve_small(S, rs, dd, Sw, s)
+                    # S is regular where the selected gaps are independent; an
+                    # exactly singular one is a numerical failure, as before
+                    if _eliminate(S, rs, s, 0.0, pcol, dd, ident) < s:
+                        status = NUMERICAL
+                        break
                     for i in range(n):
                         acc = 0.0
                         for c in range(s):
