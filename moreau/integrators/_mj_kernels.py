@@ -51,7 +51,7 @@ from numba import njit
 from .. import _jit_cache
 from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
-from ..lcp.lemke import DEFAULT_TOL, lemke_core, lemke_workspace
+from ..lcp.lemke import DEFAULT_TOL, eliminate, lemke_core, lemke_workspace
 from ..scenes import _compiled
 from ..scenes._compiled import (FRICTION_DRIVE, contact_fn, dynamics_fn, fused, gaps_fn, mass_fn,
                                 step_fn)
@@ -364,59 +364,6 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
     return ctl
 
 
-@njit(cache=True, inline="always")
-def _eliminate(A, x, s, rtol, pcol, sol, cols):
-    """Solve the ``s x s`` system ``A y = x`` by Gaussian elimination with partial pivoting.
-
-    A column whose best pivot is not above ``rtol`` times the column's
-    largest entry (before elimination, so that the test does not depend on
-    the units of one unknown) has no pivot: its unknown is set to zero, a
-    vertex of the solution set where the system is singular but consistent.
-    ``A`` and ``x`` are overwritten; ``pcol`` receives each pivot row's
-    column. Writes ``sol[cols[c]] = y[c]`` and returns the number of pivots
-    (``s`` when the system is regular).
-    """
-    prow = 0
-    for c in range(s):
-        cmax = 0.0
-        for a in range(s):
-            cmax = max(cmax, abs(A[a, c]))
-        piv = prow
-        best = 0.0
-        for r in range(prow, s):
-            if abs(A[r, c]) > best:
-                best = abs(A[r, c])
-                piv = r
-        # `not >` takes NaN as no pivot too
-        if not best > rtol * cmax:
-            continue
-        if piv != prow:
-            for j in range(s):
-                tmp = A[prow, j]
-                A[prow, j] = A[piv, j]
-                A[piv, j] = tmp
-            tmp = x[prow]
-            x[prow] = x[piv]
-            x[piv] = tmp
-        for r in range(prow + 1, s):
-            fct = A[r, c] / A[prow, c]
-            if fct != 0.0:
-                for j in range(c + 1, s):
-                    A[r, j] -= fct * A[prow, j]
-                x[r] -= fct * x[prow]
-        pcol[prow] = c
-        prow += 1
-    for c in range(s):
-        sol[cols[c]] = 0.0
-    for r in range(prow - 1, -1, -1):
-        c = pcol[r]
-        acc = x[r]
-        for j in range(c + 1, s):
-            acc -= A[r, j] * sol[cols[j]]
-        sol[cols[c]] = acc / A[r, c]
-    return prow
-
-
 @njit(cache=True)
 def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, trow, pcol):
     """Solve ``LCP(Ml, qv)`` on the remembered support; the violation, or inf if refused.
@@ -441,7 +388,7 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
             A[a, c] = Ml[idx[a], idx[c]]
     for j in range(L):
         zl[j] = 0.0
-    if _eliminate(A, x, s, WARM_PIVOT_RTOL, pcol, zl, idx) < s:
+    if eliminate(A, x, s, WARM_PIVOT_RTOL, 0.0, pcol, zl, idx) < s:
         return np.inf
     res = _lemke._residual(Ml, qv, zl, wl, mmax, qmax)
     dw = WARM_MARGIN * (qmax if qmax > 0.0 else 1.0)
@@ -462,7 +409,7 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
 
 
 @njit(cache=True)
-def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, vel, pcol):
+def _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, A, x, uidx, vel, pcol):
     """Solve the active contacts' problem in the regimes of the step before; the violation, or inf.
 
     Each active contact keeps its last regime (``reg``, as :func:`_classify`:
@@ -497,14 +444,9 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
     qmax = 0.0
     mmax = 1.0
     for r in range(m):
-        b = Uf[r]
-        if r < na:
-            i = ia[r]
-            if e[i] > 0.0:
-                b += e[i] * min(vN0[i], 0.0)
-            if trow[r] >= 0:
-                mmax = max(mmax, mu[i])
-        qmax = max(qmax, abs(b))
+        if r < na and trow[r] >= 0:
+            mmax = max(mmax, mu[ia[r]])
+        qmax = max(qmax, abs(Uf[r]))
         for c in range(m):
             mmax = max(mmax, abs(Wd[r, c]))
     qs = qmax if qmax > 0.0 else 1.0
@@ -521,10 +463,7 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
                 s += 1
     for a in range(s):
         row = uidx[a]
-        b = Uf[row]
-        if row < na and e[ia[row]] > 0.0:
-            b += e[ia[row]] * min(vN0[ia[row]], 0.0)
-        x[a] = -b
+        x[a] = -Uf[row]
         for c in range(s):
             col = uidx[c]
             val = Wd[row, col]
@@ -538,7 +477,7 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
     # vel takes the impulses: the pivoted ones, zero for a column without a pivot
     for r in range(m):
         vel[r] = 0.0
-    _eliminate(A, x, s, WARM_PIVOT_RTOL, pcol, vel, uidx)
+    eliminate(A, x, s, WARM_PIVOT_RTOL, 0.0, pcol, vel, uidx)
     for r in range(na):
         tr = trow[r]
         g = reg[ia[r]]
@@ -548,8 +487,6 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
     num = 0.0
     for r in range(m):
         acc = Uf[r]
-        if r < na and e[ia[r]] > 0.0:
-            acc += e[ia[r]] * min(vN0[ia[r]], 0.0)
         for c in range(m):
             acc += Wd[r, c] * vel[c]
         x[r] = acc
@@ -587,20 +524,23 @@ def _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, A, x, uidx, 
 
 
 @njit(cache=True)
-def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
-              work, iwork, lay, ctl, Ab, xb, idx, pcol):
+def _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
+              work, iwork, lay, ctl, Ab, xb, idx, pcol, use_memory):
     """Assemble the friction LCP of the active contacts and solve it (warm start, else Lemke).
 
     The layout is that of :func:`moreau.lcp.friction.build_friction_lcp` over
     the active contacts (``ia[:na]``): one variable per frictionless contact,
     ``(p_N, p_T+, p_T-, beta)`` per frictional one, ``M = S^T W S`` plus the
-    cone rows, and the restitution term only where ``e > 0``. The buffers
+    cone rows; ``Uf`` holds the free contact velocities, the restitution
+    target already in its normal rows. The buffers
     are at least the size ``L`` of :func:`_lcp_size`; their leading ``L``
     entries are used. ``lay`` (``[na, ia...]``) holds the layout ``Ml`` was
     last assembled in: with the same layout the matrix's zero pattern is the
     same and only its nonzero entries are rewritten.
 
-    With the warm start on (``ctl``, see :func:`new_lcp_control`), and when
+    With the warm start on (``ctl``, see :func:`new_lcp_control`) and
+    ``use_memory`` (the caller's regime solve has not just been refused: its
+    regimes, hence the remembered support, are out of date), and when
     the last LCP in its memory had the same active contacts, that solution's
     support ``B = {j : z_j > 0}`` is tried first (:func:`_warm_solve`); the
     result is accepted only when it passes the check a Lemke solution must
@@ -631,8 +571,6 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
         br = base[r]
         tr = trow[r]
         ql[br] = Uf[r]
-        if e[i] > 0.0:
-            ql[br] += e[i] * min(vN0[i], 0.0)
         if tr >= 0:
             ql[br + 1] = Uf[tr]
             ql[br + 2] = -Uf[tr]
@@ -660,7 +598,7 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
             Ml[br + 3, br + 2] = -1.0
     qv = ql[:L]
     off = CTL_IA + ia.shape[0]
-    warm = ctl[CTL_WARM] != 0
+    warm = ctl[CTL_WARM] != 0 and use_memory
     status = -1
     pivots = 0
     res = np.inf
@@ -728,7 +666,7 @@ def _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base, trow, Ml, ql, dl, 
 def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
              theta, projection, closed, save_every, record_initial, lcp_ctl,
              rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    # the loop of mj_run, inlined there twice (see mj_run)
+    # the loop of mj_run, inlined there three times (see mj_run)
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     rvel = np.zeros(2 * max(nc, 1))
@@ -963,13 +901,18 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     for j in range(n):
                         acc += H[r, j] * WiHT[j, c]
                     Wd[r, c] = acc
+            # Newton's restitution: the normal rows aim at -e times the approach speed
+            for r in range(na):
+                i = ia[r]
+                if e[i] > 0.0:
+                    Uf[r] += e[i] * min(vN0[i], 0.0)
             L = _lcp_size(na, ia, mu, base, trow)
             res = np.inf
             # the regimes of the step before (known from the second step of a call on)
             regimes = warm_on and k > k0
             if regimes:
-                res = _regime_solve(Wd, Uf, na, ia, trow, mu, e, vN0, reg, p, pN, pT, Ab, xb,
-                                    idx, rvel, pcol)
+                res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel,
+                                    pcol)
             if 0.0 <= res <= DEFAULT_TOL:
                 stats[S_LCP] += 1.0
                 stats[S_WARM] += 1.0
@@ -978,13 +921,9 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                 # margin of changing) and Lemke decides, from scratch, since the
                 # remembered support is that of the old regimes. On the first
                 # step of a call the regimes are unknown: the support may serve
-                if regimes:
-                    lcp_ctl[CTL_WARM] = 0
-                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, e, vN0, p, pN, pT, L, base,
-                                                trow, Ml, ql, dl, zl, wl, rayl, work, iwork,
-                                                lay, lcp_ctl, Ab, xb, idx, pcol)
-                if regimes:
-                    lcp_ctl[CTL_WARM] = 1
+                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                                Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                                lcp_ctl, Ab, xb, idx, pcol, not regimes)
                 if lst != 0:
                     status = LCP_HANDBACK
                     break
@@ -1077,7 +1016,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                             S[r, c] = acc
                     # S is regular where the selected gaps are independent; an
                     # exactly singular one is a numerical failure, as before
-                    if _eliminate(S, rs, s, 0.0, pcol, dd, ident) < s:
+                    if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
                         status = NUMERICAL
                         break
                     for i in range(n):

@@ -266,11 +266,69 @@ def _residual(M, q, z, w, mmax, qmax):
     return num / qs
 
 
+@njit(cache=True, inline="always")
+def eliminate(A, x, s, rtol, atol, pcol, sol, cols):
+    """Solve the ``s x s`` system ``A y = x`` by Gaussian elimination with partial pivoting.
+
+    A column whose best pivot is not above ``rtol`` times the column's
+    largest entry (before elimination, so that the test does not depend on
+    the units of one unknown), nor above ``atol``, has no pivot: its unknown
+    is set to zero, a vertex of the solution set where the system is
+    singular but consistent.
+    ``A`` and ``x`` are overwritten; ``pcol`` receives each pivot row's
+    column. Writes ``sol[cols[c]] = y[c]`` and returns the number of pivots
+    (``s`` when the system is regular).
+    """
+    prow = 0
+    for c in range(s):
+        cmax = 0.0
+        for a in range(s):
+            cmax = max(cmax, abs(A[a, c]))
+        piv = prow
+        best = 0.0
+        for r in range(prow, s):
+            if abs(A[r, c]) > best:
+                best = abs(A[r, c])
+                piv = r
+        thr = rtol * cmax
+        if atol > thr:
+            thr = atol
+        # `not >` takes NaN as no pivot too
+        if not best > thr:
+            continue
+        if piv != prow:
+            for j in range(s):
+                tmp = A[prow, j]
+                A[prow, j] = A[piv, j]
+                A[piv, j] = tmp
+            tmp = x[prow]
+            x[prow] = x[piv]
+            x[piv] = tmp
+        for r in range(prow + 1, s):
+            fct = A[r, c] / A[prow, c]
+            if fct != 0.0:
+                for j in range(c + 1, s):
+                    A[r, j] -= fct * A[prow, j]
+                x[r] -= fct * x[prow]
+        pcol[prow] = c
+        prow += 1
+    for c in range(s):
+        sol[cols[c]] = 0.0
+    for r in range(prow - 1, -1, -1):
+        c = pcol[r]
+        acc = x[r]
+        for j in range(c + 1, s):
+            acc -= A[r, j] * sol[cols[j]]
+        sol[cols[c]] = acc / A[r, c]
+    return prow
+
+
 @njit(cache=True)
 def _resolve_basis(M, q, pos, n, z_out):
     # Re-solve the terminal complementary basis directly: with J the basic
     # z variables, M_JJ z_J = -q_J. Rounding accumulated over many pivots is
-    # gone after this; returns False when M_JJ is numerically singular.
+    # gone after this; returns False when M_JJ is numerically singular (z_out
+    # is then partly written: the caller keeps its own copy).
     J = np.empty(n, dtype=np.int64)
     m = 0
     for j in range(n):
@@ -287,39 +345,10 @@ def _resolve_basis(M, q, pos, n, z_out):
     for a in range(m):
         for c in range(m):
             amax = max(amax, abs(A[a, c]))
-    for c in range(m):
-        p = c
-        big = abs(A[c, c])
-        for a in range(c + 1, m):
-            if abs(A[a, c]) > big:
-                big = abs(A[a, c])
-                p = a
-        if big <= 1e3 * np.finfo(np.float64).eps * amax or big == 0.0:
-            return False
-        if p != c:
-            for k in range(m):
-                t = A[c, k]
-                A[c, k] = A[p, k]
-                A[p, k] = t
-            t = x[c]
-            x[c] = x[p]
-            x[p] = t
-        for a in range(c + 1, m):
-            f = A[a, c] / A[c, c]
-            if f != 0.0:
-                for k in range(c, m):
-                    A[a, k] -= f * A[c, k]
-                x[a] -= f * x[c]
-    for a in range(m - 1, -1, -1):
-        acc = x[a]
-        for k in range(a + 1, m):
-            acc -= A[a, k] * x[k]
-        x[a] = acc / A[a, a]
     for j in range(n):
         z_out[j] = 0.0
-    for a in range(m):
-        z_out[J[a]] = x[a]
-    return True
+    pcol = np.empty(m, dtype=np.int64)
+    return eliminate(A, x, m, 0.0, 1e3 * np.finfo(np.float64).eps * amax, pcol, z_out, J) == m
 
 
 @njit(cache=True)

@@ -51,7 +51,8 @@ from collections import namedtuple
 import numpy as np
 from numba import njit
 
-__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn", "step_fn", "fused",
+__all__ = ["CompiledModel", "mass_fn", "dynamics_fn", "contact_fn", "gaps_fn", "drift_fn", "step_fn",
+           "fused",
            "FRICTION_DRIVE", "BOUNCING_BALL", "SLIDING_BLOCK", "PAINLEVE_ROD",
            "STICK_SLIP_MOTOR", "BIDIRECTIONAL_DRIVE", "SLIDING_BOX", "check_compiled_model"]
 
