@@ -11,6 +11,7 @@ import sys
 import time
 
 from .errors import InputError, MoreauError
+from .scenes.registry import describe, entries, scene_names
 
 __all__ = ["main"]
 
@@ -258,19 +259,13 @@ def _cmd_compare(args):
             print("wrote " + ", ".join(p for p in paths.values() if p))
         return
     if args.scene is None:
-        raise InputError("`--scene` is required (one of " + ", ".join(sorted(cmp.SCENES)) +
+        raise InputError("`--scene` is required (one of " + ", ".join(scene_names()) +
                          "), or give `--stress`")
-    params = {}
-    for item in args.param or []:
-        key, sep, val = item.partition("=")
-        if not sep:
-            raise InputError(f"`--param` takes KEY=VALUE, got {item!r}")
-        try:
-            params[key.strip()] = float(val)
-        except ValueError:
-            params[key.strip()] = val.strip()
+    params = parse_settings(list(args.param or []) + list(args.set or []), "--set")
     for key in ("frequency", "mu", "phi0", "restitution", "load", "drive"):
         if getattr(args, key) is not None:
+            if key in params:
+                raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
             params[key] = getattr(args, key)
     tag = f"compare_{args.scene}" + (f"_{params['frequency']:g}Hz" if "frequency" in params else "")
     partial = []
@@ -287,6 +282,38 @@ def _cmd_compare(args):
         print("wrote " + ", ".join(p for p in paths.values() if p))
     if report["interrupted"]:
         raise KeyboardInterrupt
+
+
+def parse_settings(items, option):
+    """``{name: value}`` from ``NAME=VALUE`` strings: numbers as floats, anything else as text."""
+    out = {}
+    for item in items:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or not key:
+            raise InputError(f"`{option}` takes NAME=VALUE, got {item!r}")
+        if key in out:
+            raise InputError(f"`{key}` is given twice in `{option}`")
+        try:
+            out[key] = float(val)
+        except ValueError:
+            out[key] = val.strip()
+    return out
+
+
+def _cmd_scenes(args):
+    """``moreau scenes``: every registered scene with its parameters."""
+    described = [describe(e) for e in entries()]
+    if args.json:
+        print(json.dumps(described))
+        return
+    for d in described:
+        print(f"{d['name']}: {d['description']}")
+        for p in d["parameters"]:
+            unit = f" [{p['unit']}]" if p["unit"] and p["unit"] != "choice" else ""
+            print(f"    {p['name']}{unit} = {p['default']!r}" + (f"  ({p['doc']})" if p["doc"] else ""))
+        if d["compare"]:
+            print("    compare case also takes: " + ", ".join(d["compare"]))
 
 
 def build_parser():
@@ -338,12 +365,13 @@ def build_parser():
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
     _add_atlas(sub)
+    sc = sub.add_parser("scenes", help="the registered scenes, their parameters and units")
+    sc.add_argument("--json", action="store_true", help="print a JSON list")
+    sc.set_defaults(func=_cmd_scenes)
     c = sub.add_parser("compare", help="error against run time of every scheme on one scene "
                                        "(table + figure), or the stiff/extreme-case map (--stress)")
-    c.add_argument("--scene", default=None,
-                   choices=["friction-drive", "stick-slip-motor", "bouncing-ball",
-                            "sliding-block", "painleve-rod", "sliding-box",
-                            "bidirectional-drive"])
+    c.add_argument("--scene", default=None, metavar="NAME",
+                   help="a registered scene (`moreau scenes` lists them)")
     c.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     c.add_argument("--mu", type=float, default=None, help="friction coefficient")
     c.add_argument("--phi0", type=float, default=None, help="friction drive: rod tilt [rad]")
@@ -351,8 +379,9 @@ def build_parser():
     c.add_argument("--load", type=float, default=None, help="load [N]")
     c.add_argument("--drive", default=None, choices=["sawtooth", "sine"],
                    help="stick-slip motor: drive shape")
-    c.add_argument("--param", action="append", metavar="KEY=VALUE",
-                   help="any other scene parameter (repeatable)")
+    c.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="any parameter of the scene or of its comparison case (repeatable)")
+    c.add_argument("--param", action="append", metavar="KEY=VALUE", help=argparse.SUPPRESS)
     c.add_argument("--stress", action="store_true",
                    help="run the stiff and extreme case catalogue instead (stability map)")
     c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")

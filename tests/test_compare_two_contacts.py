@@ -103,7 +103,7 @@ def test_bidirectional_drive_moreau_jean_is_first_order(bidir):
 
 
 def test_two_contact_scenes_refuse_bad_input():
-    with pytest.raises(InputError, match="`x10` does not apply"):
+    with pytest.raises(InputError, match="`x10` is not a parameter of scene 'bidirectional-drive'"):
         make_case("bidirectional-drive", x10=1e-6)
     with pytest.raises(InputError, match="`mu` \\* half_height must be < half_width"):
         make_case("sliding-box", mu=3.0)

@@ -92,6 +92,7 @@ Examples
 """
 
 import csv
+import inspect
 import json
 import math
 import os
@@ -99,12 +100,17 @@ import statistics
 import time
 
 import numpy as np
+from tqdm import tqdm
 
-from .._validate import positive_int
+from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
+from ..scenes.base import Scene
+from ..scenes.registry import get_entry
+from .cases import GRID, SceneCase, switching_error
 
-__all__ = ["compare", "SCENES", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
-           "check_out_dir", "make_case", "fit_order", "plateaus"]
+__all__ = ["compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
+           "check_out_dir", "make_case", "case_parameters", "fit_order", "plateaus",
+           "switching_error"]
 
 TWO_PI = 2.0 * math.pi
 #: Moreau–Jean steps per period of the full comparison (two decades)
@@ -114,8 +120,6 @@ QUICK_STEPS = (50, 150, 500, 1500, 5000)
 #: steps per period of the forced-Lemke / forced-QP rows (QP costs ~16 ms a step)
 DEFAULT_LCP_STEPS = (50, 100, 200)
 QUICK_LCP_STEPS = (50, 100)
-#: samples per period of the common grid of the trajectory error
-GRID = 50
 
 
 def fit_order(steps, errors):
@@ -148,541 +152,35 @@ def _median_time(fn, repeat, cheap=1.0):
     return statistics.median(times), out
 
 
-def _switches(letters, times):
-    """``[(t, letter)]`` at every change of the per-sample letter (first entry excluded)."""
-    out = []
-    for i in range(1, len(letters)):
-        if letters[i] != letters[i - 1]:
-            out.append((float(times[i]), letters[i]))
-    return out
-
-
-def _drop_reversal_sticks(sw, h):
-    # a one-step stick between slips of opposite sign is a reversal inside
-    # the step (see moreau.analysis.mj_steady_state): the continuous system
-    # has no stick there
-    out = []
-    i = 0
-    while i < len(sw):
-        if (i + 1 < len(sw) and sw[i][1] == "S" and sw[i + 1][0] - sw[i][0] <= 1.5 * h
-                and out and {out[-1][1], sw[i + 1][1]} == {"N", "P"}):
-            out.append((0.5 * (sw[i][0] + sw[i + 1][0]), sw[i + 1][1]))
-            i += 2
-            continue
-        out.append(sw[i])
-        i += 1
-    merged = []
-    for t, s in out:
-        if not merged or merged[-1][1] != s:
-            merged.append((t, s))
-    return merged
-
-
-def switching_error(ref, got):
-    """Largest shift between matched switching times, None if the sequences differ or are empty.
-
-    Examples
-    --------
-    >>> switching_error([(1.0, "P"), (2.0, "S")], [(1.1, "P"), (1.95, "S")])
-    0.1
-    >>> switching_error([(1.0, "P")], [(1.0, "S")]) is None
-    True
-    """
-    if not ref or len(ref) != len(got) or any(a[1] != b[1] for a, b in zip(ref, got)):
-        return None
-    return float(round(max(abs(a[0] - b[0]) for a, b in zip(ref, got)), 15))
-
-
-def _regime_switches(regimes):
-    """Switches of a steady state's ``[[tau, letter], ...]`` (the entry at tau = 0 dropped)."""
-    return [(float(t), s) for t, s in regimes[1:]]
-
-
-# -- the scenes -----------------------------------------------------------------------------
-class _Case:
-    """One scene set up for comparison (a subclass per scene)."""
-
-    ref_scheme = "exact"
-    ref_rtols = (None,)
-    tight_rtol = None
-    window = TWO_PI            # the "period" the steps are counted over
-    headline_name = ""
-    projection = False
-
-    def parameters(self):
-        return {}
-
-    # reference ---------------------------------------------------------------
-    def reference(self, rtol):
-        """``(headline, switches)`` of the reference at ``rtol``."""
-        raise NotImplementedError
-
-    def reference_grid(self):
-        """The main coordinate of the tight reference on the common grid."""
-        raise NotImplementedError
-
-    # Moreau–Jean ---------------------------------------------------------------
-    def start(self):
-        """``(q0, v0)`` at ``t = 0`` for the runs."""
-        raise NotImplementedError
-
-    def coordinate(self, q):
-        return q[:, 0]
-
-    def headline_of_run(self, res):
-        raise NotImplementedError
-
-    def run_mj(self, n, theta, lcp):
-        from ..integrators import simulate
-        q0, v0 = self.start()
-        # every step is kept: the switching times need each step's regime
-        opts = dict(h=self.window / n, theta=theta, projection=self.projection)
-        if lcp is not None:
-            opts["lcp_method"] = lcp
-        return simulate(self.scene, (0.0, self.window), q0, v0, "moreau-jean", **opts)
-
-    def mj(self, n, theta, lcp):
-        """``(headline, run)``: the timed work of one Moreau–Jean row."""
-        res = self.run_mj(n, theta, lcp)
-        if not res.success:
-            raise MoreauError(f"Moreau–Jean run failed: {res.message}")
-        return self.headline_of_run(res), res
-
-    def measure(self, n, theta, lcp, out):
-        """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
-        _, res = out
-        return self._trajectory_error(res), self._run_switches(res, self.window / n), None
-
-    def _trajectory_error(self, res):
-        grid = np.linspace(0.0, self.window, GRID + 1)
-        idx = np.searchsorted(res.t, grid - 1e-9 * self.window)
-        idx = np.minimum(idx, len(res.t) - 1)
-        if np.max(np.abs(res.t[idx] - grid)) > 1e-9 * self.window:
-            # the samples are not on the grid (steps not a multiple of GRID): interpolate
-            y = np.interp(grid, res.t, self.coordinate(res.q))
-        else:
-            y = self.coordinate(res.q)[idx]
-        return float(np.max(np.abs(y - self.reference_grid())) / self.trajectory_scale)
-
-    trajectory_scale = 1.0
-
-    def _run_switches(self, res, h):
-        return self._run_switches_of(res, h, 0)
-
-    def _run_switches_of(self, res, h, contact):
-        letters = res.regime_letters(contact)
-        t = res.t - h
-        # a step's regime is recorded at its end: the switch happened in that step.
-        # The regime in force at the start goes in front, so that a one-step
-        # stick at the first switch is recognised as a reversal too
-        sw = [(float(t[0]), letters[0])] + _switches(letters, t)
-        return _drop_reversal_sticks(sw, h)[1:]
-
-
-class _DriveCase(_Case):
-    """A periodically driven scene whose headline is the displacement of its
-    cyclic coordinate ``cyclic`` over one steady period; ``_tight()`` gives the
-    reference's periodic state and its trajectory on the comparison grid."""
-
-    cyclic = 1
-    projection = True
-
-    def reference_grid(self):
-        return self._tight()["grid"]
-
-    def start(self):
-        r = self._tight()
-        return r["q0"].copy(), r["v0"].copy()
-
-    def coordinate(self, q):
-        return q[:, self.cyclic]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, self.cyclic] - res.q[0, self.cyclic])
-
-    def mj(self, n, theta, lcp):
-        if lcp is not None:
-            return super().mj(n, theta, lcp)
-        from ..analysis.mj_steady_state import moreau_jean_steady_state
-        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
-        return ss.displacement_per_period, ss
-
-
-class _FrictionDriveCase(_DriveCase):
-    ref_scheme = "event-driven"
-    # the compiled steady state is cheap: go far enough to show the plateaus
-    default_steps = DEFAULT_STEPS + (10000, 20000)
-    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
-    tight_rtol = 1e-13
-    headline_name = "displacement per period"
-    projection = True
-
-    def __init__(self, frequency=185.0, **params):
-        from ..scenes.friction_drive import FrictionDrive, params_from_kwargs
-        self.scene = FrictionDrive(params_from_kwargs(**params), frequency)
-        self.frequency = self.scene.frequency
-        self._params = dict(params)
-        self.trajectory_scale = self.scene.u10
-        self._ref = None
-
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
-
-    def reference(self, rtol):
-        from ..analysis.steady_state import find_steady_state
-        ss = find_steady_state(self.scene, rtol=rtol)
-        return ss.displacement_per_period, _regime_switches(ss.regimes)
-
-    def _tight(self):
-        if self._ref is None:
-            from ..analysis.steady_state import find_steady_state
-            from ..integrators import simulate
-            ss = find_steady_state(self.scene, rtol=self.tight_rtol)
-            q = np.array([ss.state0[0], 0.0])
-            v = np.array(ss.state0[1:])
-            tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
-            if tau_s > 0.0:
-                # carry the periodic state from the section to tau = 2 pi = 0
-                r = simulate(self.scene, (tau_s, TWO_PI), q, v, "event-driven", rtol=1e-12)
-                q, v = np.array([r.q[-1, 0], 0.0]), r.v[-1].copy()
-            grid_run = simulate(self.scene, (0.0, TWO_PI), q, v, "event-driven", rtol=1e-12,
-                                samples_per_period=GRID)
-            grid = np.linspace(0.0, TWO_PI, GRID + 1)
-            idx = np.searchsorted(grid_run.t, grid - 1e-12)
-            if np.max(np.abs(grid_run.t[idx] - grid)) > 1e-9:
-                raise MoreauError("event-driven samples are not on the comparison grid")
-            self._ref = dict(q0=q, v0=v, grid=grid_run.q[idx, 1])
-        return self._ref
-
-
-    def measure(self, n, theta, lcp, out):
-        if lcp is not None:
-            return super().measure(n, theta, lcp, out)
-        _, ss = out
-        # the trajectory: one period of the same scheme from the reference's periodic state
-        res = self.run_mj(n, theta, None)
-        return self._trajectory_error(res), _regime_switches(ss.regimes), ss.mode
-
-
-class _StickSlipCase(_Case):
-    ref_scheme = "stick-slip-exact"
-    headline_name = "displacement per period"
-
-    def __init__(self, frequency=1000.0, drive="sawtooth", **params):
-        from ..scenes.stick_slip_motor import StickSlipMotor
-        self.scene = StickSlipMotor(frequency=frequency, drive=drive, **params)
-        self._params = dict(frequency=frequency, drive=drive, **params)
-        self._ss = None
-        self._grid = None
-
-    def parameters(self):
-        return dict(self._params)
-
-    def _steady(self):
-        if self._ss is None:
-            from ..scenes.stick_slip_exact import stick_slip_steady_state
-            self._ss = stick_slip_steady_state(self.scene)
-        return self._ss
-
-    def reference(self, rtol):
-        from ..scenes.stick_slip_exact import stick_slip_steady_state
-        ss = stick_slip_steady_state(self.scene)
-        return ss.displacement_per_period, _regime_switches(ss.regimes)
-
-    def start(self):
-        return np.array([0.0, 0.0]), np.array([self._steady().state0[0], 0.0])
-
-    def reference_grid(self):
-        if self._grid is None:
-            from ..integrators import simulate
-            grid = np.linspace(0.0, TWO_PI, GRID + 1)
-            q, v = self.start()
-            xs = [q[0]]
-            for a, b in zip(grid[:-1], grid[1:]):
-                r = simulate(self.scene, (a, b), q, v, "stick-slip-exact")
-                q, v = r.q[-1].copy(), r.v[-1].copy()
-                xs.append(q[0])
-            self._grid = np.array(xs)
-        return self._grid
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0] - res.q[0, 0])
-
-
-class _BouncingBallCase(_Case):
-    window = 2.6
-    headline_name = "height at the end of the window"
-
-    def __init__(self, restitution=0.5, radius=0.1, height=0.6):
-        from ..scenes.bouncing_ball import BouncingBall
-        self.scene = BouncingBall(restitution=restitution, radius=radius)
-        self._params = dict(restitution=restitution, radius=radius, height=height)
-        self.q0 = np.array([height])
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.q0.copy(), np.zeros(1)
-
-    def reference(self, rtol):
-        q0, v0 = self.start()
-        q, _ = self.scene.exact_solution(np.array([self.window]), q0, v0)
-        imp = self.scene.impacts(q0, v0, 64).t
-        imp = [float(t) for t in imp if t < self.window]
-        return float(q[-1, 0]), [(t, "!") for t in imp]
-
-    def reference_grid(self):
-        q0, v0 = self.start()
-        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), q0, v0)
-        return q[:, 0]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-    def _run_switches(self, res, h):
-        # impacts: a contact step that follows a flight step
-        letters = res.regime_letters()
-        t = res.t - h
-        return [(float(t[i]), "!") for i in range(1, len(letters))
-                if letters[i] != "F" and letters[i - 1] == "F"]
-
-
-class _SlidingBlockCase(_Case):
-    headline_name = "stopping distance"
-
-    def __init__(self, mu=0.5, speed=2.0):
-        from ..scenes.sliding_block import SlidingBlock
-        self.scene = SlidingBlock(mu=mu)
-        self.v0 = np.array([speed, 0.0])
-        self._params = dict(mu=mu, speed=speed)
-        self.window = 1.5 * self.scene.stopping_time(self.v0)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return np.zeros(2), self.v0.copy()
-
-    def reference(self, rtol):
-        return (float(self.scene.stopping_distance(self.v0)),
-                [(float(self.scene.stopping_time(self.v0)), "S")])
-
-    def reference_grid(self):
-        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
-        return q[:, 0]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-
-class _PainleveRodCase(_Case):
-    ref_scheme = "sliding-ode"
-    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
-    tight_rtol = 1e-13
-    window = 0.5
-    headline_name = "centre position at the end of the window"
-
-    def __init__(self, mu=0.5, phi=0.9, tip_speed=-1.0, dphi=0.4):
-        from ..scenes.painleve_rod import PainleveRod
-        self.scene = PainleveRod(mu=mu)
-        self._params = dict(mu=mu, phi=phi, tip_speed=tip_speed, dphi=dphi)
-        self.q0, self.v0 = (np.asarray(a, dtype=float)
-                            for a in self.scene.sliding_state(phi, tip_speed, dphi=dphi))
-        self._sol = None
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.q0.copy(), self.v0.copy()
-
-    def _ode(self, rtol):
-        from scipy.integrate import solve_ivp
-        rod = self.scene
-
-        def rhs(t, y):
-            a, lam_n, _ = rod.sliding_accelerations(y[:3], y[3:])
-            if not lam_n > 0.0:
-                raise MoreauError("the rod leaves the ground: the sliding reference does not apply")
-            return np.concatenate([y[3:], a])
-
-        return solve_ivp(rhs, (0.0, self.window), np.concatenate([self.q0, self.v0]),
-                         method="DOP853", rtol=rtol, atol=rtol, dense_output=True)
-
-    def reference(self, rtol):
-        sol = self._ode(rtol)
-        return float(sol.y[0, -1]), []
-
-    def reference_grid(self):
-        if self._sol is None:
-            self._sol = self._ode(self.tight_rtol)
-        return self._sol.sol(np.linspace(0.0, self.window, GRID + 1))[0]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-
-class _SlidingBoxCase(_Case):
-    headline_name = "stopping distance"
-
-    def __init__(self, mu=0.4, speed=1.0, half_width=0.5, half_height=0.25):
-        from ..scenes.sliding_box import SlidingBox
-        self.scene = SlidingBox(mu=mu, half_width=half_width, half_height=half_height)
-        self.q0, _ = self.scene.initial_state()
-        self.v0 = np.array([speed, 0.0, 0.0])
-        self._params = dict(mu=mu, speed=speed, half_width=half_width, half_height=half_height)
-        # checks mu b < a (both corners stay down) and mu > 0, before any work
-        self.window = 1.5 * self.scene.stopping_time(self.v0)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.q0.copy(), self.v0.copy()
-
-    def reference(self, rtol):
-        # both corners stop sliding together, at t* = v0 / mu
-        t_stop = float(self.scene.stopping_time(self.v0))
-        return (float(self.scene.stopping_distance(self.v0)),
-                _flatten([[(t_stop, "S")], [(t_stop, "S")]]))
-
-    def reference_grid(self):
-        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
-        return q[:, 0]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-    def _run_switches(self, res, h):
-        # each corner's stop is measured: Moreau–Jean may stop them a step apart
-        return _flatten([self._run_switches_of(res, h, c) for c in (0, 1)])
-
-
-def _contact_switches(regimes, tau_s, contact, h=0.0):
-    """Switches ``[(tau, letter)]`` of one contact over ``[0, 2 pi)`` from a steady state's regimes.
-
-    ``regimes`` holds ``[tau - tau_s, key]`` with one letter per contact in
-    ``key``; one-step sticks at a slip reversal (``h`` > 0) are dropped as in
-    the single-contact case.
-    """
-    pts = sorted(((float(t) + tau_s) % TWO_PI, k[contact]) for t, k in regimes)
-    sw = [(0.0, pts[-1][1] if pts[0][0] > 1e-12 else pts[0][1])]
-    for t, letter in pts:
-        if letter != sw[-1][1]:
-            sw.append((t, letter))
-    return _drop_reversal_sticks(sw, h)[1:]
-
-
-class _BidirectionalDriveCase(_DriveCase):
-    """The two-rod drive's steady state; Moreau–Jean against the generic event-driven reference."""
-
-    ref_scheme = "event-driven"
-    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
-    tight_rtol = 1e-12
-    headline_name = "displacement per period"
-    cyclic = 2
-
-    def __init__(self, frequency=185.0, **params):
-        from ..scenes.bidirectional_drive import BidirectionalDrive, params_from_kwargs
-        # default: rod a at full and rod b at half amplitude, so that both
-        # contacts carry load and slip both ways (mode NSP|NP at 185 Hz)
-        params.setdefault("x10_b", 1.0e-6)
-        self.scene = BidirectionalDrive(params_from_kwargs(**params), frequency)
-        self.frequency = self.scene.frequency
-        self._params = dict(params)
-        self.trajectory_scale = float(np.max(self.scene.u10))
-        self._ref = None
-
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
-
-    def _switches_of_steady(self, ss, h=0.0):
-        tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
-        return [_contact_switches(ss.regimes, tau_s, c, h) for c in range(self.scene.ncontacts)]
-
-    def reference(self, rtol):
-        from ..analysis.steady_state import find_steady_state
-        ss = find_steady_state(self.scene, "event-driven", rtol=rtol)
-        return ss.displacement_per_period, _flatten(self._switches_of_steady(ss))
-
-    def _tight(self):
-        if self._ref is None:
-            from ..analysis.steady_state import find_steady_state
-            from ..integrators import simulate
-            ss = find_steady_state(self.scene, "event-driven", rtol=self.tight_rtol)
-            n = self.scene.ndof
-            q, v = ss.state0[:n].copy(), ss.state0[n:].copy()
-            tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
-            if tau_s > 0.0:
-                # carry the periodic state from the section to tau = 2 pi = 0
-                r = simulate(self.scene, (tau_s, TWO_PI), q, v, "event-driven", rtol=1e-12)
-                q, v = r.q[-1].copy(), r.v[-1].copy()
-            q[2] = 0.0
-            run = simulate(self.scene, (0.0, TWO_PI), q, v, "event-driven", rtol=1e-12,
-                           sample_dt=TWO_PI / (8 * GRID))
-            grid = np.linspace(0.0, TWO_PI, GRID + 1)
-            self._ref = dict(q0=q, v0=v, grid=np.interp(grid, run.t, run.q[:, 2]))
-        return self._ref
-
-
-    def measure(self, n, theta, lcp, out):
-        # the trajectory and the switching times: one period of the same scheme
-        # from the reference's periodic state (the Moreau–Jean steady state names
-        # the regimes of the first contact only)
-        res = out[1] if lcp is not None else self.run_mj(n, theta, None)
-        h = self.window / n
-        sw = [self._run_switches_of(res, h, c) for c in range(self.scene.ncontacts)]
-        mode = out[1].mode if lcp is None else None
-        return self._trajectory_error(res), _flatten(sw), mode
-
-
-def _flatten(per_contact):
-    """One switch list from per-contact lists: ``(tau, "c:letter")``, contact by contact.
-
-    Examples
-    --------
-    >>> _flatten([[(2.0, "S")], [(1.0, "P"), (3.0, "N")]])
-    [(2.0, '0:S'), (1.0, '1:P'), (3.0, '1:N')]
-    """
-    return [(t, f"{c}:{s}") for c, sw in enumerate(per_contact) for t, s in sw]
-
-
-#: scene name -> (case class, accepted parameters, one-line description)
-SCENES = {
-    "friction-drive": (_FrictionDriveCase, ("frequency", "mu", "phi0", "restitution", "load",
-                                            "x10", "k", "m", "m2", "length"),
-                       "the paper's friction drive (steady state; SI parameters)"),
-    "stick-slip-motor": (_StickSlipCase, ("frequency", "drive", "mu", "normal_force", "load"),
-                         "stick-slip motor, one period from its periodic state"),
-    "bouncing-ball": (_BouncingBallCase, ("restitution", "radius", "height"),
-                      "ball dropped from rest, window 2.6 (three impacts)"),
-    "sliding-block": (_SlidingBlockCase, ("mu", "speed"), "block sliding to rest on a level plane"),
-    "painleve-rod": (_PainleveRodCase, ("mu", "phi", "tip_speed", "dphi"),
-                     "Painlevé rod sliding on its tip, well-posed side"),
-    "sliding-box": (_SlidingBoxCase, ("mu", "speed", "half_width", "half_height"),
-                    "box sliding to rest on its two corners (two frictional contacts)"),
-    "bidirectional-drive": (_BidirectionalDriveCase,
-                            ("frequency", "mu", "phi0", "restitution", "load", "x10_a",
-                             "x10_b", "phase", "k", "m", "m2", "length"),
-                            "two-rod bidirectional drive (steady state; SI parameters; "
-                            "default x10_b = 1e-6)"),
-}
-
-
 def make_case(scene, **params):
-    """Set up scene ``scene`` (a key of :data:`SCENES`) for comparison; None values are dropped."""
-    if scene not in SCENES:
-        raise InputError(f"`scene` must be one of {sorted(SCENES)}, got {scene!r}")
-    cls, allowed, _ = SCENES[scene]
+    """The comparison case of ``scene``: a registered scene's name, with its parameters.
+
+    The case class is the scene's registry entry's ``case``; it takes the
+    scene's parameters and its own (a start speed, a drop height). ``None``
+    values are dropped; a name the case does not take is refused, listing
+    the ones it does.
+    """
+    entry = get_entry(scene)
+    if entry.case is None:
+        raise InputError(f"scene {scene!r} has no comparison case; pass a Scene instance with "
+                         "`t_span`, `q0` and `v0` instead")
     params = {k: v for k, v in params.items() if v is not None}
+    allowed = case_parameters(entry)
     bad = sorted(set(params) - set(allowed))
     if bad:
-        raise InputError(f"scene {scene!r} takes the parameters {list(allowed)}; "
-                         f"`{bad[0]}` does not apply to it")
-    case = cls(**params)
+        raise InputError(f"`{bad[0]}` is not a parameter of scene {scene!r}; its parameters: "
+                         + ", ".join(allowed))
+    case = entry.case(**params)
     case.name = scene
     return case
+
+
+def case_parameters(entry):
+    """Every keyword the comparison case of registry entry ``entry`` takes (its own, then the scene's)."""
+    sig = inspect.signature(entry.case.__init__)
+    own = [p for p, v in sig.parameters.items()
+           if p != "self" and v.kind is not inspect.Parameter.VAR_KEYWORD]
+    return tuple(own + [p for p in entry.parameter_names() if p not in own])
 
 
 def _relative(value, ref):
@@ -742,13 +240,17 @@ def plateaus(rows, rel=0.02, min_error=1e-6):
 
 
 def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quick=False,
-            progress=True, on_row=None, **params):
+            progress=True, on_row=None, *, t_span=None, q0=None, v0=None, **params):
     """Error against run time of every scheme on one scene.
 
     Parameters
     ----------
-    scene : str
-        A key of :data:`SCENES`.
+    scene : str or Scene
+        The name of a registered scene (``moreau scenes`` lists them), or a
+        :class:`~moreau.scenes.base.Scene` instance (a user's own scene,
+        registered or not), which then needs ``t_span``, ``q0`` and ``v0``:
+        its reference is the event-driven scheme at tight tolerance
+        (:class:`moreau.analysis.cases.SceneCase`).
     steps : sequence of int, optional
         Moreau–Jean steps per period (per comparison window for the
         non-periodic scenes); :data:`DEFAULT_STEPS` (two decades; the
@@ -767,8 +269,11 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         Show a progress bar (tqdm, on stderr).
     on_row : callable, optional
         Called with each finished row (the caller can save as it goes).
+    t_span, q0, v0 : optional
+        The window and start state, for a Scene instance only.
     **params
-        Scene parameters (see :data:`SCENES`).
+        Parameters of a registered scene and of its comparison case
+        (:func:`case_parameters`).
 
     Returns
     -------
@@ -780,8 +285,30 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         ``message``, ``signed_error``), ``orders`` (``scheme``, ``theta``,
         ``lcp``, ``order``, ``order_headline``), ``notes`` (plateaus of the
         headline error, :func:`plateaus`) and ``interrupted``.
+
+    Examples
+    --------
+    A user's own scene (here a built-in class, used as an unregistered instance):
+
+    >>> from moreau.scenes.sliding_block import SlidingBlock
+    >>> rep = compare(SlidingBlock(mu=0.5), t_span=(0.0, 0.6), q0=[0.0, 0.0], v0=[2.0, 0.0],
+    ...               steps=[20, 40, 80], lcp_steps=[], thetas=[1.0], repeat=1, progress=False)
+    >>> rep["reference"]["scheme"], round(rep["orders"][0]["order"])
+    ('event-driven', 1)
     """
-    case = make_case(scene, **params)
+    if isinstance(scene, Scene):
+        if params:
+            raise InputError(f"`{sorted(params)[0]}` applies to a registered scene's name; a "
+                             "Scene instance carries its own parameters")
+        if t_span is None or q0 is None or v0 is None:
+            raise InputError("a Scene instance needs `t_span`, `q0` and `v0`")
+        case = SceneCase(scene, t_span, q0, v0)
+        scene = case.name
+    else:
+        if t_span is not None or q0 is not None or v0 is not None:
+            raise InputError("`t_span`, `q0` and `v0` apply to a Scene instance; a registered "
+                             "scene's case sets its own start")
+        case = make_case(scene, **params)
     if quick:
         steps = QUICK_STEPS if steps is None else steps
         lcp_steps = QUICK_LCP_STEPS if lcp_steps is None else lcp_steps
@@ -792,7 +319,6 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     lcp_steps = [positive_int("lcp_steps", n)
                  for n in (DEFAULT_LCP_STEPS if lcp_steps is None else lcp_steps)]
     repeat = positive_int("repeat", repeat)
-    from .._validate import in_closed_interval
     thetas = [in_closed_interval("theta", th, 0.5, 1.0) for th in thetas]
 
     tight = case.tight_rtol if case.tight_rtol is not None else None
@@ -829,7 +355,6 @@ def collect_rows(items, run, rows, on_row=None, progress=False, desc="", unit="i
     """
     bar = None
     if progress:
-        from tqdm import tqdm
         bar = tqdm(total=len(items), desc=desc, unit=unit)
     try:
         for item in items:

@@ -121,10 +121,9 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     cyclic = int(cyclic)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
-    from ..integrators import INTEGRATORS, simulate
+    from ..integrators import get_integrator, simulate
 
-    if scheme not in INTEGRATORS:
-        raise InputError(f"`scheme` must be one of {sorted(INTEGRATORS)}, got {scheme!r}")
+    get_integrator(scheme)  # an unknown name lists the known ones, before any work
     opts = _scheme_options(scheme, options)
     ts = float(section_tau)
     if q0 is None or v0 is None:

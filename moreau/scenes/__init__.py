@@ -1,10 +1,33 @@
-"""Mechanical systems ("scenes") that the integrators run."""
+"""Mechanical systems ("scenes") that the integrators run.
 
-from .base import Scene
-from .bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
-from .bouncing_ball import BouncingBall, BouncingBallParams
-from .friction_drive import FrictionDrive, FrictionDriveParams
-from .painleve_rod import PAINLEVE_MU_MIN, PainleveRod, PainleveRodParams, painleve_critical_mu
-from .sliding_block import SlidingBlock, SlidingBlockParams
-from .sliding_box import SlidingBox, SlidingBoxParams
-from .stick_slip_motor import SawtoothDrive, SineDrive, StickSlipMotor, StickSlipMotorParams
+Each scene lives in its own module and registers itself there
+(:mod:`moreau.scenes.registry`); nothing here lists them. The scene classes
+and their public names are reachable as attributes of this package
+(``from moreau.scenes import BouncingBall``): the first such lookup imports
+every scene module (:func:`moreau.scenes.registry.discover`).
+"""
+
+import importlib
+
+from . import registry
+from .base import Scene, params_with
+from .registry import get_entry, make_scene, register_scene, scene_names
+
+__all__ = ["Scene", "params_with", "registry", "get_entry", "make_scene", "register_scene",
+           "scene_names"]
+
+
+def __getattr__(name):
+    # PEP 562: the public names of the scene modules, found after discovery
+    # a submodule not yet imported is looked up here first by ``from moreau.scenes
+    # import x``; it must fall through to the import system, not start discovery
+    if name.startswith("_") or f"{__name__}.{name}" in registry.scene_modules():
+        raise AttributeError(name)
+    registry.discover()
+    for module in registry.scene_modules():
+        mod = importlib.import_module(module)
+        if name in getattr(mod, "__all__", ()):
+            value = getattr(mod, name)
+            globals()[name] = value
+            return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,4 +1,11 @@
-"""Unit conversions shared by the drive scenes (the paper's scaling)."""
+"""Unit conversions shared by the scenes: the paper's drive scaling and the validation scenes' SI scales."""
+
+from collections import namedtuple
+
+import numpy as np
+
+#: quantities converted to SI by ``to_si``; ``None`` where not requested
+SIValues = namedtuple("SIValues", ["t", "q", "v", "force"])
 
 
 class DriveUnits:
@@ -20,3 +27,55 @@ class DriveUnits:
     def force_to_si(self, f):
         """Dimensionless force to newtons."""
         return f * self.force_scale
+
+
+class SIUnits:
+    """SI conversion shared by the validation scenes of this package.
+
+    A scene using it sets ``time`` [s], ``force`` [N] and ``length`` [m] (the
+    SI size of one dimensionless unit) and may override ``_qscale`` when some
+    coordinates are angles.
+    """
+
+    def _qscale(self):
+        # one scale for all coordinates, so that scalars convert to scalars
+        return self.length
+
+    def to_si(self, result=None, *, t=None, q=None, v=None, force=None):
+        """Convert to SI units.
+
+        Parameters
+        ----------
+        result : SimulationResult, optional
+            A run of this scene. If given, a dict of SI time histories is
+            returned: ``t`` [s], ``q``, ``v`` (lengths in m, angles in rad),
+            ``force_N``, ``force_T`` [N], ``slip_velocity`` [m/s], ``gap`` [m]
+            and the ``regime`` codes.
+        t, q, v, force : array_like, optional
+            Dimensionless time, coordinates, velocities and contact forces,
+            converted individually when ``result`` is not given.
+
+        Returns
+        -------
+        dict or SIValues
+        """
+        T, F, L = self.time, self.force, self.length
+        qs = self._qscale()
+        if result is not None:
+            return {"t": result.t * T, "q": result.q * qs, "v": result.v * qs / T,
+                    "force_N": result.force_N * F, "force_T": result.force_T * F,
+                    "slip_velocity": result.slip_velocity * (L / T), "gap": result.gap * L,
+                    "regime": result.regime.copy()}
+        return SIValues(None if t is None else np.asarray(t, float) * T,
+                        None if q is None else np.asarray(q, float) * qs,
+                        None if v is None else np.asarray(v, float) * qs / T,
+                        None if force is None else np.asarray(force, float) * F)
+
+    def from_si(self, *, t=None, q=None, v=None, force=None):
+        """Inverse of :meth:`to_si` for individual quantities (SI -> dimensionless)."""
+        T, F = self.time, self.force
+        qs = self._qscale()
+        return SIValues(None if t is None else np.asarray(t, float) / T,
+                        None if q is None else np.asarray(q, float) / qs,
+                        None if v is None else np.asarray(v, float) * T / qs,
+                        None if force is None else np.asarray(force, float) / F)

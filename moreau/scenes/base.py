@@ -21,9 +21,16 @@ so ``lambdaN >= 0`` pushes the gap open, and in positive slip
 (``gammaT > 0``) Coulomb friction gives ``lambdaT = -mu * lambdaN``.
 """
 
+from dataclasses import fields, replace
+
 import numpy as np
 
-__all__ = ["Scene"]
+from ..errors import InputError
+
+__all__ = ["Scene", "params_with"]
+
+# central differences balance truncation (step^2) against rounding (eps / step)
+_FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
 
 
 class Scene:
@@ -69,10 +76,24 @@ class Scene:
     def force_jacobians(self, q, v, t):
         """``(dh/dq, dh/dv)``, each (ndof, ndof); used by implicit schemes.
 
-        The default is zero, which makes implicit schemes treat ``h`` explicitly.
+        The default takes central differences of :meth:`forces` (``4 ndof``
+        force evaluations, steps ``eps^(1/3) max(1, |x_j|)``), so that an
+        implicit scheme is never silently explicit on a scene that does not
+        give its Jacobians; a scene that knows them overrides this method.
         """
-        n = self.ndof
-        return np.zeros((n, n)), np.zeros((n, n))
+        q = np.asarray(q, dtype=float)
+        v = np.asarray(v, dtype=float)
+        n = q.size
+        K = np.empty((n, n))
+        C = np.empty((n, n))
+        for j in range(n):
+            dq = np.zeros(n)
+            dq[j] = _FD_STEP * max(1.0, abs(q[j]))
+            K[:, j] = (self.forces(q + dq, v, t) - self.forces(q - dq, v, t)) / (2.0 * dq[j])
+            dv = np.zeros(n)
+            dv[j] = _FD_STEP * max(1.0, abs(v[j]))
+            C[:, j] = (self.forces(q, v + dv, t) - self.forces(q, v - dv, t)) / (2.0 * dv[j])
+        return K, C
 
     # -- contacts ---------------------------------------------------------
     def gaps(self, q, t):
@@ -116,3 +137,17 @@ class Scene:
         WN, _, WT, _ = self.contact_jacobians(q, t)
         W = np.vstack([WN, WT])
         return W @ np.linalg.solve(self.mass(q), W.T)
+
+
+def params_with(cls, params, overrides):
+    """``params`` (or the defaults) with keyword overrides, unknown keys rejected."""
+    if params is None:
+        params = cls()
+    elif not isinstance(params, cls):
+        raise InputError(f"`params` must be a {cls.__name__}, got {type(params).__name__}")
+    known = {f.name for f in fields(cls)}
+    for key in overrides:
+        if key not in known:
+            raise InputError(f"`{key}` is not a parameter of {cls.__name__}; "
+                             f"known parameters: {sorted(known)}")
+    return replace(params, **overrides)

@@ -24,7 +24,10 @@ import numpy as np
 
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
-from .base import Scene
+from ._units import SIUnits, SIValues
+from .base import Scene, params_with
+from ..analysis.cases import GRID, CompareCase
+from .registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 
@@ -32,8 +35,6 @@ __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 #: of the ball just before and just after each impact (all dimensionless)
 BallImpacts = namedtuple("BallImpacts", ["t", "v_before", "v_after"])
 
-#: quantities converted to SI by ``to_si``; ``None`` where not requested
-SIValues = namedtuple("SIValues", ["t", "q", "v", "force"])
 
 
 @dataclass(frozen=True)
@@ -67,74 +68,7 @@ class BouncingBallParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-def _params_with(cls, params, overrides):
-    """``params`` (or the defaults) with keyword overrides, unknown keys rejected."""
-    if params is None:
-        params = cls()
-    elif not isinstance(params, cls):
-        raise InputError(f"`params` must be a {cls.__name__}, got {type(params).__name__}")
-    known = {f.name for f in fields(cls)}
-    for key in overrides:
-        if key not in known:
-            raise InputError(f"`{key}` is not a parameter of {cls.__name__}; "
-                             f"known parameters: {sorted(known)}")
-    return replace(params, **overrides)
-
-
-
-class _SIUnits:
-    """SI conversion shared by the validation scenes of this package.
-
-    A scene using it sets ``time`` [s], ``force`` [N] and ``length`` [m] (the
-    SI size of one dimensionless unit) and may override ``_qscale`` when some
-    coordinates are angles.
-    """
-
-    def _qscale(self):
-        # one scale for all coordinates, so that scalars convert to scalars
-        return self.length
-
-    def to_si(self, result=None, *, t=None, q=None, v=None, force=None):
-        """Convert to SI units.
-
-        Parameters
-        ----------
-        result : SimulationResult, optional
-            A run of this scene. If given, a dict of SI time histories is
-            returned: ``t`` [s], ``q``, ``v`` (lengths in m, angles in rad),
-            ``force_N``, ``force_T`` [N], ``slip_velocity`` [m/s], ``gap`` [m]
-            and the ``regime`` codes.
-        t, q, v, force : array_like, optional
-            Dimensionless time, coordinates, velocities and contact forces,
-            converted individually when ``result`` is not given.
-
-        Returns
-        -------
-        dict or SIValues
-        """
-        T, F, L = self.time, self.force, self.length
-        qs = self._qscale()
-        if result is not None:
-            return {"t": result.t * T, "q": result.q * qs, "v": result.v * qs / T,
-                    "force_N": result.force_N * F, "force_T": result.force_T * F,
-                    "slip_velocity": result.slip_velocity * (L / T), "gap": result.gap * L,
-                    "regime": result.regime.copy()}
-        return SIValues(None if t is None else np.asarray(t, float) * T,
-                        None if q is None else np.asarray(q, float) * qs,
-                        None if v is None else np.asarray(v, float) * qs / T,
-                        None if force is None else np.asarray(force, float) * F)
-
-    def from_si(self, *, t=None, q=None, v=None, force=None):
-        """Inverse of :meth:`to_si` for individual quantities (SI -> dimensionless)."""
-        T, F = self.time, self.force
-        qs = self._qscale()
-        return SIValues(None if t is None else np.asarray(t, float) / T,
-                        None if q is None else np.asarray(q, float) / qs,
-                        None if v is None else np.asarray(v, float) * T / qs,
-                        None if force is None else np.asarray(force, float) / F)
-
-
-class BouncingBall(_SIUnits, Scene):
+class BouncingBall(SIUnits, Scene):
     """A ball of radius ``r`` falling on the floor ``y = 0``, restitution ``e``.
 
     Parameters
@@ -168,7 +102,7 @@ class BouncingBall(_SIUnits, Scene):
     name = "bouncing-ball"
 
     def __init__(self, params=None, **overrides):
-        p = _params_with(BouncingBallParams, params, overrides)
+        p = params_with(BouncingBallParams, params, overrides)
         self.params = p
         self.e = p.restitution
         self.r = p.radius / p.length
@@ -338,3 +272,57 @@ class BouncingBall(_SIUnits, Scene):
         if scalar:
             return y.reshape(1, 1)[0], v.reshape(1, 1)[0]
         return y[:, None], v[:, None]
+
+
+class BouncingBallCase(CompareCase):
+    """The ball dropped from rest at ``height`` [m] (centre), window 2.6: three impacts against the exact solution."""
+
+    window = 2.6
+    headline_name = "height at the end of the window"
+
+    def __init__(self, height=0.6, restitution=0.5, radius=0.1, **params):
+        self.scene = BouncingBall(restitution=restitution, radius=radius, **params)
+        self._params = dict(restitution=restitution, radius=radius, height=height, **params)
+        self.q0 = np.array([positive("height", height)])
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), np.zeros(1)
+
+    def reference(self, rtol):
+        q0, v0 = self.start()
+        q, _ = self.scene.exact_solution(np.array([self.window]), q0, v0)
+        imp = self.scene.impacts(q0, v0, 64).t
+        imp = [float(t) for t in imp if t < self.window]
+        return float(q[-1, 0]), [(t, "!") for t in imp]
+
+    def reference_grid(self):
+        q0, v0 = self.start()
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), q0, v0)
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+    def _run_switches(self, res, h):
+        # impacts: a contact step that follows a flight step
+        letters = res.regime_letters()
+        t = res.t - h
+        return [(float(t[i]), "!") for i in range(1, len(letters))
+                if letters[i] != "F" and letters[i - 1] == "F"]
+
+
+
+register_scene(SceneEntry(
+    name="bouncing-ball",
+    factory=BouncingBall,
+    parameters=parameters_of(BouncingBallParams, {"mass": "kg", "radius": "m", "gravity": "m/s^2",
+                                                  "restitution": "", "length": "m"}),
+    description="ball bouncing on a rigid floor: impacts, Zeno accumulation (exact solution)",
+    case=BouncingBallCase,
+    reference="exact",
+    sweepable=("restitution", "radius", "gravity", "mass"),
+    mj_tolerance=5e-2,
+))

@@ -51,10 +51,14 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from .. import _validate as V
-from ..errors import InputError
+from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from ._units import DriveUnits
-from .base import Scene
+from .base import Scene, params_with
+from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
+from ..analysis.steady_state import find_steady_state
+from ..integrators import simulate
+from .registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
@@ -136,6 +140,8 @@ class FrictionDrive(DriveUnits, Scene):
         Physical parameters; the paper's values by default.
     frequency : float
         Drive frequency ``f`` [Hz], > 0.
+    **overrides
+        Individual parameters replacing those of ``params`` (``mu=0.2``).
 
     Examples
     --------
@@ -153,11 +159,10 @@ class FrictionDrive(DriveUnits, Scene):
     #: ``simulate(..., "event-driven")`` selects for it
     reference_integrator = "friction-drive-walker"
 
-    def __init__(self, params=None, frequency=185.0):
+    def __init__(self, params=None, frequency=185.0, **overrides):
         if params is None:
             params = PAPER_DEFAULTS
-        if not isinstance(params, FrictionDriveParams):
-            raise InputError("`params` must be a FrictionDriveParams instance")
+        params = params_with(FrictionDriveParams, params, overrides)
         self.params = params
         self.frequency = V.positive("frequency", frequency)
         self.omega = 2.0 * math.pi * self.frequency
@@ -325,3 +330,74 @@ def params_from_kwargs(**kwargs):
     if unknown:
         raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
     return FrictionDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
+
+
+class FrictionDriveCase(DriveCase):
+    """The friction drive's steady state; reference: the walker's steady state (contact segments in closed form)."""
+
+    ref_scheme = "event-driven"
+    # the compiled steady state is cheap: go far enough to show the plateaus
+    default_steps = (50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000)
+    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10, 1e-12)
+    tight_rtol = 1e-13
+    headline_name = "displacement per period"
+    projection = True
+
+    def __init__(self, frequency=185.0, **params):
+        self.scene = FrictionDrive(frequency=frequency, **params)
+        self.frequency = self.scene.frequency
+        self._params = dict(params)
+        self.trajectory_scale = self.scene.u10
+        self._ref = None
+
+    def parameters(self):
+        return dict(frequency=self.frequency, **self._params)
+
+    def reference(self, rtol):
+        ss = find_steady_state(self.scene, rtol=rtol)
+        return ss.displacement_per_period, regime_switches(ss.regimes)
+
+    def _tight(self):
+        if self._ref is None:
+            ss = find_steady_state(self.scene, rtol=self.tight_rtol)
+            q = np.array([ss.state0[0], 0.0])
+            v = np.array(ss.state0[1:])
+            tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)
+            if tau_s > 0.0:
+                # carry the periodic state from the section to tau = 2 pi = 0
+                r = simulate(self.scene, (tau_s, TWO_PI), q, v, "event-driven", rtol=1e-12)
+                q, v = np.array([r.q[-1, 0], 0.0]), r.v[-1].copy()
+            grid_run = simulate(self.scene, (0.0, TWO_PI), q, v, "event-driven", rtol=1e-12,
+                                samples_per_period=GRID)
+            grid = np.linspace(0.0, TWO_PI, GRID + 1)
+            idx = np.searchsorted(grid_run.t, grid - 1e-12)
+            if np.max(np.abs(grid_run.t[idx] - grid)) > 1e-9:
+                raise MoreauError("event-driven samples are not on the comparison grid")
+            self._ref = dict(q0=q, v0=v, grid=grid_run.q[idx, 1])
+        return self._ref
+
+    def measure(self, n, theta, lcp, out):
+        if lcp is not None:
+            return super().measure(n, theta, lcp, out)
+        _, ss = out
+        # the trajectory: one period of the same scheme from the reference's periodic state
+        res = self.run_mj(n, theta, None)
+        return self._trajectory_error(res), regime_switches(ss.regimes), ss.mode
+
+
+
+#: SI units of the parameters of :class:`FrictionDriveParams`
+UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "", "x10": "m",
+         "load": "N", "restitution": ""}
+
+register_scene(SceneEntry(
+    name="friction-drive",
+    factory=FrictionDrive,
+    parameters=parameters_of(FrictionDriveParams, UNITS, extra=(
+        Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
+    description="the paper's friction drive of a piezoelectric motor (steady state)",
+    case=FrictionDriveCase,
+    reference="friction-drive-walker",
+    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution"),
+    mj_tolerance=5e-3,
+))

@@ -42,7 +42,13 @@ import numpy as np
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from .base import Scene
-from .bouncing_ball import _params_with, _SIUnits
+from ._units import SIUnits
+from .base import params_with
+from scipy.integrate import solve_ivp
+
+from ..analysis.cases import GRID, CompareCase
+from ..errors import MoreauError
+from .registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["PainleveRodParams", "PainleveRod", "painleve_critical_mu", "PAINLEVE_MU_MIN"]
 
@@ -102,7 +108,7 @@ class PainleveRodParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class PainleveRod(_SIUnits, Scene):
+class PainleveRod(SIUnits, Scene):
     """Uniform rod with its lower tip on a rough floor.
 
     Parameters
@@ -134,7 +140,7 @@ class PainleveRod(_SIUnits, Scene):
     name = "painleve-rod"
 
     def __init__(self, params=None, **overrides):
-        p = _params_with(PainleveRodParams, params, overrides)
+        p = params_with(PainleveRodParams, params, overrides)
         self.params = p
         self.mu = np.array([p.mu])
         self.restitution = np.array([p.restitution])
@@ -357,3 +363,63 @@ class PainleveRod(_SIUnits, Scene):
             f"`phi` = {phi:.6g} rad ({math.degrees(phi):.4g} deg), slip velocity "
             f"vT = {gT:.6g}; `mu` exceeds the critical {painleve_critical_mu(phi):.6g} "
             f"for this angle (at least 4/3 for any angle). The contact problem has {what}.")
+
+
+class PainleveRodCase(CompareCase):
+    """The rod sliding on its tip on the well-posed side; reference: the sliding ODE by DOP853."""
+
+    ref_scheme = "sliding-ode"
+    ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
+    tight_rtol = 1e-13
+    window = 0.5
+    headline_name = "centre position at the end of the window"
+
+    def __init__(self, phi=0.9, tip_speed=-1.0, dphi=0.4, mu=0.5, **params):
+        self.scene = PainleveRod(mu=mu, **params)
+        self._params = dict(mu=mu, phi=phi, tip_speed=tip_speed, dphi=dphi, **params)
+        self.q0, self.v0 = (np.asarray(a, dtype=float)
+                            for a in self.scene.sliding_state(phi, tip_speed, dphi=dphi))
+        self._sol = None
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), self.v0.copy()
+
+    def _ode(self, rtol):
+        rod = self.scene
+
+        def rhs(t, y):
+            a, lam_n, _ = rod.sliding_accelerations(y[:3], y[3:])
+            if not lam_n > 0.0:
+                raise MoreauError("the rod leaves the ground: the sliding reference does not apply")
+            return np.concatenate([y[3:], a])
+
+        return solve_ivp(rhs, (0.0, self.window), np.concatenate([self.q0, self.v0]),
+                         method="DOP853", rtol=rtol, atol=rtol, dense_output=True)
+
+    def reference(self, rtol):
+        sol = self._ode(rtol)
+        return float(sol.y[0, -1]), []
+
+    def reference_grid(self):
+        if self._sol is None:
+            self._sol = self._ode(self.tight_rtol)
+        return self._sol.sol(np.linspace(0.0, self.window, GRID + 1))[0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+
+
+register_scene(SceneEntry(
+    name="painleve-rod",
+    factory=PainleveRod,
+    parameters=parameters_of(PainleveRodParams, {"mass": "kg", "length": "m", "mu": "",
+                                                 "gravity": "m/s^2", "restitution": ""}),
+    description="rod sliding on its tip in the Painlevé configuration",
+    case=PainleveRodCase,
+    sweepable=("mu", "mass", "length"),
+    mj_tolerance=2e-2,
+))

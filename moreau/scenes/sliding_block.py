@@ -25,7 +25,11 @@ import numpy as np
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from .base import Scene
-from .bouncing_ball import _params_with, _SIUnits
+from ._units import SIUnits
+from .base import params_with
+from .._validate import finite_scalar
+from ..analysis.cases import GRID, CompareCase
+from .registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["SlidingBlockParams", "SlidingBlock"]
 
@@ -74,7 +78,7 @@ class SlidingBlockParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class SlidingBlock(_SIUnits, Scene):
+class SlidingBlock(SIUnits, Scene):
     """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
 
     Parameters
@@ -104,7 +108,7 @@ class SlidingBlock(_SIUnits, Scene):
     name = "sliding-block"
 
     def __init__(self, params=None, **overrides):
-        p = _params_with(SlidingBlockParams, params, overrides)
+        p = params_with(SlidingBlockParams, params, overrides)
         self.params = p
         self.alpha = p.incline
         self.mu = np.array([p.mu])
@@ -254,3 +258,47 @@ class SlidingBlock(_SIUnits, Scene):
         if w0 != 0.0:
             raise InputError(f"`v0` must be tangent to the plane (v0[1] == 0), got {w0!r}")
         return float(u0)
+
+
+class SlidingBlockCase(CompareCase):
+    """The block launched at ``speed`` [m/s] until it sticks: stopping distance against the exact solution."""
+
+    headline_name = "stopping distance"
+
+    def __init__(self, speed=2.0, mu=0.5, **params):
+        self.scene = SlidingBlock(mu=mu, **params)
+        self.v0 = np.array([finite_scalar("speed", speed), 0.0])
+        self._params = dict(mu=mu, speed=speed, **params)
+        self.window = 1.5 * self.scene.stopping_time(self.v0)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return np.zeros(2), self.v0.copy()
+
+    def reference(self, rtol):
+        return (float(self.scene.stopping_distance(self.v0)),
+                [(float(self.scene.stopping_time(self.v0)), "S")])
+
+    def reference_grid(self):
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+
+
+register_scene(SceneEntry(
+    name="sliding-block",
+    factory=SlidingBlock,
+    parameters=parameters_of(SlidingBlockParams, {"mass": "kg", "mu": "", "incline": "rad",
+                                                  "gravity": "m/s^2", "restitution": "",
+                                                  "length": "m"}),
+    description="block sliding to rest on a plane (exact solution)",
+    case=SlidingBlockCase,
+    reference="exact",
+    sweepable=("mu", "incline", "mass"),
+    mj_tolerance=1e-2,
+))

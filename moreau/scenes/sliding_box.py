@@ -42,7 +42,11 @@ import numpy as np
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from .base import Scene
-from .bouncing_ball import _params_with, _SIUnits
+from ._units import SIUnits
+from .base import params_with
+from .._validate import finite_scalar
+from ..analysis.cases import GRID, CompareCase, flatten
+from .registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["SlidingBoxParams", "SlidingBox"]
 
@@ -84,7 +88,7 @@ class SlidingBoxParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class SlidingBox(_SIUnits, Scene):
+class SlidingBox(SIUnits, Scene):
     """Rigid box on a level floor, two frictional corner contacts.
 
     Parameters
@@ -107,7 +111,7 @@ class SlidingBox(_SIUnits, Scene):
     name = "sliding-box"
 
     def __init__(self, params=None, **overrides):
-        p = _params_with(SlidingBoxParams, params, overrides)
+        p = params_with(SlidingBoxParams, params, overrides)
         self.params = p
         self.a = p.half_width / p.length
         self.b = p.half_height / p.length
@@ -218,3 +222,55 @@ class SlidingBox(_SIUnits, Scene):
         q[:, 1] = self.b
         v[:, 0] = u - mu * ts
         return q, v
+
+
+class SlidingBoxCase(CompareCase):
+    """The box launched at ``speed`` [m/s] on its two corners: stopping distance against the exact solution."""
+
+    headline_name = "stopping distance"
+
+    def __init__(self, speed=1.0, mu=0.4, **params):
+        self.scene = SlidingBox(mu=mu, **params)
+        self.q0, _ = self.scene.initial_state()
+        self.v0 = np.array([finite_scalar("speed", speed), 0.0, 0.0])
+        self._params = dict(mu=mu, speed=speed, **params)
+        # checks mu b < a (both corners stay down) and mu > 0, before any work
+        self.window = 1.5 * self.scene.stopping_time(self.v0)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.q0.copy(), self.v0.copy()
+
+    def reference(self, rtol):
+        # both corners stop sliding together, at t* = v0 / mu
+        t_stop = float(self.scene.stopping_time(self.v0))
+        return (float(self.scene.stopping_distance(self.v0)),
+                flatten([[(t_stop, "S")], [(t_stop, "S")]]))
+
+    def reference_grid(self):
+        q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
+        return q[:, 0]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+    def _run_switches(self, res, h):
+        # each corner's stop is measured: Moreau–Jean may stop them a step apart
+        return flatten([self._run_switches_of(res, h, c) for c in (0, 1)])
+
+
+
+register_scene(SceneEntry(
+    name="sliding-box",
+    factory=SlidingBox,
+    parameters=parameters_of(SlidingBoxParams, {"mass": "kg", "half_width": "m", "half_height": "m",
+                                                "mu": "", "gravity": "m/s^2", "restitution": "",
+                                                "length": "m"}),
+    description="box sliding to rest on two frictional corners (two contacts, exact solution)",
+    case=SlidingBoxCase,
+    reference="exact",
+    sweepable=("mu", "half_width", "half_height", "mass"),
+    mj_tolerance=1e-2,
+))

@@ -301,6 +301,9 @@ class StickSlipReference(Integrator):
     Event(t=0.531243578339, transition, S->P)
     """
 
+    #: the scene's exact periodic steady state, for callers that know the scheme by name only
+    steady_state = staticmethod(stick_slip_steady_state)
+
     def __init__(self, scene, t0, q0, v0, t_bound):
         _check_scene(scene)
         super().__init__(scene, t0, q0, v0, t_bound)

@@ -35,7 +35,11 @@ import numpy as np
 from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ..errors import InputError
 from .base import Scene
-from .bouncing_ball import _params_with, _SIUnits
+from ._units import SIUnits
+from .base import params_with
+from ..analysis.cases import GRID, CompareCase, regime_switches
+from ..integrators import get_integrator, simulate
+from .registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["StickSlipMotorParams", "StickSlipMotor", "SineDrive", "SawtoothDrive"]
 
@@ -302,7 +306,7 @@ class StickSlipMotorParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class StickSlipMotor(_SIUnits, Scene):
+class StickSlipMotor(SIUnits, Scene):
     """Slider pressed on a stator that vibrates along the slider's path.
 
     Parameters
@@ -341,7 +345,7 @@ class StickSlipMotor(_SIUnits, Scene):
     cyclic_coordinates = (0,)
 
     def __init__(self, params=None, frequency=1000.0, drive="sawtooth", **overrides):
-        p = _params_with(StickSlipMotorParams, params, overrides)
+        p = params_with(StickSlipMotorParams, params, overrides)
         f = positive("frequency", frequency)
         self.drive = make_drive(drive)
         self.params = p
@@ -406,3 +410,63 @@ class StickSlipMotor(_SIUnits, Scene):
         if type(d) not in (SineDrive, SawtoothDrive):
             return None     # a drive subclass may change s(tau)
         return CompiledModel(STICK_SLIP_MOTOR, par, 2, 1, True, False)
+
+
+class StickSlipCase(CompareCase):
+    """One period from the exact periodic state; reference: the exact stick–slip solution."""
+
+    ref_scheme = "stick-slip-exact"
+    headline_name = "displacement per period"
+
+    def __init__(self, frequency=1000.0, drive="sawtooth", **params):
+        self.scene = StickSlipMotor(frequency=frequency, drive=drive, **params)
+        self._params = dict(frequency=frequency, drive=drive, **params)
+        self._ss = None
+        self._grid = None
+
+    def parameters(self):
+        return dict(self._params)
+
+    def _steady(self):
+        if self._ss is None:
+            self._ss = get_integrator(self.ref_scheme).steady_state(self.scene)
+        return self._ss
+
+    def reference(self, rtol):
+        ss = get_integrator(self.ref_scheme).steady_state(self.scene)
+        return ss.displacement_per_period, regime_switches(ss.regimes)
+
+    def start(self):
+        return np.array([0.0, 0.0]), np.array([self._steady().state0[0], 0.0])
+
+    def reference_grid(self):
+        if self._grid is None:
+            grid = np.linspace(0.0, TWO_PI, GRID + 1)
+            q, v = self.start()
+            xs = [q[0]]
+            for a, b in zip(grid[:-1], grid[1:]):
+                r = simulate(self.scene, (a, b), q, v, "stick-slip-exact")
+                q, v = r.q[-1].copy(), r.v[-1].copy()
+                xs.append(q[0])
+            self._grid = np.array(xs)
+        return self._grid
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0] - res.q[0, 0])
+
+
+
+register_scene(SceneEntry(
+    name="stick-slip-motor",
+    factory=StickSlipMotor,
+    parameters=parameters_of(StickSlipMotorParams, {"mass": "kg", "normal_force": "N", "mu": "",
+                                                    "amplitude": "m", "load": "N",
+                                                    "restitution": ""}, extra=(
+        Parameter("frequency", "Hz", 1000.0, "drive frequency"),
+        Parameter("drive", "choice", "sawtooth", "stator waveform: sawtooth or sine"))),
+    description="stick-slip (inertial) motor: a slider on a stator driven by a sawtooth or sine",
+    case=StickSlipCase,
+    reference="stick-slip-exact",
+    sweepable=("frequency", "mass", "normal_force", "mu", "amplitude", "load"),
+    mj_tolerance=1e-2,
+))

@@ -7,7 +7,8 @@ import pytest
 
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
-from moreau.integrators import INTEGRATORS, simulate, stick_slip_steady_state
+from moreau.integrators import INTEGRATORS, simulate
+from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 from moreau.scenes.friction_drive_walker import EventDriven
 from moreau.integrators.event_driven_generic import EventDrivenReference, GenericEventDriven
 from moreau.regimes import Regime

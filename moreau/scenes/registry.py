@@ -1,0 +1,219 @@
+"""The scene registry: every scene is one entry, registered by its own module.
+
+A scene module ends with one call to :func:`register_scene`; nothing else in
+the package lists or names the scene. The package discovers the modules of
+:mod:`moreau.scenes` when it is imported (:func:`discover`), so a new file
+with a registered scene is picked up by every command and analysis
+(``moreau scenes``, ``moreau compare --scene NAME``, the conformance tests).
+
+An entry holds:
+
+``name``
+    the name commands take (``--scene NAME``);
+``factory``
+    builds the scene from keyword parameters (``factory(**params)``), in SI
+    units where the scene has them;
+``parameters``
+    :class:`Parameter` tuples (name, unit, default, description), every
+    keyword the factory takes;
+``description``
+    one line for listings;
+``case``
+    the scene's comparison case (a :class:`moreau.analysis.cases.CompareCase`
+    subclass) for ``moreau compare``, or None;
+``reference``
+    the name of the scene's own exact or high-precision reference scheme,
+    or None where the generic event-driven scheme is the reference;
+``sweepable``
+    the parameters a sweep may vary;
+``mj_tolerance``
+    how close Moreau–Jean at the conformance test's step must come to the
+    reference (relative to the motion's scale): the scene's stated
+    tolerance for the conformance suite.
+
+Examples
+--------
+>>> from moreau.scenes import registry
+>>> "bouncing-ball" in registry.scene_names()
+True
+>>> ball = registry.make_scene("bouncing-ball", restitution=0.8)
+>>> float(ball.restitution[0])
+0.8
+>>> registry.get_entry("no-such-scene")
+Traceback (most recent call last):
+...
+moreau.errors.InputError: `scene` must be one of 'bidirectional-drive', 'bouncing-ball', 'friction-drive', 'painleve-rod', 'sliding-block', 'sliding-box', 'stick-slip-motor'; got 'no-such-scene'
+"""
+
+import dataclasses
+import importlib
+import inspect
+import math
+import pkgutil
+from typing import Callable, NamedTuple, Optional
+
+from ..errors import InputError
+
+__all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
+           "make_scene", "discover", "scene_modules", "parameters_of", "describe"]
+
+
+class Parameter(NamedTuple):
+    """One keyword parameter of a scene: ``name``, SI ``unit`` ("" when
+    dimensionless, "choice" for a name), ``default`` and a one-line ``doc``."""
+
+    name: str
+    unit: str
+    default: object
+    doc: str = ""
+
+
+@dataclasses.dataclass(frozen=True)
+class SceneEntry:
+    """A registered scene (see the module docstring for the fields)."""
+
+    name: str
+    factory: Callable
+    parameters: tuple
+    description: str
+    case: Optional[type] = None
+    reference: Optional[str] = None
+    sweepable: tuple = ()
+    mj_tolerance: float = 1e-2
+
+    def parameter_names(self):
+        return tuple(p.name for p in self.parameters)
+
+    def defaults(self):
+        """``{name: default}`` of every parameter."""
+        return {p.name: p.default for p in self.parameters}
+
+
+_REGISTRY = {}
+
+
+def register_scene(entry):
+    """Add ``entry`` (a :class:`SceneEntry`) to the registry and return it.
+
+    A second registration under the same name must come from the same
+    module (a module reloaded); two different scenes under one name is an
+    error.
+    """
+    if not isinstance(entry, SceneEntry):
+        raise InputError(f"`entry` must be a SceneEntry, got {type(entry).__name__}")
+    old = _REGISTRY.get(entry.name)
+    if old is not None and getattr(old.factory, "__module__", None) != getattr(
+            entry.factory, "__module__", None):
+        raise InputError(f"a scene named {entry.name!r} is registered already "
+                         f"(by {old.factory.__module__})")
+    names = [p.name for p in entry.parameters]
+    if len(set(names)) != len(names):
+        raise InputError(f"scene {entry.name!r} lists a parameter twice: {names}")
+    _REGISTRY[entry.name] = entry
+    return entry
+
+
+def scene_modules():
+    """Names of the public modules of :mod:`moreau.scenes` (private ``_name`` ones and this one left out)."""
+    package = importlib.import_module(__package__)
+    return [f"{__package__}.{info.name}" for info in pkgutil.iter_modules(package.__path__)
+            if not info.name.startswith("_") and info.name not in ("registry", "base")]
+
+
+_discovered = False
+
+
+def discover():
+    """Import every public module of :mod:`moreau.scenes`, so that each registers its scene.
+
+    Done once per process, lazily: by the first call of :func:`scene_names`,
+    :func:`entries` or :func:`get_entry`, so that importing one scene module
+    does not import all of them. Returns the sorted scene names.
+    """
+    global _discovered
+    if not _discovered:
+        _discovered = True
+        for module in scene_modules():
+            importlib.import_module(module)
+    return sorted(_REGISTRY)
+
+
+def scene_names():
+    """Sorted names of the registered scenes."""
+    return discover()
+
+
+def entries():
+    """The registered entries, sorted by name."""
+    return [_REGISTRY[k] for k in discover()]
+
+
+def get_entry(name):
+    """The entry registered as ``name``; an unknown name lists the known ones."""
+    discover()
+    try:
+        return _REGISTRY[name]
+    except (KeyError, TypeError):
+        known = ", ".join(repr(k) for k in scene_names())
+        raise InputError(f"`scene` must be one of {known}; got {name!r}") from None
+
+
+def make_scene(name, **params):
+    """Build the registered scene ``name`` from keyword parameters (unknown ones refused)."""
+    entry = get_entry(name)
+    known = entry.parameter_names()
+    for key in params:
+        if key not in known:
+            raise InputError(f"`{key}` is not a parameter of scene {name!r}; "
+                             f"its parameters: {', '.join(known)}")
+    return entry.factory(**params)
+
+
+def parameters_of(params_class, units, docs=None, extra=()):
+    """:class:`Parameter` tuples from a frozen parameter dataclass.
+
+    ``units`` maps every field to its SI unit ("" for dimensionless);
+    ``docs`` optionally to a one-line description; ``extra`` are further
+    :class:`Parameter` entries (e.g. the drive frequency) put first.
+    """
+    docs = docs or {}
+    out = list(extra)
+    for f in dataclasses.fields(params_class):
+        if f.name not in units:
+            raise InputError(f"`units` has no entry for the parameter `{f.name}` of "
+                             f"{params_class.__name__}")
+        default = f.default
+        if default is dataclasses.MISSING:
+            default = f.default_factory()  # type: ignore[misc]
+        out.append(Parameter(f.name, units[f.name], default, docs.get(f.name, "")))
+    return tuple(out)
+
+
+def _jsonable(value):
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    if isinstance(value, (bool, int, float, str)) or value is None:
+        return value
+    return repr(value)
+
+
+def describe(entry):
+    """JSON-ready description of ``entry``: ``name``, ``description``,
+    ``parameters`` (name, unit, default, doc), ``reference``, ``sweepable``,
+    ``compare`` (the parameters the comparison case takes besides the
+    scene's, or None without a case)."""
+    case_params = None
+    if entry.case is not None:
+        sig = inspect.signature(entry.case.__init__)
+        own = entry.parameter_names()
+        case_params = [p for p in sig.parameters if p != "self" and p not in own
+                       and sig.parameters[p].kind is not inspect.Parameter.VAR_KEYWORD]
+    return {
+        "name": entry.name,
+        "description": entry.description,
+        "parameters": [{"name": p.name, "unit": p.unit, "default": _jsonable(p.default),
+                        "doc": p.doc} for p in entry.parameters],
+        "reference": entry.reference or "event-driven-generic",
+        "sweepable": list(entry.sweepable),
+        "compare": case_params,
+    }
