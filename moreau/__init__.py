@@ -11,3 +11,22 @@ from .errors import (
 )
 
 __version__ = "0.1.0"
+
+#: the public front ends, imported on first use so that ``import moreau`` stays light
+_LAZY = {
+    "simulate": "moreau.integrators",
+    "compare": "moreau.analysis.compare",
+    "find_steady_state": "moreau.analysis.steady_state",
+    "check_scene": "moreau.check",
+    "Scene": "moreau.scenes.base",
+}
+
+
+def __getattr__(name):
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'moreau' has no attribute {name!r}")
+    import importlib  # noqa: PLC0415  (PEP 562 lazy attribute: the import is the point)
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

@@ -23,6 +23,13 @@ assert atlas["label"].shape == (14, 8)
     "scheme_comparison.ipynb": """
 assert {r["scheme"] for r in report["rows"]} == {"event-driven", "moreau-jean"}
 """,
+    "your_own_scene.ipynb": """
+assert report.ok and not moreau.check_scene(Broken()).ok
+assert abs(ref.events[0].t - 0.3) < 1e-8
+assert all(r["status"] == 0 for r in rep["rows"])
+orders = {o["theta"]: o["order"] for o in rep["orders"]}
+assert 0.8 < orders[1.0] < 1.3 and orders[0.5] > 0.8
+""",
 }
 
 

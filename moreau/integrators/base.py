@@ -7,16 +7,86 @@ to the end of the interval and returns a :class:`SimulationResult`; an
 interrupted run (Ctrl-C) keeps what it had finished.
 """
 
+import inspect
+
 import numpy as np
 
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
+from ..scenes import registry as scene_registry
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["Integrator", "simulate", "INTEGRATORS", "register_integrator"]
+__all__ = ["Integrator", "simulate", "INTEGRATORS", "register_integrator", "get_integrator",
+           "check_options"]
 
 #: registry name -> Integrator subclass, filled by :func:`register_integrator`
 INTEGRATORS = {}
+
+
+def get_integrator(name):
+    """The :class:`Integrator` subclass registered as ``name``.
+
+    A scene's own reference scheme registers itself in its scene's module, so
+    an unknown name first has the scene modules discovered
+    (:func:`moreau.scenes.registry.discover`); a name still unknown is an
+    error that lists the known ones.
+
+    Examples
+    --------
+    >>> get_integrator("moreau-jean").__name__
+    'MoreauJean'
+    >>> get_integrator("euler")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `method` must be one of 'event-driven', 'event-driven-generic', 'friction-drive-walker', 'moreau-jean', 'stick-slip-exact'; got 'euler'
+    """
+    if name not in INTEGRATORS:
+        scene_registry.discover()
+    try:
+        return INTEGRATORS[name]
+    except (KeyError, TypeError):
+        known = ", ".join(repr(k) for k in sorted(INTEGRATORS))
+        raise InputError(f"`method` must be one of {known}; got {name!r}") from None
+
+
+def check_options(name, options, scene=None):
+    """Refuse an option that scheme ``name`` does not take, before any work.
+
+    The options a scheme takes are the keyword parameters of its
+    constructor (after ``scene, t0, q0, v0, t_bound``): one place states
+    them, and a setting that would not act is an error naming the option
+    and the scheme. A scheme that hands a scene to another one (the
+    ``"event-driven"`` front, which picks the scene's own reference) states
+    that by a ``resolve(scene)`` method, and the options are those of the
+    scheme it picks.
+
+    Examples
+    --------
+    >>> check_options("moreau-jean", {"h": 0.01, "theta": 0.5})
+    >>> check_options("event-driven-generic", {"theta": 0.5})
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, ode_method, max_step, sample_dt, gap_tol, vel_tol, zeno_rtol, max_impacts, lcp_method
+    """
+    cls = get_integrator(name)
+    if scene is not None and hasattr(cls, "resolve"):
+        cls = cls.resolve(scene)
+    accepted = scheme_options(cls)
+    if accepted is None:
+        return
+    for key in options:
+        if key not in accepted:
+            raise InputError(f"`{key}` is not an option of scheme {name!r}; its options: "
+                             + ", ".join(accepted))
+
+
+def scheme_options(cls):
+    """Keyword options of an integrator class, or None where it takes any (``**options``)."""
+    sig = inspect.signature(cls.__init__)
+    params = list(sig.parameters.values())[6:]  # self, scene, t0, q0, v0, t_bound
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params):
+        return getattr(cls, "options", None)
+    return tuple(p.name for p in params)
 
 
 def register_integrator(name):
@@ -170,10 +240,10 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
         Status ``-4`` if interrupted by ``KeyboardInterrupt``; the samples
         recorded until then are kept.
     """
-    if method not in INTEGRATORS:
-        raise InputError(f"`method` must be one of {sorted(INTEGRATORS)}, got {method!r}")
+    cls = get_integrator(method)
+    check_options(method, options, scene)
     t0, t1 = t_span
-    integ = INTEGRATORS[method](scene, t0, q0, v0, t1, **options)
+    integ = cls(scene, t0, q0, v0, t1, **options)
     bar = None
     if progress:
         from tqdm.auto import tqdm

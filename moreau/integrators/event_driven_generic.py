@@ -75,7 +75,7 @@ from .._validate import nonnegative, positive, positive_int
 from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
 from ..regimes import Regime
-from .base import INTEGRATORS, Integrator, register_integrator
+from .base import Integrator, get_integrator, register_integrator
 from .result import Event
 
 __all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference"]
@@ -768,9 +768,13 @@ class EventDrivenReference(Integrator):
     'EventDriven'
     """
 
-    def __new__(cls, scene, *args, **options):
+    @staticmethod
+    def resolve(scene):
+        """The scheme that runs ``scene``: its own reference, or the generic one."""
         name = getattr(scene, "reference_integrator", None)
-        target = INTEGRATORS.get(name, GenericEventDriven) if name else GenericEventDriven
-        obj = target(scene, *args, **options)
+        return get_integrator(name) if name else GenericEventDriven
+
+    def __new__(cls, scene, *args, **options):
+        obj = cls.resolve(scene)(scene, *args, **options)
         obj.scheme = "event-driven"
         return obj
