@@ -124,7 +124,7 @@ def _cmd_steady(args):
 
 
 def _cmd_sweep(args):
-    from .analysis.sweeps import SWEEPABLE, make_scheme, run_sweep
+    from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
     if args.scene == "bidirectional":
         from .cli_bidirectional import cmd_sweep_bidirectional
         return cmd_sweep_bidirectional(args)
@@ -169,7 +169,7 @@ def _cmd_sweep(args):
 
 
 def _cmd_run(args):
-    from .analysis.histories import history_command
+    from .studies.paper.histories import history_command
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
@@ -178,8 +178,8 @@ def _cmd_run(args):
 
 
 def _cmd_atlas(args):
-    from .analysis.atlas import run_atlas
-    from .analysis.sweeps import make_scheme
+    from .studies.paper.atlas import run_atlas
+    from .studies.paper.sweeps import make_scheme
     params = _params(args)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
     planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
@@ -220,7 +220,7 @@ def _add_atlas(sub):
 # -- moreau reproduce ---------------------------------------------------------------
 
 def _cmd_reproduce(args):
-    from .analysis.reproduce import reproduce
+    from .studies.paper.reproduce import reproduce
     res = reproduce(args.out, quick=args.quick, scheduler=args.scheduler, n_jobs=args.jobs,
                     progress=not args.quiet)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
@@ -248,13 +248,13 @@ def _cmd_compare(args):
     out = cmp.check_out_dir(args.out)
     progress = not args.quiet
     if args.stress:
-        from .analysis.stress import run_catalogue, write_stress_outputs
+        from .studies.paper.stress import run_catalogue, write_stress_outputs
         report = run_catalogue(progress=progress, full=not args.quick)
         paths = write_stress_outputs(report, out, plot=not args.no_plot)
         if args.json:
             print(json.dumps(report))
         else:
-            from .analysis.stress import format_stress_table
+            from .studies.paper.stress import format_stress_table
             print(format_stress_table(report))
             print("wrote " + ", ".join(p for p in paths.values() if p))
         return

@@ -107,8 +107,8 @@ def cmd_steady_bidirectional(args):
 
 def cmd_sweep_bidirectional(args):
     """``moreau sweep --scene bidirectional PARAM START STOP ...``; every option is checked first."""
-    from .analysis.bidirectional_sweep import BIDIRECTIONAL_SWEEPABLE, run_bidirectional_sweep
-    from .analysis.sweeps import make_scheme
+    from .studies.bidirectional.bidirectional_sweep import BIDIRECTIONAL_SWEEPABLE, run_bidirectional_sweep
+    from .studies.paper.sweeps import make_scheme
 
     param = args.parameter
     if param not in BIDIRECTIONAL_SWEEPABLE:

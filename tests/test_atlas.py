@@ -8,7 +8,7 @@ import pytest
 
 from moreau import cli
 from moreau.analysis import engine
-from moreau.analysis.atlas import compute_atlas, point_label
+from moreau.studies.paper.atlas import compute_atlas, point_label
 from moreau.errors import InputError
 
 SMALL = dict(f_range=(20.0, 2000.0), f_points=3, y_points=4)

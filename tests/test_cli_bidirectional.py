@@ -5,7 +5,7 @@ import math
 
 import pytest
 
-from moreau.analysis.direction_control import bidirectional_params, direction_sweep
+from moreau.studies.bidirectional.direction_control import bidirectional_params, direction_sweep
 from moreau.cli import main
 from moreau.errors import InputError
 

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 
-from moreau.analysis import sweeps
+from moreau.studies.paper import sweeps
 from moreau.integrators import simulate
 from moreau.scenes.friction_drive_walker import EventDriven
 from moreau.scenes.friction_drive import FrictionDrive

@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from moreau.analysis.reproduce import read_table, study_grids
-from moreau.analysis.report import refine_extremum
-from moreau.analysis.valid_range import lift_off_margin, phi0_valid_range
+from moreau.studies.paper.reproduce import read_table, study_grids
+from moreau.studies.paper.report import refine_extremum
+from moreau.studies.paper.valid_range import lift_off_margin, phi0_valid_range
 from moreau.cli import main
 from moreau.scenes.friction_drive import PAPER_DEFAULTS
 
@@ -66,7 +66,7 @@ def test_quick_run_writes_every_file(quick_run):
 
 
 def test_second_run_comes_from_the_cache(quick_run):
-    from moreau.analysis.reproduce import reproduce
+    from moreau.studies.paper.reproduce import reproduce
     logs = []
     res = reproduce(quick_run, quick=True, progress=False, figures=False, report=False,
                     log=logs.append)
@@ -102,7 +102,7 @@ def _rows(parameter, xs, f=None):
     from dataclasses import asdict
 
     from moreau.analysis.engine import run_points
-    from moreau.analysis.reproduce import SWEPT_COLUMN
+    from moreau.studies.paper.reproduce import SWEPT_COLUMN
     pts = [(asdict(PAPER_DEFAULTS), x) if parameter == "frequency"
            else (asdict(PAPER_DEFAULTS.with_(**{parameter: x})), f) for x in xs]
     rows, _ = run_points(pts, n_jobs=1)
@@ -118,7 +118,7 @@ def _rows(parameter, xs, f=None):
     ("phi0", 185.0, [0.78, 0.82, 0.86, 0.90], "min", 0.84, 0.01),
 ])
 def test_report_extrema_agree_with_the_paper(parameter, f, xs, kind, paper, agree):
-    from moreau.analysis.reproduce import SWEPT_COLUMN
+    from moreau.studies.paper.reproduce import SWEPT_COLUMN
     rows = _rows(parameter, xs, f)
     x, _ = refine_extremum(rows, SWEPT_COLUMN[parameter], parameter, PAPER_DEFAULTS, f, kind)
     assert abs(x - paper) <= agree

@@ -9,7 +9,7 @@ import math
 
 import pytest
 
-from moreau.analysis.stress import CASES, SCHEMES, run_case, run_catalogue
+from moreau.studies.paper.stress import CASES, SCHEMES, run_case, run_catalogue
 from moreau.cli import main
 from moreau.errors import InputError
 
@@ -106,7 +106,7 @@ def test_case(case):
 
 
 def test_stress_command_writes_map_and_table(tmp_path, capsys, monkeypatch):
-    import moreau.analysis.stress as st
+    import moreau.studies.paper.stress as st
     keep = {k: st.CASES[k] for k in ("mu-zero", "painleve-mu1.2")}
     monkeypatch.setattr(st, "CASES", keep)
     assert main(["compare", "--stress", "--quick", "--quiet", "--json",

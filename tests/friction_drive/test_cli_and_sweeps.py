@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from moreau.analysis.modes import mode_name
-from moreau.analysis.sweeps import sweep, write_csv
+from moreau.studies.paper.sweeps import sweep, write_csv
 from moreau.cli import main
 
 KEYS = {"displacement_per_period_m", "average_velocity_m_per_s", "mode", "regimes",
@@ -153,7 +153,7 @@ def test_run_command_writes_history(tmp_path, capsys):
 
 
 def test_histories_of_both_schemes_agree():
-    from moreau.analysis.histories import run_history
+    from moreau.studies.paper.histories import run_history
     from moreau.scenes.friction_drive import PAPER_DEFAULTS
     ed = run_history(PAPER_DEFAULTS, 185.0, periods=3, samples_per_period=100)
     mj = run_history(PAPER_DEFAULTS, 185.0, periods=3, scheme="moreau-jean",

@@ -5,7 +5,7 @@ Three studies at the paper's parameters (its section 4.1):
 1. drive frequency 10 Hz .. 12.5 kHz, 250 log-spaced points;
 2. ``mu`` from 0.01 to 0.99 in steps of 0.01 at 20, 185 and 2000 Hz;
 3. ``phi0`` over its valid range (lift-off edge to Painlevé edge, see
-   :mod:`moreau.analysis.valid_range`) at 20, 185 and 2000 Hz, 101 points.
+   :mod:`moreau.studies.paper.valid_range`) at 20, 185 and 2000 Hz, 101 points.
 
 The event-driven reference gives every value; Moreau–Jean with theta = 1/2
 and theta = 1 at :data:`MJ_STEPS_PER_PERIOD` steps per period gives a
@@ -24,7 +24,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from .engine import ED_REFERENCE, Scheme, check_output_dir, code_version, mj_check_columns, run_points
+from ...analysis.engine import ED_REFERENCE, Scheme, check_output_dir, code_version, mj_check_columns, run_points
 
 __all__ = ["reproduce", "study_grids", "MJ_STEPS_PER_PERIOD", "FREQUENCIES", "write_table"]
 
@@ -37,7 +37,7 @@ SWEPT_COLUMN = {"frequency": "frequency_Hz", "mu": "mu", "phi0": "phi0_rad"}
 PARAM_COLUMNS = {"frequency": "frequency_Hz", "m": "m_kg", "m2": "m2_kg", "k": "k_N_per_m",
                  "length": "length_m", "phi0": "phi0_rad", "mu": "mu", "x10": "x10_m",
                  "load": "load_N", "restitution": "restitution",
-                 # the bidirectional drive's own parameters (moreau.analysis.bidirectional_sweep)
+                 # the bidirectional drive's own parameters (moreau.studies.bidirectional.bidirectional_sweep)
                  "x10_a": "x10_a_m", "x10_b": "x10_b_m", "phase": "phase_rad",
                  "balance": "balance"}
 VALUE_COLUMNS = ["mode", "displacement_per_period_m", "average_velocity_m_per_s",
@@ -61,7 +61,7 @@ def study_grids(params=None, quick=False):
     >>> len(g["frequency"][1]), len(g["mu_185Hz"][1]), len(g["phi0_20Hz"][1]) >= 99
     (250, 99, True)
     """
-    from ..scenes.friction_drive import PAPER_DEFAULTS
+    from ...scenes.friction_drive import PAPER_DEFAULTS
 
     params = PAPER_DEFAULTS if params is None else params
     grids = {"frequency": ("frequency", np.geomspace(10.0, 12500.0, 12 if quick else 250), None,
@@ -82,7 +82,7 @@ def range_marks(params, parameter, frequency=None):
 
     ``{"contact_loss_Hz": f}`` for a frequency sweep (where ``max D = 0``),
     ``{"painleve_edge": 1/tan(phi0)}`` for ``mu``, the valid range of
-    :func:`~moreau.analysis.valid_range.phi0_valid_range` for ``phi0``, and
+    :func:`~moreau.studies.paper.valid_range.phi0_valid_range` for ``phi0``, and
     ``{}`` for the other parameters.
 
     Examples
@@ -168,7 +168,7 @@ def read_table(path):
 
 def _sidecar(path, params, name, parameter, values, frequency, extra, checks, steps, stats,
              scheme=ED_REFERENCE):
-    from .. import __version__
+    from ... import __version__
     meta = {
         "study": name,
         "swept_parameter": SWEPT_COLUMN.get(parameter, parameter),
@@ -219,7 +219,7 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         ``{study name: list of rows}`` plus ``"_paths"`` (written files) and
         ``"_wall_time_s"``.
     """
-    from ..scenes.friction_drive import PAPER_DEFAULTS
+    from ...scenes.friction_drive import PAPER_DEFAULTS
 
     t0 = time.perf_counter()
     out = check_output_dir(out)

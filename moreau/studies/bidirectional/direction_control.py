@@ -19,15 +19,15 @@ import math
 
 import numpy as np
 
-from .._validate import positive
-from ..errors import InputError, MoreauError
+from ..._validate import positive
+from ...errors import InputError, MoreauError
 
 __all__ = ["direction_sweep", "direction_figure", "bidirectional_params"]
 
 
 def bidirectional_params(knob, value, base=None):
     """:class:`BidirectionalDriveParams` for one sweep point (see the module docstring)."""
-    from ..scenes.bidirectional_drive import BidirectionalDriveParams
+    from ...scenes.bidirectional_drive import BidirectionalDriveParams
 
     base = base or BidirectionalDriveParams()
     x10 = max(base.x10_a, base.x10_b)
@@ -74,8 +74,8 @@ def direction_sweep(knob, values, frequency=185.0, base=None, scheme="event-driv
     >>> rows[0]["mode"]                                                # doctest: +SKIP
     'NP|F'
     """
-    from ..scenes.bidirectional_drive import BidirectionalDrive
-    from .periodic_shooting import shoot_periodic
+    from ...scenes.bidirectional_drive import BidirectionalDrive
+    from ...analysis.periodic_shooting import shoot_periodic
 
     frequency = positive("frequency", frequency)
     vals = [float(v) for v in values]
@@ -133,7 +133,7 @@ def direction_figure(balance_rows, phase_rows, path, frequency):
 
 
 def main(argv=None):
-    """``python -m moreau.analysis.direction_control OUT_DIR [--frequency F]``: CSV and figure."""
+    """``python -m moreau.studies.bidirectional.direction_control OUT_DIR [--frequency F]``: CSV and figure."""
     import argparse
     import csv
     import pathlib

@@ -12,9 +12,9 @@ import math
 
 import numpy as np
 
-from .. import _validate as _v
-from .._validate import positive, positive_int
-from ..errors import InputError, MoreauError
+from ... import _validate as _v
+from ..._validate import positive, positive_int
+from ...errors import InputError, MoreauError
 
 __all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE"]
 
@@ -53,8 +53,8 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
     >>> [r["mode"] for r in rows]
     ['NS', 'NP']
     """
-    from ..scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
-    from .steady_state import find_steady_state
+    from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
+    from ...analysis.steady_state import find_steady_state
 
     if parameter not in SWEEP_DEFAULTS:
         raise InputError(f"`parameter` must be one of {sorted(SWEEP_DEFAULTS)}, got {parameter!r}")
@@ -148,7 +148,7 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     ...
     moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
     """
-    from .engine import Scheme
+    from ...analysis.engine import Scheme
     if scheme == "moreau-jean":
         return Scheme.moreau_jean(1.0 if theta is None else theta,
                                   1000 if steps_per_period is None else steps_per_period, rtol)
@@ -214,8 +214,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     list of dict
         The tidy rows.
     """
-    from ..scenes.friction_drive import PAPER_DEFAULTS
-    from .engine import check_output_dir, run_points
+    from ...scenes.friction_drive import PAPER_DEFAULTS
+    from ...analysis.engine import check_output_dir, run_points
     from .reproduce import _point, _sidecar, range_marks, tidy_rows, write_table
 
     params = PAPER_DEFAULTS if params is None else params

@@ -102,7 +102,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
     Parameters
     ----------
     rows : list of dict
-        Tidy rows (see :func:`moreau.analysis.reproduce.tidy_rows`).
+        Tidy rows (see :func:`moreau.studies.paper.reproduce.tidy_rows`).
     parameter : str
     frequency : float or None
         Drive frequency of a mu/phi0 study (title only).
@@ -197,9 +197,9 @@ def steady_period(params, frequency, samples=1200):
     Returns ``(ss, res)``: the :class:`SteadyState` and the
     :class:`SimulationResult` of that period.
     """
-    from ..integrators import simulate
-    from ..scenes.friction_drive import FrictionDrive
-    from .steady_state import find_steady_state
+    from ...integrators import simulate
+    from ...scenes.friction_drive import FrictionDrive
+    from ...analysis.steady_state import find_steady_state
 
     scene = FrictionDrive(params, frequency)
     ss = find_steady_state(scene)
@@ -266,7 +266,7 @@ def mode_figure(mode, p, f, folder):
     """One steady period in ``mode`` at parameters ``p`` and frequency ``f`` (PNG + SVG)."""
     import pathlib
 
-    from ..regimes import REGIME_LETTERS
+    from ...regimes import REGIME_LETTERS
     plt = _plt()
     folder = pathlib.Path(folder)
     if True:
@@ -321,7 +321,7 @@ _NO_MODE_COLORS = {"no contact": "#f4f4f4", "ill-posed (Painlev\u00e9)": "#77777
 def atlas_figure(atlas, stem):
     """Mode map and displacement heat map over one parameter plane (PNG + SVG).
 
-    ``atlas`` is a dict from :func:`moreau.analysis.atlas.compute_atlas`.
+    ``atlas`` is a dict from :func:`moreau.studies.paper.atlas.compute_atlas`.
     """
     from matplotlib.colors import ListedColormap, TwoSlopeNorm
     from matplotlib.lines import Line2D

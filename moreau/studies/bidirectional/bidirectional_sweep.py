@@ -8,7 +8,7 @@ sidecar and figure.
 
 Any field of :class:`~moreau.scenes.bidirectional_drive.BidirectionalDriveParams`
 can be swept, plus ``frequency`` and the direction-control knob ``balance``
-(:func:`moreau.analysis.direction_control.bidirectional_params`: ``-1`` rod
+(:func:`moreau.studies.bidirectional.direction_control.bidirectional_params`: ``-1`` rod
 ``a`` alone, ``0`` both rods, ``+1`` rod ``b`` alone). ``x10`` sets both
 stator amplitudes when it is fixed (``--x10`` or ``--set x10=...``).
 """
@@ -18,8 +18,8 @@ import math
 import sys
 from dataclasses import asdict
 
-from .._validate import positive
-from ..errors import InputError
+from ..._validate import positive
+from ...errors import InputError
 
 __all__ = ["BIDIRECTIONAL_SWEEPABLE", "BIDIRECTIONAL_COLUMNS", "point_params",
            "run_bidirectional_sweep"]
@@ -61,13 +61,13 @@ def point_params(params, parameter, value):
 def _lift_off_margin(p, frequency):
     # each rod's free normal acceleration on its contact manifold depends on its
     # own stator only (M is diagonal): the worst of the excited rods
-    from .valid_range import lift_off_margin
+    from ..paper.valid_range import lift_off_margin
     m = [lift_off_margin(p.rod(r), frequency) for r in "ab" if getattr(p, f"x10_{r}") > 0]
     return max(m) if m else math.nan
 
 
 def _marks(p, parameter, frequency):
-    from .reproduce import range_marks
+    from ..paper.reproduce import range_marks
     rods = [p.rod(r) for r in "ab" if getattr(p, f"x10_{r}") > 0]
     if not rods or parameter not in ("frequency", "mu", "phi0"):
         return {}
@@ -126,7 +126,7 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     start, stop, points, scale
         The swept values (``points`` from ``start`` to ``stop``, linear or log).
     scheme : Scheme, optional
-        From :func:`moreau.analysis.sweeps.make_scheme` (event-driven by default).
+        From :func:`moreau.studies.paper.sweeps.make_scheme` (event-driven by default).
     out : path-like
         Output folder, checked writable before any work.
 
@@ -135,9 +135,9 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     list of dict
         The tidy rows.
     """
-    from ..scenes.bidirectional_drive import BidirectionalDriveParams
-    from .engine import check_output_dir, code_version, run_points
-    from .sweeps import make_scheme, sweep_values
+    from ...scenes.bidirectional_drive import BidirectionalDriveParams
+    from ...analysis.engine import check_output_dir, code_version, run_points
+    from ..paper.sweeps import make_scheme, sweep_values
 
     params = BidirectionalDriveParams() if params is None else params
     if parameter not in BIDIRECTIONAL_SWEEPABLE:
@@ -172,10 +172,10 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     tag = "bidirectional_" + (parameter if parameter == "frequency"
                               else f"{parameter}_{frequency:g}Hz")
     stem = out / f"sweep_{tag}"
-    from .reproduce import write_table
+    from ..paper.reproduce import write_table
     write_table(table, stem.with_suffix(".csv"))
     marks = _marks(params, parameter, frequency)
-    from .. import __version__
+    from ... import __version__
     meta = {
         "study": f"sweep_{tag}",
         "scene": "bidirectional-drive",
@@ -197,7 +197,7 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     log(f"wrote {stem.with_suffix('.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
-        from .figures import sweep_figure
+        from ..paper.figures import sweep_figure
         label = scheme.name if scheme.name == "event-driven" else \
             f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
         title = f"Bidirectional drive: steady state against {parameter}" + (

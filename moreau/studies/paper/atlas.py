@@ -7,7 +7,7 @@ curves:
 
 * lift-off, ``min f_N = 0``: on the contact manifold the normal force of the
   slipping rod vanishes where the free normal acceleration ``D`` reaches 0,
-  so the curve is ``max_tau D = 0`` (:func:`~moreau.analysis.valid_range.lift_off_margin`,
+  so the curve is ``max_tau D = 0`` (:func:`~moreau.studies.paper.valid_range.lift_off_margin`,
   independent of ``mu``);
 * Painlevé: ``1 - mu tan(phi0) = 0`` (beyond it the model is ill-posed);
 * contact loss: where the computed steady state contains flight (or the rod
@@ -26,7 +26,7 @@ from dataclasses import asdict
 
 import numpy as np
 
-from ..errors import InputError
+from ...errors import InputError
 
 __all__ = ["PLANES", "compute_atlas", "run_atlas", "point_label"]
 
@@ -103,9 +103,9 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
     >>> a["label"].tolist()
     [['NS', 'NS'], ['NP', 'SP']]
     """
-    from ..scenes.friction_drive import PAPER_DEFAULTS
-    from .. import _validate as V
-    from .engine import ED_REFERENCE, run_points
+    from ...scenes.friction_drive import PAPER_DEFAULTS
+    from ... import _validate as V
+    from ...analysis.engine import ED_REFERENCE, run_points
     from .valid_range import lift_off_margin
 
     if plane not in PLANES:
@@ -197,8 +197,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
     dict
         ``{plane: atlas}`` (see :func:`compute_atlas`).
     """
-    from .. import __version__
-    from .engine import check_output_dir, code_version
+    from ... import __version__
+    from ...analysis.engine import check_output_dir, code_version
     from .reproduce import write_table
 
     for plane in planes:

@@ -32,8 +32,8 @@ def _fmt_seq(seq, fmt="{:.3g}"):
 
 
 def _disp(params, parameter, x, frequency):
-    from ..scenes.friction_drive import FrictionDrive
-    from .steady_state import find_steady_state
+    from ...scenes.friction_drive import FrictionDrive
+    from ...analysis.steady_state import find_steady_state
     if parameter == "frequency":
         sc = FrictionDrive(params, x)
     else:
@@ -292,8 +292,8 @@ def _md_table(rows, link):
 
 def write_report(results, grids, params, out, checks, wall_time=None, quick=False):
     """Write ``out/report.md`` and return its path."""
-    from .. import __version__
-    from .engine import code_version
+    from ... import __version__
+    from ...analysis.engine import code_version
     rows = claims(results, grids, params)
     link = lambda name: f"figures/{name}.png"  # noqa: E731
     n_agree = sum(r["verdict"] == "agree" for r in rows)

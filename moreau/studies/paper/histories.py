@@ -6,8 +6,8 @@ import os
 
 import numpy as np
 
-from .._validate import positive, positive_int
-from ..errors import InputError
+from ..._validate import positive, positive_int
+from ...errors import InputError
 
 __all__ = ["run_history", "write_history_csv", "plot_history"]
 
@@ -45,8 +45,8 @@ def run_history(params, frequency, periods=10.0, scheme="event-driven", steps_pe
     >>> h["status"], round(float(h["t"][-1]) * 185.0, 12)
     (0, 1.0)
     """
-    from ..integrators import simulate
-    from ..scenes.friction_drive import FrictionDrive
+    from ...integrators import simulate
+    from ...scenes.friction_drive import FrictionDrive
 
     periods = positive("periods", periods)
     samples_per_period = positive_int("samples_per_period", samples_per_period)
@@ -84,7 +84,7 @@ def plot_history(hist, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..regimes import REGIME_LETTERS, Regime
+    from ...regimes import REGIME_LETTERS, Regime
 
     t = np.asarray(hist["t"]) * 1e3
     reg = np.asarray(hist["regime"])

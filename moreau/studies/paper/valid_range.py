@@ -31,7 +31,7 @@ def lift_off_margin(params, frequency):
     >>> lift_off_margin(PAPER_DEFAULTS, 185.0) < 0 < lift_off_margin(PAPER_DEFAULTS, 20000.0)
     True
     """
-    from ..scenes.friction_drive import FrictionDrive
+    from ...scenes.friction_drive import FrictionDrive
 
     sc = FrictionDrive(params, frequency)
     phi, dphi, _ = sc.contact_angle(_TAU)
