@@ -61,7 +61,8 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
     scene = FrictionDrive(params, frequency)
     t0 = time.perf_counter()
     if scheme == "moreau-jean":
-        ss = find_steady_state(scene, scheme=scheme, steps_per_period=steps_per_period, theta=theta)
+        ss = find_steady_state(scene, scheme=scheme, steps_per_period=steps_per_period, theta=theta,
+                               **({} if rtol is None else {"tol": rtol}))
     else:
         ss = find_steady_state(scene, scheme=scheme, rtol=rtol)
     wall = time.perf_counter() - t0
@@ -94,7 +95,19 @@ def steady_state_report(params, frequency, scheme="event-driven", steps_per_peri
     return out
 
 
+def _scheme_args(args, rtol_acts=True):
+    """Refuse scheme settings that would not act, then fill in the scheme's defaults."""
+    from .studies.paper.sweeps import make_scheme
+    if args.rtol is not None and not rtol_acts:
+        raise InputError(f"`--rtol` does not act in `moreau {args.command}` (a time history "
+                         "runs each scheme at its own tolerance); leave it out")
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    args.theta, args.steps_per_period, args.rtol = (scheme.theta, scheme.steps_per_period,
+                                                    scheme.rtol)
+
+
 def _cmd_steady(args):
+    _scheme_args(args)
     if getattr(args, "scene", "friction-drive") == "bidirectional":
         from .cli_bidirectional import cmd_steady_bidirectional
         return cmd_steady_bidirectional(args)
@@ -170,6 +183,7 @@ def _cmd_sweep(args):
 
 def _cmd_run(args):
     from .studies.paper.histories import history_command
+    _scheme_args(args, rtol_acts=False)
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
@@ -322,7 +336,7 @@ def build_parser():
     p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-    _add_params(p)
+    _add_params(p, scheme_defaults=False)
     from .cli_bidirectional import add_scene_options
     add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
@@ -361,7 +375,7 @@ def build_parser():
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
-    _add_params(r)
+    _add_params(r, scheme_defaults=False)
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
     _add_atlas(sub)

@@ -57,8 +57,8 @@ def bidirectional_report(params, frequency, scheme="event-driven", steps_per_per
     scene = BidirectionalDrive(params, frequency)
     t0 = time.perf_counter()
     if scheme == "moreau-jean":
-        ss = find_steady_state(scene, scheme, rtol=rtol, steps_per_period=steps_per_period,
-                               theta=theta, projection=True)
+        ss = find_steady_state(scene, scheme, steps_per_period=steps_per_period, theta=theta,
+                               projection=True, **({} if rtol is None else {"tol": rtol}))
     else:
         ss = find_steady_state(scene, scheme, rtol=rtol)
     wall = time.perf_counter() - t0
