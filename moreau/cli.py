@@ -10,6 +10,7 @@ import math
 import sys
 import time
 
+from . import __version__
 from .errors import InputError, MoreauError
 from .scenes.registry import describe, entries, scene_names
 
@@ -332,6 +333,7 @@ def _cmd_scenes(args):
 
 def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
+    parser.add_argument("-V", "--version", action="version", version=f"moreau {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
