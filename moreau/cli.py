@@ -12,7 +12,8 @@ import time
 
 from . import __version__
 from .errors import InputError, MoreauError
-from .scenes.registry import describe, entries, scene_names
+from .analysis.summary import check_periodic, steady_state_report
+from .scenes.registry import describe, entries, get_entry, scene_names
 
 __all__ = ["main"]
 
@@ -44,58 +45,6 @@ def _params(args):
                               restitution=args.restitution)
 
 
-def steady_state_report(params, frequency, scheme="event-driven", steps_per_period=1000,
-                        theta=1.0, rtol=1e-10):
-    """Steady state of the friction drive as a JSON-ready dict in SI units.
-
-    Examples
-    --------
-    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
-    >>> r = steady_state_report(PAPER_DEFAULTS, 20.0)
-    >>> r["mode"], r["displacement_per_period_m"] < 0
-    ('NS', True)
-    """
-    from . import integrators  # noqa: F401  (load the schemes before the clock starts)
-    from .analysis.steady_state import find_steady_state
-    from .scenes.friction_drive import FrictionDrive
-
-    scene = FrictionDrive(params, frequency)
-    t0 = time.perf_counter()
-    if scheme == "moreau-jean":
-        ss = find_steady_state(scene, scheme=scheme, steps_per_period=steps_per_period, theta=theta,
-                               **({} if rtol is None else {"tol": rtol}))
-    else:
-        ss = find_steady_state(scene, scheme=scheme, rtol=rtol)
-    wall = time.perf_counter() - t0
-    disp = scene.displacement_to_si(ss.displacement_per_period)
-    out = {
-        "frequency_Hz": scene.frequency,
-        "scheme": ss.scheme,
-        "mode": ss.mode,
-        "displacement_per_period_m": disp,
-        "average_velocity_m_per_s": disp * scene.frequency,
-        "regimes": [[float(t), r] for t, r in ss.regimes],
-        # None, not NaN, where no period-1 orbit exists: JSON has no NaN
-        "min_normal_force_N": (scene.force_to_si(ss.min_normal_force)
-                               if math.isfinite(ss.min_normal_force) else None),
-        "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
-        "periodic_residual": ss.periodic_residual,
-        "shooting_iterations": ss.iterations,
-        "wall_time_s": wall,
-        "parameters": {k: getattr(params, k) for k in
-                       ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")},
-    }
-    if scheme == "moreau-jean":
-        out["steps_per_period"] = steps_per_period
-        out["theta"] = theta
-        for key in ("message", "steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
-                    "period_map_eigenvalues"):
-            if key in ss.stats:
-                val = ss.stats[key]
-                out[key] = val if not hasattr(val, "tolist") else val.tolist()
-    return out
-
-
 def _scheme_args(args, rtol_acts=True):
     """Refuse scheme settings that would not act, then fill in the scheme's defaults."""
     from .studies.paper.sweeps import make_scheme
@@ -107,29 +56,54 @@ def _scheme_args(args, rtol_acts=True):
                                                     scheme.rtol)
 
 
+#: the command-line shorthands of scene parameters (``--mu 0.2`` is ``--set mu=0.2``)
+SHORTHANDS = ("frequency", "mu", "phi0", "x10", "k", "m", "m2", "length", "load", "restitution",
+              "x10_a", "x10_b", "phase")
+
+
+def scene_parameters(args, entry):
+    """The parameters of scene ``entry`` given on the command line: ``--set`` and the shorthands.
+
+    A name the scene does not have is refused, listing the ones it has.
+    """
+    params = parse_settings(args.set or [], "--set")
+    for key in SHORTHANDS:
+        val = getattr(args, key, None)
+        if val is not None:
+            if key in params:
+                raise InputError(f"`{key}` is given twice (`--{key.replace('_', '-')}` and "
+                                 f"`--set {key}=...`)")
+            params[key] = val
+    names = entry.parameter_names()
+    for key in params:
+        if key not in names:
+            flag = (f"--{key.replace('_', '-')}" if key in SHORTHANDS and not any(
+                item.partition("=")[0].strip() == key for item in args.set or [])
+                    else f"--set {key}")
+            raise InputError(f"`{flag}`: `{key}` is not a parameter of scene {entry.name!r}; "
+                             f"its parameters: {', '.join(names)}")
+    return params
+
+
 def _cmd_steady(args):
     _scheme_args(args)
-    if getattr(args, "scene", "friction-drive") == "bidirectional":
-        from .cli_bidirectional import cmd_steady_bidirectional
-        return cmd_steady_bidirectional(args)
-    for opt in ("x10_a", "x10_b", "phase"):
-        if getattr(args, opt, None) is not None:
-            raise InputError(f"`--{opt.replace('_', '-')}` applies only to `--scene bidirectional`")
-    params = _params(args)
-    if args.frequency is None:
+    entry = get_entry(args.scene)
+    params = scene_parameters(args, entry)
+    if "frequency" in entry.parameter_names() and "frequency" not in params:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
-    rep = steady_state_report(params, args.frequency, scheme=args.scheme,
-                              steps_per_period=args.steps_per_period, theta=args.theta,
-                              rtol=args.rtol)
+    scene = entry.factory(**params)
+    check_periodic(scene)
+    rep = steady_state_report(scene, scheme=args.scheme, steps_per_period=args.steps_per_period,
+                              theta=args.theta, rtol=args.rtol)
     if args.json:
         print(json.dumps(rep))
         return
-    print(f"friction drive at {rep['frequency_Hz']:g} Hz ({rep['scheme']})")
+    print(f"{rep['scene']} at {rep['frequency_Hz']:g} Hz ({rep['scheme']})")
     print(f"  operation mode            {rep['mode']}")
     print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
-    print(f"  average rotor velocity    {rep['average_velocity_m_per_s']:.9e} m/s")
+    print(f"  average velocity          {rep['average_velocity_m_per_s']:.9e} m/s")
     if not rep["periodic"]:
-        print(f"  note                      {rep['message']}")
+        print(f"  note                      {rep.get('message', '')}")
     if rep["min_normal_force_N"] is not None:
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     print(f"  periodic residual         {rep['periodic_residual']:.2e}")
@@ -139,7 +113,7 @@ def _cmd_steady(args):
 
 def _cmd_sweep(args):
     from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
-    if args.scene == "bidirectional":
+    if get_entry(args.scene).name == "bidirectional-drive":
         from .cli_bidirectional import cmd_sweep_bidirectional
         return cmd_sweep_bidirectional(args)
     if args.parameter not in SWEEPABLE:
@@ -369,7 +343,7 @@ def build_parser():
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
     _add_params(s, scheme_defaults=False)
-    add_scene_options(s)
+    add_scene_options(s, with_set=False)
     s.set_defaults(func=_cmd_sweep)
     r = sub.add_parser("run", help="time histories from rest (CSV + figure, SI units)")
     r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")

@@ -18,7 +18,7 @@ def run_json(capsys, *args):
 
 def test_rod_b_alone_moves_the_rotor_forward_at_185_hz(capsys):
     rc, rep = run_json(capsys, "--frequency", "185", "--x10-a", "0")
-    assert rc == 0 and rep["scene"] == "bidirectional" and rep["mode"] == "F|NP"
+    assert rc == 0 and rep["scene"] == "bidirectional-drive" and rep["mode"] == "F|NP"
     # the mirror image of the single rod's -6.639079e-6 m per period
     assert rep["displacement_per_period_m"] == pytest.approx(6.6390794203e-6, rel=1e-8)
     assert rep["average_velocity_m_per_s"] == pytest.approx(rep["displacement_per_period_m"] * 185)

@@ -92,7 +92,7 @@ def test_failed_point_is_a_status(tmp_path):
     (["sweep", "mu", "0.1", "0.2", "--frequency", "185", "--phase", "1"],
      "`--phase` applies only to `--scene bidirectional`"),
     (["steady", "--frequency", "185", "--x10-b", "1e-6"],
-     "`--x10-b` applies only to `--scene bidirectional`"),
+     "`--x10-b`: `x10_b` is not a parameter of scene 'friction-drive'"),
     (["sweep", "--scene", "bidirectional", "x10", "0", "1e-6", "--frequency", "185"],
      "`x10` sets both rods"),
     (["sweep", "--scene", "bidirectional", "x10_b", "0", "1e-6", "--frequency", "185",

@@ -127,10 +127,14 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     opts = _scheme_options(scheme, options)
     ts = float(section_tau)
     if q0 is None or v0 is None:
-        try:
-            q0, v0 = scene.rest_state(ts)
-        except TypeError:      # a scene whose rest state is given at tau = 0 only
-            q0, v0 = scene.rest_state()
+        if not hasattr(scene, "rest_state"):
+            # any scene: its documented start (a user's scene need not define a rest state)
+            q0, v0 = scene.initial_state()
+        else:
+            try:
+                q0, v0 = scene.rest_state(ts)
+            except TypeError:      # a scene whose rest state is given at tau = 0 only
+                q0, v0 = scene.rest_state()
     q = np.array(q0, float)
     v = np.array(v0, float)
     q[cyclic] = 0.0

@@ -41,6 +41,18 @@ class SIUnits:
         # one scale for all coordinates, so that scalars convert to scalars
         return self.length
 
+    def displacement_to_si(self, dq):
+        """A dimensionless displacement to metres."""
+        return dq * self.length
+
+    def velocity_to_si(self, dv):
+        """A dimensionless velocity to metres per second."""
+        return dv * self.length / self.time
+
+    def force_to_si(self, f):
+        """A dimensionless force to newtons."""
+        return f * self.force
+
     def to_si(self, result=None, *, t=None, q=None, v=None, force=None):
         """Convert to SI units.
 

@@ -364,4 +364,5 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10_a", "x10_b", "phase",
                "load", "restitution"),
     mj_tolerance=5e-3,
+    aliases=("bidirectional",),
 ))

@@ -26,6 +26,8 @@ An entry holds:
     or None where the generic event-driven scheme is the reference;
 ``sweepable``
     the parameters a sweep may vary;
+``aliases``
+    former names that commands still accept;
 ``mj_tolerance``
     how close Moreau–Jean at the conformance test's step must come to the
     reference (relative to the motion's scale): the scene's stated
@@ -80,6 +82,8 @@ class SceneEntry:
     reference: Optional[str] = None
     sweepable: tuple = ()
     mj_tolerance: float = 1e-2
+    #: former names that commands still accept
+    aliases: tuple = ()
 
     def parameter_names(self):
         return tuple(p.name for p in self.parameters)
@@ -90,6 +94,7 @@ class SceneEntry:
 
 
 _REGISTRY = {}
+_ALIASES = {}
 
 
 def register_scene(entry):
@@ -110,6 +115,8 @@ def register_scene(entry):
     if len(set(names)) != len(names):
         raise InputError(f"scene {entry.name!r} lists a parameter twice: {names}")
     _REGISTRY[entry.name] = entry
+    for alias in entry.aliases:
+        _ALIASES[alias] = entry.name
     return entry
 
 
@@ -152,7 +159,7 @@ def get_entry(name):
     """The entry registered as ``name``; an unknown name lists the known ones."""
     discover()
     try:
-        return _REGISTRY[name]
+        return _REGISTRY[_ALIASES.get(name, name)]
     except (KeyError, TypeError):
         known = ", ".join(repr(k) for k in scene_names())
         raise InputError(f"`scene` must be one of {known}; got {name!r}") from None

@@ -1,0 +1,107 @@
+"""A steady state as a JSON-ready dict in SI units, for any periodically driven scene.
+
+``moreau steady --scene NAME`` prints this; it needs the scene's SI
+conversions (``displacement_to_si``, ``force_to_si``), its drive
+``frequency`` [Hz] and ``period``, which every shipped periodic scene has.
+
+Examples
+--------
+>>> from moreau.scenes.registry import make_scene
+>>> rep = steady_state_report(make_scene("friction-drive", frequency=20.0))
+>>> rep["scene"], rep["mode"], rep["displacement_per_period_m"] < 0
+('friction-drive', 'NS', True)
+"""
+
+import math
+import time
+
+from ..errors import InputError
+from .steady_state import find_steady_state
+
+__all__ = ["steady_state_report", "check_periodic"]
+
+#: steady-state statistics copied into the report of a Moreau–Jean steady state
+MJ_STATS = ("message", "steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
+            "period_map_eigenvalues")
+
+
+def check_periodic(scene):
+    """Refuse a scene without a periodic drive (no steady state to find)."""
+    name = getattr(scene, "name", type(scene).__name__)
+    if getattr(scene, "period", None) is None:
+        raise InputError(f"scene {name!r} has no periodic drive (`period` is None): a periodic "
+                         "steady state applies to periodically driven scenes only")
+    for attr in ("frequency", "displacement_to_si", "force_to_si"):
+        if not hasattr(scene, attr):
+            raise InputError(f"scene {name!r} has no `{attr}`: the SI report needs it")
+    return scene
+
+
+def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
+                        rtol=None, parameters=None):
+    """Steady state of ``scene`` as a JSON-ready dict in SI units.
+
+    Parameters
+    ----------
+    scene : Scene
+        A periodically driven scene (:func:`check_periodic`).
+    scheme : {"event-driven", "moreau-jean"}
+    steps_per_period, theta : optional
+        Moreau–Jean only (defaults 1000 and 1).
+    rtol : float, optional
+        The shooting tolerance (event-driven default 1e-10; Moreau–Jean its own).
+    parameters : dict, optional
+        The SI parameters to record (default: the scene's ``params`` fields).
+
+    Returns
+    -------
+    dict
+        ``scene``, ``frequency_Hz``, ``scheme``, ``mode``,
+        ``displacement_per_period_m``, ``average_velocity_m_per_s``,
+        ``regimes``, ``min_normal_force_N``, ``periodic``, ``periodic_residual``,
+        ``shooting_iterations``, ``wall_time_s``, ``parameters``; with
+        Moreau–Jean also ``steps_per_period``, ``theta`` and the scheme's
+        statistics.
+    """
+    check_periodic(scene)
+    opts = {}
+    if scheme == "moreau-jean":
+        opts = dict(steps_per_period=1000 if steps_per_period is None else steps_per_period,
+                    theta=1.0 if theta is None else theta)
+        if rtol is not None:
+            opts["tol"] = rtol
+    else:
+        opts = dict(rtol=1e-10 if rtol is None else rtol)
+    t0 = time.perf_counter()
+    ss = find_steady_state(scene, scheme, **opts)
+    wall = time.perf_counter() - t0
+    disp = float(scene.displacement_to_si(ss.displacement_per_period))
+    if parameters is None:
+        params = getattr(scene, "params", None)
+        parameters = ({k: getattr(params, k) for k in params.__dataclass_fields__}
+                      if params is not None and hasattr(params, "__dataclass_fields__") else {})
+    out = {
+        "scene": getattr(scene, "name", type(scene).__name__),
+        "frequency_Hz": float(scene.frequency),
+        "scheme": ss.scheme,
+        "mode": ss.mode,
+        "displacement_per_period_m": disp,
+        "average_velocity_m_per_s": disp * float(scene.frequency),
+        "regimes": [[float(t), r] for t, r in ss.regimes],
+        # None, not NaN, where no period-1 orbit exists: JSON has no NaN
+        "min_normal_force_N": (float(scene.force_to_si(ss.min_normal_force))
+                               if math.isfinite(ss.min_normal_force) else None),
+        "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
+        "periodic_residual": ss.periodic_residual,
+        "shooting_iterations": ss.iterations,
+        "wall_time_s": wall,
+        "parameters": dict(parameters),
+    }
+    if scheme == "moreau-jean":
+        out["steps_per_period"] = opts["steps_per_period"]
+        out["theta"] = opts["theta"]
+        for key in MJ_STATS:
+            if ss.stats and key in ss.stats:
+                val = ss.stats[key]
+                out[key] = val if not hasattr(val, "tolist") else val.tolist()
+    return out
