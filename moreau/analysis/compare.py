@@ -104,6 +104,7 @@ from tqdm import tqdm
 
 from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
+from ..provenance import provenance
 from ..scenes.base import Scene
 from ..scenes.registry import get_entry
 from .cases import GRID, SceneCase, switching_error
@@ -336,6 +337,13 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         "orders": [],
         "notes": [],
         "interrupted": False,
+        # what a run time means here, and on what machine it was taken
+        "time_s_meaning": ("median wall time of the computation that gives the row's headline "
+                           "value: for a periodic scene the reference's or Moreau-Jean's steady "
+                           "state, or with a forced contact solver (lcp) one period from the "
+                           "reference's periodic state; for other scenes one run over the "
+                           "window; numba compilation excluded"),
+        "provenance": provenance(),
     }
     jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
     jobs += [("mj", th, None, n) for th in thetas for n in steps]

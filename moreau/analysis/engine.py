@@ -34,8 +34,10 @@ _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitut
 
 
 #: modules that only present results (files, figures, text); editing them keeps the cache
-_PRESENTATION = {"cli.py", "analysis/figures.py", "analysis/report.py", "analysis/reproduce.py",
-                 "analysis/atlas.py", "analysis/sweeps.py", "analysis/histories.py"}
+_PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
+                 "studies/paper/figures.py", "studies/paper/report.py",
+                 "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
+                 "studies/paper/histories.py"}
 
 
 def code_version():

@@ -16,6 +16,7 @@ import math
 import time
 
 from ..errors import InputError
+from ..provenance import provenance
 from .steady_state import find_steady_state
 
 __all__ = ["steady_state_report", "check_periodic"]
@@ -59,7 +60,8 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         ``scene``, ``frequency_Hz``, ``scheme``, ``mode``,
         ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``regimes``, ``min_normal_force_N``, ``periodic``, ``periodic_residual``,
-        ``shooting_iterations``, ``wall_time_s``, ``parameters``; with
+        ``shooting_iterations``, ``wall_time_s``, ``parameters``, ``provenance``
+        (:func:`moreau.provenance.provenance`); with
         Moreau–Jean also ``steps_per_period``, ``theta`` and the scheme's
         statistics.
     """
@@ -96,6 +98,7 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "shooting_iterations": ss.iterations,
         "wall_time_s": wall,
         "parameters": dict(parameters),
+        "provenance": provenance(),
     }
     if scheme == "moreau-jean":
         out["steps_per_period"] = opts["steps_per_period"]

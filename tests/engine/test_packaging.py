@@ -21,3 +21,20 @@ def test_the_version_is_written_once():
     assert importlib.metadata.version("moreau") == moreau.__version__
     assert 'dynamic = ["version"]' in (ROOT / "pyproject.toml").read_text()
     assert (ROOT / "moreau" / "py.typed").exists() and (ROOT / "LICENSE").exists()
+
+
+def test_json_outputs_carry_their_provenance(tmp_path):
+    import json
+    run = subprocess.run([sys.executable, "-m", "moreau", "steady", "--frequency", "185", "--json"],
+                         capture_output=True, text=True)
+    prov = json.loads(run.stdout)["provenance"]
+    assert prov["moreau_version"] == moreau.__version__
+    assert prov["numpy_version"] and prov["scipy_version"] and prov["numba_version"]
+    assert prov["cpu_count"] >= 1 and prov["cpu"]
+    assert prov["command"].endswith("steady --frequency 185 --json")
+    run = subprocess.run([sys.executable, "-m", "moreau", "compare", "--scene", "sliding-block",
+                          "--quick", "--json", "--quiet", "--no-plot", "--out", str(tmp_path)],
+                         capture_output=True, text=True)
+    rep = json.loads(run.stdout)
+    assert rep["provenance"]["moreau_version"] == moreau.__version__
+    assert "median wall time" in rep["time_s_meaning"]

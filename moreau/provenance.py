@@ -1,0 +1,87 @@
+"""Where and how a result was computed: recorded in every JSON output and sidecar.
+
+Timings without the machine that took them cannot be compared, and a number
+without the code that produced it cannot be checked again. :func:`provenance`
+gathers what identifies a run: the package and code versions, the versions of
+numpy, scipy and numba, the CPU, the number of threads, the time and the
+command line.
+
+Examples
+--------
+>>> p = provenance()
+>>> sorted(p)[:4]
+['code_version', 'command', 'cpu', 'cpu_count']
+>>> p["moreau_version"] == __import__("moreau").__version__
+True
+"""
+
+import datetime
+import importlib.metadata
+import os
+import platform
+import sys
+
+from . import __version__
+
+__all__ = ["provenance"]
+
+
+def _version(dist):
+    try:
+        return importlib.metadata.version(dist)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def _cpu_name():
+    # platform.processor() is empty on many Linux systems; /proc/cpuinfo names the model
+    try:
+        with open("/proc/cpuinfo") as fh:
+            for line in fh:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def _threads():
+    # the BLAS and numba thread counts decide how a timing can be compared
+    out = {"numba": None, "omp": os.environ.get("OMP_NUM_THREADS")}
+    numba = sys.modules.get("numba")
+    if numba is not None:
+        out["numba"] = int(numba.config.NUMBA_NUM_THREADS)
+    return out
+
+
+def provenance(code_version=None):
+    """A JSON-ready dict identifying this run.
+
+    Parameters
+    ----------
+    code_version : str, optional
+        The hash of the computing sources
+        (:func:`moreau.analysis.engine.code_version`), where the caller has it.
+
+    Returns
+    -------
+    dict
+        ``moreau_version``, ``code_version``, ``numpy_version``,
+        ``scipy_version``, ``numba_version``, ``python_version``, ``platform``,
+        ``cpu``, ``cpu_count``, ``threads``, ``time_utc`` (ISO 8601) and
+        ``command`` (the command line).
+    """
+    return {
+        "moreau_version": __version__,
+        "code_version": code_version,
+        "numpy_version": _version("numpy"),
+        "scipy_version": _version("scipy"),
+        "numba_version": _version("numba"),
+        "python_version": platform.python_version(),
+        "platform": platform.platform(),
+        "cpu": _cpu_name(),
+        "cpu_count": os.cpu_count(),
+        "threads": _threads(),
+        "time_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+        "command": " ".join([os.path.basename(sys.argv[0])] + sys.argv[1:]) if sys.argv else "",
+    }
