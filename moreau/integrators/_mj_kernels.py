@@ -49,6 +49,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jit_cache
+from ..lcp import _certified
 from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, eliminate, lemke_core, lemke_workspace
@@ -1166,7 +1167,8 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
 
 #: every source whose compiled code ends up in this module's functions (the
 #: scene models and Lemke are inlined or linked in; globals are frozen in)
-KERNEL_SOURCES = (__file__, _compiled.__file__, _lemke.__file__, _certify.__file__)
+KERNEL_SOURCES = (__file__, _compiled.__file__, _lemke.__file__, _certify.__file__,
+                  _certified.__file__)
 
 # numba checks a cached kernel against this file only: tie it to all of them so
 # that editing a scene model or Lemke cannot leave stale machine code in use

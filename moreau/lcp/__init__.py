@@ -39,6 +39,8 @@ Examples
 (True, [0.5, 0.0], [0.0, 1.5])
 """
 
+import inspect
+
 from . import lemke, qp
 from ._result import (
     BREAKDOWN,
@@ -165,6 +167,10 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     Traceback (most recent call last):
     ...
     moreau.errors.InputError: `method` must be one of 'auto', 'lemke', 'qp'; got 'simplex'
+    >>> solve_lcp(np.eye(1), np.ones(1), method="qp", covering=np.ones(1))
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `covering` is not an option of method 'qp'; its options: refine
     """
     if method == "lemke" and not options:
         # the per-time-step path: skip the keyword forwarding
@@ -174,4 +180,21 @@ def solve_lcp(M, q, method="lemke", *, max_iter=None, tol=None, check_input=True
     except (KeyError, TypeError):
         known = ", ".join(repr(k) for k in sorted(METHODS))
         raise InputError(f"`method` must be one of {known}; got {method!r}") from None
+    if options:
+        accepted = _method_options(method)
+        for key in options:
+            if key not in accepted:
+                raise InputError(f"`{key}` is not an option of method {method!r}; its options: "
+                                 + (", ".join(sorted(accepted)) or "none beyond max_iter, tol, "
+                                    "check_input and friction"))
     return fn(M, q, max_iter=max_iter, tol=tol, check_input=check_input, friction=friction, **options)
+
+
+_COMMON = ("max_iter", "tol", "check_input", "friction")
+
+
+def _method_options(method):
+    """The method-specific keyword options of ``method`` (beyond the common ones)."""
+    params = inspect.signature(METHODS[method]).parameters
+    return {k for k, p in params.items() if p.kind is inspect.Parameter.KEYWORD_ONLY
+            and k not in _COMMON}

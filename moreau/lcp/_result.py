@@ -8,6 +8,8 @@ them into text.
 
 import numpy as np
 
+from ._certified import lcp_violation
+
 __all__ = [
     "LCPResult",
     "STATUS_MESSAGES",
@@ -98,69 +100,6 @@ def lcp_residual(M, q, z, w=None):
     num = float(np.max(np.abs(np.minimum(z, w))))
     scale = 1.0 + float(np.max(np.abs(q))) + float(np.max(np.abs(M))) * float(np.max(np.abs(z)))
     return num / scale
-
-
-def lcp_violation(M, q, z, w=None):
-    """How far ``z`` is from solving ``LCP(M, q)``, in units fixed by the data alone.
-
-    This is the number every method's success is certified with: a result
-    counts as solved only when ``lcp_violation(M, q, z) <= tol``.
-
-    Parameters
-    ----------
-    M : array_like, shape (n, n)
-    q : array_like, shape (n,)
-    z : array_like, shape (n,)
-    w : array_like, shape (n,), optional
-        ``M @ z + q``; computed (one matrix-vector product) when not given.
-
-    Returns
-    -------
-    float
-        ``max_i |min(m z_i, w_i)| / s`` with ``s = max|q|`` and ``m =
-        max|M|`` (each replaced by 1 when it is 0); ``inf`` when ``z`` or
-        ``w`` is not finite.
-
-    Notes
-    -----
-    With ``tol_w = tol s`` and ``tol_z = tol s / m``, ``lcp_violation <=
-    tol`` holds exactly when
-
-    * ``z >= -tol_z``,
-    * ``w = M z + q >= -tol_w``, and
-    * for every ``i``, ``z_i <= tol_z`` or ``w_i <= tol_w``
-      (``|min(z_i / tol_z, w_i / tol_w)| <= 1``: complementarity).
-
-    ``s`` is the scale of ``w`` and ``s / m`` the natural scale of ``z``, so
-    both tolerances are absolute and follow the data: the measure is
-    invariant under ``(M, q) -> (a M, b q)`` (whose solutions are ``(b / a)
-    z``) and never grows with the candidate ``z``. A point with ``w_i = -1``
-    fails by ``1 / max|q|`` however large ``z`` is.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> M = np.array([[1.0, -1.0], [-1.0, 1.0]])
-    >>> q = np.array([-1.0, -1.0])
-    >>> float(lcp_violation(M, q, np.array([2e9, 2e9])))  # w = (-1, -1)
-    1.0
-    >>> float(lcp_violation(np.eye(2), q, np.array([1.0, 1.0])))
-    0.0
-    """
-    M = np.asarray(M, dtype=float)
-    q = np.asarray(q, dtype=float)
-    z = np.asarray(z, dtype=float)
-    if z.size == 0:
-        return 0.0
-    with np.errstate(over="ignore", invalid="ignore"):
-        if w is None:
-            w = M @ z + q
-        m = float(np.max(np.abs(M)))
-        s = float(np.max(np.abs(q)))
-        m = m if m > 0.0 else 1.0
-        s = s if s > 0.0 else 1.0
-        v = float(np.max(np.abs(np.minimum(m * z, w)))) / s
-    return v if np.isfinite(v) else np.inf
 
 
 class LCPResult:

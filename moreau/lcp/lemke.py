@@ -39,16 +39,29 @@ Ratios tie within ``TIE_TOL`` relative difference, and a right-hand side
 that cancels to rounding level is set to exactly zero so that degenerate
 rows are recognised as such.
 
-A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
-the data (one matrix-vector product) and the violation of
-:func:`moreau.lcp.lcp_violation`, whose tolerances are fixed by ``max|q|``
-and ``max|M|`` and not by the size of ``z``, must be ``<= tol``. If it is
-not, the basis found is re-solved directly (``M_JJ z_J = -q_J`` by Gaussian
-elimination with partial pivoting) and checked again; if that fails too the
-status is :data:`BREAKDOWN`.
+:func:`solve` (and :func:`lemke_kernel`) pivot on balanced data: ``D M D``
+and ``D q`` with ``D`` a diagonal of powers of two that brings the rows of
+``M`` towards unit size together with their columns (a symmetric scaling
+keeps the matrix classes Lemke's theorems need), then both to unit scale.
+Powers of two make the maps exact, and ``D`` depends only on the differences
+of the rows' exponents, so a problem scaled uniformly by a power of two
+pivots bit for bit as the unscaled one; data such as ``diag(1e300, 1e-300)``
+come to unit size.
 
-A secondary ray is turned into a proof of infeasibility when it is one
-(:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
+A terminal point is never trusted blindly: ``w = M z + q`` is recomputed from
+the *caller's* data (one matrix-vector product) and the violation of
+:func:`moreau.lcp.lcp_violation`, whose tolerances are fixed by ``max|q|``
+and ``max|M|`` and not by the size of ``z``, must be ``<= tol`` at its worst
+over the rounding of that product (a bound ``(n + 2) eps (|M| |z| + |q|)``):
+a point whose complementarity rests on cancellation below rounding is not a
+solution anyone can check. If the pivoting's own check fails, the basis
+found is re-solved directly (``M_JJ z_J = -q_J`` by Gaussian elimination with
+partial pivoting) and checked again; if that fails too the status is
+:data:`BREAKDOWN`.
+
+A secondary ray is turned into a proof of infeasibility only when a Farkas
+vector built from it checks out in exact rational arithmetic on the caller's
+data (:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
 :data:`INFEASIBLE`, with the Farkas vector in ``certificate``. Otherwise it
 stays :data:`SECONDARY_RAY`, which proves nothing.
 
@@ -69,6 +82,7 @@ from numba import njit
 
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
+from ._certified import residual as _residual
 from .certify import FARKAS_TOL, infeasibility_from_ray
 from ._result import (
     BREAKDOWN,
@@ -82,6 +96,7 @@ from ._result import (
 
 __all__ = [
     "solve",
+    "balance",
     "lemke_kernel",
     "lemke_core",
     "lemke_workspace",
@@ -114,11 +129,7 @@ WORK_BUDGET = 2**30
 
 # cancellation below this many ulps of the operands is rounding, not data
 _SNAP = 16.0 * np.finfo(float).eps
-# data whose largest entry lies outside [2^-64, 2^64] are brought to unit
-# scale before pivoting (see _lemke_scaled); _core asks for it with this code
-_SCALE_LO = 2.0**-64
-_SCALE_HI = 2.0**64
-_RESCALE = -1
+
 
 
 def default_max_iter(n):
@@ -241,29 +252,6 @@ def _extract_z(b, pos, n, z_out):
     for j in range(n):
         p = pos[n + j]
         z_out[j] = b[p] if p >= 0 else 0.0
-
-
-@njit(cache=True)
-def _residual(M, q, z, w, mmax, qmax):
-    # w = M z + q from the data, and the violation of lcp_violation:
-    # max |min(mmax z_i, w_i)| / qmax, scaled by the data only
-    n = q.shape[0]
-    ms = mmax if mmax > 0.0 else 1.0
-    qs = qmax if qmax > 0.0 else 1.0
-    num = 0.0
-    for i in range(n):
-        acc = q[i]
-        for j in range(n):
-            zj = z[j]
-            if zj != 0.0:
-                acc += M[i, j] * zj
-        w[i] = acc
-        m = min(ms * z[i], acc)
-        if abs(m) > num:
-            num = abs(m)
-    if not np.isfinite(num):
-        return np.inf
-    return num / qs
 
 
 @njit(cache=True, inline="always")
@@ -433,14 +421,12 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
-    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
+    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
 
 
 @njit(cache=True)
-def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, rescale):
-    # lemke_core; with `rescale`, data whose largest entry lies outside
-    # [2^-64, 2^64] return _RESCALE before any pivoting, found by the scan
-    # for non-finite entries that runs anyway
+def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
+    # lemke_core (the public entry documents it)
     n = q.shape[0]
     for k in range(n + 1):
         ray_out[k] = 0.0
@@ -471,9 +457,6 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, rescale):
             z_out[k] = 0.0
             w_out[k] = q[k]
         return SOLVED, 0, 0.0
-    if rescale and (_exponent_to_unit(mmax) != 0 or _exponent_to_unit(qmax) != 0):
-        # extreme data: the caller brings them to unit scale and calls again
-        return _RESCALE, 0, 0.0
 
     T = work
     b = work[n + 1]
@@ -669,67 +652,245 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     ray = np.empty(n + 1)
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol, False)
 
 
 
 
 @njit(cache=True)
-def _exponent_to_unit(x):
-    # k with 2^k x in [0.5, 1) when x is finite, > 0 and outside the safe
-    # range; 0 otherwise (no scaling)
-    if not (x > 0.0 and x < np.inf) or (x >= _SCALE_LO and x <= _SCALE_HI):
-        return 0
-    return -math.frexp(x)[1]
+def balance(M, q, sexp):
+    """Power-of-two balancing of ``LCP(M, q)`` (compiled; callable from Python).
+
+    Fills ``sexp`` with exponents ``s`` of ``D = diag(2^s)`` and returns
+    ``(ok, ka, kb)``: the LCP ``(2^ka D M D, 2^kb D q)`` has its largest
+    entries in ``[0.5, 1)`` and the solutions ``2^(kb-ka) D^-1 z``. Row and
+    column ``i`` scale together, which keeps the matrix classes Lemke's
+    theorems need (PSD, copositive-plus, P); ``D`` brings the diagonal of
+    ``M`` towards one (a row with a zero diagonal entry: its largest entry),
+    so ``diag(1e300, 1e-300)`` becomes the identity and a PSD matrix has
+    entries of at most about one. ``s`` depends only on the differences of the exponents:
+    a uniform power-of-two scaling of ``M`` leaves it unchanged and the
+    balanced problem bit for bit the same. ``ok`` is False when the data
+    hold NaN or inf.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = np.zeros(2, dtype=np.int64)
+    >>> ok, ka, kb = balance(np.diag([1e300, 1e-300]), np.array([-1.0, -1.0]), s)
+    >>> Mb = np.ldexp(np.diag([1e300, 1e-300]), s[:, None] + s[None, :] + ka)
+    >>> ok, bool(0.25 <= Mb.diagonal().min() and Mb.max() < 1.0)
+    (True, True)
+    """
+    n = q.shape[0]
+    emin = 1 << 30
+    for i in range(n):
+        rmax = 0.0
+        for j in range(n):
+            a = abs(M[i, j])
+            if not a < np.inf:
+                return False, 0, 0
+            if a > rmax:
+                rmax = a
+        if not abs(q[i]) < np.inf:
+            return False, 0, 0
+        # the diagonal sets the scale where it is there (D M D then has a unit
+        # diagonal, and a PSD M entries of at most 1); a row without one, its
+        # largest entry
+        a = abs(M[i, i]) if M[i, i] != 0.0 else rmax
+        e = math.frexp(a)[1] if a > 0.0 else (1 << 30)
+        sexp[i] = e
+        if e < emin:
+            emin = e
+    for i in range(n):
+        # a zero row keeps its scale; the others shrink by half their excess
+        sexp[i] = 0 if sexp[i] == (1 << 30) else -((sexp[i] - emin) // 2)
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(math.ldexp(q[i], sexp[i])))
+        for j in range(n):
+            mmax = max(mmax, abs(math.ldexp(M[i, j], sexp[i] + sexp[j])))
+    ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
+    kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
+    return True, ka, kb
 
 
 @njit(cache=True)
-def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
-    # lemke_core on (2^a M, 2^b q) when the data are extreme, e.g. subnormal
-    # entries, on which the tableau's arithmetic keeps only a few bits. The
-    # scaled LCP has the solutions 2^(b-a) z and the same pivoting path (the
-    # artificial level scales by 2^b); powers of two make both maps exact.
-    # The violation is invariant under the scaling, so the residual stands.
-    status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, True)
-    if status != _RESCALE:
-        if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
-            status = INFEASIBLE
-        return status, pivots, residual
+def _balance_rows_to_q(M, q, rexp, cexp):
+    # the second balancing, for when the symmetric one leaves a row's q far
+    # below the others (diag(1e300, 1e-300), q = (-1, -1): D q = (-1e-300, -1),
+    # and the tiny component is lost to the tolerance of the balanced data).
+    # Rows are scaled by their q (by their largest entry where q_i = 0), then
+    # columns by their largest entry: LCP(R M C, R q) has the solutions
+    # C^-1 z. It keeps P-matrices but not PSD, so it comes second.
+    n = q.shape[0]
+    for i in range(n):
+        a = abs(q[i])
+        if a == 0.0:
+            for j in range(n):
+                a = max(a, abs(M[i, j]))
+        rexp[i] = -math.frexp(a)[1] if a > 0.0 else 0
+    for j in range(n):
+        a = 0.0
+        for i in range(n):
+            a = max(a, abs(math.ldexp(M[i, j], rexp[i])))
+        cexp[j] = -math.frexp(a)[1] if a > 0.0 else 0
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(math.ldexp(q[i], rexp[i])))
+        for j in range(n):
+            mmax = max(mmax, abs(math.ldexp(M[i, j], rexp[i] + cexp[j])))
+    ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
+    kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
+    return ka, kb
+
+
+@njit(cache=True)
+def _balance_ruiz(M, q, rexp, cexp, sweeps):
+    # the third balancing: rows and columns equilibrated apart (R M C), each
+    # by the geometric mean of its largest and smallest nonzero entry, in
+    # powers of two (a max-norm equilibration stops at once on a friction
+    # LCP, whose unit coupling entries hide a tiny Delassus block). It finds
+    # scalings a symmetric one cannot: there the impulse columns and the cone
+    # rows must scale by the block's size while the rest stays put.
+    # Computed on M / 2^e(max|M|), so a uniform power-of-two scaling of the
+    # data leaves R and C unchanged.
     n = q.shape[0]
     mmax = 0.0
     for i in range(n):
+        rexp[i] = 0
+        cexp[i] = 0
         for j in range(n):
             mmax = max(mmax, abs(M[i, j]))
+    e0 = -math.frexp(mmax)[1] if mmax > 0.0 else 0
+    for _ in range(sweeps):
+        for i in range(n):
+            hi = 0.0
+            lo = np.inf
+            for j in range(n):
+                a = abs(math.ldexp(M[i, j], e0 + rexp[i] + cexp[j]))
+                if a > 0.0:
+                    hi = max(hi, a)
+                    lo = min(lo, a)
+            if hi > 0.0:
+                rexp[i] -= (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
+        for j in range(n):
+            hi = 0.0
+            lo = np.inf
+            for i in range(n):
+                a = abs(math.ldexp(M[i, j], e0 + rexp[i] + cexp[j]))
+                if a > 0.0:
+                    hi = max(hi, a)
+                    lo = min(lo, a)
+            if hi > 0.0:
+                cexp[j] -= (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
     qmax = 0.0
+    mmax = 0.0
     for i in range(n):
-        qmax = max(qmax, abs(q[i]))
-    ka = _exponent_to_unit(mmax)
-    kb = _exponent_to_unit(qmax)
+        qmax = max(qmax, abs(math.ldexp(q[i], rexp[i])))
+        for j in range(n):
+            mmax = max(mmax, abs(math.ldexp(M[i, j], rexp[i] + cexp[j])))
+    ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
+    kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
+    return ka, kb
+
+
+@njit(cache=True)
+def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork, max_iter, tol,
+                scale_d, mmax, qmax):
+    # lemke_core on (2^ka R M C, 2^kb R q), R = diag(2^rexp), C = diag(2^cexp),
+    # mapped back (z = 2^(ka-kb) C z') and judged on the caller's data with
+    # the rounding of M z + q counted (_residual): the scaled problem is the
+    # means, the caller's is the one answered. Powers of two make every map exact.
+    n = q.shape[0]
     Ms = np.empty((n, n))
     qs = np.empty(n)
+    ds = np.empty(n)
     for i in range(n):
-        qs[i] = math.ldexp(q[i], kb)
+        qs[i] = math.ldexp(q[i], rexp[i] + kb)
+        # the covering vector of the scaled problem: all ones by default
+        # (the caller's d = 1 is a choice, not data), else the caller's mapped
+        ds[i] = math.ldexp(d[i], rexp[i]) if scale_d else d[i]
         for j in range(n):
-            Ms[i, j] = math.ldexp(M[i, j], ka)
-    status, pivots, residual = _core(Ms, qs, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, False)
+            Ms[i, j] = math.ldexp(M[i, j], rexp[i] + cexp[j] + ka)
+    status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
+                                     tol)
+    if status == INVALID_INPUT:
+        return status, pivots, residual
+    finite = True
     for j in range(n):
-        z_out[j] = math.ldexp(z_out[j], ka - kb)
-        w_out[j] = math.ldexp(w_out[j], -kb)
-    # the ray is a direction: (dz, dz0) = (2^(a-b) dz', 2^-b dz0') times the
-    # positive 2^(b-a), which keeps dz at the size it has in the tableau
+        z_out[j] = math.ldexp(z_out[j], ka - kb + cexp[j])
+        if not abs(z_out[j]) < np.inf:
+            finite = False
+        # the ray is a direction: dz = C dz', and dz0 = 2^-ka dz0' makes
+        # (dz, dz0) a ray of M dz + R^-1 d' dz0 (the covering R^-1 d'; d' = d
+        # where R = C = I, as for data of one scale)
+        ray_out[j] = math.ldexp(ray_out[j], cexp[j])
     ray_out[n] = math.ldexp(ray_out[n], -ka)
-    ok = True
-    for j in range(n):
-        if not (abs(z_out[j]) < np.inf and abs(w_out[j]) < np.inf):
-            ok = False
-    if not ok:
+    if not finite:
         # the answer is outside the range of doubles at the data's scale
         for j in range(n):
             z_out[j] = 0.0
-            w_out[j] = q[j]
         return BREAKDOWN, pivots, _residual(M, q, z_out, w_out, mmax, qmax)
+    residual = _residual(M, q, z_out, w_out, mmax, qmax)
+    if status == SOLVED or status == BREAKDOWN:
+        status = SOLVED if residual <= tol else BREAKDOWN
     if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
         status = INFEASIBLE
+    return status, pivots, residual
+
+
+@njit(cache=True)
+def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, scale_d):
+    # Lemke on the symmetrically balanced data (balance): a uniformly scaled
+    # problem pivots exactly as the unscaled one, and the matrix class is
+    # kept. Where its answer fails on the caller's data, again with rows
+    # scaled to their q (_balance_rows_to_q), then with rows and columns
+    # equilibrated apart (_balance_ruiz).
+    n = q.shape[0]
+    sexp = np.zeros(n, dtype=np.int64)
+    ok, ka, kb = balance(M, q, sexp)
+    if not ok:
+        return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    status, pivots, residual = _run_scaled(M, q, d, sexp, sexp, ka, kb, z_out, w_out, ray_out,
+                                           work, iwork, max_iter, tol, scale_d, mmax, qmax)
+    if status != BREAKDOWN:
+        return status, pivots, residual
+    rexp = np.zeros(n, dtype=np.int64)
+    cexp = np.zeros(n, dtype=np.int64)
+    for attempt in range(2):
+        if attempt == 0:
+            ka2, kb2 = _balance_rows_to_q(M, q, rexp, cexp)
+        else:
+            ka2, kb2 = _balance_ruiz(M, q, rexp, cexp, 12)
+        same = ka2 == ka and kb2 == kb
+        for i in range(n):
+            same = same and rexp[i] == sexp[i] and cexp[i] == sexp[i]
+        if same:
+            continue
+        z1 = z_out.copy()
+        w1 = w_out.copy()
+        r1 = ray_out.copy()
+        status2, pivots2, residual2 = _run_scaled(M, q, d, rexp, cexp, ka2, kb2, z_out, w_out,
+                                                  ray_out, work, iwork, max_iter, tol, scale_d,
+                                                  mmax, qmax)
+        pivots += pivots2
+        if status2 == SOLVED:
+            return status2, pivots, residual2
+        if residual2 < residual:
+            status, residual = status2, residual2
+        else:
+            z_out[:] = z1
+            w_out[:] = w1
+            ray_out[:] = r1
     return status, pivots, residual
 
 
@@ -773,21 +934,25 @@ def _ray_is_farkas(M, q, y, tol):
 
 
 @njit(cache=True)
-def _solve_packed(M, q, d, out, max_iter, tol):
+def _solve_packed(M, q, d, out, max_iter, tol, scale_d=True):
     # one compiled call per Python solve. The outputs live in one buffer
     # (z | w | ray) allocated by the caller: returning arrays from compiled
     # code costs more than the whole pivoting on a small LCP.
     n = q.shape[0]
+    if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n or out.shape[0] < 3 * n + 1:
+        # the unchecked path must never read out of bounds
+        return INVALID_INPUT, 0, np.inf
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol)
+    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol,
+                         scale_d)
 
 
 @njit(cache=True)
 def _solve_packed_ones(M, q, out, max_iter, tol):
     # covering vector of ones made here: one array argument less to type on
     # every call from Python
-    return _solve_packed(M, q, np.ones(q.shape[0]), out, max_iter, tol)
+    return _solve_packed(M, q, np.ones(q.shape[0]), out, max_iter, tol, False)
 
 
 class _LemkeResult(LCPResult):
@@ -865,7 +1030,14 @@ def _coerce(M, q):
     return M, q
 
 
+def _real(name, a):
+    # a complex array would lose its imaginary part in the float conversion
+    if np.iscomplexobj(a):
+        raise InputError(f"`{name}` must be real, got a complex array")
+
+
 def _as_matrix(M):
+    _real("M", M)
     try:
         a = np.asarray(M, dtype=float)
     except (TypeError, ValueError):
@@ -875,17 +1047,28 @@ def _as_matrix(M):
     return a
 
 
-def _as_vector(q):
+def _as_vector(q, name="q"):
+    _real(name, q)
     try:
         a = np.asarray(q, dtype=float)
     except (TypeError, ValueError):
-        raise InputError("`q` must be an array of real numbers") from None
+        raise InputError(f"`{name}` must be an array of real numbers") from None
     if a.ndim != 1:
-        raise InputError(f"`q` must be a 1-D array, got shape {a.shape}")
+        raise InputError(f"`{name}` must be a 1-D array, got shape {a.shape}")
     return a
 
 
 def _raise_nonfinite(M, q, d):
+    # the compiled code refused the data: say why, shapes first (an unchecked
+    # call with mismatched arrays is refused there before any read)
+    M = np.asarray(M)
+    q = np.asarray(q)
+    if M.ndim != 2 or M.shape[0] != M.shape[1]:
+        raise InputError(f"`M` must be square, got shape {M.shape}")
+    if q.ndim != 1 or q.shape[0] != M.shape[0]:
+        raise InputError(f"`q` must have length {M.shape[0]} to match `M`, got shape {q.shape}")
+    if d is not None and np.shape(d) != q.shape:
+        raise InputError(f"`covering` must have length {q.shape[0]}, got shape {np.shape(d)}")
     finite_array("M", M)
     finite_array("q", q)
     if d is not None:
@@ -912,9 +1095,10 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     covering : array_like, shape (n,), optional
         Covering vector ``d > 0``; all ones when not given.
     check_input : bool
-        When False, ``M`` and ``q`` must already be C-contiguous float64
-        arrays of matching shapes and no Python-side check runs (non-finite
-        data still come back as an error, detected in compiled code).
+        When False, the costlier checks of the options are skipped; the
+        types and shapes of ``M`` and ``q`` are checked on every call, and
+        non-finite data still come back as an error, detected in compiled
+        code.
     friction : FrictionLayout, optional
         Accepted so that every method shares one signature; Lemke's method
         needs no structure and ignores it.
@@ -948,22 +1132,23 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
 def _solve(M, q, max_iter, tol, check_input, covering):
     # positional twin of solve(): the entry point calls it directly, since a
     # keyword call costs a noticeable part of a 4-variable solve
+    # types and shapes are checked on every path (an unchecked call must not
+    # reach compiled code with arrays it would read out of bounds); the
+    # inline fast path of _coerce costs a handful of attribute reads
+    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
+        M = _as_matrix(M)
+    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
+        q = _as_vector(q)
+    m0, m1 = M.shape
+    if m0 != m1 or m0 != q.shape[0]:
+        M, q = _coerce(M, q)
     if check_input:
-        # inline fast path of _coerce: float64 arrays of matching shapes
-        # pass with a handful of attribute reads
-        if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
-            M = _as_matrix(M)
-        if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
-            q = _as_vector(q)
-        m0, m1 = M.shape
-        if m0 != m1 or m0 != q.shape[0]:
-            M, q = _coerce(M, q)
         if max_iter is not None:
             max_iter = positive_int("max_iter", max_iter)
         if tol is not None:
             tol = positive("tol", tol)
         if covering is not None:
-            covering = _as_vector(covering)
+            covering = _as_vector(covering, "covering")
             if covering.shape != q.shape:
                 raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
     n = q.shape[0]
@@ -983,16 +1168,13 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
-    if status == INFEASIBLE:
-        # the ray's dz is a Farkas vector by itself, checked in compiled code
-        # so that proving infeasibility costs about what the pivoting did
+    if status == INFEASIBLE or status == SECONDARY_RAY:
+        # a ray proves infeasibility only through a Farkas vector that holds
+        # exactly on the caller's data (the compiled pre-filter is not a proof)
         res.__dict__["_ray"] = (out, M, q)
-    elif status == SECONDARY_RAY:
-        res.__dict__["_ray"] = (out, M, q)
-        # no direct proof: try Lemke's theorem (is M copositive-plus?)
         y, why = infeasibility_from_ray(M, q, out[2 * n:])
+        res.status = INFEASIBLE if y is not None else SECONDARY_RAY
         if y is not None:
-            res.status = INFEASIBLE
             res.certificate = y
         res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
     return res
@@ -1002,11 +1184,11 @@ def _solve(M, q, max_iter, tol, check_input, covering):
 # must follow that file too (numba only checks this one)
 def _bind_cache():
     from .. import _jit_cache
-    from . import certify
+    from . import _certified, certify
     _jit_cache.bind_cache_to_sources(
         [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
          and getattr(f.py_func, "__module__", None) == __name__],
-        (__file__, certify.__file__))
+        (__file__, certify.__file__, _certified.__file__))
 
 
 _bind_cache()

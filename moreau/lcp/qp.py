@@ -61,6 +61,7 @@ of OSQP's certificates it came from. A certificate that does not check out
 gives :data:`~moreau.lcp.SOLVER_FAILED`.
 """
 
+import math
 import warnings
 
 import numpy as np
@@ -78,7 +79,7 @@ from ._result import (
     lcp_violation,
 )
 from .certify import farkas_vector
-from .lemke import _coerce
+from .lemke import _coerce, balance
 
 __all__ = ["solve", "DEFAULT_TOL", "qp_formulation"]
 
@@ -267,6 +268,12 @@ def _tresca(M, q, layout, max_iter, fp_tol):
 def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, refine=True):
     """Solve ``LCP(M, q)`` through convex QPs (see the module text for the formulations).
 
+    The QP is solved on balanced data, ``2^ka D M D`` and ``2^kb D q`` with
+    ``D`` a diagonal of powers of two (:func:`moreau.lcp.lemke.balance`; only
+    the uniform factors for a friction layout, whose structure a row scaling
+    would break), so that the answer does not depend on the units of the
+    data; the answer and any Farkas vector are checked on the caller's data.
+
     Parameters
     ----------
     M : array_like, shape (n, n)
@@ -290,10 +297,12 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
     -------
     LCPResult
         ``pivots`` counts the QP solves. Status :data:`~moreau.lcp.SOLVED`
-        only when the answer passes :func:`moreau.lcp.lcp_violation`;
-        :data:`~moreau.lcp.INFEASIBLE` with a checked Farkas vector in
-        ``certificate`` when OSQP proved the QP infeasible or unbounded
-        (the message says which).
+        only when the answer passes :func:`moreau.lcp.lcp_violation` on the
+        caller's data; :data:`~moreau.lcp.INFEASIBLE` only with a Farkas
+        vector in ``certificate`` that holds exactly on the caller's data
+        (:func:`moreau.lcp.certify.farkas_holds`); an OSQP verdict that does
+        not check out is :data:`~moreau.lcp.SOLVER_FAILED`, the message
+        saying so.
 
     Examples
     --------
@@ -301,6 +310,9 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
     >>> res = solve(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]))
     >>> res.success, np.round(res.z, 9).tolist()
     (True, [0.333333333, 0.333333333])
+    >>> res = solve(np.diag([1e300, 1e-300]), np.array([-1.0, -1.0]))
+    >>> res.success, np.allclose(res.z * [1e300, 1e-300], 1.0, rtol=1e-12)
+    (True, True)
     """
     M, q = _coerce(M, q)
     if check_input:
@@ -314,6 +326,50 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
             tol = positive("tol", tol)
         if friction is not None and getattr(friction, "size", None) != len(q):
             raise InputError(f"`friction` must be the layout of this LCP (size {len(q)})")
+    tol = DEFAULT_TOL if tol is None else tol
+    n = len(q)
+    sexp = np.zeros(n, dtype=np.int64)
+    ok, ka, kb = balance(M, q, sexp)
+    if not ok:
+        raise InputError("`M` and `q` must contain only finite values (no NaN or inf)")
+    if friction is not None:
+        # the Tresca fixed point reads the layout's structure from M: no scaling
+        sexp[:] = 0
+        ka = kb = 0
+    Ms = np.ldexp(M, sexp[:, None] + sexp[None, :] + ka)
+    qs = np.ldexp(q, sexp + kb)
+    res = _solve_scaled(Ms, qs, max_iter, tol, friction, refine)
+    # back to the caller's units: z = 2^(ka-kb) D z', a Farkas vector y = D y'
+    with np.errstate(over="ignore", invalid="ignore"):
+        z = np.ldexp(res.z, sexp + ka - kb)
+    if res.status == INFEASIBLE:
+        y = farkas_vector(M, q, np.ldexp(res.certificate, sexp))
+        z0 = np.zeros(n)
+        if y is not None:
+            out = LCPResult(z0, q.copy(), INFEASIBLE, res.pivots, lcp_violation(M, q, z0), "qp",
+                            detail=res.detail)
+            out.certificate = y
+            return out
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, res.pivots, lcp_violation(M, q, z0), "qp",
+                         detail=f"{res.detail} That Farkas vector of the balanced data does not "
+                         "hold exactly on the given data: infeasibility is not proven.")
+    if not np.all(np.isfinite(z)):
+        z0 = np.zeros(n)
+        return LCPResult(z0, q.copy(), SOLVER_FAILED, res.pivots, lcp_violation(M, q, z0), "qp",
+                         detail="the answer lies outside the range of doubles in the given units.")
+    with np.errstate(over="ignore", invalid="ignore"):
+        w = M @ z + q
+    viol = lcp_violation(M, q, z, w)
+    status, detail = res.status, res.detail
+    if status == SOLVED and not viol <= tol:
+        status = SOLVER_FAILED
+        detail = (f"{detail} The answer solves the balanced data but fails the check on the given "
+                  f"data: violation {viol:.2e} > tol = {tol:.1e} (rounding of M z at that size).")
+    return LCPResult(z, w, status, res.pivots, viol, "qp", detail=detail)
+
+
+def _solve_scaled(M, q, max_iter, tol, friction, refine):
+    # the QP solve proper, on balanced data (see solve)
     tol = DEFAULT_TOL if tol is None else tol
     n = len(q)
     if n == 0 or np.all(q >= 0.0):

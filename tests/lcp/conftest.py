@@ -1,5 +1,7 @@
 """Shared helpers of the LCP tests."""
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 
@@ -27,6 +29,14 @@ def assert_complementary(M, q, z, tol):
         assert abs(z @ w) <= tol * scale * max(zs, ws, 1.0) * len(z)
 
 
+def exact_w(M, q, z):
+    """``M z + q`` in exact rational arithmetic on the given floats (an independent check)."""
+    n = len(q)
+    zf = [Fraction(float(v)) for v in z]
+    return [Fraction(float(q[i])) + sum(Fraction(float(M[i, j])) * zf[j] for j in range(n) if zf[j])
+            for i in range(n)]
+
+
 def assert_certified(M, q, z, tol):
     """The certification of issue 7, written out: tolerances fixed by the data only.
 
@@ -45,10 +55,32 @@ def assert_certified(M, q, z, tol):
     assert np.all(w >= -tol_w), f"w has a negative entry {np.min(w)} < -{tol_w:.3g}"
     both = (z > tol_z) & (w > tol_w)
     assert not np.any(both), f"complementarity violated at {np.flatnonzero(both)}: z = {z[both]}, w = {w[both]}"
+    if len(q) <= 24:
+        # the same three checks on the exact w: a float product cannot hide a violation
+        we = exact_w(M, q, z)
+        tw, tz = Fraction(float(tol_w)), Fraction(float(tol_z))
+        for i, wi in enumerate(we):
+            zi = Fraction(float(z[i]))
+            assert wi >= -tw, f"exact w_{i} = {float(wi):.3g} < -{float(tw):.3g}"
+            assert zi <= tz or wi <= tw, f"exact complementarity violated at {i}"
 
 
 def assert_farkas(M, q, y, rtol=1e-9):
-    """``y`` proves ``LCP(M, q)`` infeasible: ``y >= 0``, ``M^T y <= 0``, ``q.y < 0`` (to rounding)."""
+    """``y`` proves ``LCP(M, q)`` infeasible: ``y >= 0``, ``M^T y <= 0``, ``q.y < 0``.
+
+    Checked in exact rational arithmetic on the given floats: ``q.y < 0``
+    exactly, and ``max(M^T y)`` at most ``1e-12`` of ``max|M| |q.y| / max|q|``
+    (the float image of a rational Farkas vector may miss ``M^T y <= 0`` by
+    an ulp; the float check below keeps ``rtol``).
+    """
+    n = len(q)
+    yf = [Fraction(float(v)) for v in y]
+    qy = sum(Fraction(float(q[i])) * yf[i] for i in range(n))
+    assert qy < 0, f"exact q.y = {float(qy)} is not negative"
+    slack = Fraction(1e-12) * Fraction(float(np.max(np.abs(M)))) * (-qy) / Fraction(float(np.max(np.abs(q))))
+    for j in range(n):
+        gj = sum(Fraction(float(M[i, j])) * yf[i] for i in range(n) if yf[i])
+        assert gj <= slack, f"exact (M^T y)_{j} = {float(gj):.3g} > 0"
     M = np.asarray(M, dtype=float)
     q = np.asarray(q, dtype=float)
     assert y is not None, "no certificate"

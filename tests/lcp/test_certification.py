@@ -82,14 +82,19 @@ def test_a_qp_answer_that_fails_the_certification_is_not_a_success(monkeypatch):
 def test_violation_does_not_shrink_as_z_grows():
     for t in (1.0, 1e3, 1e9, 1e15, 1e100):
         z = np.array([t, t])
-        assert lcp_violation(ISSUE_M, ISSUE_Q, z) == 1.0
+        # w = -1 exactly; at large z the sum M z cancels below what even
+        # twice the working precision can bound, and the violation grows with
+        # that uncertainty instead of shrinking: never less than 1
+        assert lcp_violation(ISSUE_M, ISSUE_Q, z) >= 1.0
+    assert lcp_violation(ISSUE_M, ISSUE_Q, np.array([1e9, 1e9])) == pytest.approx(1.0, rel=1e-12)
 
 
 def test_violation_is_the_three_checks():
     # w = z + q with M = I: each check fails alone, at exactly the stated size
     M = 4.0 * np.eye(2)
     q = np.array([-2.0, 1.0])  # tol_w = tol * 2, tol_z = tol * 2 / 4
-    assert lcp_violation(M, q, np.array([0.5, 0.0])) == 0.0
+    # an exact solution: only the rounding bound of w remains (a few ulps)
+    assert lcp_violation(M, q, np.array([0.5, 0.0])) <= 1e-14
     assert lcp_violation(M, q, np.array([0.5, -0.01])) == pytest.approx(4 * 0.01 / 2)  # z < 0
     assert lcp_violation(M, q, np.array([0.49, 0.0])) == pytest.approx(0.04 / 2)  # w < 0
     # z_2 = 0.1 > 0 and w_2 = 1.4 > 0: complementarity, min(4 * 0.1, 1.4) / 2
@@ -140,7 +145,12 @@ def test_copositive_plus_classes():
 def test_farkas_vector_rejects_what_is_no_proof():
     M = ISSUE_M
     assert farkas_vector(M, ISSUE_Q, np.array([1.0, 1.0])) is not None
-    assert farkas_vector(M, ISSUE_Q, np.array([1.0, 0.0])) is None  # M^T y = (1, -1)
+    # (1, 0) has M^T y = (1, -1): no proof by itself; the exact projection onto
+    # the null space of M^T turns it into (1, 1), which is one, checked exactly
+    assert farkas_vector(M, ISSUE_Q, np.array([1.0, 0.0])).tolist() == [1.0, 1.0]
+    assert farkas_vector(M, ISSUE_Q, np.array([1.0, 0.0]) + 0) is not None
+    assert farkas_vector(np.array([[1.0, -1.0], [-1.0, 1.0 + 1e-9]]), np.array([-1.0, 0.5]),
+                         np.array([1.0, 1.0])) is None  # the issue's case: M^T y = (0, 1e-9)
     assert farkas_vector(M, ISSUE_Q, np.array([-1.0, -1.0])) is None  # y < 0
     assert farkas_vector(M, np.array([1.0, -1.0]), np.array([1.0, 1.0])) is None  # q.y = 0
     assert farkas_vector(M, ISSUE_Q, np.array([np.nan, 1.0])) is None
@@ -148,8 +158,11 @@ def test_farkas_vector_rejects_what_is_no_proof():
 
 
 def test_a_ray_of_a_copositive_plus_matrix_that_is_no_farkas_vector_proves_nothing():
-    # a ray made up by rounding must not become a claim of infeasibility
-    y, why = infeasibility_from_ray(ISSUE_M, ISSUE_Q, np.array([1.0, 0.0, 0.0]))
+    # a ray made up by rounding must not become a claim of infeasibility:
+    # M = [[1, -1], [-1, 1 + 2^-30]] is positive definite, so the LCP is
+    # feasible, and no exact Farkas vector exists to be found
+    M = np.array([[1.0, -1.0], [-1.0, 1.0 + 2.0**-30]])
+    y, why = infeasibility_from_ray(M, ISSUE_Q, np.array([1.0, 1.0, 0.0]))
     assert y is None and "artefact" in why
 
 

@@ -13,6 +13,7 @@ from moreau.lcp import (
     SECONDARY_RAY,
     SOLVED,
     lcp_residual,
+    lcp_violation,
     lemke_core,
     lemke_kernel,
     lemke_workspace,
@@ -181,7 +182,9 @@ def test_result_fields_and_check():
     assert res.check(M, q)
     assert not res.check(M, q + np.array([0.0, -5.0]))
     assert "LCPResult(status=0" in repr(res)
-    assert res.residual == lcp_residual(M, q, res.z)
+    # the residual is the certified violation: the exact one plus the rounding bound of w
+    assert res.residual == pytest.approx(lcp_violation(M, q, res.z), abs=1e-16)
+    assert lcp_residual(M, q, res.z) <= res.residual <= 1e-14
 
 
 def test_lean_path_gives_the_same_answer_and_still_rejects_nan():
