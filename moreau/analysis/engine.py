@@ -20,12 +20,15 @@ row whose ``status`` names the cause; it never stops the run.
 """
 
 import hashlib
+import logging
 import math
 import os
 import pathlib
 import time
 
 from ..errors import ConvergenceError, InputError
+
+log = logging.getLogger(__name__)
 
 __all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
            "ED_REFERENCE", "mj_check_columns", "SCENES"]
@@ -229,6 +232,7 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
             d_col, e_col, m_col, s_col = mj_check_columns(chk)
             row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: row["status"]})
         row["compute_time_s"] = time.perf_counter() - t0
+        row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene)
         return row
     try:
         sc, ss = _checked_steady(params, frequency, scheme, scene)
@@ -250,6 +254,8 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
         except Exception as exc:  # any failure becomes the status of this point
             row[s_col] = _status_of(exc)
     row["compute_time_s"] = time.perf_counter() - t0
+    # the row carries what it was computed for: a cache entry is checked against it when read
+    row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene)
     return row
 
 
@@ -289,6 +295,44 @@ def check_output_dir(path):
     except OSError as exc:
         raise InputError(f"`--out` folder {str(p)!r} is not writable: {exc.strerror or exc}") from None
     return p
+
+
+#: the key of a row's fingerprint of its inputs (removed before rows are returned)
+INPUTS_KEY = "_inputs"
+
+
+def inputs_digest(params, frequency, scheme, checks, version, scene):
+    """A fingerprint of everything a point's row depends on (its cache entry carries it).
+
+    Examples
+    --------
+    >>> a = inputs_digest({"mu": 0.1}, 185.0, ED_REFERENCE, (), "v", "friction-drive")
+    >>> a == inputs_digest({"mu": 0.1}, 185.0, ED_REFERENCE, (), "v", "friction-drive")
+    True
+    >>> a == inputs_digest({"mu": 0.2}, 185.0, ED_REFERENCE, (), "v", "friction-drive")
+    False
+    """
+    text = repr((sorted((k, repr(v)) for k, v in dict(params).items()), repr(float(frequency)),
+                 repr(tuple(scheme)), repr(tuple(tuple(c) for c in checks)), version, scene))
+    return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def _entry_matches(res, a, chunk):
+    # the rows an entry holds against the inputs they are to answer
+    if chunk == 1:
+        return isinstance(res, dict) and res.get(INPUTS_KEY) == inputs_digest(*a)
+    pts, rest = a[0], a[1:]
+    return (isinstance(res, list) and len(res) == len(pts)
+            and all(isinstance(r, dict) and r.get(INPUTS_KEY) == inputs_digest(p, f, *rest)
+                    for r, (p, f) in zip(res, pts)))
+
+
+def _recompute(func, a):
+    out = func.call(*a)
+    # joblib's MemorizedFunc.call returns (output, metadata) in recent versions
+    if isinstance(out, tuple) and len(out) == 2 and isinstance(out[1], dict):
+        return out[0]
+    return out
 
 
 def _memory(cache_dir):
@@ -351,12 +395,37 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         sizes = [len(g) for g in groups]
     out = [None] * len(args)
     todo = []
+    notes = {"unreadable": 0, "mismatched": 0}
     for i, a in enumerate(args):
         if cache_dir is not None and func.check_call_in_cache(*a):
-            out[i] = func(*a)
+            caught = []
+            # joblib reports an unreadable entry with a traceback through its
+            # own logger, then recomputes: catch that, count it, say it once
+            func.warn = caught.append
+            try:
+                res = func(*a)
+            finally:
+                del func.warn
+            if any("loading" in str(m).lower() for m in caught):
+                # joblib could not read the entry and recomputed it: not from the cache
+                notes["unreadable"] += 1
+                todo.append(i)
+                continue
+            if not _entry_matches(res, a, chunk):
+                # an entry computed for other inputs (copied, or a hash collision): redo it
+                notes["mismatched"] += 1
+                todo.append(i)
+                continue
+            out[i] = res
         else:
             todo.append(i)
     n_cached = sum(sizes[i] for i in range(len(args)) if out[i] is not None)
+    for what, k in notes.items():
+        if k:
+            why = ("could not be read" if what == "unreadable"
+                   else "were computed for other parameters")
+            log.warning("%d cache entr%s in %s %s; recomputed", k, "y" if k == 1 else "ies",
+                        cache_dir, why)
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -383,6 +452,9 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
                 results = itertools.chain([first], rest)
             for k, res in results:
                 i = todo[k]
+                if cache_dir is not None and not _entry_matches(res, args[i], chunk) and not (
+                        chunk > 1 and isinstance(res, dict)):
+                    res = _recompute(func, args[i])
                 if chunk > 1 and isinstance(res, dict):  # a lost Dask task: every point fails
                     res = [dict(res) for _ in range(sizes[i])]
                 out[i] = res
@@ -392,6 +464,7 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         if bar is not None:
             bar.close()
     rows = out if chunk == 1 else [r for part in out for r in part]
+    rows = [{k: v for k, v in r.items() if k != INPUTS_KEY} for r in rows]
     return rows, {"cached": n_cached, "computed": len(points) - n_cached}
 
 
