@@ -13,6 +13,7 @@ __all__ = [
     "ContactLostError",
     "LCPError",
     "ConvergenceError",
+    "RunawayError",
 ]
 
 
@@ -45,3 +46,7 @@ class LCPError(MoreauError):
 
 class ConvergenceError(MoreauError):
     """An iterative procedure (shooting, root finding) did not converge."""
+
+
+class RunawayError(ConvergenceError):
+    """No steady state exists: the driven body runs away (e.g. past the motor's stall load)."""

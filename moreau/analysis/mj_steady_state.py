@@ -187,6 +187,10 @@ class PeriodMap:
         self.scene = scene
         self.period = float(period)
         self.n = positive_int("steps_per_period", steps_per_period)
+        if self.n > MAX_STEPS_PER_PERIOD:
+            raise InputError(f"`steps_per_period` = {self.n:.3g} is more than the limit "
+                             f"{MAX_STEPS_PER_PERIOD:.0e}: the shooting runs some 300 periods, "
+                             f"{300 * self.n:.2g} steps, hours at 1e7 steps/s")
         self.theta = in_closed_interval("theta", theta, 0.5, 1.0)
         if not isinstance(projection, (bool, np.bool_)):
             raise InputError(f"`projection` must be True or False, got {projection!r}")
@@ -269,6 +273,11 @@ class PeriodMap:
 
 class _Stalled(ConvergenceError):
     """Shooting found no usable derivative: worth a transient run before giving up."""
+
+
+#: bound on the steps per period of a discrete steady state (300 periods of shooting at
+#: 1e6 steps each take about 30 s at 1e7 steps/s; 1e7 about five minutes)
+MAX_STEPS_PER_PERIOD = 10**7
 
 
 def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_iter=50,

@@ -11,7 +11,7 @@ import time
 import numpy as np
 
 from .._validate import positive, positive_int
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, RunawayError
 # SteadyState is defined with the other scheme results (below this layer)
 # and re-exported here, where callers have always found it
 from ..integrators.result import SteadyState
@@ -118,6 +118,35 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
 
 def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
                       **options):
+    """Periodic steady state of a periodically driven scene, found by shooting, and checked.
+
+    The one entry point for every scheme and every caller: what the shooting
+    returns is refused (:class:`~moreau.errors.RunawayError`) when it cannot
+    be a steady state (:func:`implausible_steady_state`): a rotor faster
+    than the rod's tip can drive it, loaded or not (a runaway past stall,
+    whose state is so large that rounding hides the change a period makes,
+    so the periodic residual reads 0). See :func:`_find_steady_state` for
+    the parameters.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> find_steady_state(FrictionDrive(frequency=20.0)).mode
+    'NS'
+    >>> find_steady_state(FrictionDrive(frequency=185.0, load=0.01))
+    Traceback (most recent call last):
+    ...
+    moreau.errors.RunawayError: no steady state: past stall (load F_L = 0.01 N); the rotor runs away backwards, ...
+    """
+    ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
+    why = implausible_steady_state(scene, ss)
+    if why:
+        raise RunawayError(why)
+    return ss
+
+
+def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
+                       **options):
     """Periodic steady state of the friction drive, found by shooting.
 
     The rotor position ``u2`` does not enter the dynamics, so the period map
@@ -243,22 +272,29 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
         stats=dict(walker.counters),
         section_tau=float(st0.tau),
     )
-    why = implausible_steady_state(scene, ss)
-    if why:
-        raise ConvergenceError(why)
     return ss
 
 
 def implausible_steady_state(scene, ss):
-    """Why a converged friction-drive steady state cannot be right, or None.
+    """Why a converged steady state of a driven scene cannot be right, or None.
 
-    Without a load the rotor is driven by friction alone, so over a period
-    the friction impulse must vanish: friction has to change sign, hence the
-    rotor's velocity has to meet the tip's, and its average speed cannot
-    exceed the largest tip speed by much. Every sound point of the atlases
-    stays below 1.0 times that speed; the runaway orbits a stalled shooting
-    can settle on, with one-signed friction, are up to 1e12 times above it.
-    With a load the bound does not hold and nothing is checked.
+    Two checks, for any scheme:
+
+    * the state must resolve the change a period makes: with a velocity
+      scale ``vs`` (the scene's ``velocity_scale``, the stator's speed),
+      ``eps max|x| <= 1e-6 vs`` for the periodic state ``x``; a runaway orbit
+      (|u2'| ~ 1e14) rounds every change away and its residual reads 0;
+    * the rotor cannot on average outrun the rod's tip by far: friction has
+      to change sign for a periodic motion (with a load too: a rotor always
+      faster than the tip takes one-signed friction, which balances a load
+      only by coincidence), so its average speed stays below the largest tip
+      speed. Every sound point of the atlases stays below 1.0 times it; past
+      stall the shooting can settle on orbits far above it.
+
+    Returns
+    -------
+    str or None
+        The reason, naming the stall side when the scene has a load.
 
     Examples
     --------
@@ -267,16 +303,30 @@ def implausible_steady_state(scene, ss):
     >>> implausible_steady_state(sc, find_steady_state(sc)) is None
     True
     """
-    if scene.params.load != 0.0:
+    x = np.asarray(ss.state0, dtype=float)
+    vs = getattr(scene, "velocity_scale", None)
+    if vs is not None:
+        vs = float(np.max(np.abs(vs)))
+    load = getattr(getattr(scene, "params", None), "load", 0.0) or 0.0
+    speed = abs(ss.displacement_per_period) / TWO_PI
+    direction = "forwards" if ss.displacement_per_period > 0 else "backwards"
+    side = (f"past stall (load F_L = {load:g} N); the rotor runs away {direction}, "
+            if load else f"the rotor runs away {direction} with no load to drive it, ")
+    if not np.all(np.isfinite(x)):
+        return f"no steady state: {side}its periodic state is not finite"
+    if vs and np.finfo(float).eps * float(np.max(np.abs(x))) > 1e-6 * vs:
+        return (f"no steady state: {side}its periodic state ({float(np.max(np.abs(x))):.3g} in "
+                f"the scene's units) is too large for a period's change to be resolved: the "
+                f"periodic residual {ss.periodic_residual:.2g} only reflects rounding")
+    if not hasattr(scene, "rest_state") and not hasattr(scene, "tip_velocity"):
         return None
     tip = _max_tip_speed(scene)
     if tip == 0.0:
         return None
-    speed = abs(ss.displacement_per_period) / TWO_PI
     if not speed <= 2.0 * tip:
-        return (f"the steady state found (mode {ss.mode!r}) has the rotor {speed / tip:.3g} "
-                "times faster on average than the rod's tip can move, which friction alone "
-                "cannot sustain (the shooting converged on a runaway rotor)")
+        return (f"no steady state: {side}{speed / tip:.3g} times faster on average than the "
+                f"rod's tip can move, which friction cannot sustain (mode {ss.mode!r}; the "
+                f"shooting converged on a runaway rotor)")
     return None
 
 

@@ -132,6 +132,8 @@ of the friction LCP; on the compiled path Lemke's measure,
 after a step, 0 if none); ``projection_iterations``.
 """
 
+import math
+
 import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
@@ -303,6 +305,35 @@ def _new_counters():
             "warm_starts": 0}
 
 
+#: default bound on the steps of one run (about two minutes at 1e7 steps/s); `max_steps` raises it
+MAX_STEPS = 10**9
+#: bound on the memory the recorded samples of one run may take
+MAX_RECORD_BYTES = 2 * 1024**3
+
+
+def check_work(scene, t0, t1, h, save_every, max_steps=MAX_STEPS):
+    """Refuse, before any work, a run whose step count or recorded samples have no sane bound.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> check_work(BouncingBall(), 0.0, 6.3, 1e-9, 1)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `h` = 1e-09 over [0, 6.3] takes 6.3e+09 steps, more than `max_steps` = 1e+09: take a larger `h` or raise `max_steps`
+    """
+    steps = math.ceil((t1 - t0) / h - 1e-9)
+    if steps > max_steps:
+        raise InputError(f"`h` = {h:g} over [{t0:g}, {t1:g}] takes {steps:.2g} steps, more than "
+                         f"`max_steps` = {max_steps:.2g}: take a larger `h` or raise `max_steps`")
+    n, nc = int(scene.ndof), len(scene.mu)
+    size = (steps // save_every + 2) * 8 * (1 + 2 * n + 5 * nc)
+    if size > MAX_RECORD_BYTES:
+        raise InputError(f"recording every {save_every} of {steps:.2g} steps would take "
+                         f"{size / 1024**3:.3g} GiB, more than {MAX_RECORD_BYTES / 1024**3:g} GiB: "
+                         f"raise `save_every` to at least {math.ceil(save_every * size / MAX_RECORD_BYTES)}")
+
+
 def check_options(h, theta, projection, lcp_method, save_every=1):
     """Validate the Moreau–Jean options; return them normalised."""
     if h is None:
@@ -424,10 +455,12 @@ class MoreauJean(Integrator):
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
                  lcp_method="auto", save_every=1, fast="auto", closed0=None,
-                 lemke_max_iter=None, lcp_warm_start=True):
+                 lemke_max_iter=None, lcp_warm_start=True, max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
             h, theta, projection, lcp_method, save_every)
+        check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
+                   positive_int("max_steps", max_steps))
         if lemke_max_iter is not None:
             lemke_max_iter = positive_int("lemke_max_iter", lemke_max_iter)
             if self.lcp_method == "qp":

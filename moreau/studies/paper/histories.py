@@ -14,6 +14,10 @@ __all__ = ["run_history", "write_history_csv", "plot_history"]
 _COLUMNS = ["t", "x2", "v2", "phi", "normal_force", "tangential_force", "slip_velocity", "regime"]
 
 
+#: bound on the samples of one time history (a CSV of about 2 GB)
+MAX_SAMPLES = 10**7
+
+
 def run_history(params, frequency, periods=10.0, scheme="event-driven", steps_per_period=2000,
                 theta=1.0, samples_per_period=200, progress=False):
     """Simulate the friction drive from rest and return its SI time histories.
@@ -50,6 +54,10 @@ def run_history(params, frequency, periods=10.0, scheme="event-driven", steps_pe
 
     periods = positive("periods", periods)
     samples_per_period = positive_int("samples_per_period", samples_per_period)
+    if periods * samples_per_period > MAX_SAMPLES:
+        raise InputError(f"`periods` = {periods:g} at {samples_per_period} samples per period is "
+                         f"{periods * samples_per_period:.2g} samples, more than the limit "
+                         f"{MAX_SAMPLES:.0e} of one time history")
     scene = FrictionDrive(params, frequency)
     q0, v0 = scene.rest_state()
     span = (0.0, 2.0 * math.pi * periods)

@@ -133,6 +133,10 @@ def plot_sweep(rows, parameter, path, title=""):
 SWEEPABLE = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
 
 
+#: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
+MAX_POINTS = 10**5
+
+
 def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None):
     """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
 
@@ -171,6 +175,9 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
     start = _v.finite_scalar("START", start)
     stop = _v.finite_scalar("STOP", stop)
     points = positive_int("points", points)
+    if points > MAX_POINTS:
+        raise InputError(f"`points` = {points:.3g} is more than the limit {MAX_POINTS:.0e} of "
+                         "one sweep (an atlas covers two parameters)")
     if scale not in ("log", "linear"):
         raise InputError(f"`--scale` must be 'log' or 'linear', got {scale!r}")
     if points > 1 and start == stop:
