@@ -10,7 +10,7 @@ Python :func:`lcp_violation` all call it, so that "solved" means one thing.
 import numpy as np
 from numba import njit
 
-__all__ = ["residual", "lcp_violation"]
+__all__ = ["residual", "lcp_violation", "farkas_float"]
 
 _EPS = float(np.finfo(float).eps)
 # a row's violation below 1e-9 times this (in units of max|q|) needs no
@@ -92,6 +92,50 @@ def residual(M, q, z, w, mmax, qmax):
     if not np.isfinite(num):
         return np.inf
     return num / qs
+
+
+@njit(cache=True)
+def farkas_float(M, q, y):
+    # y >= 0, M^T y <= 0, q.y < 0 decided in floating point with a rigorous
+    # bound on each sum's rounding: 1 holds, -1 fails, 0 undecided (the exact
+    # rational check of moreau.lcp.certify.farkas_holds then settles it)
+    n = q.shape[0]
+    gam = (n + 2) * _EPS
+    pos = False
+    for i in range(n):
+        if not (y[i] >= 0.0 and y[i] < np.inf):
+            return -1
+        pos = pos or y[i] > 0.0
+    if not pos:
+        return -1
+    qy = 0.0
+    qb = 0.0
+    for i in range(n):
+        p = q[i] * y[i]
+        qy += p
+        qb += abs(p)
+    qb *= gam
+    if not (abs(qy) < np.inf and qb < np.inf):
+        return 0
+    if qy - qb >= 0.0:
+        return -1
+    sure = qy + qb < 0.0
+    for j in range(n):
+        g = 0.0
+        gb = 0.0
+        for i in range(n):
+            if y[i] != 0.0:
+                p = M[i, j] * y[i]
+                g += p
+                gb += abs(p)
+        gb *= gam
+        if not (abs(g) < np.inf and gb < np.inf):
+            return 0
+        if g - gb > 0.0:
+            return -1
+        if not g + gb <= 0.0:
+            sure = False
+    return 1 if sure else 0
 
 
 def lcp_violation(M, q, z, w=None):

@@ -22,6 +22,8 @@ from fractions import Fraction
 
 import numpy as np
 
+from ._certified import farkas_float
+
 __all__ = ["copositive_plus_class", "farkas_vector", "farkas_holds", "infeasibility_from_ray",
            "FARKAS_TOL", "RAY_FARKAS_TOL"]
 
@@ -105,24 +107,17 @@ def farkas_holds(M, q, y):
     >>> farkas_holds(M, np.array([-1.0, -1.0]), np.array([1.0, 1.0 - 2.0**-40]))
     False
     """
-    M = np.asarray(M, dtype=float)
-    q = np.asarray(q, dtype=float)
-    y = np.asarray(y, dtype=float)
+    M = np.ascontiguousarray(M, dtype=float)
+    q = np.ascontiguousarray(q, dtype=float)
+    y = np.ascontiguousarray(y, dtype=float)
     n = q.shape[0]
-    if y.shape != (n,) or not np.all(np.isfinite(y)) or np.any(y < 0.0) or not np.any(y > 0.0):
+    if y.shape != (n,) or M.shape != (n, n):
         return False
-    gam = (n + 2) * np.finfo(float).eps
-    with np.errstate(over="ignore", invalid="ignore"):
-        g = M.T @ y
-        gb = gam * (np.abs(M).T @ y)
-        qy = float(q @ y)
-        qb = gam * float(np.abs(q) @ y)
-    if not (np.all(np.isfinite(g)) and np.all(np.isfinite(gb)) and np.isfinite(qy)):
-        return _exact_farkas(M, q, y)
-    if np.any(g - gb > 0.0) or qy - qb >= 0.0:
+    verdict = farkas_float(M, q, y)
+    if verdict != 0:
+        return verdict > 0
+    if not np.all(np.isfinite(y)) or np.any(y < 0.0) or not np.any(y > 0.0):
         return False
-    if np.all(g + gb <= 0.0) and qy + qb < 0.0:
-        return True
     return _exact_farkas(M, q, y)
 
 
@@ -273,8 +268,11 @@ def farkas_vector(M, q, y, tol=None):
     for cand in _candidates(y):
         if farkas_holds(M, q, cand):
             return cand
-    # proven in rationals (M^T v = 0 on the support by construction, v >= 0,
-    # q.v < 0): the float image may miss M^T y <= 0 by an ulp, the proof stands
+    # for a monotone M only (there every Farkas vector has M^T y = 0): proven
+    # in rationals (M^T v = 0 on the support by construction, v >= 0, q.v < 0);
+    # the float image may miss M^T y <= 0 by an ulp, the proof stands
+    if copositive_plus_class(M) != "positive semidefinite (monotone)":
+        return None
     return _null_farkas(M, q, np.maximum(y / np.max(y), 0.0))
 
 

@@ -82,6 +82,7 @@ from numba import njit
 
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
+from ._certified import farkas_float
 from ._certified import residual as _residual
 from .certify import FARKAS_TOL, infeasibility_from_ray
 from ._result import (
@@ -702,18 +703,43 @@ def balance(M, q, sexp):
         sexp[i] = e
         if e < emin:
             emin = e
+    any_row = False
     for i in range(n):
         # a zero row keeps its scale; the others shrink by half their excess
-        sexp[i] = 0 if sexp[i] == (1 << 30) else -((sexp[i] - emin) // 2)
+        # (an excess below 2^_ROW_EXCESS is left alone: it costs nothing to pivot on)
+        ex = 0 if sexp[i] == (1 << 30) else sexp[i] - emin
+        sexp[i] = -(ex // 2) if ex >= _ROW_EXCESS else 0
+        any_row = any_row or sexp[i] != 0
     mmax = 0.0
     qmax = 0.0
     for i in range(n):
-        qmax = max(qmax, abs(math.ldexp(q[i], sexp[i])))
+        qmax = max(qmax, abs(_times_pow2(q[i], sexp[i])))
         for j in range(n):
-            mmax = max(mmax, abs(math.ldexp(M[i, j], sexp[i] + sexp[j])))
+            a = abs(M[i, j]) if not any_row else abs(_times_pow2(M[i, j], sexp[i] + sexp[j]))
+            if a > mmax:
+                mmax = a
     ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
     kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
     return True, ka, kb
+
+
+# 2^k as floats for |k| <= 1000: a multiplication by an exact power of two is
+# exact (barring underflow) and far cheaper than ldexp in the O(n^2) loops
+_POW2 = np.ldexp(1.0, np.arange(-1000, 1001))
+# data whose normalising exponents lie within this range are pivoted on as given
+_PLAIN_RANGE = 20
+# rows whose scale exceeds the smallest row's by less than 2^this are not rescaled
+_ROW_EXCESS = 10
+
+
+@njit(cache=True, inline="always")
+def _times_pow2(x, k):
+    if -1000 <= k <= 1000:
+        y = x * _POW2[k + 1000]
+        # a subnormal product has lost bits: ldexp rounds it once, as scaling should
+        if y == 0.0 or abs(y) >= 2.2250738585072014e-308:
+            return y
+    return math.ldexp(x, k)
 
 
 @njit(cache=True)
@@ -809,19 +835,19 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
     qs = np.empty(n)
     ds = np.empty(n)
     for i in range(n):
-        qs[i] = math.ldexp(q[i], rexp[i] + kb)
+        qs[i] = _times_pow2(q[i], rexp[i] + kb)
         # the covering vector of the scaled problem: all ones by default
         # (the caller's d = 1 is a choice, not data), else the caller's mapped
-        ds[i] = math.ldexp(d[i], rexp[i]) if scale_d else d[i]
+        ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
         for j in range(n):
-            Ms[i, j] = math.ldexp(M[i, j], rexp[i] + cexp[j] + ka)
+            Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
     status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
                                      tol)
     if status == INVALID_INPUT:
         return status, pivots, residual
     finite = True
     for j in range(n):
-        z_out[j] = math.ldexp(z_out[j], ka - kb + cexp[j])
+        z_out[j] = _times_pow2(z_out[j], ka - kb + cexp[j])
         if not abs(z_out[j]) < np.inf:
             finite = False
         # the ray is a direction: dz = C dz', and dz0 = 2^-ka dz0' makes
@@ -837,9 +863,23 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
     residual = _residual(M, q, z_out, w_out, mmax, qmax)
     if status == SOLVED or status == BREAKDOWN:
         status = SOLVED if residual <= tol else BREAKDOWN
-    if status == SECONDARY_RAY and _ray_is_farkas(M, q, ray_out, FARKAS_TOL):
+    if status == SECONDARY_RAY and _ray_proves(M, q, ray_out):
         status = INFEASIBLE
     return status, pivots, residual
+
+
+@njit(cache=True)
+def _ray_proves(M, q, ray):
+    # the ray's dz (negative rounding noise clipped) is a Farkas vector, decided
+    # rigorously in floating point (farkas_float); an undecided case stays a
+    # ray here and goes to the exact rational check in Python
+    if not _ray_is_farkas(M, q, ray, FARKAS_TOL):
+        return False
+    n = q.shape[0]
+    y = np.empty(n)
+    for i in range(n):
+        y[i] = max(ray[i], 0.0)
+    return farkas_float(M, q, y) == 1
 
 
 @njit(cache=True)
@@ -854,16 +894,33 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
     ok, ka, kb = balance(M, q, sexp)
     if not ok:
         return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    plain = -_PLAIN_RANGE <= ka <= _PLAIN_RANGE and -_PLAIN_RANGE <= kb <= _PLAIN_RANGE
+    for i in range(n):
+        plain = plain and sexp[i] == 0
+    if plain:
+        # data of one moderate scale: the pivoting's tests are all relative, so
+        # pivoting on them as given is what the normalised copy would do (the
+        # property tests scale by 2^k and compare), minus the copy
+        status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork,
+                                         max_iter, tol)
+        if status == SECONDARY_RAY and _ray_proves(M, q, ray_out):
+            status = INFEASIBLE
+        if status != BREAKDOWN:
+            return status, pivots, residual
     mmax = 0.0
     qmax = 0.0
     for i in range(n):
         qmax = max(qmax, abs(q[i]))
         for j in range(n):
             mmax = max(mmax, abs(M[i, j]))
-    status, pivots, residual = _run_scaled(M, q, d, sexp, sexp, ka, kb, z_out, w_out, ray_out,
-                                           work, iwork, max_iter, tol, scale_d, mmax, qmax)
-    if status != BREAKDOWN:
-        return status, pivots, residual
+    if plain:
+        status, pivots, residual = BREAKDOWN, pivots, residual
+    else:
+        status, pivots, residual = _run_scaled(M, q, d, sexp, sexp, ka, kb, z_out, w_out,
+                                               ray_out, work, iwork, max_iter, tol, scale_d,
+                                               mmax, qmax)
+        if status != BREAKDOWN:
+            return status, pivots, residual
     rexp = np.zeros(n, dtype=np.int64)
     cexp = np.zeros(n, dtype=np.int64)
     for attempt in range(2):
@@ -996,8 +1053,10 @@ class _LemkeResult(LCPResult):
             return None
         y = self.__dict__.get("_cert")
         if y is None:
+            # scaled by a power of two (largest entry in [1, 2)): exact, so the
+            # vector proven in compiled code is the one handed out
             y = np.maximum(self.ray[:len(self.z)], 0.0)
-            y = self.__dict__["_cert"] = y / np.max(y)
+            y = self.__dict__["_cert"] = np.ldexp(y, 1 - np.frexp(np.max(y))[1])
         return y
 
     @certificate.setter
@@ -1168,7 +1227,13 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
-    if status == INFEASIBLE or status == SECONDARY_RAY:
+    if status == INFEASIBLE:
+        # proven in compiled code: the ray's dz is a Farkas vector with every
+        # sum's rounding bounded (farkas_float); the words, with the matrix
+        # class they name, come only when someone reads them
+        res.__dict__["_ray"] = (out, M, q)
+        return res
+    if status == SECONDARY_RAY:
         # a ray proves infeasibility only through a Farkas vector that holds
         # exactly on the caller's data (the compiled pre-filter is not a proof)
         res.__dict__["_ray"] = (out, M, q)
