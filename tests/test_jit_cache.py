@@ -95,10 +95,11 @@ def test_kernel_stamps_carry_the_digest_of_all_kernel_sources():
     from moreau.lcp import lemke
 
     names = {os.path.basename(p) for p in mk.KERNEL_SOURCES}
-    assert {"_mj_kernels.py", "_compiled.py", "lemke.py", "certify.py"} <= names
+    assert {"_mj_kernels.py", "_compiled.py", "lemke.py", "certify.py", "_certified.py"} <= names
     assert mk.CACHE_MODE == "bound"
     digest = _jit_cache.sources_digest(mk.KERNEL_SOURCES)
-    for disp in (mk.mj_run, mk._lcp_step, mk._one_contact):
+    for disp in (mk._mj_run_friction_drive, mk._mj_run_3x2, mk._mj_run_any, mk._lcp_step,
+                 mk._one_contact):
         stamp = disp._cache._cache_file._source_stamp
         assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
     assert lemke.lemke_core._cache._cache_file._source_stamp[0] == "moreau-deps"

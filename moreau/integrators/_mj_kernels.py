@@ -44,6 +44,7 @@ sticking contacts to the velocities' difference over ``h``, see
 """
 
 import math
+import sys
 
 import numpy as np
 from numba import njit
@@ -1085,8 +1086,45 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
 
 # error_model="numpy": a division by zero gives inf/nan, which the loop's own
 # tests turn into SINGULAR or NUMERICAL, instead of a raise branch after every
-# division, whose clean-up path kept numba from pruning reference counts
+# division, whose clean-up path kept numba from pruning reference counts.
+#
+# The same loop three times, each its own compiled function so that a process
+# compiles (or loads from the cache) only the one its scene uses: with the
+# friction drive's kind and sizes as constants, with the sizes of the
+# two-contact scenes, and for any model. With constants, the compiler drops the
+# other scenes' branches, unrolls the small-matrix loops and evaluates the
+# sines and cosines shared by the model functions once per step; that keeps the
+# paper's scene as fast as its former hand-written kernel.
 @njit(cache=True, error_model="numpy")
+def _mj_run_friction_drive(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, lcp_ctl,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
+                    k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
+                    lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
+                    rec_gap, stats)
+
+
+@njit(cache=True, error_model="numpy")
+def _mj_run_3x2(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, lcp_ctl,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    # three degrees of freedom on two contacts (the two-rod drive, the box):
+    # with the sizes constant, the Delassus products and the contact rows' loops unroll
+    return _mj_loop(kind, par, 3, 2, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax,
+                    q, v, theta, projection, closed, save_every, record_initial, lcp_ctl,
+                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
+
+
+@njit(cache=True, error_model="numpy")
+def _mj_run_any(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+           theta, projection, closed, save_every, record_initial, lcp_ctl,
+           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
+                    v, theta, projection, closed, save_every, record_initial, lcp_ctl,
+                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
+
+
 def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
            theta, projection, closed, save_every, record_initial, lcp_ctl,
            rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
@@ -1142,27 +1180,30 @@ def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nma
     nrec : int
         Samples written.
     """
-    # The same loop three times: with the friction drive's kind and sizes as
-    # constants, with the sizes of the two-contact scenes, and for any model.
-    # With constants, the compiler drops the other scenes' branches, unrolls
-    # the small-matrix loops and evaluates the sines and cosines shared by the
-    # model functions once per step; that keeps the paper's scene as fast as
-    # its former hand-written kernel.
     if kind == FRICTION_DRIVE and n == 2 and nc == 1 and const_mass and has_jac:
-        return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
-                        k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
-                        lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
-                        rec_gap, stats)
-    if n == 3 and nc == 2:
-        # three degrees of freedom on two contacts (the two-rod drive, the box):
-        # with the sizes constant, the Delassus products and the contact rows'
-        # loops unroll
-        return _mj_loop(kind, par, 3, 2, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax,
-                        q, v, theta, projection, closed, save_every, record_initial, lcp_ctl,
-                        rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
-    return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
-                    v, theta, projection, closed, save_every, record_initial, lcp_ctl,
-                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
+        run = _mj_run_friction_drive
+    elif n == 3 and nc == 2:
+        run = _mj_run_3x2
+    else:
+        run = _mj_run_any
+    if not run.signatures:
+        _compile_note(run)
+    return run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
+               theta, projection, closed, save_every, record_initial, lcp_ctl,
+               rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
+
+
+def _compile_note(run):
+    # the first call in a process either loads the machine code from numba's
+    # cache (a fraction of a second) or compiles it (about a minute): say so on
+    # a terminal, once, so that a first run is not a silent wait
+    if sys.stderr.isatty() and not _NOTED.get(run.__name__):
+        _NOTED[run.__name__] = True
+        print("moreau: loading the compiled Moreau-Jean loop (the first use on a machine "
+              "compiles it, about a minute)...", file=sys.stderr, flush=True)
+
+
+_NOTED = {}
 
 
 #: every source whose compiled code ends up in this module's functions (the

@@ -760,17 +760,9 @@ def _balance_rows_to_q(M, q, rexp, cexp):
     for j in range(n):
         a = 0.0
         for i in range(n):
-            a = max(a, abs(math.ldexp(M[i, j], rexp[i])))
+            a = max(a, abs(_times_pow2(M[i, j], rexp[i])))
         cexp[j] = -math.frexp(a)[1] if a > 0.0 else 0
-    mmax = 0.0
-    qmax = 0.0
-    for i in range(n):
-        qmax = max(qmax, abs(math.ldexp(q[i], rexp[i])))
-        for j in range(n):
-            mmax = max(mmax, abs(math.ldexp(M[i, j], rexp[i] + cexp[j])))
-    ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
-    kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
-    return ka, kb
+    return _unit_exponents(M, q, rexp, cexp)
 
 
 @njit(cache=True)
@@ -793,31 +785,40 @@ def _balance_ruiz(M, q, rexp, cexp, sweeps):
     e0 = -math.frexp(mmax)[1] if mmax > 0.0 else 0
     for _ in range(sweeps):
         for i in range(n):
-            hi = 0.0
-            lo = np.inf
-            for j in range(n):
-                a = abs(math.ldexp(M[i, j], e0 + rexp[i] + cexp[j]))
-                if a > 0.0:
-                    hi = max(hi, a)
-                    lo = min(lo, a)
-            if hi > 0.0:
-                rexp[i] -= (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
+            rexp[i] -= _geo_exponent(M, e0, rexp, cexp, i, True)
         for j in range(n):
-            hi = 0.0
-            lo = np.inf
-            for i in range(n):
-                a = abs(math.ldexp(M[i, j], e0 + rexp[i] + cexp[j]))
-                if a > 0.0:
-                    hi = max(hi, a)
-                    lo = min(lo, a)
-            if hi > 0.0:
-                cexp[j] -= (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
+            cexp[j] -= _geo_exponent(M, e0, rexp, cexp, j, False)
+    return _unit_exponents(M, q, rexp, cexp)
+
+
+@njit(cache=True)
+def _geo_exponent(M, e0, rexp, cexp, k, row):
+    # half the summed exponents of the largest and smallest nonzero entry of
+    # row (or column) k of 2^e0 R M C: the power of two to divide it by
+    n = M.shape[0]
+    hi = 0.0
+    lo = np.inf
+    for m in range(n):
+        i, j = (k, m) if row else (m, k)
+        a = abs(_times_pow2(M[i, j], e0 + rexp[i] + cexp[j]))
+        if a > 0.0:
+            hi = max(hi, a)
+            lo = min(lo, a)
+    if hi == 0.0:
+        return 0
+    return (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
+
+
+@njit(cache=True)
+def _unit_exponents(M, q, rexp, cexp):
+    # (ka, kb) bringing max|R M C| and max|R q| to [0.5, 1)
+    n = q.shape[0]
     qmax = 0.0
     mmax = 0.0
     for i in range(n):
-        qmax = max(qmax, abs(math.ldexp(q[i], rexp[i])))
+        qmax = max(qmax, abs(_times_pow2(q[i], rexp[i])))
         for j in range(n):
-            mmax = max(mmax, abs(math.ldexp(M[i, j], rexp[i] + cexp[j])))
+            mmax = max(mmax, abs(_times_pow2(M[i, j], rexp[i] + cexp[j])))
     ka = -math.frexp(mmax)[1] if mmax > 0.0 else 0
     kb = -math.frexp(qmax)[1] if qmax > 0.0 else 0
     return ka, kb
