@@ -157,8 +157,10 @@ def _cmd_sweep(args):
 
 
 def _cmd_run(args):
+    from .analysis.engine import check_output_dir
     from .studies.paper.histories import history_command
     _scheme_args(args, rtol_acts=False)
+    check_output_dir(args.out)
     params = _params(args)
     if args.frequency is None:
         raise InputError("`--frequency` is required (drive frequency in Hz)")
@@ -383,10 +385,21 @@ def build_parser():
     return parser
 
 
+def _check_common(args):
+    # the options several commands share, checked before any of them starts work
+    from .analysis.engine import check_jobs, check_output_dir, check_scheduler
+    if getattr(args, "jobs", None) is not None:
+        check_jobs(args.jobs, 1)
+    check_scheduler(getattr(args, "scheduler", None))
+    if getattr(args, "cache", None) is not None:
+        check_output_dir(args.cache, "--cache")
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     try:
+        _check_common(args)
         args.func(args)
     except InputError as exc:
         print(f"moreau: error: {exc}", file=sys.stderr)

@@ -272,7 +272,7 @@ def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive
     return [evaluate_point(p, f, scheme, checks, version, scene) for p, f in points]
 
 
-def check_output_dir(path):
+def check_output_dir(path, option="--out"):
     """Create ``path`` if needed and make sure files can be written there.
 
     Raises
@@ -293,8 +293,61 @@ def check_output_dir(path):
         probe.write_text("ok")
         probe.unlink()
     except OSError as exc:
-        raise InputError(f"`--out` folder {str(p)!r} is not writable: {exc.strerror or exc}") from None
+        raise InputError(f"`{option}` folder {str(p)!r} is not writable: {exc.strerror or exc}") from None
     return p
+
+
+#: the most local worker processes per core that `--jobs` may ask for
+MAX_JOBS_PER_CORE = 4
+_SCHEMES = ("tcp://", "tls://", "inproc://", "ucx://", "ws://", "wss://")
+
+
+def check_jobs(n_jobs, points):
+    """The number of local worker processes to start, checked before any work.
+
+    ``-1`` means one per core; anything else must be between 1 and
+    :data:`MAX_JOBS_PER_CORE` times the cores. Never more workers than points.
+
+    Examples
+    --------
+    >>> check_jobs(1, 10)
+    1
+    >>> check_jobs(0, 10)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--jobs` must be -1 (one per core) or a whole number from 1 to ...
+    """
+    cores = os.cpu_count() or 1
+    limit = MAX_JOBS_PER_CORE * cores
+    if isinstance(n_jobs, bool) or not isinstance(n_jobs, int) or not (
+            n_jobs == -1 or 1 <= n_jobs <= limit):
+        raise InputError(f"`--jobs` must be -1 (one per core) or a whole number from 1 to "
+                         f"{limit} ({MAX_JOBS_PER_CORE} per core on this machine), got {n_jobs!r}")
+    return max(1, min(cores if n_jobs == -1 else n_jobs, points))
+
+
+def check_scheduler(scheduler):
+    """Refuse a Dask scheduler address that cannot work, before any work.
+
+    Examples
+    --------
+    >>> check_scheduler("garbage://x")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--scheduler` must be a Dask scheduler address such as tcp://host:8786, got 'garbage://x'
+    """
+    if scheduler is None or hasattr(scheduler, "submit"):
+        return scheduler
+    if not isinstance(scheduler, str) or not scheduler.startswith(_SCHEMES) or \
+            len(scheduler.split("://", 1)[1]) == 0:
+        raise InputError("`--scheduler` must be a Dask scheduler address such as "
+                         f"tcp://host:8786, got {scheduler!r}")
+    try:
+        import distributed  # noqa: F401  (optional dependency: the [dask] extra)
+    except ImportError:
+        raise InputError("`--scheduler` needs Dask, which is not installed: "
+                         "pip install -e \".[dask]\"") from None
+    return scheduler
 
 
 #: the key of a row's fingerprint of its inputs (removed before rows are returned)
@@ -381,6 +434,10 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     """
     if scene not in SCENES:
         raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
+    n_jobs = check_jobs(n_jobs, max(1, len(points)))
+    scheduler = check_scheduler(scheduler)
+    if cache_dir is not None:
+        check_output_dir(cache_dir, "--cache")
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:

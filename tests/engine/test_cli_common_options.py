@@ -1,0 +1,32 @@
+"""Issue 21 (part): options several commands share are checked before any work, exit 2, one line."""
+
+import pytest
+
+from moreau.cli import main
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--jobs", "0"], "`--jobs` must be -1 (one per core) or a whole number from 1 to"),
+    (["--jobs", "100000"], "`--jobs` must be -1"),
+    (["--scheduler", "garbage://x"], "`--scheduler` must be a Dask scheduler address"),
+    (["--cache", "/proc/x"], "`--cache` folder '/proc/x' is not writable"),
+])
+def test_shared_options_are_refused_before_work(extra, message, tmp_path, capsys):
+    argv = ["sweep", "mu", "0.1", "0.2", "--points", "2", "--frequency", "185", "--out",
+            str(tmp_path), "--quiet", "--no-plot"] + extra
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+    assert not list(tmp_path.glob("*.csv"))
+
+
+def test_reproduce_refuses_zero_jobs(tmp_path, capsys):
+    assert main(["reproduce", "--quick", "--jobs", "0", "--out", str(tmp_path)]) == 2
+    assert "`--jobs`" in capsys.readouterr().err
+
+
+def test_run_refuses_an_out_folder_it_cannot_write(tmp_path, capsys):
+    f = tmp_path / "file"
+    f.write_text("x")
+    assert main(["run", "--frequency", "185", "--out", str(f), "--quiet"]) == 2
+    assert "`--out` folder" in capsys.readouterr().err
