@@ -12,7 +12,27 @@ from .errors import InputError
 
 
 def finite_scalar(name, value):
-    """Return ``value`` as a float, or raise if it is not a finite real number."""
+    """Return ``value`` as a float, or raise if it is not a finite real number.
+
+    Only numbers count: a string (``"0.1"``) or a bool (``True``) is refused
+    rather than coerced, since either is a mistake at the call site.
+
+    Examples
+    --------
+    >>> finite_scalar("mu", 0.1)
+    0.1
+    >>> finite_scalar("mu", "0.1")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `mu` must be a real number, got '0.1' (a str)
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)) \
+            and not (isinstance(value, np.ndarray) and value.ndim == 0
+                     and np.issubdtype(value.dtype, np.number)):
+        raise InputError(f"`{name}` must be a real number, got {value!r} "
+                         f"(a {type(value).__name__})")
+    if isinstance(value, (complex, np.complexfloating)):
+        raise InputError(f"`{name}` must be a real number, got {value!r}")
     try:
         x = float(value)
     except (TypeError, ValueError):

@@ -15,6 +15,7 @@ from ..errors import ConvergenceError, InputError, RunawayError
 # SteadyState is defined with the other scheme results (below this layer)
 # and re-exported here, where callers have always found it
 from ..integrators.result import SteadyState
+from ..scenes.base import Scene
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
 
@@ -138,6 +139,8 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     ...
     moreau.errors.RunawayError: no steady state: past stall (load F_L = 0.01 N); the rotor runs away backwards, ...
     """
+    if not isinstance(scene, Scene):
+        raise InputError(f"`scene` must be a Scene instance, got {type(scene).__name__}")
     ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
     why = implausible_steady_state(scene, ss)
     if why:

@@ -30,3 +30,21 @@ def test_run_refuses_an_out_folder_it_cannot_write(tmp_path, capsys):
     f.write_text("x")
     assert main(["run", "--frequency", "185", "--out", str(f), "--quiet"]) == 2
     assert "`--out` folder" in capsys.readouterr().err
+
+
+def test_wrong_types_in_the_api_are_refused_by_name():
+    import math
+
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.errors import InputError
+    from moreau.integrators import simulate
+    from moreau.scenes.friction_drive import FrictionDrive
+
+    with pytest.raises(InputError, match="`scene` must be a Scene instance, got str"):
+        find_steady_state("hello")
+    for bad in ("0.1", True):
+        with pytest.raises(InputError, match="`mu` must be a real number"):
+            FrictionDrive(mu=bad)
+    sc = FrictionDrive()
+    with pytest.raises(InputError, match="`h` must be a real number, got '0.01'"):
+        simulate(sc, (0.0, 2 * math.pi), *sc.rest_state(), "moreau-jean", h="0.01")
