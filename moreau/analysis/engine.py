@@ -27,11 +27,13 @@ import pathlib
 import time
 
 from ..errors import ConvergenceError, InputError
+from ..scenes import registry
+from .cases import DriveCase
 
 log = logging.getLogger(__name__)
 
 __all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
-           "ED_REFERENCE", "mj_check_columns", "SCENES"]
+           "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
 
@@ -121,18 +123,23 @@ def mj_check_columns(check):
     return [f"{p}_displacement_per_period_m", f"{p}_relative_error", f"{p}_mode", f"{p}_status"]
 
 
-#: scenes the engine can evaluate, by the name :func:`evaluate_point` takes
-SCENES = ("friction-drive", "bidirectional")
+def periodic_scene_names():
+    """The registered scenes with a periodic drive: the ones the engine can evaluate."""
+    return [e.name for e in registry.entries()
+            if "frequency" in e.parameter_names() and e.case is not None
+            and issubclass(e.case, DriveCase)]
+
+
+def _check_scene(scene):
+    entry = registry.get_entry(scene)  # an unknown name lists the known ones
+    if entry.name not in periodic_scene_names():
+        raise InputError(f"`scene` must be a periodically driven scene, one of "
+                         f"{periodic_scene_names()}; got {scene!r}")
+    return entry
 
 
 def _make_scene(params, frequency, scene):
-    if scene == "bidirectional":
-        from ..scenes.bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
-        return BidirectionalDrive(BidirectionalDriveParams(**params), frequency)
-    if scene != "friction-drive":
-        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
-    from ..scenes.friction_drive import FrictionDrive, FrictionDriveParams
-    return FrictionDrive(FrictionDriveParams(**params), frequency)
+    return registry.make_scene(_check_scene(scene).name, frequency=frequency, **params)
 
 
 def _steady(params, frequency, scheme, scene="friction-drive"):
@@ -186,8 +193,8 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     version : str
         Code version (only a cache key here).
     scene : str
-        One of :data:`SCENES`: the paper's single-rod drive or the two-rod
-        bidirectional drive (Moreau–Jean with projection in either case).
+        A registered periodically driven scene (:func:`periodic_scene_names`),
+        e.g. the paper's single-rod drive or the two-rod bidirectional drive.
 
     Returns
     -------
@@ -218,10 +225,10 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
            "min_normal_force_N": math.nan, "periodic_residual": math.nan,
            "shooting_iterations": 0, "status": "ok"}
     ref = math.nan
-    if scene not in SCENES:
-        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
+    _check_scene(scene)
     # both rods of the bidirectional drive share mu and phi0: one margin for either scene
-    margin = 1.0 - params["mu"] * math.tan(params["phi0"])
+    margin = (1.0 - params["mu"] * math.tan(params["phi0"]) if "mu" in params and "phi0" in params
+              else 1.0)
     if margin <= 0:
         # in contact phi <= phi0 (the stator only lifts the rod's hinge), so the rest angle
         # is the worst case; saying so here spares building an integrator for nothing
@@ -411,7 +418,7 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     progress : bool
         A tqdm bar (shown on a terminal only).
     scene : str
-        One of :data:`SCENES`; ``params`` are that scene's parameters.
+        A registered periodically driven scene; ``params`` are its parameters.
     chunk : int
         Points per task and per cache entry. Large grids (atlases) use a
         chunk of a grid line: tens of thousands of single-point entries
@@ -432,8 +439,7 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     >>> rows[0]["mode"], st["computed"]
     ('NS', 1)
     """
-    if scene not in SCENES:
-        raise InputError(f"`scene` must be one of {list(SCENES)}, got {scene!r}")
+    _check_scene(scene)
     n_jobs = check_jobs(n_jobs, max(1, len(points)))
     scheduler = check_scheduler(scheduler)
     if cache_dir is not None:
