@@ -363,7 +363,8 @@ def collect_rows(items, run, rows, on_row=None, progress=False, desc="", unit="i
     """
     bar = None
     if progress:
-        bar = tqdm(total=len(items), desc=desc, unit=unit)
+        # disable=None: a bar on a terminal only, never in a log file
+        bar = tqdm(total=len(items), desc=desc, unit=unit, disable=None)
     try:
         for item in items:
             for row in run(item):

@@ -247,7 +247,7 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
     bar = None
     if progress:
         from tqdm.auto import tqdm
-        bar = tqdm(total=float(t1 - t0), unit="t", leave=False)
+        bar = tqdm(total=float(t1 - t0), unit="t", leave=False, disable=None)  # terminals only
     last = integ.t
     try:
         while integ.status == "running":

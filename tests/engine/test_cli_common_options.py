@@ -48,3 +48,17 @@ def test_wrong_types_in_the_api_are_refused_by_name():
     sc = FrictionDrive()
     with pytest.raises(InputError, match="`h` must be a real number, got '0.01'"):
         simulate(sc, (0.0, 2 * math.pi), *sc.rest_state(), "moreau-jean", h="0.01")
+
+
+def test_progress_bars_stay_out_of_logs(tmp_path):
+    # stderr redirected to a file, as a log would be: no tqdm bar in it
+    import subprocess
+    import sys
+    log = tmp_path / "log.txt"
+    with open(log, "w") as fh:
+        run = subprocess.run([sys.executable, "-m", "moreau", "compare", "--scene", "sliding-block",
+                              "--quick", "--no-plot", "--out", str(tmp_path)], stdout=subprocess.PIPE,
+                             stderr=fh, text=True)
+    assert run.returncode == 0
+    assert "it/s" not in log.read_text() and "run/s" not in log.read_text()
+    assert "%|" not in log.read_text()
