@@ -45,8 +45,12 @@ def test_scheme_options_change_the_computation(tmp_path):
     assert int(loose[0]["shooting_iterations"]) < int(ed[0]["shooting_iterations"])
     assert disp(loose)[0] != ref
     assert int(mj_loose[0]["shooting_iterations"]) < int(mj[0]["shooting_iterations"])
-    meta = (tmp_path / "half" / "sweep_frequency.json").read_text()
+    # the scheme and its settings are in the file name and in a column (issue 21)
+    meta = (tmp_path / "half" / "sweep_frequency_mj_theta0.5_N400.json").read_text()
     assert '"theta": 0.5' in meta and '"steps_per_period": 400' in meta
+    assert {r["scheme"] for r in half} == {"moreau-jean"} and ed[0]["scheme"] == "event-driven"
+    assert (tmp_path / "ed" / "sweep_frequency.csv").exists()
+    assert (tmp_path / "loose" / "sweep_frequency_ed_rtol0.01.csv").exists()
 
 
 @pytest.mark.parametrize("args, match", [
@@ -115,3 +119,11 @@ def test_failed_point_is_a_status_and_the_sweep_goes_on(tmp_path):
     rows = sweep(tmp_path, "phi0", "phi0", "0.8", "1.5", "--points", "2", "--frequency", "185")
     assert rows[0]["status"] == "ok"
     assert rows[1]["status"].startswith("PainleveError") and rows[1]["mode"] == ""
+
+
+def test_a_frequency_with_a_decimal_point_keeps_its_file_name(tmp_path):
+    # Path.with_suffix used to cut "sweep_mu_12.5Hz" into "sweep_mu_12.csv"
+    rows = sweep(tmp_path, "f", "mu", "0.1", "0.2", "--points", "2", "--frequency", "12.5")
+    assert len(rows) == 2
+    assert (tmp_path / "f" / "sweep_mu_12.5Hz.csv").exists()
+    assert (tmp_path / "f" / "sweep_mu_12.5Hz.json").exists()

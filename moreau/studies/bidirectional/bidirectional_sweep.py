@@ -173,7 +173,7 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
                               else f"{parameter}_{frequency:g}Hz")
     stem = out / f"sweep_{tag}"
     from ..paper.reproduce import write_table
-    write_table(table, stem.with_suffix(".csv"))
+    write_table(table, (stem.parent / (stem.name + ".csv")))
     marks = _marks(params, parameter, frequency)
     from ... import __version__
     meta = {
@@ -193,8 +193,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         "python": sys.version.split()[0],
         "engine": stats,
     }
-    stem.with_suffix(".json").write_text(json.dumps(meta, indent=2))
-    log(f"wrote {stem.with_suffix('.csv')} ({len(table)} points: {stats['computed']} computed, "
+    (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
+    log(f"wrote {(stem.parent / (stem.name + '.csv'))} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
         from ..paper.figures import sweep_figure

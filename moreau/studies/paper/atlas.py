@@ -212,7 +212,7 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
                           scheme=scheme, cache_dir=cache_dir, n_jobs=n_jobs, scheduler=scheduler,
                           progress=progress)
         stem = out / f"atlas_{plane}"
-        write_table(atlas_rows(a), stem.with_suffix(".csv"))
+        write_table(atlas_rows(a), (stem.parent / (stem.name + ".csv")))
         s = a["scheme"]
         meta = {"plane": plane, "grid": [f_points, y_points],
                 "frequency_Hz": [float(a["frequency_Hz"][0]), float(a["frequency_Hz"][-1])],
@@ -223,14 +223,14 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
                 "package_version": __version__, "code_version": code_version(),
                 "python": sys.version.split()[0], "engine": a["stats"],
                 "wall_time_s": a["wall_time_s"], "scheduler": scheduler}
-        stem.with_suffix(".json").write_text(json.dumps(meta, indent=2))
+        (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
         counts = {}
         for lab in a["label"].ravel():
             counts[lab] = counts.get(lab, 0) + 1
         log(f"atlas {plane}: {f_points} x {y_points} points ({a['stats']['computed']} computed, "
             f"{a['stats']['cached']} from the cache) in {a['wall_time_s']:.1f} s; "
             + ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])))
-        log(f"wrote {stem.with_suffix('.csv')}")
+        log(f"wrote {(stem.parent / (stem.name + '.csv'))}")
         if plot:
             from .figures import atlas_figure
             paths = atlas_figure(a, stem)

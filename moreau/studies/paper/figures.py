@@ -50,7 +50,8 @@ def save(fig, stem):
     """Save ``fig`` as ``stem.png`` and ``stem.svg``; return both paths."""
     import pathlib
     stem = pathlib.Path(stem)
-    paths = [stem.with_suffix(".png"), stem.with_suffix(".svg")]
+    # stem.name + suffix: with_suffix would cut a tag such as theta0.5_N400 at its dot
+    paths = [stem.parent / (stem.name + ".png"), stem.parent / (stem.name + ".svg")]
     fig.savefig(paths[0], dpi=130)
     fig.savefig(paths[1])
     _plt().close(fig)

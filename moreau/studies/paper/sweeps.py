@@ -133,6 +133,29 @@ def plot_sweep(rows, parameter, path, title=""):
 SWEEPABLE = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
 
 
+def _with(stem, suffix):
+    # Path.with_suffix would take the ".5_N400" of a tag like theta0.5_N400 for a suffix
+    return stem.parent / (stem.name + suffix)
+
+
+def scheme_tag(scheme):
+    """The file-name suffix of a scheme: empty for the event-driven reference at its default.
+
+    Examples
+    --------
+    >>> scheme_tag(make_scheme())
+    ''
+    >>> scheme_tag(make_scheme("moreau-jean", theta=0.5, steps_per_period=2000))
+    '_mj_theta0.5_N2000'
+    >>> scheme_tag(make_scheme("event-driven", rtol=1e-6))
+    '_ed_rtol1e-06'
+    """
+    if scheme.name == "moreau-jean":
+        tag = f"_mj_theta{scheme.theta:g}_N{scheme.steps_per_period}"
+        return tag + (f"_tol{scheme.rtol:g}" if scheme.rtol is not None else "")
+    return "" if scheme.rtol in (None, 1e-10) else f"_ed_rtol{scheme.rtol:g}"
+
+
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
 
@@ -198,7 +221,9 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     on disk (``cache_dir``, default ``OUT/cache``), in parallel on local
     processes or on a Dask scheduler, a failed point kept as its ``status``.
     Writes ``OUT/sweep_TAG.csv`` (tidy, units in the column names, the same
-    columns as ``moreau reproduce``), ``sweep_TAG.json`` (parameters, scheme,
+    columns as ``moreau reproduce`` plus ``scheme``; ``TAG`` names the
+    parameter, the frequency and any scheme or setting other than the
+    event-driven reference's default, :func:`scheme_tag`), ``sweep_TAG.json`` (parameters, scheme,
     package version) and the figure ``sweep_TAG.png``/``.svg``.
 
     Parameters
@@ -253,13 +278,18 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     rows, stats = run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                              scheduler=scheduler, progress=progress, desc=f"sweep {parameter}")
     table = tidy_rows(parameter, values, frequency, params, rows, ())
+    for r in table:
+        r["scheme"] = scheme.name
     tag = parameter if parameter == "frequency" else f"{parameter}_{frequency:g}Hz"
+    # a scheme or setting other than the reference's default is in the name, so
+    # that sweeps of one parameter by different schemes do not overwrite each other
+    tag += scheme_tag(scheme)
     stem = out / f"sweep_{tag}"
-    write_table(table, stem.with_suffix(".csv"))
+    write_table(table, _with(stem, ".csv"))
     marks = range_marks(params, parameter, frequency)
-    _sidecar(stem.with_suffix(".json"), params, f"sweep_{tag}", parameter, values, frequency,
+    _sidecar(_with(stem, ".json"), params, f"sweep_{tag}", parameter, values, frequency,
              marks, (), None, stats, scheme=scheme)
-    log(f"wrote {stem.with_suffix('.csv')} ({len(table)} points: {stats['computed']} computed, "
+    log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
         from .figures import sweep_figure
