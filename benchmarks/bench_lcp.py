@@ -201,7 +201,7 @@ def main(argv=None):
             f" {'quantecon':>10s} {'ratio':>6s} {'lemkelcp*':>10s} {'ratio':>7s}")
     print(head)
     print("-" * len(head))
-    worst_qe = 0.0
+    worst_qe = None
     for name, M, q, feasible, max_iter in bench_instances(args.quick):
         n = len(q)
         fns = dict(solvers())
@@ -238,11 +238,15 @@ def main(argv=None):
         r_qe = paired_ratio("quantecon") if "quantecon" in times else None
         r_lk = paired_ratio("lemkelcp*") if "lemkelcp*" in times else None
         if r_qe is not None and marks.get("quantecon") == "ok":
-            worst_qe = max(worst_qe, r_qe)
+            worst_qe = r_qe if worst_qe is None else max(worst_qe, r_qe)
         print(f"{name:30s} {n:4d} {cell('moreau'):>9s} {cell('moreau-lean'):>9s} {fmt_us(times['kernel']):>9s}"
               f" {cell('quantecon'):>10s} {('-' if r_qe is None else f'{r_qe:.2f}'):>6s}"
               f" {cell('lemkelcp*'):>10s} {('-' if r_lk is None else f'{r_lk:.3f}'):>7s}")
-    print(f"\nworst moreau/quantecon ratio over the instances both solve: {worst_qe:.2f}")
+    if worst_qe is None:
+        print("\nno moreau/quantecon ratio: the peer is missing (pip install quantecon) or "
+              "solved no instance")
+    else:
+        print(f"\nworst moreau/quantecon ratio over the instances both solve: {worst_qe:.2f}")
     if "lemkelcp" in dict(solvers()):
         print("lemkelcp 0.1 as published (without the patch) raised an exception on every instance with a "
               "negative q entry; 'lemkelcp*' is the same code with `wPos`/`zPos` turned into lists.")
