@@ -1,7 +1,8 @@
 """Friction drive: the generic compiled kernel against the deleted hand-written one.
 
 Issue 9 asks that moving the friction drive onto the generic kernel
-(``moreau.integrators._mj_kernels.mj_run``) costs no speed. The hand-written
+(``moreau.integrators._mj_kernels.mj_loop``, compiled per model by
+``moreau.integrators._loops.runner_for``) costs no speed. The hand-written
 kernel it replaced (``mj_run_fd`` with ``scenes/_friction_drive_jit.py``, last
 present at commit ``e635941``) is loaded from git into a throw-away package
 (kept under the temp folder so that numba's cache of it survives between
@@ -30,6 +31,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from moreau.integrators import _mj_kernels as mk
+from moreau.integrators._loops import runner_for
 from moreau.scenes import FrictionDrive
 
 OLD_COMMIT = "e635941"
@@ -99,9 +101,8 @@ def main(argv=None):
         q, v = q0.copy(), v0.copy()
         st = mk.new_stats()
         closed = np.zeros(1, dtype=np.bool_)
-        out = mk.mj_run(m.kind, m.par, m.ndof, m.ncontacts, mu, e, m.const_mass,
-                        m.has_jacobians, 0.0, h, t_bound, 0, N, q, v, 1.0, projection, closed,
-                        N, False, mk.new_lcp_control(1), *bufs(1), st)
+        out = runner_for(m)(m.par, mu, e, 0.0, h, t_bound, 0, N, q, v, 1.0, projection, closed,
+                            N, False, mk.new_lcp_control(1), *bufs(1), st)
         return out[1], q, v
 
     print(f"friction drive {args.frequency:g} Hz, h = 2 pi/1000, {N} steps, "

@@ -35,7 +35,7 @@ import dataclasses
 import numpy as np
 
 from .errors import InputError
-from .scenes._compiled import check_compiled_model
+from .compiled import check_compiled_model
 from .scenes.base import Scene
 
 __all__ = ["check_scene", "SceneReport"]

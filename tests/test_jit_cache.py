@@ -95,30 +95,26 @@ def test_kernel_stamps_carry_the_digest_of_all_kernel_sources():
     from moreau.lcp import lemke
 
     names = {os.path.basename(p) for p in mk.KERNEL_SOURCES}
-    assert {"_mj_kernels.py", "_compiled.py", "lemke.py", "certify.py", "_certified.py"} <= names
+    assert {"_mj_kernels.py", "lemke.py", "certify.py", "_certified.py"} <= names
     assert mk.CACHE_MODE == "bound"
     digest = _jit_cache.sources_digest(mk.KERNEL_SOURCES)
-    for disp in (mk._mj_run_friction_drive, mk._mj_run_3x2, mk._mj_run_any, mk._lcp_step,
-                 mk._one_contact):
+    for disp in (mk._lcp_step, mk._one_contact, mk.no_gaps):
         stamp = disp._cache._cache_file._source_stamp
         assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
     assert lemke.lemke_core._cache._cache_file._source_stamp[0] == "moreau-deps"
 
 
-def test_digest_changes_with_content(tmp_path):
-    a = tmp_path / "a.py"
-    a.write_text("x = 1\n")
-    d1 = _jit_cache.sources_digest([str(a)])
-    a.write_text("x = 2\n")
-    assert _jit_cache.sources_digest([str(a)]) != d1
-    assert _jit_cache.sources_digest([str(tmp_path / "missing.py")]) != d1
+def test_a_scene_runner_is_tied_to_its_model_and_kernel_sources(monkeypatch):
+    from moreau.integrators import _loops
+    from moreau.integrators import _mj_kernels as mk
+    from moreau.scenes import friction_drive
 
-
-def test_unknown_cache_internals_fall_back_to_memory():
-    from types import SimpleNamespace
-
-    from numba.core.caching import NullCache
-
-    disp = SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace()))
-    assert _jit_cache.bind_cache_to_sources([disp], [__file__]) == "memory"
-    assert isinstance(disp._cache, NullCache)
+    model = friction_drive.FrictionDrive(frequency=185.0).compiled_model()
+    monkeypatch.setattr(_loops, "_RUNNERS", {})
+    run = _loops.runner_for(model)
+    deps = _loops.dependency_files(list(model.functions().values()))
+    # the model's module and the rod pieces it calls (another file) are both tracked
+    assert {"friction_drive.py", "_rod.py"} <= {os.path.basename(p) for p in deps}
+    digest = _jit_cache.sources_digest(list(mk.KERNEL_SOURCES) + deps)
+    stamp = run._cache._cache_file._source_stamp
+    assert stamp[0] == "moreau-deps" and stamp[1][1] == digest

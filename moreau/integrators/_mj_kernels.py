@@ -3,9 +3,10 @@
 This is the fast path of :mod:`moreau.integrators.moreau_jean`: the same
 scheme, the same time grid, index set, contact problem, regime
 classification and projection, run as one ``numba`` call over a block of
-steps that allocates nothing per step. The scene's model comes from
-:mod:`moreau.scenes._compiled` as ``(kind, par)``; the loop itself knows no
-scene.
+steps that allocates nothing per step. The scene's model comes as the
+functions of its :class:`moreau.compiled.CompiledModel`; the loop itself
+knows no scene, and :mod:`moreau.integrators._loops` compiles it once per
+model, on first use.
 
 The contact problem of a step is solved as the generic path solves it:
 
@@ -44,7 +45,6 @@ sticking contacts to the velocities' difference over ``h``, see
 """
 
 import math
-import sys
 
 import numpy as np
 from numba import njit
@@ -54,11 +54,8 @@ from ..lcp import _certified
 from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, eliminate, lemke_core, lemke_workspace
-from ..scenes import _compiled
-from ..scenes._compiled import (FRICTION_DRIVE, contact_fn, dynamics_fn, fused, gaps_fn, mass_fn,
-                                step_fn)
 
-__all__ = ["mj_run", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
+__all__ = ["mj_loop", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
 
 # status codes (those of SimulationResult where they overlap)
@@ -203,7 +200,7 @@ def _invert_small(A, out, n):
     Singular means to working precision: a 1-norm condition number of 1e14 or
     more, or a non-finite entry. Loop-free and call-free on purpose: numba
     reference-counts the arrays of an inlined function, and LLVM prunes those
-    counts only around straight-line code (see moreau.scenes._compiled).
+    counts only around straight-line code.
     """
     ok = True
     na = 0.0
@@ -664,11 +661,73 @@ def _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, 
     return status, pivots, res, used
 
 
-@njit(cache=True, inline="always")
-def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-             theta, projection, closed, save_every, record_initial, lcp_ctl,
-             rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    # the loop of mj_run, inlined there three times (see mj_run)
+def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, save_every,
+            record_initial, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
+            rec_gap, stats):
+    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
+
+    A template, not called as it stands: :func:`moreau.integrators._loops.runner_for`
+    compiles it once per model, in a namespace that adds the model to this
+    module's globals: its functions ``mass_fn``, ``forces_fn``,
+    ``contacts_fn`` and ``gaps_fn`` (:class:`moreau.compiled.CompiledModel`),
+    and the constants ``NDOF``, ``NCONTACTS``, ``CONST_MASS`` (``M``
+    independent of ``q``), ``HAS_JAC`` (``dh/dq`` or ``dh/dv`` nonzero) and
+    ``HAS_GAPS`` (the model has ``gaps``). Numba
+    freezes globals, so the compiler drops the branches the model does not
+    take and unrolls the small-matrix loops; passing the functions as
+    arguments instead would make them run-time values, which numba can
+    neither inline nor cache.
+
+    Parameters
+    ----------
+    par : float64[:]
+        The model's parameters.
+    mu, e : float64[:]
+        Friction and restitution of each contact.
+    t0, h, t_bound : float
+        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
+    k0 : int
+        Index of the first step (``t_k0 = t0 + k0 h``).
+    nmax : int
+        Most steps to take in this call.
+    q, v : float64[n]
+        State at ``t_k0``; overwritten with the final state.
+    theta : float
+    projection : bool
+    closed : bool[nc]
+        Contacts that carried a normal impulse in the step before ``k0``; updated.
+    save_every : int
+        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
+    record_initial : bool
+        Also record the state at ``t_k0`` (with the first step's regime and forces).
+    lcp_ctl : int64[:]
+        From :func:`new_lcp_control`: ``force_lemke`` (solve a single active
+        contact by Lemke too, ``lcp_method="lemke"``), ``warm_start`` (try
+        the last contact LCP's support before Lemke, see :func:`_lcp_step`),
+        ``max_iter`` (Lemke's pivot limit; ``<= 0``: the default, 1000, or
+        ``50 L`` above ``L = 20``), then the warm start's memory, read and
+        updated; the caller keeps the array from one call to the next.
+    rec_* : arrays
+        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
+        ones (ns, nc); long enough for this call's samples.
+    stats : float64[:]
+        Accumulated statistics, layout :data:`STAT_NAMES`.
+
+    Returns
+    -------
+    status : int
+        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
+        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
+        of the step Lemke could not solve).
+    k : int
+        Index of the next step (steps taken: ``k - k0``).
+    nrec : int
+        Samples written.
+    """
+    n = NDOF  # noqa: F821  (the model's namespace, see above)
+    nc = NCONTACTS  # noqa: F821
+    const_mass = CONST_MASS  # noqa: F821
+    has_jac = HAS_JAC  # noqa: F821
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     rvel = np.zeros(2 * max(nc, 1))
@@ -678,7 +737,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
     Wh = np.empty((n, n))
     Wi = np.empty((n, n))
     wk = np.empty((n, n))
-    # model outputs, packed (see moreau.scenes._compiled): D = [h | K | C]
+    # model outputs, packed (see moreau.compiled): D = [h | K | C]
     D = np.zeros((n, 1 + 2 * n))
     D0 = np.zeros((n, 1 + 2 * n))
     rhs = np.empty(n)
@@ -756,18 +815,13 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             break
         # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
         # the gaps at (q_k, t_k) were computed at the end of the step before
-        drive = fused(kind)
-        if drive:
-            step_fn(kind, par, q, v, tk, t1, not (const_mass and k > k0), k == k0, th != 1.0,
-                    has_jac, M, D, D0, G0, G1)
-        else:
-            if not (const_mass and k > k0):
-                mass_fn(kind, par, q, M)
-            dynamics_fn(kind, par, q, v, t1, D, has_jac)
-            if th != 1.0:
-                dynamics_fn(kind, par, q, v, tk, D0, False)
-            if nc > 0:
-                contact_fn(kind, par, q, tk, G0, k == k0, False)
+        if not (const_mass and k > k0):
+            mass_fn(par, q, M)
+        forces_fn(par, q, v, t1, D, has_jac)
+        if th != 1.0:
+            forces_fn(par, q, v, tk, D0, False)
+        if nc > 0:
+            contacts_fn(par, q, tk, G0, k == k0, False)
         if th != 1.0:
             for i in range(n):
                 D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
@@ -824,8 +878,8 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                     if mu[i] > 0.0:
                         fa[nfa] = i
                         nfa += 1
-        if na > 0 and not drive:
-            contact_fn(kind, par, q, t1, G1, False, True)
+        if na > 0:
+            contacts_fn(par, q, t1, G1, False, True)
         if na == 1 and not force_lemke:
             # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
             # matrix, built from the contact's two rows only; loops over n alone, so
@@ -954,13 +1008,16 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
         gaps_current = False
         if projection and nc > 0:
             if not const_mass:
-                mass_fn(kind, par, q1, M)
+                mass_fn(par, q1, M)
             for i in range(nc):
                 sel[i] = cnew[i]
             # M^-1 of a constant mass matrix is kept from the last projection
             pinv = const_mass and have_Mi
             for _ in range(PROJECTION_MAXITER):
-                gaps_fn(kind, par, q1, t1, Gq)
+                if HAS_GAPS:  # noqa: F821
+                    gaps_fn(par, q1, t1, Gq)
+                else:
+                    contacts_fn(par, q1, t1, Gq, True, False)
                 gaps_current = True
                 anysel = False
                 gmax = 0.0
@@ -982,7 +1039,7 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
                         break
                     pinv = True
                     have_Mi = True
-                contact_fn(kind, par, q1, t1, Gq, False, False)
+                contacts_fn(par, q1, t1, Gq, False, False)
                 s = 0
                 for i in range(nc):
                     if sel[i]:
@@ -1039,7 +1096,10 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
             break
         if nc > 0:
             if not gaps_current:
-                gaps_fn(kind, par, q1, t1, Gq)
+                if HAS_GAPS:  # noqa: F821
+                    gaps_fn(par, q1, t1, Gq)
+                else:
+                    contacts_fn(par, q1, t1, Gq, True, False)
             for i in range(nc):
                 if -Gq[i, 0] > stats[S_PEN]:
                     stats[S_PEN] = -Gq[i, 0]
@@ -1087,132 +1147,18 @@ def _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, n
 # error_model="numpy": a division by zero gives inf/nan, which the loop's own
 # tests turn into SINGULAR or NUMERICAL, instead of a raise branch after every
 # division, whose clean-up path kept numba from pruning reference counts.
-#
-# The same loop three times, each its own compiled function so that a process
-# compiles (or loads from the cache) only the one its scene uses: with the
-# friction drive's kind and sizes as constants, with the sizes of the
-# two-contact scenes, and for any model. With constants, the compiler drops the
-# other scenes' branches, unrolls the small-matrix loops and evaluates the
-# sines and cosines shared by the model functions once per step; that keeps the
-# paper's scene as fast as its former hand-written kernel.
-@njit(cache=True, error_model="numpy")
-def _mj_run_friction_drive(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, lcp_ctl,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    return _mj_loop(FRICTION_DRIVE, par, 2, 1, mu, e, True, True, t0, h, t_bound,
-                    k0, nmax, q, v, theta, projection, closed, save_every, record_initial,
-                    lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
-                    rec_gap, stats)
+@njit(cache=True)
+def no_gaps(par, q, t, G):
+    """Stands in for a model without a ``gaps`` function (never called: ``HAS_GAPS`` is False)."""
+    G[0, 0] = math.nan
 
 
-@njit(cache=True, error_model="numpy")
-def _mj_run_3x2(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, lcp_ctl,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    # three degrees of freedom on two contacts (the two-rod drive, the box):
-    # with the sizes constant, the Delassus products and the contact rows' loops unroll
-    return _mj_loop(kind, par, 3, 2, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax,
-                    q, v, theta, projection, closed, save_every, record_initial, lcp_ctl,
-                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
-
-
-@njit(cache=True, error_model="numpy")
-def _mj_run_any(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, lcp_ctl,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    return _mj_loop(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q,
-                    v, theta, projection, closed, save_every, record_initial, lcp_ctl,
-                    rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
-
-
-def mj_run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-           theta, projection, closed, save_every, record_initial, lcp_ctl,
-           rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
-    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
-
-    Parameters
-    ----------
-    kind, par : int, float64[:]
-        The scene's :class:`~moreau.scenes._compiled.CompiledModel`.
-    n, nc : int
-        Degrees of freedom and contacts.
-    mu, e : float64[:]
-        Friction and restitution of each contact.
-    const_mass, has_jac : bool
-        ``M`` independent of ``q``; ``dh/dq`` or ``dh/dv`` nonzero.
-    t0, h, t_bound : float
-        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
-    k0 : int
-        Index of the first step (``t_k0 = t0 + k0 h``).
-    nmax : int
-        Most steps to take in this call.
-    q, v : float64[n]
-        State at ``t_k0``; overwritten with the final state.
-    theta : float
-    projection : bool
-    closed : bool[nc]
-        Contacts that carried a normal impulse in the step before ``k0``; updated.
-    save_every : int
-        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
-    record_initial : bool
-        Also record the state at ``t_k0`` (with the first step's regime and forces).
-    lcp_ctl : int64[:]
-        From :func:`new_lcp_control`: ``force_lemke`` (solve a single active
-        contact by Lemke too, ``lcp_method="lemke"``), ``warm_start`` (try
-        the last contact LCP's support before Lemke, see :func:`_lcp_step`),
-        ``max_iter`` (Lemke's pivot limit; ``<= 0``: the default, 1000, or
-        ``50 L`` above ``L = 20``), then the warm start's memory, read and
-        updated; the caller keeps the array from one call to the next.
-    rec_* : arrays
-        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
-        ones (ns, nc); long enough for this call's samples.
-    stats : float64[:]
-        Accumulated statistics, layout :data:`STAT_NAMES`.
-
-    Returns
-    -------
-    status : int
-        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
-        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
-        of the step Lemke could not solve).
-    k : int
-        Index of the next step (steps taken: ``k - k0``).
-    nrec : int
-        Samples written.
-    """
-    if kind == FRICTION_DRIVE and n == 2 and nc == 1 and const_mass and has_jac:
-        run = _mj_run_friction_drive
-    elif n == 3 and nc == 2:
-        run = _mj_run_3x2
-    else:
-        run = _mj_run_any
-    if not run.signatures:
-        _compile_note(run)
-    return run(kind, par, n, nc, mu, e, const_mass, has_jac, t0, h, t_bound, k0, nmax, q, v,
-               theta, projection, closed, save_every, record_initial, lcp_ctl,
-               rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats)
-
-
-def _compile_note(run):
-    # the first call in a process either loads the machine code from numba's
-    # cache (a fraction of a second) or compiles it (about a minute): say so on
-    # a terminal, once, so that a first run is not a silent wait
-    if sys.stderr.isatty() and not _NOTED.get(run.__name__):
-        _NOTED[run.__name__] = True
-        print("moreau: loading the compiled Moreau-Jean loop (the first use on a machine "
-              "compiles it, about a minute)...", file=sys.stderr, flush=True)
-
-
-_NOTED = {}
-
-
-#: every source whose compiled code ends up in this module's functions (the
-#: scene models and Lemke are inlined or linked in; globals are frozen in)
-KERNEL_SOURCES = (__file__, _compiled.__file__, _lemke.__file__, _certify.__file__,
-                  _certified.__file__)
+#: every source whose compiled code ends up in this module's functions and in
+#: the runners built on mj_loop (Lemke is linked in; globals are frozen in)
+KERNEL_SOURCES = (__file__, _lemke.__file__, _certify.__file__, _certified.__file__)
 
 # numba checks a cached kernel against this file only: tie it to all of them so
-# that editing a scene model or Lemke cannot leave stale machine code in use
+# that editing Lemke cannot leave stale machine code in use
 CACHE_MODE = _jit_cache.bind_cache_to_sources(
     [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
      and getattr(f.py_func, "__module__", None) == __name__],

@@ -141,6 +141,8 @@ from ..errors import InputError, LCPError, PainleveError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 from . import _mj_kernels as _kernels
+from ._loops import runner_for
+from ._mj_kernels import LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
@@ -583,7 +585,6 @@ class MoreauJean(Integrator):
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
     def _fast_block(self):
-        from ._mj_kernels import LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, mj_run
 
         m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
         nmax = FAST_BLOCK
@@ -595,9 +596,8 @@ class MoreauJean(Integrator):
         closed = self._closed.copy()
         st = self._stats
         st[:] = 0.0
-        status, k, nrec = mj_run(
-            m.kind, m.par, n, nc, self.mu_c, self.e_c, m.const_mass, m.has_jacobians,
-            self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta, self.projection,
+        status, k, nrec = runner_for(m)(
+            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta, self.projection,
             closed, self.save_every, self._pending_initial, self._lcp_ctl, *buf, st)
         ndone = k - self._k
         if nrec:
@@ -732,7 +732,7 @@ class MoreauJean(Integrator):
 
 
 def compiled_model_of(scene):
-    """The scene's :class:`~moreau.scenes._compiled.CompiledModel`, or None.
+    """The scene's :class:`~moreau.compiled.CompiledModel`, or None.
 
     None when the scene has no ``compiled_model()``, or when a subclass
     overrides one of the model methods (``mass``, ``forces``,

@@ -69,6 +69,10 @@ import numpy as np
 from .. import _validate as V
 from ..errors import InputError
 from ._units import DriveUnits
+from numba import njit
+
+from ..compiled import CompiledModel
+from ._rod import rod_forces, rod_gap, rod_rows
 from .base import Scene, params_with
 from .friction_drive import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
@@ -163,6 +167,49 @@ class BidirectionalDriveParams:
         return cls(m=params.m, m2=params.m2, k=params.k, length=params.length, phi0=params.phi0,
                    mu=params.mu, x10_a=params.x10, x10_b=params.x10 if x10_b is None else x10_b,
                    phase=phase, load=params.load, restitution=params.restitution)
+
+
+# -- compiled model (moreau.compiled) ---------------------------------------------------
+# par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b; rod r (angle q[r], stator phase
+# delta_r) on the rotor q[2], the second rod mirrored (sgn = -1)
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0 / 3.0
+    M[1, 1] = 1.0 / 3.0
+    M[2, 2] = par[0]
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    for r in range(2):
+        rod_forces(D, r, par[1], par[2], par[4 + r], math.sin(q[r]), math.cos(q[r]),
+                   math.cos(t - par[6 + r]), need_jac)
+    D[2, 0] = -par[3]
+
+
+@njit(cache=True)
+def _gaps(par, q, t, G):
+    for r in range(2):
+        G[r, 0] = rod_gap(par[2], par[4 + r], math.sin(q[r]), math.cos(t - par[6 + r]))
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    for r in range(2):
+        s = math.sin(q[r])
+        if need_gap:
+            G[r, 0] = rod_gap(par[2], par[4 + r], s, math.cos(t - par[6 + r]))
+        rod_rows(G, r, r, 2, 3, 1.0 - 2.0 * r, par[4 + r], s, math.cos(q[r]),
+                 math.sin(t - par[6 + r]), need_T)
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    for r in range(2):
+        w2 = v[r] * v[r]
+        Dr[r, 0] = w2 * math.sin(q[r]) - par[4 + r] * math.cos(t - par[6 + r])
+        Dr[r, 1] = (1.0 - 2.0 * r) * w2 * math.cos(q[r])
 
 
 def params_from_kwargs(**kwargs):
@@ -299,11 +346,10 @@ class BidirectionalDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import BIDIRECTIONAL_DRIVE, CompiledModel
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.u10[0], self.u10[1],
                         self.delta[0], self.delta[1]], dtype=np.float64)
-        return CompiledModel(BIDIRECTIONAL_DRIVE, par, 3, 2, True, True)
+        return CompiledModel(_mass, _forces, _contacts, _drift, par, 3, 2, True, True, gaps=_gaps)
 
     def single_rod(self, which):
         """The paper's :class:`FrictionDrive` for rod ``"a"`` or ``"b"`` alone, same frequency."""

@@ -22,6 +22,9 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from numba import njit
+
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from ._units import SIUnits, SIValues
@@ -133,10 +136,8 @@ class BouncingBall(SIUnits, Scene):
         return np.array([self.r + 1.0]), np.zeros(1)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import BOUNCING_BALL, CompiledModel
-        return CompiledModel(BOUNCING_BALL, np.array([self.r], dtype=np.float64), 1, 1,
-                             True, False)
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
 
     # -- exact solution -------------------------------------------------------
     def _initial(self, q0, v0):
@@ -313,6 +314,30 @@ class BouncingBallCase(CompareCase):
         return [(float(t[i]), "!") for i in range(1, len(letters))
                 if letters[i] != "F" and letters[i - 1] == "F"]
 
+
+
+# -- compiled model (moreau.compiled); par: r ---------------------------------------------
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    D[0, 0] = -1.0
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[0] - par[0]
+    G[0, 3] = 1.0
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
 
 
 register_scene(SceneEntry(

@@ -54,6 +54,10 @@ from .. import _validate as V
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from ._units import DriveUnits
+from numba import njit
+
+from ..compiled import CompiledModel
+from ._rod import rod_forces, rod_gap, rod_rows
 from .base import Scene, params_with
 from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ..analysis.steady_state import find_steady_state
@@ -297,10 +301,9 @@ class FrictionDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import FRICTION_DRIVE, CompiledModel
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0], dtype=np.float64)
-        return CompiledModel(FRICTION_DRIVE, par, 2, 1, True, True)
+        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
 
     # -- units ------------------------------------------------------------------
     def to_si(self, result):
@@ -321,6 +324,40 @@ class FrictionDrive(DriveUnits, Scene):
             "slip_velocity": result.slip_velocity[:, 0] * l * w,
             "regime": result.regime[:, 0].copy(),
         }
+
+
+# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0 -----------------
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0 / 3.0
+    M[1, 1] = par[0]
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    rod_forces(D, 0, par[1], par[4], par[2], math.sin(q[0]), math.cos(q[0]), math.cos(t), need_jac)
+    D[1, 0] = -par[3]
+
+
+@njit(cache=True)
+def _gaps(par, q, t, G):
+    G[0, 0] = rod_gap(par[4], par[2], math.sin(q[0]), math.cos(t))
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    s = math.sin(q[0])
+    if need_gap:
+        G[0, 0] = rod_gap(par[4], par[2], s, math.cos(t))
+    rod_rows(G, 0, 0, 1, 2, 1.0, par[2], s, math.cos(q[0]), math.sin(t), need_T)
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    w2 = v[0] * v[0]
+    Dr[0, 0] = w2 * math.sin(q[0]) - par[2] * math.cos(t)
+    Dr[0, 1] = w2 * math.cos(q[0])
 
 
 def params_from_kwargs(**kwargs):

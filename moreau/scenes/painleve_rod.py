@@ -39,6 +39,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from numba import njit
+
+from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from .base import Scene
@@ -177,9 +180,8 @@ class PainleveRod(SIUnits, Scene):
         return self.sliding_state(phi=math.pi / 4, tip_speed=1.0)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import PAINLEVE_ROD, CompiledModel
-        return CompiledModel(PAINLEVE_ROD, np.zeros(1), 3, 1, True, False)
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        return CompiledModel(_mass, _forces, _contacts, _drift, [], 3, 1, True, False)
 
     # -- units ----------------------------------------------------------------
     def _qscale(self):
@@ -411,6 +413,38 @@ class PainleveRodCase(CompareCase):
     def headline_of_run(self, res):
         return float(res.q[-1, 0])
 
+
+
+# -- compiled model (moreau.compiled); no parameters ------------------------------------
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0
+    M[1, 1] = 1.0
+    M[2, 2] = 1.0 / 3.0
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    D[1, 0] = -1.0
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[1] - math.sin(q[2])
+    G[0, 4] = 1.0
+    G[0, 5] = -math.cos(q[2])
+    if need_T:
+        G[0, 6] = 1.0
+        G[0, 8] = math.sin(q[2])
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    w2 = v[2] * v[2]
+    Dr[0, 0] = math.sin(q[2]) * w2
+    Dr[0, 1] = math.cos(q[2]) * w2
 
 
 register_scene(SceneEntry(

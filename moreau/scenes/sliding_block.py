@@ -22,6 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from numba import njit
+
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from .base import Scene
@@ -142,10 +145,9 @@ class SlidingBlock(SIUnits, Scene):
         return np.zeros(2), np.array([1.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import SLIDING_BLOCK, CompiledModel
-        par = np.array([math.sin(self.alpha), math.cos(self.alpha)], dtype=np.float64)
-        return CompiledModel(SLIDING_BLOCK, par, 2, 1, True, False)
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        par = [math.sin(self.alpha), math.cos(self.alpha)]
+        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
     # -- exact solution -------------------------------------------------------
     @property
@@ -288,6 +290,35 @@ class SlidingBlockCase(CompareCase):
     def headline_of_run(self, res):
         return float(res.q[-1, 0])
 
+
+
+# -- compiled model (moreau.compiled); par: sin(alpha), cos(alpha) -------------------------
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0
+    M[1, 1] = 1.0
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    D[0, 0] = par[0]
+    D[1, 0] = -par[1]
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[1]
+    G[0, 4] = 1.0
+    if need_T:
+        G[0, 5] = 1.0
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
+    Dr[0, 1] = 0.0
 
 
 register_scene(SceneEntry(

@@ -39,6 +39,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from numba import njit
+
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from .base import Scene
@@ -159,10 +162,9 @@ class SlidingBox(SIUnits, Scene):
         return np.array([0.0, self.b, 0.0]), np.array([1.0, 0.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import SLIDING_BOX, CompiledModel
-        return CompiledModel(SLIDING_BOX, np.array([self.a, self.b, self.inertia]), 3, 2,
-                             True, False)
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        return CompiledModel(_mass, _forces, _contacts, _drift, [self.a, self.b, self.inertia],
+                             3, 2, True, False)
 
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
@@ -260,6 +262,49 @@ class SlidingBoxCase(CompareCase):
         # each corner's stop is measured: Moreau–Jean may stop them a step apart
         return flatten([self._run_switches_of(res, h, c) for c in (0, 1)])
 
+
+
+# -- compiled model (moreau.compiled); par: a, b, inertia -----------------------------
+# corners at body coordinates (-a, -b) and (+a, -b)
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0
+    M[1, 1] = 1.0
+    M[2, 2] = par[2]
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    D[1, 0] = -1.0
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    s = math.sin(q[2])
+    c = math.cos(q[2])
+    a = par[0]
+    b = par[1]
+    for i in range(2):
+        sg = 2.0 * i - 1.0
+        if need_gap:
+            G[i, 0] = q[1] + sg * a * s - b * c
+        G[i, 4] = 1.0
+        G[i, 5] = sg * a * c + b * s
+        if need_T:
+            G[i, 6] = 1.0
+            G[i, 8] = -sg * a * s + b * c
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    s = math.sin(q[2])
+    c = math.cos(q[2])
+    w2 = v[2] * v[2]
+    for i in range(2):
+        sg = 2.0 * i - 1.0
+        Dr[i, 0] = w2 * (-sg * par[0] * s + par[1] * c)
+        Dr[i, 1] = w2 * (-sg * par[0] * c - par[1] * s)
 
 
 register_scene(SceneEntry(

@@ -32,6 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from numba import njit
+
+from ..compiled import CompiledModel
 from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ..errors import InputError
 from .base import Scene
@@ -393,8 +396,7 @@ class StickSlipMotor(SIUnits, Scene):
         return np.zeros(2), np.array([float(ds), 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.scenes._compiled`)."""
-        from ._compiled import STICK_SLIP_MOTOR, CompiledModel
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = np.zeros(22)
         par[0], par[1] = self.fL, self.n
         d = self.drive
@@ -409,7 +411,7 @@ class StickSlipMotor(SIUnits, Scene):
             return None
         if type(d) not in (SineDrive, SawtoothDrive):
             return None     # a drive subclass may change s(tau)
-        return CompiledModel(STICK_SLIP_MOTOR, par, 2, 1, True, False)
+        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
 
 class StickSlipCase(CompareCase):
@@ -454,6 +456,61 @@ class StickSlipCase(CompareCase):
     def headline_of_run(self, res):
         return float(res.q[-1, 0] - res.q[0, 0])
 
+
+
+# -- compiled model (moreau.compiled) ---------------------------------------------------
+# par: [fL, n, drive (0 sine, 1 sawtooth), b, psi, nseg, starts[4], acc[4], vel[4], pos[4]]
+
+@njit(cache=True)
+def _drive(par, t):
+    # (s, s', s'') of the stator at t
+    if par[2] == 0.0:
+        b = par[3]
+        a2 = 2.0 * t + par[4]
+        return (math.sin(t) + b * math.sin(a2), math.cos(t) + 2.0 * b * math.cos(a2),
+                -math.sin(t) - 4.0 * b * math.sin(a2))
+    nseg = int(par[5])
+    # Python's float modulo, as np.mod in the Python model
+    tm = t % TWO_PI
+    k = -1
+    for i in range(nseg):
+        if par[6 + i] <= tm:
+            k = i
+    if k < 0:
+        k = nseg - 1
+    st = par[6 + k]
+    dt = tm - st if tm >= st else tm + TWO_PI - st
+    a = par[10 + k]
+    v0 = par[14 + k]
+    return par[18 + k] + v0 * dt + 0.5 * a * dt * dt, v0 + a * dt, a
+
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = 1.0
+    M[1, 1] = 1.0
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    D[0, 0] = -par[0]
+    D[1, 0] = -par[1]
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[1]
+    G[0, 4] = 1.0
+    if need_T:
+        G[0, 5] = 1.0
+        G[0, 2] = -_drive(par, t)[1]
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
+    Dr[0, 1] = -_drive(par, t)[2]
 
 
 register_scene(SceneEntry(

@@ -1,0 +1,140 @@
+"""One compiled Moreau–Jean loop per model, built when the model is first used.
+
+:func:`runner_for` compiles the loop template
+:func:`moreau.integrators._mj_kernels.mj_loop` for one
+:class:`moreau.compiled.CompiledModel`: in a namespace that holds the
+model's functions, sizes and flags as globals, which numba freezes as
+constants. A process compiles only the models it runs, and each model once.
+
+Where the model's functions can be imported by name (every shipped scene,
+and a user's scene kept in their own module), the compiled loop goes to
+numba's disk cache under a name derived from those import paths, and later
+processes load it in a fraction of a second. The cache entry is tied to the
+contents of every source file the loop depends on (:mod:`moreau._jit_cache`):
+the loop, Lemke, the model's module and the modules of the compiled
+functions it calls. An edit to any of them compiles the loop again instead
+of running stale machine code. Functions defined in ``__main__`` or a
+notebook give a loop compiled in memory, again in each process: their names
+do not identify them across processes.
+"""
+
+import hashlib
+import importlib
+import sys
+import threading
+import types
+
+from numba import njit
+
+from .. import _jit_cache
+from . import _mj_kernels
+from ._mj_kernels import no_gaps
+
+__all__ = ["runner_for", "dependency_files"]
+
+_RUNNERS = {}
+_LOCK = threading.Lock()
+_NOTED = set()
+
+
+def _import_path(f):
+    """``"module:name"`` by which ``f`` can be imported again, or None."""
+    py = getattr(f, "py_func", f)
+    module, qualname = getattr(py, "__module__", None), getattr(py, "__qualname__", "")
+    if not module or module == "__main__" or not qualname.isidentifier():
+        # defined in a script, a notebook, a function or a class: not importable by name
+        return None
+    try:
+        obj = getattr(importlib.import_module(module), qualname)
+    except (ImportError, AttributeError):
+        return None
+    return f"{module}:{qualname}" if obj is f else None
+
+
+def dependency_files(functions):
+    """Source files of ``functions`` and of every compiled function they call by name.
+
+    Follows globals (``helper(...)``) and module attributes (``mod.helper(...)``)
+    that are numba functions, recursively.
+    """
+    files, seen, todo = [], set(), list(functions)
+    while todo:
+        f = todo.pop()
+        if id(f) in seen:
+            continue
+        seen.add(id(f))
+        py = getattr(f, "py_func", None)
+        if py is None:
+            continue
+        path = py.__code__.co_filename
+        if path not in files:
+            files.append(path)
+        names, codes = set(), [py.__code__]
+        while codes:
+            code = codes.pop()
+            names.update(code.co_names)
+            codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
+        for name in names:
+            val = py.__globals__.get(name)
+            if isinstance(val, types.ModuleType):
+                todo.extend(getattr(val, n) for n in names
+                            if hasattr(getattr(val, n, None), "py_func"))
+            elif hasattr(val, "py_func"):
+                todo.append(val)
+    return sorted(files)
+
+
+def _constants(model):
+    return {"NDOF": model.ndof, "NCONTACTS": model.ncontacts, "CONST_MASS": model.const_mass,
+            "HAS_JAC": model.has_jacobians, "HAS_GAPS": model.gaps is not None}
+
+
+def _build(model):
+    consts = _constants(model)
+    fns = model.functions()
+    paths = {k: _import_path(f) for k, f in fns.items()}
+    cacheable = all(p is not None for p in paths.values())
+    namespace = dict(vars(_mj_kernels))
+    namespace.update(consts, mass_fn=model.mass, forces_fn=model.forces,
+                     contacts_fn=model.contacts, gaps_fn=model.gaps or no_gaps)
+    # numba names a function's disk-cache files after its qualified name: one
+    # per model, from the import paths of its functions and its constants
+    tag = repr(sorted(paths.items())) + repr(sorted(consts.items()))
+    name = "mj_loop_" + hashlib.sha256(tag.encode()).hexdigest()[:16]
+    template = _mj_kernels.mj_loop
+    fn = types.FunctionType(template.__code__, namespace, name, template.__defaults__)
+    fn.__qualname__ = name
+    fn.__module__ = template.__module__
+    fn.__doc__ = template.__doc__
+    run = njit(cache=cacheable, error_model="numpy")(fn)
+    if cacheable:
+        _jit_cache.bind_cache_to_sources(
+            [run], list(_mj_kernels.KERNEL_SOURCES) + dependency_files(list(fns.values())))
+    return run
+
+
+def runner_for(model):
+    """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`), built once.
+
+    Returns a numba function with the arguments of
+    :func:`moreau.integrators._mj_kernels.mj_loop`.
+    """
+    key = (tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
+           tuple(sorted(_constants(model).items())))
+    with _LOCK:
+        run = _RUNNERS.get(key)
+        if run is None:
+            run = _RUNNERS[key] = _build(model)
+    if not run.signatures:
+        _compile_note(run)
+    return run
+
+
+def _compile_note(run):
+    # the first call in a process either loads the machine code from numba's cache
+    # (a fraction of a second) or compiles it (seconds): say so on a terminal, once,
+    # so that a first run is not a silent wait
+    if id(run) not in _NOTED and sys.stderr.isatty():
+        _NOTED.add(id(run))
+        print("moreau: loading the compiled Moreau-Jean loop of this scene (its first use "
+              "on a machine compiles it)...", file=sys.stderr, flush=True)
