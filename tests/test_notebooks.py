@@ -29,6 +29,9 @@ assert abs(ref.events[0].t - 0.3) < 1e-8
 assert all(r["status"] == 0 for r in rep["rows"])
 orders = {o["theta"]: o["order"] for o in rep["orders"]}
 assert 0.8 < orders[1.0] < 1.3 and orders[0.5] > 0.8
+assert moreau.check_scene(fast_scene).ok
+assert np.max(np.abs(same.q - slow_run.q)) <= 1e-12 and np.max(np.abs(same.v - slow_run.v)) <= 1e-12
+assert fast_run.success and fast_run.stats["steps"] == 200000
 """,
 }
 

@@ -8,7 +8,9 @@ slips back: the classic stick-slip oscillator.
 """
 
 import numpy as np
+from numba import njit
 
+from moreau.compiled import CompiledModel
 from moreau.scenes.base import Scene
 
 
@@ -39,3 +41,49 @@ class BeltBlock(Scene):
 
     def initial_state(self):
         return np.zeros(2), np.array([self.vb, 0.0])
+
+
+# -- the same model through the compiled hook (moreau.compiled) ------------------------
+# par = (k, vb). Kept in this importable module, so the engine caches its compiled loop on
+# disk; the functions are the Python methods above, written for numba.
+
+@njit
+def belt_mass(par, q, M):
+    M[0, 0] = 1.0
+    M[1, 1] = 1.0
+
+
+@njit
+def belt_forces(par, q, v, t, D, need_jac):
+    D[0, 0] = -par[0] * q[0]
+    D[1, 0] = -1.0
+    if need_jac:
+        D[0, 1] = -par[0]
+
+
+@njit
+def belt_contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[1]
+    G[0, 4] = 1.0           # WN = (0, 1)
+    if need_T:
+        G[0, 2] = -par[1]   # wT = -vb
+        G[0, 5] = 1.0       # WT = (1, 0)
+
+
+@njit
+def belt_drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
+    Dr[0, 1] = 0.0
+
+
+class CompiledBeltBlock(BeltBlock):
+    """:class:`BeltBlock` with its compiled model, and the exact force Jacobians."""
+
+    def force_jacobians(self, q, v, t):
+        return np.array([[-self.k, 0.0], [0.0, 0.0]]), np.zeros((2, 2))
+
+    def compiled_model(self):
+        return CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift,
+                             par=[self.k, self.vb], ndof=2, ncontacts=1, const_mass=True,
+                             has_jacobians=True)

@@ -1,0 +1,148 @@
+"""A user's scene gets the compiled Moreau–Jean loop through ``moreau.compiled``, no package edit."""
+
+import os
+import subprocess
+import sys
+import textwrap
+
+import numpy as np
+import pytest
+from numba import njit
+
+from moreau.compiled import CompiledModel, check_compiled_model
+from moreau.errors import InputError
+from moreau.integrators import _loops, simulate
+from moreau.integrators.moreau_jean import MoreauJean
+
+from belt_scene import BeltBlock, CompiledBeltBlock, belt_contacts, belt_drift, belt_forces, belt_mass
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def test_the_compiled_model_equals_the_python_methods():
+    rng = np.random.default_rng(3)
+    sc = CompiledBeltBlock(k=3.0, vb=0.7, mu=0.4)
+    for _ in range(20):
+        q, v = rng.normal(size=2), rng.normal(size=2)
+        assert check_compiled_model(sc, q, v, rng.uniform(0, 5)) <= 1e-12
+
+
+def test_a_wrong_compiled_model_is_caught_by_the_check():
+    @njit
+    def wrong_forces(par, q, v, t, D, need_jac):
+        D[0, 0] = -par[0] * q[0]
+        D[1, 0] = -2.0      # gravity doubled: not the Python model
+
+    class Wrong(CompiledBeltBlock):
+        def compiled_model(self):
+            m = super().compiled_model()
+            return CompiledModel(m.mass, wrong_forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+
+    assert check_compiled_model(Wrong(), [0.1, 0.0], [0.0, 0.0], 0.0) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("theta", [0.5, 1.0])
+def test_the_compiled_loop_runs_the_generic_step_to_rounding(theta):
+    sc = CompiledBeltBlock()
+    q0, v0 = sc.initial_state()
+    fast = MoreauJean(sc, 0.0, q0, v0, 6.0, h=0.01, theta=theta, fast=True)
+    assert fast._fast
+    while fast.status == "running":
+        fast.step()
+    slow = simulate(sc, (0.0, 6.0), q0, v0, "moreau-jean", h=0.01, theta=theta, fast=False)
+    res = fast.result()
+    assert res.success and slow.success
+    np.testing.assert_allclose(res.q, slow.q, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(res.v, slow.v, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(res.regime, slow.regime)
+    # the block sticks, slips and sticks again: both regimes are exercised
+    assert len(np.unique(res.regime)) >= 2
+
+
+def test_functions_defined_in_a_function_run_compiled_in_memory():
+    # a notebook's or script's functions cannot be imported again by name: the loop is
+    # compiled for this process only, and still gives the same answer
+    @njit
+    def mass(par, q, M):
+        M[0, 0] = 1.0
+        M[1, 1] = 1.0
+
+    class Local(CompiledBeltBlock):
+        def compiled_model(self):
+            m = super().compiled_model()
+            return CompiledModel(mass, m.forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+
+    model = Local().compiled_model()
+    assert _loops._import_path(mass) is None
+    run = _loops.runner_for(model)
+    assert type(run._cache).__name__ == "NullCache"
+    sc = Local()
+    q0, v0 = sc.initial_state()
+    a = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=0.01)
+    b = simulate(CompiledBeltBlock(), (0.0, 3.0), q0, v0, "moreau-jean", h=0.01)
+    np.testing.assert_array_equal(a.q, b.q)
+
+
+def test_an_importable_model_is_cached_and_an_edit_recompiles(tmp_path):
+    # a user's model module, run in fresh processes: the second loads the compiled loop
+    # from numba's disk cache; after an edit of the model, the third compiles again and
+    # runs the edited model (never the stale machine code)
+    src = open(os.path.join(HERE, "belt_scene.py")).read()
+    (tmp_path / "user_belt.py").write_text(src)
+    script = textwrap.dedent("""
+        import json, sys
+        import numpy as np
+        from moreau.integrators import simulate, _loops
+        from user_belt import CompiledBeltBlock
+        sc = CompiledBeltBlock()
+        q0, v0 = sc.initial_state()
+        r = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.01, fast=True)
+        run = _loops.runner_for(sc.compiled_model())
+        print(json.dumps({"hits": sum(run.stats.cache_hits.values()),
+                          "misses": sum(run.stats.cache_misses.values()),
+                          "x": float(r.q[-1, 0])}))
+    """)
+    env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               NUMBA_CACHE_DIR=str(tmp_path / "numba"))
+
+    def run():
+        out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,
+                             text=True, timeout=600, cwd=tmp_path)
+        assert out.returncode == 0, out.stderr
+        import json
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    first, second = run(), run()
+    assert first["misses"] == 1 and first["hits"] == 0
+    assert second["hits"] == 1 and second["misses"] == 0
+    assert second["x"] == first["x"]
+    # the spring twice as stiff, in the compiled model only: the edited code must run
+    (tmp_path / "user_belt.py").write_text(src.replace("D[0, 0] = -par[0] * q[0]",
+                                                       "D[0, 0] = -2.0 * par[0] * q[0]"))
+    third = run()
+    assert third["misses"] == 1
+    assert third["x"] != first["x"]
+
+
+def test_bad_compiled_models_are_refused_by_name():
+    def plain(par, q, M):
+        M[0, 0] = 1.0
+
+    with pytest.raises(InputError, match=r"`mass` must be a numba.njit function"):
+        CompiledModel(plain, belt_forces, belt_contacts, belt_drift, [1.0], 2, 1, True, True)
+    with pytest.raises(InputError, match=r"`ndof` must be >= 1"):
+        CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [1.0], 0, 1, True, True)
+    with pytest.raises(InputError, match=r"`par` must be finite"):
+        CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [np.nan], 2, 1, True, True)
+    with pytest.raises(InputError, match=r"`const_mass` must be True or False"):
+        CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [1.0], 2, 1, "yes", True)
+
+
+def test_a_model_of_other_sizes_than_its_scene_is_refused():
+    class Mismatch(BeltBlock):
+        def compiled_model(self):
+            return CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [4.0, 0.5],
+                                 3, 1, True, True)
+
+    with pytest.raises(InputError, match=r"describes 3 dof"):
+        MoreauJean(Mismatch(), 0.0, np.zeros(2), np.zeros(2), 1.0, h=0.01, fast=True)
