@@ -97,10 +97,12 @@ import json, sys, time
 t0 = time.perf_counter()
 from moreau.integrators import simulate
 from moreau.integrators import _loops
-from moreau.scenes import *
+import moreau.scenes as scenes
 from belt_scene import CompiledBeltBlock
 t1 = time.perf_counter()
-sc = {ctor}
+name = {ctor!r}.split("(")[0]
+cls = CompiledBeltBlock if name == "CompiledBeltBlock" else getattr(scenes, name)
+sc = eval({ctor!r}, {{name: cls}})
 q0, v0 = sc.initial_state()
 t2 = time.perf_counter()
 res = simulate(sc, (0.0, 10 * {h!r}), q0, v0, "moreau-jean", h={h!r})
