@@ -138,11 +138,14 @@ import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError, LCPError, PainleveError
+from ..lcp import lcp_residual, solve_lcp
+from ..lcp.friction import build_friction_lcp, friction_impulses
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 from . import _mj_kernels as _kernels
 from ._loops import runner_for
-from ._mj_kernels import LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, new_lcp_control,
+                          new_stats)
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
@@ -500,7 +503,6 @@ class MoreauJean(Integrator):
         # a forced QP solver is a request to run that solver, so it takes the generic path
         self._fast = model is not None and fast is not False and self.lcp_method != "qp"
         if self._fast:
-            from ._mj_kernels import new_lcp_control, new_stats
             self._model = model
             self._stats = new_stats()
             # options of the loop's contact problems and the warm start's memory,
@@ -696,9 +698,6 @@ class MoreauJean(Integrator):
         return v1, slip
 
     def _solve_lcp(self, W, U_free, mu, e, vN_pre, ia, pN, pT):
-        from ..lcp import lcp_residual, solve_lcp
-        from ..lcp.friction import build_friction_lcp, friction_impulses
-
         Ml, ql, layout = build_friction_lcp(W, U_free, mu, e, vN_pre)
         r = solve_lcp(Ml, ql, method=self.lcp_method, friction=layout,
                       max_iter=self.lemke_max_iter)

@@ -80,8 +80,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import _jit_cache
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
+from . import _certified, certify
 from ._certified import farkas_float
 from ._certified import residual as _residual
 from .certify import FARKAS_TOL, infeasibility_from_ray
@@ -1246,15 +1248,9 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     return res
 
 
-# the compiled functions freeze FARKAS_TOL from certify.py: their on-disk cache
-# must follow that file too (numba only checks this one)
-def _bind_cache():
-    from .. import _jit_cache
-    from . import _certified, certify
-    _jit_cache.bind_cache_to_sources(
-        [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
-         and getattr(f.py_func, "__module__", None) == __name__],
-        (__file__, certify.__file__, _certified.__file__))
-
-
-_bind_cache()
+# the compiled functions freeze FARKAS_TOL from certify.py and link _certified.py:
+# their on-disk cache must follow those files too (numba only checks this one)
+_jit_cache.bind_cache_to_sources(
+    [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
+     and getattr(f.py_func, "__module__", None) == __name__],
+    (__file__, certify.__file__, _certified.__file__))
