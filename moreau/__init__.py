@@ -1,5 +1,7 @@
 """moreau: simulation of non-smooth mechanics (unilateral contact, Coulomb friction, impacts)."""
 
+import importlib
+
 from .errors import (
     ContactLostError,
     ConvergenceError,
@@ -26,7 +28,7 @@ def __getattr__(name):
     module = _LAZY.get(name)
     if module is None:
         raise AttributeError(f"module 'moreau' has no attribute {name!r}")
-    import importlib  # noqa: PLC0415  (PEP 562 lazy attribute: the import is the point)
+    # PEP 562 lazy attribute: the front end's module is imported on first use only
     value = getattr(importlib.import_module(module), name)
     globals()[name] = value
     return value

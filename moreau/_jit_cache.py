@@ -19,6 +19,12 @@ slower, never stale.
 import hashlib
 import os
 
+try:
+    # numba's internal cache classes: another numba version may not have this one
+    from numba.core.caching import NullCache
+except ImportError:
+    NullCache = None
+
 __all__ = ["sources_digest", "bind_cache_to_sources"]
 
 
@@ -90,8 +96,7 @@ def bind_cache_to_sources(dispatchers, paths):
 
 def _disable_disk_cache(disp):
     try:
-        from numba.core.caching import NullCache
-        disp._cache = NullCache()
+        disp._cache = NullCache() if NullCache is not None else _NoCache()
     except Exception:
         # last resort: a dispatcher without a usable cache object compiles in memory
         disp._cache = _NoCache()

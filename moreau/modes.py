@@ -24,6 +24,8 @@ how the event-driven reference marks its impacts.
 
 import numpy as np
 
+from .regimes import REGIME_LETTERS, Regime
+
 __all__ = ["mode_name", "split_tokens", "step_letters", "impacts_after_flight"]
 
 _ORDER = {"N": 0, "S": 1, "P": 2, "F": 3}
@@ -128,8 +130,6 @@ def step_letters(regime, slip=None, mu=None):
     >>> step_letters([3, 3, 3], slip=[0.2, -0.1, 0.0], mu=0.0)
     ['P', 'N', 'P']
     """
-    from .regimes import REGIME_LETTERS, Regime
-
     codes = np.asarray(regime, dtype=int).ravel()
     letters = [REGIME_LETTERS[Regime(int(c))] for c in codes]
     if mu is not None and not float(mu) > 0.0:

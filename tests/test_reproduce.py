@@ -6,8 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from moreau.studies.paper.reproduce import read_table, study_grids
+from moreau.studies.paper.reproduce import study_grids
 from moreau.studies.paper.report import refine_extremum
+from moreau.studies.paper.tables import read_table
 from moreau.studies.paper.valid_range import lift_off_margin, phi0_valid_range
 from moreau.cli import main
 from moreau.scenes.friction_drive import PAPER_DEFAULTS
@@ -102,7 +103,7 @@ def _rows(parameter, xs, f=None):
     from dataclasses import asdict
 
     from moreau.analysis.engine import run_points
-    from moreau.studies.paper.reproduce import SWEPT_COLUMN
+    from moreau.studies.paper.tables import SWEPT_COLUMN
     pts = [(asdict(PAPER_DEFAULTS), x) if parameter == "frequency"
            else (asdict(PAPER_DEFAULTS.with_(**{parameter: x})), f) for x in xs]
     rows, _ = run_points(pts, n_jobs=1)
@@ -118,7 +119,7 @@ def _rows(parameter, xs, f=None):
     ("phi0", 185.0, [0.78, 0.82, 0.86, 0.90], "min", 0.84, 0.01),
 ])
 def test_report_extrema_agree_with_the_paper(parameter, f, xs, kind, paper, agree):
-    from moreau.studies.paper.reproduce import SWEPT_COLUMN
+    from moreau.studies.paper.tables import SWEPT_COLUMN
     rows = _rows(parameter, xs, f)
     x, _ = refine_extremum(rows, SWEPT_COLUMN[parameter], parameter, PAPER_DEFAULTS, f, kind)
     assert abs(x - paper) <= agree

@@ -111,7 +111,7 @@ from .cases import GRID, SceneCase, switching_error
 
 __all__ = ["compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
            "check_out_dir", "make_case", "case_parameters", "fit_order", "plateaus",
-           "switching_error"]
+           "switching_error", "run_row"]
 
 TWO_PI = 2.0 * math.pi
 #: Moreau–Jean steps per period of the full comparison (two decades)
@@ -349,7 +349,7 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     jobs += [("mj", th, None, n) for th in thetas for n in steps]
     jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
     report["interrupted"] = collect_rows(
-        jobs, lambda job: [_run_row(case, *job, repeat, ref_value, ref_switches)],
+        jobs, lambda job: [run_row(case, *job, repeat, ref_value, ref_switches)],
         report["rows"], on_row, progress, desc=f"compare {scene}", unit="run")
     report["orders"] = _orders(report["rows"])
     report["notes"] = plateaus(report["rows"])
@@ -381,7 +381,33 @@ def collect_rows(items, run, rows, on_row=None, progress=False, desc="", unit="i
     return False
 
 
-def _run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
+def run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
+    """One row of the comparison table: run one scheme at one setting and measure its errors.
+
+    Parameters
+    ----------
+    case : CompareCase
+        From :func:`make_case`.
+    kind : {"ref", "mj"}
+        The scene's reference, or Moreau–Jean.
+    theta : float or None
+        Moreau–Jean's theta (None for the reference).
+    lcp : {None, "lemke", "qp"}
+        Contact solver forced on every Moreau–Jean step (None: the scheme's own).
+    setting : float or int
+        The reference's tolerance, or Moreau–Jean's steps per period.
+    repeat : int
+        Run-time samples (the median is reported).
+    ref_value, ref_switches
+        The reference's headline value and switching times at its tightest setting.
+
+    Returns
+    -------
+    dict
+        The keys of :data:`CSV_FIELDS`; a run that fails with a
+        :class:`~moreau.errors.MoreauError` has ``status`` -1 and the error in
+        ``message``.
+    """
     row = {"scheme": case.ref_scheme if kind == "ref" else "moreau-jean", "theta": theta,
            "lcp": lcp, "steps_per_period": None if kind == "ref" else int(setting),
            "rtol": setting if kind == "ref" else None, "time_s": None, "error": None,

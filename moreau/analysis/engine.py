@@ -20,15 +20,20 @@ row whose ``status`` names the cause; it never stops the run.
 """
 
 import hashlib
+import itertools
 import logging
 import math
 import os
 import pathlib
 import time
 
+import joblib
+
+from .. import __version__
 from ..errors import ConvergenceError, InputError
 from ..scenes import registry
 from .cases import DriveCase
+from .steady_state import find_steady_state, implausible_steady_state
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +47,7 @@ _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitut
 _PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
                  "studies/paper/figures.py", "studies/paper/report.py",
                  "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
-                 "studies/paper/histories.py"}
+                 "studies/paper/histories.py", "studies/paper/tables.py"}
 
 
 def code_version():
@@ -57,7 +62,6 @@ def code_version():
     >>> v.startswith("0.") and len(v.split("+")[1]) == 16
     True
     """
-    from .. import __version__
     root = pathlib.Path(__file__).resolve().parents[1]
     h = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
@@ -143,8 +147,6 @@ def _make_scene(params, frequency, scene):
 
 
 def _steady(params, frequency, scheme, scene="friction-drive"):
-    from .steady_state import find_steady_state
-
     scene = _make_scene(params, frequency, scene)
     if scheme.name == "moreau-jean":
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
@@ -157,7 +159,6 @@ def _steady(params, frequency, scheme, scene="friction-drive"):
 
 def _implausible(params, scene, ss):
     """Why a converged steady state cannot be right, or None (any scheme, either drive)."""
-    from .steady_state import implausible_steady_state
     return implausible_steady_state(scene, ss)
 
 
@@ -396,7 +397,6 @@ def _recompute(func, a):
 
 
 def _memory(cache_dir):
-    import joblib
     return joblib.Memory(location=None if cache_dir is None else str(cache_dir), verbose=0)
 
 
@@ -501,9 +501,6 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
             elif n_jobs == 1 or len(todo) == 1:
                 results = ((k, func(*args[i])) for k, i in enumerate(todo))
             else:
-                import itertools
-
-                import joblib
                 # the first task runs here: it compiles (or loads) the numba kernels
                 # once and writes numba's on-disk cache, which the workers then load
                 # instead of each compiling the same kernels at the same time

@@ -45,9 +45,10 @@ import time
 
 import numpy as np
 
-from .._validate import in_closed_interval, positive, positive_int
-from ..errors import ConvergenceError, InputError, MoreauError
+from .._validate import finite_array, in_closed_interval, positive, positive_int
+from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
 from .modes import impacts_after_flight, mode_name, step_letters
+from ..integrators.moreau_jean import MoreauJean
 from ..integrators.result import SteadyState
 
 __all__ = ["moreau_jean_steady_state", "merge_step_regimes", "PeriodMap"]
@@ -237,9 +238,6 @@ class PeriodMap:
         ``record=True`` the per-step history of contact 0 is kept in
         :attr:`last` (a dict).
         """
-        from ..errors import PainleveError
-        from ..integrators.moreau_jean import MoreauJean
-
         q, v = self.full_state(x)
         nc = self.scene.ncontacts
         c0 = np.broadcast_to(np.asarray(closed, dtype=bool), (nc,)).copy()
@@ -363,7 +361,6 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     if x_guess is None:
         x = pm.state(*scene.initial_state())
     else:
-        from .._validate import finite_array
         x = finite_array("x_guess", x_guess, shape=(pm.dim,)).copy()
     closed = np.asarray(scene.gaps(*pm.full_state(x)[:1], 0.0), dtype=float) <= 0.0
 

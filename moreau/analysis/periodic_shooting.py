@@ -28,6 +28,8 @@ from scipy.linalg import null_space
 
 from .._validate import positive, positive_int
 from ..errors import ConvergenceError, InputError
+from ..integrators import get_integrator, simulate
+from ..integrators.event_driven_generic import project_positions
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
@@ -40,8 +42,6 @@ TWO_PI = 2.0 * math.pi
 def _project(scene, t, q, v, touching):
     if not len(touching):
         return q, v
-    from ..integrators.event_driven_generic import project_positions
-
     q = project_positions(scene, t, q, touching, max_iter=5)
     WN, wN, _, _ = scene.contact_jacobians(q, t)
     WN, wN = WN[touching], wN[touching]
@@ -121,7 +121,6 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     cyclic = int(cyclic)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
-    from ..integrators import get_integrator, simulate
 
     get_integrator(scheme)  # an unknown name lists the known ones, before any work
     opts = _scheme_options(scheme, options)

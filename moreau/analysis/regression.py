@@ -32,6 +32,7 @@ import time
 import numpy as np
 
 from ..errors import InputError, MoreauError
+from .compare import make_case, run_row
 
 __all__ = ["CASES", "measure", "check_accuracy", "time_ratio_flag", "calibration_time",
            "load_baselines", "save_baselines", "ACCURACY_SLACK", "ACCURACY_FLOOR", "TIME_FACTOR",
@@ -96,7 +97,6 @@ _CACHE = {}
 def _setup(scene_key):
     """The compare case of a scene and its tight reference (cached per process)."""
     if scene_key not in _CACHE:
-        from .compare import make_case
         name, params = _SCENES[scene_key]
         case = make_case(name, **params)
         ref_value, ref_switches = case.reference(case.tight_rtol)
@@ -125,11 +125,10 @@ def measure(key):
 
     Raises :class:`~moreau.errors.MoreauError` if the run fails.
     """
-    from .compare import _run_row
     c = _spec(key)
     case, ref_value, ref_switches = _setup(c["scene"])
-    row = _run_row(case, c["kind"], c["theta"], c["lcp"], c["setting"], 1, ref_value,
-                   ref_switches)
+    row = run_row(case, c["kind"], c["theta"], c["lcp"], c["setting"], 1, ref_value,
+                  ref_switches)
     if row["status"] != 0:
         raise MoreauError(f"regression case {key} failed: {row['message']}")
     return {k: row[k] for k in ("error", "trajectory_error", "switching_error")}

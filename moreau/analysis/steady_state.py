@@ -9,6 +9,7 @@ import math
 import time
 
 import numpy as np
+from scipy.optimize import minimize_scalar
 
 from .._validate import positive, positive_int
 from ..errors import ConvergenceError, InputError, RunawayError
@@ -16,8 +17,11 @@ from ..errors import ConvergenceError, InputError, RunawayError
 # and re-exported here, where callers have always found it
 from ..integrators.result import SteadyState
 from ..scenes.base import Scene
+from ..scenes.friction_drive_walker import ContactState, FrictionDriveWalker
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
+from .mj_steady_state import moreau_jean_steady_state
+from .periodic_shooting import shoot_periodic
 
 __all__ = ["SteadyState", "find_steady_state"]
 
@@ -50,7 +54,6 @@ def _min_normal_force(walker, segments):
         best = min(best, float(fN[i]))
         if 0 < i < n - 1:
             # refine the sampled minimum: f_N varies fast near the stator's lowest point
-            from scipy.optimize import minimize_scalar
             r = minimize_scalar(lambda t: float(sc.contact_forces(t, a.regime)[0]),
                                 bounds=(tau[i - 1], tau[i + 1]), method="bounded",
                                 options={"xatol": 1e-12})
@@ -72,8 +75,6 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     ``None`` when the rod is in flight at the section, where the map is not
     scalar.
     """
-    from ..scenes.friction_drive_walker import ContactState
-
     vs = walker.vscale
     phi_s, dphi_s = walker.manifold(tau_s)
 
@@ -193,17 +194,14 @@ def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, m
     'NS'
     """
     if scheme == "moreau-jean":
-        from .mj_steady_state import moreau_jean_steady_state
         return moreau_jean_steady_state(scene, **options)
     if scheme != "event-driven":
         raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {scheme!r}")
     if getattr(scene, "reference_integrator", None) != "friction-drive-walker":
         # any other periodic scene: Newton shooting on the generic event-driven period map
-        from .periodic_shooting import shoot_periodic
         return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
-    from ..scenes.friction_drive_walker import FrictionDriveWalker
 
     t_start = time.perf_counter()
     walker = FrictionDriveWalker(scene, rtol=min(1e-12, rtol * 1e-2), **options)

@@ -67,6 +67,7 @@ step-size control, which costs steps and some accuracy.
 """
 
 import math
+from itertools import combinations, product
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -517,8 +518,6 @@ class GenericEventDriven(Integrator):
         return True
 
     def _enumerate(self, t, q, v, first, cand, sign, cone):
-        from itertools import product
-
         ms = self.ms
         choices = []
         for i in cand:
@@ -549,7 +548,6 @@ class GenericEventDriven(Integrator):
             K = K - A[:n, n:] @ np.linalg.solve(A[n:, n:], A[n:, :n])
         scale = max(float(np.max(np.abs(K))), 1e-300)
         for r in range(1, min(n, 8) + 1):
-            from itertools import combinations
             for idx in combinations(range(n), r):
                 d = np.linalg.det(K[np.ix_(idx, idx)])
                 if d <= 1e-13 * scale ** r:

@@ -66,6 +66,7 @@ import warnings
 
 import numpy as np
 import scipy.sparse as sp
+from qpsolvers import Problem, solve_problem
 
 from .._validate import positive, positive_int
 from ..errors import InputError
@@ -114,8 +115,6 @@ def _osqp_run(P, c, lb=None, ub=None, G=None, h=None, initvals=None, max_iter=No
     # absolute and relative tolerances, so the data are first brought to
     # unit scale (z = alpha * x_hat, alpha = max|c| / max|P|): a Delassus
     # matrix of 1e-5 would otherwise read as "dual infeasible".
-    from qpsolvers import Problem, solve_problem
-
     n = len(c)
     sP = float(np.max(np.abs(P))) if P.size else 0.0
     sc = max(float(np.max(np.abs(c))) if n else 0.0, float(np.max(np.abs(h))) if h is not None and len(h) else 0.0)

@@ -18,8 +18,19 @@ import math
 import sys
 from dataclasses import asdict
 
+from ... import __version__
 from ..._validate import positive
+# the module, not its function: a test (or a user) that replaces
+# engine.run_points reaches these sweeps too
+from ...analysis import engine
+from ...analysis.engine import check_output_dir, code_version
 from ...errors import InputError
+from ...scenes.bidirectional_drive import BidirectionalDriveParams
+from ..paper.figures import sweep_figure
+from ..paper.sweeps import make_scheme, sweep_values
+from ..paper.tables import write_table
+from ..paper.valid_range import lift_off_margin, range_marks
+from .direction_control import bidirectional_params
 
 __all__ = ["BIDIRECTIONAL_SWEEPABLE", "BIDIRECTIONAL_COLUMNS", "point_params",
            "run_bidirectional_sweep"]
@@ -50,7 +61,6 @@ def point_params(params, parameter, value):
     if parameter == "frequency":
         return params
     if parameter == "balance":
-        from .direction_control import bidirectional_params
         return bidirectional_params("balance", float(value), params)
     if parameter not in BIDIRECTIONAL_SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(BIDIRECTIONAL_SWEEPABLE)}, "
@@ -61,13 +71,11 @@ def point_params(params, parameter, value):
 def _lift_off_margin(p, frequency):
     # each rod's free normal acceleration on its contact manifold depends on its
     # own stator only (M is diagonal): the worst of the excited rods
-    from ..paper.valid_range import lift_off_margin
     m = [lift_off_margin(p.rod(r), frequency) for r in "ab" if getattr(p, f"x10_{r}") > 0]
     return max(m) if m else math.nan
 
 
 def _marks(p, parameter, frequency):
-    from ..paper.reproduce import range_marks
     rods = [p.rod(r) for r in "ab" if getattr(p, f"x10_{r}") > 0]
     if not rods or parameter not in ("frequency", "mu", "phi0"):
         return {}
@@ -135,10 +143,6 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     list of dict
         The tidy rows.
     """
-    from ...scenes.bidirectional_drive import BidirectionalDriveParams
-    from ...analysis.engine import check_output_dir, code_version, run_points
-    from ..paper.sweeps import make_scheme, sweep_values
-
     params = BidirectionalDriveParams() if params is None else params
     if parameter not in BIDIRECTIONAL_SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(BIDIRECTIONAL_SWEEPABLE)} for the "
@@ -166,16 +170,15 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
 
     pts = [(asdict(point_params(params, parameter, x)),
             float(x) if parameter == "frequency" else frequency) for x in values]
-    rows, stats = run_points(pts, scheme, cache_dir=cache_dir, n_jobs=n_jobs, scheduler=scheduler,
-                             progress=progress, desc=f"sweep {parameter}", scene="bidirectional")
+    rows, stats = engine.run_points(pts, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                                    scheduler=scheduler, progress=progress,
+                                    desc=f"sweep {parameter}", scene="bidirectional")
     table = tidy_rows(parameter, values, frequency, params, rows)
     tag = "bidirectional_" + (parameter if parameter == "frequency"
                               else f"{parameter}_{frequency:g}Hz")
     stem = out / f"sweep_{tag}"
-    from ..paper.reproduce import write_table
     write_table(table, (stem.parent / (stem.name + ".csv")))
     marks = _marks(params, parameter, frequency)
-    from ... import __version__
     meta = {
         "study": f"sweep_{tag}",
         "scene": "bidirectional-drive",
@@ -197,7 +200,6 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     log(f"wrote {(stem.parent / (stem.name + '.csv'))} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
-        from ..paper.figures import sweep_figure
         label = scheme.name if scheme.name == "event-driven" else \
             f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
         title = f"Bidirectional drive: steady state against {parameter}" + (

@@ -15,20 +15,23 @@ Each point is the periodic steady state found by
 scheme (the generic event-driven reference by default).
 """
 
+import argparse
+import csv
 import math
+import pathlib
 
 import numpy as np
 
 from ..._validate import positive
+from ...analysis.periodic_shooting import shoot_periodic
 from ...errors import InputError, MoreauError
+from ...scenes.bidirectional_drive import BidirectionalDrive, BidirectionalDriveParams
 
 __all__ = ["direction_sweep", "direction_figure", "bidirectional_params"]
 
 
 def bidirectional_params(knob, value, base=None):
     """:class:`BidirectionalDriveParams` for one sweep point (see the module docstring)."""
-    from ...scenes.bidirectional_drive import BidirectionalDriveParams
-
     base = base or BidirectionalDriveParams()
     x10 = max(base.x10_a, base.x10_b)
     if knob == "balance":
@@ -74,9 +77,6 @@ def direction_sweep(knob, values, frequency=185.0, base=None, scheme="event-driv
     >>> rows[0]["mode"]                                                # doctest: +SKIP
     'NP|F'
     """
-    from ...scenes.bidirectional_drive import BidirectionalDrive
-    from ...analysis.periodic_shooting import shoot_periodic
-
     frequency = positive("frequency", frequency)
     vals = [float(v) for v in values]
     pts = [bidirectional_params(knob, v, base) for v in vals]   # validate before any work
@@ -134,10 +134,6 @@ def direction_figure(balance_rows, phase_rows, path, frequency):
 
 def main(argv=None):
     """``python -m moreau.studies.bidirectional.direction_control OUT_DIR [--frequency F]``: CSV and figure."""
-    import argparse
-    import csv
-    import pathlib
-
     ap = argparse.ArgumentParser(description="direction-control sweeps of the bidirectional drive")
     ap.add_argument("out", help="output folder (created; must not hold earlier results)")
     ap.add_argument("--frequency", type=float, default=185.0)

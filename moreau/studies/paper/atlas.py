@@ -26,7 +26,17 @@ from dataclasses import asdict
 
 import numpy as np
 
+from ... import __version__
+from ... import _validate as V
+# the module, not its function: a test (or a user) that replaces
+# engine.run_points reaches the atlas too
+from ...analysis import engine
+from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version
 from ...errors import InputError
+from ...scenes.friction_drive import PAPER_DEFAULTS
+from .figures import atlas_figure
+from .tables import write_table
+from .valid_range import lift_off_margin
 
 __all__ = ["PLANES", "compute_atlas", "run_atlas", "point_label"]
 
@@ -103,11 +113,6 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
     >>> a["label"].tolist()
     [['NS', 'NS'], ['NP', 'SP']]
     """
-    from ...scenes.friction_drive import PAPER_DEFAULTS
-    from ... import _validate as V
-    from ...analysis.engine import ED_REFERENCE, run_points
-    from .valid_range import lift_off_margin
-
     if plane not in PLANES:
         raise InputError(f"`plane` must be one of {list(PLANES)}, got {plane!r}")
     y_name, y_default, y_label, y_col = PLANES[plane]
@@ -128,9 +133,9 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
     t0 = time.perf_counter()
     line = [params.with_(**{y_name: float(y)}) for y in ys]
     points = [(asdict(p), float(f)) for f in freqs for p in line]
-    rows, stats = run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
-                             scheduler=scheduler, progress=progress, desc=f"atlas {plane}",
-                             chunk=y_points)
+    rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                                    scheduler=scheduler, progress=progress,
+                                    desc=f"atlas {plane}", chunk=y_points)
     shape = (f_points, y_points)
     pick = np.empty(shape, dtype=object)
     out = {k: np.full(shape, np.nan) for k in ("displacement_per_period_m", "min_normal_force_N",
@@ -197,10 +202,6 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
     dict
         ``{plane: atlas}`` (see :func:`compute_atlas`).
     """
-    from ... import __version__
-    from ...analysis.engine import check_output_dir, code_version
-    from .reproduce import write_table
-
     for plane in planes:
         if plane not in PLANES:
             raise InputError(f"`plane` must be one of {list(PLANES)}, got {plane!r}")
@@ -232,7 +233,6 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
             + ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])))
         log(f"wrote {(stem.parent / (stem.name + '.csv'))}")
         if plot:
-            from .figures import atlas_figure
             paths = atlas_figure(a, stem)
             log(f"wrote {paths[0]}")
         results[plane] = a

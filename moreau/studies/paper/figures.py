@@ -11,8 +11,15 @@
 """
 
 import math
+import pathlib
 
 import numpy as np
+
+from ...analysis.steady_state import find_steady_state
+from ...integrators import simulate
+from ...regimes import REGIME_LETTERS
+from ...scenes.friction_drive import FrictionDrive
+from .tables import PARAM_COLUMNS, SWEPT_COLUMN
 
 __all__ = ["MODE_COLORS", "REGIME_COLORS", "mode_color", "sweep_figure", "mode_figures",
            "steady_period", "atlas_figure", "save"]
@@ -48,7 +55,6 @@ def mode_color(mode, others=None):
 
 def save(fig, stem):
     """Save ``fig`` as ``stem.png`` and ``stem.svg``; return both paths."""
-    import pathlib
     stem = pathlib.Path(stem)
     # stem.name + suffix: with_suffix would cut a tag such as theta0.5_N400 at its dot
     paths = [stem.parent / (stem.name + ".png"), stem.parent / (stem.name + ".svg")]
@@ -103,7 +109,7 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
     Parameters
     ----------
     rows : list of dict
-        Tidy rows (see :func:`moreau.studies.paper.reproduce.tidy_rows`).
+        Tidy rows (see :func:`moreau.studies.paper.tables.tidy_rows`).
     parameter : str
     frequency : float or None
         Drive frequency of a mu/phi0 study (title only).
@@ -120,7 +126,6 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
     scheme_label : str
         Legend entry of the main curve (the scheme that computed it).
     """
-    from .reproduce import PARAM_COLUMNS, SWEPT_COLUMN
     plt = _plt()
     col = SWEPT_COLUMN.get(parameter, PARAM_COLUMNS.get(parameter, parameter))
     x = np.array([r[col] for r in rows], float)
@@ -198,10 +203,6 @@ def steady_period(params, frequency, samples=1200):
     Returns ``(ss, res)``: the :class:`SteadyState` and the
     :class:`SimulationResult` of that period.
     """
-    from ...integrators import simulate
-    from ...scenes.friction_drive import FrictionDrive
-    from ...analysis.steady_state import find_steady_state
-
     scene = FrictionDrive(params, frequency)
     ss = find_steady_state(scene)
     phi, dphi, du2 = ss.state0
@@ -220,7 +221,6 @@ PREFERRED_POINTS = {"NS": ("frequency", 20.0), "NSPS": ("frequency", 158.0),
 def _mode_points(results):
     """A parameter point for each paper mode: the paper's point where the data show that
     mode there, else the middle of the mode's widest run in the studies."""
-    from .reproduce import SWEPT_COLUMN
     best = {}
     for mode, (name, value) in PREFERRED_POINTS.items():
         rows = results.get(name) or []
@@ -265,9 +265,6 @@ def mode_figures(results, params, folder):
 
 def mode_figure(mode, p, f, folder):
     """One steady period in ``mode`` at parameters ``p`` and frequency ``f`` (PNG + SVG)."""
-    import pathlib
-
-    from ...regimes import REGIME_LETTERS
     plt = _plt()
     folder = pathlib.Path(folder)
     if True:

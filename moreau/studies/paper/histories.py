@@ -8,6 +8,9 @@ import numpy as np
 
 from ..._validate import positive, positive_int
 from ...errors import InputError
+from ...integrators import simulate
+from ...regimes import REGIME_LETTERS, Regime
+from ...scenes.friction_drive import FrictionDrive
 
 __all__ = ["run_history", "write_history_csv", "plot_history"]
 
@@ -49,9 +52,6 @@ def run_history(params, frequency, periods=10.0, scheme="event-driven", steps_pe
     >>> h["status"], round(float(h["t"][-1]) * 185.0, 12)
     (0, 1.0)
     """
-    from ...integrators import simulate
-    from ...scenes.friction_drive import FrictionDrive
-
     periods = positive("periods", periods)
     samples_per_period = positive_int("samples_per_period", samples_per_period)
     if periods * samples_per_period > MAX_SAMPLES:
@@ -91,8 +91,6 @@ def plot_history(hist, path):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from ...regimes import REGIME_LETTERS, Regime
 
     t = np.asarray(hist["t"]) * 1e3
     reg = np.asarray(hist["regime"])

@@ -11,6 +11,13 @@ satisfy it at every point.
 import math
 
 import numpy as np
+from scipy.optimize import minimize_scalar
+
+from ... import __version__
+from ...analysis.engine import code_version
+from ...analysis.steady_state import find_steady_state
+from ...scenes.friction_drive import FrictionDrive
+from .tables import SWEPT_COLUMN
 
 ARROW = " \u2192 "
 
@@ -32,8 +39,6 @@ def _fmt_seq(seq, fmt="{:.3g}"):
 
 
 def _disp(params, parameter, x, frequency):
-    from ...scenes.friction_drive import FrictionDrive
-    from ...analysis.steady_state import find_steady_state
     if parameter == "frequency":
         sc = FrictionDrive(params, x)
     else:
@@ -49,7 +54,6 @@ def refine_extremum(rows, col, parameter, params, frequency, kind="min"):
 
     Returns ``(x, displacement_m)``.
     """
-    from scipy.optimize import minimize_scalar
     ok = [r for r in rows if r["status"] == "ok"]
     x = np.array([r[col] for r in ok])
     d = np.array([r["displacement_per_period_m"] for r in ok])
@@ -73,7 +77,6 @@ def _row(claim, paper, ours, ok, note="", fig=""):
 
 def claims(results, grids, params):
     """The table rows: ``claim, paper, ours, verdict, note, figure``."""
-    from .reproduce import SWEPT_COLUMN
     out = []
     fr = results["frequency"]
     okf = [r for r in fr if r["status"] == "ok"]
@@ -292,8 +295,6 @@ def _md_table(rows, link):
 
 def write_report(results, grids, params, out, checks, wall_time=None, quick=False):
     """Write ``out/report.md`` and return its path."""
-    from ... import __version__
-    from ...analysis.engine import code_version
     rows = claims(results, grids, params)
     link = lambda name: f"figures/{name}.png"  # noqa: E731
     n_agree = sum(r["verdict"] == "agree" for r in rows)

@@ -51,7 +51,13 @@ import time
 
 import numpy as np
 
+from ...analysis.compare import collect_rows
+from ...analysis.mj_steady_state import moreau_jean_steady_state
+from ...analysis.steady_state import find_steady_state
 from ...errors import ConvergenceError, InputError, MoreauError
+from ...integrators import simulate
+from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
+from .valid_range import phi0_valid_range
 
 __all__ = ["CASES", "SCHEMES", "OUTCOMES", "BOUND", "run_case", "run_catalogue",
            "write_stress_outputs", "format_stress_table", "plot_stability_map"]
@@ -70,7 +76,6 @@ STEPS = 1000
 
 
 def _scene(frequency=185.0, **params):
-    from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
     return FrictionDrive(PAPER_DEFAULTS.with_(**params), frequency)
 
 
@@ -109,9 +114,6 @@ def _guard(case, scheme, fn):
 # -- steady-state cases -----------------------------------------------------------------------
 def _steady_case(case, scene, steps=STEPS, bound=BOUND, note=""):
     """Event-driven steady state as reference; Moreau–Jean steady states at ``steps`` and 2x."""
-    from ...analysis.mj_steady_state import moreau_jean_steady_state
-    from ...analysis.steady_state import find_steady_state
-
     rows = []
     ref = {}
 
@@ -152,9 +154,6 @@ def _steady_case(case, scene, steps=STEPS, bound=BOUND, note=""):
 
 def _ill_posed_case(case, scene):
     """Beyond the Painlevé limit: every scheme must fail and name the cause."""
-    from ...analysis.mj_steady_state import moreau_jean_steady_state
-    from ...analysis.steady_state import find_steady_state
-
     def expect_failure(fn, scheme):
         def run():
             ss = fn()
@@ -174,7 +173,6 @@ def _ill_posed_case(case, scene):
 
 # -- flight and impacts above the contact-loss limit ---------------------------------------
 def _long_run_average(scene, method, periods, skip, **opts):
-    from ...integrators import simulate
     q0, v0 = scene.rest_state()
     res = simulate(scene, (0.0, TWO_PI * periods), q0, v0, method, **opts)
     if res.status != 0:
@@ -187,9 +185,6 @@ def _long_run_average(scene, method, periods, skip, **opts):
 
 
 def _flight_case(case, scene, full, steps=2000, bound=0.05):
-    from ...analysis.mj_steady_state import moreau_jean_steady_state
-    from ...analysis.steady_state import find_steady_state
-
     periods, skip = (200, 100) if full else (30, 10)
     window = f"periods {skip}..{periods} from rest"
     ref = {}
@@ -251,9 +246,6 @@ def _energy(scene, q, v):
 
 
 def _long_case(case, scene, full, steps=1000, bound=1e-6):
-    from ...integrators import simulate
-    from ...analysis.mj_steady_state import moreau_jean_steady_state
-
     total = 10 ** 7 if full else 10 ** 6
     periods = total // steps
     rows = [_row(case, "event-driven", "n/a", time_s=0.0,
@@ -293,8 +285,6 @@ def _long_case(case, scene, full, steps=1000, bound=1e-6):
 
 # -- the catalogue ----------------------------------------------------------------------------
 def _phi0_edges(frequency=185.0):
-    from ...scenes.friction_drive import PAPER_DEFAULTS
-    from .valid_range import phi0_valid_range
     r = phi0_valid_range(PAPER_DEFAULTS, frequency)
     return r["lift_off_edge"], r["painleve_edge"]
 
@@ -382,8 +372,6 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None):
         if c not in CASES:
             raise InputError(f"`cases` must hold keys of CASES ({list(CASES)}), got {c!r}")
     report = {"full": bool(full), "bound": BOUND, "rows": [], "interrupted": False}
-    from ...analysis.compare import collect_rows
-
     report["interrupted"] = collect_rows(cases, lambda c: run_case(c, full), report["rows"],
                                          on_row, progress, desc="stress catalogue", unit="case")
     return report

@@ -14,7 +14,15 @@ import numpy as np
 
 from ... import _validate as _v
 from ..._validate import positive, positive_int
+# the modules, not their functions: a test (or a user) that replaces
+# engine.run_points or steady_state.find_steady_state reaches the sweeps too
+from ...analysis import engine, steady_state
+from ...analysis.engine import Scheme, check_output_dir
 from ...errors import InputError, MoreauError
+from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
+from .figures import sweep_figure
+from .tables import sweep_point, tidy_rows, write_sidecar, write_table
+from .valid_range import range_marks
 
 __all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE"]
 
@@ -53,9 +61,6 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
     >>> [r["mode"] for r in rows]
     ['NS', 'NP']
     """
-    from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
-    from ...analysis.steady_state import find_steady_state
-
     if parameter not in SWEEP_DEFAULTS:
         raise InputError(f"`parameter` must be one of {sorted(SWEEP_DEFAULTS)}, got {parameter!r}")
     params = PAPER_DEFAULTS if params is None else params
@@ -79,7 +84,7 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
                     scene = FrictionDrive(params, float(x))
                 else:
                     scene = FrictionDrive(params.with_(**{parameter: float(x)}), frequency)
-                ss = find_steady_state(scene, rtol=rtol)
+                ss = steady_state.find_steady_state(scene, rtol=rtol)
                 d = scene.displacement_to_si(ss.displacement_per_period)
                 row.update(mode=ss.mode, displacement_per_period_m=d,
                            average_velocity_m_per_s=d * scene.frequency,
@@ -175,7 +180,6 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     ...
     moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
     """
-    from ...analysis.engine import Scheme
     if scheme == "moreau-jean":
         return Scheme.moreau_jean(1.0 if theta is None else theta,
                                   1000 if steps_per_period is None else steps_per_period, rtol)
@@ -246,10 +250,6 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     list of dict
         The tidy rows.
     """
-    from ...scenes.friction_drive import PAPER_DEFAULTS
-    from ...analysis.engine import check_output_dir, run_points
-    from .reproduce import _point, _sidecar, range_marks, tidy_rows, write_table
-
     params = PAPER_DEFAULTS if params is None else params
     if parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
@@ -269,14 +269,15 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         frequency = positive("frequency", frequency)
     # every value must make a valid parameter set before any work starts
     for x in (values[0], values[-1]):
-        _point(params, parameter, x, frequency if frequency is not None else float(x))
+        sweep_point(params, parameter, x, frequency if frequency is not None else float(x))
     scheme = make_scheme() if scheme is None else scheme
     out = check_output_dir(out)
     cache_dir = out / "cache" if cache_dir is None else cache_dir
 
-    points_ = [_point(params, parameter, x, frequency) for x in values]
-    rows, stats = run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
-                             scheduler=scheduler, progress=progress, desc=f"sweep {parameter}")
+    points_ = [sweep_point(params, parameter, x, frequency) for x in values]
+    rows, stats = engine.run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                                    scheduler=scheduler, progress=progress,
+                                    desc=f"sweep {parameter}")
     table = tidy_rows(parameter, values, frequency, params, rows, ())
     for r in table:
         r["scheme"] = scheme.name
@@ -287,12 +288,11 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     stem = out / f"sweep_{tag}"
     write_table(table, _with(stem, ".csv"))
     marks = range_marks(params, parameter, frequency)
-    _sidecar(_with(stem, ".json"), params, f"sweep_{tag}", parameter, values, frequency,
-             marks, (), None, stats, scheme=scheme)
+    write_sidecar(_with(stem, ".json"), params, f"sweep_{tag}", parameter, values, frequency,
+                  marks, (), None, stats, scheme=scheme)
     log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
-        from .figures import sweep_figure
         label = scheme.name if scheme.name == "event-driven" else \
             f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
         paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",

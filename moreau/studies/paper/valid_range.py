@@ -16,8 +16,11 @@ rod's motion is an explicit function of ``tau``, so both limits are explicit:
 import math
 
 import numpy as np
+from scipy.optimize import brentq, minimize_scalar
 
-__all__ = ["lift_off_margin", "painleve_edge", "lift_off_edges", "phi0_valid_range"]
+from ...scenes.friction_drive import FrictionDrive
+
+__all__ = ["lift_off_margin", "painleve_edge", "lift_off_edges", "phi0_valid_range", "range_marks"]
 
 _TAU = np.linspace(0.0, 2.0 * math.pi, 1025)
 
@@ -31,16 +34,12 @@ def lift_off_margin(params, frequency):
     >>> lift_off_margin(PAPER_DEFAULTS, 185.0) < 0 < lift_off_margin(PAPER_DEFAULTS, 20000.0)
     True
     """
-    from ...scenes.friction_drive import FrictionDrive
-
     sc = FrictionDrive(params, frequency)
     phi, dphi, _ = sc.contact_angle(_TAU)
     D = sc.coefficients(phi, dphi, _TAU)[3]
     i = int(np.argmax(D))
     best = float(D[i])
     if 0 < i < len(_TAU) - 1:
-        from scipy.optimize import minimize_scalar
-
         def negD(t):
             p, dp, _ = sc.contact_angle(t)
             return -float(sc.coefficients(p, dp, t)[3])
@@ -62,8 +61,6 @@ def lift_off_edges(params, frequency, lo=None, hi=None, n=241):
     Returns a sorted list of ``(phi0, side)`` with ``side`` ``"enters"`` when
     contact holds above the edge and ``"leaves"`` when it holds below.
     """
-    from scipy.optimize import brentq
-
     lo = math.asin(2.0 * params.x10 / params.length) + 1e-6 if lo is None else lo
     hi = math.pi / 2 - 1e-6 if hi is None else hi
 
@@ -106,3 +103,31 @@ def phi0_valid_range(params, frequency):
     low = enters[0] if enters else math.asin(2.0 * params.x10 / params.length)
     inner = [p for p, _ in edges if p > low + 1e-9]
     return {"lift_off_edge": low, "painleve_edge": top, "inner_edges": inner}
+
+
+def range_marks(params, parameter, frequency=None):
+    """Limits of the contact model along one swept parameter, to mark on its figure.
+
+    ``{"contact_loss_Hz": f}`` for a frequency sweep (where ``max D = 0``),
+    ``{"painleve_edge": 1/tan(phi0)}`` for ``mu``, the valid range of
+    :func:`phi0_valid_range` for ``phi0``, and ``{}`` for the other parameters.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> round(range_marks(PAPER_DEFAULTS, "mu", 185.0)["painleve_edge"], 6)
+    1.0
+    """
+    if parameter == "frequency":
+        # the frequency where the rod would lift off (max D = 0), if there is one
+        f_hi = 1e3
+        while lift_off_margin(params, f_hi) < 0 and f_hi < 1e7:
+            f_hi *= 2
+        if f_hi >= 1e7:
+            return {}
+        return {"contact_loss_Hz": brentq(lambda f: lift_off_margin(params, f), f_hi / 2, f_hi)}
+    if parameter == "mu":
+        return {"painleve_edge": 1.0 / math.tan(params.phi0)}
+    if parameter == "phi0":
+        return phi0_valid_range(params, frequency)
+    return {}
