@@ -6,14 +6,21 @@ paper's dimensionless variables.
 
 import argparse
 import json
-import math
 import sys
-import time
 
 from . import __version__
-from .errors import InputError, MoreauError
+from .analysis import compare as cmp
+from .analysis.engine import check_jobs, check_output_dir, check_scheduler
 from .analysis.summary import check_periodic, steady_state_report
+from .cli_bidirectional import add_scene_options, cmd_sweep_bidirectional
+from .errors import InputError, MoreauError
+from .scenes.friction_drive import params_from_kwargs
 from .scenes.registry import describe, entries, get_entry, scene_names
+from .studies.paper.atlas import run_atlas
+from .studies.paper.histories import history_command
+from .studies.paper.reproduce import reproduce
+from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs
+from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
 
 __all__ = ["main"]
 
@@ -39,7 +46,6 @@ def _add_params(p, scheme_defaults=True):
 
 
 def _params(args):
-    from .scenes.friction_drive import params_from_kwargs
     return params_from_kwargs(mu=args.mu, phi0=args.phi0, x10=args.x10, k=args.k, m=args.m,
                               m2=args.m2, length=args.length, load=args.load,
                               restitution=args.restitution)
@@ -47,7 +53,6 @@ def _params(args):
 
 def _scheme_args(args, rtol_acts=True):
     """Refuse scheme settings that would not act, then fill in the scheme's defaults."""
-    from .studies.paper.sweeps import make_scheme
     if args.rtol is not None and not rtol_acts:
         raise InputError(f"`--rtol` does not act in `moreau {args.command}` (a time history "
                          "runs each scheme at its own tolerance); leave it out")
@@ -112,9 +117,7 @@ def _cmd_steady(args):
 
 
 def _cmd_sweep(args):
-    from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
     if get_entry(args.scene).name == "bidirectional-drive":
-        from .cli_bidirectional import cmd_sweep_bidirectional
         return cmd_sweep_bidirectional(args)
     if args.parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` {args.parameter!r} applies only to `--scene bidirectional`")
@@ -157,8 +160,6 @@ def _cmd_sweep(args):
 
 
 def _cmd_run(args):
-    from .analysis.engine import check_output_dir
-    from .studies.paper.histories import history_command
     _scheme_args(args, rtol_acts=False)
     check_output_dir(args.out)
     params = _params(args)
@@ -169,8 +170,6 @@ def _cmd_run(args):
 
 
 def _cmd_atlas(args):
-    from .studies.paper.atlas import run_atlas
-    from .studies.paper.sweeps import make_scheme
     params = _params(args)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
     planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
@@ -211,7 +210,6 @@ def _add_atlas(sub):
 # -- moreau reproduce ---------------------------------------------------------------
 
 def _cmd_reproduce(args):
-    from .studies.paper.reproduce import reproduce
     res = reproduce(args.out, quick=args.quick, scheduler=args.scheduler, n_jobs=args.jobs,
                     progress=not args.quiet)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
@@ -234,18 +232,15 @@ def _add_reproduce(sub):
 
 def _cmd_compare(args):
     """``moreau compare``: work-precision of every scheme on one scene, or the stress map."""
-    from .analysis import compare as cmp
 
     out = cmp.check_out_dir(args.out)
     progress = not args.quiet
     if args.stress:
-        from .studies.paper.stress import run_catalogue, write_stress_outputs
         report = run_catalogue(progress=progress, full=not args.quick)
         paths = write_stress_outputs(report, out, plot=not args.no_plot)
         if args.json:
             print(json.dumps(report))
         else:
-            from .studies.paper.stress import format_stress_table
             print(format_stress_table(report))
             print("wrote " + ", ".join(p for p in paths.values() if p))
         return
@@ -315,7 +310,6 @@ def build_parser():
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)
-    from .cli_bidirectional import add_scene_options
     add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "
@@ -387,7 +381,6 @@ def build_parser():
 
 def _check_common(args):
     # the options several commands share, checked before any of them starts work
-    from .analysis.engine import check_jobs, check_output_dir, check_scheduler
     if getattr(args, "jobs", None) is not None:
         check_jobs(args.jobs, 1)
     check_scheduler(getattr(args, "scheduler", None))

@@ -6,10 +6,11 @@ are those of the single-rod drive and apply to both rods; ``--x10-a``,
 ``--x10-b`` and ``--phase`` set the two stators (``--x10`` sets both).
 """
 
-import json
-import time
 
 from .errors import InputError
+from .scenes.bidirectional_drive import params_from_kwargs
+from .studies.bidirectional.bidirectional_sweep import BIDIRECTIONAL_SWEEPABLE, run_bidirectional_sweep
+from .studies.paper.sweeps import make_scheme
 
 __all__ = ["add_scene_options", "cmd_sweep_bidirectional"]
 
@@ -31,7 +32,6 @@ def add_scene_options(p, with_set=True):
 
 
 def _params(args):
-    from .scenes.bidirectional_drive import params_from_kwargs
     x10 = args.x10
     return params_from_kwargs(
         mu=args.mu, phi0=args.phi0, k=args.k, m=args.m, m2=args.m2, length=args.length,
@@ -42,8 +42,6 @@ def _params(args):
 
 def cmd_sweep_bidirectional(args):
     """``moreau sweep --scene bidirectional PARAM START STOP ...``; every option is checked first."""
-    from .studies.bidirectional.bidirectional_sweep import BIDIRECTIONAL_SWEEPABLE, run_bidirectional_sweep
-    from .studies.paper.sweeps import make_scheme
 
     param = args.parameter
     if param not in BIDIRECTIONAL_SWEEPABLE:

@@ -46,30 +46,6 @@ _ENV = {**os.environ,
 OPTIONAL = {"matplotlib", "tqdm", "dask", "distributed", "siconos", "quantecon", "IPython",
             "nbformat", "nbclient", "hypothesis"}
 
-#: TEMPORARY: files being rewritten in parallel (issue 17); each is exempt from the
-#: private-name and function-level-import checks until its rewrite lands, and is
-#: then removed from here (the test says when an entry is no longer needed)
-_PENDING = {
-    "moreau/cli.py",
-    "moreau/cli_bidirectional.py",
-    "moreau/integrators/moreau_jean.py",
-    "moreau/lcp/lemke.py",
-    "moreau/scenes/bidirectional_drive.py",
-    "moreau/scenes/bouncing_ball.py",
-    "moreau/scenes/friction_drive.py",
-    "moreau/scenes/painleve_rod.py",
-    "moreau/scenes/sliding_block.py",
-    "moreau/scenes/sliding_box.py",
-    "moreau/scenes/stick_slip_motor.py",
-}
-
-#: TEMPORARY: private names imported from a module of _PENDING, whose rewrite makes them
-#: public (or moves them to a private module); (importing file, "module.name")
-_PENDING_PRIVATE = {
-    ("moreau/lcp/qp.py", "moreau.lcp.lemke._coerce"),
-}
-
-
 # -- the import statements of the package's files ------------------------------------------------
 class _File:
     """One source file of the package: its module name and its import statements."""
@@ -126,7 +102,7 @@ def _package_of(module):
 
 
 # -- (a) private names ------------------------------------------------------------------------------
-def _private_imports(f, exempt=True):
+def _private_imports(f):
     """``from X import _name`` of ``f`` where ``_name`` is not a package-internal helper."""
     bad = []
     for node, _ in f.imports:
@@ -145,23 +121,13 @@ def _private_imports(f, exempt=True):
             if _is_private_module(src) and f.module.startswith(_package_of(src) + "."):
                 # a private module's names are for its own package
                 continue
-            if exempt and (f.rel, f"{src}.{name}") in _PENDING_PRIVATE:
-                continue
             bad.append(f"{f.rel}:{node.lineno}: {name} from {src}")
     return bad
 
 
 def test_no_private_name_is_imported_from_a_public_module():
-    bad = [b for f in FILES.values() if f.rel not in _PENDING for b in _private_imports(f)]
+    bad = [b for f in FILES.values() for b in _private_imports(f)]
     assert not bad, "private names imported across modules:\n" + "\n".join(bad)
-
-
-def test_pending_private_imports_are_still_there():
-    for rel, dotted in sorted(_PENDING_PRIVATE):
-        f = next(f for f in FILES.values() if f.rel == rel)
-        src, _, name = dotted.rpartition(".")
-        assert any(b.endswith(f": {name} from {src}") for b in _private_imports(f, exempt=False)), \
-            f"{rel} no longer imports {dotted}: remove it from _PENDING_PRIVATE"
 
 
 # -- (b) imports inside functions ---------------------------------------------------------------------
@@ -181,16 +147,8 @@ def _function_imports(f):
 
 
 def test_imports_are_at_the_top_except_optional_dependencies():
-    bad = [b for f in FILES.values() if f.rel not in _PENDING for b in _function_imports(f)]
+    bad = [b for f in FILES.values() for b in _function_imports(f)]
     assert not bad, "imports inside functions (move them to the top):\n" + "\n".join(bad)
-
-
-def test_pending_lists_only_files_that_still_need_it():
-    for rel in sorted(_PENDING):
-        f = next((f for f in FILES.values() if f.rel == rel), None)
-        assert f is not None, f"_PENDING names {rel}, which does not exist"
-        clean = not _function_imports(f) and not _private_imports(f, exempt=False)
-        assert not clean, f"{rel} follows the rules now: remove it from _PENDING"
 
 
 # -- (c) cycles ---------------------------------------------------------------------------------------

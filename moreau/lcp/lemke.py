@@ -1078,7 +1078,8 @@ _F8 = np.dtype(np.float64)
 _NDARRAY = np.ndarray
 
 
-def _coerce(M, q):
+def coerce_lcp(M, q):
+    """``(M, q)`` as float64 arrays of matching square shapes; refusals name the argument."""
     # cheap when the caller already passes float64 arrays, the common case
     if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
         M = _as_matrix(M)
@@ -1196,14 +1197,14 @@ def _solve(M, q, max_iter, tol, check_input, covering):
     # keyword call costs a noticeable part of a 4-variable solve
     # types and shapes are checked on every path (an unchecked call must not
     # reach compiled code with arrays it would read out of bounds); the
-    # inline fast path of _coerce costs a handful of attribute reads
+    # inline fast path of coerce_lcp costs a handful of attribute reads
     if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
         M = _as_matrix(M)
     if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
     m0, m1 = M.shape
     if m0 != m1 or m0 != q.shape[0]:
-        M, q = _coerce(M, q)
+        M, q = coerce_lcp(M, q)
     if check_input:
         if max_iter is not None:
             max_iter = positive_int("max_iter", max_iter)

@@ -80,7 +80,7 @@ from ._result import (
     lcp_violation,
 )
 from .certify import farkas_vector
-from .lemke import _coerce, balance
+from .lemke import balance, coerce_lcp
 
 __all__ = ["solve", "DEFAULT_TOL", "qp_formulation"]
 
@@ -313,7 +313,7 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, ref
     >>> res.success, np.allclose(res.z * [1e300, 1e-300], 1.0, rtol=1e-12)
     (True, True)
     """
-    M, q = _coerce(M, q)
+    M, q = coerce_lcp(M, q)
     if check_input:
         if not (np.all(np.isfinite(M))):
             raise InputError("`M` must contain only finite values (no NaN or inf)")
