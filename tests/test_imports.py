@@ -12,7 +12,6 @@ import json
 import math
 import os
 import pathlib
-import pkgutil
 import subprocess
 import sys
 import time
