@@ -6,18 +6,20 @@ paper's dimensionless variables.
 
 import argparse
 import json
+import os
 import sys
 
 from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler
+from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
 from .cli_bidirectional import add_scene_options, cmd_sweep_bidirectional
 from .errors import InputError, MoreauError
 from .scenes.friction_drive import params_from_kwargs
-from .scenes.registry import describe, entries, get_entry, scene_names
+from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
+from .scenes.registry import describe, discover, entries, get_entry, scene_names
 from .studies.paper.atlas import run_atlas
-from .studies.paper.histories import history_command
 from .studies.paper.reproduce import reproduce
 from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs
 from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
@@ -25,7 +27,13 @@ from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
 __all__ = ["main"]
 
 
-def _add_params(p, scheme_defaults=True):
+def scheme_names():
+    """Every registered scheme (the scenes' own references included)."""
+    discover()
+    return sorted(INTEGRATORS)
+
+
+def _add_params(p, scheme_defaults=True, schemes=("event-driven", "moreau-jean")):
     p.add_argument("--mu", type=float, default=None, help="friction coefficient (default 0.1)")
     p.add_argument("--phi0", type=float, default=None, help="initial rod tilt [rad] (default pi/4)")
     p.add_argument("--x10", type=float, default=None, help="stator amplitude [m] (default 2e-6)")
@@ -35,7 +43,7 @@ def _add_params(p, scheme_defaults=True):
     p.add_argument("--length", type=float, default=None, help="rod length [m] (default 1e-3)")
     p.add_argument("--load", type=float, default=None, help="rotor load F_L [N] (default 0)")
     p.add_argument("--restitution", type=float, default=None, help="impact restitution e (default 0)")
-    p.add_argument("--scheme", default="event-driven", choices=["event-driven", "moreau-jean"])
+    p.add_argument("--scheme", default="event-driven", choices=list(schemes))
     # without defaults a command can tell (and refuse) a setting that would not act
     p.add_argument("--steps-per-period", type=int, default=1000 if scheme_defaults else None,
                    help="Moreau-Jean steps per drive period (default 1000)")
@@ -160,13 +168,62 @@ def _cmd_sweep(args):
 
 
 def _cmd_run(args):
-    _scheme_args(args, rtol_acts=False)
+    """``moreau run``: a time history of any registered scene under any registered scheme."""
     check_output_dir(args.out)
-    params = _params(args)
-    if args.frequency is None:
-        raise InputError("`--frequency` is required (drive frequency in Hz)")
-    history_command(params, args.frequency, args.periods, args.scheme, args.steps_per_period,
-                    args.theta, args.out, plot=not args.no_plot, progress=not args.quiet)
+    entry = get_entry(args.scene)
+    params = scene_parameters(args, entry)
+    scene = entry.factory(**params)
+    options = parse_settings(args.option or [], "--option")
+    for key in ("theta", "rtol"):
+        val = getattr(args, key)
+        if val is not None:
+            if key in options:
+                raise InputError(f"`{key}` is given twice (`--{key}` and `--option {key}=...`)")
+            options[key] = val
+    periodic = getattr(scene, "period", None) is not None
+    periods, duration = args.periods, args.duration
+    if periods is not None and duration is not None:
+        raise InputError("give one of `--periods` and `--duration`")
+    if periods is None and duration is None:
+        if not periodic:
+            raise InputError(f"`--duration` is required: scene {entry.name!r} has no drive period")
+        periods = 10.0
+    cls = get_integrator(args.scheme)
+    cls = cls.resolve(scene) if hasattr(cls, "resolve") else cls
+    stepping = "h" in (scheme_options(cls) or ())
+    steps = args.steps
+    if args.steps_per_period is not None:
+        if steps is not None:
+            raise InputError("give one of `--steps` and `--steps-per-period`")
+        if periods is None:
+            raise InputError("`--steps-per-period` needs `--periods`; with `--duration` give `--steps`")
+        steps = int(round(args.steps_per_period * periods))
+    if stepping and steps is None and "h" not in options:
+        if periods is None:
+            raise InputError(f"scheme {args.scheme!r} steps in time: give `--steps`")
+        steps = int(round(1000 * periods))
+    check_options(args.scheme, options, scene)
+    res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
+                            steps=steps, samples=args.samples,
+                            progress=not args.quiet, **options)
+    shown = dict(options)
+    if stepping and steps is not None:
+        shown["steps"] = steps
+    tag = history_tag(entry.name, params, args.scheme, shown)
+    path = os.path.join(args.out, tag + ".csv")
+    os.makedirs(args.out, exist_ok=True)
+    side = write_history(cols, path, {
+        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
+        "periods": periods, "duration": duration, "status": res.status, "message": res.message,
+        "command": "moreau run"})
+    print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
+          f"{res.message}")
+    if not args.no_plot:
+        fig = os.path.join(args.out, tag + ".png")
+        plot_history(cols, fig, title=f"{entry.name} ({args.scheme})")
+        print(f"wrote {fig}")
+    if not res.success:
+        raise MoreauError(f"the run stopped early: {res.message}")
 
 
 def _cmd_atlas(args):
@@ -341,13 +398,23 @@ def build_parser():
     _add_params(s, scheme_defaults=False)
     add_scene_options(s, with_set=False)
     s.set_defaults(func=_cmd_sweep)
-    r = sub.add_parser("run", help="time histories from rest (CSV + figure, SI units)")
+    r = sub.add_parser("run", help="time history of any scene under any scheme, from its initial "
+                                    "state (CSV with units, JSON sidecar, figure)")
     r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
-    r.add_argument("--periods", type=float, default=10.0, help="drive periods to simulate")
+    r.add_argument("--periods", type=float, default=None,
+                   help="drive periods to simulate (default 10 for a driven scene)")
+    r.add_argument("--duration", type=float, default=None,
+                   help="time to simulate [s] (or the scene's time unit if it has no SI units)")
+    r.add_argument("--steps", type=int, default=None,
+                   help="time-stepping schemes: steps over the whole run")
+    r.add_argument("--samples", type=int, default=2000, help="samples kept (default 2000)")
+    r.add_argument("--option", action="append", metavar="NAME=VALUE",
+                   help="any option of the scheme (repeatable), e.g. --option lcp_method=lemke")
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
-    _add_params(r, scheme_defaults=False)
+    _add_params(r, scheme_defaults=False, schemes=scheme_names())
+    add_scene_options(r)
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
     _add_atlas(sub)

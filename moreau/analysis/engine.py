@@ -47,7 +47,7 @@ _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitut
 _PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
                  "studies/paper/figures.py", "studies/paper/report.py",
                  "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
-                 "studies/paper/histories.py", "studies/paper/tables.py"}
+                 "analysis/history.py", "studies/paper/tables.py"}
 
 
 def code_version():

@@ -7,6 +7,29 @@ import numpy as np
 #: quantities converted to SI by ``to_si``; ``None`` where not requested
 SIValues = namedtuple("SIValues", ["t", "q", "v", "force"])
 
+#: SI unit of each named time history that a scene's ``to_si`` returns
+SI_UNITS = {"t": "s", "x2": "m", "v2": "m/s", "phi": "rad", "phi_a": "rad", "phi_b": "rad",
+            "normal_force": "N", "tangential_force": "N", "force_N": "N", "force_T": "N",
+            "slip_velocity": "m/s", "gap": "m", "regime": ""}
+
+
+def columns_of(histories, units):
+    """``[(name, unit, 1-D array)]`` of a ``to_si`` dict: one column per contact of 2-D entries.
+
+    ``units`` maps each name to its unit, or to one unit per column of a 2-D entry.
+    """
+    out = []
+    for name, arr in histories.items():
+        arr = np.asarray(arr)
+        unit = units[name]
+        if arr.ndim == 1:
+            out.append((name, unit, arr))
+            continue
+        for j in range(arr.shape[1]):
+            out.append((f"{name}_{j}", unit[j] if isinstance(unit, (list, tuple)) else unit,
+                        arr[:, j]))
+    return out
+
 
 class DriveUnits:
     """SI conversions for a scene scaled by a rod length ``l`` and a drive frequency ``w``.
@@ -28,6 +51,15 @@ class DriveUnits:
         """Dimensionless force to newtons."""
         return f * self.force_scale
 
+    @property
+    def time_unit_s(self):
+        """Seconds per unit of the scene's time ``tau = w t``."""
+        return 1.0 / self.omega
+
+    def si_columns(self, result):
+        """The SI time histories of ``result`` as ``[(name, unit, column)]`` (see :meth:`to_si`)."""
+        return columns_of(self.to_si(result), SI_UNITS)
+
 
 class SIUnits:
     """SI conversion shared by the validation scenes of this package.
@@ -37,9 +69,25 @@ class SIUnits:
     coordinates are angles.
     """
 
+    #: coordinates that are angles (their SI unit is rad, not m)
+    angle_coordinates = ()
+
     def _qscale(self):
         # one scale for all coordinates, so that scalars convert to scalars
         return self.length
+
+    @property
+    def time_unit_s(self):
+        """Seconds per unit of the scene's time."""
+        return self.time
+
+    def si_columns(self, result):
+        """The SI time histories of ``result`` as ``[(name, unit, column)]`` (see :meth:`to_si`)."""
+        n = result.q.shape[1]
+        ang = set(self.angle_coordinates)
+        units = dict(SI_UNITS, q=["rad" if i in ang else "m" for i in range(n)],
+                     v=["rad/s" if i in ang else "m/s" for i in range(n)])
+        return columns_of(self.to_si(result), units)
 
     def displacement_to_si(self, dq):
         """A dimensionless displacement to metres."""

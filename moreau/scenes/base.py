@@ -126,6 +126,28 @@ class Scene:
         """
         return None
 
+    # -- units -------------------------------------------------------------
+    #: seconds per unit of the scene's time; None for a scene without SI units (its
+    #: time histories stay in its own units)
+    time_unit_s = None
+
+    def si_columns(self, result):
+        """Time histories of ``result`` as ``[(name, unit, column)]``.
+
+        Scenes with SI units give them in SI (``moreau.scenes._units``); this
+        default gives the scene's own units, marked dimensionless (unit ``""``):
+        ``t``, ``q_i``, ``v_i``, and per contact ``force_N``, ``force_T``
+        (impulses over the step for time-stepping schemes), ``slip_velocity``,
+        ``gap`` and ``regime``.
+        """
+        cols = [("t", "", result.t)]
+        for name, arr in (("q", result.q), ("v", result.v), ("force_N", result.force_N),
+                          ("force_T", result.force_T), ("slip_velocity", result.slip_velocity),
+                          ("gap", result.gap), ("regime", result.regime)):
+            arr = np.asarray(arr)
+            cols.extend((f"{name}_{j}", "", arr[:, j]) for j in range(arr.shape[1]))
+        return cols
+
     # -- conveniences shared by all scenes --------------------------------
     def contact_velocities(self, q, v, t):
         """Normal and tangential relative velocities ``(gN_dot, gammaT)``."""

@@ -184,6 +184,8 @@ class PainleveRod(SIUnits, Scene):
         return CompiledModel(_mass, _forces, _contacts, _drift, [], 3, 1, True, False)
 
     # -- units ----------------------------------------------------------------
+    angle_coordinates = (2,)
+
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
 

@@ -166,6 +166,8 @@ class SlidingBox(SIUnits, Scene):
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.a, self.b, self.inertia],
                              3, 2, True, False)
 
+    angle_coordinates = (2,)
+
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
 

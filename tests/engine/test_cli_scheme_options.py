@@ -8,8 +8,16 @@ from moreau.cli import main
 @pytest.mark.parametrize("argv, message", [
     (["steady", "--frequency", "185", "--theta", "0.5"], "`--theta` applies only to `--scheme moreau-jean`"),
     (["steady", "--frequency", "185", "--steps-per-period", "100"], "`--steps-per-period` applies only"),
-    (["run", "--frequency", "185", "--rtol", "1e-3"], "`--rtol` does not act in `moreau run`"),
-    (["run", "--frequency", "185", "--scheme", "moreau-jean", "--rtol", "1e-3"], "`--rtol` does not act"),
+    (["run", "--frequency", "185", "--scheme", "moreau-jean", "--rtol", "1e-3"],
+     "`rtol` is not an option of scheme 'moreau-jean'"),
+    (["run", "--scene", "bouncing-ball", "--duration", "1", "--theta", "0.5"],
+     "`theta` is not an option of scheme 'event-driven'"),
+    (["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean",
+      "--option", "hh=0.1", "--steps", "10"], "`hh` is not an option of scheme 'moreau-jean'"),
+    (["run", "--scene", "bouncing-ball", "--steps", "100"], "`--duration` is required"),
+    (["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean"],
+     "give `--steps`"),
+    (["run", "--frequency", "185", "--steps", "100"], "`steps` applies to time-stepping schemes"),
     (["steady", "--scene", "bidirectional", "--frequency", "185", "--theta", "1"], "`--theta` applies only"),
 ])
 def test_unused_scheme_setting_is_refused(argv, message, capsys):
@@ -24,3 +32,12 @@ def test_moreau_jean_steady_takes_its_tolerance(capsys):
     rep = json.loads(capsys.readouterr().out)
     assert rep["scheme"] == "moreau-jean" and rep["steps_per_period"] == 200
     assert rep["periodic_residual"] <= 1e-9
+
+
+def test_run_takes_the_event_driven_tolerance(tmp_path, capsys):
+    # the reference's tolerance acts in a time history: a looser one takes fewer events' iterations
+    import json
+    assert main(["run", "--scene", "bouncing-ball", "--duration", "1.5", "--rtol", "1e-6",
+                 "--out", str(tmp_path), "--quiet", "--no-plot"]) == 0
+    side = json.loads(next(tmp_path.glob("*.json")).read_text())
+    assert side["options"]["rtol"] == 1e-6 and side["scheme"] == "event-driven"

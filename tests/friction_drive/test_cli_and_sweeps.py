@@ -1,5 +1,6 @@
 """The `moreau` command and the sweep helpers."""
 
+import csv
 import json
 import math
 import subprocess
@@ -144,21 +145,34 @@ def test_run_command_writes_history(tmp_path, capsys):
     rc = main(["run", "--frequency", "185", "--periods", "2", "--out", str(tmp_path), "--quiet",
                "--no-plot"])
     assert rc == 0
-    path = tmp_path / "history_185Hz_event-driven.csv"
-    data = np.genfromtxt(path, delimiter=",", names=True)
-    assert data["t"][-1] == pytest.approx(2 / 185.0)
-    assert np.all(data["normal_force"] > 0)
+    path = tmp_path / "history_friction-drive_frequency185_event-driven.csv"
+    with open(path) as fh:
+        rows = list(csv.DictReader(fh))
+    # units in the column names, regimes by name
+    assert list(rows[0]) == ["t [s]", "x2 [m]", "v2 [m/s]", "phi [rad]", "normal_force [N]",
+                             "tangential_force [N]", "slip_velocity [m/s]", "regime"]
+    assert float(rows[-1]["t [s]"]) == pytest.approx(2 / 185.0)
+    assert all(float(r["normal_force [N]"]) > 0 for r in rows)
+    assert {r["regime"] for r in rows} <= {"stick", "positive", "negative", "flight"}
+    assert {"positive", "negative"} <= {r["regime"] for r in rows}
     # two periods from rest: the rotor has moved backwards by a few micrometres
-    assert -2e-5 < data["x2"][-1] < -5e-6
+    assert -2e-5 < float(rows[-1]["x2 [m]"]) < -5e-6
+    side = json.loads(path.with_suffix(".json").read_text())
+    assert side["scene"] == "friction-drive" and side["scheme"] == "event-driven"
+    assert side["parameters"] == {"frequency": 185.0} and side["status"] == 0
+    assert {"name": "x2", "unit": "m"} in side["columns"]
+    assert side["provenance"]["numpy_version"] and side["provenance"]["command"]
 
 
 def test_histories_of_both_schemes_agree():
-    from moreau.studies.paper.histories import run_history
-    from moreau.scenes.friction_drive import PAPER_DEFAULTS
-    ed = run_history(PAPER_DEFAULTS, 185.0, periods=3, samples_per_period=100)
-    mj = run_history(PAPER_DEFAULTS, 185.0, periods=3, scheme="moreau-jean",
-                     steps_per_period=4000, samples_per_period=100)
-    assert ed["status"] == mj["status"] == 0
-    assert mj["x2"][-1] == pytest.approx(ed["x2"][-1], rel=2e-3)
+    from moreau.analysis.history import run_history
+    from moreau.scenes.friction_drive import FrictionDrive
+    sc = FrictionDrive(frequency=185.0)
+    ed, ed_cols = run_history(sc, periods=3, samples=300)
+    mj, mj_cols = run_history(sc, periods=3, scheme="moreau-jean", steps=12000, samples=300)
+    assert ed.status == mj.status == 0
+    x2 = {name: dict((n, a) for n, _, a in cols)["x2"] for name, cols in
+          (("ed", ed_cols), ("mj", mj_cols))}
+    assert x2["mj"][-1] == pytest.approx(x2["ed"][-1], rel=2e-3)
     with pytest.raises(ValueError, match="`periods` must be > 0"):
-        run_history(PAPER_DEFAULTS, 185.0, periods=0)
+        run_history(sc, periods=0)
