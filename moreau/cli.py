@@ -11,18 +11,17 @@ import sys
 
 from . import __version__
 from .analysis import compare as cmp
-from .analysis.engine import check_jobs, check_output_dir, check_scheduler
+from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
+from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
-from .cli_bidirectional import add_scene_options, cmd_sweep_bidirectional
 from .errors import InputError, MoreauError
-from .scenes.friction_drive import params_from_kwargs
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
-from .scenes.registry import describe, discover, entries, get_entry, scene_names
-from .studies.paper.atlas import run_atlas
+from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
+                              resolve_hook, scene_names)
+from .studies.paper.atlas import command as atlas_command
 from .studies.paper.reproduce import reproduce
 from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs
-from .studies.paper.sweeps import SWEEPABLE, make_scheme, run_sweep
 
 __all__ = ["main"]
 
@@ -53,12 +52,6 @@ def _add_params(p, scheme_defaults=True, schemes=("event-driven", "moreau-jean")
                    help="shooting tolerance (default 1e-10 event-driven, 1e-12 Moreau-Jean)")
 
 
-def _params(args):
-    return params_from_kwargs(mu=args.mu, phi0=args.phi0, x10=args.x10, k=args.k, m=args.m,
-                              m2=args.m2, length=args.length, load=args.load,
-                              restitution=args.restitution)
-
-
 def _scheme_args(args, rtol_acts=True):
     """Refuse scheme settings that would not act, then fill in the scheme's defaults."""
     if args.rtol is not None and not rtol_acts:
@@ -72,6 +65,22 @@ def _scheme_args(args, rtol_acts=True):
 #: the command-line shorthands of scene parameters (``--mu 0.2`` is ``--set mu=0.2``)
 SHORTHANDS = ("frequency", "mu", "phi0", "x10", "k", "m", "m2", "length", "load", "restitution",
               "x10_a", "x10_b", "phase")
+
+
+def add_scene_options(p, with_set=True):
+    """The ``--scene`` switch and the two-stator options of ``moreau steady``."""
+    default = default_scene()
+    p.add_argument("--scene", default=default, metavar="NAME",
+                   help=f"a registered scene (`moreau scenes`; default {default})")
+    if with_set:
+        p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                       help="any parameter of the scene (repeatable), e.g. --set mu=0.3")
+    p.add_argument("--x10-a", dest="x10_a", type=float, default=None,
+                   help="bidirectional: stator amplitude of rod a [m] (default --x10 or 2e-6)")
+    p.add_argument("--x10-b", dest="x10_b", type=float, default=None,
+                   help="bidirectional: stator amplitude of rod b [m] (default --x10 or 2e-6)")
+    p.add_argument("--phase", type=float, default=None,
+                   help="bidirectional: phase lag of stator b [rad] (default 0)")
 
 
 def scene_parameters(args, entry):
@@ -125,46 +134,27 @@ def _cmd_steady(args):
 
 
 def _cmd_sweep(args):
-    if get_entry(args.scene).name == "bidirectional-drive":
-        return cmd_sweep_bidirectional(args)
-    if args.parameter not in SWEEPABLE:
-        raise InputError(f"`PARAM` {args.parameter!r} applies only to `--scene bidirectional`")
-    for opt in ("x10_a", "x10_b", "phase"):
-        if getattr(args, opt) is not None:
-            raise InputError(f"`--{opt.replace('_', '-')}` applies only to `--scene bidirectional`")
-    settings = {}
-    for item in args.set or []:
-        key, sep, val = item.partition("=")
-        key = key.strip()
-        if not sep or key not in SWEEPABLE:
-            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {list(SWEEPABLE)}, "
-                             f"got {item!r}")
-        if key == args.parameter:
-            raise InputError(f"`--set {key}` fixes the swept parameter; leave it out")
-        try:
-            settings[key] = float(val)
-        except ValueError:
-            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
-    if args.parameter != "frequency" and getattr(args, args.parameter, None) is not None:
-        raise InputError(f"`--{args.parameter}` fixes the swept parameter; leave it out")
-    frequency = settings.pop("frequency", args.frequency)
-    for key, val in settings.items():
-        if getattr(args, key, None) is not None:
-            raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
-        setattr(args, key, val)
-    params = _params(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    """``moreau sweep``: the scene's own study sweep where its entry names one, else the generic one."""
+    entry = get_entry(args.scene)
+    if entry.sweep is not None:
+        return resolve_hook(entry.sweep)(args)
     if args.num is not None and args.points is not None:
         raise InputError("`--num` is the old name of `--points`; give one of them")
-    scale = args.scale
-    if args.log:
-        if scale == "linear":
-            raise InputError("`--log` contradicts `--scale linear`")
-        scale = "log"
-    run_sweep(args.parameter, params, frequency=frequency, start=args.start, stop=args.stop,
-              points=args.points if args.points is not None else args.num, scale=scale,
-              scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
-              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+    if args.start is None or args.stop is None:
+        raise InputError(f"`START` and `STOP` are required for a sweep of scene {entry.name!r}")
+    scale = "log" if args.log else (args.scale or "linear")
+    if args.log and args.scale == "linear":
+        raise InputError("`--log` contradicts `--scale linear`")
+    points = args.points if args.points is not None else args.num
+    values = sweep_values(args.start, args.stop, 50 if points is None else points, scale)
+    params = scene_parameters(args, entry)
+    if args.parameter in params and args.parameter != "frequency":
+        raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
+    frequency = params.pop("frequency", None)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
+                    scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
+                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
 
 
 def _cmd_run(args):
@@ -226,22 +216,6 @@ def _cmd_run(args):
         raise MoreauError(f"the run stopped early: {res.message}")
 
 
-def _cmd_atlas(args):
-    params = _params(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
-    planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
-    if args.quick:
-        if args.f_points is not None or args.y_points is not None:
-            raise InputError("`--quick` sets the grid; leave out `--f-points`/`--y-points`")
-        f_points, y_points = 24, 12
-    else:
-        f_points = 200 if args.f_points is None else args.f_points
-        y_points = 100 if args.y_points is None else args.y_points
-    run_atlas(planes, params, out=args.out, f_range=(args.fmin, args.fmax), f_points=f_points,
-              y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
-              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
-
-
 def _add_atlas(sub):
     p = sub.add_parser("atlas", help="operation mode and displacement over the (f, mu) and "
                                      "(f, phi0) planes, with the lift-off, Painleve and "
@@ -261,7 +235,7 @@ def _add_atlas(sub):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
     _add_params(p, scheme_defaults=False)
-    p.set_defaults(func=_cmd_atlas)
+    p.set_defaults(func=atlas_command)
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -372,12 +346,10 @@ def build_parser():
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "
                                       "cached and in parallel")
     s.add_argument("parameter", metavar="PARAM",
-                   choices=["frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load",
-                            "restitution", "x10_a", "x10_b", "phase", "balance"],
-                   help="parameter to sweep: frequency [Hz] or a scene parameter (SI units); "
-                        "x10_a, x10_b, phase and balance with --scene bidirectional")
+                   help="parameter to sweep: frequency [Hz] or a parameter of the scene (SI "
+                        "units; `moreau scenes` lists them)")
     s.add_argument("start", metavar="START", type=float, nargs="?", default=None,
-                   help="first value (default for frequency/mu/phi0: the paper's range)")
+                   help="first value (the friction drive has defaults for frequency, mu, phi0)")
     s.add_argument("stop", metavar="STOP", type=float, nargs="?", default=None, help="last value")
     s.add_argument("--points", type=int, default=None, help="number of values")
     s.add_argument("--num", type=int, default=None, help=argparse.SUPPRESS)  # old name of --points

@@ -32,12 +32,11 @@ import joblib
 from .. import __version__
 from ..errors import ConvergenceError, InputError
 from ..scenes import registry
-from .cases import DriveCase
 from .steady_state import find_steady_state, implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
+__all__ = ["make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -121,6 +120,30 @@ class Scheme(tuple):
 ED_REFERENCE = Scheme("event-driven", rtol=1e-10)
 
 
+def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None):
+    """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
+
+    ``theta`` and ``steps_per_period`` apply to Moreau–Jean only (defaults 1
+    and 1000 there); ``rtol`` is the shooting tolerance of either scheme.
+
+    Examples
+    --------
+    >>> make_scheme("moreau-jean", steps_per_period=500)
+    ('moreau-jean', 1.0, 500, None)
+    >>> make_scheme("event-driven", theta=0.5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
+    """
+    if scheme == "moreau-jean":
+        return Scheme.moreau_jean(1.0 if theta is None else theta,
+                                  1000 if steps_per_period is None else steps_per_period, rtol)
+    for name, val in (("--theta", theta), ("--steps-per-period", steps_per_period)):
+        if val is not None and scheme == "event-driven":
+            raise InputError(f"`{name}` applies only to `--scheme moreau-jean`")
+    return Scheme(scheme, rtol=1e-10 if rtol is None else rtol)
+
+
 def mj_check_columns(check):
     """CSV column names of one Moreau–Jean cross-check."""
     p = check.label
@@ -128,10 +151,28 @@ def mj_check_columns(check):
 
 
 def periodic_scene_names():
-    """The registered scenes with a periodic drive: the ones the engine can evaluate."""
-    return [e.name for e in registry.entries()
-            if "frequency" in e.parameter_names() and e.case is not None
-            and issubclass(e.case, DriveCase)]
+    """The registered scenes with a periodic drive (and SI conversions): the ones the engine evaluates.
+
+    Decided on each scene built with its defaults: a drive period, a
+    frequency parameter, and the displacement and force conversions the rows
+    need.
+    """
+    names = tuple(registry.scene_names())
+    if _PERIODIC.get("names") != names:
+        out = []
+        for e in registry.entries():
+            if "frequency" not in e.parameter_names():
+                continue
+            sc = e.factory()
+            if getattr(sc, "period", None) is not None and all(
+                    hasattr(sc, a) for a in ("displacement_to_si", "force_to_si")):
+                out.append(e.name)
+        _PERIODIC.update(names=names, periodic=out)
+    return list(_PERIODIC["periodic"])
+
+
+# periodic_scene_names() of the registry as it was last seen (every point checks its scene)
+_PERIODIC = {}
 
 
 def _check_scene(scene):

@@ -437,4 +437,7 @@ register_scene(SceneEntry(
     reference="friction-drive-walker",
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution"),
     mj_tolerance=5e-3,
+    # the paper's sweep, with its valid-range marks and default ranges
+    sweep="moreau.studies.paper.sweeps:command",
+    default=True,
 ))

@@ -32,6 +32,12 @@ An entry holds:
     how close Moreau–Jean at the conformance test's step must come to the
     reference (relative to the motion's scale): the scene's stated
     tolerance for the conformance suite.
+``sweep``
+    ``"module:function"`` of the scene's own study sweep, which ``moreau
+    sweep --scene NAME`` runs with its parsed arguments instead of the
+    generic one (:mod:`moreau.analysis.sweep`); None for the generic sweep.
+``default``
+    the scene commands take when none is named (one scene: the paper's).
 
 Examples
 --------
@@ -57,7 +63,8 @@ from typing import Callable, NamedTuple, Optional
 from ..errors import InputError
 
 __all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
-           "make_scene", "discover", "scene_modules", "parameters_of", "describe"]
+           "make_scene", "discover", "scene_modules", "parameters_of", "describe", "default_scene",
+           "resolve_hook"]
 
 
 class Parameter(NamedTuple):
@@ -84,6 +91,8 @@ class SceneEntry:
     mj_tolerance: float = 1e-2
     #: former names that commands still accept
     aliases: tuple = ()
+    sweep: Optional[str] = None
+    default: bool = False
 
     def parameter_names(self):
         return tuple(p.name for p in self.parameters)
@@ -163,6 +172,31 @@ def get_entry(name):
     except (KeyError, TypeError):
         known = ", ".join(repr(k) for k in scene_names())
         raise InputError(f"`scene` must be one of {known}; got {name!r}") from None
+
+
+def default_scene():
+    """The name of the scene commands take when none is named (the entry with ``default=True``)."""
+    names = [e.name for e in entries() if e.default]
+    if len(names) != 1:
+        raise InputError(f"exactly one registered scene must be the default, found {names}")
+    return names[0]
+
+
+def resolve_hook(path):
+    """The function named by ``"module:function"`` (a registry entry's hook), imported on use.
+
+    Examples
+    --------
+    >>> resolve_hook("math:sqrt")(4.0)
+    2.0
+    """
+    module, sep, name = str(path).partition(":")
+    if not sep:
+        raise InputError(f"a hook must read 'module:function', got {path!r}")
+    try:
+        return getattr(importlib.import_module(module), name)
+    except (ImportError, AttributeError) as exc:
+        raise InputError(f"the hook {path!r} cannot be loaded: {exc}") from None
 
 
 def make_scene(name, **params):

@@ -25,14 +25,14 @@ from ..._validate import positive
 from ...analysis import engine
 from ...analysis.engine import check_output_dir, code_version
 from ...errors import InputError
-from ...scenes.bidirectional_drive import BidirectionalDriveParams
+from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
 from ..paper.figures import sweep_figure
 from ..paper.sweeps import make_scheme, sweep_values
 from ..paper.tables import write_table
 from ..paper.valid_range import lift_off_margin, range_marks
 from .direction_control import bidirectional_params
 
-__all__ = ["BIDIRECTIONAL_SWEEPABLE", "BIDIRECTIONAL_COLUMNS", "point_params",
+__all__ = ["command", "params_from_args", "BIDIRECTIONAL_SWEEPABLE", "BIDIRECTIONAL_COLUMNS", "point_params",
            "run_bidirectional_sweep"]
 
 #: swept (or fixed) parameter -> CSV column, units in the name
@@ -219,3 +219,64 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
             prev = label
     return table
 
+
+def params_from_args(args):
+    """The two-rod drive's parameters from a command's options (``--x10-a`` etc.; ``--x10`` sets both)."""
+    x10 = args.x10
+    return params_from_kwargs(
+        mu=args.mu, phi0=args.phi0, k=args.k, m=args.m, m2=args.m2, length=args.length,
+        load=args.load, restitution=args.restitution, phase=args.phase,
+        x10_a=args.x10_a if args.x10_a is not None else x10,
+        x10_b=args.x10_b if args.x10_b is not None else x10)
+
+
+def command(args):
+    """``moreau sweep --scene bidirectional-drive PARAM START STOP ...`` (its registry entry names
+    this function); every option is checked before any work."""
+
+    param = args.parameter
+    if param not in BIDIRECTIONAL_SWEEPABLE:
+        raise InputError(f"`PARAM` must be one of {list(BIDIRECTIONAL_SWEEPABLE)} for "
+                         f"`--scene bidirectional`, got {param!r} (`x10` sets both rods: "
+                         "sweep `x10_a`, `x10_b` or `balance`)")
+    settable = [p for p in BIDIRECTIONAL_SWEEPABLE if p != "balance"] + ["x10"]
+    settings = {}
+    for item in args.set or []:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or key not in settable:
+            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {settable}, got {item!r}")
+        try:
+            settings[key] = float(val)
+        except ValueError:
+            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    # the stator amplitudes a balance point sets, and the parameter swept, cannot also be fixed
+    fixed_by_sweep = {"balance": ("x10_a", "x10_b")}.get(param, (param,))
+    for key in fixed_by_sweep:
+        if key in settings:
+            raise InputError(f"`--set {key}` fixes what the sweep of {param!r} varies; leave it out")
+        if key != "frequency" and getattr(args, key, None) is not None:
+            raise InputError(f"`--{key.replace('_', '-')}` fixes what the sweep of {param!r} "
+                             "varies; leave it out")
+    frequency = settings.pop("frequency", args.frequency)
+    if "frequency" in fixed_by_sweep and args.frequency is not None:
+        raise InputError("`--frequency` is the swept parameter here; leave it out")
+    for key, val in settings.items():
+        if getattr(args, key, None) is not None:
+            raise InputError(f"`{key}` is given twice (`--{key.replace('_', '-')}` and "
+                             f"`--set {key}=...`)")
+        setattr(args, key, val)
+    params = params_from_args(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    if args.num is not None and args.points is not None:
+        raise InputError("`--num` is the old name of `--points`; give one of them")
+    scale = args.scale or "linear"
+    if args.log:
+        if args.scale == "linear":
+            raise InputError("`--log` contradicts `--scale linear`")
+        scale = "log"
+    run_bidirectional_sweep(param, params, frequency=frequency, start=args.start, stop=args.stop,
+                            points=args.points if args.points is not None else args.num,
+                            scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
+                            n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
+                            plot=not args.no_plot)

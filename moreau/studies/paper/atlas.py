@@ -31,14 +31,15 @@ from ... import _validate as V
 # the module, not its function: a test (or a user) that replaces
 # engine.run_points reaches the atlas too
 from ...analysis import engine
-from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version
+from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version, make_scheme
 from ...errors import InputError
 from ...scenes.friction_drive import PAPER_DEFAULTS
 from .figures import atlas_figure
+from .sweeps import params_from_args
 from .tables import write_table
 from .valid_range import lift_off_margin
 
-__all__ = ["PLANES", "compute_atlas", "run_atlas", "point_label"]
+__all__ = ["PLANES", "compute_atlas", "run_atlas", "point_label", "command"]
 
 #: plane name -> (parameter on the y axis, default range, axis label, CSV column)
 PLANES = {
@@ -237,3 +238,20 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
             log(f"wrote {paths[0]}")
         results[plane] = a
     return results
+
+
+def command(args):
+    """``moreau atlas``: the friction drive's atlas from the parsed command-line arguments."""
+    params = params_from_args(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
+    if args.quick:
+        if args.f_points is not None or args.y_points is not None:
+            raise InputError("`--quick` sets the grid; leave out `--f-points`/`--y-points`")
+        f_points, y_points = 24, 12
+    else:
+        f_points = 200 if args.f_points is None else args.f_points
+        y_points = 100 if args.y_points is None else args.y_points
+    run_atlas(planes, params, out=args.out, f_range=(args.fmin, args.fmax), f_points=f_points,
+              y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)

@@ -17,14 +17,15 @@ from ..._validate import positive, positive_int
 # the modules, not their functions: a test (or a user) that replaces
 # engine.run_points or steady_state.find_steady_state reaches the sweeps too
 from ...analysis import engine, steady_state
-from ...analysis.engine import Scheme, check_output_dir
+from ...analysis.engine import check_output_dir, make_scheme
 from ...errors import InputError, MoreauError
-from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
+from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive, params_from_kwargs
 from .figures import sweep_figure
 from .tables import sweep_point, tidy_rows, write_sidecar, write_table
 from .valid_range import range_marks
 
-__all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE"]
+__all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE",
+           "command", "params_from_args"]
 
 #: parameter -> (start, stop, num, log)
 SWEEP_DEFAULTS = {
@@ -165,30 +166,6 @@ def scheme_tag(scheme):
 MAX_POINTS = 10**5
 
 
-def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None):
-    """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
-
-    ``theta`` and ``steps_per_period`` apply to Moreau–Jean only (defaults 1
-    and 1000 there); ``rtol`` is the shooting tolerance of either scheme.
-
-    Examples
-    --------
-    >>> make_scheme("moreau-jean", steps_per_period=500)
-    ('moreau-jean', 1.0, 500, None)
-    >>> make_scheme("event-driven", theta=0.5)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
-    """
-    if scheme == "moreau-jean":
-        return Scheme.moreau_jean(1.0 if theta is None else theta,
-                                  1000 if steps_per_period is None else steps_per_period, rtol)
-    for name, val in (("--theta", theta), ("--steps-per-period", steps_per_period)):
-        if val is not None and scheme == "event-driven":
-            raise InputError(f"`{name}` applies only to `--scheme moreau-jean`")
-    return Scheme(scheme, rtol=1e-10 if rtol is None else rtol)
-
-
 def sweep_values(parameter, start, stop, points, scale="linear"):
     """The swept values, checked: ``points`` values from ``start`` to ``stop``.
 
@@ -306,3 +283,58 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
             log(f"  from {r[col]:.6g}: {label}")
             prev = label
     return table
+
+
+def params_from_args(args):
+    """The friction drive's parameters from the options of a command (``--mu``, ``--phi0``, ...)."""
+    return params_from_kwargs(mu=args.mu, phi0=args.phi0, x10=args.x10, k=args.k, m=args.m,
+                              m2=args.m2, length=args.length, load=args.load,
+                              restitution=args.restitution)
+
+
+
+
+def command(args):
+    """``moreau sweep`` of the paper's friction drive (its registry entry names this function).
+
+    ``args`` are the parsed arguments of ``moreau sweep``; every option is
+    checked before any work.
+    """
+    if args.parameter not in SWEEPABLE:
+        raise InputError(f"`PARAM` {args.parameter!r} is not a parameter of the friction drive")
+    for opt in ("x10_a", "x10_b", "phase"):
+        if getattr(args, opt) is not None:
+            raise InputError(f"`--{opt.replace('_', '-')}` is not a parameter of the friction drive")
+    settings = {}
+    for item in args.set or []:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or key not in SWEEPABLE:
+            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {list(SWEEPABLE)}, "
+                             f"got {item!r}")
+        if key == args.parameter:
+            raise InputError(f"`--set {key}` fixes the swept parameter; leave it out")
+        try:
+            settings[key] = float(val)
+        except ValueError:
+            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    if args.parameter != "frequency" and getattr(args, args.parameter, None) is not None:
+        raise InputError(f"`--{args.parameter}` fixes the swept parameter; leave it out")
+    frequency = settings.pop("frequency", args.frequency)
+    for key, val in settings.items():
+        if getattr(args, key, None) is not None:
+            raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
+        setattr(args, key, val)
+    params = params_from_args(args)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    if args.num is not None and args.points is not None:
+        raise InputError("`--num` is the old name of `--points`; give one of them")
+    scale = args.scale
+    if args.log:
+        if scale == "linear":
+            raise InputError("`--log` contradicts `--scale linear`")
+        scale = "log"
+    run_sweep(args.parameter, params, frequency=frequency, start=args.start, stop=args.stop,
+              points=args.points if args.points is not None else args.num, scale=scale,
+              scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)

@@ -1,0 +1,228 @@
+"""Steady states of any periodically driven scene over one of its parameters.
+
+The generic ``moreau sweep``: every point is one call of the sweep engine
+(:func:`moreau.analysis.engine.run_points`: cached, in parallel, a failed
+point kept as its ``status``), for any registered scene with a periodic
+drive (:func:`moreau.analysis.engine.periodic_scene_names`) and any of its
+numeric parameters. A scene whose study has its own sweep (the paper's
+friction drive, with its valid-range marks) names it in its registry entry
+(``SceneEntry.sweep``); ``moreau sweep`` then runs that one.
+
+Outputs: ``OUT/sweep_SCENE_PARAM[_FREQ]_SCHEME.csv`` (tidy: the swept value,
+the fixed parameters, the steady state, units in the column names), a JSON
+sidecar (scene, parameters, scheme, engine statistics, provenance) and a
+figure of the displacement per period and the operation mode.
+
+Examples
+--------
+>>> rows = run_scene_sweep("stick-slip-motor", "load", [0.0, 0.1], frequency=1000.0,
+...                        out=None, progress=False, plot=False, log=lambda s: None)
+>>> [r["status"] for r in rows], rows[0]["displacement_per_period_m"] > rows[1]["displacement_per_period_m"]
+(['ok', 'ok'], True)
+"""
+
+import csv
+import json
+import math
+
+import numpy as np
+
+from .._validate import finite_scalar, positive, positive_int
+from ..errors import InputError
+from ..provenance import provenance
+from ..scenes import registry
+from . import engine
+from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
+
+__all__ = ["run_scene_sweep", "sweep_tag", "sweep_values", "VALUE_COLUMNS", "MAX_POINTS"]
+
+#: bound on the points of one sweep
+MAX_POINTS = 10**5
+
+#: the steady-state columns of a sweep row (SI units in the names)
+VALUE_COLUMNS = ("mode", "displacement_per_period_m", "average_velocity_m_per_s",
+                 "min_normal_force_N", "periodic_residual", "shooting_iterations", "status",
+                 "compute_time_s")
+
+
+def sweep_values(start, stop, points, scale="linear"):
+    """``points`` values from ``start`` to ``stop``, linear or log-spaced, checked.
+
+    Examples
+    --------
+    >>> sweep_values(10, 1000, 3, "log").tolist()
+    [10.0, 100.0, 1000.0]
+    """
+    start = finite_scalar("START", start)
+    stop = finite_scalar("STOP", stop)
+    points = positive_int("points", points)
+    if points > MAX_POINTS:
+        raise InputError(f"`points` = {points:.3g} is more than the limit {MAX_POINTS:.0e} of one "
+                         "sweep")
+    if scale not in ("linear", "log"):
+        raise InputError(f"`scale` must be 'linear' or 'log', got {scale!r}")
+    if scale == "log":
+        if start <= 0 or stop <= 0:
+            raise InputError("`START` and `STOP` must be > 0 for a log-spaced sweep")
+        return np.geomspace(start, stop, points)
+    return np.linspace(start, stop, points)
+
+
+def _column(p):
+    return f"{p.name} [{p.unit}]" if p.unit and p.unit != "choice" else p.name
+
+
+def sweep_tag(scene, parameter, frequency, scheme):
+    """File stem of a sweep: scene, parameter, the frequency when fixed, and the scheme's settings.
+
+    Examples
+    --------
+    >>> sweep_tag("stick-slip-motor", "load", 1000.0, ED_REFERENCE)
+    'sweep_stick-slip-motor_load_1000Hz_event-driven'
+    """
+    parts = [f"sweep_{scene}", parameter]
+    if parameter != "frequency":
+        parts.append(f"{frequency:g}Hz")
+    parts.append(scheme.name)
+    if scheme.name == "moreau-jean":
+        parts += [f"theta{scheme.theta:g}", f"N{scheme.steps_per_period}"]
+    if scheme.rtol is not None and scheme.rtol != ED_REFERENCE.rtol:
+        parts.append(f"rtol{scheme.rtol:g}")
+    return "_".join(parts)
+
+
+def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme=ED_REFERENCE,
+                    out="out", cache_dir=None, n_jobs=-1, scheduler=None, progress=True,
+                    plot=True, log=print):
+    """Steady states of the registered scene ``scene`` over ``values`` of ``parameter``.
+
+    Parameters
+    ----------
+    scene : str
+        A registered scene with a periodic drive.
+    parameter : str
+        One of the scene's numeric parameters, or ``"frequency"``.
+    values : array_like
+        The swept values, in the parameter's SI unit.
+    fixed : dict, optional
+        Other parameters of the scene (SI units); the rest keep their defaults.
+    frequency : float, optional
+        Drive frequency [Hz]; required unless ``parameter`` is ``"frequency"``.
+    scheme : moreau.analysis.engine.Scheme
+    out : path-like or None
+        Output folder, checked writable before any work; None writes nothing.
+    cache_dir : path-like, optional
+        The engine's cache (default ``OUT/cache``; none without ``out``).
+
+    Returns
+    -------
+    list of dict
+        One tidy row per value.
+    """
+    entry = registry.get_entry(scene)
+    if entry.name not in periodic_scene_names():
+        raise InputError(f"`--scene` must be a periodically driven scene for a sweep, one of "
+                         f"{periodic_scene_names()}; got {scene!r}")
+    params = {p.name: p for p in entry.parameters}
+    numeric = [n for n, p in params.items() if p.unit != "choice"]
+    if parameter not in numeric:
+        raise InputError(f"`PARAM` must be a numeric parameter of scene {entry.name!r}, one of "
+                         f"{numeric}; got {parameter!r}")
+    fixed = dict(fixed or {})
+    for key in fixed:
+        if key not in params:
+            raise InputError(f"`{key}` is not a parameter of scene {entry.name!r}; its "
+                             f"parameters: {', '.join(params)}")
+    if parameter in fixed:
+        raise InputError(f"`{parameter}` is swept; do not fix it too")
+    values = np.asarray(values, dtype=float).reshape(-1)
+    if values.size == 0 or not np.all(np.isfinite(values)):
+        raise InputError("`values` must be finite numbers, at least one")
+    if parameter == "frequency":
+        if frequency is not None or "frequency" in fixed:
+            raise InputError("`--frequency` is the swept parameter here; leave it out")
+    elif frequency is None:
+        frequency = fixed.pop("frequency", None)
+        if frequency is None:
+            raise InputError(f"`--frequency` is required for a sweep of {parameter!r} "
+                             "(drive frequency in Hz)")
+    if frequency is not None:
+        frequency = positive("frequency", frequency)
+    defaults = {k: v for k, v in entry.defaults().items() if k != "frequency"}
+
+    def point(x):
+        p = dict(defaults, **fixed)
+        f = float(x) if parameter == "frequency" else frequency
+        if parameter != "frequency":
+            p[parameter] = float(x)
+        return p, f
+
+    # every value must make a valid scene before any work starts (the extremes)
+    for x in (values.min(), values.max()):
+        p, f = point(x)
+        registry.make_scene(entry.name, frequency=f, **p)
+    if out is not None:
+        out = check_output_dir(out)
+        cache_dir = out / "cache" if cache_dir is None else cache_dir
+    points = [point(x) for x in values]
+    rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                                    scheduler=scheduler, progress=progress,
+                                    desc=f"sweep {parameter}", scene=entry.name)
+    swept = "frequency [Hz]" if parameter == "frequency" else _column(params[parameter])
+    table = []
+    for x, (p, f), row in zip(values, points, rows):
+        r = {swept: float(x), "scene": entry.name, "scheme": scheme.name}
+        if parameter != "frequency":
+            r["frequency [Hz]"] = f
+        for name, val in p.items():
+            if name != parameter:
+                r[_column(params[name])] = val
+        for c in VALUE_COLUMNS:
+            r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
+        table.append(r)
+    if out is None:
+        return table
+    stem = out / sweep_tag(entry.name, parameter, frequency, scheme)
+    csv_path = stem.with_name(stem.name + ".csv")
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(table[0]))
+        w.writeheader()
+        w.writerows(table)
+    meta = {"scene": entry.name, "swept_parameter": swept, "points": int(values.size),
+            "range": [float(values.min()), float(values.max())], "frequency_Hz": frequency,
+            "fixed_parameters": dict(defaults, **fixed),
+            "scheme": {"name": scheme.name, "theta": scheme.theta,
+                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol},
+            "engine": stats, "provenance": provenance(engine.code_version())}
+    json_path = stem.with_name(stem.name + ".json")
+    json_path.write_text(json.dumps(meta, indent=1, default=str))
+    log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
+        f"{stats['cached']} from the cache) and {json_path.name}")
+    if plot:
+        fig_path = stem.with_name(stem.name + ".png")
+        _figure(table, swept, entry.name, fig_path)
+        log(f"wrote {fig_path}")
+    return table
+
+
+def _figure(table, swept, scene, path):
+    import matplotlib  # noqa: PLC0415  (figures only)
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    x = np.array([r[swept] for r in table])
+    d = np.array([r["displacement_per_period_m"] for r in table], dtype=float)
+    modes = [r["mode"] if r["status"] == "ok" else "failed" for r in table]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.plot(x, d * 1e6, "k-", lw=0.8)
+    for m in sorted(set(modes)):
+        sel = np.array([mm == m for mm in modes])
+        ax.plot(x[sel], np.where(np.isfinite(d[sel]), d[sel] * 1e6, 0.0), "o", ms=4, label=m)
+    ax.axhline(0.0, color="0.7", lw=0.5)
+    ax.set_xlabel(swept)
+    ax.set_ylabel("displacement per period [um]")
+    ax.set_title(f"{scene}: steady state")
+    ax.legend(title="mode", fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

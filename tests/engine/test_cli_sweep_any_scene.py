@@ -1,0 +1,68 @@
+"""``moreau sweep`` on a periodic scene without a study of its own: the generic sweep."""
+
+import csv
+import json
+
+import pytest
+
+from moreau.cli import main
+from moreau.analysis.engine import periodic_scene_names
+from moreau.analysis.steady_state import find_steady_state
+from moreau.scenes import registry
+
+
+def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):
+    assert main(["sweep", "load", "0", "0.1", "--points", "3", "--scene", "stick-slip-motor",
+                 "--frequency", "1000", "--out", str(tmp_path), "--quiet", "--jobs", "1"]) == 0
+    stem = tmp_path / "sweep_stick-slip-motor_load_1000Hz_event-driven"
+    with open(stem.with_suffix(".csv")) as fh:
+        rows = list(csv.DictReader(fh))
+    assert [float(r["load [N]"]) for r in rows] == [0.0, 0.05, 0.1]
+    assert all(r["status"] == "ok" and r["scene"] == "stick-slip-motor" for r in rows)
+    assert all(float(r["frequency [Hz]"]) == 1000.0 and r["drive"] == "sawtooth" for r in rows)
+    # each point is the steady state computed on its own
+    for r in rows:
+        sc = registry.make_scene("stick-slip-motor", frequency=1000.0, load=float(r["load [N]"]))
+        ss = find_steady_state(sc)
+        assert float(r["displacement_per_period_m"]) == pytest.approx(
+            sc.displacement_to_si(ss.displacement_per_period), rel=1e-9)
+        assert r["mode"] == ss.mode
+    d = [float(r["displacement_per_period_m"]) for r in rows]
+    assert d[0] > d[1] > d[2]          # a load slows the slider
+    meta = json.loads(stem.with_suffix(".json").read_text())
+    assert meta["scene"] == "stick-slip-motor" and meta["swept_parameter"] == "load [N]"
+    assert meta["engine"]["computed"] == 3 and meta["provenance"]["moreau_version"]
+    assert stem.with_suffix(".png").exists()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["sweep", "bogus", "0", "1", "--scene", "stick-slip-motor", "--frequency", "1000"],
+     "`PARAM` must be a numeric parameter of scene 'stick-slip-motor'"),
+    (["sweep", "drive", "0", "1", "--scene", "stick-slip-motor", "--frequency", "1000"],
+     "`PARAM` must be a numeric parameter"),
+    (["sweep", "load", "0", "1", "--scene", "sliding-box"],
+     "`--scene` must be a periodically driven scene for a sweep"),
+    (["sweep", "load", "0", "1", "--scene", "stick-slip-motor"], "`--frequency` is required"),
+    (["sweep", "load", "--scene", "stick-slip-motor", "--frequency", "1000"],
+     "`START` and `STOP` are required"),
+    (["sweep", "load", "0", "1", "--scene", "stick-slip-motor", "--frequency", "1000",
+      "--set", "load=0.3"], "`load` is swept"),
+    (["sweep", "load", "0", "1", "--scene", "stick-slip-motor", "--frequency", "1000",
+      "--set", "stiffness=3"], "`stiffness` is not a parameter of scene 'stick-slip-motor'"),
+])
+def test_generic_sweep_refuses_bad_input_before_work(argv, message, tmp_path, capsys):
+    assert main(argv + ["--out", str(tmp_path / "o")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists() or not any((tmp_path / "o").glob("*.csv"))
+
+
+def test_study_sweeps_are_named_by_their_entries_and_load():
+    names = periodic_scene_names()
+    assert {"friction-drive", "bidirectional-drive", "stick-slip-motor"} <= set(names)
+    for name in names:
+        hook = registry.get_entry(name).sweep
+        if hook is not None:
+            assert callable(registry.resolve_hook(hook))
+    assert registry.default_scene() == "friction-drive"
+    with pytest.raises(ValueError, match="cannot be loaded"):
+        registry.resolve_hook("moreau.nope:command")
