@@ -50,6 +50,7 @@ from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
 from .modes import impacts_after_flight, mode_name, step_letters
 from ..integrators.moreau_jean import MoreauJean
 from ..integrators.result import SteadyState
+from .steady_solvers import register_steady_solver
 
 __all__ = ["moreau_jean_steady_state", "merge_step_regimes", "PeriodMap"]
 
@@ -650,3 +651,10 @@ def _jacobian(pm, x, closed, scale, rel, y1=None, central=False):
         else:
             J[:, i] = (yp - y1) / d
     return J
+
+
+@register_steady_solver("moreau-jean")
+def _steady_solver(scene, rtol=None, v_guess=None, max_iter=None, **options):
+    # find_steady_state's entry: the discrete map takes its own tolerance (`tol`),
+    # iteration bound and guess (`x_guess`) in `options`
+    return moreau_jean_steady_state(scene, **options)

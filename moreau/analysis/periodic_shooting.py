@@ -33,6 +33,7 @@ from ..integrators.event_driven_generic import project_positions
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
+from .steady_solvers import register_steady_solver
 
 __all__ = ["shoot_periodic"]
 
@@ -254,3 +255,10 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         stats={"period_maps": calls[0], "unknowns": int(z.size)},
         section_tau=ts,
     )
+
+
+@register_steady_solver("event-driven")
+def _steady_solver(scene, rtol=1e-10, v_guess=None, max_iter=30, **options):
+    # find_steady_state's entry for any periodic scene: Newton shooting on the period
+    # map of the event-driven reference the scene resolves to
+    return shoot_periodic(scene, "event-driven", rtol=rtol, max_iter=max_iter, **options)

@@ -77,3 +77,39 @@ def test_the_package_exposes_the_scene_classes_without_a_list():
     assert SawtoothDrive.name == "sawtooth"
     with pytest.raises(ImportError):
         from moreau.scenes import NoSuchScene  # noqa: F401
+
+
+def test_steady_state_solvers_come_from_their_registry():
+    from moreau.analysis import steady_solvers
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.scenes.friction_drive import FrictionDrive
+
+    names = steady_solvers.steady_solver_names()
+    # the generic ones, and the friction drive's walker registered by its scene's module
+    assert {"event-driven", "moreau-jean", "friction-drive-walker"} <= set(names)
+    sc = FrictionDrive(frequency=20.0)
+    # "event-driven" on a scene with its own reference takes that reference's solver
+    a = find_steady_state(sc)
+    b = find_steady_state(sc, scheme="friction-drive-walker")
+    assert a.displacement_per_period == b.displacement_per_period and a.mode == "NS"
+    with pytest.raises(ValueError, match=r"`scheme` has no steady-state solver: 'euler'"):
+        find_steady_state(sc, scheme="euler")
+
+
+def test_a_registered_steady_solver_is_used_by_find_steady_state():
+    from moreau.analysis import steady_solvers
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.scenes.friction_drive import FrictionDrive
+
+    calls = []
+
+    def solver(scene, rtol=None, v_guess=None, max_iter=None, **options):
+        calls.append(options)
+        return find_steady_state(scene, scheme="moreau-jean", steps_per_period=200)
+
+    steady_solvers.register_steady_solver("test-scheme")(solver)
+    try:
+        ss = find_steady_state(FrictionDrive(frequency=185.0), scheme="test-scheme", marker=1)
+    finally:
+        steady_solvers._SOLVERS.pop("test-scheme")
+    assert calls == [{"marker": 1}] and ss.mode == "NP"
