@@ -38,7 +38,7 @@ def get_integrator(name):
     >>> get_integrator("euler")
     Traceback (most recent call last):
     ...
-    moreau.errors.InputError: `method` must be one of 'event-driven', 'event-driven-generic', 'friction-drive-walker', 'moreau-jean', 'stick-slip-exact'; got 'euler'
+    moreau.errors.InputError: `method` must be one of 'compliant-radau', 'compliant-rk45', 'event-driven', 'event-driven-generic', 'friction-drive-walker', 'moreau-jean', 'stick-slip-exact'; got 'euler'
     """
     if name not in INTEGRATORS:
         scene_registry.discover()

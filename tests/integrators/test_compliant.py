@@ -1,0 +1,115 @@
+"""Regularised (compliant) contact under Radau and RK45, against exact non-smooth solutions."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+from moreau.errors import InputError
+from moreau.integrators import simulate
+from moreau.integrators.compliant import damping_for_restitution
+from moreau.scenes import make_scene
+
+
+def _ball_error(stiffness, method="compliant-radau"):
+    # elastic ball (e = 1, no damping): the compliant bounce converges to the exact one
+    ball = make_scene("bouncing-ball", restitution=1.0)
+    q0, v0 = ball.initial_state()
+    T = 2.5                     # past the first bounce (at sqrt(2))
+    r = simulate(ball, (0.0, T), q0, v0, method, stiffness=stiffness, damping=0.0,
+                 rtol=1e-10, atol=1e-12)
+    assert r.success, r.message
+    qe, _ = ball.exact_solution([T], q0, v0)
+    return abs(r.q[-1, 0] - qe[0, 0])
+
+
+def test_elastic_ball_converges_to_the_exact_bounce_as_the_contact_stiffens():
+    errors = [_ball_error(k) for k in (1e3, 1e5, 1e7)]
+    # the contact lasts ~ pi / sqrt(k): the error falls about tenfold per hundredfold k
+    assert errors[0] > 3 * errors[1] > 9 * errors[2]
+    assert errors[2] < 1e-3
+
+
+def _one_dof_restitution(k, c, v_in):
+    # an independent computation of the clamped Kelvin-Voigt contact: a unit mass hitting
+    # a spring-damper at speed v_in, without gravity, until the force k d + c d' returns to 0
+    def rhs(t, y):
+        return [y[1], -(k * y[0] + c * y[1])]
+
+    def release(t, y):
+        return k * y[0] + c * y[1] if t > 0 else 1.0
+    release.terminal, release.direction = True, -1
+    sol = solve_ivp(rhs, (0.0, 10.0 / math.sqrt(k)), [0.0, v_in], events=release, rtol=1e-12,
+                    atol=1e-14, max_step=0.01 / math.sqrt(k))
+    return -sol.y_events[0][0][1] / v_in
+
+
+@pytest.mark.parametrize("e", [0.3, 0.8])
+def test_kelvin_voigt_ball_rebounds_as_the_one_dof_contact_model(e):
+    k = 1e6
+    ball = make_scene("bouncing-ball", restitution=e)
+    q0, v0 = ball.initial_state()
+    r = simulate(ball, (0.0, 1.6), q0, v0, "compliant-radau", stiffness=k, rtol=1e-10,
+                 atol=1e-13)
+    assert r.success
+    v = r.v[:, 0]
+    v_in = math.sqrt(2.0)                       # free fall from one unit above the floor
+    leave = np.flatnonzero((r.force_N[:-1, 0] > 0) & (r.force_N[1:, 0] == 0))[0] + 1
+    expected = _one_dof_restitution(k, damping_for_restitution(e, k, 1.0), v_in)
+    # gravity is about 1e-6 of the contact force: the rebound is the 1-dof contact's
+    assert v[leave] / v_in == pytest.approx(expected, rel=2e-3)
+    # the unclamped law would rebound with e itself; the clamp lets go before the spring
+    # pulls back, so the rebound is a little faster
+    assert e < expected < e + 0.1
+
+
+def test_sliding_block_stops_where_the_exact_block_stops():
+    blk = make_scene("sliding-block", mu=0.3)
+    q0, v0 = blk.initial_state()
+    T = 1.0 / (0.3 * 1.0) + 1.0                 # past the stop at v0 / (mu g)
+    qe, ve = blk.exact_solution([T], q0, v0)
+    errs = []
+    for k, eps in ((1e3, 1e-2), (1e4, 1e-3)):
+        r = simulate(blk, (0.0, T), q0, v0, "compliant-radau", stiffness=k,
+                     friction_velocity=eps, rtol=1e-10, atol=1e-12)
+        assert r.success
+        errs.append(abs(r.q[-1, 0] - qe[0, 0]))
+    # measured 1.3e-3 and 4.4e-5
+    assert errs[1] < errs[0] / 10 and errs[1] < 1e-4
+    # resting on the spring: penetration g / k
+    assert r.q[-1, 1] == pytest.approx(-1.0 / 1e4, rel=1e-6)
+
+
+def test_radau_and_rk45_integrate_the_same_model():
+    blk = make_scene("sliding-block", mu=0.3, incline=0.2)
+    q0, v0 = blk.initial_state()
+    opts = dict(stiffness=1e5, friction_velocity=1e-3, rtol=1e-10, atol=1e-12)
+    a = simulate(blk, (0.0, 2.0), q0, v0, "compliant-radau", **opts)
+    b = simulate(blk, (0.0, 2.0), q0, v0, "compliant-rk45", **opts)
+    assert a.success and b.success
+    np.testing.assert_allclose(a.q[-1], b.q[-1], atol=1e-7)
+
+
+def test_samples_on_a_grid_and_regimes_named():
+    blk = make_scene("sliding-block", mu=0.3)
+    q0, v0 = blk.initial_state()
+    r = simulate(blk, (0.0, 4.0), q0, v0, "compliant-radau", stiffness=1e3,
+                 friction_velocity=1e-2, rtol=1e-6, atol=1e-9, sample_dt=0.25)
+    np.testing.assert_allclose(r.t, np.arange(0.0, 4.01, 0.25), atol=1e-12)
+    # slides forward, then sticks (at t = 0 it only touches: no force yet)
+    assert set(np.unique(r.regime[r.t > 0.1])) == {1, 3}
+
+
+@pytest.mark.parametrize("opts, message", [
+    ({"stiffness": -1.0}, "`stiffness` must be > 0"),
+    ({"friction_velocity": 0.0}, "`friction_velocity` must be > 0"),
+    ({"contact_model": "hertz"}, "`contact_model` must be one of"),
+    ({"damping": -2.0}, "`damping` must be >= 0"),
+    ({"theta": 0.5}, "`theta` is not an option of scheme 'compliant-rk45'"),
+])
+def test_bad_options_are_refused_by_name(opts, message):
+    ball = make_scene("bouncing-ball")
+    q0, v0 = ball.initial_state()
+    with pytest.raises(InputError, match=message):
+        simulate(ball, (0.0, 1.0), q0, v0, "compliant-rk45", **opts)
