@@ -290,7 +290,9 @@ def _cmd_compare(args):
     def keep(row):
         partial.append(row)
 
-    report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep, **params)
+    schemes = [x.strip() for x in args.schemes.split(",") if x.strip()] if args.schemes else None
+    report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep,
+                         schemes=schemes, **params)
     paths = cmp.write_outputs(report, out, tag=tag, plot=not args.no_plot)
     if args.json:
         print(json.dumps(report))
@@ -409,6 +411,8 @@ def build_parser():
     c.add_argument("--param", action="append", metavar="KEY=VALUE", help=argparse.SUPPRESS)
     c.add_argument("--stress", action="store_true",
                    help="run the stiff and extreme case catalogue instead (stability map)")
+    c.add_argument("--schemes", default=None, metavar="NAME,...",
+                   help="other registered schemes to compare too, e.g. compliant-radau,compliant-rk45")
     c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")
     c.add_argument("--out", default="out", help="output folder (default ./out)")
     c.add_argument("--json", action="store_true", help="print one JSON object")

@@ -148,3 +148,21 @@ def test_2000_hz_plateau_is_a_grid_effect_and_is_flagged():
     (note,) = rep["notes"]
     assert note["theta"] == 0.5 and note["steps_per_period"] == [5000, 10000, 20000]
     assert "grid time" in note["text"]
+
+
+def test_other_registered_schemes_get_rows_on_request():
+    from moreau.analysis.compare import compare as run_compare
+    rep = run_compare("bouncing-ball", quick=True, lcp_steps=[], thetas=[1.0], progress=False,
+                      schemes=["compliant-rk45"])
+    rows = [r for r in rep["rows"] if r["scheme"] == "compliant-rk45"]
+    assert [r["setting"] for r in rows] == ["stiffness=1000", "stiffness=10000"]
+    for r in rows:
+        assert r["status"] == 0 and 0.0 < r["error"] < 1.0 and r["trajectory_error"] > 0.0
+    # not asked: not run; a steady-state headline: not applicable
+    assert not any(r["scheme"].startswith("compliant") for r in run_compare(
+        "sliding-block", quick=True, lcp_steps=[], thetas=[1.0], progress=False)["rows"])
+    steady = run_compare("friction-drive", frequency=185.0, steps=[200], lcp_steps=[],
+                         thetas=[1.0], repeat=1, progress=False, schemes=["compliant-radau"])
+    assert not any(r["scheme"] == "compliant-radau" for r in steady["rows"])
+    with pytest.raises(ValueError, match="`schemes` must name schemes that compare can run"):
+        run_compare("bouncing-ball", quick=True, progress=False, schemes=["moreau-jean"])

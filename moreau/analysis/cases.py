@@ -171,6 +171,23 @@ class CompareCase:
             raise MoreauError(f"Moreau–Jean run failed: {res.message}")
         return self.headline_of_run(res), res
 
+    #: whether the case's headline comes from one run over the window (then any
+    #: registered scheme can be compared on it), not from a steady state
+    runs_any_scheme = True
+
+    def run_scheme(self, name, options):
+        """A run of the registered scheme ``name`` over the window, sampled on the grid."""
+        q0, v0 = self.start()
+        return simulate(self.scene, (0.0, self.window), q0, v0, name,
+                        sample_dt=self.window / GRID, **options)
+
+    def scheme(self, name, options):
+        """``(headline, run)``: the timed work of one row of another scheme."""
+        res = self.run_scheme(name, options)
+        if not res.success:
+            raise MoreauError(f"{name} run failed: {res.message}")
+        return self.headline_of_run(res), res
+
     def measure(self, n, theta, lcp, out):
         """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
         _, res = out
@@ -220,6 +237,7 @@ class DriveCase(CompareCase):
     tight_rtol = 1e-12
     headline_name = "displacement per period"
     projection = True
+    runs_any_scheme = False      # the headline is a steady state
     _ref = None
 
     @property
@@ -362,6 +380,12 @@ class SceneCase(CompareCase):
             grid = np.linspace(0.0, self.window, GRID + 1)
             self._grid = np.interp(grid, res.t - self.t0, res.q[:, self.index])
         return self._grid
+
+    def run_scheme(self, name, options):
+        res = simulate(self.scene, (self.t0, self.t0 + self.window), self.q0, self.v0, name,
+                       sample_dt=self.window / GRID, **options)
+        res.t = res.t - self.t0
+        return res
 
     def run_mj(self, n, theta, lcp):
         opts = dict(h=self.window / n, theta=theta, projection=self.projection)

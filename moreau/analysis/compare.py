@@ -104,6 +104,7 @@ from tqdm import tqdm
 
 from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
+from ..integrators.base import INTEGRATORS
 from ..provenance import provenance
 from ..scenes.base import Scene
 from ..scenes.registry import get_entry
@@ -111,7 +112,7 @@ from .cases import GRID, SceneCase, switching_error
 
 __all__ = ["compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
            "check_out_dir", "make_case", "case_parameters", "fit_order", "plateaus",
-           "switching_error", "run_row"]
+           "switching_error", "run_row", "run_other_row", "other_schemes"]
 
 TWO_PI = 2.0 * math.pi
 #: Moreau–Jean steps per period of the full comparison (two decades)
@@ -241,7 +242,8 @@ def plateaus(rows, rel=0.02, min_error=1e-6):
 
 
 def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quick=False,
-            progress=True, on_row=None, *, t_span=None, q0=None, v0=None, **params):
+            progress=True, on_row=None, *, t_span=None, q0=None, v0=None, schemes=None,
+            **params):
     """Error against run time of every scheme on one scene.
 
     Parameters
@@ -272,6 +274,11 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         Called with each finished row (the caller can save as it goes).
     t_span, q0, v0 : optional
         The window and start state, for a Scene instance only.
+    schemes : sequence of str, optional
+        Other registered schemes to run beside the reference and Moreau–Jean
+        (those that state how, ``Integrator.compare_settings``, e.g.
+        ``"compliant-radau"``); none by default. They run where the headline
+        comes from one run over the window (not on steady states).
     **params
         Parameters of a registered scene and of its comparison case
         (:func:`case_parameters`).
@@ -348,9 +355,17 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
     jobs += [("mj", th, None, n) for th in thetas for n in steps]
     jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
-    report["interrupted"] = collect_rows(
-        jobs, lambda job: [run_row(case, *job, repeat, ref_value, ref_switches)],
-        report["rows"], on_row, progress, desc=f"compare {scene}", unit="run")
+    jobs += [("other", name, key, value, fixed)
+             for name, key, values, fixed in other_schemes(case, quick, schemes or [])
+             for value in values]
+
+    def run(job):
+        if job[0] == "other":
+            return [run_other_row(case, *job[1:], repeat, ref_value, ref_switches)]
+        return [run_row(case, *job, repeat, ref_value, ref_switches)]
+
+    report["interrupted"] = collect_rows(jobs, run, report["rows"], on_row, progress,
+                                         desc=f"compare {scene}", unit="run")
     report["orders"] = _orders(report["rows"])
     report["notes"] = plateaus(report["rows"])
     return report
@@ -410,7 +425,8 @@ def run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
     """
     row = {"scheme": case.ref_scheme if kind == "ref" else "moreau-jean", "theta": theta,
            "lcp": lcp, "steps_per_period": None if kind == "ref" else int(setting),
-           "rtol": setting if kind == "ref" else None, "time_s": None, "error": None,
+           "rtol": setting if kind == "ref" else None, "setting": None, "time_s": None,
+           "error": None,
            "signed_error": None,
            "trajectory_error": None, "switching_error": None, "mode": None, "status": 0,
            "message": ""}
@@ -432,6 +448,47 @@ def run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
     return row
 
 
+def other_schemes(case, quick=False, names=None):
+    """``(name, setting, values, fixed_options)`` of the registered schemes that compare runs.
+
+    Every registered scheme with ``compare_settings`` (the reference and
+    Moreau–Jean have rows of their own), or those of ``names``; none where the
+    case's headline is a steady state.
+    """
+    registered = {n: cls for n, cls in INTEGRATORS.items()
+                  if getattr(cls, "compare_settings", None) is not None}
+    if names is not None:
+        for n in names:
+            if n not in registered:
+                raise InputError(f"`schemes` must name schemes that compare can run, from "
+                                 f"{sorted(registered)}; got {n!r}")
+        registered = {n: registered[n] for n in names}
+    if not getattr(case, "runs_any_scheme", False):
+        return []
+    out = []
+    for name in sorted(registered):
+        key, values, quick_values, fixed = registered[name].compare_settings
+        out.append((name, key, quick_values if quick else values, dict(fixed)))
+    return out
+
+
+def run_other_row(case, name, key, value, fixed, repeat, ref_value, ref_switches):
+    """One row of another registered scheme at ``key = value`` (see :func:`other_schemes`)."""
+    row = {"scheme": name, "theta": None, "lcp": None, "steps_per_period": None, "rtol": None,
+           "setting": f"{key}={value:g}", "time_s": None, "error": None, "signed_error": None,
+           "trajectory_error": None, "switching_error": None, "mode": None, "status": 0,
+           "message": ""}
+    try:
+        opts = dict(fixed, **{key: value})
+        t, (value_, res) = _median_time(lambda: case.scheme(name, opts), repeat)
+        row.update(time_s=t, error=_relative(value_, ref_value),
+                   signed_error=_signed(value_, ref_value),
+                   trajectory_error=case._trajectory_error(res))
+    except MoreauError as exc:
+        row.update(status=-1, message=f"{type(exc).__name__}: {exc}")
+    return row
+
+
 def _orders(rows):
     series = {}
     for r in rows:
@@ -447,7 +504,7 @@ def _orders(rows):
 
 
 # -- output ---------------------------------------------------------------------------------
-CSV_FIELDS = ("scheme", "theta", "lcp", "steps_per_period", "rtol", "time_s", "error",
+CSV_FIELDS = ("scheme", "theta", "lcp", "steps_per_period", "rtol", "setting", "time_s", "error",
               "signed_error", "trajectory_error", "switching_error", "mode", "status", "message")
 
 
@@ -491,7 +548,7 @@ def write_outputs(report, out, tag=None, plot=True):
 
 def _label(r):
     if r["scheme"] != "moreau-jean":
-        return r["scheme"]
+        return r["scheme"] + (f" ({r['setting'].split('=')[0]})" if r.get("setting") else "")
     th = "1/2" if r["theta"] == 0.5 else f"{r['theta']:g}"
     return f"Moreau–Jean θ={th}" + (f", {r['lcp']}" if r["lcp"] else "")
 
@@ -552,7 +609,7 @@ def format_table(report):
                      f"{g(r['steps_per_period'], '6d'):>6} {g(r['rtol'], '7.0e'):>7} "
                      f"{r['time_s'] * 1e3:10.2f} {g(r['error'], '9.2e'):>9} "
                      f"{g(r['trajectory_error'], '9.2e'):>9} {g(r['switching_error'], '9.2e'):>9} "
-                     f"{r['mode'] or ''}")
+                     f"{r['mode'] or r.get('setting') or ''}")
     for o in report["orders"]:
         th = o["theta"]
         lines.append(f"order  theta={th:g} lcp={o['lcp'] or '-'}: "

@@ -121,6 +121,10 @@ class Integrator:
     """
 
     scheme = ""
+    #: how ``moreau compare`` runs this scheme beside the reference and Moreau–Jean, or
+    #: None: ``(setting, values, quick_values, fixed_options)``, one row per value of the
+    #: option ``setting`` (e.g. a compliant contact's stiffness)
+    compare_settings = None
 
     def __init__(self, scene, t0, q0, v0, t_bound):
         self.scene = scene
