@@ -23,12 +23,14 @@ velocities of the size of ``eps`` (``friction_velocity``). Then
 
     M(q) v' = h(q, v, t) + WN^T fN + WT^T fT,    q' = v.
 
-Kelvin–Voigt damping defaults to the scene's restitution ``e``: a linear
-spring–damper on the contact's effective mass ``m = 1 / (WN M^-1 WN^T)`` (at
-the initial state) rebounds with ``e = exp(-zeta pi / sqrt(1 - zeta^2))``,
-so ``zeta = -ln e / sqrt(pi^2 + ln^2 e)`` (``zeta = 1`` for ``e = 0``) and
-``c = 2 zeta sqrt(k m)``. Hunt–Crossley takes ``damping`` as given (default
-0: elastic).
+Kelvin–Voigt damping defaults to the scene's restitution ``e``: the damping
+ratio ``zeta`` whose clamped linear spring–damper, on the contact's
+effective mass ``m = 1 / (WN M^-1 WN^T)`` (at the initial state), rebounds
+with ``e`` (:func:`clamped_restitution`; the unclamped formula ``e =
+exp(-zeta pi / sqrt(1 - zeta^2))`` would rebound faster), and ``c = 2 zeta
+sqrt(k m)``. Such a contact is never more plastic than ``e`` of about 0.136
+(critical damping is used below that). Hunt–Crossley takes ``damping`` as
+given (default 0: elastic).
 
 The recorded regime of a contact is flight while it carries no normal force,
 stick while its slip speed is within ``10 eps``, else the slip's sign. Forces
@@ -49,33 +51,70 @@ import math
 
 import numpy as np
 from scipy.integrate import RK45, Radau
+from scipy.optimize import brentq
 
 from .._validate import nonnegative, positive
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 
-__all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution"]
+__all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution",
+           "clamped_restitution"]
 
 #: normal force laws: name -> exponent of the penetration
 CONTACT_MODELS = {"kelvin-voigt": 1.0, "hunt-crossley": 1.5}
 
 
+def clamped_restitution(zeta):
+    """Rebound of a mass on a linear spring–damper whose force is clamped at zero, damping ratio ``zeta``.
+
+    With unit mass and stiffness the penetration is ``d = exp(-zeta t)
+    sin(w t) / w`` (``w = sqrt(1 - zeta^2)``, impact at unit speed); the
+    contact lets go when the force ``d + 2 zeta d'`` returns to zero, at
+    ``w t = pi + atan2(-2 zeta, (1 - 2 zeta^2) / w)``, before the spring
+    would pull, so the rebound ``-d'`` there exceeds the unclamped
+    ``exp(-zeta pi / w)``. For ``0 <= zeta < 1``.
+
+    Examples
+    --------
+    >>> clamped_restitution(0.0)
+    1.0
+    >>> round(clamped_restitution(0.2), 4)
+    0.5717
+    """
+    if not 0.0 <= zeta < 1.0:
+        raise InputError(f"`zeta` must be in [0, 1), got {zeta!r}")
+    w = math.sqrt(1.0 - zeta * zeta)
+    phi = math.pi + math.atan2(-2.0 * zeta, (1.0 - 2.0 * zeta * zeta) / w)
+    return -math.exp(-zeta * phi / w) * (math.cos(phi) - zeta / w * math.sin(phi))
+
+
+#: the damping ratio beyond which the closed form loses digits (w -> 0), and the
+#: least restitution a clamped Kelvin-Voigt contact reaches below it (about 0.136)
+_ZETA_MAX = 0.999
+_E_MIN = clamped_restitution(_ZETA_MAX)
+
+
 def damping_for_restitution(e, stiffness, mass):
-    """Kelvin–Voigt damping ``c`` whose linear spring–damper rebounds with restitution ``e``.
+    """Kelvin–Voigt damping ``c`` whose clamped spring–damper rebounds with restitution ``e``.
+
+    Solves :func:`clamped_restitution` ``(zeta) = e`` and returns ``c = 2
+    zeta sqrt(k m)``. A clamped Kelvin–Voigt contact cannot be more plastic
+    than about ``e = 0.136``: below that, critical damping (``zeta = 1``) is
+    used and the rebound stays near 0.13.
 
     Examples
     --------
     >>> c = damping_for_restitution(0.5, 1e6, 1.0)
-    >>> zeta = c / (2 * 1e3)
-    >>> round(math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2)), 12)
+    >>> round(clamped_restitution(c / (2 * 1e3)), 12)
     0.5
     """
-    if e <= 0.0:
+    if e >= 1.0:
+        return 0.0
+    if e <= _E_MIN:
         zeta = 1.0
     else:
-        le = math.log(e)
-        zeta = -le / math.sqrt(math.pi ** 2 + le * le)
+        zeta = brentq(lambda z: clamped_restitution(z) - e, 0.0, _ZETA_MAX, xtol=1e-15)
     return 2.0 * zeta * math.sqrt(stiffness * mass)
 
 

@@ -59,9 +59,8 @@ def test_kelvin_voigt_ball_rebounds_as_the_one_dof_contact_model(e):
     expected = _one_dof_restitution(k, damping_for_restitution(e, k, 1.0), v_in)
     # gravity is about 1e-6 of the contact force: the rebound is the 1-dof contact's
     assert v[leave] / v_in == pytest.approx(expected, rel=2e-3)
-    # the unclamped law would rebound with e itself; the clamp lets go before the spring
-    # pulls back, so the rebound is a little faster
-    assert e < expected < e + 0.1
+    # the damping is chosen for the clamped law: the rebound is the scene's restitution
+    assert expected == pytest.approx(e, rel=1e-6)
 
 
 def test_sliding_block_stops_where_the_exact_block_stops():
@@ -113,3 +112,15 @@ def test_bad_options_are_refused_by_name(opts, message):
     q0, v0 = ball.initial_state()
     with pytest.raises(InputError, match=message):
         simulate(ball, (0.0, 1.0), q0, v0, "compliant-rk45", **opts)
+
+
+def test_clamped_restitution_matches_the_one_dof_contact_and_is_bounded_below():
+    from moreau.integrators.compliant import clamped_restitution
+    for zeta in (0.05, 0.3, 0.8):
+        c = 2.0 * zeta * 1e3
+        assert clamped_restitution(zeta) == pytest.approx(_one_dof_restitution(1e6, c, 1.0),
+                                                          rel=1e-6)
+        # faster than the unclamped spring-damper's exp(-zeta pi / sqrt(1 - zeta^2))
+        assert clamped_restitution(zeta) > math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2))
+    # no clamped Kelvin-Voigt contact is fully plastic: critical damping below ~0.136
+    assert damping_for_restitution(0.0, 1e6, 1.0) == pytest.approx(2.0 * 1e3)
