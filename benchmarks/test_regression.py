@@ -2,7 +2,7 @@
 
 Run the full suite (about a minute; documented in the README)::
 
-    python -m pytest benchmarks/test_regression.py
+    python -m pytest benchmarks/test_regression.py -n 0
 
 Each case (:data:`moreau.analysis.regression.CASES`) is timed by
 pytest-benchmark (median over its rounds); its errors are measured once and
