@@ -36,7 +36,7 @@ from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
 __all__ = ["run_scene_sweep", "sweep_tag", "sweep_values", "VALUE_COLUMNS", "MAX_POINTS"]
 
-#: bound on the points of one sweep
+#: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
 
 #: the steady-state columns of a sweep row (SI units in the names)

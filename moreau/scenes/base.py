@@ -26,6 +26,7 @@ from dataclasses import fields, replace
 import numpy as np
 
 from ..errors import InputError
+from ._units import columns_of
 
 __all__ = ["Scene", "params_with"]
 
@@ -140,13 +141,10 @@ class Scene:
         (impulses over the step for time-stepping schemes), ``slip_velocity``,
         ``gap`` and ``regime``.
         """
-        cols = [("t", "", result.t)]
-        for name, arr in (("q", result.q), ("v", result.v), ("force_N", result.force_N),
-                          ("force_T", result.force_T), ("slip_velocity", result.slip_velocity),
-                          ("gap", result.gap), ("regime", result.regime)):
-            arr = np.asarray(arr)
-            cols.extend((f"{name}_{j}", "", arr[:, j]) for j in range(arr.shape[1]))
-        return cols
+        histories = {"t": result.t, "q": result.q, "v": result.v, "force_N": result.force_N,
+                     "force_T": result.force_T, "slip_velocity": result.slip_velocity,
+                     "gap": result.gap, "regime": result.regime}
+        return columns_of(histories, dict.fromkeys(histories, ""))
 
     # -- conveniences shared by all scenes --------------------------------
     def contact_velocities(self, q, v, t):

@@ -12,11 +12,11 @@ import math
 
 import numpy as np
 
-from ... import _validate as _v
-from ..._validate import positive, positive_int
+from ..._validate import positive
 # the modules, not their functions: a test (or a user) that replaces
 # engine.run_points or steady_state.find_steady_state reaches the sweeps too
 from ...analysis import engine, steady_state
+from ...analysis import sweep as scene_sweep
 from ...analysis.engine import check_output_dir, make_scheme
 from ...errors import InputError, MoreauError
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive, params_from_kwargs
@@ -162,12 +162,10 @@ def scheme_tag(scheme):
     return "" if scheme.rtol in (None, 1e-10) else f"_ed_rtol{scheme.rtol:g}"
 
 
-#: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
-MAX_POINTS = 10**5
-
-
 def sweep_values(parameter, start, stop, points, scale="linear"):
-    """The swept values, checked: ``points`` values from ``start`` to ``stop``.
+    """The swept values of a friction-drive sweep, checked (see
+    :func:`moreau.analysis.sweep.sweep_values`); ``START`` and ``STOP`` differ when there are
+    several points.
 
     Examples
     --------
@@ -176,21 +174,10 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
     """
     if parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
-    start = _v.finite_scalar("START", start)
-    stop = _v.finite_scalar("STOP", stop)
-    points = positive_int("points", points)
-    if points > MAX_POINTS:
-        raise InputError(f"`points` = {points:.3g} is more than the limit {MAX_POINTS:.0e} of "
-                         "one sweep (an atlas covers two parameters)")
-    if scale not in ("log", "linear"):
-        raise InputError(f"`--scale` must be 'log' or 'linear', got {scale!r}")
-    if points > 1 and start == stop:
+    values = scene_sweep.sweep_values(start, stop, points, scale)
+    if len(values) > 1 and values[0] == values[-1]:
         raise InputError("`START` and `STOP` must differ when `--points` > 1")
-    if scale == "log":
-        if start <= 0 or stop <= 0:
-            raise InputError(f"`--scale log` needs START and STOP > 0, got {start!r} and {stop!r}")
-        return np.geomspace(start, stop, points)
-    return np.linspace(start, stop, points)
+    return values
 
 
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
