@@ -32,7 +32,7 @@ def scheme_names():
     return sorted(INTEGRATORS)
 
 
-def _add_params(p, scheme_defaults=True, schemes=("event-driven", "moreau-jean")):
+def _add_params(p, scheme_defaults=True):
     p.add_argument("--mu", type=float, default=None, help="friction coefficient (default 0.1)")
     p.add_argument("--phi0", type=float, default=None, help="initial rod tilt [rad] (default pi/4)")
     p.add_argument("--x10", type=float, default=None, help="stator amplitude [m] (default 2e-6)")
@@ -42,10 +42,13 @@ def _add_params(p, scheme_defaults=True, schemes=("event-driven", "moreau-jean")
     p.add_argument("--length", type=float, default=None, help="rod length [m] (default 1e-3)")
     p.add_argument("--load", type=float, default=None, help="rotor load F_L [N] (default 0)")
     p.add_argument("--restitution", type=float, default=None, help="impact restitution e (default 0)")
-    p.add_argument("--scheme", default="event-driven", choices=list(schemes))
+    p.add_argument("--scheme", default="event-driven", choices=scheme_names(),
+                   help="any registered scheme (default event-driven)")
+    p.add_argument("--option", action="append", metavar="NAME=VALUE",
+                   help="any other option of the scheme (repeatable), e.g. --option stiffness=1e6")
     # without defaults a command can tell (and refuse) a setting that would not act
     p.add_argument("--steps-per-period", type=int, default=1000 if scheme_defaults else None,
-                   help="Moreau-Jean steps per drive period (default 1000)")
+                   help="time-stepping schemes' steps per drive period (default 1000)")
     p.add_argument("--theta", type=float, default=1.0 if scheme_defaults else None,
                    help="Moreau-Jean theta in [1/2, 1] (default 1)")
     p.add_argument("--rtol", type=float, default=1e-10 if scheme_defaults else None,
@@ -57,9 +60,11 @@ def _scheme_args(args, rtol_acts=True):
     if args.rtol is not None and not rtol_acts:
         raise InputError(f"`--rtol` does not act in `moreau {args.command}` (a time history "
                          "runs each scheme at its own tolerance); leave it out")
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         args.scheme_options)
     args.theta, args.steps_per_period, args.rtol = (scheme.theta, scheme.steps_per_period,
                                                     scheme.rtol)
+    args.scheme_options = scheme.options
 
 
 #: the command-line shorthands of scene parameters (``--mu 0.2`` is ``--set mu=0.2``)
@@ -116,7 +121,7 @@ def _cmd_steady(args):
     scene = entry.factory(**params)
     check_periodic(scene)
     rep = steady_state_report(scene, scheme=args.scheme, steps_per_period=args.steps_per_period,
-                              theta=args.theta, rtol=args.rtol)
+                              theta=args.theta, rtol=args.rtol, options=args.scheme_options)
     if args.json:
         print(json.dumps(rep))
         return
@@ -151,7 +156,8 @@ def _cmd_sweep(args):
     if args.parameter in params and args.parameter != "frequency":
         raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
     frequency = params.pop("frequency", None)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         args.scheme_options)
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
@@ -163,7 +169,7 @@ def _cmd_run(args):
     entry = get_entry(args.scene)
     params = scene_parameters(args, entry)
     scene = entry.factory(**params)
-    options = parse_settings(args.option or [], "--option")
+    options = dict(args.scheme_options)
     for key in ("theta", "rtol"):
         val = getattr(args, key)
         if val is not None:
@@ -382,12 +388,10 @@ def build_parser():
     r.add_argument("--steps", type=int, default=None,
                    help="time-stepping schemes: steps over the whole run")
     r.add_argument("--samples", type=int, default=2000, help="samples kept (default 2000)")
-    r.add_argument("--option", action="append", metavar="NAME=VALUE",
-                   help="any option of the scheme (repeatable), e.g. --option lcp_method=lemke")
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
-    _add_params(r, scheme_defaults=False, schemes=scheme_names())
+    _add_params(r, scheme_defaults=False)
     add_scene_options(r)
     r.set_defaults(func=_cmd_run)
     _add_reproduce(sub)
@@ -429,6 +433,9 @@ def _check_common(args):
     check_scheduler(getattr(args, "scheduler", None))
     if getattr(args, "cache", None) is not None:
         check_output_dir(args.cache, "--cache")
+    if hasattr(args, "option"):
+        # `--option NAME=VALUE` of the scheme, parsed once for every command (and study hook)
+        args.scheme_options = parse_settings(args.option or [], "--option")
 
 
 def main(argv=None):

@@ -79,6 +79,6 @@ def test_atlas_command_files_and_checks(tmp_path, capsys, monkeypatch):
     assert cli.main(["atlas", "--out", str(blocker / "x"), "--quiet"]) == 2
     assert "not writable" in capsys.readouterr().err
     assert cli.main(["atlas", "--theta", "0.5", "--out", str(tmp_path), "--quiet"]) == 2
-    assert "`--theta` applies only" in capsys.readouterr().err
+    assert "`--theta` does not act with `--scheme event-driven`" in capsys.readouterr().err
     with pytest.raises(InputError, match="`plane` must be one of"):
         compute_atlas("mu-phi0")

@@ -101,7 +101,7 @@ def test_failed_point_is_a_status(tmp_path):
       "--set", "x10_a=1e-6"], "`--set x10_a` fixes what the sweep"),
     (["sweep", "--scene", "bidirectional", "phase", "0", "1"], "`--frequency` is required"),
     (["sweep", "--scene", "bidirectional", "phase", "0", "1", "--frequency", "185",
-      "--theta", "0.5"], "`--theta` applies only"),
+      "--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`"),
     (["sweep", "--scene", "bidirectional", "x10_b", "0", "1e-3", "--frequency", "185"],
      "`x10_b` must be < length*sin(phi0)/2"),
     (["sweep", "--scene", "bidirectional", "balance", "-2", "1", "--frequency", "185"],

@@ -54,8 +54,8 @@ def test_scheme_options_change_the_computation(tmp_path):
 
 
 @pytest.mark.parametrize("args, match", [
-    (["--theta", "0.5"], "`--theta` applies only to `--scheme moreau-jean`"),
-    (["--steps-per-period", "100"], "`--steps-per-period` applies only"),
+    (["--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)"),
+    (["--steps-per-period", "100"], "`--steps-per-period` does not act with `--scheme event-driven`: it applies to time-stepping schemes"),
     (["--scheme", "moreau-jean", "--theta", "0.2"], "`theta` must be in [1/2, 1]"),
     (["--rtol", "0"], "`rtol` must be > 0"),
     (["--set", "frequency=185"], "fixes the swept parameter"),

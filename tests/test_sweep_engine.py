@@ -1,6 +1,7 @@
 """The sweep engine: disk cache, resume after an interrupt, failure status, Dask path."""
 
 import math
+import pickle
 from dataclasses import asdict
 
 import pytest
@@ -85,11 +86,25 @@ def test_dask_local_cluster_shares_the_cache(tmp_path):
 def test_scheme_settings_are_checked():
     with pytest.raises(InputError, match="`theta` must be in"):
         Scheme.moreau_jean(0.3, 1000)
-    with pytest.raises(InputError, match="apply only to the moreau-jean"):
+    with pytest.raises(InputError, match="`theta` is not an option of scheme 'event-driven'"):
         Scheme("event-driven", theta=0.5)
-    with pytest.raises(InputError, match="`scheme` must be one of"):
+    with pytest.raises(InputError, match="`method` must be one of .*'moreau-jean'"):
         Scheme("rk4")
+    with pytest.raises(InputError, match="`steps_per_period` applies only to time-stepping"):
+        Scheme("compliant-rk45", steps_per_period=100)
+    with pytest.raises(InputError, match="`theta` is not an option of scheme 'compliant-rk45'"):
+        Scheme("compliant-rk45", theta=1.0)
+    # a setting the scheme does not take is refused when the settings are made, not in a worker
+    with pytest.raises(InputError, match="`stiffnes` is not an option of scheme 'compliant-rk45'"):
+        Scheme("compliant-rk45", options={"stiffnes": 1e6})
+    with pytest.raises(InputError, match="`steps_per_period` must be an integer >= 8"):
+        Scheme.moreau_jean(1.0, 7)
     assert ED_REFERENCE.label == "ed" and Scheme.moreau_jean(0.5, 100).label == "mj_theta0.5"
+    assert Scheme("compliant-radau", options={"stiffness": 1e5}).label == \
+        "compliant-radau_stiffness100000"
+    # pickling (the workers get their settings this way) keeps every field
+    s = Scheme("compliant-rk45", rtol=1e-6, options={"stiffness": 1e6})
+    assert pickle.loads(pickle.dumps(s)) == s
 
 
 def test_output_folder_is_checked_before_work(tmp_path, capsys, monkeypatch):

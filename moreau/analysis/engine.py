@@ -32,11 +32,12 @@ import joblib
 from .. import __version__
 from ..errors import ConvergenceError, InputError
 from ..scenes import registry
-from .steady_state import find_steady_state, implausible_steady_state
+from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
+from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme",
+__all__ = ["make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -69,79 +70,6 @@ def code_version():
         h.update(str(path.relative_to(root)).encode())
         h.update(path.read_bytes())
     return f"{__version__}+{h.hexdigest()[:16]}"
-
-
-class Scheme(tuple):
-    """Settings of one steady-state computation: ``(name, theta, steps_per_period, rtol)``.
-
-    ``theta`` and ``steps_per_period`` are None for the event-driven scheme.
-
-    Examples
-    --------
-    >>> Scheme.moreau_jean(0.5, 2000).label
-    'mj_theta0.5'
-    """
-
-    def __new__(cls, name, theta=None, steps_per_period=None, rtol=None):
-        if name not in ("event-driven", "moreau-jean"):
-            raise InputError(f"`scheme` must be one of ['event-driven', 'moreau-jean'], got {name!r}")
-        if name == "moreau-jean":
-            if theta is None or steps_per_period is None:
-                raise InputError("`theta` and `steps_per_period` are required for moreau-jean")
-            if not 0.5 <= float(theta) <= 1.0:
-                raise InputError(f"`theta` must be in [1/2, 1], got {theta!r}")
-            if int(steps_per_period) < 8:
-                raise InputError(f"`steps_per_period` must be >= 8, got {steps_per_period!r}")
-            theta, steps_per_period = float(theta), int(steps_per_period)
-        elif theta is not None or steps_per_period is not None:
-            raise InputError("`theta` and `steps_per_period` apply only to the moreau-jean scheme")
-        if rtol is not None and not (math.isfinite(rtol) and rtol > 0):
-            raise InputError(f"`rtol` must be > 0, got {rtol!r}")
-        return super().__new__(cls, (name, theta, steps_per_period,
-                                     None if rtol is None else float(rtol)))
-
-    @classmethod
-    def moreau_jean(cls, theta, steps_per_period, rtol=None):
-        return cls("moreau-jean", theta, steps_per_period, rtol)
-
-    name = property(lambda self: self[0])
-    theta = property(lambda self: self[1])
-    steps_per_period = property(lambda self: self[2])
-    rtol = property(lambda self: self[3])
-
-    @property
-    def label(self):
-        return "ed" if self.name == "event-driven" else f"mj_theta{self.theta:g}"
-
-    def __getnewargs__(self):
-        return tuple(self)
-
-
-ED_REFERENCE = Scheme("event-driven", rtol=1e-10)
-
-
-def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None):
-    """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
-
-    ``theta`` and ``steps_per_period`` apply to Moreau–Jean only (defaults 1
-    and 1000 there); ``rtol`` is the shooting tolerance of either scheme.
-
-    Examples
-    --------
-    >>> make_scheme("moreau-jean", steps_per_period=500)
-    ('moreau-jean', 1.0, 500, None)
-    >>> make_scheme("event-driven", theta=0.5)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `--theta` applies only to `--scheme moreau-jean`
-    """
-    if scheme == "moreau-jean":
-        return Scheme.moreau_jean(1.0 if theta is None else theta,
-                                  1000 if steps_per_period is None else steps_per_period, rtol)
-    for name, val in (("--theta", theta), ("--steps-per-period", steps_per_period)):
-        if val is not None and scheme == "event-driven":
-            raise InputError(f"`{name}` applies only to `--scheme moreau-jean`")
-    return Scheme(scheme, rtol=1e-10 if rtol is None else rtol)
 
 
 def mj_check_columns(check):
@@ -189,13 +117,7 @@ def _make_scene(params, frequency, scene):
 
 def _steady(params, frequency, scheme, scene="friction-drive"):
     scene = _make_scene(params, frequency, scene)
-    if scheme.name == "moreau-jean":
-        kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
-        ss = find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
-                               steps_per_period=scheme.steps_per_period, **kw)
-    else:
-        ss = find_steady_state(scene, rtol=1e-10 if scheme.rtol is None else scheme.rtol)
-    return scene, ss
+    return scene, steady_of(scene, scheme)
 
 
 def _implausible(params, scene, ss):

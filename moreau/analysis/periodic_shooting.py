@@ -29,6 +29,7 @@ from scipy.linalg import null_space
 from .._validate import positive, positive_int
 from ..errors import ConvergenceError, InputError
 from ..integrators import get_integrator, simulate
+from ..integrators.base import check_options, scheme_options as options_of
 from ..integrators.event_driven_generic import project_positions
 from ..integrators.result import SteadyState
 from ..modes import mode_name
@@ -52,15 +53,24 @@ def _project(scene, t, q, v, touching):
 
 
 def _scheme_options(scheme, options):
+    # a time-stepping scheme (one that takes a step ``h``) is given its step as a
+    # number of steps per drive period; any other scheme refuses that setting
     opts = dict(options)
-    if scheme == "moreau-jean":
+    accepted = options_of(get_integrator(scheme)) or ()
+    if "h" in accepted:
         n = positive_int("steps_per_period", opts.pop("steps_per_period", 2000))
-        opts.setdefault("h", TWO_PI / n)
+        if "h" in opts:
+            raise InputError("give the step of the period map as `steps_per_period`, not `h`")
+        opts["h"] = TWO_PI / n
+    elif "steps_per_period" in opts:
+        raise InputError(f"`steps_per_period` applies to time-stepping schemes; scheme "
+                         f"{scheme!r} chooses its own steps")
     return opts
 
 
 def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=None, cyclic=None,
-                   rtol=1e-10, max_iter=30, transient_periods=0, **options):
+                   rtol=1e-10, max_iter=30, transient_periods=0, scheme_options=None,
+                   **options):
     """Periodic steady state of a ``2 pi``-periodic scene, by Newton shooting.
 
     Parameters
@@ -84,6 +94,9 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         Newton iterations.
     transient_periods : int
         Periods simulated from the guess before shooting.
+    scheme_options : dict, optional
+        Options of the scheme whose names the shooting's own parameters take
+        (a compliant scheme's ``rtol``); merged with ``options``.
     **options
         Passed to the scheme (``steps_per_period`` is turned into ``h`` for
         Moreau–Jean, 2000 by default).
@@ -124,7 +137,12 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     max_iter = positive_int("max_iter", max_iter)
 
     get_integrator(scheme)  # an unknown name lists the known ones, before any work
-    opts = _scheme_options(scheme, options)
+    clash = set(scheme_options or {}) & set(options)
+    if clash:
+        raise InputError(f"`{sorted(clash)[0]}` is given twice (in `scheme_options` and as a keyword)")
+    opts = _scheme_options(scheme, {**options, **(scheme_options or {})})
+    check_options(scheme, opts, scene)
+    takes = options_of(get_integrator(scheme)) or ()
     ts = float(section_tau)
     if q0 is None or v0 is None:
         if not hasattr(scene, "rest_state"):
@@ -144,7 +162,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     def period(q, v, record=False):
         calls[0] += 1
         run_opts = dict(opts)
-        if not record and scheme != "moreau-jean":
+        if not record and "sample_dt" in takes:
             run_opts.setdefault("sample_dt", TWO_PI)
         res = simulate(scene, (ts, ts + TWO_PI), q, v, scheme, **run_opts)
         if not res.success:

@@ -12,10 +12,12 @@ import numpy as np
 from ..errors import InputError, RunawayError
 # SteadyState is defined with the other scheme results (below this layer)
 # and re-exported here, where callers have always found it
+from ..integrators import INTEGRATORS, get_integrator
 from ..integrators.result import SteadyState
 from ..scenes.base import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
-from . import mj_steady_state, periodic_shooting  # noqa: F401
+from . import mj_steady_state  # noqa: F401
+from .periodic_shooting import shoot_periodic
 from .steady_solvers import get_steady_solver, has_solver
 
 __all__ = ["SteadyState", "find_steady_state"]
@@ -105,6 +107,18 @@ def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, m
     if scheme == "event-driven" and own is not None and has_solver(own):
         # the scene's own reference has a steady-state solver of its own (its walker)
         scheme = own
+    if not has_solver(scheme):
+        # any other registered scheme: Newton shooting on the period map it computes
+        try:
+            get_integrator(scheme)
+        except InputError:
+            known = ", ".join(repr(k) for k in sorted(INTEGRATORS))
+            raise InputError(f"`scheme` must be a registered scheme, one of {known}; "
+                             f"got {scheme!r}") from None
+        if v_guess is not None:
+            raise InputError(f"`v_guess` is not taken by the shooting of scheme {scheme!r}; "
+                             "give `q0` and `v0`")
+        return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     solver = get_steady_solver(scheme)
     return solver(scene, rtol=rtol, v_guess=v_guess, max_iter=max_iter, **options)
 def implausible_steady_state(scene, ss):

@@ -17,7 +17,7 @@ import time
 
 from ..errors import InputError
 from ..provenance import provenance
-from .steady_state import find_steady_state
+from .scheme_settings import make_scheme, steady_of
 
 __all__ = ["steady_state_report", "check_periodic"]
 
@@ -39,18 +39,22 @@ def check_periodic(scene):
 
 
 def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
-                        rtol=None, parameters=None):
+                        rtol=None, parameters=None, options=None):
     """Steady state of ``scene`` as a JSON-ready dict in SI units.
 
     Parameters
     ----------
     scene : Scene
         A periodically driven scene (:func:`check_periodic`).
-    scheme : {"event-driven", "moreau-jean"}
+    scheme : str
+        Any registered scheme (:func:`moreau.analysis.scheme_settings.make_scheme`).
     steps_per_period, theta : optional
-        Moreau–Jean only (defaults 1000 and 1).
+        Time-stepping schemes' steps per period (default 1000); ``theta`` for
+        the schemes that take one (Moreau–Jean, default 1).
     rtol : float, optional
         The shooting tolerance (event-driven default 1e-10; Moreau–Jean its own).
+    options : dict, optional
+        The scheme's other options (a compliant contact's ``stiffness``).
     parameters : dict, optional
         The SI parameters to record (default: the scene's ``params`` fields).
 
@@ -66,16 +70,9 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         statistics.
     """
     check_periodic(scene)
-    opts = {}
-    if scheme == "moreau-jean":
-        opts = dict(steps_per_period=1000 if steps_per_period is None else steps_per_period,
-                    theta=1.0 if theta is None else theta)
-        if rtol is not None:
-            opts["tol"] = rtol
-    else:
-        opts = dict(rtol=1e-10 if rtol is None else rtol)
+    settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = find_steady_state(scene, scheme, **opts)
+    ss = steady_of(scene, settings)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:
@@ -100,9 +97,13 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "parameters": dict(parameters),
         "provenance": provenance(),
     }
+    if settings.steps_per_period is not None:
+        out["steps_per_period"] = settings.steps_per_period
+    if settings.theta is not None:
+        out["theta"] = settings.theta
+    if settings.options:
+        out["options"] = settings.options
     if scheme == "moreau-jean":
-        out["steps_per_period"] = opts["steps_per_period"]
-        out["theta"] = opts["theta"]
         for key in MJ_STATS:
             if ss.stats and key in ss.stats:
                 val = ss.stats[key]

@@ -84,8 +84,11 @@ def sweep_tag(scene, parameter, frequency, scheme):
     if parameter != "frequency":
         parts.append(f"{frequency:g}Hz")
     parts.append(scheme.name)
-    if scheme.name == "moreau-jean":
-        parts += [f"theta{scheme.theta:g}", f"N{scheme.steps_per_period}"]
+    if scheme.theta is not None:
+        parts.append(f"theta{scheme.theta:g}")
+    if scheme.steps_per_period is not None:
+        parts.append(f"N{scheme.steps_per_period}")
+    parts += [f"{k}{v:g}" if isinstance(v, float) else f"{k}{v}" for k, v in scheme[4]]
     if scheme.rtol is not None and scheme.rtol != ED_REFERENCE.rtol:
         parts.append(f"rtol{scheme.rtol:g}")
     return "_".join(parts)
@@ -192,7 +195,8 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             "range": [float(values.min()), float(values.max())], "frequency_Hz": frequency,
             "fixed_parameters": dict(defaults, **fixed),
             "scheme": {"name": scheme.name, "theta": scheme.theta,
-                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol},
+                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
+                       "options": scheme.options},
             "engine": stats, "provenance": provenance(engine.code_version())}
     json_path = stem.with_name(stem.name + ".json")
     json_path.write_text(json.dumps(meta, indent=1, default=str))

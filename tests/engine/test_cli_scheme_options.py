@@ -6,8 +6,8 @@ from moreau.cli import main
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["steady", "--frequency", "185", "--theta", "0.5"], "`--theta` applies only to `--scheme moreau-jean`"),
-    (["steady", "--frequency", "185", "--steps-per-period", "100"], "`--steps-per-period` applies only"),
+    (["steady", "--frequency", "185", "--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)"),
+    (["steady", "--frequency", "185", "--steps-per-period", "100"], "`--steps-per-period` does not act with `--scheme event-driven`: it applies to time-stepping schemes"),
     (["run", "--frequency", "185", "--scheme", "moreau-jean", "--rtol", "1e-3"],
      "`rtol` is not an option of scheme 'moreau-jean'"),
     (["run", "--scene", "bouncing-ball", "--duration", "1", "--theta", "0.5"],
@@ -18,7 +18,7 @@ from moreau.cli import main
     (["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean"],
      "give `--steps`"),
     (["run", "--frequency", "185", "--steps", "100"], "`steps` applies to time-stepping schemes"),
-    (["steady", "--scene", "bidirectional", "--frequency", "185", "--theta", "1"], "`--theta` applies only"),
+    (["steady", "--scene", "bidirectional", "--frequency", "185", "--theta", "1"], "`--theta` does not act with `--scheme event-driven`"),
 ])
 def test_unused_scheme_setting_is_refused(argv, message, capsys):
     assert main(argv) == 2

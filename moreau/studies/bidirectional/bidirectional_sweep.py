@@ -189,7 +189,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         "parameters_SI": asdict(params),
         "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
                              "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                             "projection": True if scheme.name == "moreau-jean" else None},
+                             "projection": True if scheme.name == "moreau-jean" else None,
+                             "options": scheme.options},
         "valid_range": marks,
         "package_version": __version__,
         "code_version": code_version(),
@@ -200,8 +201,7 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     log(f"wrote {(stem.parent / (stem.name + '.csv'))} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
-        label = scheme.name if scheme.name == "event-driven" else \
-            f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
+        label = scheme.description
         title = f"Bidirectional drive: steady state against {parameter}" + (
             f" at f = {frequency:g} Hz" if frequency is not None else "")
         try:
@@ -267,7 +267,8 @@ def command(args):
                              f"`--set {key}=...`)")
         setattr(args, key, val)
     params = params_from_args(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         getattr(args, "scheme_options", None))
     if args.num is not None and args.points is not None:
         raise InputError("`--num` is the old name of `--points`; give one of them")
     scale = args.scale or "linear"

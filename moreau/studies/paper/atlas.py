@@ -243,7 +243,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
 def command(args):
     """``moreau atlas``: the friction drive's atlas from the parsed command-line arguments."""
     params = params_from_args(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         getattr(args, "scheme_options", None))
     planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
     if args.quick:
         if args.f_points is not None or args.y_points is not None:

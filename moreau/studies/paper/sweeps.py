@@ -156,10 +156,12 @@ def scheme_tag(scheme):
     >>> scheme_tag(make_scheme("event-driven", rtol=1e-6))
     '_ed_rtol1e-06'
     """
-    if scheme.name == "moreau-jean":
+    if scheme.name == "moreau-jean" and not scheme.options:
         tag = f"_mj_theta{scheme.theta:g}_N{scheme.steps_per_period}"
         return tag + (f"_tol{scheme.rtol:g}" if scheme.rtol is not None else "")
-    return "" if scheme.rtol in (None, 1e-10) else f"_ed_rtol{scheme.rtol:g}"
+    if scheme.name == "event-driven" and not scheme.options:
+        return "" if scheme.rtol in (None, 1e-10) else f"_ed_rtol{scheme.rtol:g}"
+    return f"_{scheme.label}" + (f"_tol{scheme.rtol:g}" if scheme.rtol is not None else "")
 
 
 def sweep_values(parameter, start, stop, points, scale="linear"):
@@ -257,8 +259,7 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
-        label = scheme.name if scheme.name == "event-driven" else \
-            f"Moreau\u2013Jean \u03b8 = {scheme.theta:g} ({scheme.steps_per_period} steps/period)"
+        label = scheme.description
         paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",
                              scheme_label=label)
         log(f"wrote {paths[0]}")
@@ -313,7 +314,8 @@ def command(args):
             raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
         setattr(args, key, val)
     params = params_from_args(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         getattr(args, "scheme_options", None))
     if args.num is not None and args.points is not None:
         raise InputError("`--num` is the old name of `--points`; give one of them")
     scale = args.scale

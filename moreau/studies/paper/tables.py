@@ -106,7 +106,8 @@ def write_sidecar(path, params, name, parameter, values, frequency, extra, check
         "frequency_Hz": frequency,
         "parameters_SI": asdict(params),
         "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
-                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol},
+                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
+                             "options": scheme.options},
         "cross_checks": [{"name": c.name, "theta": c.theta, "steps_per_period": c.steps_per_period}
                          for c in checks],
         "valid_range": {k: v for k, v in extra.items()},

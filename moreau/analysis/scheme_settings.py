@@ -1,0 +1,200 @@
+"""The settings of one steady-state computation under any registered scheme.
+
+A :class:`Scheme` names a registered scheme with its step, its ``theta``,
+the shooting tolerance and the scheme's other options, checked against the
+scheme when the settings are made (so that a setting the scheme does not
+take never reaches a worker process). Sweeps, atlases and ``moreau steady``
+carry one; :func:`steady_of` computes the steady state it describes.
+"""
+
+import math
+
+from ..errors import InputError
+from ..integrators import INTEGRATORS, get_integrator
+from ..integrators.base import check_options, scheme_options
+from .steady_state import find_steady_state
+
+__all__ = ["Scheme", "make_scheme", "steady_of", "ED_REFERENCE", "ADAPTIVE_SHOOTING_RTOL"]
+
+#: shooting tolerance of a scheme that picks its own steps (a compliant contact's Radau or
+#: RK45), when none is given: its period map is only as smooth as its error control
+ADAPTIVE_SHOOTING_RTOL = 1e-8
+
+
+class Scheme(tuple):
+    """Settings of one steady-state computation: ``(name, theta, steps_per_period, rtol, options)``.
+
+    ``name`` is any registered scheme (:data:`moreau.integrators.INTEGRATORS`).
+    ``steps_per_period`` applies to the time-stepping schemes (those with a
+    step ``h``) and ``theta`` to those with a ``theta``; both are None
+    otherwise. ``rtol`` is the shooting tolerance. ``options`` holds the
+    scheme's other options as sorted ``(name, value)`` pairs (a compliant
+    contact's ``stiffness``), checked against the scheme when the settings are
+    made, so that a setting the scheme does not take never reaches a worker.
+
+    Examples
+    --------
+    >>> Scheme.moreau_jean(0.5, 2000).label
+    'mj_theta0.5'
+    >>> Scheme("compliant-rk45", options={"stiffness": 1e6}).label
+    'compliant-rk45_stiffness1e+06'
+    >>> Scheme("event-driven", theta=0.5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven'
+    """
+
+    def __new__(cls, name, theta=None, steps_per_period=None, rtol=None, options=None):
+        takes = _takes(name)
+        opts = dict(options or {})
+        for key, val in (("theta", theta), ("steps_per_period", steps_per_period)):
+            if key in opts:
+                raise InputError(f"`{key}` is a setting of its own, not one of `options`")
+        if "h" in opts:
+            raise InputError("give the step as `steps_per_period`, not as the option `h`")
+        if theta is not None:
+            if "theta" not in takes:
+                raise InputError(f"`theta` is not an option of scheme {name!r}")
+            theta = float(theta)
+            if not 0.5 <= theta <= 1.0:
+                raise InputError(f"`theta` must be in [1/2, 1], got {theta!r}")
+        elif "theta" in takes:
+            raise InputError(f"`theta` is required for scheme {name!r}")
+        if steps_per_period is not None:
+            if "h" not in takes:
+                raise InputError(f"`steps_per_period` applies only to time-stepping schemes; "
+                                 f"scheme {name!r} chooses its own steps")
+            if isinstance(steps_per_period, bool) or int(steps_per_period) != steps_per_period \
+                    or int(steps_per_period) < 8:
+                raise InputError(f"`steps_per_period` must be an integer >= 8, got "
+                                 f"{steps_per_period!r}")
+            steps_per_period = int(steps_per_period)
+        elif "h" in takes:
+            raise InputError(f"`steps_per_period` is required for scheme {name!r}")
+        if rtol is not None and not (math.isfinite(rtol) and rtol > 0):
+            raise InputError(f"`rtol` must be > 0, got {rtol!r}")
+        check_options(name, opts)
+        return super().__new__(cls, (name, theta, steps_per_period,
+                                     None if rtol is None else float(rtol),
+                                     tuple(sorted(opts.items()))))
+
+    @classmethod
+    def moreau_jean(cls, theta, steps_per_period, rtol=None):
+        return cls("moreau-jean", theta, steps_per_period, rtol)
+
+    name = property(lambda self: self[0])
+    theta = property(lambda self: self[1])
+    steps_per_period = property(lambda self: self[2])
+    rtol = property(lambda self: self[3])
+    options = property(lambda self: dict(self[4]))
+
+    @property
+    def label(self):
+        """A short name for columns and file names: ``ed``, ``mj_theta1``, or the scheme's name
+        with its step and options."""
+        if self.name == "event-driven" and not self[4]:
+            return "ed"
+        if self.name == "moreau-jean" and not self[4]:
+            return f"mj_theta{self.theta:g}"
+        parts = [self.name]
+        if self.theta is not None:
+            parts.append(f"theta{self.theta:g}")
+        if self.steps_per_period is not None:
+            parts.append(f"N{self.steps_per_period}")
+        parts += [f"{k}{v:g}" if isinstance(v, float) else f"{k}{v}" for k, v in self[4]]
+        return "_".join(parts)
+
+    @property
+    def description(self):
+        """The settings in words, for figure legends.
+
+        Examples
+        --------
+        >>> Scheme.moreau_jean(0.5, 2000).description
+        'Moreau–Jean θ = 0.5 (2000 steps/period)'
+        >>> Scheme("compliant-rk45", options={"stiffness": 1e6}).description
+        'compliant-rk45 (stiffness=1e+06)'
+        """
+        if self.name == "moreau-jean":
+            text = f"Moreau\u2013Jean \u03b8 = {self.theta:g} ({self.steps_per_period} steps/period)"
+        else:
+            extra = ([f"\u03b8 = {self.theta:g}"] if self.theta is not None else []) + (
+                [f"{self.steps_per_period} steps/period"] if self.steps_per_period else [])
+            extra += [f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self[4]]
+            text = self.name + (f" ({', '.join(extra)})" if extra else "")
+        return text
+
+    def __getnewargs__(self):
+        return (self[0], self[1], self[2], self[3], dict(self[4]))
+
+
+def _takes(name):
+    """The options scheme ``name`` takes (an unknown name lists the registered ones)."""
+    return scheme_options(get_integrator(name)) or ()
+
+
+ED_REFERENCE = Scheme("event-driven", rtol=1e-10)
+
+
+def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=None, options=None):
+    """The :class:`~moreau.analysis.engine.Scheme` of a sweep; refuses settings that would not act.
+
+    ``theta`` applies to the schemes that take one (Moreau–Jean, default 1),
+    ``steps_per_period`` to the time-stepping schemes (default 1000);
+    ``rtol`` is the shooting tolerance of any scheme (default 1e-10 for the
+    event-driven one, the scheme's own otherwise); ``options`` are the
+    scheme's other options.
+
+    Examples
+    --------
+    >>> make_scheme("moreau-jean", steps_per_period=500)
+    ('moreau-jean', 1.0, 500, None, ())
+    >>> make_scheme("compliant-radau", options={"stiffness": 1e5})
+    ('compliant-radau', None, None, None, (('stiffness', 100000.0),))
+    >>> make_scheme("event-driven", theta=0.5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)
+    """
+    takes = _takes(scheme)
+    for flag, key, val in (("--theta", "theta", theta),
+                           ("--steps-per-period", "h", steps_per_period)):
+        if val is not None and key not in takes:
+            users = [n for n in sorted(INTEGRATORS) if key in (scheme_options(INTEGRATORS[n]) or ())]
+            what = "schemes with a theta" if key == "theta" else "time-stepping schemes"
+            raise InputError(f"`{flag}` does not act with `--scheme {scheme}`: it applies to "
+                             f"{what} ({', '.join(users)})")
+    if "theta" in takes and theta is None:
+        theta = 1.0
+    if "h" in takes and steps_per_period is None:
+        steps_per_period = 1000
+    if scheme == "event-driven" and rtol is None:
+        rtol = 1e-10
+    return Scheme(scheme, theta, steps_per_period, rtol, options)
+
+
+def steady_of(scene, scheme):
+    """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> steady_of(make_scene("friction-drive", frequency=20.0), ED_REFERENCE).mode
+    'NS'
+    """
+    if scheme.name == "moreau-jean":
+        # the compiled discrete period map names its tolerance `tol`
+        kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
+        return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
+                                 steps_per_period=scheme.steps_per_period, **kw, **scheme.options)
+    # an adaptive scheme's period map carries its own error tolerance: the shooting
+    # aims above it unless told otherwise (a fixed-step map is deterministic)
+    kw = {"rtol": scheme.rtol if scheme.rtol is not None else
+          1e-10 if scheme.steps_per_period is not None else ADAPTIVE_SHOOTING_RTOL}
+    if scheme.steps_per_period is not None:
+        kw["steps_per_period"] = scheme.steps_per_period
+    if scheme.theta is not None:
+        kw["theta"] = scheme.theta
+    if scheme.options:
+        kw["scheme_options"] = scheme.options
+    return find_steady_state(scene, scheme=scheme.name, **kw)
