@@ -158,11 +158,31 @@ def test_other_registered_schemes_get_rows_on_request():
     assert [r["setting"] for r in rows] == ["stiffness=1000", "stiffness=10000"]
     for r in rows:
         assert r["status"] == 0 and 0.0 < r["error"] < 1.0 and r["trajectory_error"] > 0.0
-    # not asked: not run; a steady-state headline: not applicable
+    # not asked: not run
     assert not any(r["scheme"].startswith("compliant") for r in run_compare(
         "sliding-block", quick=True, lcp_steps=[], thetas=[1.0], progress=False)["rows"])
-    steady = run_compare("friction-drive", frequency=185.0, steps=[200], lcp_steps=[],
-                         thetas=[1.0], repeat=1, progress=False, schemes=["compliant-radau"])
-    assert not any(r["scheme"] == "compliant-radau" for r in steady["rows"])
+    with pytest.raises(ValueError, match="`schemes` must name schemes that compare can run"):
+        run_compare("bouncing-ball", quick=True, progress=False, schemes=["moreau-jean"])
+
+
+def test_another_scheme_on_a_drive_is_its_own_steady_state():
+    # a periodic scene's row of any scheme is that scheme's steady state, as for Moreau-Jean
+    from moreau.analysis.compare import make_case
+    from moreau.analysis.scheme_settings import make_scheme, steady_of
+    case = make_case("friction-drive", frequency=185.0)
+    opts = {"stiffness": 1e4, "friction_velocity": 1e-3}
+    value, ss = case.scheme("compliant-rk45", opts)
+    direct = steady_of(case.scene, make_scheme("compliant-rk45", options=opts))
+    assert value == pytest.approx(direct.displacement_per_period, rel=1e-9)
+    assert ss.periodic_residual < 1e-8
+    # a soft contact, k = 1e4 in the scene's units: a model error of about 15 %
+    ref, _ = case.reference(1e-10)
+    assert 0.05 < abs(value / ref - 1) < 0.3
+    # its trajectory error is one period of the same scheme from the reference's state
+    assert 0.0 < case.measure_scheme("compliant-rk45", opts, (value, ss)) < 1.0
+
+
+def test_a_named_scheme_that_compare_cannot_run_is_refused():
+    from moreau.analysis.compare import compare as run_compare
     with pytest.raises(ValueError, match="`schemes` must name schemes that compare can run"):
         run_compare("bouncing-ball", quick=True, progress=False, schemes=["moreau-jean"])

@@ -34,9 +34,11 @@ import numpy as np
 
 from .._validate import finite_array
 from ..errors import InputError, MoreauError
-from ..integrators import simulate
+from ..integrators import get_integrator, simulate
+from ..integrators.base import scheme_options
 from ..regimes import REGIME_LETTERS
 from .mj_steady_state import moreau_jean_steady_state
+from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
 __all__ = ["CompareCase", "DriveCase", "SceneCase", "GRID", "switching_error", "flatten",
@@ -171,15 +173,24 @@ class CompareCase:
             raise MoreauError(f"Moreau–Jean run failed: {res.message}")
         return self.headline_of_run(res), res
 
-    #: whether the case's headline comes from one run over the window (then any
-    #: registered scheme can be compared on it), not from a steady state
-    runs_any_scheme = True
-
     def run_scheme(self, name, options):
-        """A run of the registered scheme ``name`` over the window, sampled on the grid."""
+        """A run of the registered scheme ``name`` over the window, sampled on the grid.
+
+        ``steps_per_period`` in ``options`` is a time-stepping scheme's number
+        of steps over the window (its ``h``), as in the Moreau–Jean rows.
+        """
         q0, v0 = self.start()
         return simulate(self.scene, (0.0, self.window), q0, v0, name,
-                        sample_dt=self.window / GRID, **options)
+                        **self._run_options(name, options))
+
+    def _run_options(self, name, options):
+        opts = dict(options)
+        n = opts.pop("steps_per_period", None)
+        if n is not None:
+            opts["h"] = self.window / n
+        if "sample_dt" in (scheme_options(get_integrator(name)) or ()):
+            opts.setdefault("sample_dt", self.window / GRID)
+        return opts
 
     def scheme(self, name, options):
         """``(headline, run)``: the timed work of one row of another scheme."""
@@ -187,6 +198,10 @@ class CompareCase:
         if not res.success:
             raise MoreauError(f"{name} run failed: {res.message}")
         return self.headline_of_run(res), res
+
+    def measure_scheme(self, name, options, out):
+        """The trajectory error of another scheme's row, from its timed output."""
+        return self._trajectory_error(out[1])
 
     def measure(self, n, theta, lcp, out):
         """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
@@ -237,7 +252,6 @@ class DriveCase(CompareCase):
     tight_rtol = 1e-12
     headline_name = "displacement per period"
     projection = True
-    runs_any_scheme = False      # the headline is a steady state
     _ref = None
 
     @property
@@ -262,6 +276,22 @@ class DriveCase(CompareCase):
             return super().mj(n, theta, lcp)
         ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
         return ss.displacement_per_period, ss
+
+    def scheme(self, name, options):
+        # any scheme's headline on a drive is its own periodic steady state (the fixed
+        # point of the period map it computes), as for the reference and Moreau-Jean
+        opts = dict(options)
+        n = opts.pop("steps_per_period", None)
+        theta = opts.pop("theta", None)
+        ss = steady_of(self.scene, make_scheme(name, theta, n, None, opts))
+        return ss.displacement_per_period, ss
+
+    def measure_scheme(self, name, options, out):
+        # the trajectory: one period of the same scheme from the reference's periodic state
+        res = self.run_scheme(name, options)
+        if not res.success:
+            raise MoreauError(f"{name} run failed: {res.message}")
+        return self._trajectory_error(res)
 
     def _switches_of_steady(self, ss, h=0.0):
         tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)

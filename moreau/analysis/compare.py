@@ -277,8 +277,8 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     schemes : sequence of str, optional
         Other registered schemes to run beside the reference and Moreau–Jean
         (those that state how, ``Integrator.compare_settings``, e.g.
-        ``"compliant-radau"``); none by default. They run where the headline
-        comes from one run over the window (not on steady states).
+        ``"compliant-radau"``); none by default. On a periodic scene each
+        row is that scheme's own steady state, as for Moreau–Jean.
     **params
         Parameters of a registered scene and of its comparison case
         (:func:`case_parameters`).
@@ -346,10 +346,10 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         "interrupted": False,
         # what a run time means here, and on what machine it was taken
         "time_s_meaning": ("median wall time of the computation that gives the row's headline "
-                           "value: for a periodic scene the reference's or Moreau-Jean's steady "
-                           "state, or with a forced contact solver (lcp) one period from the "
-                           "reference's periodic state; for other scenes one run over the "
-                           "window; numba compilation excluded"),
+                           "value: for a periodic scene the steady state of the row's scheme "
+                           "(the fixed point of its period map), or with a forced contact "
+                           "solver (lcp) one period from the reference's periodic state; for "
+                           "other scenes one run over the window; numba compilation excluded"),
         "provenance": provenance(),
     }
     jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
@@ -452,8 +452,7 @@ def other_schemes(case, quick=False, names=None):
     """``(name, setting, values, fixed_options)`` of the registered schemes that compare runs.
 
     Every registered scheme with ``compare_settings`` (the reference and
-    Moreau–Jean have rows of their own), or those of ``names``; none where the
-    case's headline is a steady state.
+    Moreau–Jean have rows of their own), or those of ``names``.
     """
     registered = {n: cls for n, cls in INTEGRATORS.items()
                   if getattr(cls, "compare_settings", None) is not None}
@@ -463,8 +462,6 @@ def other_schemes(case, quick=False, names=None):
                 raise InputError(f"`schemes` must name schemes that compare can run, from "
                                  f"{sorted(registered)}; got {n!r}")
         registered = {n: registered[n] for n in names}
-    if not getattr(case, "runs_any_scheme", False):
-        return []
     out = []
     for name in sorted(registered):
         key, values, quick_values, fixed = registered[name].compare_settings
@@ -483,7 +480,7 @@ def run_other_row(case, name, key, value, fixed, repeat, ref_value, ref_switches
         t, (value_, res) = _median_time(lambda: case.scheme(name, opts), repeat)
         row.update(time_s=t, error=_relative(value_, ref_value),
                    signed_error=_signed(value_, ref_value),
-                   trajectory_error=case._trajectory_error(res))
+                   trajectory_error=case.measure_scheme(name, opts, (value_, res)))
     except MoreauError as exc:
         row.update(status=-1, message=f"{type(exc).__name__}: {exc}")
     return row

@@ -19,7 +19,10 @@ of contact ``i`` is zero while ``delta_i <= 0`` and otherwise
 clamped at zero so that a separating contact never pulls. The tangential
 force of a frictional contact with slip velocity ``gT = WT_i v + wT_i`` is
 ``fT = -mu fN gT / sqrt(gT^2 + eps^2)``, Coulomb's law smoothed over slip
-velocities of the size of ``eps`` (``friction_velocity``). Then
+velocities of the size of ``eps = friction_velocity * velocity_scale``, with
+the scene's ``velocity_scale`` (the stator's speed on the drives; 1 where a
+scene has none): a smoothing that is small on one scene must be small on
+all, and the drives' slip speeds are three decades below the ball's. Then
 
     M(q) v' = h(q, v, t) + WN^T fN + WT^T fT,    q' = v.
 
@@ -137,7 +140,8 @@ class _Compliant(Integrator):
                              f"{contact_model!r}")
         self.contact_model = contact_model
         self.power = CONTACT_MODELS[contact_model]
-        self.eps = positive("friction_velocity", friction_velocity)
+        vs = float(np.max(np.abs(getattr(scene, "velocity_scale", 1.0))))
+        self.eps = positive("friction_velocity", friction_velocity) * (vs if vs > 0 else 1.0)
         self.rtol = positive("rtol", rtol)
         self.atol = positive("atol", atol)
         nc = scene.ncontacts
@@ -272,7 +276,8 @@ class CompliantRadau(_Compliant):
 
     Options: ``stiffness`` (> 0), ``damping`` (>= 0; default from the
     restitution for Kelvin–Voigt), ``contact_model`` (``"kelvin-voigt"`` or
-    ``"hunt-crossley"``), ``friction_velocity`` (> 0), ``rtol``, ``atol``,
+    ``"hunt-crossley"``), ``friction_velocity`` (> 0, in units of the scene's
+    ``velocity_scale``), ``rtol``, ``atol``,
     ``max_step`` (default a tenth of a contact's duration), ``sample_dt``
     (default: every step).
     """

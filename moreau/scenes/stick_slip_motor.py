@@ -417,8 +417,6 @@ class StickSlipMotor(SIUnits, Scene):
 class StickSlipCase(CompareCase):
     """One period from the exact periodic state; reference: the exact stick–slip solution."""
 
-    runs_any_scheme = False      # the headline is a steady state
-
     ref_scheme = "stick-slip-exact"
     headline_name = "displacement per period"
 
