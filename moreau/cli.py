@@ -12,6 +12,7 @@ import sys
 from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
+from .analysis.atlas import run_scene_atlas
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
@@ -19,7 +20,6 @@ from .errors import InputError, MoreauError
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
-from .studies.paper.atlas import command as atlas_command
 from .studies.paper.reproduce import reproduce
 from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs
 
@@ -223,16 +223,36 @@ def _cmd_run(args):
 
 
 def _add_atlas(sub):
-    p = sub.add_parser("atlas", help="operation mode and displacement over the (f, mu) and "
-                                     "(f, phi0) planes, with the lift-off, Painleve and "
-                                     "contact-loss boundaries")
-    p.add_argument("--plane", choices=["both", "f-mu", "f-phi0"], default="both")
-    p.add_argument("--f-points", type=int, default=None, help="frequencies (default 200, log-spaced)")
-    p.add_argument("--y-points", type=int, default=None, help="mu or phi0 values (default 100)")
-    p.add_argument("--fmin", type=float, default=10.0, help="lowest frequency [Hz] (default 10)")
-    p.add_argument("--fmax", type=float, default=12500.0,
-                   help="highest frequency [Hz] (default 12500)")
-    p.add_argument("--quick", action="store_true", help="a 24 x 12 grid per plane")
+    p = sub.add_parser("atlas", help="operation mode and displacement over a parameter plane of "
+                                     "any periodic scene (--x, --y); the friction drive's own: "
+                                     "the (f, mu) and (f, phi0) planes with the lift-off, "
+                                     "Painleve and contact-loss boundaries")
+    p.add_argument("--x", nargs=3, metavar=("PARAM", "START", "STOP"), default=None,
+                   help="first axis: a parameter of the scene (or frequency) and its range (SI)")
+    p.add_argument("--y", nargs=3, metavar=("PARAM", "START", "STOP"), default=None,
+                   help="second axis, as --x")
+    p.add_argument("--x-points", type=int, default=None, help="values on --x (default 20)")
+    p.add_argument("--x-scale", choices=["linear", "log"], default=None,
+                   help="spacing on --x (default log for frequency, else linear)")
+    p.add_argument("--y-scale", choices=["linear", "log"], default=None,
+                   help="spacing on --y (default log for frequency, else linear)")
+    p.add_argument("--frequency", type=float, default=None,
+                   help="drive frequency [Hz] when neither axis is frequency")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="fix another parameter of the scene (repeatable)")
+    p.add_argument("--plane", choices=["both", "f-mu", "f-phi0"], default=None,
+                   help="friction drive's own atlas: the plane (default both)")
+    p.add_argument("--f-points", type=int, default=None,
+                   help="friction drive's own atlas: frequencies (default 200, log-spaced)")
+    p.add_argument("--y-points", type=int, default=None,
+                   help="values on --y (default 20), or mu or phi0 values of the friction "
+                        "drive's own atlas (default 100)")
+    p.add_argument("--fmin", type=float, default=None,
+                   help="friction drive's own atlas: lowest frequency [Hz] (default 10)")
+    p.add_argument("--fmax", type=float, default=None,
+                   help="friction drive's own atlas: highest frequency [Hz] (default 12500)")
+    p.add_argument("--quick", action="store_true", help="a coarse grid (24 x 12 per plane; "
+                                                        "8 x 6 with --x/--y)")
     p.add_argument("--out", default="out", help="output folder (default ./out)")
     p.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
@@ -241,7 +261,52 @@ def _add_atlas(sub):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
     _add_params(p, scheme_defaults=False)
-    p.set_defaults(func=atlas_command)
+    add_scene_options(p, with_set=False)
+    p.set_defaults(func=_cmd_atlas)
+
+
+#: options of a scene's own atlas that the generic one (--x, --y) does not take
+_OWN_ATLAS_OPTIONS = ("plane", "f_points", "fmin", "fmax")
+
+
+def _cmd_atlas(args):
+    """``moreau atlas``: the scene's own atlas where its entry names one, else the generic one."""
+    entry = get_entry(args.scene)
+    if args.x is None and args.y is None:
+        if entry.atlas is None:
+            raise InputError(f"scene {entry.name!r} has no atlas of its own: give the plane as "
+                             "`--x PARAM START STOP --y PARAM START STOP`")
+        for key in ("x_points", "x_scale", "y_scale", "frequency"):
+            if getattr(args, key) is not None:
+                raise InputError(f"`--{key.replace('_', '-')}` applies with `--x` and `--y`")
+        return resolve_hook(entry.atlas)(args)
+    if args.x is None or args.y is None:
+        raise InputError("give both axes: `--x PARAM START STOP` and `--y PARAM START STOP`")
+    for key in _OWN_ATLAS_OPTIONS:
+        if getattr(args, key) is not None:
+            raise InputError(f"`--{key.replace('_', '-')}` belongs to a scene's own atlas; with "
+                             "`--x` and `--y` give the ranges there")
+    axes = []
+    for flag, (name, start, stop), points, scale in (
+            ("--x", args.x, args.x_points, args.x_scale),
+            ("--y", args.y, args.y_points, args.y_scale)):
+        try:
+            start, stop = float(start), float(stop)
+        except ValueError:
+            raise InputError(f"`{flag}` takes PARAM START STOP with numbers, got "
+                             f"{start!r} {stop!r}") from None
+        if args.quick and points is not None:
+            raise InputError("`--quick` sets the grid; leave out `--x-points`/`--y-points`")
+        n = (8 if flag == "--x" else 6) if args.quick else (20 if points is None else points)
+        scale = scale or ("log" if name == "frequency" else "linear")
+        axes.append((name, sweep_values(start, stop, n, scale)))
+    params = scene_parameters(args, entry)
+    frequency = params.pop("frequency", None)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         args.scheme_options)
+    run_scene_atlas(entry.name, axes[0], axes[1], fixed=params, frequency=frequency,
+                    scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
+                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
 
 
 # -- moreau reproduce ---------------------------------------------------------------

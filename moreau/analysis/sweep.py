@@ -34,7 +34,8 @@ from ..scenes import registry
 from . import engine
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
-__all__ = ["run_scene_sweep", "sweep_tag", "sweep_values", "VALUE_COLUMNS", "MAX_POINTS"]
+__all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
+           "MAX_POINTS"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
@@ -94,6 +95,80 @@ def sweep_tag(scene, parameter, frequency, scheme):
     return "_".join(parts)
 
 
+def plan_points(scene, swept, values, fixed=None, frequency=None):
+    """Check a sweep's or an atlas's settings before any work, and say how to make its points.
+
+    Parameters
+    ----------
+    scene : str
+        A registered scene with a periodic drive.
+    swept : tuple of str
+        The varied parameters (numeric parameters of the scene, or ``"frequency"``).
+    values : tuple of array_like
+        Their values (SI units), one array per swept parameter.
+    fixed, frequency
+        As in :func:`run_scene_sweep`.
+
+    Returns
+    -------
+    entry : SceneEntry
+    columns : dict
+        Parameter name -> CSV column name (with its unit).
+    point : callable
+        ``point({name: value})`` -> ``(params, frequency)`` of one engine point.
+    frequency : float or None
+        The fixed drive frequency (None when it is swept).
+    """
+    entry = registry.get_entry(scene)
+    if entry.name not in periodic_scene_names():
+        raise InputError(f"`--scene` must be a periodically driven scene, one of "
+                         f"{periodic_scene_names()}; got {scene!r}")
+    params = {p.name: p for p in entry.parameters}
+    numeric = [n for n, p in params.items() if p.unit != "choice"]
+    for name in swept:
+        if name not in numeric:
+            raise InputError(f"`PARAM` must be a numeric parameter of scene {entry.name!r}, one "
+                             f"of {numeric}; got {name!r}")
+    fixed = dict(fixed or {})
+    for key in fixed:
+        if key not in params:
+            raise InputError(f"`{key}` is not a parameter of scene {entry.name!r}; its "
+                             f"parameters: {', '.join(params)}")
+    for name in swept:
+        if name in fixed:
+            raise InputError(f"`{name}` is swept; do not fix it too")
+    for name, vals in zip(swept, values):
+        vals = np.asarray(vals, dtype=float).reshape(-1)
+        if vals.size == 0 or not np.all(np.isfinite(vals)):
+            raise InputError(f"the values of `{name}` must be finite numbers, at least one")
+    if "frequency" in swept:
+        if frequency is not None or "frequency" in fixed:
+            raise InputError("`--frequency` is the swept parameter here; leave it out")
+    elif frequency is None:
+        frequency = fixed.pop("frequency", None)
+        if frequency is None:
+            raise InputError(f"`--frequency` is required for a sweep of {', '.join(swept)} "
+                             "(drive frequency in Hz)")
+    if frequency is not None:
+        frequency = positive("frequency", frequency)
+    defaults = {k: v for k, v in entry.defaults().items() if k != "frequency"}
+
+    def point(at):
+        p = dict(defaults, **fixed)
+        f = float(at["frequency"]) if "frequency" in at else frequency
+        p.update({k: float(v) for k, v in at.items() if k != "frequency"})
+        return p, f
+
+    # every corner of the range must make a valid scene before any work starts
+    extremes = [(float(np.min(v)), float(np.max(v))) for v in values]
+    for corner in np.array(np.meshgrid(*extremes)).reshape(len(swept), -1).T:
+        p, f = point(dict(zip(swept, corner)))
+        registry.make_scene(entry.name, frequency=f, **p)
+    columns = {n: _column(p) for n, p in params.items()}
+    columns["frequency"] = "frequency [Hz]"
+    return entry, columns, point, frequency
+
+
 def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme=ED_REFERENCE,
                     out="out", cache_dir=None, n_jobs=-1, scheduler=None, progress=True,
                     plot=True, log=print):
@@ -122,64 +197,25 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     list of dict
         One tidy row per value.
     """
-    entry = registry.get_entry(scene)
-    if entry.name not in periodic_scene_names():
-        raise InputError(f"`--scene` must be a periodically driven scene for a sweep, one of "
-                         f"{periodic_scene_names()}; got {scene!r}")
-    params = {p.name: p for p in entry.parameters}
-    numeric = [n for n, p in params.items() if p.unit != "choice"]
-    if parameter not in numeric:
-        raise InputError(f"`PARAM` must be a numeric parameter of scene {entry.name!r}, one of "
-                         f"{numeric}; got {parameter!r}")
-    fixed = dict(fixed or {})
-    for key in fixed:
-        if key not in params:
-            raise InputError(f"`{key}` is not a parameter of scene {entry.name!r}; its "
-                             f"parameters: {', '.join(params)}")
-    if parameter in fixed:
-        raise InputError(f"`{parameter}` is swept; do not fix it too")
     values = np.asarray(values, dtype=float).reshape(-1)
-    if values.size == 0 or not np.all(np.isfinite(values)):
-        raise InputError("`values` must be finite numbers, at least one")
-    if parameter == "frequency":
-        if frequency is not None or "frequency" in fixed:
-            raise InputError("`--frequency` is the swept parameter here; leave it out")
-    elif frequency is None:
-        frequency = fixed.pop("frequency", None)
-        if frequency is None:
-            raise InputError(f"`--frequency` is required for a sweep of {parameter!r} "
-                             "(drive frequency in Hz)")
-    if frequency is not None:
-        frequency = positive("frequency", frequency)
-    defaults = {k: v for k, v in entry.defaults().items() if k != "frequency"}
-
-    def point(x):
-        p = dict(defaults, **fixed)
-        f = float(x) if parameter == "frequency" else frequency
-        if parameter != "frequency":
-            p[parameter] = float(x)
-        return p, f
-
-    # every value must make a valid scene before any work starts (the extremes)
-    for x in (values.min(), values.max()):
-        p, f = point(x)
-        registry.make_scene(entry.name, frequency=f, **p)
+    entry, columns, point, frequency = plan_points(scene, (parameter,), (values,), fixed,
+                                                   frequency)
     if out is not None:
         out = check_output_dir(out)
         cache_dir = out / "cache" if cache_dir is None else cache_dir
-    points = [point(x) for x in values]
+    points = [point({parameter: x}) for x in values]
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", scene=entry.name)
-    swept = "frequency [Hz]" if parameter == "frequency" else _column(params[parameter])
+    swept = columns[parameter]
     table = []
     for x, (p, f), row in zip(values, points, rows):
         r = {swept: float(x), "scene": entry.name, "scheme": scheme.name}
         if parameter != "frequency":
-            r["frequency [Hz]"] = f
+            r[columns["frequency"]] = f
         for name, val in p.items():
             if name != parameter:
-                r[_column(params[name])] = val
+                r[columns[name]] = val
         for c in VALUE_COLUMNS:
             r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
         table.append(r)
@@ -193,7 +229,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
         w.writerows(table)
     meta = {"scene": entry.name, "swept_parameter": swept, "points": int(values.size),
             "range": [float(values.min()), float(values.max())], "frequency_Hz": frequency,
-            "fixed_parameters": dict(defaults, **fixed),
+            "fixed_parameters": {k: v for k, v in points[0][0].items() if k != parameter},
             "scheme": {"name": scheme.name, "theta": scheme.theta,
                        "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
                        "options": scheme.options},

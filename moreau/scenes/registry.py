@@ -38,6 +38,11 @@ An entry holds:
     generic one (:mod:`moreau.analysis.sweep`); None for the generic sweep.
 ``default``
     the scene commands take when none is named (one scene: the paper's).
+``atlas``
+    ``"module:function"`` of the scene's own atlas, which ``moreau atlas
+    --scene NAME`` runs with its parsed arguments when no plane is given
+    (``--x``, ``--y``: the generic atlas, :mod:`moreau.analysis.atlas`); None
+    where the scene has none.
 
 Examples
 --------
@@ -93,6 +98,7 @@ class SceneEntry:
     aliases: tuple = ()
     sweep: Optional[str] = None
     default: bool = False
+    atlas: Optional[str] = None
 
     def parameter_names(self):
         return tuple(p.name for p in self.parameters)

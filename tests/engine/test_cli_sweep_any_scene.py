@@ -41,7 +41,7 @@ def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_
     (["sweep", "drive", "0", "1", "--scene", "stick-slip-motor", "--frequency", "1000"],
      "`PARAM` must be a numeric parameter"),
     (["sweep", "load", "0", "1", "--scene", "sliding-box"],
-     "`--scene` must be a periodically driven scene for a sweep"),
+     "`--scene` must be a periodically driven scene, one of"),
     (["sweep", "load", "0", "1", "--scene", "stick-slip-motor"], "`--frequency` is required"),
     (["sweep", "load", "--scene", "stick-slip-motor", "--frequency", "1000"],
      "`START` and `STOP` are required"),

@@ -242,10 +242,17 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
 
 def command(args):
     """``moreau atlas``: the friction drive's atlas from the parsed command-line arguments."""
+    for opt in ("x10_a", "x10_b", "phase"):
+        if getattr(args, opt, None) is not None:
+            raise InputError(f"`--{opt.replace('_', '-')}` is not a parameter of the friction drive")
+    if getattr(args, "set", None):
+        raise InputError("`--set` applies with `--x` and `--y`; the friction drive's own atlas "
+                         "takes its fixed parameters as `--mu`, `--x10`, ...")
     params = params_from_args(args)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
                          getattr(args, "scheme_options", None))
-    planes = ("f-mu", "f-phi0") if args.plane == "both" else (args.plane,)
+    plane = args.plane or "both"
+    planes = ("f-mu", "f-phi0") if plane == "both" else (plane,)
     if args.quick:
         if args.f_points is not None or args.y_points is not None:
             raise InputError("`--quick` sets the grid; leave out `--f-points`/`--y-points`")
@@ -253,6 +260,8 @@ def command(args):
     else:
         f_points = 200 if args.f_points is None else args.f_points
         y_points = 100 if args.y_points is None else args.y_points
-    run_atlas(planes, params, out=args.out, f_range=(args.fmin, args.fmax), f_points=f_points,
+    f_range = (10.0 if args.fmin is None else args.fmin,
+               12500.0 if args.fmax is None else args.fmax)
+    run_atlas(planes, params, out=args.out, f_range=f_range, f_points=f_points,
               y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)

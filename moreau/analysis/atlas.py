@@ -1,0 +1,188 @@
+"""Operation-mode atlas of any periodically driven scene over two of its parameters.
+
+The generic ``moreau atlas --scene NAME --x PARAM START STOP --y PARAM START
+STOP``: the steady state at every point of a grid of a parameter plane, each
+one a call of the sweep engine (:func:`moreau.analysis.engine.run_points`:
+cached, in parallel, a failed point kept as its ``status``), for any
+registered scene with a periodic drive and any scheme. A scene whose study
+has an atlas of its own (the paper's friction drive, with its lift-off and
+Painlevé curves) names it in its registry entry (``SceneEntry.atlas``);
+``moreau atlas`` runs that one unless ``--x`` and ``--y`` are given.
+
+Outputs: ``OUT/atlas_SCENE_X-Y[_FREQ]_SCHEME.csv`` (one tidy row per point,
+units in the column names), a JSON sidecar (scene, axes, fixed parameters,
+scheme, engine statistics, provenance) and a figure: the operation mode of
+every point as a coloured map beside the displacement per period.
+
+Examples
+--------
+>>> rows = run_scene_atlas("stick-slip-motor", ("load", [0.0, 0.1]), ("mu", [0.2, 0.3]),
+...                        frequency=1000.0, out=None, progress=False, plot=False,
+...                        log=lambda s: None)
+>>> len(rows), sorted({r["status"] for r in rows})
+(4, ['ok'])
+"""
+
+import csv
+import json
+import math
+
+import numpy as np
+
+from ..errors import InputError
+from ..provenance import provenance
+from . import engine
+from .engine import ED_REFERENCE, check_output_dir
+from .sweep import VALUE_COLUMNS, MAX_POINTS, plan_points, sweep_tag
+
+__all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure"]
+
+
+def atlas_tag(scene, x, y, frequency, scheme):
+    """File stem of an atlas: scene, the two parameters, the fixed frequency, the scheme.
+
+    Examples
+    --------
+    >>> atlas_tag("stick-slip-motor", "load", "mu", 1000.0, ED_REFERENCE)
+    'atlas_stick-slip-motor_load-mu_1000Hz_event-driven'
+    """
+    parameter = "frequency" if "frequency" in (x, y) else f"{x}-{y}"
+    tag = sweep_tag(scene, parameter, frequency, scheme)
+    if parameter == "frequency":
+        tag = tag.replace("_frequency_", f"_{x}-{y}_", 1)
+    return "atlas_" + tag[len("sweep_"):]
+
+
+def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE, out="out",
+                    cache_dir=None, n_jobs=-1, scheduler=None, progress=True, plot=True,
+                    log=print):
+    """Steady states of the registered scene ``scene`` on the grid ``x`` by ``y``.
+
+    Parameters
+    ----------
+    scene : str
+        A registered scene with a periodic drive.
+    x, y : (str, array_like)
+        Each axis: a numeric parameter of the scene (or ``"frequency"``) and
+        its values in the parameter's SI unit. The two differ.
+    fixed : dict, optional
+        Other parameters of the scene (SI units); the rest keep their defaults.
+    frequency : float, optional
+        Drive frequency [Hz]; required unless an axis is ``"frequency"``.
+    scheme : moreau.analysis.scheme_settings.Scheme
+    out : path-like or None
+        Output folder, checked writable before any work; None writes nothing.
+    cache_dir : path-like, optional
+        The engine's cache (default ``OUT/cache``; none without ``out``).
+
+    Returns
+    -------
+    list of dict
+        One tidy row per point, ``x`` varying fastest.
+    """
+    (xname, xv), (yname, yv) = x, y
+    if xname == yname:
+        raise InputError(f"`--x` and `--y` must be two different parameters, got {xname!r} twice")
+    xv = np.asarray(xv, dtype=float).reshape(-1)
+    yv = np.asarray(yv, dtype=float).reshape(-1)
+    if xv.size * yv.size > MAX_POINTS:
+        raise InputError(f"the grid has {xv.size * yv.size} points, more than the limit "
+                         f"{MAX_POINTS:.0e} of one atlas")
+    entry, columns, point, frequency = plan_points(scene, (xname, yname), (xv, yv), fixed,
+                                                   frequency)
+    if out is not None:
+        out = check_output_dir(out)
+        cache_dir = out / "cache" if cache_dir is None else cache_dir
+    grid = [(a, b) for b in yv for a in xv]
+    points = [point({xname: a, yname: b}) for a, b in grid]
+    rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
+                                    scheduler=scheduler, progress=progress,
+                                    desc=f"atlas {xname}-{yname}", scene=entry.name)
+    table = []
+    for (a, b), (p, f), row in zip(grid, points, rows):
+        r = {columns[xname]: float(a), columns[yname]: float(b), "scene": entry.name,
+             "scheme": scheme.name}
+        if "frequency" not in (xname, yname):
+            r[columns["frequency"]] = f
+        for name, val in p.items():
+            if name not in (xname, yname):
+                r[columns[name]] = val
+        for c in VALUE_COLUMNS:
+            r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
+        table.append(r)
+    if out is None:
+        return table
+    stem = out / atlas_tag(entry.name, xname, yname, frequency, scheme)
+    csv_path = stem.with_name(stem.name + ".csv")
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(table[0]))
+        w.writeheader()
+        w.writerows(table)
+    meta = {"scene": entry.name,
+            "x": {"parameter": columns[xname], "points": int(xv.size),
+                  "range": [float(xv.min()), float(xv.max())]},
+            "y": {"parameter": columns[yname], "points": int(yv.size),
+                  "range": [float(yv.min()), float(yv.max())]},
+            "frequency_Hz": frequency,
+            "fixed_parameters": {k: v for k, v in points[0][0].items()
+                                 if k not in (xname, yname)},
+            "scheme": {"name": scheme.name, "theta": scheme.theta,
+                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
+                       "options": scheme.options},
+            "modes": _mode_counts(table),
+            "engine": stats, "provenance": provenance(engine.code_version())}
+    json_path = stem.with_name(stem.name + ".json")
+    json_path.write_text(json.dumps(meta, indent=1, default=str))
+    log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
+        f"{stats['cached']} from the cache) and {json_path.name}")
+    if plot:
+        fig_path = stem.with_name(stem.name + ".png")
+        mode_map_figure(table, columns[xname], columns[yname], xv, yv,
+                        f"{entry.name}: steady state ({scheme.description})", fig_path)
+        log(f"wrote {fig_path}")
+    return table
+
+
+def _label(row):
+    return row["mode"] if row["status"] == "ok" else "failed"
+
+
+def _mode_counts(table):
+    counts = {}
+    for r in table:
+        counts[_label(r)] = counts.get(_label(r), 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
+def mode_map_figure(table, xcol, ycol, xv, yv, title, path):
+    """Two panels: the operation mode of every point, and the displacement per period."""
+    import matplotlib  # noqa: PLC0415  (figures only)
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+    from matplotlib.colors import ListedColormap  # noqa: PLC0415
+
+    labels = [_label(r) for r in table]
+    names = list(_mode_counts(table))
+    index = np.array([names.index(m) for m in labels], float).reshape(len(yv), len(xv))
+    disp = np.array([r["displacement_per_period_m"] for r in table], float).reshape(
+        len(yv), len(xv)) * 1e6
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.5))
+    colors = [plt.get_cmap("tab10")(i % 10) for i in range(len(names))]
+    if "failed" in names:
+        colors[names.index("failed")] = (0.85, 0.85, 0.85, 1.0)
+    a1.pcolormesh(xv, yv, index, cmap=ListedColormap(colors), vmin=-0.5,
+                  vmax=len(names) - 0.5, shading="nearest")
+    handles = [plt.Rectangle((0, 0), 1, 1, color=c) for c in colors]
+    a1.legend(handles, names, title="mode", fontsize=7, loc="best")
+    lim = np.nanmax(np.abs(disp)) if np.isfinite(disp).any() else 1.0
+    im = a2.pcolormesh(xv, yv, disp, cmap="RdBu_r", vmin=-lim, vmax=lim, shading="nearest")
+    fig.colorbar(im, ax=a2, label="displacement per period [\u00b5m]")
+    for ax in (a1, a2):
+        ax.set_xlabel(xcol)
+        ax.set_ylabel(ycol)
+        if xv.size > 2 and xv.min() > 0 and np.allclose(np.diff(np.log(xv)), np.log(xv[1] / xv[0])):
+            ax.set_xscale("log")
+    fig.suptitle(title, fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

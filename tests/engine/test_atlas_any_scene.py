@@ -1,0 +1,64 @@
+"""`moreau atlas --scene NAME --x ... --y ...`: the mode map of any periodic scene."""
+
+import csv
+
+import pytest
+
+from moreau.analysis.atlas import run_scene_atlas
+from moreau.analysis.steady_state import find_steady_state
+from moreau.cli import main
+from moreau.scenes.registry import make_scene
+
+
+def test_every_point_is_the_scenes_steady_state():
+    rows = run_scene_atlas("stick-slip-motor", ("load", [0.0, 0.05]), ("mu", [0.2, 0.3]),
+                           frequency=1000.0, out=None, progress=False, plot=False,
+                           n_jobs=1, log=lambda s: None)
+    # x varies fastest
+    assert [(r["load [N]"], r["mu"]) for r in rows] == [(0.0, 0.2), (0.05, 0.2), (0.0, 0.3),
+                                                       (0.05, 0.3)]
+    for r in rows:
+        motor = make_scene("stick-slip-motor", frequency=1000.0, load=r["load [N]"], mu=r["mu"])
+        ss = find_steady_state(motor)
+        assert r["status"] == "ok" and r["mode"] == ss.mode
+        assert r["displacement_per_period_m"] == pytest.approx(
+            motor.displacement_to_si(ss.displacement_per_period), rel=1e-9)
+
+
+def test_the_command_writes_table_sidecar_and_figure(tmp_path, capsys):
+    rc = main(["atlas", "--scene", "stick-slip-motor", "--x", "frequency", "500", "2000",
+               "--y", "mu", "0.2", "0.3", "--x-points", "3", "--y-points", "2", "--jobs", "1",
+               "--out", str(tmp_path), "--quiet"])
+    assert rc == 0, capsys.readouterr().err
+    stem = tmp_path / "atlas_stick-slip-motor_frequency-mu_event-driven"
+    with open(f"{stem}.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 6 and {r["scheme"] for r in rows} == {"event-driven"}
+    # log-spaced frequency by default
+    assert [float(r["frequency [Hz]"]) for r in rows[:3]] == pytest.approx([500, 1000, 2000])
+    assert (tmp_path / f"{stem.name}.json").exists() and (tmp_path / f"{stem.name}.png").exists()
+
+
+@pytest.mark.parametrize("argv, message", [
+    (["--scene", "stick-slip-motor", "--frequency", "1000"],
+     "scene 'stick-slip-motor' has no atlas of its own"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1"], "give both axes"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1", "--y", "load", "0", "1",
+      "--frequency", "1000"], "two different parameters"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1", "--y", "mu", "0.1", "0.2",
+      "--frequency", "1000", "--fmin", "10"], "`--fmin` belongs to a scene's own atlas"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1", "--y", "drive", "0.1", "0.2",
+      "--frequency", "1000"], "`PARAM` must be a numeric parameter of scene"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1", "--y", "stiffness", "0.1", "0.2",
+      "--frequency", "1000"], "`PARAM` must be a numeric parameter of scene"),
+    (["--scene", "stick-slip-motor", "--x", "load", "0", "1", "--y", "mu", "0.1", "0.2"],
+     "`--frequency` is required"),
+    (["--set", "mu=0.2"], "`--set` applies with `--x` and `--y`"),
+    (["--x-points", "4"], "`--x-points` applies with `--x` and `--y`"),
+    (["--scene", "sliding-block", "--x", "mu", "0.1", "0.2", "--y", "speed", "1", "2"],
+     "must be a periodically driven scene"),
+])
+def test_bad_atlas_settings_are_refused_before_work(argv, message, tmp_path, capsys):
+    assert main(["atlas", *argv, "--out", str(tmp_path / "o")]) == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "o").exists()
