@@ -41,6 +41,10 @@ __all__ = ["shoot_periodic"]
 TWO_PI = 2.0 * math.pi
 
 
+#: periods of plain iteration tried after Newton stalls on a time-stepping scheme's period map
+FIXED_POINT_PERIODS = 100
+
+
 def _project(scene, t, q, v, touching):
     if not len(touching):
         return q, v
@@ -91,7 +95,11 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         Tolerance on the period-map residual in the free directions,
         relative to the velocity scale of the state.
     max_iter : int
-        Newton iterations.
+        Newton iterations. Where they do not reach ``rtol`` with a
+        time-stepping scheme (one with a step ``h``, whose period map is only
+        piecewise smooth), the period map is iterated plainly from Newton's
+        last state, up to :data:`FIXED_POINT_PERIODS` periods
+        (``stats["fixed_point_periods"]``).
     transient_periods : int
         Periods simulated from the guess before shooting.
     scheme_options : dict, optional
@@ -221,11 +229,21 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
                       float(np.max(np.abs(wT), initial=0.0)))
     vscale = max(vmax[0], float(np.max(np.abs(r))), 1e-300)
     it = 0
+    fixed_point_periods = 0
     while np.max(np.abs(r)) > rtol * vscale:
         it += 1
         if it > max_iter:
-            raise ConvergenceError(f"shooting did not converge in `max_iter`={max_iter} Newton "
-                                   f"steps (residual {np.max(np.abs(r)) / vscale:.3g} relative)")
+            newton = (f"shooting did not converge in `max_iter`={max_iter} Newton steps "
+                      f"(residual {np.max(np.abs(r)) / vscale:.3g} relative)")
+            if "h" not in takes:
+                raise ConvergenceError(newton)
+            # a time-stepping scheme's period map is only piecewise smooth (its
+            # index set changes on the grid), which can stall Newton on a map that
+            # plain iteration contracts: iterate it from Newton's best state
+            qs, vs = state(z, base)
+            qs, vs, r, fixed_point_periods = _iterate_period_map(
+                period, qs, vs, cyclic, Bq, Bv, rtol * vscale, FIXED_POINT_PERIODS, newton)
+            break
         qs, vs = state(z, base)
         J = np.empty((r.size, z.size))
         for k in range(z.size):
@@ -244,7 +262,8 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
             lam *= 0.5
         z = z + lam * step
         r, disp = rn, dn
-    qs, vs = state(z, base)
+    if not fixed_point_periods:
+        qs, vs = state(z, base)
     res = period(qs, vs, record=True)
     disp = float(res.q[-1, cyclic] - qs[cyclic])
     nc = scene.ncontacts
@@ -270,9 +289,24 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         periodic_residual=float(np.max(np.abs(r)) / vscale),
         iterations=it,
         wall_time=time.perf_counter() - start,
-        stats={"period_maps": calls[0], "unknowns": int(z.size)},
+        stats={"period_maps": calls[0], "unknowns": int(z.size),
+               "fixed_point_periods": fixed_point_periods},
         section_tau=ts,
     )
+
+
+def _iterate_period_map(period, q, v, cyclic, Bq, Bv, tol, max_periods, why):
+    """Iterate the period map from ``(q, v)`` until it repeats within ``tol`` (free directions)."""
+    for k in range(1, max_periods + 1):
+        res = period(q, v)
+        qe, ve = res.q[-1].copy(), res.v[-1].copy()
+        qe[cyclic] = q[cyclic]
+        r = np.concatenate([Bq.T @ (qe - q), Bv.T @ (ve - v)])
+        q, v = qe, ve
+        if np.max(np.abs(r)) <= tol:
+            return q, v, r, k
+    raise ConvergenceError(f"{why}, and {max_periods} periods of plain iteration left a "
+                           f"residual of {np.max(np.abs(r)):.3g} (the tolerance is {tol:.3g})")
 
 
 @register_steady_solver("event-driven")

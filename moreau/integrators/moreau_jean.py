@@ -137,18 +137,17 @@ import math
 import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
-from ..errors import InputError, LCPError, PainleveError
-from ..lcp import lcp_residual, solve_lcp
-from ..lcp.friction import build_friction_lcp, friction_impulses
+from ..errors import InputError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
-from . import _mj_kernels as _kernels
 from ._loops import runner_for
+from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, new_lcp_control,
                           new_stats)
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["MoreauJean", "one_contact_impulse", "classify_impulse", "LCP_METHODS"]
+__all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
+           "LCP_METHODS"]
 
 #: accepted values of the ``lcp_method`` option
 LCP_METHODS = ("auto", "lemke", "qp")
@@ -198,110 +197,6 @@ def classify_impulse(pN, pT, mu):
         if pT >= bound:
             return Regime.NEGATIVE
     return Regime.STICK
-
-
-def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
-    """Exact solution of the one-contact velocity-level Coulomb problem.
-
-    Solves the same problem as the friction LCP of
-    :func:`moreau.lcp.friction.build_friction_lcp` for a single contact by
-    enumerating its cases: no impulse, stick, positive slip, negative slip.
-
-    Parameters
-    ----------
-    W : array_like, shape (2, 2) or (1, 1)
-        Delassus matrix over the rows ``(N, T)``; ``(1, 1)`` when ``mu = 0``.
-    u_free : array_like, shape (2,) or (1,)
-        Free normal and tangential velocity at the end of the step.
-    mu : float
-        Friction coefficient, ``>= 0``.
-    e : float
-        Newton restitution coefficient.
-    vN_pre : float
-        Normal velocity before the step; the impact law uses ``min(vN_pre, 0)``.
-
-    Returns
-    -------
-    pN, pT : float
-        Normal and tangential impulse (``pT = 0`` when ``mu = 0``).
-
-    Raises
-    ------
-    PainleveError
-        The contact must act (``u_N < -e min(vN_pre, 0)``), the discrete
-        Painlevé condition ``W_NN - mu |W_NT| > 0`` fails, and either the
-        free slip ``u_T`` runs along the branch whose normal velocity does not
-        grow with ``pN`` (the paradox: only an impulsive jam could solve it) or
-        the problem has no solution or several. Where the condition fails but
-        the contact slides the harmless way and the solution is unique, it is
-        returned.
-
-    Notes
-    -----
-    For fixed ``pN`` the tangential problem has one solution ``pT(pN)``
-    (``W_TT > 0``); the normal velocity ``b + W_NN pN + W_NT pT(pN)`` then
-    grows with ``pN`` in stick (slope ``W_NN - W_NT W_TN / W_TT > 0``) and in
-    slip (slope ``W_NN -/+ mu W_NT``, positive under the Painlevé condition),
-    so exactly one case applies and the result is unique. Cases are tested in
-    the order stick, positive slip, negative slip; where two hold (on a case
-    boundary) they give the same impulse. When the condition fails, all three
-    cases are tried. With ``u_N >= -e min(vN_pre, 0)`` the answer is "no
-    impulse" even if a paradoxical slip branch offers a second solution.
-
-    Examples
-    --------
-    Unit mass sliding at speed 1 onto the ground at approach speed 1, ``mu = 0.5``:
-
-    >>> one_contact_impulse([[1.0, 0.0], [0.0, 1.0]], [-1.0, 1.0], 0.5)
-    (1.0, -0.5)
-    """
-    W = np.asarray(W, dtype=float)
-    u = np.asarray(u_free, dtype=float).reshape(-1)
-    mu, e, vN_pre = float(mu), float(e), float(vN_pre)
-    if mu > 0.0:
-        pN, pT = _one_contact(*(float(x) for x in (W[0, 0], W[0, 1], W[1, 0], W[1, 1], u[0], u[1])),
-                              mu, e, vN_pre)
-        return pN, pT
-    return _one_contact_frictionless(float(W[0, 0]), float(u[0]), e, vN_pre), 0.0
-
-
-def _one_contact_frictionless(Wnn, uN, e, vN_pre):
-    b = uN + e * min(vN_pre, 0.0)
-    if b >= 0.0:
-        return 0.0
-    if not Wnn > 0.0:
-        raise PainleveError(f"the contact's Delassus entry W_NN = {Wnn!r} must be > 0")
-    return -b / Wnn
-
-
-def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
-    # the compiled case analysis itself, so that the fast and the generic path
-    # agree to rounding; here only the failure gets its explanation
-    pN, pT, ok = _kernels._one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre)
-    if ok:
-        return pN, pT
-    if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
-        # one slip branch has a non-increasing normal velocity and the step would
-        # slide along it: the only way out is an impulsive jam whose size does not
-        # vanish with h, so the continuous problem is paradoxical
-        raise PainleveError(
-            f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
-            f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) with the contact sliding "
-            f"the paradoxical way: no sliding solution exists")
-    raise PainleveError(
-        f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
-        f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) and the contact problem has "
-        f"no unique solution")
-
-
-def one_contact_residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
-    """Scaled residual of ``(pN, pT)`` in the one-contact friction LCP.
-
-    The same number :func:`moreau.lcp.lcp_residual` gives for the LCP of
-    :func:`~moreau.lcp.friction.build_friction_lcp` at the point
-    ``z = (pN, max(pT, 0), max(-pT, 0), |u_T|)``, computed without building it.
-    """
-    return _kernels._residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT)
 
 
 def _new_counters():
@@ -672,25 +567,11 @@ class MoreauJean(Integrator):
         U_free = H @ v_free + w
         mu, e = self.mu_c[ia], self.e_c[ia]
         na = len(ia)
-        c = self.counters
-        c["lcp_solves"] += 1
         if na == 1 and self.lcp_method == "auto":
-            c["direct_solves"] += 1
-            if mu[0] > 0.0:
-                pn, pt = _one_contact(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0], U_free[1],
-                                      mu[0], e[0], vN0[0])
-                res = one_contact_residual(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U_free[0],
-                                           U_free[1], mu[0], e[0], vN0[0], pn, pt)
-                p = np.array([pn, pt])
-            else:
-                pn, pt = _one_contact_frictionless(W[0, 0], U_free[0], e[0], vN0[0]), 0.0
-                res = one_contact_residual(W[0, 0], 0.0, 0.0, 0.0, U_free[0], 0.0, 0.0,
-                                           e[0], vN0[0], pn, 0.0)
-                p = np.array([pn])
-            pN[ia[0]], pT[ia[0]] = pn, pt
+            p, pN[ia], pT[ia] = solve_contact_problem(W, U_free, mu, e, vN0[ia],
+                                                      counters=self.counters, t=self.t)
         else:
-            p, res = self._solve_lcp(W, U_free, mu, e, vN0[ia], ia, pN, pT)
-        c["max_residual"] = max(c["max_residual"], float(res))
+            p = self._solve_lcp(W, U_free, mu, e, vN0[ia], ia, pN, pT)
         v1 = v_free + Winv_HT @ p
         U = U_free + W @ p
         slip = np.zeros(sc.ncontacts)
@@ -698,19 +579,11 @@ class MoreauJean(Integrator):
         return v1, slip
 
     def _solve_lcp(self, W, U_free, mu, e, vN_pre, ia, pN, pT):
-        Ml, ql, layout = build_friction_lcp(W, U_free, mu, e, vN_pre)
-        r = solve_lcp(Ml, ql, method=self.lcp_method, friction=layout,
-                      max_iter=self.lemke_max_iter)
-        c = self.counters
-        if r.method == "lemke":
-            c["pivots"] += int(r.pivots)
-        if r.fallback_used:
-            c["fallbacks"] += 1
-        if not r.success:
-            raise LCPError(f"contact problem at t = {self.t!r} not solved: {r.message}")
-        pn, pt = friction_impulses(r.z, layout)
-        pN[ia], pT[ia] = pn, pt
-        return friction_impulses(r.z, layout, stacked=True), lcp_residual(Ml, ql, r.z)
+        # the assembled LCP of several contacts (or of one, with a forced solver)
+        p, pN[ia], pT[ia] = solve_contact_problem(
+            W, U_free, mu, e, vN_pre, lcp_method=self.lcp_method, counters=self.counters,
+            lemke_max_iter=self.lemke_max_iter, t=self.t)
+        return p
 
     def _project(self, q, t, closed):
         """Mass-weighted projection onto ``g = 0`` (closed contacts) and ``g >= 0`` (the rest)."""
