@@ -272,9 +272,10 @@ class DriveCase(CompareCase):
         return float(res.q[-1, self.cyclic] - res.q[0, self.cyclic])
 
     def mj(self, n, theta, lcp):
-        if lcp is not None:
-            return super().mj(n, theta, lcp)
-        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection)
+        # every row's headline is its scheme's own steady state, and its time the time
+        # to compute it, whichever contact solver the steps use
+        ss = moreau_jean_steady_state(self.scene, n, theta=theta, projection=self.projection,
+                                      lcp_method=lcp or "auto")
         return ss.displacement_per_period, ss
 
     def scheme(self, name, options):
@@ -323,10 +324,10 @@ class DriveCase(CompareCase):
         # the trajectory and the switching times: one period of the same scheme
         # from the reference's periodic state (the Moreau–Jean steady state names
         # the regimes of the first contact only)
-        res = out[1] if lcp is not None else self.run_mj(n, theta, None)
+        res = self.run_mj(n, theta, lcp)
         h = self.window / n
         sw = [self._run_switches_of(res, h, c) for c in range(self.scene.ncontacts)]
-        mode = out[1].mode if lcp is None else None
+        mode = out[1].mode
         return self._trajectory_error(res), flatten(sw), mode
 
 

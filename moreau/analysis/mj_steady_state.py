@@ -48,7 +48,7 @@ import numpy as np
 from .._validate import finite_array, in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
 from .modes import impacts_after_flight, mode_name, step_letters
-from ..integrators.moreau_jean import MoreauJean
+from ..integrators.moreau_jean import LCP_METHODS, MoreauJean
 from ..integrators.result import SteadyState
 from .steady_solvers import register_steady_solver
 
@@ -161,6 +161,7 @@ class PeriodMap:
     theta : float
     projection : bool
     fast : bool or "auto"
+    lcp_method : {"auto", "lemke", "qp"}
         Passed to :class:`~moreau.integrators.moreau_jean.MoreauJean`.
 
     Raises
@@ -177,7 +178,8 @@ class PeriodMap:
     ((3,), [True])
     """
 
-    def __init__(self, scene, steps_per_period, theta=1.0, projection=True, fast="auto"):
+    def __init__(self, scene, steps_per_period, theta=1.0, projection=True, fast="auto",
+                 lcp_method="auto"):
         period = getattr(scene, "period", None)
         if period is None:
             raise InputError(f"`scene` ({type(scene).__name__}) has no periodic drive "
@@ -200,6 +202,9 @@ class PeriodMap:
         if fast not in ("auto", True, False):
             raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
         self.fast = fast
+        if lcp_method not in LCP_METHODS:
+            raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
+        self.lcp_method = lcp_method
         self.cyclic = cyc
         nq = scene.ndof
         self.kept = np.array([i for i in range(nq) if i not in cyc], dtype=int)
@@ -244,6 +249,7 @@ class PeriodMap:
         c0 = np.broadcast_to(np.asarray(closed, dtype=bool), (nc,)).copy()
         integ = MoreauJean(self.scene, 0.0, q, v, self.period, h=self.h, theta=self.theta,
                            projection=self.projection, fast=self.fast, closed0=c0,
+                           lcp_method=self.lcp_method,
                            save_every=1 if record else self.n)
         while integ.status == "running":
             integ.step()
@@ -280,7 +286,8 @@ MAX_STEPS_PER_PERIOD = 10**7
 
 
 def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_iter=50,
-                             projection=True, x_guess=None, fast="auto", transient_periods=300):
+                             projection=True, x_guess=None, fast="auto", transient_periods=300,
+                             lcp_method="auto"):
     """Periodic steady state of the Moreau–Jean map of a periodic scene, by shooting.
 
     Parameters
@@ -306,6 +313,9 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         Initial ``x`` at ``t = 0``; by default the scene's ``initial_state()``.
     fast : {"auto", True, False}
         Use the compiled loop (every scene with a compiled model).
+    lcp_method : {"auto", "lemke", "qp"}
+        The contact solver of every step (Moreau–Jean's option); ``"qp"``
+        takes the generic Python step.
     transient_periods : int
         When shooting stalls (e.g. the rod in flight at the section, where the
         discrete map has no usable derivative), up to this many periods are
@@ -355,7 +365,7 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     tol = positive("tol", tol)
     max_iter = positive_int("max_iter", max_iter)
     transient_periods = positive_int("transient_periods", transient_periods)
-    pm = PeriodMap(scene, steps_per_period, theta, projection, fast)
+    pm = PeriodMap(scene, steps_per_period, theta, projection, fast, lcp_method)
     vs = float(getattr(scene, "velocity_scale", 1.0))
     nk = len(pm.kept)
     scale = np.concatenate([np.ones(nk), np.full(scene.ndof, vs)])
