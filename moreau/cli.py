@@ -481,7 +481,8 @@ def build_parser():
     c.add_argument("--stress", action="store_true",
                    help="run the stiff and extreme case catalogue instead (stability map)")
     c.add_argument("--schemes", default=None, metavar="NAME,...",
-                   help="other registered schemes to compare too, e.g. compliant-radau,compliant-rk45")
+                   help="other registered schemes to compare too, e.g. compliant-radau,schatzman-paoli, "
+                        "or all")
     c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")
     c.add_argument("--out", default="out", help="output folder (default ./out)")
     c.add_argument("--json", action="store_true", help="print one JSON object")

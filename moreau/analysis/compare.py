@@ -113,7 +113,7 @@ from ..scenes.base import Scene
 from ..scenes.registry import get_entry
 from .cases import GRID, SceneCase, switching_error
 
-__all__ = ["compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
+__all__ = ["pareto", "PARETO_TARGETS", "compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
            "check_out_dir", "make_case", "case_parameters", "fit_order", "plateaus",
            "switching_error", "run_row", "run_other_row", "other_schemes"]
 
@@ -345,6 +345,7 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
         "reference": {"scheme": case.ref_scheme, "rtol": tight, "headline_value": ref_value},
         "rows": [],
         "orders": [],
+        "pareto": [],
         "notes": [],
         "interrupted": False,
         # what a run time means here, and on what machine it was taken
@@ -370,6 +371,7 @@ def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quic
     report["interrupted"] = collect_rows(jobs, run, report["rows"], on_row, progress,
                                          desc=f"compare {scene}", unit="run")
     report["orders"] = _orders(report["rows"])
+    report["pareto"] = pareto(report["rows"])
     report["notes"] = plateaus(report["rows"])
     return report
 
@@ -455,10 +457,13 @@ def other_schemes(case, quick=False, names=None):
     """``(name, setting, values, fixed_options)`` of the registered schemes that compare runs.
 
     Every registered scheme with ``compare_settings`` (the reference and
-    Moreau–Jean have rows of their own), or those of ``names``.
+    Moreau–Jean have rows of their own), or those of ``names`` (``["all"]``:
+    every one).
     """
     registered = {n: cls for n, cls in INTEGRATORS.items()
                   if getattr(cls, "compare_settings", None) is not None}
+    if names is not None and list(names) == ["all"]:
+        names = None
     if names is not None:
         for n in names:
             if n not in registered:
@@ -492,15 +497,64 @@ def run_other_row(case, name, key, value, fixed, repeat, ref_value, ref_switches
 def _orders(rows):
     series = {}
     for r in rows:
-        if r["scheme"] == "moreau-jean" and r["status"] == 0:
-            series.setdefault((r["theta"], r["lcp"]), []).append(r)
+        if r["status"] != 0:
+            continue
+        if r["scheme"] == "moreau-jean":
+            series.setdefault(("moreau-jean", r["theta"], r["lcp"]), []).append(
+                (r["steps_per_period"], r))
+        elif (r.get("setting") or "").startswith("steps_per_period="):
+            n = int(float(r["setting"].split("=", 1)[1]))
+            series.setdefault((r["scheme"], None, None), []).append((n, r))
     out = []
-    for (theta, lcp), rs in series.items():
-        n = [r["steps_per_period"] for r in rs]
-        out.append({"scheme": "moreau-jean", "theta": theta, "lcp": lcp,
+    for (name, theta, lcp), pairs in series.items():
+        n = [p[0] for p in pairs]
+        rs = [p[1] for p in pairs]
+        out.append({"scheme": name, "theta": theta, "lcp": lcp,
                     "order": fit_order(n, [r["trajectory_error"] for r in rs]),
                     "order_headline": fit_order(n, [r["error"] for r in rs])})
     return out
+
+
+#: the errors at which :func:`pareto` names the fastest row
+PARETO_TARGETS = (1e-2, 1e-4, 1e-6)
+
+
+def pareto(rows, targets=PARETO_TARGETS):
+    """For each target error, the fastest row whose headline error reaches it.
+
+    Returns a list of ``{"target", "scheme", "label", "time_s", "error"}``;
+    ``scheme`` is None where no row reaches the target. The reference's own
+    rows count: they show what the target costs with the reference scheme.
+
+    Examples
+    --------
+    >>> rows = [dict(scheme="a", theta=None, lcp=None, setting="", status=0, time_s=1.0,
+    ...              error=1e-3),
+    ...         dict(scheme="b", theta=None, lcp=None, setting="", status=0, time_s=0.1,
+    ...              error=5e-3)]
+    >>> [(p["target"], p["scheme"]) for p in pareto(rows)]
+    [(0.01, 'b'), (0.0001, None), (1e-06, None)]
+    """
+    out = []
+    ok = [r for r in rows if r["status"] == 0 and r.get("error") is not None
+          and r.get("time_s") is not None]
+    for target in targets:
+        hits = [r for r in ok if r["error"] <= target]
+        best = min(hits, key=lambda r: r["time_s"]) if hits else None
+        out.append({"target": target, "scheme": best and best["scheme"],
+                    "label": best and _label(best) + _setting_suffix(best),
+                    "time_s": best and best["time_s"], "error": best and best["error"]})
+    return out
+
+
+def _setting_suffix(r):
+    if r.get("steps_per_period"):
+        return f", {r['steps_per_period']} steps"
+    if r.get("rtol"):
+        return f", rtol {r['rtol']:g}"
+    if r.get("setting"):
+        return f", {r['setting']}"
+    return ""
 
 
 # -- output ---------------------------------------------------------------------------------
@@ -612,9 +666,14 @@ def format_table(report):
                      f"{r['mode'] or r.get('setting') or ''}")
     for o in report["orders"]:
         th = o["theta"]
-        lines.append(f"order  theta={th:g} lcp={o['lcp'] or '-'}: "
-                     f"{g(o['order'], '.2f')} (trajectory), {g(o['order_headline'], '.2f')} "
-                     f"(headline)")
+        lines.append(f"order  {o['scheme']}" + (f" theta={th:g} lcp={o['lcp'] or '-'}"
+                                                 if th is not None else "")
+                     + f": {g(o['order'], '.2f')} (trajectory), "
+                     f"{g(o['order_headline'], '.2f')} (headline)")
+    for p in report.get("pareto", []):
+        lines.append(f"fastest to error {p['target']:g}: "
+                     + (f"{p['label']} ({p['time_s'] * 1e3:.3g} ms, error {p['error']:.2e})"
+                        if p["scheme"] else "no row"))
     for note in report.get("notes", []):
         lines.append("note: " + note["text"])
     return "\n".join(lines)
