@@ -1,7 +1,7 @@
-"""One compiled Moreau–Jean loop per model, built when the model is first used.
+"""One compiled loop per (model, scheme), built when the pair is first used.
 
-:func:`runner_for` compiles the loop template
-:func:`moreau.integrators._mj_kernels.mj_loop` for one
+:func:`runner_for` compiles a scheme's loop template (Moreau–Jean's
+:func:`moreau.integrators._mj_kernels.mj_loop` by default) for one
 :class:`moreau.compiled.CompiledModel`: in a namespace that holds the
 model's functions, sizes and flags as globals, which numba freezes as
 constants. A process compiles only the models it runs, and each model once.
@@ -89,42 +89,48 @@ def _constants(model):
             "HAS_JAC": model.has_jacobians, "HAS_GAPS": model.gaps is not None}
 
 
-def _build(model):
+def _build(model, template):
     consts = _constants(model)
     fns = model.functions()
     paths = {k: _import_path(f) for k, f in fns.items()}
     cacheable = all(p is not None for p in paths.values())
-    namespace = dict(vars(_mj_kernels))
+    module = sys.modules[template.__module__]
+    namespace = dict(vars(module))
     namespace.update(consts, mass_fn=model.mass, forces_fn=model.forces,
                      contacts_fn=model.contacts, gaps_fn=model.gaps or no_gaps)
     # numba names a function's disk-cache files after its qualified name: one
     # per model, from the import paths of its functions and its constants
     tag = repr(sorted(paths.items())) + repr(sorted(consts.items()))
-    name = "mj_loop_" + hashlib.sha256(tag.encode()).hexdigest()[:16]
-    template = _mj_kernels.mj_loop
+    name = template.__name__ + "_" + hashlib.sha256(tag.encode()).hexdigest()[:16]
     fn = types.FunctionType(template.__code__, namespace, name, template.__defaults__)
     fn.__qualname__ = name
     fn.__module__ = template.__module__
     fn.__doc__ = template.__doc__
     run = njit(cache=cacheable, error_model="numpy")(fn)
     if cacheable:
-        _jit_cache.bind_cache_to_sources(
-            [run], list(_mj_kernels.KERNEL_SOURCES) + dependency_files(list(fns.values())))
+        sources = list(_mj_kernels.KERNEL_SOURCES)
+        if module.__file__ not in sources:
+            sources.append(module.__file__)
+        _jit_cache.bind_cache_to_sources([run], sources + dependency_files(list(fns.values())))
     return run
 
 
-def runner_for(model):
+def runner_for(model, template=None):
     """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`), built once.
 
-    Returns a numba function with the arguments of
-    :func:`moreau.integrators._mj_kernels.mj_loop`.
+    ``template`` is the loop of a scheme, written against the model's
+    globals (default :func:`moreau.integrators._mj_kernels.mj_loop`, the
+    Moreau–Jean loop); a scheme module passes its own. Returns a numba
+    function with the template's arguments.
     """
-    key = (tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
+    template = template or _mj_kernels.mj_loop
+    key = (template.__module__, template.__name__,
+           tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
            tuple(sorted(_constants(model).items())))
     with _LOCK:
         run = _RUNNERS.get(key)
         if run is None:
-            run = _RUNNERS[key] = _build(model)
+            run = _RUNNERS[key] = _build(model, template)
     if not run.signatures:
         _compile_note(run)
     return run
@@ -136,5 +142,5 @@ def _compile_note(run):
     # so that a first run is not a silent wait
     if id(run) not in _NOTED and sys.stderr.isatty():
         _NOTED.add(id(run))
-        print("moreau: loading the compiled Moreau-Jean loop of this scene (its first use "
+        print("moreau: loading the compiled loop of this scene and scheme (its first use "
               "on a machine compiles it)...", file=sys.stderr, flush=True)

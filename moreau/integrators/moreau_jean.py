@@ -140,11 +140,11 @@ from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
+from ._blocks import CompiledRecording
 from ._loops import runner_for
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, new_lcp_control,
                           new_stats)
-from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
@@ -274,7 +274,7 @@ def next_time(t0, k, h, t_bound):
 
 
 @register_integrator("moreau-jean")
-class MoreauJean(Integrator):
+class MoreauJean(CompiledRecording, Integrator):
     """Moreau–Jean theta-scheme with velocity-level Newton impacts and exact 2D Coulomb friction.
 
     See the module docstring for the scheme, the index set, the regime
@@ -523,36 +523,6 @@ class MoreauJean(Integrator):
         elif status == NUMERICAL:
             self._fail(-5, f"non-finite state after the step at t = {self.t!r} (the step `h` is "
                            f"probably too large for an explicit part of the forces)")
-
-    def _record(self, t, q, v, regime, force_N, force_T, slip, gap):
-        if not self._fast:
-            return super()._record(t, q, v, regime, force_N, force_T, slip, gap)
-        # a step taken in Python inside a compiled run: a one-sample block
-        nc = self.scene.ncontacts
-        self._blocks.append((np.array([t], float), np.array(q, float).reshape(1, -1),
-                             np.array(v, float).reshape(1, -1),
-                             np.asarray(regime, np.int64).reshape(1, nc),
-                             *(np.asarray(a, float).reshape(1, nc)
-                               for a in (force_N, force_T, slip, gap))))
-
-    def result(self):
-        """Assemble the recorded samples into a :class:`SimulationResult`."""
-        if not self._fast:
-            return super().result()
-        n, nc = self.scene.ndof, self.scene.ncontacts
-        if self._blocks:
-            t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*self._blocks))
-        else:
-            t = np.zeros(0)
-            q = v = np.zeros((0, n))
-            reg = np.zeros((0, nc), dtype=np.int64)
-            fN = fT = slip = gap = np.zeros((0, nc))
-        code = self.status_code
-        return SimulationResult(
-            t=t, q=q, v=v, regime=reg.astype(int), force_N=fN, force_T=fT,
-            slip_velocity=slip, gap=gap, events=[], status=code,
-            message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
-            stats=dict(self.counters))
 
     def _contact_step(self, q, t1, v_free, Winv, active, vN0, pN, pT):
         sc = self.scene

@@ -72,16 +72,21 @@ import numpy as np
 
 from .._validate import positive, positive_int
 from ..errors import InputError
+from ._blocks import CompiledRecording
+from ._loops import runner_for
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
+                          new_lcp_control, new_stats)
+from ._sp_kernels import sp_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
-from .moreau_jean import (LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
-                          classify_impulse, next_time)
+from .moreau_jean import (FAST_BLOCK, LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
+                          classify_impulse, compiled_model_of, next_time)
 
 __all__ = ["SchatzmanPaoli"]
 
 
 @register_integrator("schatzman-paoli")
-class SchatzmanPaoli(Integrator):
+class SchatzmanPaoli(CompiledRecording, Integrator):
     """Schatzman–Paoli time stepping (see the module docstring).
 
     Parameters
@@ -97,6 +102,11 @@ class SchatzmanPaoli(Integrator):
         Pivot limit of Lemke's method.
     save_every : int
         Record one sample every ``save_every`` steps (and the last one).
+    fast : {"auto", True, False}
+        Run the compiled loop (:mod:`moreau.integrators._sp_kernels`, the same
+        step, equal to rounding) on a scene with a ``compiled_model()``;
+        ``"auto"`` does so unless ``lcp_method="qp"``. A step whose contact
+        problem Lemke cannot solve is taken by the generic step (QP fallback).
     max_steps : int
         Bound on the number of steps of the run.
 
@@ -130,7 +140,7 @@ class SchatzmanPaoli(Integrator):
                         (100, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, lcp_method="auto",
-                 lemke_max_iter=None, save_every=1, max_steps=MAX_STEPS):
+                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
         if h is None:
             raise InputError("`h` (the time step) is required for the schatzman-paoli scheme")
@@ -157,8 +167,64 @@ class SchatzmanPaoli(Integrator):
         self._pending_initial = True
         # the Verlet velocity that carries the two-step recursion (see the module docstring)
         self._v_verlet = self.v.copy()
+        if fast not in ("auto", True, False):
+            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
+        model = compiled_model_of(scene)
+        if fast is True and (model is None or lcp_method == "qp"):
+            raise InputError("`fast=True` needs a scene with a compiled model and an "
+                             "`lcp_method` other than 'qp'")
+        self._fast = model is not None and fast is not False and lcp_method != "qp"
+        if self._fast:
+            self._model = model
+            self._stats = new_stats()
+            self._lcp_ctl = new_lcp_control(nc, force_lemke=lcp_method == "lemke",
+                                            warm_start=False, max_iter=lemke_max_iter or 0)
+            self._blocks = []
+            for name in STAT_NAMES:
+                self.counters.setdefault(name, 0)
 
     def _step_impl(self):
+        if self._fast:
+            return self._fast_block()
+        return self._generic_step()
+
+    def _fast_block(self):
+        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
+        ns = FAST_BLOCK // self.save_every + 2
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+               np.empty((ns, nc)), np.empty((ns, nc)))
+        q, v, vv = self.q.copy(), self.v.copy(), self._v_verlet.copy()
+        closed = self._closed.copy()
+        st = self._stats
+        st[:] = 0.0
+        status, k, nrec = runner_for(m, sp_loop)(
+            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
+            q, v, vv, closed, self.save_every, self._pending_initial, self._lcp_ctl, *buf, st)
+        ndone = k - self._k
+        if nrec:
+            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
+        if ndone:
+            self._pending_initial = False
+        self._k, self.q, self.v, self._v_verlet, self._closed = k, q, v, vv, closed
+        t = self.t0 + k * self.h
+        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        c = self.counters
+        for name, x in zip(STAT_NAMES, st):
+            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
+        c["steps"] += ndone - 1     # the base class counts one step per call
+        if status in (LCP_HANDBACK, PAINLEVE):
+            # the generic step solves it (QP fallback) or raises with the diagnosis
+            c["steps"] += 1
+            self._generic_step()
+            return
+        if status == SINGULAR:
+            self._fail(-5, f"the mass matrix is singular at t = {self.t!r}")
+        elif status == NUMERICAL:
+            self._fail(-5, f"non-finite state after the step at t = {self.t!r} (the explicit "
+                           f"step `h` = {self.h!r} is probably too large for the stiffest force)")
+
+    def _generic_step(self):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         vv = self._v_verlet

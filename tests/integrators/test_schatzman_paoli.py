@@ -122,3 +122,18 @@ def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(InputError) as err:
         simulate(Block(), (0.0, 1.0), [0.0, 0.0], [1.0, 0.0], "schatzman-paoli", **options)
     assert message in str(err.value)
+
+
+@pytest.mark.parametrize("scene_name", ["bouncing-ball", "friction-drive", "sliding-box"])
+def test_the_compiled_loop_is_the_generic_step(scene_name):
+    # one frictionless impact scene, the rheonomic frictional drive, two contacts through Lemke
+    sc = make_scene(scene_name)
+    q0, v0 = sc.initial_state()
+    T = sc.period or 2.0
+    fast = simulate(sc, (0.0, 2 * T), q0, v0, "schatzman-paoli", h=T / 400, fast=True)
+    slow = simulate(sc, (0.0, 2 * T), q0, v0, "schatzman-paoli", h=T / 400, fast=False)
+    assert fast.success and slow.success and fast.t.shape == slow.t.shape
+    assert np.max(np.abs(fast.q - slow.q)) <= 1e-12 * max(1.0, np.max(np.abs(slow.q)))
+    assert np.max(np.abs(fast.v - slow.v)) <= 1e-12 * max(1.0, np.max(np.abs(slow.v)))
+    assert np.array_equal(fast.regime, slow.regime)
+    assert fast.stats["lcp_solves"] == slow.stats["lcp_solves"]
