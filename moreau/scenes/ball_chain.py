@@ -1,0 +1,378 @@
+"""A chain of balls on a line, struck at one end (Newton's cradle, a bead chain).
+
+``N`` equal balls of radius ``r`` lie on a line; balls ``1 .. N-1`` are at
+rest and touch their neighbours, and ball 0 (the striker, mass ratio
+``striker_mass / mass``) approaches ball 1 at ``striker_speed`` from a gap
+``striker_gap``. Contacts are frictionless, with one Newton restitution
+coefficient ``e``; there is no gravity along the line.
+
+The scene where the schemes must differ. When the striker arrives every
+contact of the chain is closed at once, and the model's answer depends on
+the impact law:
+
+* **Newton's law at every contact, simultaneously** (the model as stated,
+  what Moreau–Jean and the event-driven reference solve): the impulses
+  solve one LCP, ``0 <= U+_i + e min(U-_i, 0) _|_ P_i >= 0``, over all
+  contacts (:func:`simultaneous_impact`). For equal balls and ``e = 1``
+  with ``N = 3`` the striker rebounds at ``-1/3`` and the two others leave
+  together at ``2/3``: the chain moves as a block.
+* **The sequential-impact picture** (:func:`sequential_impacts`): the
+  contacts collide one pair at a time, in order along the chain, repeated
+  until no pair approaches. For equal balls and ``e = 1`` the striker stops
+  and the last ball leaves with the striker's speed: Newton's cradle as it
+  is seen.
+* **Two balls** (``N = 2``) have one contact and one answer
+  (:func:`two_ball_impact`): ``v0+ = (m0 - e m1) V / (m0 + m1)``,
+  ``v1+ = (1 + e) m0 V / (m0 + m1)``, from momentum conservation and
+  ``v1+ - v0+ = e V``.
+
+Scales
+------
+Lengths in the radius ``r``, time in ``r / V`` (``V`` the striker speed),
+masses in the ball mass ``m``, forces in ``m V^2 / r``. The striker speed is
+1 in scene units, the chain's contacts are 2 apart, and the dimensionless
+motion depends on ``N``, the mass ratio, ``e`` and ``striker_gap / r``.
+
+Coordinates: ``q_i`` the centre of ball ``i``, ball 1 at 0; the gap of
+contact ``i`` (balls ``i`` and ``i + 1``) is ``q_{i+1} - q_i - 2``.
+"""
+
+import numbers
+from dataclasses import dataclass
+
+import numpy as np
+
+from numba import njit
+
+from ..compiled import CompiledModel
+from .._validate import in_closed_interval, nonnegative, positive
+from ..analysis.cases import GRID, CompareCase
+from ..errors import InputError, LCPError, MoreauError
+from ..lcp import solve_lcp
+from ._units import SIUnits
+from .base import Scene, params_with
+from .registry import SceneEntry, parameters_of, register_scene
+
+__all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
+           "simultaneous_impact"]
+
+#: the chain lengths the scene takes
+MIN_BALLS, MAX_BALLS = 2, 100
+
+
+@dataclass(frozen=True)
+class BallChainParams:
+    """SI parameters of the ball chain.
+
+    Attributes
+    ----------
+    n_balls : int
+        Number of balls ``N`` including the striker, in [2, 100].
+    mass : float
+        Mass of each ball of the chain [kg], > 0.
+    striker_mass : float
+        Mass of the striker [kg], > 0.
+    radius : float
+        Radius of every ball [m], > 0.
+    striker_speed : float
+        Speed of the striker towards the chain [m/s], > 0.
+    restitution : float
+        Newton restitution of every contact, in [0, 1].
+    striker_gap : float
+        Initial gap between the striker and the chain [m], >= 0.
+    """
+
+    n_balls: int = 3
+    mass: float = 0.1
+    striker_mass: float = 0.1
+    radius: float = 0.01
+    striker_speed: float = 1.0
+    restitution: float = 1.0
+    striker_gap: float = 0.01
+
+    def __post_init__(self):
+        n = self.n_balls
+        if isinstance(n, bool) or not isinstance(n, numbers.Integral) and not (
+                isinstance(n, float) and n.is_integer()):
+            raise InputError(f"`n_balls` must be a whole number in [{MIN_BALLS}, {MAX_BALLS}], "
+                             f"got {n!r}")
+        if not MIN_BALLS <= int(n) <= MAX_BALLS:
+            raise InputError(f"`n_balls` must be in [{MIN_BALLS}, {MAX_BALLS}], got {n!r}")
+        object.__setattr__(self, "n_balls", int(n))
+        for name in ("mass", "striker_mass", "radius", "striker_speed"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "restitution",
+                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        object.__setattr__(self, "striker_gap", nonnegative("striker_gap", self.striker_gap))
+
+
+class BallChain(SIUnits, Scene):
+    """``N`` balls on a line, the striker approaching the resting chain.
+
+    Parameters
+    ----------
+    params : BallChainParams, optional
+    **overrides
+        Individual parameters replacing those of ``params`` (e.g. ``n_balls=5``).
+
+    Examples
+    --------
+    >>> chain = BallChain(n_balls=3)
+    >>> chain.ndof, chain.ncontacts, chain.impact_time
+    (3, 2, 1.0)
+    >>> [round(float(x), 12) for x in simultaneous_impact(chain.masses, [1.0, 0.0, 0.0], 1.0)]
+    [-0.333333333333, 0.666666666667, 0.666666666667]
+    """
+
+    name = "ball-chain"
+
+    def __init__(self, params=None, **overrides):
+        p = params_with(BallChainParams, params, overrides)
+        self.params = p
+        n = p.n_balls
+        self.ndof = n
+        self.mu = np.zeros(n - 1)
+        self.restitution = np.full(n - 1, p.restitution)
+        self.length = p.radius
+        self.time = p.radius / p.striker_speed
+        self.force = p.mass * p.striker_speed ** 2 / p.radius
+        self.mass_ratio = p.striker_mass / p.mass
+        self.masses = np.ones(n)
+        self.masses[0] = self.mass_ratio
+        self.gap0 = p.striker_gap / p.radius
+
+    @property
+    def impact_time(self):
+        """Time at which the striker reaches the chain (scene units: the gap over the speed 1)."""
+        return self.gap0
+
+    # -- Scene interface --------------------------------------------------------
+    def mass(self, q):
+        return np.diag(self.masses)
+
+    def forces(self, q, v, t):
+        return np.zeros(self.ndof)
+
+    def force_jacobians(self, q, v, t):
+        z = np.zeros((self.ndof, self.ndof))
+        return z, z.copy()
+
+    def gaps(self, q, t):
+        q = np.asarray(q, dtype=float)
+        return q[1:] - q[:-1] - 2.0
+
+    def contact_jacobians(self, q, t):
+        n = self.ndof
+        WN = np.zeros((n - 1, n))
+        i = np.arange(n - 1)
+        WN[i, i] = -1.0
+        WN[i, i + 1] = 1.0
+        return WN, np.zeros(n - 1), np.zeros((0, n)), np.zeros(0)
+
+    def contact_drift(self, q, v, t):
+        return np.zeros(self.ndof - 1), np.zeros(0)
+
+    def initial_state(self):
+        """The chain at rest, touching, ball 1 at 0; the striker ``gap0`` away at speed 1."""
+        q = 2.0 * np.arange(self.ndof, dtype=float) - 2.0
+        q[0] -= self.gap0
+        v = np.zeros(self.ndof)
+        v[0] = 1.0
+        return q, v
+
+    def compiled_model(self):
+        """Compiled form of this model (:mod:`moreau.compiled`); ``par = (mass ratio,)``."""
+        return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
+                             self.ndof - 1, True, False)
+
+    def kinetic_energy(self, v):
+        """``sum m_i v_i^2 / 2`` of velocities ``v`` (..., N), in scene units."""
+        v = np.asarray(v, dtype=float)
+        return 0.5 * np.sum(self.masses * v * v, axis=-1)
+
+
+# -- the impact laws ---------------------------------------------------------------------------
+
+def two_ball_impact(m0, m1, V, e):
+    """Velocities ``(v0+, v1+)`` after ball ``m0`` at speed ``V`` hits ``m1`` at rest.
+
+    Momentum ``m0 V = m0 v0+ + m1 v1+`` and Newton's law ``v1+ - v0+ = e V``.
+
+    Examples
+    --------
+    >>> two_ball_impact(1.0, 1.0, 1.0, 1.0)
+    (0.0, 1.0)
+    >>> two_ball_impact(1.0, 3.0, 2.0, 0.0)
+    (0.5, 0.5)
+    """
+    s = m0 + m1
+    return (m0 - e * m1) * V / s, (1.0 + e) * m0 * V / s
+
+
+def sequential_impacts(masses, v, e, max_sweeps=100000):
+    """Final velocities of the sequential-impact picture of a chain.
+
+    Pairs ``(i, i+1)`` that approach (``v_i > v_{i+1}``) collide as two
+    balls (:func:`two_ball_impact` in their relative motion), left to right,
+    sweep after sweep, until no pair approaches.
+
+    Parameters
+    ----------
+    masses, v : array_like, shape (N,)
+        Masses and velocities before the impacts.
+    e : float
+        Restitution coefficient of every pair.
+    max_sweeps : int
+        Bound on the sweeps along the chain.
+
+    Raises
+    ------
+    InputError
+        Bad shapes or values.
+    MoreauError
+        If pairs still approach after ``max_sweeps`` sweeps (``e = 0`` on an
+        unequal chain may need many; it never happens with equal balls).
+
+    Examples
+    --------
+    >>> sequential_impacts([1.0, 1.0, 1.0], [1.0, 0.0, 0.0], 1.0).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    m = np.asarray(masses, dtype=float)
+    u = np.array(v, dtype=float)
+    if m.ndim != 1 or u.shape != m.shape or m.size < 2:
+        raise InputError(f"`masses` and `v` must have one equal length >= 2, got {m.shape} "
+                         f"and {u.shape}")
+    if not np.all(m > 0.0):
+        raise InputError("`masses` must be > 0")
+    e = in_closed_interval("e", e, 0.0, 1.0)
+    for _ in range(max_sweeps):
+        hit = False
+        for i in range(m.size - 1):
+            rel = u[i] - u[i + 1]
+            if rel > 0.0:
+                a, b = two_ball_impact(m[i], m[i + 1], rel, e)
+                u[i], u[i + 1] = u[i + 1] + a, u[i + 1] + b
+                hit = True
+        if not hit:
+            return u
+    raise MoreauError(f"the sequential impacts did not end within {max_sweeps} sweeps")
+
+
+def simultaneous_impact(masses, v, e):
+    """Velocities after one simultaneous impact with Newton's law at every contact.
+
+    All ``N - 1`` contacts closed: with ``P`` the contact impulses,
+    ``v+ = v + M^-1 WN^T P`` and ``0 <= WN v+ + e min(WN v, 0) _|_ P >= 0``,
+    an LCP with the positive definite matrix ``WN M^-1 WN^T`` (unique
+    solution), solved by Lemke's method (certified; an unsolved problem raises).
+
+    Examples
+    --------
+    >>> [round(float(x), 12) for x in simultaneous_impact([1.0, 1.0, 1.0], [1.0, 0.0, 0.0], 0.0)]
+    [0.333333333333, 0.333333333333, 0.333333333333]
+    """
+    m = np.asarray(masses, dtype=float)
+    u = np.asarray(v, dtype=float)
+    n = m.size
+    WN = np.zeros((n - 1, n))
+    i = np.arange(n - 1)
+    WN[i, i] = -1.0
+    WN[i, i + 1] = 1.0
+    U = WN @ u
+    A = WN @ (WN.T / m[:, None])
+    r = solve_lcp(A, U + e * np.minimum(U, 0.0), method="lemke")
+    if not r.success:
+        raise LCPError(f"the simultaneous impact problem was not solved: {r.message}")
+    return u + (WN.T @ r.z) / m
+
+
+# -- comparison case -----------------------------------------------------------------------------
+
+class BallChainCase(CompareCase):
+    """The striker's impact on the chain: where the last ball is two time units after it.
+
+    The reference is the model's exact answer, one simultaneous impact at
+    ``t* = gap / V`` (:func:`simultaneous_impact`), after which every ball
+    flies at constant speed; the window ends two time units after the
+    impact. The headline (the last ball's position at the end) carries both
+    the impact's outcome and its time, so a scheme's error shows how well it
+    places the impact within its steps.
+    """
+
+    headline_name = "position of the last ball after the impacts"
+
+    def __init__(self, **params):
+        self.scene = BallChain(**params)
+        self._params = dict(params)
+        self.window = self.scene.impact_time + 2.0
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.scene.initial_state()
+
+    def _last_ball(self, t):
+        sc = self.scene
+        q0, v0 = sc.initial_state()
+        v_after = simultaneous_impact(sc.masses, v0, sc.params.restitution)
+        # at rest until the impact, then at its final speed
+        return q0[-1] + v_after[-1] * np.maximum(np.asarray(t, float) - sc.impact_time, 0.0)
+
+    def reference(self, rtol):
+        return float(self._last_ball(self.window)), [(float(self.scene.impact_time), "0:S")]
+
+    def reference_grid(self):
+        return self._last_ball(np.linspace(0.0, self.window, GRID + 1))
+
+    def coordinate(self, q):
+        return q[:, -1]
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, -1])
+
+
+# -- compiled model (moreau.compiled); par = (striker mass / ball mass,) -------------------
+
+@njit(cache=True)
+def _mass(par, q, M):
+    M[0, 0] = par[0]
+    for i in range(1, q.shape[0]):
+        M[i, i] = 1.0
+
+
+@njit(cache=True)
+def _forces(par, q, v, t, D, need_jac):
+    for i in range(q.shape[0]):
+        D[i, 0] = 0.0
+
+
+@njit(cache=True)
+def _contacts(par, q, t, G, need_gap, need_T):
+    n = q.shape[0]
+    for i in range(n - 1):
+        if need_gap:
+            G[i, 0] = q[i + 1] - q[i] - 2.0
+        G[i, 3 + i] = -1.0
+        G[i, 4 + i] = 1.0
+
+
+@njit(cache=True)
+def _drift(par, q, v, t, Dr):
+    for i in range(q.shape[0] - 1):
+        Dr[i, 0] = 0.0
+
+
+register_scene(SceneEntry(
+    name="ball-chain",
+    factory=BallChain,
+    parameters=parameters_of(BallChainParams, {"n_balls": "", "mass": "kg", "striker_mass": "kg",
+                                               "radius": "m", "striker_speed": "m/s",
+                                               "restitution": "", "striker_gap": "m"}),
+    description="a striker hits a resting chain of N balls: simultaneous impacts (Newton's cradle)",
+    case=BallChainCase,
+    reference="exact",
+    sweepable=("restitution", "striker_mass", "n_balls"),
+    mj_tolerance=1e-3,
+))
