@@ -1,0 +1,202 @@
+"""The scheme family against Siconos's OSIs: accuracy, speed and energy on two impact scenes.
+
+For every registered time-stepping scheme of moreau with a step ``h``
+(Moreau–Jean at theta 1/2 and 1, Schatzman–Paoli, ...), for moreau's
+event-driven reference, and for Siconos's OSIs
+(``benchmarks/siconos_osis.py``, run by the system interpreter when
+``python3-siconos`` is installed), on
+
+``ball``
+    the bouncing ball (radius 0.05, from rest at 1.05, e = 0.5), error of the
+    height and velocity at ``t = 2`` against the exact solution;
+``oscillator``
+    a unit mass on a unit spring with a wall at ``q = -0.5``, e = 1, from
+    ``q = 1`` at rest (energy 1/2), error at ``t = 20`` against moreau's
+    event-driven reference at rtol 1e-12;
+
+and the energy table: the largest and the final relative energy drift over
+1e5 steps (``h = 1e-3``) on the elastic (e = 1) ball and on the oscillator.
+(Schatzman–Paoli's velocity on an impact step is the mean of the two sides,
+so its largest drift is that of one sample inside the impact; its final
+drift is the one to read.) Speeds are steps per second (median of ``--repeat`` runs), with the ratio
+to Siconos's MoreauJeanOSI measured in the same run.
+
+Run: ``python benchmarks/bench_scheme_family.py [--quick] [--out DIR]``;
+writes ``scheme_family.json`` and ``scheme_family.csv`` to ``--out``
+(default ``./out``) and prints the tables.
+"""
+
+import argparse
+import csv
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import numpy as np
+
+from _timing import median_time
+from moreau.integrators import simulate
+from moreau.scenes.base import Scene
+from moreau.scenes.registry import make_scene
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SICONOS_OSIS = ("MoreauJeanOSI", "MoreauJeanGOSI", "MoreauJeanCombinedProjectionOSI",
+                "MoreauJeanDirectProjectionOSI", "MoreauJeanBilbaoOSI", "LsodarOSI")
+#: moreau's schemes in the table: name, options, label
+SCHEMES = (("moreau-jean", {"theta": 0.5}, "moreau-jean theta=1/2"),
+           ("moreau-jean", {"theta": 1.0}, "moreau-jean theta=1"),
+           ("schatzman-paoli", {}, "schatzman-paoli"))
+
+
+class WallOscillator(Scene):
+    """Unit mass on a unit spring, a wall at ``q = -0.5`` (restitution 1)."""
+
+    ndof, mu, restitution = 1, np.array([0.0]), np.array([1.0])
+    name = "wall-oscillator"
+
+    def mass(self, q):
+        return np.eye(1)
+
+    def forces(self, q, v, t):
+        return -np.asarray(q, dtype=float)
+
+    def force_jacobians(self, q, v, t):
+        return -np.eye(1), np.zeros((1, 1))
+
+    def gaps(self, q, t):
+        return np.array([q[0] + 0.5])
+
+    def contact_jacobians(self, q, t):
+        return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+
+    def contact_drift(self, q, v, t):
+        return np.zeros(1), np.zeros(0)
+
+    def initial_state(self):
+        return np.array([1.0]), np.array([0.0])
+
+
+def cases(e_ball=0.5):
+    ball = make_scene("bouncing-ball", restitution=e_ball)
+    osc = WallOscillator()
+    return {"ball": (ball, lambda q, v: 0.5 * v * v + q),
+            "oscillator": (osc, lambda q, v: 0.5 * (v * v + q * q))}
+
+
+def reference(name, scene, t_end):
+    q0, v0 = scene.initial_state()
+    if name == "ball":
+        q, v = scene.exact_solution(np.array([t_end]), q0, v0)
+        return float(q[0, 0]), float(v[0, 0])
+    r = simulate(scene, (0.0, t_end), q0, v0, "event-driven", rtol=1e-12, atol=1e-14)
+    return float(r.q[-1, 0]), float(r.v[-1, 0])
+
+
+def siconos(case, osi, h, t_end, e):
+    py = "/usr/bin/python3"
+    if not os.path.exists(py):
+        return {"osi": osi, "case": case, "error": "no system python3 with siconos"}
+    cmd = [py, os.path.join(HERE, "siconos_osis.py"), case, osi, "--h", repr(h),
+           "--t-end", repr(t_end), "--e", repr(e)]
+    run = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    try:
+        return json.loads(run.stdout.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        tail = (run.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"osi": osi, "case": case, "error": f"exit {run.returncode}: {tail}"}
+
+
+def moreau_row(label, scheme, options, scene, energy, t_end, h, repeat):
+    q0, v0 = scene.initial_state()
+    opts = dict(options, h=h) if scheme != "event-driven" else dict(options)
+
+    def go():
+        return simulate(scene, (0.0, t_end), q0, v0, scheme, **opts)
+
+    res = go()
+    sec = median_time(go, repeat=repeat, warmup=1)
+    en = energy(res.q[:, 0], res.v[:, 0])
+    steps = res.stats.get("steps", len(res.t) - 1)
+    return {"scheme": label, "steps": steps, "seconds": sec, "q": float(res.q[-1, 0]),
+            "v": float(res.v[-1, 0]), "status": res.status,
+            "energy_drift": float(np.max(np.abs(en - en[0])) / abs(en[0])),
+            "final_energy_drift": float(abs(en[-1] - en[0]) / abs(en[0]))}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", default="out")
+    ap.add_argument("--quick", action="store_true", help="1e4 steps in the energy table, one run")
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--no-siconos", action="store_true")
+    a = ap.parse_args()
+    if os.path.exists(a.out) and not os.path.isdir(a.out):
+        sys.exit(f"`--out` must be a folder, but {a.out!r} is a file")
+    os.makedirs(a.out, exist_ok=True)
+    repeat = 1 if a.quick else a.repeat
+    use_siconos = not a.no_siconos and shutil.which("/usr/bin/python3") is not None
+    rows = []
+    h = 1e-3
+    for name, t_end in (("ball", 2.0), ("oscillator", 20.0)):
+        scene, energy = cases()[name]
+        q_ref, v_ref = reference(name, scene, t_end)
+        for scheme, opts, label in SCHEMES + (("event-driven", {}, "moreau event-driven"),):
+            r = moreau_row(label, scheme, opts, scene, energy, t_end, h, repeat)
+            rows.append(dict(r, table="accuracy", case=name,
+                             error=max(abs(r["q"] - q_ref), abs(r["v"] - v_ref))))
+        if use_siconos:
+            for osi in SICONOS_OSIS:
+                r = siconos(name, osi, h, t_end, 0.5)
+                r["failure"] = r.pop("error", None)
+                err = (max(abs(r["q"] - q_ref), abs(r["v"] - v_ref)) if "q" in r else None)
+                rows.append(dict(r, table="accuracy", case=name, scheme="siconos " + osi,
+                                 error=err))
+    # the energy table: 1e5 steps (1e4 quick) at h = 1e-3, elastic ball and oscillator
+    t_energy = 10.0 if a.quick else 100.0
+    for name in ("ball", "oscillator"):
+        scene, energy = cases(e_ball=1.0)[name]
+        for scheme, opts, label in SCHEMES:
+            r = moreau_row(label, scheme, opts, scene, energy, t_energy, h, 1)
+            rows.append(dict(r, table="energy", case=name))
+        if use_siconos:
+            for osi in SICONOS_OSIS:
+                r = siconos(name, osi, h, t_energy, 1.0)
+                r["failure"] = r.pop("error", None)
+                rows.append(dict(r, table="energy", case=name, scheme="siconos " + osi))
+    base = {r["case"]: r["steps"] / r["seconds"] for r in rows
+            if r["table"] == "accuracy" and r["scheme"] == "siconos MoreauJeanOSI"
+            and r.get("seconds")}
+    for r in rows:
+        if r.get("seconds") and r["scheme"] not in ("moreau event-driven", "siconos LsodarOSI"):
+            r["steps_per_s"] = r["steps"] / r["seconds"]
+            if r["table"] == "accuracy" and r["case"] in base:
+                r["ratio_to_siconos_mj"] = r["steps_per_s"] / base[r["case"]]
+    with open(os.path.join(a.out, "scheme_family.json"), "w") as fh:
+        json.dump(rows, fh, indent=1)
+    fields = ("table", "case", "scheme", "steps", "seconds", "steps_per_s", "ratio_to_siconos_mj",
+              "error", "energy_drift", "final_energy_drift", "status", "failure")
+    with open(os.path.join(a.out, "scheme_family.csv"), "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=fields + ("q", "v"), extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+    for table in ("accuracy", "energy"):
+        print(f"\n{table} (h = {h:g})")
+        for r in (x for x in rows if x["table"] == table):
+            if r.get("failure"):
+                print(f"  {r['case']:10s} {r['scheme']:40s} failed: {r['failure']}")
+                continue
+            extra = (f"error {r['error']:.2e}  {r['seconds'] * 1e3:.3g} ms"
+                     + (f", {r['steps_per_s']:.3g} steps/s" if "steps_per_s" in r else "")
+                     + (f" ({r['ratio_to_siconos_mj']:.3g}x Siconos MJ)"
+                        if "ratio_to_siconos_mj" in r else "")
+                     if table == "accuracy" else
+                     f"max drift {r['energy_drift']:.2e}"
+                     + (f", final {r['final_energy_drift']:.2e}" if "final_energy_drift" in r
+                        else ""))
+            print(f"  {r['case']:10s} {r['scheme']:40s} {extra}")
+
+
+if __name__ == "__main__":
+    main()
