@@ -6,42 +6,9 @@ import pytest
 from moreau.analysis.scheme_settings import ED_REFERENCE, make_scheme, steady_of
 from moreau.errors import InputError
 from moreau.integrators import simulate
-from moreau.scenes.base import Scene
 from moreau.scenes.registry import make_scene
 
-
-class Oscillator(Scene):
-    """Unit mass on a unit spring, its one contact far away (never active)."""
-    ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
-
-    def mass(self, q):
-        return np.eye(1)
-
-    def forces(self, q, v, t):
-        return -np.asarray(q, float)
-
-    def gaps(self, q, t):
-        return np.array([q[0] + 10.0])
-
-    def contact_jacobians(self, q, t):
-        return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
-
-
-class Block(Scene):
-    """Unit point mass on the ground under gravity 1, Coulomb friction mu = 0.5."""
-    ndof, mu, restitution = 2, np.array([0.5]), np.array([0.0])
-
-    def mass(self, q):
-        return np.eye(2)
-
-    def forces(self, q, v, t):
-        return np.array([0.0, -1.0])
-
-    def gaps(self, q, t):
-        return np.array([q[1]])
-
-    def contact_jacobians(self, q, t):
-        return np.array([[0.0, 1.0]]), np.zeros(1), np.array([[1.0, 0.0]]), np.zeros(1)
+from _toy_scenes import Block, Oscillator
 
 
 def _order(name, **options):
