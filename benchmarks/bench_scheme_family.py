@@ -1,7 +1,8 @@
 """The scheme family against Siconos's OSIs: accuracy, speed and energy on two impact scenes.
 
-For every registered time-stepping scheme of moreau with a step ``h``
-(Moreau–Jean at theta 1/2 and 1, Schatzman–Paoli, ...), for moreau's
+For every registered time-stepping scheme of moreau (Moreau–Jean at theta
+1/2 and 1, and each scheme that ``moreau compare`` runs by its steps per
+period), for moreau's
 event-driven reference, and for Siconos's OSIs
 (``benchmarks/siconos_osis.py``, run by the system interpreter when
 ``python3-siconos`` is installed), on
@@ -35,19 +36,54 @@ import subprocess
 import sys
 
 import numpy as np
+from numba import njit
 
 from _timing import median_time
-from moreau.integrators import simulate
+from moreau.compiled import CompiledModel
+from moreau.integrators import INTEGRATORS, simulate
 from moreau.scenes.base import Scene
 from moreau.scenes.registry import make_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 SICONOS_OSIS = ("MoreauJeanOSI", "MoreauJeanGOSI", "MoreauJeanCombinedProjectionOSI",
                 "MoreauJeanDirectProjectionOSI", "MoreauJeanBilbaoOSI", "LsodarOSI")
-#: moreau's schemes in the table: name, options, label
-SCHEMES = (("moreau-jean", {"theta": 0.5}, "moreau-jean theta=1/2"),
-           ("moreau-jean", {"theta": 1.0}, "moreau-jean theta=1"),
-           ("schatzman-paoli", {}, "schatzman-paoli"))
+
+
+def time_stepping_schemes():
+    """``(name, options, label)``: Moreau–Jean at theta 1/2 and 1, and every other
+    registered scheme that compare runs by its steps per period."""
+    out = [("moreau-jean", {"theta": 0.5}, "moreau-jean theta=1/2"),
+           ("moreau-jean", {"theta": 1.0}, "moreau-jean theta=1")]
+    for name in sorted(INTEGRATORS):
+        settings = getattr(INTEGRATORS[name], "compare_settings", None)
+        if settings and settings[0] == "steps_per_period":
+            out.append((name, {}, name))
+    return tuple(out)
+
+
+# the wall oscillator's compiled model (moreau.compiled): the user-scene hook
+@njit(cache=True)
+def _osc_mass(par, q, M):
+    M[0, 0] = 1.0
+
+
+@njit(cache=True)
+def _osc_forces(par, q, v, t, D, need_jac):
+    D[0, 0] = -q[0]
+    if need_jac:
+        D[0, 1] = -1.0
+
+
+@njit(cache=True)
+def _osc_contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[0] + 0.5
+    G[0, 3] = 1.0
+
+
+@njit(cache=True)
+def _osc_drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
 
 
 class WallOscillator(Scene):
@@ -76,6 +112,10 @@ class WallOscillator(Scene):
 
     def initial_state(self):
         return np.array([1.0]), np.array([0.0])
+
+    def compiled_model(self):
+        return CompiledModel(_osc_mass, _osc_forces, _osc_contacts, _osc_drift, [0.0], 1, 1,
+                             True, True)
 
 
 def cases(e_ball=0.5):
@@ -142,7 +182,7 @@ def main():
     for name, t_end in (("ball", 2.0), ("oscillator", 20.0)):
         scene, energy = cases()[name]
         q_ref, v_ref = reference(name, scene, t_end)
-        for scheme, opts, label in SCHEMES + (("event-driven", {}, "moreau event-driven"),):
+        for scheme, opts, label in time_stepping_schemes() + (("event-driven", {}, "moreau event-driven"),):
             r = moreau_row(label, scheme, opts, scene, energy, t_end, h, repeat)
             rows.append(dict(r, table="accuracy", case=name,
                              error=max(abs(r["q"] - q_ref), abs(r["v"] - v_ref))))
@@ -157,7 +197,7 @@ def main():
     t_energy = 10.0 if a.quick else 100.0
     for name in ("ball", "oscillator"):
         scene, energy = cases(e_ball=1.0)[name]
-        for scheme, opts, label in SCHEMES:
+        for scheme, opts, label in time_stepping_schemes():
             r = moreau_row(label, scheme, opts, scene, energy, t_energy, h, 1)
             rows.append(dict(r, table="energy", case=name))
         if use_siconos:

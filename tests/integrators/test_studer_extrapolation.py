@@ -1,0 +1,78 @@
+"""Step-size adjustment and extrapolation: the error follows the tolerance, with no plateau."""
+
+import numpy as np
+import pytest
+
+from moreau.errors import InputError
+from moreau.integrators import simulate
+from moreau.scenes.registry import make_scene
+
+from _toy_scenes import Block, Oscillator
+
+NAME = "studer-extrapolation"
+TOLS = (1e-4, 1e-6, 1e-8, 1e-10)
+
+
+def _errors(run):
+    return [run(tol) for tol in TOLS]
+
+
+def _assert_follows_the_tolerance(errs, factor):
+    # monotone in the tolerance, no plateau: each error within `factor` of its tolerance
+    assert all(b < a for a, b in zip(errs, errs[1:])), errs
+    for tol, err in zip(TOLS, errs):
+        assert err < factor * tol, (tol, err)
+
+
+def test_smooth_oscillator_error_follows_the_tolerance():
+    def run(tol):
+        r = simulate(Oscillator(), (0.0, 4.0), [1.0], [0.0], NAME, tol=tol)
+        return max(abs(r.q[-1, 0] - np.cos(4.0)), abs(r.v[-1, 0] + np.sin(4.0)))
+    # measured 9.6e-5, 2.5e-6, 6.6e-8, 1.8e-9
+    _assert_follows_the_tolerance(_errors(run), 30.0)
+
+
+def test_bouncing_ball_impacts_are_located_to_the_tolerance():
+    ball = make_scene("bouncing-ball", restitution=0.5)
+    q0, v0 = ball.initial_state()
+    qx, vx = ball.exact_solution(np.array([2.0]), q0, v0)
+
+    def run(tol):
+        r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=tol)
+        assert r.stats["forced_steps"] == 0
+        return max(abs(r.q[-1, 0] - qx[0, 0]), abs(r.v[-1, 0] - vx[0, 0]))
+    # measured 6.9e-5, 4.4e-7, 4.7e-9, 3.7e-11 (Moreau-Jean at h = 1e-4: 1.6e-4)
+    _assert_follows_the_tolerance(_errors(run), 1.0)
+
+
+def test_a_sliding_block_stop_is_located_to_the_tolerance():
+    def run(tol):
+        r = simulate(Block(), (0.0, 3.0), [0.0, 0.0], [1.0, 0.0], NAME, tol=tol)
+        assert r.regime_letters()[-1] == "S" and abs(r.v[-1, 0]) < 1e-15
+        return abs(r.q[-1, 0] - 1.0)
+    # measured 1.7e-4, 6.5e-7, 1.8e-8, 7.2e-11
+    _assert_follows_the_tolerance(_errors(run), 2.0)
+
+
+def test_smooth_phases_are_extrapolated_to_the_order_of_the_columns():
+    # the same accuracy costs far fewer base steps with more columns
+    def cost(columns):
+        r = simulate(Oscillator(), (0.0, 4.0), [1.0], [0.0], NAME, tol=1e-10, columns=columns)
+        return r.stats["base_steps"]
+    assert cost(6) < cost(4) < cost(2) / 5
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"tol": 0.0}, "`tol` must be"),
+    ({"tol": 1.5}, "`tol` must be"),
+    ({"columns": 1}, "`columns` must be a whole number in [2, 8]"),
+    ({"columns": 2.5}, "`columns` must be a whole number in [2, 8]"),
+    ({"h0": -1.0}, "`h0` must be"),
+    ({"h_min": 0.0}, "`h_min` must be"),
+    ({"lcp_method": "pgs"}, "`lcp_method` must be one of"),
+    ({"h": 1e-3}, "`h` is not an option of scheme 'studer-extrapolation'"),
+])
+def test_bad_options_are_refused_by_name(options, message):
+    with pytest.raises(InputError) as err:
+        simulate(Block(), (0.0, 1.0), [0.0, 0.0], [1.0, 0.0], NAME, **options)
+    assert message in str(err.value)
