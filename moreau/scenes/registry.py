@@ -52,10 +52,10 @@ True
 >>> ball = registry.make_scene("bouncing-ball", restitution=0.8)
 >>> float(ball.restitution[0])
 0.8
->>> registry.get_entry("no-such-scene")
+>>> registry.get_entry("no-such-scene")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-moreau.errors.InputError: `scene` must be one of 'bidirectional-drive', 'bouncing-ball', 'friction-drive', 'painleve-rod', 'sliding-block', 'sliding-box', 'stick-slip-motor'; got 'no-such-scene'
+moreau.errors.InputError: `scene` must be one of 'ball-chain', 'bidirectional-drive', ..., 'stick-slip-motor'; got 'no-such-scene'
 """
 
 import dataclasses

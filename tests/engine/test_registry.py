@@ -15,8 +15,8 @@ NAMES = registry.scene_names()
 
 
 def test_discovery_finds_every_scene_module_that_registers_one():
-    # the seven shipped scenes, found without any list of them
-    assert NAMES == ["bidirectional-drive", "bouncing-ball", "friction-drive", "painleve-rod",
+    # the eight shipped scenes, found without any list of them
+    assert NAMES == ["ball-chain", "bidirectional-drive", "bouncing-ball", "friction-drive", "painleve-rod",
                      "sliding-block", "sliding-box", "stick-slip-motor"]
 
 
@@ -45,7 +45,7 @@ def test_bad_parameters_are_refused_by_name_before_any_work(name):
 
 
 def test_unknown_scene_lists_the_known_ones():
-    with pytest.raises(InputError, match="`scene` must be one of 'bidirectional-drive'"):
+    with pytest.raises(InputError, match="`scene` must be one of 'ball-chain', 'bidirectional-drive'"):
         registry.get_entry("belt")
 
 
