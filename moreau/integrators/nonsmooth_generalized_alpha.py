@@ -26,7 +26,7 @@ with the coefficients from the spectral radius at infinity ``rho_inf`` in
 is the undamped trapezoidal rule).
 
 *Velocity level.* The contacts whose predicted gap ``g(q*, t_{n+1})`` is
-``<= 0`` (or that carried an impulse in the step before) form the step's
+``<= 1e-12`` (or that carried an impulse in the step before) form the step's
 contact problem, with Newton's law and 2D Coulomb friction on
 ``U = H v_{n+1} + w(t_{n+1})``, the pre-step normal velocity
 ``WN(q_n) v_n + wN(t_n)`` in the restitution term: the problem of
@@ -53,10 +53,15 @@ import numpy as np
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, LCPError
 from ..lcp import solve_lcp
+from ._blocks import CompiledRecording
+from ._loops import runner_for
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
+                          new_lcp_control, new_stats)
+from ._nsga_kernels import CONVERGENCE, nsga_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
-from .moreau_jean import (LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
-                          classify_impulse, next_time)
+from .moreau_jean import (FAST_BLOCK, LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
+                          classify_impulse, compiled_model_of, next_time)
 
 __all__ = ["NonsmoothGeneralizedAlpha", "alpha_coefficients"]
 
@@ -65,6 +70,10 @@ NEWTON_RTOL = 1e-12
 NEWTON_MAXITER = 25
 # the position correction stops when every corrected gap is above -this
 POSITION_TOL = 1e-14
+# a predicted gap below this counts as closed: after a corrected impact the flight is
+# symmetric and the next impact lands on the floor on a grid time, where rounding alone
+# would otherwise decide between contact and flight (and change the energy lost)
+CONTACT_TOL = 1e-12
 POSITION_MAXITER = 8
 
 
@@ -85,7 +94,7 @@ def alpha_coefficients(rho_inf):
 
 
 @register_integrator("nonsmooth-generalized-alpha")
-class NonsmoothGeneralizedAlpha(Integrator):
+class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
     """Nonsmooth generalized-α time stepping (see the module docstring).
 
     Parameters
@@ -102,6 +111,12 @@ class NonsmoothGeneralizedAlpha(Integrator):
         Correct positions onto the admissible set (no penetration, no drift).
     lcp_method : {"auto", "lemke", "qp"}
     save_every : int
+    fast : {"auto", True, False}
+        Run the compiled loop (:mod:`moreau.integrators._nsga_kernels`, the same
+        step, equal to rounding) on a scene with a ``compiled_model()``;
+        ``"auto"`` does so unless ``lcp_method="qp"``. A step the loop cannot
+        finish (Lemke fails, the Painlevé condition, the smooth Newton
+        iteration) is taken by the generic step.
     max_steps : int
 
     Examples
@@ -129,7 +144,7 @@ class NonsmoothGeneralizedAlpha(Integrator):
                         (100, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
-                 lcp_method="auto", save_every=1, max_steps=MAX_STEPS):
+                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
         if h is None:
             raise InputError("`h` (the time step) is required for the "
@@ -159,6 +174,57 @@ class NonsmoothGeneralizedAlpha(Integrator):
                                np.asarray(scene.forces(self.q, self.v, self.t0), float))
         self._acc = acc0
         self._a = acc0.copy()
+        if fast not in ("auto", True, False):
+            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
+        model = compiled_model_of(scene)
+        if fast is True and (model is None or lcp_method == "qp"):
+            raise InputError("`fast=True` needs a scene with a compiled model and an "
+                             "`lcp_method` other than 'qp'")
+        self._fast = model is not None and fast is not False and lcp_method != "qp"
+        if self._fast:
+            self._model = model
+            self._stats = new_stats()
+            self._lcp_ctl = new_lcp_control(nc, force_lemke=lcp_method == "lemke",
+                                            warm_start=False)
+            self._blocks = []
+            self._coef = np.array([self.am, self.af, self.gamma, self.beta])
+            for name in STAT_NAMES:
+                self.counters.setdefault(name, 0)
+
+    def _fast_block(self):
+        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
+        ns = FAST_BLOCK // self.save_every + 2
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+               np.empty((ns, nc)), np.empty((ns, nc)))
+        q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()
+        closed = self._closed.copy()
+        st = self._stats
+        st[:] = 0.0
+        status, k, nrec = runner_for(m, nsga_loop)(
+            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
+            q, v, a, acc, self._coef, closed, self.save_every, self._pending_initial,
+            self.position_level, self._lcp_ctl, *buf, st)
+        ndone = k - self._k
+        if nrec:
+            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
+        if ndone:
+            self._pending_initial = False
+        self._k, self.q, self.v, self._a, self._acc, self._closed = k, q, v, a, acc, closed
+        t = self.t0 + k * self.h
+        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        c = self.counters
+        for name, x in zip(STAT_NAMES, st):
+            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
+        c["steps"] += ndone - 1     # the base class counts one step per call
+        if status in (LCP_HANDBACK, PAINLEVE, CONVERGENCE):
+            c["steps"] += 1
+            self._generic_step()
+            return
+        if status == SINGULAR:
+            self._fail(-5, f"a singular mass or iteration matrix at t = {self.t!r}")
+        elif status == NUMERICAL:
+            self._fail(-5, f"non-finite state after the step at t = {self.t!r}")
 
     def _smooth(self, q, v, a, acc, t1, h):
         """Newton on ``acc_{n+1}``: the smooth generalized-α step (no contact)."""
@@ -206,6 +272,11 @@ class NonsmoothGeneralizedAlpha(Integrator):
         return q
 
     def _step_impl(self):
+        if self._fast:
+            return self._fast_block()
+        return self._generic_step()
+
+    def _generic_step(self):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
@@ -217,7 +288,7 @@ class NonsmoothGeneralizedAlpha(Integrator):
         v1, q1 = vs, qs
         if nc:
             gs = np.asarray(sc.gaps(qs, t1), float)
-            active = (gs <= 0.0) | self._closed
+            active = (gs <= CONTACT_TOL) | self._closed
             if active.any():
                 ia = np.flatnonzero(active)
                 fa = ia[self._trow[ia] >= 0]

@@ -103,3 +103,20 @@ def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(InputError) as err:
         simulate(Block(), (0.0, 1.0), [0.0, 0.0], [1.0, 0.0], NAME, **options)
     assert message in str(err.value)
+
+
+@pytest.mark.parametrize("scene_name", ["bouncing-ball", "friction-drive", "sliding-box"])
+def test_the_compiled_loop_is_the_generic_step(scene_name):
+    # impacts with the position correction, the rheonomic frictional drive (Newton on
+    # its nonlinear forces), two contacts through Lemke in both problems
+    sc = make_scene(scene_name)
+    q0, v0 = sc.initial_state()
+    T = sc.period or 2.0
+    # 397 steps: at 400 the ball's predicted position meets the floor exactly on a grid
+    # time, where rounding alone decides between contact and flight
+    fast = simulate(sc, (0.0, 2 * T), q0, v0, NAME, h=T / 397, fast=True)
+    slow = simulate(sc, (0.0, 2 * T), q0, v0, NAME, h=T / 397, fast=False)
+    assert fast.success and slow.success and fast.t.shape == slow.t.shape
+    assert np.max(np.abs(fast.q - slow.q)) <= 1e-11 * max(1.0, np.max(np.abs(slow.q)))
+    assert np.max(np.abs(fast.v - slow.v)) <= 1e-11 * max(1.0, np.max(np.abs(slow.v)))
+    assert np.array_equal(fast.regime, slow.regime)

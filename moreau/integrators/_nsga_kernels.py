@@ -1,0 +1,399 @@
+"""The compiled nonsmooth generalized-α loop: a template compiled once per model.
+
+The same step as :class:`moreau.integrators.nonsmooth_generalized_alpha.NonsmoothGeneralizedAlpha`
+(see its module docstring), on the functions of a
+:class:`moreau.compiled.CompiledModel`: the smooth generalized-α Newton
+iteration on the model's forces and Jacobians, the velocity-level contact
+problem of :mod:`moreau.integrators._mj_kernels` (the one-contact
+enumeration, Lemke for several) and the position correction (a scalar
+complementarity for one contact, a frictionless LCP by Lemke for several).
+Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
+:func:`moreau.integrators._loops.runner_for` compiles in the model's namespace.
+"""
+
+import math
+
+import numpy as np
+
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
+                          S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
+                          _lcp_size, _lcp_step, _one_contact, _residual, lemke_workspace)
+
+__all__ = ["nsga_loop", "CONVERGENCE"]
+
+#: status: the smooth Newton iteration did not converge (the state is the start of the step)
+CONVERGENCE = -8
+NEWTON_RTOL = 1e-12
+NEWTON_MAXITER = 25
+POSITION_TOL = 1e-14
+CONTACT_TOL = 1e-12
+POSITION_MAXITER = 8
+
+
+def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, save_every,
+              record_initial, position_level, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN,
+              rec_fT, rec_slip, rec_gap, stats):
+    """Run up to ``nmax`` nonsmooth generalized-α steps of a compiled model in one call.
+
+    Arguments as :func:`moreau.integrators._mj_kernels.mj_loop`, plus ``a`` and
+    ``acc`` (float64[n], the algorithmic and the smooth acceleration, updated),
+    ``coef = (alpha_m, alpha_f, gamma, beta)`` and ``position_level``.
+    Returns ``(status, k, nrec)``; on :data:`LCP_HANDBACK`, :data:`PAINLEVE`
+    or :data:`CONVERGENCE` the state is the start of the failed step, which
+    the caller takes in Python.
+    """
+    n = NDOF  # noqa: F821  (the model's namespace)
+    nc = NCONTACTS  # noqa: F821
+    has_jac = HAS_JAC  # noqa: F821
+    am = coef[0]
+    af = coef[1]
+    gamma = coef[2]
+    beta = coef[3]
+    cfac = (1.0 - af) / (1.0 - am)
+    force_lemke = lcp_ctl[0] != 0
+    M = np.zeros((n, n))
+    Mi = np.empty((n, n))
+    J = np.empty((n, n))
+    Ji = np.empty((n, n))
+    wk = np.empty((n, n))
+    D = np.zeros((n, 1 + 2 * n))
+    x = np.empty(n)
+    r = np.empty(n)
+    a1 = np.empty(n)
+    qs = np.empty(n)
+    vs = np.empty(n)
+    v1 = np.empty(n)
+    q1 = np.empty(n)
+    ncm = max(nc, 1)
+    mrows = 2 * ncm
+    G0 = np.zeros((ncm, 3 + 2 * n))
+    Gs = np.zeros((ncm, 3 + 2 * n))
+    Gq = np.zeros((ncm, 3 + 2 * n))
+    vN0 = np.zeros(ncm)
+    pN = np.zeros(ncm)
+    pT = np.zeros(ncm)
+    slip = np.zeros(ncm)
+    reg = np.zeros(ncm, dtype=np.int64)
+    ia = np.zeros(ncm, dtype=np.int64)
+    fa = np.zeros(ncm, dtype=np.int64)
+    H = np.zeros((mrows, n))
+    w = np.zeros(mrows)
+    MiHT = np.zeros((n, mrows))
+    Wd = np.zeros((mrows, mrows))
+    Uf = np.zeros(mrows)
+    p = np.zeros(mrows)
+    base = np.zeros(ncm, dtype=np.int64)
+    trow = np.zeros(ncm, dtype=np.int64)
+    Lmax = 4 * ncm
+    Ml = np.zeros((Lmax, Lmax))
+    ql = np.zeros(Lmax)
+    dl = np.ones(Lmax)
+    zl = np.zeros(Lmax)
+    wl = np.zeros(Lmax)
+    rayl = np.zeros(Lmax + 1)
+    work, iwork = lemke_workspace(Lmax)
+    lay = np.zeros(1 + ncm, dtype=np.int64)
+    lay[0] = -1
+    Ab = np.zeros((Lmax, Lmax))
+    xb = np.zeros(Lmax)
+    idx = np.zeros(Lmax, dtype=np.int64)
+    pcol = np.zeros(4 * ncm, dtype=np.int64)
+    # the position correction's frictionless LCP: its own buffers and layout memory
+    mu0 = np.zeros(ncm)
+    Ml2 = np.zeros((Lmax, Lmax))
+    lay2 = np.zeros(1 + ncm, dtype=np.int64)
+    lay2[0] = -1
+    Wn = np.zeros((mrows, mrows))
+    gn = np.zeros(mrows)
+    nu = np.zeros(mrows)
+    nuN = np.zeros(ncm)
+    nuT = np.zeros(ncm)
+    X = np.zeros((n, ncm))
+
+    nrec = 0
+    k = k0
+    status = OK
+    to_save = save_every - k0 % save_every
+    while k - k0 < nmax:
+        tk = t0 + k * h
+        t1 = t0 + (k + 1) * h
+        hk = h
+        last = False
+        if t1 >= t_bound - 1e-9 * h:
+            t1 = t_bound
+            hk = t_bound - tk
+            last = True
+        if tk >= t_bound:
+            break
+        # -- the smooth step: Newton on acc_{n+1}
+        for i in range(n):
+            x[i] = acc[i]
+        converged = False
+        for _ in range(NEWTON_MAXITER):
+            for i in range(n):
+                a1[i] = cfac * x[i] + (af * acc[i] - am * a[i]) / (1.0 - am)
+                qs[i] = q[i] + hk * v[i] + hk * hk * ((0.5 - beta) * a[i] + beta * a1[i])
+                vs[i] = v[i] + hk * ((1.0 - gamma) * a[i] + gamma * a1[i])
+            mass_fn(par, qs, M)  # noqa: F821
+            forces_fn(par, qs, vs, t1, D, True)  # noqa: F821
+            for i in range(n):
+                acc_r = -D[i, 0]
+                for j in range(n):
+                    acc_r += M[i, j] * x[j]
+                    jj = M[i, j]
+                    if has_jac:
+                        jj -= cfac * (hk * hk * beta * D[i, 1 + j] + hk * gamma * D[i, 1 + n + j])
+                    J[i, j] = jj
+                r[i] = acc_r
+            if n <= 3:
+                ok = _invert_small(J, Ji, n)
+            else:
+                ok = _invert_gj(J, Ji, wk, n)
+            if not ok:
+                status = SINGULAR
+                break
+            dmax = 0.0
+            xmax = 0.0
+            for i in range(n):
+                dx = 0.0
+                for j in range(n):
+                    dx -= Ji[i, j] * r[j]
+                x[i] += dx
+                dmax = max(dmax, abs(dx))
+                xmax = max(xmax, abs(x[i]))
+            if dmax <= NEWTON_RTOL * max(1.0, xmax):
+                converged = True
+                break
+        if status != OK:
+            break
+        if not converged:
+            status = CONVERGENCE
+            break
+        for i in range(n):
+            a1[i] = cfac * x[i] + (af * acc[i] - am * a[i]) / (1.0 - am)
+            qs[i] = q[i] + hk * v[i] + hk * hk * ((0.5 - beta) * a[i] + beta * a1[i])
+            vs[i] = v[i] + hk * ((1.0 - gamma) * a[i] + gamma * a1[i])
+            v1[i] = vs[i]
+            q1[i] = qs[i]
+        # -- contacts at the predicted position
+        na = 0
+        nfa = 0
+        for i in range(nc):
+            pN[i] = 0.0
+            pT[i] = 0.0
+            slip[i] = 0.0
+        if nc > 0:
+            if HAS_GAPS:  # noqa: F821
+                gaps_fn(par, qs, t1, Gs)  # noqa: F821
+            else:
+                contacts_fn(par, qs, t1, Gs, True, False)  # noqa: F821
+            for i in range(nc):
+                if Gs[i, 0] <= CONTACT_TOL or closed[i]:
+                    ia[na] = i
+                    na += 1
+                    if mu[i] > 0.0:
+                        fa[nfa] = i
+                        nfa += 1
+        if na > 0:
+            contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
+            for i in range(nc):
+                acc_v = G0[i, 1]
+                for j in range(n):
+                    acc_v += G0[i, 3 + j] * v[j]
+                vN0[i] = acc_v
+            mass_fn(par, qs, M)  # noqa: F821
+            if n <= 3:
+                ok = _invert_small(M, Mi, n)
+            else:
+                ok = _invert_gj(M, Mi, wk, n)
+            if not ok:
+                status = SINGULAR
+                break
+            contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
+            m = na + nfa
+            for rr in range(na):
+                i = ia[rr]
+                for j in range(n):
+                    H[rr, j] = Gs[i, 3 + j]
+                w[rr] = Gs[i, 1]
+            for rr in range(nfa):
+                i = fa[rr]
+                for j in range(n):
+                    H[na + rr, j] = Gs[i, 3 + n + j]
+                w[na + rr] = Gs[i, 2]
+            for c in range(m):
+                for i in range(n):
+                    acc_v = 0.0
+                    for j in range(n):
+                        acc_v += Mi[i, j] * H[c, j]
+                    MiHT[i, c] = acc_v
+            for rr in range(m):
+                acc_v = w[rr]
+                for j in range(n):
+                    acc_v += H[rr, j] * vs[j]
+                Uf[rr] = acc_v
+                for c in range(m):
+                    acc_v = 0.0
+                    for j in range(n):
+                        acc_v += H[rr, j] * MiHT[j, c]
+                    Wd[rr, c] = acc_v
+            if na == 1 and not force_lemke:
+                i = ia[0]
+                stats[S_LCP] += 1.0
+                stats[S_DIRECT] += 1.0
+                if nfa == 1:
+                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                              Uf[1], mu[i], e[i], vN0[i])
+                    if not ok:
+                        status = PAINLEVE
+                        break
+                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
+                                    e[i], vN0[i], pn, pt)
+                    p[0] = pn
+                    p[1] = pt
+                else:
+                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
+                                              vN0[i])
+                    if not ok:
+                        status = PAINLEVE
+                        break
+                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
+                                    0.0)
+                    p[0] = pn
+                pN[i] = pn
+                pT[i] = pt
+            else:
+                for rr in range(na):
+                    i = ia[rr]
+                    if e[i] > 0.0:
+                        Uf[rr] += e[i] * min(vN0[i], 0.0)
+                L = _lcp_size(na, ia, mu, base, trow)
+                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                                Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                                lcp_ctl, Ab, xb, idx, pcol, False)
+                if lst != 0:
+                    status = LCP_HANDBACK
+                    break
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
+                for rr in range(na):
+                    if e[ia[rr]] > 0.0:
+                        Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+            for i in range(n):
+                acc_v = vs[i]
+                for c in range(m):
+                    acc_v += MiHT[i, c] * p[c]
+                v1[i] = acc_v
+            for rr in range(nfa):
+                tr = na + rr
+                acc_v = Uf[tr]
+                for c in range(m):
+                    acc_v += Wd[tr, c] * p[c]
+                slip[fa[rr]] = acc_v
+            if position_level:
+                # Gauss-Newton with complementarity on the active contacts' gaps
+                for _ in range(POSITION_MAXITER):
+                    if HAS_GAPS:  # noqa: F821
+                        gaps_fn(par, q1, t1, Gq)  # noqa: F821
+                    else:
+                        contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                    gmin = 0.0
+                    for rr in range(na):
+                        gmin = min(gmin, Gq[ia[rr], 0])
+                    if gmin >= -POSITION_TOL:
+                        break
+                    if n > 0:
+                        contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                    for c in range(na):
+                        for i in range(n):
+                            acc_v = 0.0
+                            for j in range(n):
+                                acc_v += Mi[i, j] * Gq[ia[c], 3 + j]
+                            X[i, c] = acc_v
+                        gn[c] = Gq[ia[c], 0]
+                    for rr in range(na):
+                        for c in range(na):
+                            acc_v = 0.0
+                            for j in range(n):
+                                acc_v += Gq[ia[rr], 3 + j] * X[j, c]
+                            Wn[rr, c] = acc_v
+                    if na == 1:
+                        nu[0] = max(0.0, -gn[0] / Wn[0, 0])
+                    else:
+                        L2 = _lcp_size(na, ia, mu0, base, trow)
+                        lst, piv, res, warm = _lcp_step(Wn, gn, na, ia, mu0, nu, nuN, nuT, L2,
+                                                        base, trow, Ml2, ql, dl, zl, wl, rayl,
+                                                        work, iwork, lay2, lcp_ctl, Ab, xb, idx,
+                                                        pcol, False)
+                        if lst != 0:
+                            status = LCP_HANDBACK
+                            break
+                    for i in range(n):
+                        acc_v = 0.0
+                        for c in range(na):
+                            acc_v += X[i, c] * nu[c]
+                        q1[i] += acc_v
+                if status != OK:
+                    break
+        finite = True
+        for i in range(n):
+            if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
+                finite = False
+        if not finite:
+            status = NUMERICAL
+            break
+        if nc > 0:
+            if HAS_GAPS:  # noqa: F821
+                gaps_fn(par, q1, t1, Gq)  # noqa: F821
+            else:
+                contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+            for i in range(nc):
+                if -Gq[i, 0] > stats[S_PEN]:
+                    stats[S_PEN] = -Gq[i, 0]
+                reg[i] = _classify(pN[i], pT[i], mu[i])
+        if record_initial:
+            rec_t[nrec] = tk
+            for j in range(n):
+                rec_q[nrec, j] = q[j]
+                rec_v[nrec, j] = v[j]
+            if nc > 0:
+                if HAS_GAPS:  # noqa: F821
+                    gaps_fn(par, q, tk, G0)  # noqa: F821
+                else:
+                    contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
+            for i in range(nc):
+                rec_reg[nrec, i] = reg[i]
+                rec_fN[nrec, i] = pN[i] / hk
+                rec_fT[nrec, i] = pT[i] / hk
+                rec_slip[nrec, i] = slip[i]
+                rec_gap[nrec, i] = G0[i, 0]
+            nrec += 1
+            record_initial = False
+        for i in range(nc):
+            closed[i] = pN[i] > 0.0
+        for j in range(n):
+            q[j] = q1[j]
+            v[j] = v1[j]
+            a[j] = a1[j]
+            acc[j] = x[j]
+        k += 1
+        to_save -= 1
+        if to_save == 0:
+            to_save = save_every
+        if to_save == save_every or last:
+            rec_t[nrec] = t1
+            for j in range(n):
+                rec_q[nrec, j] = q[j]
+                rec_v[nrec, j] = v[j]
+            for i in range(nc):
+                rec_reg[nrec, i] = reg[i]
+                rec_fN[nrec, i] = pN[i] / hk
+                rec_fT[nrec, i] = pT[i] / hk
+                rec_slip[nrec, i] = slip[i]
+                rec_gap[nrec, i] = Gq[i, 0]
+            nrec += 1
+        if last:
+            break
+    return status, k, nrec
