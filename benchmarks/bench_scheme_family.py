@@ -61,6 +61,16 @@ def time_stepping_schemes():
     return tuple(out)
 
 
+def tolerance_schemes():
+    """``(name, options, label)`` of the registered schemes driven by a tolerance ``tol``."""
+    out = []
+    for name in sorted(INTEGRATORS):
+        settings = getattr(INTEGRATORS[name], "compare_settings", None)
+        if settings and settings[0] == "tol":
+            out += [(name, {"tol": tol}, f"{name} tol={tol:g}") for tol in (1e-6, 1e-9)]
+    return tuple(out)
+
+
 # the wall oscillator's compiled model (moreau.compiled): the user-scene hook
 @njit(cache=True)
 def _osc_mass(par, q, M):
@@ -150,7 +160,8 @@ def siconos(case, osi, h, t_end, e):
 
 def moreau_row(label, scheme, options, scene, energy, t_end, h, repeat):
     q0, v0 = scene.initial_state()
-    opts = dict(options, h=h) if scheme != "event-driven" else dict(options)
+    opts = dict(options, h=h) if "tol" not in options and scheme != "event-driven" \
+        else dict(options)
 
     def go():
         return simulate(scene, (0.0, t_end), q0, v0, scheme, **opts)
@@ -182,7 +193,8 @@ def main():
     for name, t_end in (("ball", 2.0), ("oscillator", 20.0)):
         scene, energy = cases()[name]
         q_ref, v_ref = reference(name, scene, t_end)
-        for scheme, opts, label in time_stepping_schemes() + (("event-driven", {}, "moreau event-driven"),):
+        for scheme, opts, label in (time_stepping_schemes() + tolerance_schemes()
+                                    + (("event-driven", {}, "moreau event-driven"),)):
             r = moreau_row(label, scheme, opts, scene, energy, t_end, h, repeat)
             rows.append(dict(r, table="accuracy", case=name,
                              error=max(abs(r["q"] - q_ref), abs(r["v"] - v_ref))))
@@ -209,7 +221,8 @@ def main():
             if r["table"] == "accuracy" and r["scheme"] == "siconos MoreauJeanOSI"
             and r.get("seconds")}
     for r in rows:
-        if r.get("seconds") and r["scheme"] not in ("moreau event-driven", "siconos LsodarOSI"):
+        if (r.get("seconds") and r["scheme"] not in ("moreau event-driven", "siconos LsodarOSI")
+                and " tol=" not in r["scheme"]):
             r["steps_per_s"] = r["steps"] / r["seconds"]
             if r["table"] == "accuracy" and r["case"] in base:
                 r["ratio_to_siconos_mj"] = r["steps_per_s"] / base[r["case"]]
