@@ -203,3 +203,13 @@ def test_schemes_all_runs_every_comparable_scheme():
     from moreau.analysis.compare import make_case, other_schemes
     names = {o[0] for o in other_schemes(make_case("bouncing-ball"), quick=True, names=["all"])}
     assert {"schatzman-paoli", "compliant-radau", "compliant-rk45"} <= names
+
+
+def test_a_closed_form_reference_is_not_a_pareto_winner():
+    from moreau.analysis.compare import pareto
+    rows = [dict(scheme="exact", theta=None, lcp=None, setting="", status=0, time_s=1e-6,
+                 error=0.0),
+            dict(scheme="moreau-jean", theta=1.0, lcp=None, steps_per_period=100, setting="",
+                 status=0, time_s=1e-3, error=5e-3)]
+    p = pareto(rows)
+    assert p[0]["scheme"] == "moreau-jean" and p[1]["scheme"] is None
