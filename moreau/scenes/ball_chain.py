@@ -45,7 +45,8 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import in_closed_interval, nonnegative, positive
+from .._validate import (finite_array, finite_scalar, in_closed_interval, nonnegative, positive,
+                         positive_int)
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
@@ -193,10 +194,35 @@ class BallChain(SIUnits, Scene):
 
 # -- the impact laws ---------------------------------------------------------------------------
 
+def _chain_state(masses, v):
+    """``masses`` and ``v`` as float vectors of one length >= 2, checked."""
+    m = finite_array("masses", masses, ndim=1)
+    u = finite_array("v", v, ndim=1).copy()
+    if m.size < 2 or u.shape != m.shape:
+        raise InputError(f"`masses` and `v` must have one equal length >= 2, got {m.shape} "
+                         f"and {u.shape}")
+    if not np.all(m > 0.0):
+        raise InputError(f"`masses` must be > 0, got {m.min()!r} as the smallest")
+    return m, u
+
 def two_ball_impact(m0, m1, V, e):
     """Velocities ``(v0+, v1+)`` after ball ``m0`` at speed ``V`` hits ``m1`` at rest.
 
     Momentum ``m0 V = m0 v0+ + m1 v1+`` and Newton's law ``v1+ - v0+ = e V``.
+
+    Parameters
+    ----------
+    m0, m1 : float
+        Masses of the moving and the resting ball, > 0.
+    V : float
+        Speed of ``m0`` towards ``m1`` (finite).
+    e : float
+        Newton restitution coefficient, in [0, 1].
+
+    Returns
+    -------
+    (float, float)
+        ``(v0+, v1+)``.
 
     Examples
     --------
@@ -205,6 +231,9 @@ def two_ball_impact(m0, m1, V, e):
     >>> two_ball_impact(1.0, 3.0, 2.0, 0.0)
     (0.5, 0.5)
     """
+    m0, m1 = positive("m0", m0), positive("m1", m1)
+    V = finite_scalar("V", V)
+    e = in_closed_interval("e", e, 0.0, 1.0)
     s = m0 + m1
     return (m0 - e * m1) * V / s, (1.0 + e) * m0 * V / s
 
@@ -223,29 +252,33 @@ def sequential_impacts(masses, v, e, max_sweeps=100000):
     e : float
         Restitution coefficient of every pair.
     max_sweeps : int
-        Bound on the sweeps along the chain.
+        Bound on the sweeps along the chain, >= 1.
 
     Raises
     ------
     InputError
         Bad shapes or values.
     MoreauError
-        If pairs still approach after ``max_sweeps`` sweeps (``e = 0`` on an
-        unequal chain may need many; it never happens with equal balls).
+        If pairs still approach after ``max_sweeps`` sweeps.
+
+    Notes
+    -----
+    At ``e = 1`` the pairwise impacts keep momentum and energy, and equal
+    balls end after one sweep with the striker's speed on the last ball.
+    Below ``e = 1`` the picture can collapse inelastically: the pairs
+    collide again and again with relative speeds falling geometrically,
+    and the chain tends to one common speed (equal balls at ``e = 1/2``: 3
+    sweeps for ``N = 3``, but ``N = 10`` ends at ``1/N`` for all, to
+    rounding, after 94 sweeps). ``max_sweeps`` bounds that.
 
     Examples
     --------
     >>> sequential_impacts([1.0, 1.0, 1.0], [1.0, 0.0, 0.0], 1.0).tolist()
     [0.0, 0.0, 1.0]
     """
-    m = np.asarray(masses, dtype=float)
-    u = np.array(v, dtype=float)
-    if m.ndim != 1 or u.shape != m.shape or m.size < 2:
-        raise InputError(f"`masses` and `v` must have one equal length >= 2, got {m.shape} "
-                         f"and {u.shape}")
-    if not np.all(m > 0.0):
-        raise InputError("`masses` must be > 0")
+    m, u = _chain_state(masses, v)
     e = in_closed_interval("e", e, 0.0, 1.0)
+    max_sweeps = positive_int("max_sweeps", max_sweeps)
     for _ in range(max_sweeps):
         hit = False
         for i in range(m.size - 1):
@@ -272,8 +305,8 @@ def simultaneous_impact(masses, v, e):
     >>> [round(float(x), 12) for x in simultaneous_impact([1.0, 1.0, 1.0], [1.0, 0.0, 0.0], 0.0)]
     [0.333333333333, 0.333333333333, 0.333333333333]
     """
-    m = np.asarray(masses, dtype=float)
-    u = np.asarray(v, dtype=float)
+    m, u = _chain_state(masses, v)
+    e = in_closed_interval("e", e, 0.0, 1.0)
     n = m.size
     WN = np.zeros((n - 1, n))
     i = np.arange(n - 1)
