@@ -33,10 +33,20 @@ flights in 5 periods at 185 Hz) and the rotor displacement differs by 0.1 %;
 1e-5 lies above the drifted gaps of the closed contact (|g| < 7e-6), so both
 index sets hold the contact at every step and the runs agree to 1e-4.
 
+The ball chain (``--case ball-chain``) is the project's ``BallChain`` in its
+dimensionless form (radius 1, unit balls, striker mass ratio ``ratio`` at
+speed 1, ``gap`` from the resting chain): one ``LagrangianLinearTIDS`` per
+ball, one ``LagrangianLinearTIR`` (``y = q_{i+1} - q_i - 2``) with
+``NewtonImpactNSL(e)`` per neighbouring pair, ``MoreauJeanOSI(theta)`` and an
+``LCP``. ``--chain-params`` (JSON ``{"sizes", "ratio", "e", "gap", "h",
+"t_end"}``) sets the runs; each size reports its median time, steps and
+final velocities (for the caller's check that Siconos ran the same model).
+
 Usage::
 
     /usr/bin/python3 benchmarks/siconos_peer.py [--steps 20000] [--repeats 5] [--theta 1.0]
     /usr/bin/python3 benchmarks/siconos_peer.py --case friction-drive --fd-params JSON
+    /usr/bin/python3 benchmarks/siconos_peer.py --case ball-chain --chain-params JSON
 """
 
 import argparse
@@ -184,12 +194,53 @@ def measure_friction_drive(params, steps, repeats, theta, threshold):
     return out
 
 
+def ball_chain(n, ratio, e, gap, h, t_end, theta):
+    """One Siconos Moreau–Jean run of the ball chain; ``(steps, seconds, v_end)``."""
+    import siconos.kernel as sk
+
+    balls = []
+    for i in range(n):
+        q = 2.0 * i - 2.0 - (gap if i == 0 else 0.0)
+        balls.append(sk.LagrangianLinearTIDS([q], [1.0 if i == 0 else 0.0],
+                                             [[ratio if i == 0 else 1.0]]))
+    nsds = sk.NonSmoothDynamicalSystem(0.0, t_end)
+    for b in balls:
+        nsds.insertDynamicalSystem(b)
+    for i in range(n - 1):
+        # y = q_{i+1} - q_i - 2 over the two balls' stacked coordinates
+        rel = sk.LagrangianLinearTIR([[-1.0, 1.0]], [-2.0])
+        nsds.link(sk.Interaction(sk.NewtonImpactNSL(e), rel), balls[i], balls[i + 1])
+    sim = sk.TimeStepping(nsds, sk.TimeDiscretisation(0.0, h), sk.MoreauJeanOSI(theta), sk.LCP())
+    k = 0
+    t0 = time.perf_counter()
+    while sim.hasNextEvent():
+        sim.computeOneStep()
+        sim.nextStep()
+        k += 1
+    dt = time.perf_counter() - t0
+    return k, dt, [float(b.velocity()[0]) for b in balls]
+
+
+def measure_ball_chain(par, repeats, theta):
+    out = {}
+    for n in par["sizes"]:
+        args = (int(n), par["ratio"], par["e"], par["gap"], par["h"], par["t_end"], theta)
+        k, _, v = ball_chain(*args)          # warm-up, and the state for the caller's check
+        med = statistics.median(ball_chain(*args)[1] for _ in range(repeats))
+        out[str(n)] = {"steps": k, "median_s": med, "us_per_step": med / k * 1e6,
+                       "theta": theta, "v_end": v}
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--steps", type=int, default=20000)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--theta", type=float, default=1.0)
-    ap.add_argument("--case", choices=("bouncing-ball", "friction-drive"), default="bouncing-ball")
+    ap.add_argument("--case", choices=("bouncing-ball", "friction-drive", "ball-chain"),
+                    default="bouncing-ball")
+    ap.add_argument("--chain-params", default='{"sizes": [2, 10], "ratio": 1.0, "e": 1.0, '
+                    '"gap": 1.0, "h": 0.01, "t_end": 1.5}', help="JSON of the ball-chain runs")
     ap.add_argument("--fd-params", default="[]", help="JSON list of friction-drive parameter sets")
     ap.add_argument("--fd-threshold", type=float, default=1e-5,
                     help="constraint activation threshold of the index set (see the docstring)")
@@ -206,6 +257,10 @@ def main():
         fd = measure_friction_drive(json.loads(args.fd_params), args.steps, args.repeats,
                                     args.theta, args.fd_threshold)
         print(json.dumps({"available": True, "version": version, "friction_drive": fd}))
+        return
+    if args.case == "ball-chain":
+        chain = measure_ball_chain(json.loads(args.chain_params), args.repeats, args.theta)
+        print(json.dumps({"available": True, "version": version, "ball_chain": chain}))
         return
     bouncing_ball(200, 1e-3, args.theta)      # warm-up
     times = []
