@@ -21,7 +21,8 @@ index set). Per N and per solver path, the time per step (median of
     ``benchmarks/siconos_peer.py`` under ``/usr/bin/python3`` when that
     interpreter has Siconos (left empty otherwise).
 
-Every run's final velocities are checked against the simultaneous Newton
+BLAS runs on one thread (unless ``OPENBLAS_NUM_THREADS`` etc. are set):
+every path, and Siconos, on one core. Every run's final velocities are checked against the simultaneous Newton
 impact (the chain leaves as a block: striker ``(2 - N) / N``, the others
 ``2 / N``); the largest deviation of any path is a column. The first
 compiled run of each N compiles (or loads) its loop and is not timed; its
@@ -31,19 +32,27 @@ Run: ``python benchmarks/bench_ball_chain.py [--quick] [--no-siconos] --out DIR`
 writes ``ball_chain.csv`` and ``ball_chain.json`` to ``DIR``.
 """
 
-import argparse
-import csv
-import json
 import os
-import subprocess
-import sys
-import time
 
-import numpy as np
+# One BLAS thread, set before numpy loads its library: the compiled loop and
+# Siconos's solver run on one core, and on this 2-core shared machine a
+# threaded BLAS made the generic step's 100 x 100 products vary from 0.6 to
+# 110 ms a step with the load of other processes
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from _timing import median_time
-from moreau.integrators import simulate
-from moreau.scenes.ball_chain import BallChain, simultaneous_impact
+import argparse  # noqa: E402
+import csv  # noqa: E402
+import json  # noqa: E402
+import subprocess  # noqa: E402
+import sys  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+from _timing import median_time  # noqa: E402
+from moreau.integrators import simulate  # noqa: E402
+from moreau.scenes.ball_chain import BallChain, simultaneous_impact  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 H = 0.01
