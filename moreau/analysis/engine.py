@@ -33,11 +33,12 @@ from .. import __version__
 from ..errors import ConvergenceError, InputError
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
+from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
 from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
+__all__ = ["audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -139,7 +140,8 @@ def _status_of(exc):
     return f"{type(exc).__name__}: {msg}"
 
 
-def evaluate_point(params, frequency, scheme, checks=(), version="", scene="friction-drive"):
+def evaluate_point(params, frequency, scheme, checks=(), version="", scene="friction-drive",
+                   energy=False):
     """Steady state at one parameter point, as a row of SI values.
 
     Parameters
@@ -159,6 +161,11 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     scene : str
         A registered periodically driven scene (:func:`periodic_scene_names`),
         e.g. the paper's single-rod drive or the two-rod bidirectional drive.
+    energy : bool
+        Add the energy audit of the steady period
+        (:data:`moreau.analysis.energy.ENERGY_COLUMNS`, joules per period and
+        the closing error); a point whose scheme has no audit gets NaN there
+        and the reason in ``energy_status``.
 
     Returns
     -------
@@ -203,8 +210,11 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
             d_col, e_col, m_col, s_col = mj_check_columns(chk)
             row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: row["status"]})
         row["compute_time_s"] = time.perf_counter() - t0
-        row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene)
+        if energy:
+            row.update(_energy_columns(None, None, scheme, row["status"]))
+        row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene, energy)
         return row
+    sc = ss = None
     try:
         sc, ss = _checked_steady(params, frequency, scheme, scene)
         ref = sc.displacement_to_si(ss.displacement_per_period)
@@ -214,6 +224,9 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
                    periodic_residual=ss.periodic_residual, shooting_iterations=ss.iterations)
     except Exception as exc:  # any failure becomes the status of this point
         row["status"] = _status_of(exc)
+        sc = ss = None
+    if energy:
+        row.update(_energy_columns(sc, ss, scheme, row["status"]))
     for chk in checks:
         d_col, e_col, m_col, s_col = mj_check_columns(chk)
         row.update({d_col: math.nan, e_col: math.nan, m_col: "", s_col: "ok"})
@@ -226,11 +239,43 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
             row[s_col] = _status_of(exc)
     row["compute_time_s"] = time.perf_counter() - t0
     # the row carries what it was computed for: a cache entry is checked against it when read
-    row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene)
+    row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene, energy)
     return row
 
 
-def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive"):
+def _energy_columns(sc, ss, scheme, status):
+    """The audit's columns of one point: SI terms and closing error, or NaN and the reason."""
+    cols = dict.fromkeys(ENERGY_COLUMNS, math.nan)
+    if ss is None:
+        cols["energy_status"] = f"no steady state ({status.split(':')[0]})"
+        return cols
+    if not has_energy_audit(sc, scheme.name):
+        cols["energy_status"] = f"no energy audit for scheme {scheme.name!r}"
+        return cols
+    try:
+        audit = energy_to_si(sc, energy_audit(sc, ss, scheme.name, audit_options(scheme)))
+    except Exception as exc:  # a failed audit is the point's energy_status, not a failure
+        cols["energy_status"] = _status_of(exc)
+        return cols
+    for (_, si), col in zip(ENERGY_TERMS, ENERGY_COLUMNS):
+        cols[col] = audit[si]
+    cols["energy_closing_error"] = audit["closing_error"]
+    cols["energy_status"] = "ok"
+    return cols
+
+
+def audit_options(scheme):
+    """The settings of a :class:`Scheme` that its energy audit needs to redo the steady period."""
+    out = dict(scheme.options)
+    if scheme.steps_per_period is not None:
+        out["steps_per_period"] = scheme.steps_per_period
+    if scheme.theta is not None:
+        out["theta"] = scheme.theta
+    return out
+
+
+def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive",
+                    energy=False):
     """:func:`evaluate_point` over a list of ``(params, frequency)``: one cache entry for many points.
 
     Examples
@@ -240,7 +285,7 @@ def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive
     >>> [r["mode"] for r in evaluate_points([(asdict(PAPER_DEFAULTS), 20.0)] * 2, ED_REFERENCE)]
     ['NS', 'NS']
     """
-    return [evaluate_point(p, f, scheme, checks, version, scene) for p, f in points]
+    return [evaluate_point(p, f, scheme, checks, version, scene, energy) for p, f in points]
 
 
 def check_output_dir(path, option="--out"):
@@ -325,7 +370,7 @@ def check_scheduler(scheduler):
 INPUTS_KEY = "_inputs"
 
 
-def inputs_digest(params, frequency, scheme, checks, version, scene):
+def inputs_digest(params, frequency, scheme, checks, version, scene, energy=False):
     """A fingerprint of everything a point's row depends on (its cache entry carries it).
 
     Examples
@@ -337,7 +382,8 @@ def inputs_digest(params, frequency, scheme, checks, version, scene):
     False
     """
     text = repr((sorted((k, repr(v)) for k, v in dict(params).items()), repr(float(frequency)),
-                 repr(tuple(scheme)), repr(tuple(tuple(c) for c in checks)), version, scene))
+                 repr(tuple(scheme)), repr(tuple(tuple(c) for c in checks)), version, scene)
+                + (("energy",) if energy else ()))
     return hashlib.sha256(text.encode()).hexdigest()[:32]
 
 
@@ -364,7 +410,7 @@ def _memory(cache_dir):
 
 
 def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
-               progress=False, desc="points", chunk=1, scene="friction-drive"):
+               progress=False, desc="points", chunk=1, scene="friction-drive", energy=False):
     """Evaluate many points, reusing cached ones, in parallel.
 
     Parameters
@@ -386,6 +432,8 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         Points per task and per cache entry. Large grids (atlases) use a
         chunk of a grid line: tens of thousands of single-point entries
         would cost more in files and scheduling than in computing.
+    energy : bool
+        Add the energy audit's columns to every row (:func:`evaluate_point`).
 
     Returns
     -------
@@ -411,13 +459,14 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     chunk = max(1, int(chunk))
     if chunk == 1:
         func = _memory(cache_dir).cache(evaluate_point, ignore=[])
-        args = [(dict(p), float(f), scheme, tuple(checks), version, scene) for p, f in points]
+        args = [(dict(p), float(f), scheme, tuple(checks), version, scene, bool(energy))
+                for p, f in points]
         sizes = [1] * len(args)
     else:
         func = _memory(cache_dir).cache(evaluate_points, ignore=[])
         groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
-        args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene)
-                for g in groups]
+        args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene,
+                 bool(energy)) for g in groups]
         sizes = [len(g) for g in groups]
     out = [None] * len(args)
     todo = []

@@ -425,6 +425,8 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
             "theta": pm.theta,
             "projection": pm.projection,
             "period_maps": pm.evaluations,
+            # the index-set memory at the section: with state0 it reproduces the steady period
+            "closed_at_section": [bool(c) for c in np.atleast_1d(closed)],
         },
     )
 

@@ -15,8 +15,10 @@ Examples
 import math
 import time
 
-from ..errors import InputError
+from ..errors import InputError, MoreauError
 from ..provenance import provenance
+from .energy import energy_audit, energy_to_si, has_energy_audit
+from .engine import audit_options
 from .scheme_settings import make_scheme, steady_of
 
 __all__ = ["steady_state_report", "check_periodic"]
@@ -36,6 +38,18 @@ def check_periodic(scene):
         if not hasattr(scene, attr):
             raise InputError(f"scene {name!r} has no `{attr}`: the SI report needs it")
     return scene
+
+
+def _energy_of(scene, ss, settings):
+    """``(energy dict in J per period, None)``, or ``(None, why there is none)``."""
+    if not has_energy_audit(scene, settings.name):
+        return None, (f"no energy audit for scheme {settings.name!r} on scene "
+                      f"{getattr(scene, 'name', type(scene).__name__)!r}")
+    try:
+        audit = energy_audit(scene, ss, settings.name, audit_options(settings))
+    except MoreauError as exc:
+        return None, f"no energy audit: {exc}"
+    return energy_to_si(scene, audit), None
 
 
 def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
@@ -65,7 +79,10 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``regimes``, ``min_normal_force_N``, ``periodic``, ``periodic_residual``,
         ``shooting_iterations``, ``wall_time_s``, ``parameters``, ``provenance``
-        (:func:`moreau.provenance.provenance`); with
+        (:func:`moreau.provenance.provenance`), ``energy`` (the energy audit of
+        the steady period, :mod:`moreau.analysis.energy`: joules per period
+        and ``closing_error``; None with an ``energy_note`` where the scheme
+        has no audit); with
         Moreau–Jean also ``steps_per_period``, ``theta`` and the scheme's
         statistics.
     """
@@ -103,6 +120,9 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         out["theta"] = settings.theta
     if settings.options:
         out["options"] = settings.options
+    out["energy"], note = _energy_of(scene, ss, settings)
+    if note:
+        out["energy_note"] = note
     if scheme == "moreau-jean":
         for key in MJ_STATS:
             if ss.stats and key in ss.stats:

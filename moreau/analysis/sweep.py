@@ -9,7 +9,9 @@ friction drive, with its valid-range marks) names it in its registry entry
 (``SceneEntry.sweep``); ``moreau sweep`` then runs that one.
 
 Outputs: ``OUT/sweep_SCENE_PARAM[_FREQ]_SCHEME.csv`` (tidy: the swept value,
-the fixed parameters, the steady state, units in the column names), a JSON
+the fixed parameters, the steady state, its energy audit
+(:data:`moreau.analysis.energy.ENERGY_COLUMNS`, joules per period), units in
+the column names), a JSON
 sidecar (scene, parameters, scheme, engine statistics, provenance) and a
 figure of the displacement per period and the operation mode.
 
@@ -32,6 +34,7 @@ from ..errors import InputError
 from ..provenance import provenance
 from ..scenes import registry
 from . import engine
+from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
@@ -206,7 +209,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     points = [point({parameter: x}) for x in values]
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"sweep {parameter}", scene=entry.name)
+                                    desc=f"sweep {parameter}", scene=entry.name, energy=True)
     swept = columns[parameter]
     table = []
     for x, (p, f), row in zip(values, points, rows):
@@ -218,6 +221,8 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
                 r[columns[name]] = val
         for c in VALUE_COLUMNS:
             r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
+        for c in ENERGY_COLUMNS:
+            r[c] = row.get(c, "" if c == "energy_status" else math.nan)
         table.append(r)
     if out is None:
         return table

@@ -331,6 +331,13 @@ class BidirectionalDrive(DriveUnits, Scene):
         """Slip velocities ``u2' + s_r sin(phi_r) phi_r'`` of both rods (defined also for mu = 0)."""
         return v[2] + self._side * np.sin(np.asarray(q[:2], float)) * np.asarray(v[:2], float)
 
+    def rod_layout(self):
+        """``(u10, delta, side)`` of both rods: stator amplitudes, phases and tip directions.
+
+        The layout the energy audit (:mod:`moreau.analysis.energy`) reads.
+        """
+        return self.u10.copy(), self.delta.copy(), self._side.copy()
+
     def rest_state(self, tau=0.0):
         """State at ``tau`` with both rods on their contact manifolds and the rotor at rest.
 

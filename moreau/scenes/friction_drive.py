@@ -252,6 +252,14 @@ class FrictionDrive(DriveUnits, Scene):
             return fT * s / c - Fs / c, fT
         raise InputError(f"`regime` must be POSITIVE, NEGATIVE or STICK, got {regime!r}")
 
+    def rod_layout(self):
+        """``(u10, delta, side)``: one rod, its stator amplitude, phase 0, tip towards ``+x``.
+
+        The layout the energy audit (:mod:`moreau.analysis.energy`) reads;
+        :class:`~moreau.scenes.bidirectional_drive.BidirectionalDrive` gives two rods.
+        """
+        return np.array([self.u10]), np.zeros(1), np.ones(1)
+
     def painleve_margin(self, phi):
         """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""
         return 1.0 - float(self.mu[0]) * np.tan(phi)

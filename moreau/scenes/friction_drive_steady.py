@@ -13,6 +13,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from .._validate import positive, positive_int
+from ..analysis.energy import RodEnergy, balance, gauss_legendre, register_energy_audit
 from ..analysis.steady_solvers import register_steady_solver
 from ..errors import ConvergenceError
 from ..integrators.result import SteadyState
@@ -20,7 +21,7 @@ from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
 from .friction_drive_walker import ContactState, FrictionDriveWalker
 
-__all__ = ["walker_steady_state"]
+__all__ = ["walker_steady_state", "walker_energy_audit"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -202,3 +203,109 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
     return ss
 
 
+
+
+def _contact_power(walker, start, regime):
+    """Stator, load and friction power along a contact piece that starts at ``start``."""
+    sc = walker.scene
+    ser = walker.series.get(regime)
+    a0 = float(ser.A(np.array([start.tau]))[0]) if ser is not None else 0.0
+
+    def power(tau):
+        phi, dphi, ddphi = sc.contact_angle(tau)
+        s, c = np.sin(phi), np.cos(phi)
+        fN, fT = sc.contact_forces(tau, regime)
+        if regime == Regime.STICK:
+            du2 = -s * dphi
+            slip = np.zeros_like(tau)
+        else:
+            du2 = start.du2 + ser.c0 * (tau - start.tau) + ser.A(tau) - a0
+            slip = du2 + s * dphi
+        stator = (sc.ddu1(tau) + 0.5 * (ddphi * c - dphi * dphi * s) + fN) * sc.du1(tau)
+        return np.vstack([stator, sc.fL * du2, -fT * slip])
+    return power
+
+
+def _flight_power(sc, sol):
+    def power(tau):
+        y = np.asarray(sol(tau))
+        phi, dphi, du2 = y[0], y[1], y[3]
+        s, c = np.sin(phi), np.cos(phi)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - s) - 0.5 * sc.ddu1(tau) * c)
+        stator = (sc.ddu1(tau) + 0.5 * (ddphi * c - dphi * dphi * s)) * sc.du1(tau)
+        return np.vstack([stator, sc.fL * du2, np.zeros_like(tau)])
+    return power
+
+
+def _flight_parts(sol, a, b):
+    # (dense output, its step times) of the pieces a flight's dense output is joined from
+    if hasattr(sol, "first"):
+        return [(sol.first, a, sol.t_split), (sol.second, sol.t_split, b)]
+    return [(sol, a, b)]
+
+
+def _flight_integral(sc, sol, a, b):
+    total = np.zeros(3)
+    for part, lo, hi in _flight_parts(sol, a, b):
+        if not hi > lo:
+            continue
+        ts = np.asarray(getattr(part, "ts", [lo, hi]), float)
+        edges = np.unique(np.concatenate([[lo, hi], ts[(ts > lo) & (ts < hi)]]))
+        # one 16-point rule per solver step: the dense output is one polynomial there
+        mid, half = 0.5 * (edges[:-1] + edges[1:]), 0.5 * np.diff(edges)
+        x, w = np.polynomial.legendre.leggauss(16)
+        tau = (mid[:, None] + half[:, None] * x).ravel()
+        total += _flight_power(sc, part)(tau) @ (half[:, None] * w).ravel()
+    return total
+
+
+def _qv(st):
+    return np.array([st.phi, st.u2]), np.array([st.dphi, st.du2])
+
+
+@register_energy_audit("friction-drive-walker")
+def walker_energy_audit(scene, steady, options):
+    """Energy audit of the walker's steady period (:mod:`moreau.analysis.energy`).
+
+    The period is walked again from the steady state's section; the power
+    terms are integrated along the exact contact pieces and the flights'
+    dense output, and each jump of the state between pieces enters through
+    its impulses. Closes to about 1e-12 of the stator's work.
+    """
+    walker = FrictionDriveWalker(scene, rtol=float(options.get("walker_rtol", 1e-12)))
+    tau_s = float(getattr(steady, "section_tau", 0.0) or 0.0)
+    phi, dphi, du2 = (float(x) for x in steady.state0)
+    st0 = walker.classify(ContactState(tau_s, Regime.FLIGHT, phi, dphi, 0.0, du2))
+    start = st0.copy()
+    pieces = []
+    # the walker changes a finished segment's end state in place (impact, manifold): copy
+    end = walker.advance(st0, tau_s + TWO_PI,
+                         on_segment=lambda a, b, sol: pieces.append((a.copy(), b.copy(), sol)))
+    energy = RodEnergy(scene)
+    stator = load = pos = neg = impact = 0.0
+    prev = start
+    for a, b, sol in pieces + [(end, None, None)]:
+        # a jump of the state between the previous piece's end and this start
+        qa, va = _qv(a)
+        qp, vp = _qv(prev)
+        if np.any(va != vp):
+            w, loss = energy.jump(qp, vp, va, a.tau)
+            stator += w
+            impact += loss
+        if b is None:
+            break
+        if a.regime == Regime.FLIGHT:
+            I = _flight_integral(scene, sol, a.tau, b.tau)
+        else:
+            I = gauss_legendre(_contact_power(walker, a, a.regime), a.tau, b.tau)
+        stator += I[0]
+        load += I[1]
+        if a.regime == Regime.POSITIVE:
+            pos += I[2]
+        elif a.regime == Regime.NEGATIVE:
+            neg += I[2]
+        prev = b
+    dE = float(energy.energy(*_qv(end), end.tau) - energy.energy(*_qv(start), start.tau))
+    return balance({"stator_work": stator, "load_work": load, "friction_positive_slip": pos,
+                    "friction_negative_slip": neg, "impact_loss": impact,
+                    "stored_energy_change": dE})

@@ -23,6 +23,7 @@ from ..._validate import positive
 # the module, not its function: a test (or a user) that replaces
 # engine.run_points reaches these sweeps too
 from ...analysis import engine
+from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import check_output_dir, code_version
 from ...errors import InputError
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
@@ -109,6 +110,9 @@ def tidy_rows(parameter, values, frequency, params, rows):
         r["lift_off_margin"] = _lift_off_margin(p, f)
         for c in _VALUE_COLUMNS:
             r[c] = row.get(c, math.nan if c != "mode" else "")
+        for c in ENERGY_COLUMNS:
+            if c in row:
+                r[c] = row[c]
         r["compute_time_s"] = row.get("compute_time_s", math.nan)
         out.append(r)
     return out
@@ -172,7 +176,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
             float(x) if parameter == "frequency" else frequency) for x in values]
     rows, stats = engine.run_points(pts, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"sweep {parameter}", scene="bidirectional")
+                                    desc=f"sweep {parameter}", scene="bidirectional",
+                                    energy=True)
     table = tidy_rows(parameter, values, frequency, params, rows)
     tag = "bidirectional_" + (parameter if parameter == "frequency"
                               else f"{parameter}_{frequency:g}Hz")

@@ -243,7 +243,7 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     points_ = [sweep_point(params, parameter, x, frequency) for x in values]
     rows, stats = engine.run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"sweep {parameter}")
+                                    desc=f"sweep {parameter}", energy=True)
     table = tidy_rows(parameter, values, frequency, params, rows, ())
     for r in table:
         r["scheme"] = scheme.name

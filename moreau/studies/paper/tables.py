@@ -13,6 +13,7 @@ import sys
 from dataclasses import asdict
 
 from ... import __version__
+from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import ED_REFERENCE, code_version, mj_check_columns
 from .valid_range import lift_off_margin
 
@@ -67,6 +68,10 @@ def tidy_rows(parameter, values, frequency, params, rows, checks, steps=None):
             for chk in checks:
                 for c in mj_check_columns(chk):
                     r[c] = row.get(c, math.nan)
+        # the energy audit, where the rows were computed with it (moreau sweep)
+        for c in ENERGY_COLUMNS:
+            if c in row:
+                r[c] = row[c]
         r["compute_time_s"] = row.get("compute_time_s", math.nan)
         out.append(r)
     return out
