@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``run``.
+"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``run``, ``characteristic``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -13,6 +13,7 @@ from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
 from .analysis.atlas import run_scene_atlas
+from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
@@ -161,6 +162,33 @@ def _cmd_sweep(args):
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+
+
+def _cmd_characteristic(args):
+    """``moreau characteristic``: velocity, power and efficiency against the load, stall located."""
+    entry = get_entry(args.scene)
+    params = scene_parameters(args, entry)
+    if "load" in params:
+        raise InputError("`--load` is swept by the characteristic (from no load to beyond "
+                         "stall); leave it out")
+    frequency = params.pop("frequency", None)
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         args.scheme_options)
+    ch = motor_characteristic(entry.name, frequency=frequency, fixed=params, scheme=scheme,
+                              points=args.points, out=args.out, plot=not args.no_plot,
+                              log=(lambda s: None) if args.json else print)
+    s = ch["summary"]
+    if args.json:
+        print(json.dumps(s))
+        return
+    print(f"{s['scene']} at {s['frequency_Hz']:g} Hz ({s['scheme']}): load characteristic")
+    print(f"  no-load velocity       {s['no_load_velocity_m_per_s']:.9e} m/s "
+          f"({s['no_load_direction']})")
+    print(f"  stall force            {s['stall_force_N']:.9e} N")
+    print(f"  max output power       {s['max_power_W']:.9e} W at load "
+          f"{s['load_at_max_power_N']:.9e} N")
+    print(f"  load convention        {s['load_convention']}")
+    print(f"  beyond stall           {s['reversal']}")
 
 
 def _cmd_run(args):
@@ -459,6 +487,19 @@ def build_parser():
     _add_params(r, scheme_defaults=False)
     add_scene_options(r)
     r.set_defaults(func=_cmd_run)
+    ch = sub.add_parser("characteristic", help="the motor's load characteristic: no-load "
+                                               "velocity, stall force, maximum output power "
+                                               "(CSV, JSON sidecar, figure)")
+    ch.add_argument("--frequency", type=float, default=None,
+                    help="drive frequency [Hz] (default: the scene's)")
+    ch.add_argument("--points", type=int, default=41,
+                    help="loads from no load to 1.25 times the stall force (default 41)")
+    ch.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+    ch.add_argument("--out", default="out", help="output folder (default ./out)")
+    ch.add_argument("--no-plot", action="store_true", help="skip the figure")
+    _add_params(ch, scheme_defaults=False)
+    add_scene_options(ch)
+    ch.set_defaults(func=_cmd_characteristic)
     _add_reproduce(sub)
     _add_atlas(sub)
     sc = sub.add_parser("scenes", help="the registered scenes, their parameters and units")

@@ -1,0 +1,361 @@
+"""The motor characteristic: mean rotor velocity, output power and efficiency against the load.
+
+``moreau characteristic --scene NAME`` sweeps the load of a periodically
+driven scene with a ``load`` parameter (the friction drive, the two-rod
+drive, the stick–slip motor) from no load to beyond stall, each point a
+periodic steady state under the chosen scheme, and gives what a motor
+designer reads off the curve:
+
+* the no-load velocity ``v0`` (the mean rotor velocity at ``F_L = 0``);
+* the stall force: the load at which the mean velocity is zero, located by
+  Brent's method on ``v(F_L)`` (bracketed by stepping the load along the
+  secant of the curve), not read off the grid;
+* the maximum mechanical output power ``P = F_L v`` and the load at which it
+  occurs, refined by a bounded Brent minimisation around the best grid
+  point.
+
+Sign convention: the scenes' load ``F_L`` pushes the rotor towards ``-x``
+(``J u2'' = f_T - f_L``), so a load opposes a forward motion when positive
+and a backward one when negative; the power ``F_L v`` is positive when the
+motor works against the load. Every force is reported signed in this
+convention: at 185 Hz the paper's drive runs backwards and its stall force
+is negative. Past the stall force the load reverses the motion (the rotor is
+pushed back through the slipping contact); those rows say so in their
+``motion`` column and the summary counts them. Further out the rotor runs
+away (no steady state), which the rows report as their ``status``.
+
+With an energy audit (:mod:`moreau.analysis.energy`) each row also has the
+stators' input power and the efficiency ``P / P_in``.
+
+Examples
+--------
+>>> ch = motor_characteristic("friction-drive", frequency=2000.0, points=5, out=None,
+...                           plot=False)
+>>> round(ch["summary"]["stall_force_N"], 6) > 0, ch["summary"]["no_load_velocity_m_per_s"] > 0
+(True, True)
+"""
+
+import csv
+import json
+import math
+
+import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
+from .._validate import finite_scalar, positive, positive_int
+from ..errors import ConvergenceError, InputError, MoreauError, RunawayError
+from ..provenance import provenance
+from ..scenes import registry
+from .energy import energy_audit, energy_to_si, has_energy_audit
+from .engine import audit_options, check_output_dir, periodic_scene_names
+from .mj_steady_state import moreau_jean_steady_state
+from .scheme_settings import ED_REFERENCE, steady_of
+from .steady_state import implausible_steady_state
+
+__all__ = ["motor_characteristic", "characteristic_tag", "COLUMNS", "MAX_POINTS"]
+
+#: bound on the grid of one characteristic (each point a steady state)
+MAX_POINTS = 10**4
+
+#: the CSV columns (SI units in the names)
+COLUMNS = ("load_N", "average_velocity_m_per_s", "output_power_W", "input_power_W",
+           "efficiency", "motion", "mode", "status")
+
+#: first probe of the load, as a share of the scene's force unit
+_FIRST_PROBE = 1e-3
+#: load steps while bracketing the stall force, at most this factor at a time
+_MAX_GROWTH = 4.0
+_MAX_PROBES = 60
+#: Newton and bracketing iterations of a Moreau–Jean steady state that failed with its default
+_MJ_MAX_ITER = 300
+
+
+def characteristic_tag(scene, frequency, scheme):
+    """File stem of a characteristic: scene, frequency and the scheme's settings.
+
+    Examples
+    --------
+    >>> characteristic_tag("friction-drive", 185.0, ED_REFERENCE)
+    'characteristic_friction-drive_185Hz_event-driven'
+    """
+    parts = [f"characteristic_{scene}", f"{frequency:g}Hz", scheme.name]
+    if scheme.theta is not None:
+        parts.append(f"theta{scheme.theta:g}")
+    if scheme.steps_per_period is not None:
+        parts.append(f"N{scheme.steps_per_period}")
+    parts += [f"{k}{v:g}" if isinstance(v, float) else f"{k}{v}" for k, v in scheme[4]]
+    return "_".join(parts)
+
+
+class _Curve:
+    """``v(F_L)`` of one scene and scheme, each load's steady state computed once."""
+
+    def __init__(self, entry, frequency, fixed, scheme):
+        self.entry, self.frequency, self.fixed, self.scheme = entry, frequency, fixed, scheme
+        self.points = {}
+
+    def scene(self, load):
+        kw = dict(self.fixed, load=float(load))
+        if self.frequency is not None:
+            kw["frequency"] = self.frequency
+        return registry.make_scene(self.entry.name, **kw)
+
+    def at(self, load):
+        """``(velocity [m/s] or None, status, scene, steady state or None)`` at ``load`` [N]."""
+        load = float(load)
+        if load not in self.points:
+            sc = self.scene(load)
+            try:
+                ss = self._steady(sc)
+                if not (ss.stats or {}).get("periodic", True):
+                    raise MoreauError(ss.stats.get("message", "no period-1 orbit"))
+                v = float(sc.displacement_to_si(ss.displacement_per_period)) / float(
+                    sc.period * sc.time_unit_s)
+                self.points[load] = (v, "ok", sc, ss)
+            except MoreauError as exc:
+                self.points[load] = (None, f"{type(exc).__name__}: {' '.join(str(exc).split())}",
+                                     sc, None)
+        return self.points[load]
+
+    def _steady(self, sc):
+        try:
+            return steady_of(sc, self.scheme)
+        except RunawayError:
+            raise
+        except ConvergenceError:
+            if self.scheme.name != "moreau-jean":
+                raise
+        # near stall the discrete map's fixed point in u2' is found by bracketing, one
+        # period map per step: give it the iterations it needs (65 at 185 Hz, N = 1000)
+        kw = dict(self.scheme.options)
+        if self.scheme.rtol is not None:
+            kw["tol"] = self.scheme.rtol
+        ss = moreau_jean_steady_state(sc, self.scheme.steps_per_period, self.scheme.theta,
+                                      max_iter=_MJ_MAX_ITER, **kw)
+        why = implausible_steady_state(sc, ss)
+        if why:
+            raise RunawayError(why)
+        return ss
+
+    def velocity(self, load):
+        v, status, _, _ = self.at(load)
+        if v is None:
+            raise MoreauError(f"no steady state at load {load!r} N inside the stall bracket "
+                              f"({status})")
+        return v
+
+
+def _stall(curve, v0, unit):
+    """Signed stall force: bracket the sign change of ``v(F)`` along the opposing load, then Brent."""
+    s = math.copysign(1.0, v0)
+    fa, va = 0.0, v0
+    f = s * _FIRST_PROBE * unit
+    bad = None
+    for _ in range(_MAX_PROBES):
+        v, status, _, _ = curve.at(f)
+        if v is None:
+            # past the reversal region already (a runaway): halve back towards the last good load
+            bad = f
+            f = 0.5 * (fa + bad)
+            if abs(bad - fa) <= 1e-9 * abs(bad):
+                raise MoreauError(f"no stall found: the steady state is lost at load {bad:.6g} N "
+                                  f"({status}) while the motion has not reversed yet")
+            continue
+        if v * s <= 0.0:
+            if v == 0.0:
+                return f
+            root = brentq(curve.velocity, fa, f, xtol=1e-12 * abs(f), rtol=1e-10, maxiter=100)
+            return float(root)
+        # the secant's zero, overshot by a tenth, at most _MAX_GROWTH times further out
+        slope = (v - va) / (f - fa)
+        target = abs(f) * _MAX_GROWTH
+        if slope != 0.0 and (v / slope) * s > 0.0:
+            target = min(target, 1.1 * abs(f - v / slope))
+        fa, va = f, v
+        f = s * max(target, 1.05 * abs(f))
+        if bad is not None and abs(f) >= abs(bad):
+            f = 0.5 * (fa + bad)
+    raise MoreauError(f"no stall found within {_MAX_PROBES} loads up to {fa:.6g} N: the mean "
+                      f"velocity keeps the no-load sign ({va:.6g} m/s there)")
+
+
+def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE, points=41,
+                         beyond=1.25, out="out", plot=True, log=print):
+    """The load characteristic of the registered scene ``scene`` (module docstring).
+
+    Parameters
+    ----------
+    scene : str
+        A registered periodically driven scene with a ``load`` parameter.
+    frequency : float, optional
+        Drive frequency [Hz] (default: the scene's default).
+    fixed : dict, optional
+        Other parameters of the scene (SI); ``load`` is the swept one.
+    scheme : moreau.analysis.engine.Scheme
+        Event-driven reference (default) or any scheme with a steady state.
+    points : int
+        Loads on the grid, >= 3, from no load to ``beyond`` times the stall force.
+    beyond : float
+        The grid's end, as a multiple of the stall force, > 1.
+    out : path-like or None
+        Output folder (checked writable before any work); None writes nothing.
+    plot : bool
+        Write the figure (needs matplotlib).
+
+    Returns
+    -------
+    dict
+        ``summary`` (the ``--json`` output: ``stall_force_N``,
+        ``no_load_velocity_m_per_s``, ``max_power_W``, ``load_at_max_power_N``,
+        the reversal, the settings) and ``rows`` (the CSV).
+    """
+    entry = registry.get_entry(scene)
+    if entry.name not in periodic_scene_names():
+        raise InputError(f"`--scene` must be a periodically driven scene, one of "
+                         f"{periodic_scene_names()}; got {scene!r}")
+    names = entry.parameter_names()
+    if "load" not in names:
+        raise InputError(f"`--scene` {entry.name!r} has no `load` parameter to sweep")
+    fixed = dict(fixed or {})
+    if "load" in fixed:
+        raise InputError("`load` is swept by the characteristic; do not fix it")
+    if "frequency" in fixed:
+        if frequency is not None:
+            raise InputError("`frequency` is given twice (`--frequency` and `--set frequency=...`)")
+        frequency = fixed.pop("frequency")
+    if frequency is None:
+        frequency = entry.defaults().get("frequency")
+    if frequency is not None:
+        frequency = positive("frequency", frequency)
+    points = positive_int("points", points)
+    if not 3 <= points <= MAX_POINTS:
+        raise InputError(f"`--points` must be from 3 to {MAX_POINTS}, got {points}")
+    beyond = finite_scalar("beyond", beyond)
+    if not beyond > 1.0:
+        raise InputError(f"`beyond` must be > 1 (the grid goes past the stall force), got {beyond!r}")
+    curve = _Curve(entry, frequency, fixed, scheme)
+    sc0 = curve.scene(0.0)   # the parameters make a valid scene before any work
+    if out is not None:
+        out = check_output_dir(out)
+
+    v0, status, _, _ = curve.at(0.0)
+    if v0 is None:
+        raise MoreauError(f"no steady state at no load: {status}")
+    if v0 == 0.0:
+        raise MoreauError("the rotor does not move at no load: no characteristic to trace")
+    unit = float(sc0.force_to_si(1.0))
+    stall = _stall(curve, v0, unit)
+    n_stall = len(curve.points)
+
+    loads = np.linspace(0.0, beyond * stall, points)
+    rows = [_row(curve, f, v0, scheme) for f in loads]
+    power = np.array([r["output_power_W"] if r["status"] == "ok" else -math.inf for r in rows])
+    i = int(np.argmax(power))
+    lo, hi = loads[max(i - 1, 0)], loads[min(i + 1, points - 1)]
+    lo, hi = sorted((lo, hi))
+    # the power curve is smooth near its maximum: Brent's bounded minimisation of -F v
+    res = minimize_scalar(lambda f: -f * curve.velocity(f), bounds=(lo, hi), method="bounded",
+                          options={"xatol": 1e-10 * abs(stall)})
+    f_best, p_best = (float(res.x), float(-res.fun)) if -res.fun >= power[i] else (
+        float(loads[i]), float(power[i]))
+    reversed_rows = [r for r in rows if r["motion"] == "reversed"]
+    direction = "forward" if v0 > 0 else "backward"
+    summary = {
+        "scene": entry.name,
+        "frequency_Hz": frequency,
+        "scheme": scheme.name,
+        "no_load_velocity_m_per_s": v0,
+        "stall_force_N": stall,
+        "max_power_W": p_best,
+        "load_at_max_power_N": f_best,
+        "no_load_direction": direction,
+        "load_convention": ("a positive load pushes the rotor towards -x; a load opposing the "
+                            f"no-load ({direction}) motion is {'positive' if v0 > 0 else 'negative'}"),
+        "reverses_motion": bool(reversed_rows),
+        "reversal": (f"loads beyond the stall force {stall:.6g} N reverse the motion: "
+                     f"{len(reversed_rows)} of the {points} grid loads, e.g. {reversed_rows[-1]['load_N']:.6g} N "
+                     f"moves the rotor at {reversed_rows[-1]['average_velocity_m_per_s']:.6g} m/s"
+                     if reversed_rows else
+                     "no grid load beyond the stall force has a steady state (the rotor runs away)"),
+        "points": points,
+        "steady_states_for_stall": n_stall,
+        "parameters": {k: v for k, v in sc0.params.__dict__.items() if k != "load"}
+        if hasattr(sc0, "params") else dict(fixed),
+        "scheme_settings": {"theta": scheme.theta, "steps_per_period": scheme.steps_per_period,
+                            "rtol": scheme.rtol, "options": scheme.options},
+    }
+    if out is not None:
+        stem = out / characteristic_tag(entry.name, frequency or 0.0, scheme)
+        csv_path = stem.with_name(stem.name + ".csv")
+        with open(csv_path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(COLUMNS))
+            w.writeheader()
+            w.writerows(rows)
+        side = dict(summary, provenance=provenance(), csv=csv_path.name)
+        json_path = stem.with_name(stem.name + ".json")
+        json_path.write_text(json.dumps(side, indent=1, default=str))
+        log(f"wrote {csv_path} and {json_path.name}")
+        if plot:
+            fig = stem.with_name(stem.name + ".png")
+            if _figure(rows, summary, fig):
+                log(f"wrote {fig}")
+            else:
+                log("matplotlib is not installed: no figure (pip install matplotlib)")
+    return {"summary": summary, "rows": rows}
+
+
+def _row(curve, load, v0, scheme):
+    v, status, sc, ss = curve.at(load)
+    row = dict.fromkeys(COLUMNS, math.nan)
+    row.update(load_N=float(load), motion="", mode="", status=status)
+    if v is None:
+        return row
+    row.update(average_velocity_m_per_s=v, output_power_W=float(load) * v, mode=ss.mode,
+               motion="reversed" if v * v0 < 0.0 else ("stalled" if v == 0.0 else "driven"))
+    if has_energy_audit(sc, scheme.name):
+        try:
+            audit = energy_to_si(sc, energy_audit(sc, ss, scheme.name, audit_options(scheme)))
+        except MoreauError:
+            return row
+        p_in = audit["stator_work_J"] / float(sc.period * sc.time_unit_s)
+        row.update(input_power_W=p_in, efficiency=row["output_power_W"] / p_in)
+    return row
+
+
+def _figure(rows, summary, path):
+    try:
+        import matplotlib  # noqa: PLC0415  (optional: figures only)
+    except ImportError:
+        return False
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    f = np.array([r["load_N"] for r in ok]) * 1e3
+    v = np.array([r["average_velocity_m_per_s"] for r in ok]) * 1e3
+    p = np.array([r["output_power_W"] for r in ok]) * 1e6
+    eff = np.array([r["efficiency"] for r in ok])
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    a1.plot(f, v, "k.-", lw=0.8)
+    a1.axhline(0.0, color="0.7", lw=0.5)
+    a1.axvline(summary["stall_force_N"] * 1e3, color="C3", lw=0.8, ls="--",
+               label=f"stall {summary['stall_force_N'] * 1e3:.4g} mN")
+    a1.set_ylabel("mean rotor velocity [mm/s]")
+    a1.legend(fontsize=8)
+    a1.set_title(f"{summary['scene']} at {summary['frequency_Hz']:g} Hz ({summary['scheme']}): "
+                 "load characteristic")
+    a2.plot(f, p, "C0.-", lw=0.8, label="output power F_L v")
+    a2.plot(summary["load_at_max_power_N"] * 1e3, summary["max_power_W"] * 1e6, "C3o",
+            label=f"max {summary['max_power_W'] * 1e6:.4g} uW")
+    a2.axhline(0.0, color="0.7", lw=0.5)
+    a2.set_ylabel("output power [uW]")
+    a2.set_xlabel("load F_L [mN] (positive pushes the rotor towards -x)")
+    if np.any(np.isfinite(eff)):
+        ax = a2.twinx()
+        ax.plot(f, eff * 100, "C2--", lw=0.8, label="efficiency")
+        ax.set_ylabel("efficiency [%]", color="C2")
+    a2.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
