@@ -2,6 +2,7 @@
 
 import json
 import math
+from dataclasses import asdict
 
 import numpy as np
 import pytest
@@ -128,7 +129,6 @@ def test_steady_json_says_when_no_audit(capsys):
 
 
 def test_sweep_rows_carry_the_audit():
-    from dataclasses import asdict
     row = evaluate_point(asdict(PAPER_DEFAULTS), 185.0, ED_REFERENCE, energy=True)
     assert set(ENERGY_COLUMNS) <= set(row)
     assert row["energy_status"] == "ok" and abs(row["energy_closing_error"]) < 1e-9
