@@ -321,6 +321,35 @@ def check_scheduler(scheduler):
     return scheduler
 
 
+#: seconds to wait for a Dask scheduler to answer before the run is refused
+SCHEDULER_TIMEOUT_S = 10.0
+
+
+def connect_scheduler(scheduler):
+    """A Dask client for ``scheduler``, connected before any work, and whether it is ours to close.
+
+    An address where no scheduler answers within :data:`SCHEDULER_TIMEOUT_S`
+    is refused as bad input (the run has not started), not left to fail as a
+    network traceback half-way through.
+
+    Examples
+    --------
+    >>> connect_scheduler(None)
+    (None, False)
+    """
+    scheduler = check_scheduler(scheduler)
+    if scheduler is None or hasattr(scheduler, "submit"):
+        return scheduler, False
+    from distributed import Client  # optional dependency, checked by check_scheduler
+
+    try:
+        return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s"), True
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"`--scheduler` {scheduler}: no Dask scheduler answered there within "
+                         f"{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}); start one with "
+                         "`dask scheduler` or check the address") from None
+
+
 #: the key of a row's fingerprint of its inputs (removed before rows are returned)
 INPUTS_KEY = "_inputs"
 
@@ -407,6 +436,17 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     scheduler = check_scheduler(scheduler)
     if cache_dir is not None:
         check_output_dir(cache_dir, "--cache")
+    client, own_client = connect_scheduler(scheduler)
+    try:
+        return _run_points(points, scheme, checks, cache_dir, n_jobs, client, progress, desc,
+                           chunk, scene)
+    finally:
+        if own_client:
+            client.close()
+
+
+def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, desc, chunk,
+                scene):
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
@@ -495,20 +535,14 @@ def _indexed(func, k, a):
     return k, func(*a)
 
 
-def _dask_results(func, args, scheduler):
-    from distributed import Client, as_completed
+def _dask_results(func, args, client):
+    from distributed import as_completed  # optional dependency, checked by check_scheduler
 
-    own = not hasattr(scheduler, "submit")
-    client = Client(scheduler) if own else scheduler
-    try:
-        futures = {client.submit(func, *a, pure=False): k for k, a in enumerate(args)}
-        for fut in as_completed(list(futures)):
-            k = futures[fut]
-            try:
-                row = fut.result()
-            except Exception as exc:  # a lost worker: the point fails, the run goes on
-                row = {"status": _status_of(exc)}
-            yield k, row
-    finally:
-        if own:
-            client.close()
+    futures = {client.submit(func, *a, pure=False): k for k, a in enumerate(args)}
+    for fut in as_completed(list(futures)):
+        k = futures[fut]
+        try:
+            row = fut.result()
+        except Exception as exc:  # a lost worker: the point fails, the run goes on
+            row = {"status": _status_of(exc)}
+        yield k, row
