@@ -16,7 +16,7 @@ from .analysis.atlas import run_scene_atlas
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
-from .errors import InputError, MoreauError
+from .errors import InputError, Interrupted, MoreauError
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
@@ -516,6 +516,13 @@ def main(argv=None):
     except MoreauError as exc:
         print(f"moreau: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
         return 1
+    except Interrupted as exc:
+        resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
+        print(f"\nmoreau: interrupted: {exc}{resume}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("\nmoreau: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 

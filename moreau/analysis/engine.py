@@ -25,12 +25,14 @@ import logging
 import math
 import os
 import pathlib
+import signal
 import time
+import warnings
 
 import joblib
 
 from .. import __version__
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, Interrupted
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .steady_state import implausible_steady_state
@@ -497,6 +499,7 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
         from tqdm.auto import tqdm
         bar = tqdm(total=len(points), initial=n_cached, desc=desc, unit="pt",
                    disable=None, leave=False)
+    done = n_cached
     try:
         if todo:
             if scheduler is not None:
@@ -508,8 +511,12 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
                 # once and writes numba's on-disk cache, which the workers then load
                 # instead of each compiling the same kernels at the same time
                 first = (0, func(*args[todo[0]]))
-                par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
-                                      batch_size=1)
+                done += sizes[todo[0]]
+                # the workers ignore Ctrl-C: the parent alone stops the run and ends them,
+                # so that an interrupt prints no worker tracebacks and leaves no orphans
+                with joblib.parallel_config("loky", initializer=_ignore_sigint):
+                    par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
+                                          batch_size=1)
                 rest = par(joblib.delayed(_indexed)(func, k, args[i])
                            for k, i in enumerate(todo) if k > 0)
                 results = itertools.chain([first], rest)
@@ -523,6 +530,14 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
                 out[i] = res
                 if bar is not None:
                     bar.update(sizes[i])
+                done = n_cached + sum(sizes[j] for j in todo if out[j] is not None)
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
+            bar = None
+        _end_workers(locals().get("rest"))
+        raise Interrupted(done, len(points), None if cache_dir is None else str(cache_dir),
+                          desc) from None
     finally:
         if bar is not None:
             bar.close()
@@ -533,6 +548,23 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
 
 def _indexed(func, k, a):
     return k, func(*a)
+
+
+def _ignore_sigint():
+    # a loky worker's initializer: Ctrl-C on a terminal reaches the whole process group
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _end_workers(results):
+    # closing joblib's generator aborts the run and ends its workers
+    if results is not None and hasattr(results, "close"):
+        try:
+            with warnings.catch_warnings():
+                # joblib counts the tasks it cancels in a UserWarning: the interrupt line says it
+                warnings.simplefilter("ignore")
+                results.close()
+        except Exception as exc:  # ending the pool must not hide the interrupt
+            log.debug("closing the worker pool after an interrupt: %s", exc)
 
 
 def _dask_results(func, args, client):
