@@ -75,7 +75,8 @@ def run_moreau_lean(M, q, max_iter=None):
     return r.success, r.z
 
 
-@njit(cache=True)
+# compiled in memory: an on-disk cache would be written into benchmarks/__pycache__
+@njit
 def _kernel_loop(M, q, z, w, reps):
     st = 0
     for _ in range(reps):

@@ -17,7 +17,8 @@ from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
-from .errors import InputError, MoreauError
+from .errors import InputError, Interrupted, MoreauError
+from .outputs import claim_outputs
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
@@ -161,7 +162,8 @@ def _cmd_sweep(args):
                          args.scheme_options)
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
-                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
+                    force=args.force)
 
 
 def _cmd_characteristic(args):
@@ -234,12 +236,15 @@ def _cmd_run(args):
     if stepping and steps is not None:
         shown["steps"] = steps
     tag = history_tag(entry.name, params, args.scheme, shown)
+    settings = claim_outputs(os.path.join(args.out, tag), {
+        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
+        "periods": periods, "duration": duration, "samples": args.samples}, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
     side = write_history(cols, path, {
         "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
         "periods": periods, "duration": duration, "status": res.status, "message": res.message,
-        "command": "moreau run"})
+        "command": "moreau run", "settings": settings})
     print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
           f"{res.message}")
     if not args.no_plot:
@@ -288,6 +293,9 @@ def _add_atlas(sub):
     p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    p.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier atlas with other settings (refused "
+                        "otherwise)")
     _add_params(p, scheme_defaults=False)
     add_scene_options(p, with_set=False)
     p.set_defaults(func=_cmd_atlas)
@@ -334,7 +342,8 @@ def _cmd_atlas(args):
                          args.scheme_options)
     run_scene_atlas(entry.name, axes[0], axes[1], fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
-                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+                    scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
+                    force=args.force)
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -468,6 +477,8 @@ def build_parser():
     s.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
+    s.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier run with other settings (refused otherwise)")
     _add_params(s, scheme_defaults=False)
     add_scene_options(s, with_set=False)
     s.set_defaults(func=_cmd_sweep)
@@ -484,6 +495,8 @@ def build_parser():
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
+    r.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier run with other settings (refused otherwise)")
     _add_params(r, scheme_defaults=False)
     add_scene_options(r)
     r.set_defaults(func=_cmd_run)
@@ -557,6 +570,13 @@ def main(argv=None):
     except MoreauError as exc:
         print(f"moreau: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
         return 1
+    except Interrupted as exc:
+        resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
+        print(f"\nmoreau: interrupted: {exc}{resume}", file=sys.stderr)
+        return 130
+    except KeyboardInterrupt:
+        print("\nmoreau: interrupted", file=sys.stderr)
+        return 130
     return 0
 
 

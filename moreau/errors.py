@@ -1,7 +1,9 @@
 """Exception hierarchy of :mod:`moreau`.
 
 Every exception the package raises on purpose derives from :class:`MoreauError`,
-so ``except MoreauError`` catches them all. Bad input additionally derives from
+so ``except MoreauError`` catches them all, except :class:`Interrupted`: a
+``KeyboardInterrupt`` carrying what an interrupted run kept, which no
+``except Exception`` may swallow. Bad input additionally derives from
 :class:`ValueError`, so code that already handles ``ValueError`` keeps working.
 """
 
@@ -14,6 +16,7 @@ __all__ = [
     "LCPError",
     "ConvergenceError",
     "RunawayError",
+    "Interrupted",
 ]
 
 
@@ -50,3 +53,30 @@ class ConvergenceError(MoreauError):
 
 class RunawayError(ConvergenceError):
     """No steady state exists: the driven body runs away (e.g. past the motor's stall load)."""
+
+
+class Interrupted(KeyboardInterrupt):
+    """A long run stopped by the user (Ctrl-C); the message says what was kept.
+
+    A subclass of ``KeyboardInterrupt``, so that code catching
+    ``Exception`` (a failing point becoming a status) never takes an
+    interrupt for a failure.
+
+    Attributes
+    ----------
+    done, total : int
+        Points finished (computed or read from the cache) and asked for.
+    cache_dir : str or None
+        Where the finished points are kept; a rerun with the same cache
+        reads them instead of computing them again.
+
+    Examples
+    --------
+    >>> str(Interrupted(3, 10, "out/cache", "sweep mu"))
+    'sweep mu: 3 of 10 points finished, kept in out/cache'
+    """
+
+    def __init__(self, done, total, cache_dir=None, what="run"):
+        self.done, self.total, self.cache_dir = int(done), int(total), cache_dir
+        kept = f", kept in {cache_dir}" if cache_dir is not None else " (no cache: nothing kept)"
+        super().__init__(f"{what}: {self.done} of {self.total} points finished{kept}")

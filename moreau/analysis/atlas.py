@@ -30,6 +30,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
+from ..outputs import claim_outputs
 from ..provenance import provenance
 from . import engine
 from .engine import ED_REFERENCE, check_output_dir
@@ -55,7 +56,7 @@ def atlas_tag(scene, x, y, frequency, scheme):
 
 def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE, out="out",
                     cache_dir=None, n_jobs=-1, scheduler=None, progress=True, plot=True,
-                    log=print):
+                    log=print, force=False):
     """Steady states of the registered scene ``scene`` on the grid ``x`` by ``y``.
 
     Parameters
@@ -74,6 +75,9 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         Output folder, checked writable before any work; None writes nothing.
     cache_dir : path-like, optional
         The engine's cache (default ``OUT/cache``; none without ``out``).
+    force : bool
+        Replace the files of an earlier atlas with other settings; refused
+        otherwise, before any work (:func:`moreau.outputs.claim_outputs`).
 
     Returns
     -------
@@ -90,11 +94,18 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
                          f"{MAX_POINTS:.0e} of one atlas")
     entry, columns, point, frequency = plan_points(scene, (xname, yname), (xv, yv), fixed,
                                                    frequency)
+    grid = [(a, b) for b in yv for a in xv]
+    points = [point({xname: a, yname: b}) for a, b in grid]
     if out is not None:
         out = check_output_dir(out)
         cache_dir = out / "cache" if cache_dir is None else cache_dir
-    grid = [(a, b) for b in yv for a in xv]
-    points = [point({xname: a, yname: b}) for a, b in grid]
+        stem = out / atlas_tag(entry.name, xname, yname, frequency, scheme)
+        settings = claim_outputs(stem, {
+            "scene": entry.name, "x": [xname, xv.tolist()], "y": [yname, yv.tolist()],
+            "frequency_Hz": frequency,
+            "fixed": {k: v for k, v in points[0][0].items() if k not in (xname, yname)},
+            "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                       scheme.options]}, force)
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"atlas {xname}-{yname}", scene=entry.name)
@@ -112,7 +123,6 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         table.append(r)
     if out is None:
         return table
-    stem = out / atlas_tag(entry.name, xname, yname, frequency, scheme)
     csv_path = stem.with_name(stem.name + ".csv")
     with open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(table[0]))
@@ -130,7 +140,8 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
                        "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
                        "options": scheme.options},
             "modes": _mode_counts(table),
-            "engine": stats, "provenance": provenance(engine.code_version())}
+            "engine": stats, "provenance": provenance(engine.code_version()),
+            "settings": settings}
     json_path = stem.with_name(stem.name + ".json")
     json_path.write_text(json.dumps(meta, indent=1, default=str))
     log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "

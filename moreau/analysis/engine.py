@@ -25,12 +25,14 @@ import logging
 import math
 import os
 import pathlib
+import signal
 import time
+import warnings
 
 import joblib
 
 from .. import __version__
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, Interrupted
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
@@ -366,6 +368,35 @@ def check_scheduler(scheduler):
     return scheduler
 
 
+#: seconds to wait for a Dask scheduler to answer before the run is refused
+SCHEDULER_TIMEOUT_S = 10.0
+
+
+def connect_scheduler(scheduler):
+    """A Dask client for ``scheduler``, connected before any work, and whether it is ours to close.
+
+    An address where no scheduler answers within :data:`SCHEDULER_TIMEOUT_S`
+    is refused as bad input (the run has not started), not left to fail as a
+    network traceback half-way through.
+
+    Examples
+    --------
+    >>> connect_scheduler(None)
+    (None, False)
+    """
+    scheduler = check_scheduler(scheduler)
+    if scheduler is None or hasattr(scheduler, "submit"):
+        return scheduler, False
+    from distributed import Client  # optional dependency, checked by check_scheduler
+
+    try:
+        return Client(scheduler, timeout=f"{SCHEDULER_TIMEOUT_S}s"), True
+    except (OSError, TimeoutError) as exc:
+        raise InputError(f"`--scheduler` {scheduler}: no Dask scheduler answered there within "
+                         f"{SCHEDULER_TIMEOUT_S:g} s ({type(exc).__name__}); start one with "
+                         "`dask scheduler` or check the address") from None
+
+
 #: the key of a row's fingerprint of its inputs (removed before rows are returned)
 INPUTS_KEY = "_inputs"
 
@@ -455,6 +486,17 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     scheduler = check_scheduler(scheduler)
     if cache_dir is not None:
         check_output_dir(cache_dir, "--cache")
+    client, own_client = connect_scheduler(scheduler)
+    try:
+        return _run_points(points, scheme, checks, cache_dir, n_jobs, client, progress, desc,
+                           chunk, scene)
+    finally:
+        if own_client:
+            client.close()
+
+
+def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, desc, chunk,
+                scene):
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
@@ -506,6 +548,7 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         from tqdm.auto import tqdm
         bar = tqdm(total=len(points), initial=n_cached, desc=desc, unit="pt",
                    disable=None, leave=False)
+    done = n_cached
     try:
         if todo:
             if scheduler is not None:
@@ -517,8 +560,12 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
                 # once and writes numba's on-disk cache, which the workers then load
                 # instead of each compiling the same kernels at the same time
                 first = (0, func(*args[todo[0]]))
-                par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
-                                      batch_size=1)
+                done += sizes[todo[0]]
+                # the workers ignore Ctrl-C: the parent alone stops the run and ends them,
+                # so that an interrupt prints no worker tracebacks and leaves no orphans
+                with joblib.parallel_config("loky", initializer=_ignore_sigint):
+                    par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
+                                          batch_size=1)
                 rest = par(joblib.delayed(_indexed)(func, k, args[i])
                            for k, i in enumerate(todo) if k > 0)
                 results = itertools.chain([first], rest)
@@ -532,6 +579,14 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
                 out[i] = res
                 if bar is not None:
                     bar.update(sizes[i])
+                done = n_cached + sum(sizes[j] for j in todo if out[j] is not None)
+    except KeyboardInterrupt:
+        if bar is not None:
+            bar.close()
+            bar = None
+        _end_workers(locals().get("rest"))
+        raise Interrupted(done, len(points), None if cache_dir is None else str(cache_dir),
+                          desc) from None
     finally:
         if bar is not None:
             bar.close()
@@ -544,20 +599,31 @@ def _indexed(func, k, a):
     return k, func(*a)
 
 
-def _dask_results(func, args, scheduler):
-    from distributed import Client, as_completed
+def _ignore_sigint():
+    # a loky worker's initializer: Ctrl-C on a terminal reaches the whole process group
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
-    own = not hasattr(scheduler, "submit")
-    client = Client(scheduler) if own else scheduler
-    try:
-        futures = {client.submit(func, *a, pure=False): k for k, a in enumerate(args)}
-        for fut in as_completed(list(futures)):
-            k = futures[fut]
-            try:
-                row = fut.result()
-            except Exception as exc:  # a lost worker: the point fails, the run goes on
-                row = {"status": _status_of(exc)}
-            yield k, row
-    finally:
-        if own:
-            client.close()
+
+def _end_workers(results):
+    # closing joblib's generator aborts the run and ends its workers
+    if results is not None and hasattr(results, "close"):
+        try:
+            with warnings.catch_warnings():
+                # joblib counts the tasks it cancels in a UserWarning: the interrupt line says it
+                warnings.simplefilter("ignore")
+                results.close()
+        except Exception as exc:  # ending the pool must not hide the interrupt
+            log.debug("closing the worker pool after an interrupt: %s", exc)
+
+
+def _dask_results(func, args, client):
+    from distributed import as_completed  # optional dependency, checked by check_scheduler
+
+    futures = {client.submit(func, *a, pure=False): k for k, a in enumerate(args)}
+    for fut in as_completed(list(futures)):
+        k = futures[fut]
+        try:
+            row = fut.result()
+        except Exception as exc:  # a lost worker: the point fails, the run goes on
+            row = {"status": _status_of(exc)}
+        yield k, row

@@ -31,6 +31,7 @@ import numpy as np
 
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import InputError
+from ..outputs import claim_outputs
 from ..provenance import provenance
 from ..scenes import registry
 from . import engine
@@ -174,7 +175,7 @@ def plan_points(scene, swept, values, fixed=None, frequency=None):
 
 def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme=ED_REFERENCE,
                     out="out", cache_dir=None, n_jobs=-1, scheduler=None, progress=True,
-                    plot=True, log=print):
+                    plot=True, log=print, force=False):
     """Steady states of the registered scene ``scene`` over ``values`` of ``parameter``.
 
     Parameters
@@ -194,6 +195,9 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
         Output folder, checked writable before any work; None writes nothing.
     cache_dir : path-like, optional
         The engine's cache (default ``OUT/cache``; none without ``out``).
+    force : bool
+        Replace the files of an earlier sweep with other settings
+        (:func:`moreau.outputs.claim_outputs`); refused otherwise, before any work.
 
     Returns
     -------
@@ -203,10 +207,17 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     values = np.asarray(values, dtype=float).reshape(-1)
     entry, columns, point, frequency = plan_points(scene, (parameter,), (values,), fixed,
                                                    frequency)
+    points = [point({parameter: x}) for x in values]
     if out is not None:
         out = check_output_dir(out)
         cache_dir = out / "cache" if cache_dir is None else cache_dir
-    points = [point({parameter: x}) for x in values]
+        stem = out / sweep_tag(entry.name, parameter, frequency, scheme)
+        settings = claim_outputs(stem, {
+            "scene": entry.name, "parameter": parameter, "values": values.tolist(),
+            "frequency_Hz": frequency,
+            "fixed": {k: v for k, v in points[0][0].items() if k != parameter},
+            "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                       scheme.options]}, force)
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", scene=entry.name, energy=True)
@@ -226,7 +237,6 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
         table.append(r)
     if out is None:
         return table
-    stem = out / sweep_tag(entry.name, parameter, frequency, scheme)
     csv_path = stem.with_name(stem.name + ".csv")
     with open(csv_path, "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(table[0]))
@@ -238,7 +248,8 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             "scheme": {"name": scheme.name, "theta": scheme.theta,
                        "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
                        "options": scheme.options},
-            "engine": stats, "provenance": provenance(engine.code_version())}
+            "engine": stats, "provenance": provenance(engine.code_version()),
+            "settings": settings}
     json_path = stem.with_name(stem.name + ".json")
     json_path.write_text(json.dumps(meta, indent=1, default=str))
     log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "

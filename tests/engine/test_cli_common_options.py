@@ -62,3 +62,34 @@ def test_progress_bars_stay_out_of_logs(tmp_path):
     assert run.returncode == 0
     assert "it/s" not in log.read_text() and "run/s" not in log.read_text()
     assert "%|" not in log.read_text()
+
+
+def _free_port():
+    import socket
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def test_a_scheduler_that_does_not_answer_is_refused_before_work(tmp_path, capsys, monkeypatch):
+    from moreau.analysis import engine
+
+    monkeypatch.setattr(engine, "SCHEDULER_TIMEOUT_S", 1.0)
+    addr = f"tcp://127.0.0.1:{_free_port()}"
+    argv = ["sweep", "mu", "0.1", "0.2", "--points", "2", "--frequency", "185", "--out",
+            str(tmp_path), "--quiet", "--no-plot", "--scheduler", addr]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"moreau: error: `--scheduler` {addr}: no Dask scheduler answered there "
+                          "within 1 s") and err.count("\n") == 1
+    assert not list(tmp_path.glob("*.csv"))
+
+
+def test_a_scheduler_without_dask_names_the_extra(tmp_path, capsys, monkeypatch):
+    import sys
+
+    monkeypatch.setitem(sys.modules, "distributed", None)  # as if Dask were not installed
+    argv = ["reproduce", "--quick", "--scheduler", "tcp://127.0.0.1:8786", "--out", str(tmp_path)]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == ("moreau: error: `--scheduler` needs Dask, which is not "
+                                       "installed: pip install -e \".[dask]\"\n")

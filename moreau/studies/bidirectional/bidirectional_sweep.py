@@ -26,9 +26,11 @@ from ...analysis import engine
 from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import check_output_dir, code_version
 from ...errors import InputError
+from ...outputs import claim_outputs
+from ...provenance import provenance
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
 from ..paper.figures import sweep_figure
-from ..paper.sweeps import make_scheme, sweep_values
+from ..paper.sweeps import make_scheme, scheme_tag, sweep_values
 from ..paper.tables import write_table
 from ..paper.valid_range import lift_off_margin, range_marks
 from .direction_control import bidirectional_params
@@ -120,7 +122,8 @@ def tidy_rows(parameter, values, frequency, params, rows):
 
 def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, stop=None,
                             points=None, scale="linear", scheme=None, out="out", cache_dir=None,
-                            n_jobs=-1, scheduler=None, progress=True, plot=True, log=print):
+                            n_jobs=-1, scheduler=None, progress=True, plot=True, log=print,
+                            force=False):
     """Steady states of the bidirectional drive over one parameter, through the sweep engine.
 
     Writes ``OUT/sweep_bidirectional_TAG.csv`` (tidy, units in the column
@@ -171,6 +174,15 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     scheme = make_scheme() if scheme is None else scheme
     out = check_output_dir(out)
     cache_dir = out / "cache" if cache_dir is None else cache_dir
+    # the scheme and its non-default settings are in the name, as in the friction drive's sweep
+    tag = "bidirectional_" + (parameter if parameter == "frequency"
+                              else f"{parameter}_{frequency:g}Hz") + scheme_tag(scheme)
+    stem = out / f"sweep_{tag}"
+    settings = claim_outputs(stem, {
+        "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
+        "frequency_Hz": frequency, "parameters_SI": asdict(params),
+        "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                   scheme.options]}, force)
 
     pts = [(asdict(point_params(params, parameter, x)),
             float(x) if parameter == "frequency" else frequency) for x in values]
@@ -179,9 +191,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
                                     desc=f"sweep {parameter}", scene="bidirectional",
                                     energy=True)
     table = tidy_rows(parameter, values, frequency, params, rows)
-    tag = "bidirectional_" + (parameter if parameter == "frequency"
-                              else f"{parameter}_{frequency:g}Hz")
-    stem = out / f"sweep_{tag}"
+    for r in table:
+        r["scheme"] = scheme.name
     write_table(table, (stem.parent / (stem.name + ".csv")))
     marks = _marks(params, parameter, frequency)
     meta = {
@@ -201,6 +212,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         "code_version": code_version(),
         "python": sys.version.split()[0],
         "engine": stats,
+        "provenance": provenance(code_version()),
+        "settings": settings,
     }
     (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
     log(f"wrote {(stem.parent / (stem.name + '.csv'))} ({len(table)} points: {stats['computed']} computed, "
@@ -285,4 +298,4 @@ def command(args):
                             points=args.points if args.points is not None else args.num,
                             scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
                             n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
-                            plot=not args.no_plot)
+                            plot=not args.no_plot, force=args.force)

@@ -33,9 +33,11 @@ from ... import _validate as V
 from ...analysis import engine
 from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version, make_scheme
 from ...errors import InputError
+from ...outputs import claim_outputs
+from ...provenance import provenance
 from ...scenes.friction_drive import PAPER_DEFAULTS
 from .figures import atlas_figure
-from .sweeps import params_from_args
+from .sweeps import params_from_args, scheme_tag
 from .tables import write_table
 from .valid_range import lift_off_margin
 
@@ -191,11 +193,13 @@ def atlas_rows(atlas):
 
 def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 12500.0),
               f_points=200, y_points=100, scheme=None, cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print):
+              progress=True, plot=True, log=print, force=False):
     """The ``moreau atlas`` command: for each plane a tidy CSV, a JSON sidecar and a figure.
 
     Files: ``OUT/atlas_f-mu.csv`` (``.json``, ``.png``, ``.svg``) and the
-    same for ``f-phi0``. The cache lives in ``cache_dir`` (``OUT/cache`` by
+    same for ``f-phi0``; a scheme other than the event-driven reference's
+    default adds its tag (``atlas_f-mu_mj_theta1_N1000``). Files of an earlier
+    atlas with other settings are not replaced unless ``force``. The cache lives in ``cache_dir`` (``OUT/cache`` by
     default). The output folder is checked before any work.
 
     Returns
@@ -208,14 +212,25 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
             raise InputError(f"`plane` must be one of {list(PLANES)}, got {plane!r}")
     out = check_output_dir(out)
     cache_dir = out / "cache" if cache_dir is None else cache_dir
+    scheme = ED_REFERENCE if scheme is None else scheme
+    # the scheme and its non-default settings are in the names, as in the sweeps' names
+    stems = {plane: out / f"atlas_{plane}{scheme_tag(scheme)}" for plane in planes}
+    settings = {plane: claim_outputs(stems[plane], {
+        "plane": plane, "f_range": list(f_range), "grid": [f_points, y_points],
+        "parameters_SI": asdict(PAPER_DEFAULTS if params is None else params),
+        "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                   scheme.options]}, force) for plane in planes}
     results = {}
     for plane in planes:
         a = compute_atlas(plane, params, f_range=f_range, f_points=f_points, y_points=y_points,
                           scheme=scheme, cache_dir=cache_dir, n_jobs=n_jobs, scheduler=scheduler,
                           progress=progress)
-        stem = out / f"atlas_{plane}"
-        write_table(atlas_rows(a), (stem.parent / (stem.name + ".csv")))
+        stem = stems[plane]
         s = a["scheme"]
+        rows = atlas_rows(a)
+        for r in rows:
+            r["scheme"] = s.name
+        write_table(rows, (stem.parent / (stem.name + ".csv")))
         meta = {"plane": plane, "grid": [f_points, y_points],
                 "frequency_Hz": [float(a["frequency_Hz"][0]), float(a["frequency_Hz"][-1])],
                 a["y_name"]: [float(a["y"][0]), float(a["y"][-1])],
@@ -224,7 +239,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
                            "rtol": s.rtol},
                 "package_version": __version__, "code_version": code_version(),
                 "python": sys.version.split()[0], "engine": a["stats"],
-                "wall_time_s": a["wall_time_s"], "scheduler": scheduler}
+                "wall_time_s": a["wall_time_s"], "scheduler": scheduler,
+                "provenance": provenance(code_version()), "settings": settings[plane]}
         (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
         counts = {}
         for lab in a["label"].ravel():
@@ -264,4 +280,5 @@ def command(args):
                12500.0 if args.fmax is None else args.fmax)
     run_atlas(planes, params, out=args.out, f_range=f_range, f_points=f_points,
               y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
-              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
+              force=args.force)

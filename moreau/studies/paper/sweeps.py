@@ -9,6 +9,7 @@ sweep keeps the points it had finished.
 
 import csv
 import math
+from dataclasses import asdict
 
 import numpy as np
 
@@ -19,6 +20,7 @@ from ...analysis import engine, steady_state
 from ...analysis import sweep as scene_sweep
 from ...analysis.engine import check_output_dir, make_scheme
 from ...errors import InputError, MoreauError
+from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive, params_from_kwargs
 from .figures import sweep_figure
 from .tables import sweep_point, tidy_rows, write_sidecar, write_table
@@ -184,7 +186,7 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
 
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print):
+              progress=True, plot=True, log=print, force=False):
     """The ``moreau sweep`` command: steady states over one parameter through the sweep engine.
 
     Every point goes through :func:`moreau.analysis.engine.run_points`: cached
@@ -239,6 +241,16 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     scheme = make_scheme() if scheme is None else scheme
     out = check_output_dir(out)
     cache_dir = out / "cache" if cache_dir is None else cache_dir
+    tag = parameter if parameter == "frequency" else f"{parameter}_{frequency:g}Hz"
+    # a scheme or setting other than the reference's default is in the name, so
+    # that sweeps of one parameter by different schemes do not overwrite each other
+    tag += scheme_tag(scheme)
+    stem = out / f"sweep_{tag}"
+    settings = claim_outputs(stem, {
+        "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
+        "frequency_Hz": frequency, "parameters_SI": asdict(params),
+        "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                   scheme.options]}, force)
 
     points_ = [sweep_point(params, parameter, x, frequency) for x in values]
     rows, stats = engine.run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
@@ -247,15 +259,10 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     table = tidy_rows(parameter, values, frequency, params, rows, ())
     for r in table:
         r["scheme"] = scheme.name
-    tag = parameter if parameter == "frequency" else f"{parameter}_{frequency:g}Hz"
-    # a scheme or setting other than the reference's default is in the name, so
-    # that sweeps of one parameter by different schemes do not overwrite each other
-    tag += scheme_tag(scheme)
-    stem = out / f"sweep_{tag}"
     write_table(table, _with(stem, ".csv"))
     marks = range_marks(params, parameter, frequency)
     write_sidecar(_with(stem, ".json"), params, f"sweep_{tag}", parameter, values, frequency,
-                  marks, (), None, stats, scheme=scheme)
+                  marks, (), None, stats, scheme=scheme, settings=settings)
     log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
     if plot:
@@ -326,4 +333,5 @@ def command(args):
     run_sweep(args.parameter, params, frequency=frequency, start=args.start, stop=args.stop,
               points=args.points if args.points is not None else args.num, scale=scale,
               scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
-              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot)
+              scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
+              force=args.force)

@@ -15,6 +15,7 @@ from dataclasses import asdict
 from ... import __version__
 from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import ED_REFERENCE, code_version, mj_check_columns
+from ...provenance import provenance
 from .valid_range import lift_off_margin
 
 __all__ = ["SWEPT_COLUMN", "PARAM_COLUMNS", "VALUE_COLUMNS", "sweep_point", "tidy_rows",
@@ -101,8 +102,12 @@ def read_table(path):
 
 
 def write_sidecar(path, params, name, parameter, values, frequency, extra, checks, steps, stats,
-                  scheme=ED_REFERENCE):
-    """Write the JSON sidecar of one study's CSV: what was swept, how, and by which code."""
+                  scheme=ED_REFERENCE, settings=None):
+    """Write the JSON sidecar of one study's CSV: what was swept, how, and by which code.
+
+    ``settings`` (from :func:`moreau.outputs.claim_outputs`) is stored so that a
+    later run with other settings does not replace the files silently.
+    """
     meta = {
         "study": name,
         "swept_parameter": SWEPT_COLUMN.get(parameter, parameter),
@@ -120,5 +125,8 @@ def write_sidecar(path, params, name, parameter, values, frequency, extra, check
         "code_version": code_version(),
         "python": sys.version.split()[0],
         "engine": stats,
+        "provenance": provenance(code_version()),
     }
+    if settings is not None:
+        meta["settings"] = settings
     path.write_text(json.dumps(meta, indent=2))
