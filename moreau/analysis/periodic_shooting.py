@@ -230,6 +230,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     vscale = max(vmax[0], float(np.max(np.abs(r))), 1e-300)
     it = 0
     fixed_point_periods = 0
+    best = (float(np.max(np.abs(r))), z.copy())
     while np.max(np.abs(r)) > rtol * vscale:
         it += 1
         if it > max_iter:
@@ -239,8 +240,9 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
                 raise ConvergenceError(newton)
             # a time-stepping scheme's period map is only piecewise smooth (its
             # index set changes on the grid), which can stall Newton on a map that
-            # plain iteration contracts: iterate it from Newton's best state
-            qs, vs = state(z, base)
+            # plain iteration contracts: iterate it from Newton's best state (the
+            # last one can be far off where a finite difference crossed a jump)
+            qs, vs = state(best[1], base)
             qs, vs, r, fixed_point_periods = _iterate_period_map(
                 period, qs, vs, cyclic, Bq, Bv, rtol * vscale, FIXED_POINT_PERIODS, newton)
             break
@@ -262,6 +264,8 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
             lam *= 0.5
         z = z + lam * step
         r, disp = rn, dn
+        if np.max(np.abs(r)) < best[0]:
+            best = (float(np.max(np.abs(r))), z.copy())
     if not fixed_point_periods:
         qs, vs = state(z, base)
     res = period(qs, vs, record=True)
