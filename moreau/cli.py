@@ -136,6 +136,13 @@ def _cmd_steady(args):
     if rep["min_normal_force_N"] is not None:
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     print(f"  periodic residual         {rep['periodic_residual']:.2e}")
+    if rep["period"] != 1:
+        print(f"  orbit period              {rep['period']} drive periods")
+    if rep["floquet_multipliers"] is not None:
+        mult = ", ".join(f"{re:.6g}{im:+.3g}j" if im else f"{re:.6g}"
+                         for re, im in rep["floquet_multipliers"])
+        print(f"  Floquet multipliers       {mult} ({'stable' if rep['stable'] else 'unstable'}, "
+              f"margin {rep['stability_margin']:.3g})")
     print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
     print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")
 

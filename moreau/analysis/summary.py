@@ -18,6 +18,7 @@ import time
 from ..errors import InputError, MoreauError
 from ..provenance import provenance
 from .energy import energy_audit, energy_to_si, has_energy_audit
+from .floquet import floquet_report
 from .engine import audit_options
 from .scheme_settings import make_scheme, steady_of
 
@@ -78,7 +79,12 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         ``scene``, ``frequency_Hz``, ``scheme``, ``mode``,
         ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``regimes``, ``min_normal_force_N``, ``periodic``, ``periodic_residual``,
-        ``shooting_iterations``, ``wall_time_s``, ``parameters``, ``provenance``
+        ``shooting_iterations``, ``period`` (drive periods of the orbit),
+        ``floquet_multipliers`` (``[re, im]`` pairs, largest modulus first),
+        ``max_multiplier``, ``stable``, ``stability_margin`` (``1 - max
+        |lambda|``) and ``floquet_method`` (:mod:`moreau.analysis.floquet`;
+        None where there is no periodic orbit), ``wall_time_s``,
+        ``parameters``, ``provenance``
         (:func:`moreau.provenance.provenance`), ``energy`` (the energy audit of
         the steady period, :mod:`moreau.analysis.energy`: joules per period
         and ``closing_error``; None with an ``energy_note`` where the scheme
@@ -110,6 +116,8 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
         "periodic_residual": ss.periodic_residual,
         "shooting_iterations": ss.iterations,
+        "period": int(getattr(ss, "period", 1)),
+        **floquet_report(ss),
         "wall_time_s": wall,
         "parameters": dict(parameters),
         "provenance": provenance(),
