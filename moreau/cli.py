@@ -123,7 +123,8 @@ def _cmd_steady(args):
     scene = entry.factory(**params)
     check_periodic(scene)
     rep = steady_state_report(scene, scheme=args.scheme, steps_per_period=args.steps_per_period,
-                              theta=args.theta, rtol=args.rtol, options=args.scheme_options)
+                              theta=args.theta, rtol=args.rtol, options=args.scheme_options,
+                              max_period=args.max_period)
     if args.json:
         print(json.dumps(rep))
         return
@@ -458,6 +459,9 @@ def build_parser():
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)
+    p.add_argument("--max-period", type=int, default=1,
+                   help="where the period-1 orbit fails or is unstable, look for a stable "
+                        "period-k orbit, k <= MAX_PERIOD (at most 8; default 1)")
     add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "

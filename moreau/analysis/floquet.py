@@ -25,7 +25,7 @@ Examples
 >>> multiplier_pairs(m)[0], multiplier_pairs(m)[2]
 ([-0.9, 0.1], [0.5, 0.0])
 >>> stability(m)[0], round(stability(m)[1], 6)
-(True, 0.094475)
+(True, 0.094461)
 """
 
 import numpy as np

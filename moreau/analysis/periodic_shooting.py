@@ -71,7 +71,7 @@ def free_bases(scene, q, t, cyclic, touching):
     --------
     >>> from moreau.scenes.friction_drive import FrictionDrive
     >>> sc = FrictionDrive(frequency=185.0)
-    >>> q, v = sc.rest_state(0.0)
+    >>> q, v = sc.rest_state()
     >>> Bq, Bv = free_bases(sc, q, 0.0, 1, [0])
     >>> Bq.shape, Bv.shape
     ((2, 0), (2, 1))

@@ -54,7 +54,7 @@ def _energy_of(scene, ss, settings):
 
 
 def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
-                        rtol=None, parameters=None, options=None):
+                        rtol=None, parameters=None, options=None, max_period=1):
     """Steady state of ``scene`` as a JSON-ready dict in SI units.
 
     Parameters
@@ -72,6 +72,9 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         The scheme's other options (a compliant contact's ``stiffness``).
     parameters : dict, optional
         The SI parameters to record (default: the scene's ``params`` fields).
+    max_period : int
+        Look for orbits of up to this many drive periods where period 1
+        fails or is unstable (:func:`moreau.analysis.steady_state.find_steady_state`).
 
     Returns
     -------
@@ -95,7 +98,7 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     check_periodic(scene)
     settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = steady_of(scene, settings)
+    ss = steady_of(scene, settings, max_period=max_period)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:

@@ -40,7 +40,7 @@ Examples
 >>> sc = FrictionDrive(frequency=185.0)
 >>> ss = find_steady_state(sc)
 >>> m = walker_monodromy(sc, ss)
->>> m.shape, abs(m[0, 0] - walker_period_map_slope(sc, ss)) < 1e-6
+>>> m.shape, bool(abs(m[0, 0] - walker_period_map_slope(sc, ss)) < 1e-6)
 ((1, 1), True)
 """
 

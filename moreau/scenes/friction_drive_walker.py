@@ -118,8 +118,8 @@ def impact_impulses(sc, mu, e, tau, phi, dphi, du2, sin=math.sin, cos=math.cos):
     --------
     >>> from moreau.scenes.friction_drive import FrictionDrive
     >>> sc = FrictionDrive(frequency=15000.0)
-    >>> pN, pT = impact_impulses(sc, 0.0, 0.0, 0.0, 0.7, -1e-3, 0.0)
-    >>> pN > 0.0, pT
+    >>> pN, pT = impact_impulses(sc, 0.0, 0.0, 0.0, 0.7, 1e-3, 0.0)   # approaching
+    >>> bool(pN > 0.0), pT
     (True, 0.0)
     """
     s, c = sin(phi), cos(phi)
