@@ -123,7 +123,8 @@ def _cmd_steady(args):
     scene = entry.factory(**params)
     check_periodic(scene)
     rep = steady_state_report(scene, scheme=args.scheme, steps_per_period=args.steps_per_period,
-                              theta=args.theta, rtol=args.rtol, options=args.scheme_options)
+                              theta=args.theta, rtol=args.rtol, options=args.scheme_options,
+                              max_period=args.max_period)
     if args.json:
         print(json.dumps(rep))
         return
@@ -136,6 +137,13 @@ def _cmd_steady(args):
     if rep["min_normal_force_N"] is not None:
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     print(f"  periodic residual         {rep['periodic_residual']:.2e}")
+    if rep["period"] != 1:
+        print(f"  orbit period              {rep['period']} drive periods")
+    if rep["floquet_multipliers"] is not None:
+        mult = ", ".join(f"{re:.6g}{im:+.3g}j" if im else f"{re:.6g}"
+                         for re, im in rep["floquet_multipliers"])
+        print(f"  Floquet multipliers       {mult} ({'stable' if rep['stable'] else 'unstable'}, "
+              f"margin {rep['stability_margin']:.3g})")
     print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
     print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")
 
@@ -451,6 +459,9 @@ def build_parser():
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)
+    p.add_argument("--max-period", type=int, default=1,
+                   help="where the period-1 orbit fails or is unstable, look for a stable "
+                        "period-k orbit, k <= MAX_PERIOD (at most 8; default 1)")
     add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "

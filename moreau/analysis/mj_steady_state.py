@@ -50,6 +50,8 @@ from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
 from .modes import impacts_after_flight, mode_name, step_letters
 from ..integrators.moreau_jean import LCP_METHODS, MoreauJean
 from ..integrators.result import SteadyState
+from .floquet import period_map_jacobian, sorted_multipliers
+from .periodic_shooting import free_bases
 from .steady_solvers import register_steady_solver
 
 __all__ = ["moreau_jean_steady_state", "merge_step_regimes", "PeriodMap"]
@@ -340,7 +342,8 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         same from a 1e-7 perturbation: the derivative of the piecewise-linear
         discrete map), ``transient_periods`` (periods simulated before the
         final shooting), ``steps_per_period``, ``theta``, ``projection`` and
-        ``period_maps``. Without a period-1 orbit: ``periodic = False``,
+        ``period_maps``. ``floquet_multipliers``: those of the discrete map
+        in the free directions (:func:`_floquet`). Without a period-1 orbit: ``periodic = False``,
         ``message``, ``average_over_periods``, ``orbit_period`` (the smallest
         ``p <= 8`` with ``Phi^p(x) = x`` to ``sqrt(tol)``, or None).
 
@@ -400,6 +403,7 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     J_loc = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
     eig = np.linalg.eigvals(J_sec)
     eig_loc = np.linalg.eigvals(J_loc)
+    multipliers = _floquet(pm, x, closed, 2.0 * math.sqrt(pm.h) * vs)
     mode, merged, fmin = _modes_of_run(scene, pm, last)
     return SteadyState(
         scheme="moreau-jean",
@@ -428,7 +432,39 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
             # the index-set memory at the section: with state0 it reproduces the steady period
             "closed_at_section": [bool(c) for c in np.atleast_1d(closed)],
         },
+        floquet_multipliers=multipliers,
+        floquet_method="finite-differences",
     )
+
+
+def _floquet(pm, x, closed, step):
+    """Multipliers of the discrete period map in its free directions (central differences).
+
+    The directions are those of the continuous system at the section
+    (:func:`moreau.analysis.periodic_shooting.free_bases`, the closed
+    contacts pinning their gaps and normal velocities): a perturbation that
+    opens a closed contact is projected back by the scheme within a step and
+    would only add spurious zero multipliers. The discrete map is piecewise
+    smooth on the scale of one step (an event falls into one step or the
+    next, :func:`_shoot`), so its local derivative is not the continuous
+    system's; a perturbation ``2 sqrt(h)`` of the velocity scale spans
+    ``~sqrt(N)`` steps' worth of event shift, whose quantisation then falls
+    as the step shrinks while the curvature error stays ``O(h)``. Measured
+    on the paper's drive (theta = 1) against the walker's saltation
+    multiplier: at 2000 Hz errors 1.8e-4, 4.6e-5, 5.5e-6, 5.8e-6 at
+    N = 1000, 4000, 16000, 64000; at 185 Hz 6.0e-4, 8.5e-5, 3.4e-4, 1.5e-4
+    (not monotone: the quantisation).
+    """
+    q, _ = pm.full_state(x)
+    touching = np.flatnonzero(np.atleast_1d(closed))
+    Bq, Bv = free_bases(pm.scene, q, 0.0, pm.cyclic[0], touching)
+    B = np.zeros((pm.dim, Bq.shape[1] + Bv.shape[1]))
+    B[:len(pm.kept), :Bq.shape[1]] = Bq[pm.kept]
+    B[len(pm.kept):, Bq.shape[1]:] = Bv
+    if not B.shape[1]:
+        return sorted_multipliers([])
+    J = period_map_jacobian(lambda z: B.T @ pm(x + B @ z, closed)[0], np.zeros(B.shape[1]), step)
+    return sorted_multipliers(np.linalg.eigvals(J))
 
 
 def _settle(pm, x, closed, scale, tol, max_iter):

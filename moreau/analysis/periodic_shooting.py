@@ -34,9 +34,10 @@ from ..integrators.event_driven_generic import project_positions
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
+from .floquet import period_map_jacobian, sorted_multipliers
 from .steady_solvers import register_steady_solver
 
-__all__ = ["shoot_periodic"]
+__all__ = ["shoot_periodic", "free_bases"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -54,6 +55,38 @@ def _project(scene, t, q, v, touching):
     MiW = np.linalg.solve(scene.mass(q), WN.T)
     v = v - MiW @ np.linalg.solve(WN @ MiW, WN @ v + wN)
     return q, v
+
+
+def free_bases(scene, q, t, cyclic, touching):
+    """Orthonormal bases ``(Bq, Bv)`` of the free directions of a state at a section.
+
+    ``Bq`` (``ndof`` rows, the cyclic coordinate's row zero) spans the
+    position changes that keep the ``touching`` contacts' gaps closed to
+    first order, ``Bv`` the velocity changes that keep their normal
+    velocities; with no contact touching, every non-cyclic coordinate and
+    every velocity is free. The period map and its Floquet multipliers act
+    on ``z = (Bq^T dq, Bv^T dv)``.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> q, v = sc.rest_state()
+    >>> Bq, Bv = free_bases(sc, q, 0.0, 1, [0])
+    >>> Bq.shape, Bv.shape
+    ((2, 0), (2, 1))
+    """
+    touching = np.asarray(touching, dtype=int)
+    keep = np.array([i for i in range(scene.ndof) if i != cyclic], dtype=int)
+    if not len(touching):
+        return np.eye(scene.ndof)[:, keep], np.eye(scene.ndof)
+    WN = scene.contact_jacobians(q, t)[0][touching]
+    Bq = np.zeros((scene.ndof, 0))
+    nq = null_space(WN[:, keep])
+    if nq.size:
+        Bq = np.zeros((scene.ndof, nq.shape[1]))
+        Bq[keep] = nq
+    return Bq, null_space(WN)
 
 
 def _scheme_options(scheme, options):
@@ -74,7 +107,7 @@ def _scheme_options(scheme, options):
 
 def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=None, cyclic=None,
                    rtol=1e-10, max_iter=30, transient_periods=0, scheme_options=None,
-                   **options):
+                   periods=1, floquet=True, **options):
     """Periodic steady state of a ``2 pi``-periodic scene, by Newton shooting.
 
     Parameters
@@ -105,6 +138,16 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     scheme_options : dict, optional
         Options of the scheme whose names the shooting's own parameters take
         (a compliant scheme's ``rtol``); merged with ``options``.
+    periods : int
+        Shoot on this iterate of the period map (``k`` drive periods): a
+        period-``k`` orbit. The displacement is reported per drive period.
+    floquet : bool
+        Compute the Floquet multipliers at the fixed point: central
+        differences of the period map in the free directions (``2 n`` more
+        period maps for ``n`` free directions), with steps of ``1e-6`` of
+        the velocity scale, or for a time-stepping scheme ``2 sqrt(h)`` of
+        it (its map is piecewise smooth on the scale of one step, as for
+        :mod:`moreau.analysis.mj_steady_state`).
     **options
         Passed to the scheme (``steps_per_period`` is turned into ``h`` for
         Moreau–Jean, 2000 by default).
@@ -115,7 +158,9 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         ``state0`` is the full state ``(q, v)`` at the section (the cyclic
         coordinate at 0); ``mode`` names each contact's cyclic regime
         sequence, contacts separated by ``"|"``; ``regimes`` lists
-        ``[tau, letters]`` with one letter per contact.
+        ``[tau, letters]`` with one letter per contact (``tau`` over the
+        ``periods`` drive periods); ``floquet_multipliers`` are those of the
+        (iterated) period map, ``period`` the number of drive periods.
 
     Raises
     ------
@@ -143,6 +188,8 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     cyclic = int(cyclic)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
+    periods = positive_int("periods", periods)
+    span = periods * TWO_PI
 
     get_integrator(scheme)  # an unknown name lists the known ones, before any work
     clash = set(scheme_options or {}) & set(options)
@@ -172,12 +219,12 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         run_opts = dict(opts)
         if not record and "sample_dt" in takes:
             run_opts.setdefault("sample_dt", TWO_PI)
-        res = simulate(scene, (ts, ts + TWO_PI), q, v, scheme, **run_opts)
+        res = simulate(scene, (ts, ts + span), q, v, scheme, **run_opts)
         if not res.success:
             raise ConvergenceError(f"the period map failed ({scheme}): {res.message}")
         return res
 
-    for _ in range(int(transient_periods)):
+    for _ in range(-(-int(transient_periods) // periods)):
         res = period(q, v)
         q, v = res.q[-1].copy(), res.v[-1].copy()
         q[cyclic] = 0.0
@@ -185,18 +232,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     gap_tol = 1e-12 * max(1.0, float(np.max(np.abs(q))))
     touching = np.flatnonzero(scene.gaps(q, ts) <= gap_tol)
     q, v = _project(scene, ts, q, v, touching)
-    keep = np.array([i for i in range(scene.ndof) if i != cyclic])
-    if len(touching):
-        WN = scene.contact_jacobians(q, ts)[0][touching]
-        Bq = np.zeros((scene.ndof, 0))
-        nq = null_space(WN[:, keep])
-        if nq.size:
-            Bq = np.zeros((scene.ndof, nq.shape[1]))
-            Bq[keep] = nq
-        Bv = null_space(WN)
-    else:
-        Bq = np.eye(scene.ndof)[:, keep]
-        Bv = np.eye(scene.ndof)
+    Bq, Bv = free_bases(scene, q, ts, cyclic, touching)
     nz_q = Bq.shape[1]
 
     def state(z, base):
@@ -223,7 +259,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     r, disp = residual(q, v)
     # the velocity scale of the motion over the period (the section may
     # catch the scene at rest)
-    for tk in np.linspace(ts, ts + TWO_PI, 33):
+    for tk in np.linspace(ts, ts + span, 33 * periods):
         _, wN, _, wT = scene.contact_jacobians(q, tk)
         vmax[0] = max(vmax[0], float(np.max(np.abs(wN), initial=0.0)),
                       float(np.max(np.abs(wT), initial=0.0)))
@@ -246,14 +282,8 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
             qs, vs, r, fixed_point_periods = _iterate_period_map(
                 period, qs, vs, cyclic, Bq, Bv, rtol * vscale, FIXED_POINT_PERIODS, newton)
             break
-        qs, vs = state(z, base)
-        J = np.empty((r.size, z.size))
-        for k in range(z.size):
-            dz = np.zeros_like(z)
-            dz[k] = 1e-7 * max(vscale, abs(z[k]))
-            qk, vk = state(z + dz, base)
-            rk, _ = residual(qk, vk)
-            J[:, k] = (rk - r) / dz[k]
+        J = period_map_jacobian(lambda zz: residual(*state(zz, base))[0], z,
+                                1e-7 * np.maximum(vscale, np.abs(z)), f0=r, central=False)
         step = np.linalg.lstsq(J, -r, rcond=None)[0]
         lam = 1.0
         for _ in range(6):
@@ -269,7 +299,14 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     if not fixed_point_periods:
         qs, vs = state(z, base)
     res = period(qs, vs, record=True)
-    disp = float(res.q[-1, cyclic] - qs[cyclic])
+    disp = float(res.q[-1, cyclic] - qs[cyclic]) / periods
+    multipliers = None
+    if floquet:
+        # the residual's Jacobian in the free directions is B^T DP B - I (orthonormal bases)
+        fd = 2.0 * math.sqrt(opts["h"]) if "h" in opts else 1e-6
+        Jr = period_map_jacobian(lambda zz: residual(*state(zz, (qs, vs)))[0],
+                                 np.zeros(z.size), fd * vscale)
+        multipliers = sorted_multipliers(np.linalg.eigvals(Jr + np.eye(z.size)))
     nc = scene.ncontacts
     modes, regimes = [], []
     for c in range(nc):
@@ -279,7 +316,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     for tk, row in zip(res.t[:-1], res.regime[:-1]):
         key = "".join(REGIME_LETTERS[Regime(int(x))] for x in row)
         if key != prev:
-            regimes.append([float((tk - ts) % TWO_PI), key])
+            regimes.append([float((tk - ts) % span), key])
             prev = key
     closed = res.regime != int(Regime.FLIGHT)
     fmin = float(np.min(np.where(closed, res.force_N, np.inf))) if closed.any() else 0.0
@@ -296,6 +333,9 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         stats={"period_maps": calls[0], "unknowns": int(z.size),
                "fixed_point_periods": fixed_point_periods},
         section_tau=ts,
+        floquet_multipliers=multipliers,
+        floquet_method="finite-differences" if floquet else "",
+        period=periods,
     )
 
 

@@ -173,7 +173,7 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     return Scheme(scheme, theta, steps_per_period, rtol, options)
 
 
-def steady_of(scene, scheme):
+def steady_of(scene, scheme, max_period=1):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
 
     Examples
@@ -186,7 +186,8 @@ def steady_of(scene, scheme):
         # the compiled discrete period map names its tolerance `tol`
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
         return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
-                                 steps_per_period=scheme.steps_per_period, **kw, **scheme.options)
+                                 steps_per_period=scheme.steps_per_period, max_period=max_period,
+                                 **kw, **scheme.options)
     # an adaptive scheme's period map carries its own error tolerance: the shooting
     # aims above it unless told otherwise (a fixed-step map is deterministic)
     kw = {"rtol": scheme.rtol if scheme.rtol is not None else
@@ -197,4 +198,4 @@ def steady_of(scene, scheme):
         kw["theta"] = scheme.theta
     if scheme.options:
         kw["scheme_options"] = scheme.options
-    return find_steady_state(scene, scheme=scheme.name, **kw)
+    return find_steady_state(scene, scheme=scheme.name, max_period=max_period, **kw)

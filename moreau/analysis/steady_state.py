@@ -9,7 +9,8 @@ import math
 
 import numpy as np
 
-from ..errors import InputError, RunawayError
+from .._validate import positive_int
+from ..errors import ConvergenceError, InputError, RunawayError
 # SteadyState is defined with the other scheme results (below this layer)
 # and re-exported here, where callers have always found it
 from ..integrators import INTEGRATORS, get_integrator
@@ -17,6 +18,7 @@ from ..integrators.result import SteadyState
 from ..scenes.base import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
 from . import mj_steady_state  # noqa: F401
+from .period_k import find_period_k
 from .periodic_shooting import shoot_periodic
 from .steady_solvers import get_steady_solver, has_solver
 
@@ -27,7 +29,7 @@ TWO_PI = 2.0 * math.pi
 
 
 def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
-                      **options):
+                      max_period=1, **options):
     """Periodic steady state of a periodically driven scene, found by shooting, and checked.
 
     The one entry point for every scheme and every caller: what the shooting
@@ -37,6 +39,14 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     whose state is so large that rounding hides the change a period makes,
     so the periodic residual reads 0). See :func:`_find_steady_state` for
     the parameters.
+
+    With ``max_period`` > 1, where the period-1 shooting fails
+    (:class:`~moreau.errors.ConvergenceError`) or its orbit is unstable (a
+    Floquet multiplier outside the unit circle), orbits of period ``k = 2 ..
+    max_period`` are sought by shooting on the ``k``-th iterate of the
+    period map (:func:`moreau.analysis.period_k.find_period_k`); the first
+    stable one is returned (``period = k``). Without one the period-1
+    result (or its error) stands.
 
     Examples
     --------
@@ -50,11 +60,46 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     """
     if not isinstance(scene, Scene):
         raise InputError(f"`scene` must be a Scene instance, got {type(scene).__name__}")
-    ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
+    max_period = positive_int("max_period", max_period)
+    if max_period > MAX_PERIOD:
+        raise InputError(f"`max_period` must be at most {MAX_PERIOD}, got {max_period}")
+    try:
+        ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
+        failure = None
+    except ConvergenceError as exc:
+        if max_period == 1:
+            raise
+        ss, failure = None, exc
+    if max_period > 1 and (ss is None or ss.stable is False):
+        start = ss
+        if start is None and options.get("q0") is not None and options.get("v0") is not None:
+            start = (options["q0"], options["v0"])
+        alt = find_period_k(scene, scheme, max_period, start=start,
+                            section_tau=float(options.get("section_tau", 0.0)),
+                            rtol=max(rtol, 1e-10), options=_shooting_options(scheme, options))
+        if alt is not None:
+            ss = alt
+        elif failure is not None:
+            raise failure
     why = implausible_steady_state(scene, ss)
     if why:
         raise RunawayError(why)
     return ss
+
+
+#: the longest orbit period find_steady_state looks for
+MAX_PERIOD = 8
+
+#: options of the steady-state solvers that are not options of the scheme itself
+_SOLVER_ONLY = ("tol", "x_guess", "transient_periods", "fast", "section_tau", "q0", "v0",
+                "cyclic", "scheme_options")
+
+
+def _shooting_options(scheme, options):
+    # the scheme's own settings, for shooting on an iterate of its period map
+    out = {k: v for k, v in options.items() if k not in _SOLVER_ONLY}
+    out.update(options.get("scheme_options") or {})
+    return out
 
 
 def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,

@@ -18,6 +18,7 @@ import time
 from ..errors import InputError, MoreauError
 from ..provenance import provenance
 from .energy import energy_audit, energy_to_si, has_energy_audit
+from .floquet import floquet_report
 from .engine import audit_options
 from .scheme_settings import make_scheme, steady_of
 
@@ -53,7 +54,7 @@ def _energy_of(scene, ss, settings):
 
 
 def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
-                        rtol=None, parameters=None, options=None):
+                        rtol=None, parameters=None, options=None, max_period=1):
     """Steady state of ``scene`` as a JSON-ready dict in SI units.
 
     Parameters
@@ -71,6 +72,9 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         The scheme's other options (a compliant contact's ``stiffness``).
     parameters : dict, optional
         The SI parameters to record (default: the scene's ``params`` fields).
+    max_period : int
+        Look for orbits of up to this many drive periods where period 1
+        fails or is unstable (:func:`moreau.analysis.steady_state.find_steady_state`).
 
     Returns
     -------
@@ -78,7 +82,12 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         ``scene``, ``frequency_Hz``, ``scheme``, ``mode``,
         ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``regimes``, ``min_normal_force_N``, ``periodic``, ``periodic_residual``,
-        ``shooting_iterations``, ``wall_time_s``, ``parameters``, ``provenance``
+        ``shooting_iterations``, ``period`` (drive periods of the orbit),
+        ``floquet_multipliers`` (``[re, im]`` pairs, largest modulus first),
+        ``max_multiplier``, ``stable``, ``stability_margin`` (``1 - max
+        |lambda|``) and ``floquet_method`` (:mod:`moreau.analysis.floquet`;
+        None where there is no periodic orbit), ``wall_time_s``,
+        ``parameters``, ``provenance``
         (:func:`moreau.provenance.provenance`), ``energy`` (the energy audit of
         the steady period, :mod:`moreau.analysis.energy`: joules per period
         and ``closing_error``; None with an ``energy_note`` where the scheme
@@ -89,7 +98,7 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     check_periodic(scene)
     settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = steady_of(scene, settings)
+    ss = steady_of(scene, settings, max_period=max_period)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:
@@ -110,6 +119,8 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
         "periodic_residual": ss.periodic_residual,
         "shooting_iterations": ss.iterations,
+        "period": int(getattr(ss, "period", 1)),
+        **floquet_report(ss),
         "wall_time_s": wall,
         "parameters": dict(parameters),
         "provenance": provenance(),

@@ -136,6 +136,19 @@ class SteadyState:
         Scheme-specific counters (steps, LCP solves, fallbacks, ...).
     section_tau : float
         Phase of the Poincaré section at which ``state0`` is given.
+    floquet_multipliers : ndarray of complex or None
+        Eigenvalues of the period map's Jacobian at the fixed point,
+        restricted to the free directions (cyclic coordinate and pinned
+        contact directions removed), largest modulus first; None where
+        they were not computed (no periodic orbit).
+    floquet_method : str
+        How they were computed: ``"saltation"`` (variational equations and
+        saltation matrices of an event-driven walk) or
+        ``"finite-differences"`` (of the period map).
+    period : int
+        Drive periods after which the orbit repeats (1 for a period-1 orbit;
+        ``k`` for one found on the ``k``-th iterate of the period map).
+        ``displacement_per_period`` is per drive period in either case.
     """
 
     scheme: str
@@ -149,3 +162,26 @@ class SteadyState:
     wall_time: float = 0.0
     stats: dict = field(default_factory=dict)
     section_tau: float = 0.0
+    floquet_multipliers: np.ndarray = None
+    floquet_method: str = ""
+    period: int = 1
+
+    @property
+    def max_multiplier(self):
+        """Largest modulus of the Floquet multipliers (None if they were not computed)."""
+        m = self.floquet_multipliers
+        if m is None:
+            return None
+        return float(np.max(np.abs(m))) if len(m) else 0.0
+
+    @property
+    def stable(self):
+        """Whether every Floquet multiplier lies inside the unit circle (None if unknown)."""
+        top = self.max_multiplier
+        return None if top is None else bool(top < 1.0)
+
+    @property
+    def stability_margin(self):
+        """``1 - max |lambda|``: distance of the largest multiplier from the unit circle."""
+        top = self.max_multiplier
+        return None if top is None else 1.0 - top

@@ -19,6 +19,8 @@ from ..errors import ConvergenceError
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
+from ..analysis.floquet import sorted_multipliers
+from .friction_drive_floquet import GrazingEvent, walker_monodromy, walker_period_map_slope
 from .friction_drive_walker import ContactState, FrictionDriveWalker
 
 __all__ = ["walker_steady_state", "walker_energy_audit"]
@@ -126,6 +128,8 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
     iteration (the map is contracting, often barely so at high frequency).
     ``rtol`` bounds the estimated distance of ``u2'`` from the fixed point
     relative to the tip-velocity scale; ``v_guess`` is the first ``u2'``.
+    The Floquet multiplier of the map comes from the saltation matrices of
+    the period's events (:mod:`moreau.scenes.friction_drive_floquet`).
     """
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
@@ -200,6 +204,17 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
         stats=dict(walker.counters),
         section_tau=float(st0.tau),
     )
+    # the multiplier of the scalar map: saltation matrices through the period's events,
+    # or where an event grazes its surface (no derivative exists there) the map's own
+    # central differences, which then measure its slope on a 1e-5 scale
+    try:
+        M = walker_monodromy(scene, ss, rtol=walker.rtol)
+        ss.floquet_method = "saltation"
+    except GrazingEvent:
+        M = np.array([[walker_period_map_slope(scene, ss, rtol=walker.rtol)]])
+        ss.floquet_method = "finite-differences"
+    ss.floquet_multipliers = sorted_multipliers(np.linalg.eigvals(M))
+    ss.wall_time = time.perf_counter() - t_start
     return ss
 
 

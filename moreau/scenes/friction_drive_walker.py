@@ -29,7 +29,7 @@ from ..regimes import Regime
 from ..integrators.base import Integrator, register_integrator
 from ..integrators.result import Event
 
-__all__ = ["EventDriven", "ContactState", "FrictionDriveWalker"]
+__all__ = ["EventDriven", "ContactState", "FrictionDriveWalker", "impact_impulses"]
 
 TWO_PI = 2.0 * math.pi
 _F, _P, _N, _S = Regime.FLIGHT, Regime.POSITIVE, Regime.NEGATIVE, Regime.STICK
@@ -103,6 +103,46 @@ class _SlipSeries:
     def both(self, tau):
         b = self._basis(tau)
         return (b @ self.cA).real, (b @ self.cAA).real
+
+
+def impact_impulses(sc, mu, e, tau, phi, dphi, du2, sin=math.sin, cos=math.cos):
+    """Impulses ``(p_N, p_T)`` of Newton's impact law with Coulomb friction (the walker's).
+
+    ``sin`` and ``cos`` may be complex functions (``cmath``): the case
+    analysis compares real parts only, so a complex-step derivative of the
+    post-impact state follows the branch of the real impact
+    (:mod:`moreau.scenes.friction_drive_floquet` takes its saltation
+    matrices that way).
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> sc = FrictionDrive(frequency=15000.0)
+    >>> pN, pT = impact_impulses(sc, 0.0, 0.0, 0.0, 0.7, 1e-3, 0.0)   # approaching
+    >>> bool(pN > 0.0), pT
+    (True, 0.0)
+    """
+    s, c = sin(phi), cos(phi)
+    vN = -c * dphi - sc.u10 * sin(tau)
+    vT = du2 + s * dphi
+    A, B, C = 3 * c * c, 3 * s * c, 1.0 / sc.J + 3 * s * s
+    dvN = -(1.0 + e) * vN
+    if mu > 0:
+        det = A * C - B * B
+        pN_s = (C * dvN - B * vT) / det
+        pT_s = (B * dvN - A * vT) / det
+        if pN_s.real >= 0 and abs(pT_s.real) <= mu * pN_s.real:
+            return pN_s, pT_s
+        p = dvN / (A + mu * B)
+        if (vT - B * p - mu * C * p).real > 0:
+            return p, -mu * p
+        if (A - mu * B).real <= 0:
+            raise PainleveError(
+                f"impact at tau={float(tau.real):.12g} with 1 - mu*tan(phi) = "
+                f"{1 - mu * math.tan(phi.real):.3g} <= 0 has no unique solution")
+        p = dvN / (A - mu * B)
+        return p, mu * p
+    return dvN / A, 0.0
 
 
 class _JoinedDense:
@@ -500,33 +540,9 @@ class FrictionDriveWalker:
 
         Returns the post-impact state and the impulses ``(p_N, p_T)``.
         """
-        sc, mu, e = self.scene, self.mu, self.e
-        phi = st.phi
-        s, c = math.sin(phi), math.cos(phi)
-        vN = -c * st.dphi - sc.u10 * math.sin(st.tau)
-        vT = st.du2 + s * st.dphi
-        A, B, C = 3 * c * c, 3 * s * c, 1.0 / sc.J + 3 * s * s
-        dvN = -(1.0 + e) * vN
-        pN = pT = None
-        if mu > 0:
-            det = A * C - B * B
-            pN_s = (C * dvN - B * vT) / det
-            pT_s = (B * dvN - A * vT) / det
-            if pN_s >= 0 and abs(pT_s) <= mu * pN_s:
-                pN, pT = pN_s, pT_s
-            else:
-                p = dvN / (A + mu * B)
-                if vT - B * p - mu * C * p > 0:
-                    pN, pT = p, -mu * p
-                else:
-                    if A - mu * B <= 0:
-                        raise PainleveError(
-                            f"impact at tau={st.tau:.12g} with 1 - mu*tan(phi) = "
-                            f"{1 - mu * math.tan(phi):.3g} <= 0 has no unique solution")
-                    p = dvN / (A - mu * B)
-                    pN, pT = p, mu * p
-        else:
-            pN, pT = dvN / A, 0.0
+        sc = self.scene
+        s, c = math.sin(st.phi), math.cos(st.phi)
+        pN, pT = impact_impulses(sc, self.mu, self.e, st.tau, st.phi, st.dphi, st.du2)
         out = st.copy()
         out.dphi = st.dphi + 3.0 * (-c * pN + s * pT)
         out.du2 = st.du2 + pT / sc.J
