@@ -1,23 +1,118 @@
-"""Recording for schemes that run blocks of steps in a compiled loop.
+"""The compiled path of a time-stepping scheme: its choice, its blocks, its recording.
 
-A compiled loop writes its samples into buffers, one block per call; a step
-taken in Python inside such a run (a contact problem handed back to the
-generic step) is a one-sample block. :class:`CompiledRecording` keeps the
-blocks and assembles them into a :class:`SimulationResult`; a scheme sets
-``self._fast`` (and ``self._blocks = []``) when it runs compiled.
+A compiled loop (a template of :mod:`moreau.integrators._loops`) runs up to
+:data:`FAST_BLOCK` steps a call and writes its samples into buffers, one
+block per call; a step taken in Python inside such a run (a contact problem
+handed back to the generic step) is a one-sample block.
+:class:`CompiledRecording` decides whether a run is compiled
+(:meth:`~CompiledRecording._choose_compiled`), runs one block and keeps its
+books (:meth:`~CompiledRecording._run_block`), and assembles the blocks into
+a :class:`SimulationResult`.
 """
 
 import numpy as np
 
+from ..errors import InputError
+from ._loops import runner_for
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
+                          new_lcp_control, new_stats)
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["CompiledRecording"]
+__all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP"]
+
+# time steps per call of the compiled loop: large enough to hide the call,
+# small enough for a live progress bar and a prompt Ctrl-C
+FAST_BLOCK = 1 << 16
+
+#: the failure message of an explicit scheme whose state overflowed (``{t}``, ``{h}``)
+EXPLICIT_BLOWUP = ("non-finite state after the step at t = {t!r} (the explicit step `h` = {h!r} "
+                   "is probably too large for the stiffest force)")
 
 
 class CompiledRecording:
     """Mixin of :class:`~moreau.integrators.base.Integrator` subclasses with a compiled path."""
 
     _fast = False
+
+    def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
+        """Check ``fast`` and set up the compiled path where it applies.
+
+        ``model`` is the scene's compiled model or None. A forced QP solver is
+        a request to run that solver, so it takes the generic path.
+        """
+        if fast not in ("auto", True, False):
+            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
+        if fast is True and model is None:
+            raise InputError(f"`fast=True` needs a scene with a compiled model "
+                             f"(`compiled_model()`); {type(self.scene).__name__} has none, or a "
+                             f"subclass changed its equations; use fast='auto' or False")
+        if fast is True and lcp_method == "qp":
+            raise InputError("`fast=True` solves contacts in closed form or by Lemke; "
+                             "`lcp_method='qp'` needs fast='auto' or False")
+        self._fast = model is not None and fast is not False and lcp_method != "qp"
+        if self._fast:
+            self._model = model
+            self._stats = new_stats()
+            # options of the loop's contact problems and the warm start's memory,
+            # carried from one compiled block to the next
+            self._lcp_ctl = new_lcp_control(self.scene.ncontacts,
+                                            force_lemke=lcp_method == "lemke",
+                                            warm_start=warm_start, max_iter=lemke_max_iter or 0)
+            self._blocks = []
+            for name in STAT_NAMES:
+                self.counters.setdefault(name, 0)
+
+    def _run_block(self, template, before, after):
+        """Run one block of ``template``'s loop and keep the books; return its status.
+
+        The loop's arguments are ``par, mu, e, t0, h, t_bound, k0, nmax``,
+        then ``before``, ``self.save_every, record_initial``, ``after``, the
+        recording buffers and the statistics. The caller passes copies of its
+        state in ``before``/``after``, stores them back after the call, then
+        hands the status to :meth:`_after_block`.
+        """
+        n, nc = self.scene.ndof, self.scene.ncontacts
+        ns = FAST_BLOCK // self.save_every + 2
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+               np.empty((ns, nc)), np.empty((ns, nc)))
+        st = self._stats
+        st[:] = 0.0
+        m = self._model
+        status, k, nrec = runner_for(m, template)(
+            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
+            *before, self.save_every, self._pending_initial, *after, *buf, st)
+        ndone = k - self._k
+        if nrec:
+            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
+        if ndone:
+            self._pending_initial = False
+        self._k = k
+        t = self.t0 + k * self.h
+        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        c = self.counters
+        for name, x in zip(STAT_NAMES, st):
+            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
+        c["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
+        return status
+
+    def _after_block(self, status, handback=(LCP_HANDBACK, PAINLEVE),
+                     singular="the mass matrix is singular at t = {t!r}",
+                     numerical="non-finite state after the step at t = {t!r}"):
+        """Act on a block's status once the caller has stored its state back.
+
+        A status in ``handback`` has the generic step take the step the loop
+        stopped at (QP fallback, or the full diagnosis of a Painlevé case);
+        ``singular`` and ``numerical`` are the failure messages (``{t}``: the
+        time reached, ``{h}``: the step).
+        """
+        if status in handback:
+            self.counters["steps"] += 1
+            self._generic_step()
+        elif status == SINGULAR:
+            self._fail(-5, singular.format(t=self.t, h=self.h))
+        elif status == NUMERICAL:
+            self._fail(-5, numerical.format(t=self.t, h=self.h))
 
     def _record(self, t, q, v, regime, force_N, force_T, slip, gap):
         if not self._fast:

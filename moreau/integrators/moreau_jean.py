@@ -141,10 +141,8 @@ from ..errors import InputError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 from ._blocks import CompiledRecording
-from ._loops import runner_for
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
-from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES, new_lcp_control,
-                          new_stats)
+from ._mj_kernels import mj_loop
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
@@ -160,10 +158,6 @@ SLIP_RTOL = 1e-10
 # gaps of the package's scenes are O(1e-3 .. 1) in their own units)
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
-
-# time steps per call of the compiled loop: large enough to hide the call,
-# small enough for a live progress bar and a prompt Ctrl-C
-FAST_BLOCK = 1 << 16
 
 
 def classify_impulse(pN, pT, mu):
@@ -234,16 +228,40 @@ def check_work(scene, t0, t1, h, save_every, max_steps=MAX_STEPS):
                          f"raise `save_every` to at least {math.ceil(save_every * size / MAX_RECORD_BYTES)}")
 
 
+def check_step(scheme, h):
+    """The time step ``h`` of a fixed-step scheme, required and > 0."""
+    if h is None:
+        raise InputError(f"`h` (the time step) is required for the {scheme} scheme")
+    return positive("h", h)
+
+
+def check_lcp_options(lcp_method, lemke_max_iter=None):
+    """Validate the contact-problem options of a scheme; return them normalised.
+
+    Examples
+    --------
+    >>> check_lcp_options("qp", 5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` runs no Lemke
+    """
+    if lcp_method not in LCP_METHODS:
+        raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
+    if lemke_max_iter is not None:
+        lemke_max_iter = positive_int("lemke_max_iter", lemke_max_iter)
+        if lcp_method == "qp":
+            raise InputError("`lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` "
+                             "runs no Lemke")
+    return lcp_method, lemke_max_iter
+
+
 def check_options(h, theta, projection, lcp_method, save_every=1):
     """Validate the Moreau–Jean options; return them normalised."""
-    if h is None:
-        raise InputError("`h` (the time step) is required for the moreau-jean scheme")
-    h = positive("h", h)
+    h = check_step("moreau-jean", h)
     theta = in_closed_interval("theta", theta, 0.5, 1.0)
     if not isinstance(projection, (bool, np.bool_)):
         raise InputError(f"`projection` must be True or False, got {projection!r}")
-    if lcp_method not in LCP_METHODS:
-        raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
+    lcp_method, _ = check_lcp_options(lcp_method)
     save_every = positive_int("save_every", save_every)
     return h, theta, bool(projection), lcp_method, save_every
 
@@ -361,12 +379,7 @@ class MoreauJean(CompiledRecording, Integrator):
             h, theta, projection, lcp_method, save_every)
         check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
                    positive_int("max_steps", max_steps))
-        if lemke_max_iter is not None:
-            lemke_max_iter = positive_int("lemke_max_iter", lemke_max_iter)
-            if self.lcp_method == "qp":
-                raise InputError("`lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` "
-                                 "runs no Lemke")
-        self.lemke_max_iter = lemke_max_iter
+        _, self.lemke_max_iter = check_lcp_options(self.lcp_method, lemke_max_iter)
         if not isinstance(lcp_warm_start, (bool, np.bool_)):
             raise InputError(f"`lcp_warm_start` must be True or False, got {lcp_warm_start!r}")
         self.lcp_warm_start = bool(lcp_warm_start)
@@ -385,28 +398,9 @@ class MoreauJean(CompiledRecording, Integrator):
         self._k = 0
         self.counters = _new_counters()
         self._pending_initial = True
-        if fast not in ("auto", True, False):
-            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
-        model = compiled_model_of(scene)
-        if fast is True and model is None:
-            raise InputError(f"`fast=True` needs a scene with a compiled model "
-                             f"(`compiled_model()`); {type(scene).__name__} has none, or a "
-                             f"subclass changed its equations; use fast='auto' or False")
-        if fast is True and self.lcp_method == "qp":
-            raise InputError("`fast=True` solves contacts in closed form or by Lemke; "
-                             "`lcp_method='qp'` needs fast='auto' or False")
-        # a forced QP solver is a request to run that solver, so it takes the generic path
-        self._fast = model is not None and fast is not False and self.lcp_method != "qp"
-        if self._fast:
-            self._model = model
-            self._stats = new_stats()
-            # options of the loop's contact problems and the warm start's memory,
-            # carried from one compiled block to the next
-            self._lcp_ctl = new_lcp_control(
-                nc, force_lemke=self.lcp_method == "lemke",
-                warm_start=self.lcp_warm_start and self.lcp_method == "auto",
-                max_iter=self.lemke_max_iter or 0)
-            self._blocks = []
+        self._choose_compiled(fast, compiled_model_of(scene), self.lcp_method,
+                              self.lemke_max_iter,
+                              warm_start=self.lcp_warm_start and self.lcp_method == "auto")
 
     @property
     def closed(self):
@@ -482,47 +476,20 @@ class MoreauJean(CompiledRecording, Integrator):
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
     def _fast_block(self):
-
-        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
-        nmax = FAST_BLOCK
-        ns = nmax // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
-               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
-               np.empty((ns, nc)), np.empty((ns, nc)))
-        q, v = self.q.copy(), self.v.copy()
-        closed = self._closed.copy()
-        st = self._stats
-        st[:] = 0.0
-        status, k, nrec = runner_for(m)(
-            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta, self.projection,
-            closed, self.save_every, self._pending_initial, self._lcp_ctl, *buf, st)
-        ndone = k - self._k
-        if nrec:
-            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
-        if ndone:
-            self._pending_initial = False
-        self._k, self.q, self.v, self._closed = k, q, v, closed
-        t = self.t0 + k * self.h
-        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
-        c = self.counters
-        for name, x in zip(STAT_NAMES, st):
-            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
-        # the base class counts one step per call of _step_impl
-        c["steps"] += ndone - 1
-        if status in (LCP_HANDBACK, PAINLEVE):
-            # Lemke failed on this step: the generic step solves it (QP fallback with
-            # lcp_method="auto", an LCPError with "lemke"), then the loop resumes.
-            # Painlevé: the generic step meets the same case and raises with the
-            # full diagnosis (the state is the start of that step).
-            c["steps"] += 1
-            self._generic_step()
-            return
-        if status == SINGULAR:
-            self._fail(-5, f"the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is "
-                           f"singular at t = {self.t!r}; reduce `h` or use a smaller `theta`")
-        elif status == NUMERICAL:
-            self._fail(-5, f"non-finite state after the step at t = {self.t!r} (the step `h` is "
-                           f"probably too large for an explicit part of the forces)")
+        q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
+        status = self._run_block(mj_loop, (q, v, self.theta, self.projection, closed),
+                                 (self._lcp_ctl,))
+        self.q, self.v, self._closed = q, v, closed
+        # Lemke failed on this step: the generic step solves it (QP fallback with
+        # lcp_method="auto", an LCPError with "lemke"), then the loop resumes.
+        # Painlevé: the generic step meets the same case and raises with the full
+        # diagnosis (the state is the start of that step).
+        self._after_block(
+            status,
+            singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
+                      "t = {t!r}; reduce `h` or use a smaller `theta`"),
+            numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
+                       "too large for an explicit part of the forces)"))
 
     def _contact_step(self, q, t1, v_free, Winv, active, vN0, pN, pT):
         sc = self.scene

@@ -50,18 +50,16 @@ is an ``O(h)`` error at each impact only.
 
 import numpy as np
 
-from .._validate import in_closed_interval, positive, positive_int
+from .._validate import in_closed_interval, positive_int
 from ..errors import ConvergenceError, InputError, LCPError
 from ..lcp import solve_lcp
 from ._blocks import CompiledRecording
-from ._loops import runner_for
-from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
-                          new_lcp_control, new_stats)
+from ._mj_kernels import LCP_HANDBACK, PAINLEVE
 from ._nsga_kernels import CONVERGENCE, nsga_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
-from .moreau_jean import (FAST_BLOCK, LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
-                          classify_impulse, compiled_model_of, next_time)
+from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
+                          check_work, classify_impulse, compiled_model_of, next_time)
 
 __all__ = ["NonsmoothGeneralizedAlpha", "alpha_coefficients"]
 
@@ -146,17 +144,12 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
                  lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
-        if h is None:
-            raise InputError("`h` (the time step) is required for the "
-                             "nonsmooth-generalized-alpha scheme")
-        self.h = positive("h", h)
+        self.h = check_step("nonsmooth-generalized-alpha", h)
         self.rho_inf = in_closed_interval("rho_inf", rho_inf, 0.0, 1.0)
         if not isinstance(position_level, (bool, np.bool_)):
             raise InputError(f"`position_level` must be True or False, got {position_level!r}")
         self.position_level = bool(position_level)
-        if lcp_method not in LCP_METHODS:
-            raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
-        self.lcp_method = lcp_method
+        self.lcp_method, _ = check_lcp_options(lcp_method)
         self.save_every = positive_int("save_every", save_every)
         check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
                    positive_int("max_steps", max_steps))
@@ -174,57 +167,17 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                                np.asarray(scene.forces(self.q, self.v, self.t0), float))
         self._acc = acc0
         self._a = acc0.copy()
-        if fast not in ("auto", True, False):
-            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
-        model = compiled_model_of(scene)
-        if fast is True and (model is None or lcp_method == "qp"):
-            raise InputError("`fast=True` needs a scene with a compiled model and an "
-                             "`lcp_method` other than 'qp'")
-        self._fast = model is not None and fast is not False and lcp_method != "qp"
-        if self._fast:
-            self._model = model
-            self._stats = new_stats()
-            self._lcp_ctl = new_lcp_control(nc, force_lemke=lcp_method == "lemke",
-                                            warm_start=False)
-            self._blocks = []
-            self._coef = np.array([self.am, self.af, self.gamma, self.beta])
-            for name in STAT_NAMES:
-                self.counters.setdefault(name, 0)
+        self._coef = np.array([self.am, self.af, self.gamma, self.beta])
+        self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
 
     def _fast_block(self):
-        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
-        ns = FAST_BLOCK // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
-               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
-               np.empty((ns, nc)), np.empty((ns, nc)))
         q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()
         closed = self._closed.copy()
-        st = self._stats
-        st[:] = 0.0
-        status, k, nrec = runner_for(m, nsga_loop)(
-            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
-            q, v, a, acc, self._coef, closed, self.save_every, self._pending_initial,
-            self.position_level, self._lcp_ctl, *buf, st)
-        ndone = k - self._k
-        if nrec:
-            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
-        if ndone:
-            self._pending_initial = False
-        self._k, self.q, self.v, self._a, self._acc, self._closed = k, q, v, a, acc, closed
-        t = self.t0 + k * self.h
-        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
-        c = self.counters
-        for name, x in zip(STAT_NAMES, st):
-            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
-        c["steps"] += ndone - 1     # the base class counts one step per call
-        if status in (LCP_HANDBACK, PAINLEVE, CONVERGENCE):
-            c["steps"] += 1
-            self._generic_step()
-            return
-        if status == SINGULAR:
-            self._fail(-5, f"a singular mass or iteration matrix at t = {self.t!r}")
-        elif status == NUMERICAL:
-            self._fail(-5, f"non-finite state after the step at t = {self.t!r}")
+        status = self._run_block(nsga_loop, (q, v, a, acc, self._coef, closed),
+                                 (self.position_level, self._lcp_ctl))
+        self.q, self.v, self._a, self._acc, self._closed = q, v, a, acc, closed
+        self._after_block(status, handback=(LCP_HANDBACK, PAINLEVE, CONVERGENCE),
+                          singular="a singular mass or iteration matrix at t = {t!r}")
 
     def _smooth(self, q, v, a, acc, t1, h):
         """Newton on ``acc_{n+1}``: the smooth generalized-α step (no contact)."""

@@ -53,7 +53,7 @@ from .._validate import in_open_interval, positive, positive_int
 from ..errors import InputError
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
-from .moreau_jean import LCP_METHODS, check_scene_contacts, classify_impulse
+from .moreau_jean import check_lcp_options, check_scene_contacts, classify_impulse
 
 __all__ = ["StuderExtrapolation"]
 
@@ -118,9 +118,7 @@ class StuderExtrapolation(Integrator):
         span = self.t_bound - self.t0
         self.h = span / 100.0 if h0 is None else positive("h0", h0)
         self.h_min = 1e-12 * span if h_min is None else positive("h_min", h_min)
-        if lcp_method not in LCP_METHODS:
-            raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
-        self.lcp_method = lcp_method
+        self.lcp_method, _ = check_lcp_options(lcp_method)
         self.max_steps = positive_int("max_steps", max_steps)
         self.mu_c, self.e_c = check_scene_contacts(scene)
         nc = scene.ncontacts

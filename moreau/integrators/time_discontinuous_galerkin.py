@@ -78,18 +78,15 @@ step in contact.
 
 import numpy as np
 
-from .._validate import positive, positive_int
+from .._validate import positive_int
 from ..errors import InputError
-from ._blocks import CompiledRecording
-from ._loops import runner_for
-from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
-                          new_lcp_control, new_stats)
+from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._tdg_kernels import tdg_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
 from .event_driven_generic import project_positions
-from .moreau_jean import (FAST_BLOCK, LCP_METHODS, MAX_STEPS, check_scene_contacts, check_work,
-                          classify_impulse, compiled_model_of, next_time)
+from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
+                          check_work, classify_impulse, compiled_model_of, next_time)
 
 __all__ = ["TimeDiscontinuousGalerkin", "LOBATTO_TABLEAUS"]
 
@@ -165,22 +162,11 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
                  lemke_max_iter=None, save_every=1, projection=True, fast="auto",
                  max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
-        if h is None:
-            raise InputError("`h` (the time step) is required for the "
-                             "time-discontinuous-galerkin scheme")
-        self.h = positive("h", h)
+        self.h = check_step("time-discontinuous-galerkin", h)
         if isinstance(degree, bool) or degree not in LOBATTO_TABLEAUS:
             raise InputError(f"`degree` must be one of {sorted(LOBATTO_TABLEAUS)}, got {degree!r}")
         self.degree = int(degree)
-        if lcp_method not in LCP_METHODS:
-            raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
-        self.lcp_method = lcp_method
-        if lemke_max_iter is not None:
-            lemke_max_iter = positive_int("lemke_max_iter", lemke_max_iter)
-            if lcp_method == "qp":
-                raise InputError("`lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` "
-                                 "runs no Lemke")
-        self.lemke_max_iter = lemke_max_iter
+        self.lcp_method, self.lemke_max_iter = check_lcp_options(lcp_method, lemke_max_iter)
         self.save_every = positive_int("save_every", save_every)
         if not isinstance(projection, (bool, np.bool_)):
             raise InputError(f"`projection` must be True or False, got {projection!r}")
@@ -196,21 +182,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
                          "projection_iterations": 0}
         self._pending_initial = True
-        if fast not in ("auto", True, False):
-            raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
-        model = compiled_model_of(scene)
-        if fast is True and (model is None or lcp_method == "qp"):
-            raise InputError("`fast=True` needs a scene with a compiled model and an "
-                             "`lcp_method` other than 'qp'")
-        self._fast = model is not None and fast is not False and lcp_method != "qp"
-        if self._fast:
-            self._model = model
-            self._stats = new_stats()
-            self._lcp_ctl = new_lcp_control(nc, force_lemke=lcp_method == "lemke",
-                                            warm_start=False, max_iter=lemke_max_iter or 0)
-            self._blocks = []
-            for name in STAT_NAMES:
-                self.counters.setdefault(name, 0)
+        self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
 
     # -- the pieces of one step ----------------------------------------------
     def _rows(self, ia, q, t):
@@ -239,41 +211,12 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         return self._generic_step()
 
     def _fast_block(self):
-        m, n, nc = self._model, self.scene.ndof, self.scene.ncontacts
-        ns = FAST_BLOCK // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
-               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
-               np.empty((ns, nc)), np.empty((ns, nc)))
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         c_st, a_st, b_st = LOBATTO_TABLEAUS[self.degree]
-        st = self._stats
-        st[:] = 0.0
-        status, k, nrec = runner_for(m, tdg_loop)(
-            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
-            q, v, closed, self.save_every, self._pending_initial, c_st, a_st, b_st,
-            self.projection, self._lcp_ctl, *buf, st)
-        ndone = k - self._k
-        if nrec:
-            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
-        if ndone:
-            self._pending_initial = False
-        self._k, self.q, self.v, self._closed = k, q, v, closed
-        t = self.t0 + k * self.h
-        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
-        c = self.counters
-        for name, x in zip(STAT_NAMES, st):
-            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
-        c["steps"] += ndone - 1     # the base class counts one step per call
-        if status in (LCP_HANDBACK, PAINLEVE):
-            # the generic step solves it (QP fallback) or raises with the diagnosis
-            c["steps"] += 1
-            self._generic_step()
-            return
-        if status == SINGULAR:
-            self._fail(-5, f"the mass matrix is singular at t = {self.t!r}")
-        elif status == NUMERICAL:
-            self._fail(-5, f"non-finite state after the step at t = {self.t!r} (the explicit "
-                           f"step `h` = {self.h!r} is probably too large for the stiffest force)")
+        status = self._run_block(tdg_loop, (q, v, closed),
+                                 (c_st, a_st, b_st, self.projection, self._lcp_ctl))
+        self.q, self.v, self._closed = q, v, closed
+        self._after_block(status, numerical=EXPLICIT_BLOWUP)
 
     def _generic_step(self):
         sc = self.scene
@@ -331,8 +274,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
             if na:
                 dirs.append(np.linalg.solve(Mi, Hi.T))
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
-            self._fail(-5, f"non-finite state after the step at t = {t0!r} (the explicit "
-                           f"step `h` = {h!r} is probably too large for the stiffest force)")
+            self._fail(-5, EXPLICIT_BLOWUP.format(t=t0, h=h))
             self.counters["steps"] -= 1     # the base class counts this failed step
             return
         pN = np.zeros(nc)

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-import moreau.integrators.moreau_jean as mjmod
+import moreau.integrators._blocks as blocks
 from moreau.integrators import simulate
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
 
@@ -50,7 +50,7 @@ def test_compiled_path_equals_generic_path(freq, theta, projection, params):
 def test_compiled_blocks_join_seamlessly(monkeypatch):
     sc = FrictionDrive(frequency=185.0)
     whole = mj(sc, 1, 300, save_every=7)
-    monkeypatch.setattr(mjmod, "FAST_BLOCK", 11)
+    monkeypatch.setattr(blocks, "FAST_BLOCK", 11)
     pieces = mj(sc, 1, 300, save_every=7)
     np.testing.assert_array_equal(whole.t, pieces.t)
     np.testing.assert_array_equal(whole.q, pieces.q)
