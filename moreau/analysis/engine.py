@@ -489,14 +489,14 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     client, own_client = connect_scheduler(scheduler)
     try:
         return _run_points(points, scheme, checks, cache_dir, n_jobs, client, progress, desc,
-                           chunk, scene)
+                           chunk, scene, energy)
     finally:
         if own_client:
             client.close()
 
 
 def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, desc, chunk,
-                scene):
+                scene, energy):
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
