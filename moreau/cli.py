@@ -241,8 +241,11 @@ def _cmd_run(args):
         "periods": periods, "duration": duration, "samples": args.samples}, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
+    names = getattr(scene, "coordinate_names", None)
     side = write_history(cols, path, {
-        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
+        "scene": entry.name, "parameters": params,
+        "coordinates": None if names is None else {f"q_{i}": n for i, n in enumerate(names)},
+        "scheme": args.scheme, "options": shown,
         "periods": periods, "duration": duration, "status": res.status, "message": res.message,
         "command": "moreau run", "settings": settings})
     print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
