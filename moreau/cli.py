@@ -17,6 +17,7 @@ from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
+from ._log import configure_cli
 from .errors import InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
@@ -449,6 +450,9 @@ def _cmd_scenes(args):
 def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
     parser.add_argument("-V", "--version", action="version", version=f"moreau {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="show notes (a compile starting) on stderr also when it is not a "
+                             "terminal, e.g. in a log file")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
@@ -564,6 +568,7 @@ def _check_common(args):
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
+    configure_cli(args.verbose)
     try:
         _check_common(args)
         args.func(args)

@@ -493,7 +493,7 @@ class MoreauJean(CompiledRecording, Integrator):
         closed = self._closed.copy()
         st = self._stats
         st[:] = 0.0
-        status, k, nrec = runner_for(m)(
+        status, k, nrec = runner_for(m, scene=self.scene)(
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, nmax, q, v, self.theta, self.projection,
             closed, self.save_every, self._pending_initial, self._lcp_ctl, *buf, st)
         ndone = k - self._k

@@ -201,7 +201,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         closed = self._closed.copy()
         st = self._stats
         st[:] = 0.0
-        status, k, nrec = runner_for(m, nsga_loop)(
+        status, k, nrec = runner_for(m, nsga_loop, self.scene)(
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
             q, v, a, acc, self._coef, closed, self.save_every, self._pending_initial,
             self.position_level, self._lcp_ctl, *buf, st)

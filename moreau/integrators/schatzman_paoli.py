@@ -198,7 +198,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         closed = self._closed.copy()
         st = self._stats
         st[:] = 0.0
-        status, k, nrec = runner_for(m, sp_loop)(
+        status, k, nrec = runner_for(m, sp_loop, self.scene)(
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
             q, v, vv, closed, self.save_every, self._pending_initial, self._lcp_ctl, *buf, st)
         ndone = k - self._k
