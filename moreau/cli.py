@@ -354,7 +354,7 @@ def _cmd_atlas(args):
 
 def _cmd_reproduce(args):
     res = reproduce(args.out, quick=args.quick, scheduler=args.scheduler, n_jobs=args.jobs,
-                    progress=not args.quiet)
+                    progress=not args.quiet, force=args.force)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
           f"start with {args.out}/report.md")
     print("  " + ", ".join(f"{k[:-2].replace('_', ' ')} {v:.1f} s" for k, v in res["_timings"].items()))
@@ -370,6 +370,9 @@ def _add_reproduce(sub):
     p.add_argument("--jobs", type=int, default=-1,
                    help="local worker processes (default -1: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier run with other settings (--quick "
+                        "against a full run; refused otherwise)")
     p.set_defaults(func=_cmd_reproduce)
 
 
