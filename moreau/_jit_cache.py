@@ -25,7 +25,7 @@ try:
 except ImportError:
     NullCache = None
 
-__all__ = ["sources_digest", "bind_cache_to_sources"]
+__all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code"]
 
 
 def sources_digest(paths):
@@ -92,6 +92,36 @@ def bind_cache_to_sources(dispatchers, paths):
             stamp = stamp[1][0]
         cache_file._source_stamp = ("moreau-deps", (stamp, digest))
     return mode
+
+
+def has_cached_code(dispatcher):
+    """Whether the first call of ``dispatcher`` will load machine code instead of compiling.
+
+    True when the function has been compiled in this process, or when
+    numba's disk cache holds an entry that is fresh for the current sources
+    (:func:`bind_cache_to_sources`) and was built for this CPU. False
+    otherwise, including when numba's cache internals are not the expected
+    ones: the answer only decides whether to tell the user that a compile is
+    starting.
+
+    Examples
+    --------
+    >>> from numba import njit
+    >>> @njit
+    ... def f(x):
+    ...     return x + 1
+    >>> has_cached_code(f), f(1), has_cached_code(f)
+    (False, 2, True)
+    """
+    if getattr(dispatcher, "signatures", None):
+        return True
+    try:
+        index = dispatcher._cache._cache_file._load_index()
+        magic = dispatcher.targetctx.codegen().magic_tuple()
+        return any(key[1] == magic for key in index)
+    except Exception:
+        # a null cache, another numba version: nothing known to be on disk
+        return False
 
 
 def _disable_disk_cache(disp):

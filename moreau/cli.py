@@ -17,6 +17,7 @@ from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
+from ._log import configure_cli
 from .errors import InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
 from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
@@ -249,8 +250,11 @@ def _cmd_run(args):
         "periods": periods, "duration": duration, "samples": args.samples}, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
+    names = getattr(scene, "coordinate_names", None)
     side = write_history(cols, path, {
-        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
+        "scene": entry.name, "parameters": params,
+        "coordinates": None if names is None else {f"q_{i}": n for i, n in enumerate(names)},
+        "scheme": args.scheme, "options": shown,
         "periods": periods, "duration": duration, "status": res.status, "message": res.message,
         "command": "moreau run", "settings": settings})
     print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
@@ -358,7 +362,7 @@ def _cmd_atlas(args):
 
 def _cmd_reproduce(args):
     res = reproduce(args.out, quick=args.quick, scheduler=args.scheduler, n_jobs=args.jobs,
-                    progress=not args.quiet)
+                    progress=not args.quiet, force=args.force)
     print(f"wrote {len(res['_paths'])} files to {args.out} in {res['_wall_time_s']:.1f} s; "
           f"start with {args.out}/report.md")
     print("  " + ", ".join(f"{k[:-2].replace('_', ' ')} {v:.1f} s" for k, v in res["_timings"].items()))
@@ -374,6 +378,9 @@ def _add_reproduce(sub):
     p.add_argument("--jobs", type=int, default=-1,
                    help="local worker processes (default -1: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier run with other settings (--quick "
+                        "against a full run; refused otherwise)")
     p.set_defaults(func=_cmd_reproduce)
 
 
@@ -454,6 +461,9 @@ def _cmd_scenes(args):
 def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
     parser.add_argument("-V", "--version", action="version", version=f"moreau {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="show notes (a compile starting) on stderr also when it is not a "
+                             "terminal, e.g. in a log file")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
@@ -572,6 +582,7 @@ def _check_common(args):
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
+    configure_cli(args.verbose)
     try:
         _check_common(args)
         args.func(args)

@@ -77,6 +77,39 @@ def test_second_run_comes_from_the_cache(quick_run):
         [r["displacement_per_period_m"] for r in first]
 
 
+def test_a_full_run_into_a_quick_runs_folder_is_refused_before_any_work(quick_run, capsys):
+    before = {p: p.stat().st_mtime_ns for p in quick_run.rglob("*") if p.is_file()}
+    capsys.readouterr()
+    assert main(["reproduce", "--out", str(quick_run), "--quiet", "--jobs", "1"]) == 2
+    assert capsys.readouterr().err == (
+        "moreau: error: `--out` already holds frequency.csv/.json from a run with other settings "
+        "(mj_steps_per_period, points, quick): give `--force` to replace them, or another "
+        "`--out`\n")
+    # no point computed, no file touched
+    assert {p: p.stat().st_mtime_ns for p in quick_run.rglob("*") if p.is_file()} == before
+    meta = json.loads((quick_run / "data" / "mu_185Hz.json").read_text())
+    assert meta["settings"] == {"quick": True, "points": 8, "frequency_Hz": 185.0,
+                                "mj_steps_per_period": 200}
+
+
+def test_force_replaces_the_files_of_a_run_with_other_settings(tmp_path):
+    from moreau.errors import InputError
+    from moreau.studies.paper.reproduce import reproduce
+    (tmp_path / "data").mkdir()
+    full = {"quick": False, "points": 99, "frequency_Hz": 185.0, "mj_steps_per_period": 2000}
+    (tmp_path / "data" / "mu_185Hz.json").write_text(json.dumps({"settings": full}))
+    (tmp_path / "data" / "mu_185Hz.csv").write_text("mu\n0.5\n")
+    with pytest.raises(InputError, match=r"mu_185Hz.csv/.json from a run with other settings "
+                                         r"\(mj_steps_per_period, points, quick\)"):
+        reproduce(tmp_path, quick=True, n_jobs=1, progress=False, figures=False, report=False,
+                  log=lambda msg: None)
+    assert not (tmp_path / "cache").exists()
+    reproduce(tmp_path, quick=True, n_jobs=1, progress=False, figures=False, report=False,
+              log=lambda msg: None, force=True)
+    assert len(read_table(tmp_path / "data" / "mu_185Hz.csv")) == 8
+    assert json.loads((tmp_path / "data" / "mu_185Hz.json").read_text())["settings"]["quick"]
+
+
 def test_grids_of_the_three_studies():
     g = study_grids()
     f = g["frequency"][1]

@@ -1,10 +1,14 @@
 """Time histories of any scene under any registered scheme: CSV, JSON sidecar and figure.
 
 The engine of ``moreau run``. A scene with SI units gives its histories in SI
-(``Scene.si_columns``), with the unit in each column name (``t [s]``,
-``x2 [m]``); the regime of each contact is written by name (``stick``,
-``positive``, ``negative``, ``flight``). A JSON sidecar records the scene,
-its parameters, the scheme and its options, the run's status and the
+(``Scene.si_columns``), the same columns for every scene (the keys of
+``to_si``, :data:`moreau.scenes._units.COMMON_KEYS`, one column per
+coordinate and per contact), with the unit in each column name (``t [s]``,
+``q_1 [m]``, ``force_N_0 [N]``); the regime of each contact is written by
+name (``stick``, ``positive``, ``negative``, ``flight``). A JSON sidecar
+records the scene, its parameters, what each coordinate is where the scene
+names them (``coordinates``: the friction drive's ``q_0`` is ``phi`` and
+``q_1`` is ``x2``), the scheme and its options, the run's status and the
 provenance (:mod:`moreau.provenance`).
 
 Examples
@@ -175,8 +179,8 @@ def plot_history(columns, path, title=""):
     by = {n: (u, np.asarray(a)) for n, u, a in columns}
     tu, t = by["t"]
     coords = [n for n in by if n not in ("t",) and not n.startswith(
-        ("v", "force", "normal", "tangential", "slip", "gap", "regime"))]
-    forces = [n for n in by if n.startswith(("force_N", "normal_force"))]
+        ("v", "force", "slip", "gap", "regime"))]
+    forces = [n for n in by if n.startswith("force_N")]
     regimes = [n for n in by if n.startswith("regime")]
     fig, ax = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
     for n in coords:

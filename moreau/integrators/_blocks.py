@@ -79,7 +79,7 @@ class CompiledRecording:
         st = self._stats
         st[:] = 0.0
         m = self._model
-        status, k, nrec = runner_for(m, template)(
+        status, k, nrec = runner_for(m, template, self.scene)(
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
             *before, self.save_every, self._pending_initial, *after, *buf, st)
         ndone = k - self._k

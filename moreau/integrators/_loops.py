@@ -20,6 +20,7 @@ do not identify them across processes.
 
 import hashlib
 import importlib
+import logging
 import sys
 import threading
 import types
@@ -27,6 +28,7 @@ import types
 from numba import njit
 
 from .. import _jit_cache
+from .._log import note
 from . import _mj_kernels
 from ._mj_kernels import no_gaps
 
@@ -35,6 +37,14 @@ __all__ = ["runner_for", "dependency_files"]
 _RUNNERS = {}
 _LOCK = threading.Lock()
 _NOTED = set()
+log = logging.getLogger(__name__)
+
+#: the schemes' names of the loop templates, for the compile note
+SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
+                      "nsga_loop": "nonsmooth generalized-alpha"}
+#: what a first compile takes (README: 16-19 s for the first scene with Lemke and
+#: the QP path, 5-10 s for each later one)
+COMPILE_SECONDS = "5-20"
 
 
 def _import_path(f):
@@ -115,13 +125,16 @@ def _build(model, template):
     return run
 
 
-def runner_for(model, template=None):
+def runner_for(model, template=None, scene=None):
     """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`), built once.
 
     ``template`` is the loop of a scheme, written against the model's
     globals (default :func:`moreau.integrators._mj_kernels.mj_loop`, the
     Moreau–Jean loop); a scheme module passes its own. Returns a numba
-    function with the template's arguments.
+    function with the template's arguments. When its first call will compile
+    (nothing in this process, nothing fresh in numba's disk cache), one INFO
+    note says so (:func:`moreau._log.note`: on a terminal, or through
+    ``logging``), naming ``scene`` (the scene being run, for the note only).
     """
     template = template or _mj_kernels.mj_loop
     key = (template.__module__, template.__name__,
@@ -131,16 +144,18 @@ def runner_for(model, template=None):
         run = _RUNNERS.get(key)
         if run is None:
             run = _RUNNERS[key] = _build(model, template)
-    if not run.signatures:
-        _compile_note(run)
+    if id(run) not in _NOTED:
+        _NOTED.add(id(run))
+        if not _jit_cache.has_cached_code(run):
+            scheme = SCHEME_OF_TEMPLATE.get(template.__name__, template.__name__)
+            note(log, "compiling the %s loop for scene %s (first use on this machine, about "
+                 "%s s)...", scheme, _scene_label(scene), COMPILE_SECONDS)
     return run
 
 
-def _compile_note(run):
-    # the first call in a process either loads the machine code from numba's cache
-    # (a fraction of a second) or compiles it (seconds): say so on a terminal, once,
-    # so that a first run is not a silent wait
-    if id(run) not in _NOTED and sys.stderr.isatty():
-        _NOTED.add(id(run))
-        print("moreau: loading the compiled loop of this scene and scheme (its first use "
-              "on a machine compiles it)...", file=sys.stderr, flush=True)
+def _scene_label(scene):
+    name = getattr(scene, "name", None)
+    # "scene" is the base class's placeholder: a user's scene is named by its class
+    if isinstance(name, str) and name and name != "scene":
+        return name
+    return "(unnamed)" if scene is None else type(scene).__name__

@@ -363,26 +363,26 @@ class BidirectionalDrive(DriveUnits, Scene):
         return FrictionDrive(self.params.rod(which), frequency=self.frequency)
 
     # -- units ------------------------------------------------------------------
+    #: ``q = (phi_a, phi_b, u2)``: the rod angles are in rad
+    angle_coordinates = (0, 1)
+    #: what each coordinate is, in the names of ``to_si``'s extras (a run's sidecar)
+    coordinate_names = ("phi_a", "phi_b", "x2")
+
     def to_si(self, result):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
-        Returns a dict: ``t`` [s], ``x2`` rotor displacement [m], ``v2`` rotor
-        velocity [m/s], ``phi_a``, ``phi_b`` [rad], ``normal_force`` and
-        ``tangential_force`` [N] (shape ``(n, 2)``), ``slip_velocity`` [m/s]
-        and the ``regime`` codes of both contacts.
+        Returns a dict with the keys every scene gives
+        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 3) =
+        (``phi_a``, ``phi_b`` [rad], rotor displacement [m]), ``v`` (n, 3)
+        [rad/s, rad/s, m/s], ``force_N``, ``force_T`` (n, 2) [N] (rods a, b),
+        ``slip_velocity`` (n, 2) [m/s], ``gap`` (n, 2) [m], ``regime`` (n, 2)
+        codes; and the named coordinates: ``x2`` rotor displacement [m],
+        ``v2`` rotor velocity [m/s], ``phi_a``, ``phi_b`` [rad], each (n,).
         """
-        l, w = self.params.length, self.omega
-        return {
-            "t": result.t / w,
-            "x2": result.q[:, 2] * l,
-            "v2": result.v[:, 2] * l * w,
-            "phi_a": result.q[:, 0].copy(),
-            "phi_b": result.q[:, 1].copy(),
-            "normal_force": result.force_N * self.force_scale,
-            "tangential_force": result.force_T * self.force_scale,
-            "slip_velocity": result.slip_velocity * l * w,
-            "regime": result.regime.copy(),
-        }
+        si = self._si_histories(result)
+        si.update(x2=si["q"][:, 2].copy(), v2=si["v"][:, 2].copy(),
+                  phi_a=si["q"][:, 0].copy(), phi_b=si["q"][:, 1].copy())
+        return si
 
 
 class BidirectionalDriveCase(DriveCase):

@@ -314,24 +314,33 @@ class FrictionDrive(DriveUnits, Scene):
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
 
     # -- units ------------------------------------------------------------------
+    #: ``q = (phi, u2)``: the rod angle is in rad
+    angle_coordinates = (0,)
+    #: what each coordinate is, in the names of ``to_si``'s extras (a run's sidecar)
+    coordinate_names = ("phi", "x2")
+
     def to_si(self, result):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
-        Returns a dict: ``t`` [s], ``x2`` rotor displacement [m], ``v2`` rotor
-        velocity [m/s], ``phi`` rod angle [rad], ``normal_force`` and
-        ``tangential_force`` [N], ``slip_velocity`` [m/s], ``regime`` codes.
+        Returns a dict with the keys every scene gives
+        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 2) =
+        (rod angle [rad], rotor displacement [m]), ``v`` (n, 2) [rad/s, m/s],
+        ``force_N``, ``force_T`` (n, 1) [N], ``slip_velocity`` (n, 1) [m/s],
+        ``gap`` (n, 1) [m], ``regime`` (n, 1) codes; and the drive's named
+        coordinates: ``x2`` rotor displacement [m], ``v2`` rotor velocity
+        [m/s], ``phi`` rod angle [rad], each (n,).
+
+        Examples
+        --------
+        >>> from moreau.integrators import simulate
+        >>> s = FrictionDrive(frequency=185.0)
+        >>> si = s.to_si(simulate(s, (0.0, 1.0), *s.rest_state(), "event-driven"))
+        >>> si["q"].shape[1], si["force_N"].shape[1], bool((si["x2"] == si["q"][:, 1]).all())
+        (2, 1, True)
         """
-        l, w = self.params.length, self.omega
-        return {
-            "t": result.t / w,
-            "x2": result.q[:, 1] * l,
-            "v2": result.v[:, 1] * l * w,
-            "phi": result.q[:, 0].copy(),
-            "normal_force": result.force_N[:, 0] * self.force_scale,
-            "tangential_force": result.force_T[:, 0] * self.force_scale,
-            "slip_velocity": result.slip_velocity[:, 0] * l * w,
-            "regime": result.regime[:, 0].copy(),
-        }
+        si = self._si_histories(result)
+        si.update(x2=si["q"][:, 1].copy(), v2=si["v"][:, 1].copy(), phi=si["q"][:, 0].copy())
+        return si
 
 
 # -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0 -----------------

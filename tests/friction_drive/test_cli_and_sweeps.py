@@ -148,19 +148,21 @@ def test_run_command_writes_history(tmp_path, capsys):
     path = tmp_path / "history_friction-drive_frequency185_event-driven.csv"
     with open(path) as fh:
         rows = list(csv.DictReader(fh))
-    # units in the column names, regimes by name
-    assert list(rows[0]) == ["t [s]", "x2 [m]", "v2 [m/s]", "phi [rad]", "normal_force [N]",
-                             "tangential_force [N]", "slip_velocity [m/s]", "regime"]
+    # the columns every scene's table has, units in the names, regimes by name
+    assert list(rows[0]) == ["t [s]", "q_0 [rad]", "q_1 [m]", "v_0 [rad/s]", "v_1 [m/s]",
+                             "force_N_0 [N]", "force_T_0 [N]", "slip_velocity_0 [m/s]",
+                             "gap_0 [m]", "regime_0"]
     assert float(rows[-1]["t [s]"]) == pytest.approx(2 / 185.0)
-    assert all(float(r["normal_force [N]"]) > 0 for r in rows)
-    assert {r["regime"] for r in rows} <= {"stick", "positive", "negative", "flight"}
-    assert {"positive", "negative"} <= {r["regime"] for r in rows}
+    assert all(float(r["force_N_0 [N]"]) > 0 for r in rows)
+    assert {r["regime_0"] for r in rows} <= {"stick", "positive", "negative", "flight"}
+    assert {"positive", "negative"} <= {r["regime_0"] for r in rows}
     # two periods from rest: the rotor has moved backwards by a few micrometres
-    assert -2e-5 < float(rows[-1]["x2 [m]"]) < -5e-6
+    assert -2e-5 < float(rows[-1]["q_1 [m]"]) < -5e-6
     side = json.loads(path.with_suffix(".json").read_text())
     assert side["scene"] == "friction-drive" and side["scheme"] == "event-driven"
     assert side["parameters"] == {"frequency": 185.0} and side["status"] == 0
-    assert {"name": "x2", "unit": "m"} in side["columns"]
+    assert {"name": "q_1", "unit": "m"} in side["columns"]
+    assert side["coordinates"] == {"q_0": "phi", "q_1": "x2"}
     assert side["provenance"]["numpy_version"] and side["provenance"]["command"]
 
 
@@ -171,7 +173,7 @@ def test_histories_of_both_schemes_agree():
     ed, ed_cols = run_history(sc, periods=3, samples=300)
     mj, mj_cols = run_history(sc, periods=3, scheme="moreau-jean", steps=12000, samples=300)
     assert ed.status == mj.status == 0
-    x2 = {name: dict((n, a) for n, _, a in cols)["x2"] for name, cols in
+    x2 = {name: dict((n, a) for n, _, a in cols)["q_1"] for name, cols in
           (("ed", ed_cols), ("mj", mj_cols))}
     assert x2["mj"][-1] == pytest.approx(x2["ed"][-1], rel=2e-3)
     with pytest.raises(ValueError, match="`periods` must be > 0"):

@@ -11,7 +11,9 @@ The event-driven reference gives every value; Moreau–Jean with theta = 1/2
 and theta = 1 at :data:`MJ_STEPS_PER_PERIOD` steps per period gives a
 cross-check at every point. The points go through the sweep engine
 (:mod:`moreau.analysis.engine`): cached on disk under ``DIR/cache``, in
-parallel, a failing point recorded as a status.
+parallel, a failing point recorded as a status. A folder that holds the
+files of a run with other settings (``--quick`` against a full run) is
+refused before any work unless ``force`` (:mod:`moreau.outputs`).
 """
 
 import pathlib
@@ -21,6 +23,7 @@ import joblib
 import numpy as np
 
 from ...analysis.engine import ED_REFERENCE, Scheme, check_output_dir, run_points
+from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS
 from .figures import mode_figure_jobs, sweep_figure
 from .report import write_report
@@ -74,7 +77,7 @@ def run_jobs(jobs, n_jobs=-1):
 
 
 def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, progress=True,
-              figures=True, report=True, log=print):
+              figures=True, report=True, log=print, force=False):
     """Run the paper's three studies and write data, figures and the report.
 
     Parameters
@@ -87,6 +90,10 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         Dask scheduler address; local processes otherwise.
     n_jobs : int
         Local processes (-1: all cores).
+    force : bool
+        Replace the files of an earlier run with other settings (a quick run
+        in the folder of a full one, or the reverse); refused otherwise,
+        before any work. A rerun with the same settings resumes.
 
     Returns
     -------
@@ -101,6 +108,11 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
     steps = 200 if quick else MJ_STEPS_PER_PERIOD
     checks = mj_checks(steps)
     grids = study_grids(params, quick)
+    # what decides each table's content: the grid and the cross-check's steps
+    settings = {name: claim_outputs(out / "data" / name, {
+        "quick": bool(quick), "points": int(len(values)), "frequency_Hz": frequency,
+        "mj_steps_per_period": steps}, force)
+        for name, (_, values, frequency, _) in grids.items()}
     points, owner = [], []
     for name, (parameter, values, frequency, _) in grids.items():
         for x in values:
@@ -118,7 +130,7 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
         path = out / "data" / f"{name}.csv"
         write_table(table, path)
         write_sidecar(path.with_suffix(".json"), params, name, parameter, values, frequency,
-                      extra, checks, steps, stats)
+                      extra, checks, steps, stats, settings=settings[name])
         paths += [path, path.with_suffix(".json")]
     timings["points_and_tables_s"] = time.perf_counter() - t0 - timings["grids_s"]
     if figures:

@@ -1,0 +1,116 @@
+"""A first compile says so: one INFO note, on a terminal or through ``logging``; never a compile here.
+
+The note is made by :func:`moreau.integrators._loops.runner_for`, the one
+place a compiled loop is built, when its first call will compile (nothing in
+the process, nothing fresh in numba's disk cache). The tests replace that
+answer (``_jit_cache.has_cached_code``) instead of compiling, and never call
+the loop, except the command-line test, which loads a cached loop.
+"""
+
+import importlib.util
+import io
+import logging
+
+import pytest
+
+from moreau import _jit_cache, _log
+from moreau.cli import main
+from moreau.integrators import _loops
+from moreau.scenes import BouncingBall, FrictionDrive
+
+NOTE = ("compiling the Moreau–Jean loop for scene friction-drive (first use on this machine, "
+        "about 5-20 s)...")
+
+
+class _Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+
+@pytest.fixture
+def fresh_loops(monkeypatch):
+    # a process that has built no loop yet (the built loops are not compiled here)
+    monkeypatch.setattr(_loops, "_RUNNERS", {})
+    monkeypatch.setattr(_loops, "_NOTED", set())
+
+
+@pytest.fixture
+def quiet_moreau_logger():
+    # the state a program that configures no logging sees; the CLI tests change it
+    root = logging.getLogger("moreau")
+    saved = root.handlers[:], root.level
+    root.handlers[:] = []
+    root.setLevel(logging.NOTSET)
+    yield root
+    root.handlers[:], _ = saved[0], root.setLevel(saved[1])
+
+
+def test_a_loop_that_will_compile_is_announced_once(fresh_loops, monkeypatch, caplog):
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    scene = FrictionDrive(frequency=185.0)
+    with caplog.at_level(logging.INFO, logger="moreau"):
+        run = _loops.runner_for(scene.compiled_model(), scene=scene)
+        again = _loops.runner_for(scene.compiled_model(), scene=scene)
+    assert again is run and not run.signatures          # built, not compiled
+    assert [r.getMessage() for r in caplog.records] == [NOTE]
+    assert caplog.records[0].name == "moreau.integrators._loops"
+    assert caplog.records[0].levelno == logging.INFO
+
+
+def test_a_cached_loop_is_not_announced(fresh_loops, monkeypatch, caplog):
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: True)
+    scene = BouncingBall()
+    with caplog.at_level(logging.DEBUG, logger="moreau"):
+        _loops.runner_for(scene.compiled_model(), scene=scene)
+    assert caplog.records == []
+
+
+def test_without_logging_configured_a_terminal_gets_one_line(fresh_loops, monkeypatch,
+                                                             quiet_moreau_logger):
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    scene = FrictionDrive(frequency=185.0)
+    monkeypatch.setattr("sys.stderr", _Terminal())
+    _loops.runner_for(scene.compiled_model(), scene=scene)
+    _loops.runner_for(scene.compiled_model(), scene=scene)
+    assert __import__("sys").stderr.getvalue() == "moreau: " + NOTE + "\n"
+    # and nothing where stderr is a file (a log)
+    monkeypatch.setattr(_loops, "_NOTED", set())
+    log_file = io.StringIO()
+    monkeypatch.setattr("sys.stderr", log_file)
+    _loops.runner_for(scene.compiled_model(), scene=scene)
+    assert log_file.getvalue() == ""
+
+
+def test_the_command_line_shows_the_note_with_verbose_only_in_a_log(fresh_loops, monkeypatch,
+                                                                    capsys, tmp_path,
+                                                                    quiet_moreau_logger):
+    # the run loads the bouncing ball's cached loop (compiled once by the other tests)
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    args = ["run", "--scene", "bouncing-ball", "--scheme", "moreau-jean", "--duration", "0.05",
+            "--steps", "50", "--no-plot", "--quiet", "--out", str(tmp_path)]
+    assert main(args) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(_loops, "_RUNNERS", {})
+    monkeypatch.setattr(_loops, "_NOTED", set())
+    assert main(["-v"] + args + ["--force"]) == 0
+    err = capsys.readouterr().err
+    assert err == ("moreau: compiling the Moreau–Jean loop for scene bouncing-ball (first use "
+                   "on this machine, about 5-20 s)...\n")
+
+
+def _load(path, name):
+    spec = importlib.util.spec_from_file_location(name, path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_has_cached_code_sees_numba_disk_cache(tmp_path):
+    src = tmp_path / "toy_kernel.py"
+    src.write_text("from numba import njit\n\n\n@njit(cache=True)\ndef f(x):\n    return x + 1.0\n")
+    first = _load(src, "toy_kernel")
+    assert not _jit_cache.has_cached_code(first.f)
+    assert first.f(1.0) == 2.0                       # compiles (a trivial function) and saves
+    second = _load(src, "toy_kernel")                # a new dispatcher, as in a new process
+    assert not second.f.signatures
+    assert _jit_cache.has_cached_code(second.f)

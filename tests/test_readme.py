@@ -1,0 +1,211 @@
+"""The README against the program: what it says about outputs, and every command it shows."""
+
+import json
+import os
+import pathlib
+import re
+import shlex
+import subprocess
+import sys
+
+import pytest
+
+import moreau
+from moreau.cli import build_parser
+
+README = pathlib.Path(moreau.__file__).resolve().parent.parent / "README.md"
+
+
+def _subparsers():
+    (sub,) = [a for a in build_parser()._actions if a.__class__.__name__ == "_SubParsersAction"]
+    return sub.choices
+
+
+def test_every_command_that_takes_force_is_documented_with_it():
+    takes = {name for name, p in _subparsers().items()
+             if any("--force" in a.option_strings for a in p._actions)}
+    assert takes == {"sweep", "atlas", "run", "reproduce"}
+    paragraphs = [p for p in re.split(r"\n\s*\n", README.read_text()) if "`--force`" in p]
+    documented = {name for name in takes for p in paragraphs
+                  if re.search(rf"`moreau\s+{name}`", p)}
+    assert documented == takes
+
+
+# -- every command of the README, in a fresh process ----------------------------------
+#
+# Each README command maps to what runs here: the same command where it takes a few
+# seconds, its quick variant where the README's own takes minutes (fewer points, fewer
+# steps, one worker: the same code paths), or a reason to skip it (it installs
+# packages or needs a cluster). A command added to the README without an entry here
+# fails `test_the_table_covers_every_readme_command`. The commands of one README block
+# run one after the other in one folder, as a user pasting the block would, so that
+# a later command that would clash with an earlier one's files shows up.
+
+SKIP_INSTALL = "installs packages"
+SKIP_CLUSTER = "needs a Dask cluster (HEAD is a placeholder); --scheduler is tested in-process"
+
+#: README command (comment stripped) -> (commands to run, files they must write) or a reason
+COMMANDS = {
+    # "moreau reproduce" after the install: the full run takes about an hour
+    'python -m venv .venv && . .venv/bin/activate && pip install -e . && moreau reproduce':
+        (["moreau reproduce --quick --jobs 1"],
+         ["moreau-results/report.md", "moreau-results/data/frequency.csv",
+          "moreau-results/data/phi0_2000Hz.json", "moreau-results/figures/mu_185Hz.png",
+          "moreau-results/figures/mode_NP.png"]),
+    'python -m venv .venv && . .venv/bin/activate && pip install -e ".[test]" && python -m pytest -q':
+        "installs packages; the test suite is what runs this",
+    'moreau sweep frequency 10 12500 --points 250 --scale log':
+        (["moreau sweep frequency 10 12500 --points 3 --scale log --jobs 1"],
+         ["out/sweep_frequency.csv", "out/sweep_frequency.json", "out/sweep_frequency.png"]),
+    'moreau sweep mu 0.01 0.99 --points 99 --set frequency=185':
+        (["moreau sweep mu 0.01 0.99 --points 2 --set frequency=185 --jobs 1"],
+         ["out/sweep_mu_185Hz.csv", "out/sweep_mu_185Hz.json", "out/sweep_mu_185Hz.svg"]),
+    'moreau sweep k 5e3 2e4 --points 40 --set frequency=185 --set mu=0.2':
+        (["moreau sweep k 5e3 2e4 --points 2 --set frequency=185 --set mu=0.2 --jobs 1"],
+         ["out/sweep_k_185Hz.csv", "out/sweep_k_185Hz.json"]),
+    'moreau sweep mu --frequency 185 --scheme moreau-jean --theta 0.5 --steps-per-period 2000':
+        (["moreau sweep mu --frequency 185 --scheme moreau-jean --theta 0.5 "
+          "--steps-per-period 200 --points 2 --jobs 1"],
+         ["out/sweep_mu_185Hz_mj_theta0.5_N200.csv", "out/sweep_mu_185Hz_mj_theta0.5_N200.json"]),
+    'moreau atlas':
+        (["moreau atlas --f-points 3 --y-points 2 --jobs 1"],
+         ["out/atlas_f-mu.csv", "out/atlas_f-mu.json", "out/atlas_f-mu.png",
+          "out/atlas_f-phi0.csv", "out/atlas_f-phi0.svg"]),
+    'moreau atlas --plane f-phi0 --f-points 100 --y-points 50 --mu 0.2 --out out/mu0.2':
+        (["moreau atlas --plane f-phi0 --f-points 3 --y-points 2 --mu 0.2 --out out/mu0.2 "
+          "--jobs 1"],
+         ["out/mu0.2/atlas_f-phi0.csv", "out/mu0.2/atlas_f-phi0.json"]),
+    'moreau sweep load 0 0.1 --points 11 --scene stick-slip-motor --frequency 1000':
+        (["moreau sweep load 0 0.1 --points 2 --scene stick-slip-motor --frequency 1000 "
+          "--jobs 1"],
+         ["out/sweep_stick-slip-motor_load_1000Hz_event-driven.csv",
+          "out/sweep_stick-slip-motor_load_1000Hz_event-driven.json"]),
+    'pip install -e ".[dask]"': SKIP_INSTALL,
+    'dask scheduler': SKIP_CLUSTER,
+    'dask worker tcp://HEAD:8786 --nworkers 8 --nthreads 1': SKIP_CLUSTER,
+    'moreau atlas --scheduler tcp://HEAD:8786 --out /shared/atlas --cache /shared/moreau-cache':
+        SKIP_CLUSTER,
+    'moreau reproduce --scheduler tcp://HEAD:8786 --out /shared/results': SKIP_CLUSTER,
+    'moreau steady --frequency 185 --json': (["moreau steady --frequency 185 --json"], []),
+    'moreau steady --frequency 2000 --mu 0.5': (["moreau steady --frequency 2000 --mu 0.5"], []),
+    'moreau steady --scene stick-slip-motor --frequency 1000 --set drive=sine':
+        (["moreau steady --scene stick-slip-motor --frequency 1000 --set drive=sine"], []),
+    'moreau run --frequency 185 --periods 10':
+        (["moreau run --frequency 185 --periods 10"],
+         ["out/history_friction-drive_frequency185_event-driven.csv",
+          "out/history_friction-drive_frequency185_event-driven.json",
+          "out/history_friction-drive_frequency185_event-driven.png"]),
+    'moreau run --frequency 185 --scheme moreau-jean --steps-per-period 2000':
+        (["moreau run --frequency 185 --scheme moreau-jean --steps-per-period 2000"],
+         ["out/history_friction-drive_frequency185_moreau-jean_steps20000.csv",
+          "out/history_friction-drive_frequency185_moreau-jean_steps20000.json"]),
+    'moreau run --scene sliding-box --duration 0.5 --scheme moreau-jean --steps 5000 --theta 0.5':
+        (["moreau run --scene sliding-box --duration 0.5 --scheme moreau-jean --steps 5000 "
+          "--theta 0.5"],
+         ["out/history_sliding-box_moreau-jean_steps5000_theta0.5.csv",
+          "out/history_sliding-box_moreau-jean_steps5000_theta0.5.png"]),
+    'moreau run --scene bouncing-ball --set restitution=0.9 --duration 2 --rtol 1e-12':
+        (["moreau run --scene bouncing-ball --set restitution=0.9 --duration 2 --rtol 1e-12"],
+         ["out/history_bouncing-ball_restitution0.9_event-driven_rtol1e-12.csv",
+          "out/history_bouncing-ball_restitution0.9_event-driven_rtol1e-12.json"]),
+    'moreau steady --frequency 185 --scheme moreau-jean --steps-per-period 2000 --json':
+        (["moreau steady --frequency 185 --scheme moreau-jean --steps-per-period 2000 --json"],
+         []),
+    'moreau steady --scene bidirectional-drive --frequency 185 --x10-b 0':
+        (["moreau steady --scene bidirectional-drive --frequency 185 --x10-b 0"], []),
+    'moreau steady --scene bidirectional-drive --frequency 185 --x10-a 0':
+        (["moreau steady --scene bidirectional-drive --frequency 185 --x10-a 0"], []),
+    'moreau steady --scene bidirectional-drive --frequency 185 --phase 1.0 --scheme moreau-jean':
+        (["moreau steady --scene bidirectional-drive --frequency 185 --phase 1.0 "
+          "--scheme moreau-jean"], []),
+    'python -m moreau.studies.bidirectional.direction_control out/':
+        (["python -m moreau.studies.bidirectional.direction_control out/ --points 2"],
+         ["out/direction_control.csv", "out/bidirectional_direction_control.png"]),
+    'moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 25 --frequency 185':
+        (["moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 2 --frequency 185 "
+          "--jobs 1"],
+         ["out/sweep_bidirectional_phase_185Hz.csv", "out/sweep_bidirectional_phase_185Hz.json"]),
+    'moreau sweep --scene bidirectional-drive balance -1 1 --points 21 --frequency 185 '
+    '--scheme moreau-jean':
+        (["moreau sweep --scene bidirectional-drive balance -1 1 --points 2 --frequency 185 "
+          "--scheme moreau-jean --jobs 1"],
+         ["out/sweep_bidirectional_balance_185Hz_mj_theta1_N1000.csv",
+          "out/sweep_bidirectional_balance_185Hz_mj_theta1_N1000.json"]),
+    'pip install -e ".[bench]"': SKIP_INSTALL,
+    # the benchmarks time for minutes (bench_lcp --quick: 22 s, tested in-process by
+    # tests/test_bench_lcp_peer.py): here they only start and read their options
+    'python benchmarks/bench_event_driven.py':
+        (["python benchmarks/bench_event_driven.py --help"], []),
+    'python benchmarks/bench_moreau_jean.py':
+        (["python benchmarks/bench_moreau_jean.py --help"], []),
+    'python benchmarks/bench_lcp.py --quick': (["python benchmarks/bench_lcp.py --help"], []),
+    # about a minute: the four cases of one scene
+    'python -m pytest benchmarks/test_regression.py -n 0':
+        (["python -m pytest benchmarks/test_regression.py -n 0 -q -p no:cacheprovider "
+          "-k ball"], []),
+    'python -m pytest benchmarks/test_regression.py -n 0 --update-baselines':
+        "rewrites the stored baselines of the checkout",
+    'moreau scenes [--json]': (["moreau scenes", "moreau scenes --json"], []),
+    'moreau compare --scene friction-drive --frequency 185 [--out DIR] [--json] [--quick]':
+        (["moreau compare --scene friction-drive --frequency 185 --out cmp --json --quick"],
+         ["cmp/compare_friction-drive_185Hz.csv", "cmp/compare_friction-drive_185Hz.json",
+          "cmp/compare_friction-drive_185Hz.png"]),
+    'moreau compare --scene NAME [--set NAME=VALUE ...]':
+        (["moreau compare --scene painleve-rod --set mu=0.5 --quick"],
+         ["out/compare_painleve-rod.csv", "out/compare_painleve-rod.json"]),
+    'moreau compare --scene sliding-box --set speed=2 --set mu=0.3':
+        (["moreau compare --scene sliding-box --set speed=2 --set mu=0.3 --quick"],
+         ["out/compare_sliding-box.csv", "out/compare_sliding-box.png"]),
+    'moreau compare --stress [--quick]':
+        (["moreau compare --stress --quick"], ["out/stress.csv", "out/stress.json"]),
+    'moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45':
+        (["moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45 "
+          "--quick"], ["out/compare_bouncing-ball.csv", "out/compare_bouncing-ball.json"]),
+}
+
+
+def readme_blocks():
+    """The README's bash blocks, each a list of commands without their comments."""
+    blocks = re.findall(r"```bash\n(.*?)```", README.read_text(), flags=re.S)
+    return [[line.split("  #")[0].strip() for line in b.splitlines()
+             if line.strip() and not line.startswith("#")] for b in blocks]
+
+
+def test_the_table_covers_every_readme_command():
+    readme = [c for block in readme_blocks() for c in block]
+    assert sorted(set(readme)) == sorted(COMMANDS)
+
+
+def _argv(command):
+    # `benchmarks/...` is the checkout's (the scripts find the test scenes beside them)
+    words = [str(README.parent / w) if w.startswith("benchmarks/") else w
+             for w in shlex.split(command)]
+    if words[0] == "moreau":
+        return [sys.executable, "-m", "moreau"] + words[1:]
+    if words[0] == "python":
+        return [sys.executable] + words[1:]
+    raise AssertionError(f"no way to run {command!r}")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("block", range(len(readme_blocks())))
+def test_every_readme_command_runs_in_a_fresh_process(block, tmp_path):
+    commands = readme_blocks()[block]
+    runnable = [COMMANDS[c] for c in commands if not isinstance(COMMANDS[c], str)]
+    if not runnable:
+        pytest.skip("; ".join(sorted({COMMANDS[c] for c in commands})))
+    root = README.parent
+    # a user's shell, not an xdist worker's (pytest-benchmark turns itself off under one)
+    env = {k: v for k, v in os.environ.items() if not k.startswith("PYTEST_")}
+    env["PYTHONPATH"] = os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])
+    for variants, files in runnable:
+        for command in variants:
+            done = subprocess.run(_argv(command), cwd=tmp_path, env=env, capture_output=True,
+                                  text=True, timeout=300)
+            assert done.returncode == 0, (command, done.stdout[-2000:], done.stderr[-2000:])
+            assert "Traceback" not in done.stderr, (command, done.stderr[-2000:])
+            if "--json" in command.split():
+                assert json.loads(done.stdout), command
+        for name in files:
+            path = tmp_path / name
+            assert path.is_file() and path.stat().st_size > 0, (commands, name)
