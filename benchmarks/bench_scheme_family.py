@@ -15,6 +15,18 @@ event-driven reference, and for Siconos's OSIs
     ``q = 1`` at rest (energy 1/2), error at ``t = 20`` against moreau's
     event-driven reference at rtol 1e-12;
 
+and the friction drive (``friction-drive``, 185 Hz, the paper's parameters,
+from rest, ``h = 2 pi / 1000``): the average displacement per period of the
+rotor over periods 10..20 (5..10 with ``--quick``) against moreau's
+event-driven reference (rtol 1e-12) over the same window, for moreau's
+compiled Moreau–Jean (theta 1/2 and 1) and for Siconos's MoreauJeanOSI,
+MoreauJeanCombinedProjectionOSI, MoreauJeanDirectProjectionOSI,
+MoreauJeanGOSI, MoreauJeanBilbaoOSI and LsodarOSI (those that cannot run
+the system say why), with each one's steps per second and moreau's
+compiled Moreau–Jean theta = 1/2 rate over it (``moreau_mj_speedup``),
+measured in the same run (Siconos: one run after the plugin build; moreau:
+median of ``--repeat`` runs after a warm-up);
+
 and the energy table: the largest and the final relative energy drift over
 1e5 steps (``h = 1e-3``) on the elastic (e = 1) ball and on the oscillator.
 (Schatzman–Paoli's velocity on an impact step is the mean of the two sides,
@@ -22,7 +34,7 @@ so its largest drift is that of one sample inside the impact; its final
 drift is the one to read.) Speeds are steps per second (median of ``--repeat`` runs), with the ratio
 to Siconos's MoreauJeanOSI measured in the same run.
 
-Run: ``python benchmarks/bench_scheme_family.py [--quick] [--out DIR]``;
+Run: ``python benchmarks/bench_scheme_family.py [--quick] [--out DIR] [--friction-drive-only]``;
 writes ``scheme_family.json`` and ``scheme_family.csv`` to ``--out``
 (default ``./out``) and prints the tables.
 """
@@ -42,9 +54,22 @@ from _timing import median_time
 from moreau.compiled import CompiledModel
 from moreau.integrators import INTEGRATORS, simulate
 from moreau.scenes.base import Scene
+from moreau.scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
 from moreau.scenes.registry import make_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+TWO_PI = 2.0 * np.pi
+#: the OSIs tried on the friction drive (issue 18's list, and the direct projection)
+FD_OSIS = ("MoreauJeanOSI", "MoreauJeanCombinedProjectionOSI", "MoreauJeanDirectProjectionOSI",
+           "MoreauJeanBilbaoOSI", "MoreauJeanGOSI", "LsodarOSI")
+#: why an OSI that fails on the friction drive cannot run it, where Siconos does not say
+FD_WHY = {"LsodarOSI": "EventDriven's impact and acceleration problems are LCPs, which take no "
+                       "Coulomb friction (NewtonImpactFrictionNSL): Siconos throws "
+                       "std::exception at the first advanceToEvent"}
+#: what a run that finishes does wrong, as observed (Siconos 4.4, Debian)
+FD_NOTES = {"MoreauJeanGOSI": "the rod is not driven: over one period phi moves by 3e-6 and u2 by "
+                              "1e-21; the stator's motion enters only through the relation's "
+                              "h_dot, which MoreauJeanGOSI's global problem appears to ignore"}
 SICONOS_OSIS = ("MoreauJeanOSI", "MoreauJeanGOSI", "MoreauJeanCombinedProjectionOSI",
                 "MoreauJeanDirectProjectionOSI", "MoreauJeanBilbaoOSI", "LsodarOSI")
 
@@ -158,6 +183,87 @@ def siconos(case, osi, h, t_end, e):
         return {"osi": osi, "case": case, "error": f"exit {run.returncode}: {tail}"}
 
 
+def fd_params(scene, label):
+    """The friction drive's dimensionless parameters as ``siconos_osis.py`` takes them."""
+    q0, v0 = scene.rest_state()
+    return {"label": label, "J": scene.J, "P": scene.P, "u10": scene.u10, "fL": scene.fL,
+            "sin_phi0": scene.sin_phi0, "mu": float(scene.mu[0]),
+            "e": float(scene.restitution[0]), "q0": [float(x) for x in q0],
+            "v0": [float(x) for x in v0]}
+
+
+def siconos_fd(osi, par, periods):
+    cmd = ["/usr/bin/python3", os.path.join(HERE, "siconos_osis.py"), "friction-drive", osi,
+           "--fd-params", json.dumps(par), "--periods", str(periods)]
+    try:
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=900)
+    except subprocess.TimeoutExpired:
+        return {"osi": osi, "error": "no result in 900 s"}
+    try:
+        return json.loads(run.stdout.strip().splitlines()[-1])
+    except (ValueError, IndexError):
+        tail = (run.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"osi": osi, "error": f"exit {run.returncode}: {tail}"}
+
+
+def friction_drive_rows(quick, repeat, use_siconos, frequency=185.0):
+    """Rows of the friction-drive table (see the module docstring)."""
+    scene = FrictionDrive(PAPER_DEFAULTS, frequency)
+    label = f"{frequency:g} Hz"
+    periods, skip = (10, 5) if quick else (20, 10)
+    steps = 1000
+    q0, v0 = scene.rest_state()
+    # the reference over the window: to the window's start, then on to its end
+    a = simulate(scene, (0.0, TWO_PI * skip), q0, v0, "event-driven", rtol=1e-12)
+    b = simulate(scene, (TWO_PI * skip, TWO_PI * periods), a.q[-1], a.v[-1], "event-driven",
+                 rtol=1e-12)
+    if a.status != 0 or b.status != 0 or abs(b.t[-1] - TWO_PI * periods) > 1e-9:
+        raise RuntimeError(f"event-driven reference failed: {a.message} {b.message}")
+    d_ref = float((b.q[-1, 1] - a.q[-1, 1]) / (periods - skip))
+    window = f"periods {skip}..{periods} from rest"
+    rows = [{"table": "friction-drive", "case": label, "scheme": "moreau event-driven",
+             "displacement_per_period": d_ref, "window": window}]
+
+    def rel(d):
+        return abs(d - d_ref) / abs(d_ref)
+
+    mj_rate = None
+    for theta in (0.5, 1.0):
+        def go(theta=theta):
+            return simulate(scene, (0.0, TWO_PI * periods), q0, v0, "moreau-jean",
+                            h=TWO_PI / steps, theta=theta, save_every=steps)
+        res = go()
+        sec = median_time(go, repeat=repeat, warmup=1)
+        d = float((res.q[periods, 1] - res.q[skip, 1]) / (periods - skip))
+        rate = res.stats["steps"] / sec
+        if theta == 0.5:
+            mj_rate = rate
+        rows.append({"table": "friction-drive", "case": label,
+                     "scheme": f"moreau-jean theta={theta:g} (compiled)",
+                     "steps": res.stats["steps"],
+                     "seconds": sec, "steps_per_s": rate, "displacement_per_period": d,
+                     "error": rel(d), "window": window})
+    if use_siconos:
+        par = fd_params(scene, label)
+        for osi in FD_OSIS:
+            r = siconos_fd(osi, par, periods)
+            row = {"table": "friction-drive", "case": label, "scheme": "siconos " + osi,
+                   "window": window}
+            if "error" in r:
+                row["failure"] = r["error"] + (f" ({FD_WHY[osi]})" if osi in FD_WHY else "")
+            else:
+                u2 = r["u2_periods"]
+                d = float((u2[periods] - u2[skip]) / (periods - skip))
+                rate = r["steps"] / r["seconds"]
+                row.update(steps=r["steps"], seconds=r["seconds"], steps_per_s=rate,
+                           displacement_per_period=d, error=rel(d),
+                           moreau_mj_speedup=mj_rate / rate)
+                if osi in FD_NOTES:
+                    row["note"] = FD_NOTES[osi]
+            rows.append(row)
+    return rows
+
+
 def moreau_row(label, scheme, options, scene, energy, t_end, h, repeat):
     q0, v0 = scene.initial_state()
     opts = dict(options, h=h) if "tol" not in options and scheme != "event-driven" \
@@ -182,6 +288,8 @@ def main():
     ap.add_argument("--quick", action="store_true", help="1e4 steps in the energy table, one run")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--no-siconos", action="store_true")
+    ap.add_argument("--friction-drive-only", action="store_true",
+                    help="only the friction-drive table")
     a = ap.parse_args()
     if os.path.exists(a.out) and not os.path.isdir(a.out):
         sys.exit(f"`--out` must be a folder, but {a.out!r} is a file")
@@ -190,7 +298,7 @@ def main():
     use_siconos = not a.no_siconos and shutil.which("/usr/bin/python3") is not None
     rows = []
     h = 1e-3
-    for name, t_end in (("ball", 2.0), ("oscillator", 20.0)):
+    for name, t_end in (() if a.friction_drive_only else (("ball", 2.0), ("oscillator", 20.0))):
         scene, energy = cases()[name]
         q_ref, v_ref = reference(name, scene, t_end)
         for scheme, opts, label in (time_stepping_schemes() + tolerance_schemes()
@@ -205,9 +313,10 @@ def main():
                 err = (max(abs(r["q"] - q_ref), abs(r["v"] - v_ref)) if "q" in r else None)
                 rows.append(dict(r, table="accuracy", case=name, scheme="siconos " + osi,
                                  error=err))
+    rows += friction_drive_rows(a.quick, repeat, use_siconos)
     # the energy table: 1e5 steps (1e4 quick) at h = 1e-3, elastic ball and oscillator
     t_energy = 10.0 if a.quick else 100.0
-    for name in ("ball", "oscillator"):
+    for name in (() if a.friction_drive_only else ("ball", "oscillator")):
         scene, energy = cases(e_ball=1.0)[name]
         for scheme, opts, label in time_stepping_schemes():
             r = moreau_row(label, scheme, opts, scene, energy, t_energy, h, 1)
@@ -229,11 +338,13 @@ def main():
     with open(os.path.join(a.out, "scheme_family.json"), "w") as fh:
         json.dump(rows, fh, indent=1)
     fields = ("table", "case", "scheme", "steps", "seconds", "steps_per_s", "ratio_to_siconos_mj",
-              "error", "energy_drift", "final_energy_drift", "status", "failure")
+              "moreau_mj_speedup", "error", "displacement_per_period", "window", "energy_drift",
+              "final_energy_drift", "status", "failure", "note")
     with open(os.path.join(a.out, "scheme_family.csv"), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=fields + ("q", "v"), extrasaction="ignore")
         w.writeheader()
         w.writerows(rows)
+    print_friction_drive(rows)
     for table in ("accuracy", "energy"):
         print(f"\n{table} (h = {h:g})")
         for r in (x for x in rows if x["table"] == table):
@@ -249,6 +360,25 @@ def main():
                      + (f", final {r['final_energy_drift']:.2e}" if "final_energy_drift" in r
                         else ""))
             print(f"  {r['case']:10s} {r['scheme']:40s} {extra}")
+
+
+def print_friction_drive(rows):
+    fd = [r for r in rows if r["table"] == "friction-drive"]
+    if not fd:
+        return
+    print(f"\nfriction drive {fd[0]['case']} (h = T/1000), displacement per period over "
+          f"{fd[0]['window']}")
+    for r in fd:
+        if r.get("failure"):
+            print(f"  {r['scheme']:40s} failed: {r['failure']}")
+        elif "error" not in r:
+            print(f"  {r['scheme']:40s} d = {r['displacement_per_period']:.10g} (reference)")
+        else:
+            extra = (f", moreau MJ theta=1/2 {r['moreau_mj_speedup']:.3g}x faster"
+                     if "moreau_mj_speedup" in r else "")
+            print(f"  {r['scheme']:40s} d = {r['displacement_per_period']:.8g}  error "
+                  f"{r['error']:.2e}  {r['steps_per_s']:.3g} steps/s{extra}"
+                  + (f"\n      note: {r['note']}" if "note" in r else ""))
 
 
 if __name__ == "__main__":

@@ -390,7 +390,9 @@ def _cmd_compare(args):
     out = cmp.check_out_dir(args.out)
     progress = not args.quiet
     if args.stress:
-        report = run_catalogue(progress=progress, full=not args.quick)
+        # with --stress, --schemes names the map's columns (keys of stress.SCHEMES)
+        cols = None if args.schemes in (None, "all") else args.schemes.split(",")
+        report = run_catalogue(progress=progress, full=not args.quick, schemes=cols)
         paths = write_stress_outputs(report, out, plot=not args.no_plot)
         if args.json:
             print(json.dumps(report))
@@ -557,7 +559,8 @@ def build_parser():
                    help="run the stiff and extreme case catalogue instead (stability map)")
     c.add_argument("--schemes", default=None, metavar="NAME,...",
                    help="other registered schemes to compare too, e.g. compliant-radau,schatzman-paoli, "
-                        "or all")
+                        "or all; with --stress, the map's columns (e.g. event-driven,mj-1/2,"
+                        "schatzman-paoli; all by default)")
     c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")
     c.add_argument("--out", default="out", help="output folder (default ./out)")
     c.add_argument("--json", action="store_true", help="print one JSON object")

@@ -9,7 +9,9 @@ import math
 
 import pytest
 
-from moreau.studies.paper.stress import CASES, SCHEMES, run_case, run_catalogue
+from moreau.integrators import INTEGRATORS
+from moreau.integrators.base import scheme_options
+from moreau.studies.paper.stress import CASES, CLASSIC, SCHEMES, run_case, run_catalogue
 from moreau.cli import main
 from moreau.errors import InputError
 
@@ -54,8 +56,8 @@ def test_every_case_has_an_expectation():
     assert set(EXPECTED) == set(CASES)
 
 
-def _check_common(rows):
-    assert [r["scheme"] for r in rows] == list(SCHEMES)
+def _check_common(rows, schemes=CLASSIC):
+    assert [r["scheme"] for r in rows] == list(schemes)
     for r in rows:
         assert r["outcome"] != "bug", r["message"]
         for key in ("value", "error", "estimate"):
@@ -71,7 +73,8 @@ def _check_common(rows):
 
 @pytest.mark.parametrize("case", list(EXPECTED))
 def test_case(case):
-    rows = run_case(case)
+    # the first three columns; the other schemes' columns are tested below on cheap cases
+    rows = run_case(case, schemes=CLASSIC)
     _check_common(rows)
     assert tuple(r["outcome"] for r in rows) == EXPECTED[case], [r["message"] for r in rows]
     ed, mj1, mj05 = rows
@@ -113,6 +116,11 @@ def test_stress_command_writes_map_and_table(tmp_path, capsys, monkeypatch):
                  "--out", str(tmp_path)]) == 0
     rep = json.loads(capsys.readouterr().out)
     assert {r["case"] for r in rep["rows"]} == set(keep)
+    # every column by default, each case one row per scheme, no bug
+    assert [c["key"] for c in rep["schemes"]] == list(SCHEMES)
+    for case in keep:
+        rows = [r for r in rep["rows"] if r["case"] == case]
+        _check_common(rows, SCHEMES)
     for f in ("stress.csv", "stress.json", "stress.png"):
         assert (tmp_path / f).stat().st_size > 0
     assert main(["compare", "--stress", "--quick", "--quiet", "--out", str(tmp_path)]) == 0
@@ -125,3 +133,59 @@ def test_unknown_case_is_refused():
         run_case("nope")
     with pytest.raises(InputError, match="`cases`"):
         run_catalogue(cases=["nope"], progress=False)
+
+
+# -- every registered time-stepping scheme has a column ----------------------------------------
+NEW = tuple(k for k in SCHEMES if k not in CLASSIC)
+
+
+def test_every_time_stepping_scheme_has_a_column():
+    stepping = {n for n, cls in INTEGRATORS.items() if "h" in (scheme_options(cls) or ())}
+    assert SCHEMES[:3] == CLASSIC
+    assert stepping - {"moreau-jean"} == set(NEW)
+    assert {"schatzman-paoli", "nonsmooth-generalized-alpha",
+            "time-discontinuous-galerkin"} <= set(NEW)
+
+
+@pytest.fixture(scope="module")
+def new_columns():
+    # the generic steps (fast=False): cheap on these two cases and no compile
+    rep = run_catalogue(cases=["painleve-mu1.2", "mu-zero"], schemes=("event-driven",) + NEW,
+                        progress=False, fast=False)
+    return rep
+
+
+def test_new_columns_fail_beyond_the_painleve_limit(new_columns):
+    rows = [r for r in new_columns["rows"] if r["case"] == "painleve-mu1.2"]
+    _check_common(rows, ("event-driven",) + NEW)
+    for r in rows:
+        assert r["outcome"] == "failed" and "Painlev" in r["message"], (r["scheme"], r["message"])
+
+
+def test_new_columns_are_exact_without_friction(new_columns):
+    rows = [r for r in new_columns["rows"] if r["case"] == "mu-zero"]
+    _check_common(rows, ("event-driven",) + NEW)
+    assert [r["outcome"] for r in rows] == ["stable"] * len(rows)
+    for r in rows[1:]:
+        # no friction, no drive of the rotor: d = 0 to rounding in every scheme
+        assert r["error"] < 1e-10 and r["estimate"] < 1e-10, r["scheme"]
+    assert new_columns["schemes"][1:] == [{"key": k, "scheme": k, "options": {}} for k in NEW]
+
+
+def test_stress_map_has_a_column_per_scheme(new_columns, tmp_path):
+    from moreau.studies.paper.stress import format_stress_table, write_stress_outputs
+    paths = write_stress_outputs(new_columns, str(tmp_path))
+    assert (tmp_path / "stress.png").stat().st_size > 0
+    with open(paths["csv"]) as fh:
+        text = fh.read()
+    table = format_stress_table(new_columns)
+    for k in NEW:
+        assert f"painleve-mu1.2,{k},failed" in text
+        assert k in table
+
+
+def test_unknown_column_is_refused():
+    with pytest.raises(InputError, match="`schemes` must hold keys of SCHEMES"):
+        run_case("mu-zero", schemes=["euler"])
+    with pytest.raises(InputError, match="`fast` must be"):
+        run_case("mu-zero", fast="yes")

@@ -1,9 +1,15 @@
 """Stiff and extreme cases of the friction drive: what each scheme does (``moreau compare --stress``).
 
-Every case of :data:`CASES` is run with three schemes: the event-driven
-reference (``"event-driven"``), Moreau–Jean with ``theta = 1`` (``"mj-1"``)
-and with ``theta = 1/2`` (``"mj-1/2"``), both with position projection, the
-package's default for the friction drive. Each run ends in one outcome:
+Every case of :data:`CASES` is run with every scheme of :data:`SCHEMES`:
+the event-driven reference (``"event-driven"``), Moreau–Jean with ``theta =
+1`` (``"mj-1"``) and with ``theta = 1/2`` (``"mj-1/2"``), both with position
+projection, the package's default for the friction drive, and every other
+registered time-stepping scheme (one with a step ``h``: Schatzman–Paoli,
+the nonsmooth generalized-α, the time-discontinuous Galerkin scheme, ...)
+under its registry name, with its default options. Each scheme's steady
+state is its own discrete one (Moreau–Jean's compiled period map, the others
+by Newton shooting on the period map they compute). Each run ends in one
+outcome:
 
 ``stable``
     a finite result within the stated bound ``bound`` of the reference
@@ -38,9 +44,11 @@ in the quick catalogue that the tests run.
 
 Examples
 --------
->>> rep = run_catalogue(cases=["mu-zero"], progress=False)
+>>> rep = run_catalogue(cases=["mu-zero"], progress=False, fast=False)
 >>> sorted({r["outcome"] for r in rep["rows"]})
 ['stable']
+>>> [r["scheme"] for r in rep["rows"]][:3]
+['event-driven', 'mj-1', 'mj-1/2']
 """
 
 import csv
@@ -55,17 +63,46 @@ from ...analysis.compare import collect_rows
 from ...analysis.mj_steady_state import moreau_jean_steady_state
 from ...analysis.steady_state import find_steady_state
 from ...errors import ConvergenceError, InputError, MoreauError
-from ...integrators import simulate
+from ...integrators import INTEGRATORS, simulate
+from ...integrators.base import scheme_options
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
 from .valid_range import phi0_valid_range
 
-__all__ = ["CASES", "SCHEMES", "OUTCOMES", "BOUND", "run_case", "run_catalogue",
+__all__ = ["CASES", "SCHEMES", "CLASSIC", "check_schemes", "OUTCOMES", "BOUND", "run_case",
+           "run_catalogue", "column_label",
            "write_stress_outputs", "format_stress_table", "plot_stability_map"]
 
 TWO_PI = 2.0 * math.pi
+
+
+def _columns():
+    """``key -> (registered scheme, options)`` of every column, in the map's order.
+
+    The event-driven reference, then every registered time-stepping scheme
+    (one whose constructor takes a step ``h``), read from the registry so
+    that a new scheme gets its column without a list naming it: Moreau–Jean
+    first, the others by name; a scheme with a ``theta`` twice, at ``theta =
+    1`` and ``1/2`` (keys ``mj-1`` and ``mj-1/2`` for Moreau–Jean).
+    """
+    cols = {"event-driven": ("event-driven", {})}
+    for name in sorted(INTEGRATORS, key=lambda n: (n != "moreau-jean", n)):
+        takes = scheme_options(INTEGRATORS[name]) or ()
+        if "h" not in takes:
+            continue
+        if "theta" in takes:
+            short = "mj" if name == "moreau-jean" else name
+            cols[f"{short}-1"] = (name, {"theta": 1.0})
+            cols[f"{short}-1/2"] = (name, {"theta": 0.5})
+        else:
+            cols[name] = (name, {})
+    return cols
+
+
+_COLUMNS = _columns()
 #: scheme keys, in the order of the map's columns
-SCHEMES = ("event-driven", "mj-1", "mj-1/2")
-_THETA = {"mj-1": 1.0, "mj-1/2": 0.5}
+SCHEMES = tuple(_COLUMNS)
+#: the catalogue's first columns: the reference and Moreau–Jean at theta = 1 and 1/2
+CLASSIC = ("event-driven", "mj-1", "mj-1/2")
 #: outcome -> colour of the stability map
 OUTCOMES = {"stable": "#4daf4a", "averaged": "#a6d96a", "inaccurate": "#fdae61",
             "failed": "#abd9e9", "n/a": "#dddddd", "bug": "#d7191c"}
@@ -111,9 +148,35 @@ def _guard(case, scheme, fn):
     return row
 
 
+# -- the schemes of the columns ---------------------------------------------------------------
+def _steady(scene, key, steps, fast):
+    """Steady state of column ``key`` at ``steps`` steps per period."""
+    name, opts = _COLUMNS[key]
+    if name == "moreau-jean":
+        # the compiled discrete period map (projection, the friction drive's default)
+        return moreau_jean_steady_state(scene, steps, theta=opts["theta"])
+    return find_steady_state(scene, scheme=name, steps_per_period=steps, rtol=1e-10,
+                             scheme_options=_run_options(key, fast))
+
+
+def _run_options(key, fast):
+    """Options of a run of column ``key`` besides its step (``fast`` where the scheme takes it)."""
+    name, opts = _COLUMNS[key]
+    out = dict(opts)
+    if name == "moreau-jean":
+        out["projection"] = True
+    if fast != "auto" and "fast" in (scheme_options(INTEGRATORS[name]) or ()):
+        out["fast"] = fast
+    return out
+
+
+def _stepping(schemes):
+    return [k for k in schemes if k != "event-driven"]
+
+
 # -- steady-state cases -----------------------------------------------------------------------
-def _steady_case(case, scene, steps=STEPS, bound=BOUND, note=""):
-    """Event-driven steady state as reference; Moreau–Jean steady states at ``steps`` and 2x."""
+def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note=""):
+    """Event-driven steady state as reference; each time-stepping scheme's at ``steps`` and 2x."""
     rows = []
     ref = {}
 
@@ -123,14 +186,15 @@ def _steady_case(case, scene, steps=STEPS, bound=BOUND, note=""):
         return _row(case, "event-driven", "stable", value=ss.displacement_per_period,
                     mode=ss.mode, message="reference (shooting rtol 1e-12)" + note)
 
-    rows.append(_guard(case, "event-driven", ed))
-    for scheme in ("mj-1", "mj-1/2"):
-        theta = _THETA[scheme]
-
-        def mj():
-            ss = moreau_jean_steady_state(scene, steps, theta=theta)
+    # the reference is needed by every column, shown only where asked for
+    ed_row = _guard(case, "event-driven", ed)
+    if "event-driven" in schemes:
+        rows.append(ed_row)
+    for scheme in _stepping(schemes):
+        def ts(scheme=scheme):
+            ss = _steady(scene, scheme, steps, fast)
             d = ss.displacement_per_period
-            d2 = moreau_jean_steady_state(scene, 2 * steps, theta=theta).displacement_per_period
+            d2 = _steady(scene, scheme, 2 * steps, fast).displacement_per_period
             est = 2.0 * abs(d - d2) / max(abs(d2), 0.01 * scene.u10)
             row = _row(case, scheme, "stable", value=d, mode=ss.mode, bound=bound, estimate=est)
             if not ref:
@@ -148,11 +212,11 @@ def _steady_case(case, scene, steps=STEPS, bound=BOUND, note=""):
             row["message"] = msg
             return row
 
-        rows.append(_guard(case, scheme, mj))
+        rows.append(_guard(case, scheme, ts))
     return rows
 
 
-def _ill_posed_case(case, scene):
+def _ill_posed_case(case, scene, schemes, fast):
     """Beyond the Painlevé limit: every scheme must fail and name the cause."""
     def expect_failure(fn, scheme):
         def run():
@@ -162,12 +226,13 @@ def _ill_posed_case(case, scene):
                         message="returned a steady state for an ill-posed problem")
         return run
 
-    rows = [_guard(case, "event-driven",
-                   expect_failure(lambda: find_steady_state(scene, rtol=1e-12), "event-driven"))]
-    for scheme in ("mj-1", "mj-1/2"):
-        th = _THETA[scheme]
+    rows = []
+    if "event-driven" in schemes:
+        rows.append(_guard(case, "event-driven", expect_failure(
+            lambda: find_steady_state(scene, rtol=1e-12), "event-driven")))
+    for scheme in _stepping(schemes):
         rows.append(_guard(case, scheme, expect_failure(
-            lambda: moreau_jean_steady_state(scene, STEPS, theta=th), scheme)))
+            lambda scheme=scheme: _steady(scene, scheme, STEPS, fast), scheme)))
     return rows
 
 
@@ -184,7 +249,7 @@ def _long_run_average(scene, method, periods, skip, **opts):
     return float((res.q[j, 1] - res.q[i, 1]) / n_per), letters
 
 
-def _flight_case(case, scene, full, steps=2000, bound=0.05):
+def _flight_case(case, scene, full, schemes, fast, steps=2000, bound=0.05):
     periods, skip = (200, 100) if full else (30, 10)
     window = f"periods {skip}..{periods} from rest"
     ref = {}
@@ -203,25 +268,26 @@ def _flight_case(case, scene, full, steps=2000, bound=0.05):
         return _row(case, "event-driven", "averaged", value=avg, mode=None,
                     message=note + f"reference: average over {window}")
 
-    rows = [_guard(case, "event-driven", ed)]
-    for scheme in ("mj-1", "mj-1/2"):
-        th = _THETA[scheme]
-
-        def mj():
+    ed_row = _guard(case, "event-driven", ed)
+    rows = [ed_row] if "event-driven" in schemes else []
+    for scheme in _stepping(schemes):
+        def ts(scheme=scheme):
+            name = _COLUMNS[scheme][0]
             note = ""
             try:
-                ss = moreau_jean_steady_state(scene, steps, theta=th)
+                ss = _steady(scene, scheme, steps, fast)
                 if ss.stats.get("periodic", True):
                     note = f"periodic steady state {ss.mode}; "
                 else:
-                    note = "no period-1 orbit of the Moreau–Jean map; "
+                    note = f"no period-1 orbit of the {name} map; "
             except ConvergenceError as exc:
                 note = f"no periodic steady state ({str(exc).split(':')[0]}); "
             h = TWO_PI / steps
-            avg, _ = _long_run_average(scene, "moreau-jean", periods, skip, h=h, theta=th,
-                                       projection=True, save_every=steps)
-            avg2, _ = _long_run_average(scene, "moreau-jean", periods, skip, h=h / 2, theta=th,
-                                        projection=True, save_every=2 * steps)
+            opts = _run_options(scheme, fast)
+            avg, _ = _long_run_average(scene, name, periods, skip, h=h, save_every=steps,
+                                       **opts)
+            avg2, _ = _long_run_average(scene, name, periods, skip, h=h / 2,
+                                        save_every=2 * steps, **opts)
             est = 2.0 * abs(avg - avg2) / max(abs(avg2), 0.01 * scene.u10)
             row = _row(case, scheme, "averaged", value=avg, bound=bound, estimate=est)
             if ref:
@@ -233,7 +299,7 @@ def _flight_case(case, scene, full, steps=2000, bound=0.05):
             row["message"] = note + f" (step-halving estimate {est:.2g})"
             return row
 
-        rows.append(_guard(case, scheme, mj))
+        rows.append(_guard(case, scheme, ts))
     return rows
 
 
@@ -245,30 +311,46 @@ def _energy(scene, q, v):
             + 0.5 * scene.J * v[:, 1] ** 2)
 
 
-def _long_case(case, scene, full, steps=1000, bound=1e-6):
+def _section_state(ss):
+    """``(q0, v0)`` at the section of a steady state: Moreau–Jean's map keeps ``(phi, phi',
+    u2')`` (the rotor at 0), the generic shooting the full state."""
+    x = np.asarray(ss.state0, float)
+    if x.size == 3:
+        return np.array([x[0], 0.0]), np.array([x[1], x[2]])
+    n = x.size // 2
+    q0 = x[:n].copy()
+    q0[1] = 0.0
+    return q0, x[n:].copy()
+
+
+def _long_case(case, scene, full, schemes, fast, steps=1000, bound=1e-6):
     total = 10 ** 7 if full else 10 ** 6
     periods = total // steps
-    rows = [_row(case, "event-driven", "n/a", time_s=0.0,
-                 message="event-driven takes no time steps; its error does not grow with them")]
-    for scheme in ("mj-1", "mj-1/2"):
-        th = _THETA[scheme]
-
-        def mj():
-            ss = moreau_jean_steady_state(scene, steps, theta=th)
-            x = ss.state0
-            q0, v0 = np.array([x[0], 0.0]), np.array([x[1], x[2]])
-            res = simulate(scene, (0.0, TWO_PI * periods), q0, v0, "moreau-jean",
-                           h=TWO_PI / steps, theta=th, projection=True, save_every=steps)
+    rows = []
+    if "event-driven" in schemes:
+        rows.append(_row(case, "event-driven", "n/a", time_s=0.0,
+                         message="event-driven takes no time steps; its error does not grow "
+                                 "with them"))
+    for scheme in _stepping(schemes):
+        def ts(scheme=scheme):
+            name = _COLUMNS[scheme][0]
+            ss = _steady(scene, scheme, steps, fast)
+            q0, v0 = _section_state(ss)
+            res = simulate(scene, (0.0, TWO_PI * periods), q0, v0, name,
+                           h=TWO_PI / steps, save_every=steps, **_run_options(scheme, fast))
             if res.status != 0:
                 raise MoreauError(f"long run stopped: {res.message}")
             if res.stats["steps"] != total:
                 raise MoreauError(f"long run took {res.stats['steps']} steps, not {total}")
+            if "max_penetration" not in res.stats:
+                raise MoreauError(f"{name} does not report its penetration (stats "
+                                  "'max_penetration')")
             d = np.diff(res.q[:, 1])
             E = _energy(scene, res.q, res.v)
             drift = float(np.max(np.abs(d - ss.displacement_per_period))
                           / max(abs(ss.displacement_per_period), 0.01 * scene.u10))
             e_spread = float((E.max() - E.min()) / E.max())
-            pen = float(res.stats.get("max_penetration", 0.0)) / scene.u10
+            pen = float(res.stats["max_penetration"]) / scene.u10
             worst = max(drift, e_spread, pen)
             out = "stable" if worst <= bound else "inaccurate"
             return _row(case, scheme, out, value=float(d[-1]),
@@ -279,7 +361,7 @@ def _long_case(case, scene, full, steps=1000, bound=1e-6):
                                  f"at period starts {e_spread:.1e}, max penetration / u10 "
                                  f"{pen:.1e}"))
 
-        rows.append(_guard(case, scheme, mj))
+        rows.append(_guard(case, scheme, ts))
     return rows
 
 
@@ -293,58 +375,112 @@ def _c(title, fn):
     return {"title": title, "run": fn}
 
 
-#: case id -> {"title", "run": callable(case_id, full) -> rows}
+def _steady_at(frequency=185.0, steps=STEPS, **params):
+    """A steady-state case of ``_scene(frequency, **params)``; a callable parameter is
+    evaluated when the case runs (the phi0 edges cost a computation)."""
+    def run(c, full, schemes, fast):
+        values = {k: v() if callable(v) else v for k, v in params.items()}
+        return _steady_case(c, _scene(frequency, **values), schemes, fast, steps=steps)
+    return run
+
+
+def _flight(e):
+    return lambda c, full, schemes, fast: _flight_case(c, _scene(15000.0, restitution=e), full,
+                                                       schemes, fast)
+
+
+#: case id -> {"title", "run": callable(case_id, full, schemes, fast) -> rows}
 CASES = {
     "stiff-1Hz-N50": _c("f = 1 Hz (P = 1.3e7), 50 steps per period",
-                        lambda c, full: _steady_case(c, _scene(1.0), steps=50)),
-    "stiff-1Hz-N1000": _c("f = 1 Hz, 1000 steps per period",
-                          lambda c, full: _steady_case(c, _scene(1.0), steps=1000)),
-    "stiff-1Hz-N1e5": _c("f = 1 Hz, 1e5 steps per period",
-                         lambda c, full: _steady_case(c, _scene(1.0), steps=100000)),
-    "flight-15kHz-e0": _c("f = 15 kHz (contact lost above 12.3 kHz), e = 0",
-                          lambda c, full: _flight_case(c, _scene(15000.0, restitution=0.0), full)),
-    "flight-15kHz-e0.5": _c("f = 15 kHz, e = 0.5",
-                            lambda c, full: _flight_case(c, _scene(15000.0, restitution=0.5),
-                                                         full)),
-    "flight-15kHz-e1": _c("f = 15 kHz, e = 1",
-                          lambda c, full: _flight_case(c, _scene(15000.0, restitution=1.0), full)),
-    "painleve-mu0.9": _c("mu = 0.9 (Painlevé limit 1/tan(phi0) = 1)",
-                         lambda c, full: _steady_case(c, _scene(mu=0.9))),
-    "painleve-mu0.99": _c("mu = 0.99", lambda c, full: _steady_case(c, _scene(mu=0.99))),
-    "painleve-mu0.999": _c("mu = 0.999", lambda c, full: _steady_case(c, _scene(mu=0.999))),
+                        _steady_at(1.0, steps=50)),
+    "stiff-1Hz-N1000": _c("f = 1 Hz, 1000 steps per period", _steady_at(1.0, steps=1000)),
+    "stiff-1Hz-N1e5": _c("f = 1 Hz, 1e5 steps per period", _steady_at(1.0, steps=100000)),
+    "flight-15kHz-e0": _c("f = 15 kHz (contact lost above 12.3 kHz), e = 0", _flight(0.0)),
+    "flight-15kHz-e0.5": _c("f = 15 kHz, e = 0.5", _flight(0.5)),
+    "flight-15kHz-e1": _c("f = 15 kHz, e = 1", _flight(1.0)),
+    "painleve-mu0.9": _c("mu = 0.9 (Painlevé limit 1/tan(phi0) = 1)", _steady_at(mu=0.9)),
+    "painleve-mu0.99": _c("mu = 0.99", _steady_at(mu=0.99)),
+    "painleve-mu0.999": _c("mu = 0.999", _steady_at(mu=0.999)),
     "painleve-mu1.2": _c("mu = 1.2, beyond the limit (ill-posed)",
-                         lambda c, full: _ill_posed_case(c, _scene(mu=1.2))),
-    "mu-zero": _c("mu = 0 (no friction)", lambda c, full: _steady_case(c, _scene(mu=0.0))),
-    "mass-ratio-1e-3": _c("m2/m = 1e-3", lambda c, full: _steady_case(c, _scene(m2=2e-8))),
-    "mass-ratio-1e6": _c("m2/m = 1e6", lambda c, full: _steady_case(c, _scene(m2=20.0))),
+                         lambda c, full, schemes, fast: _ill_posed_case(c, _scene(mu=1.2),
+                                                                        schemes, fast)),
+    "mu-zero": _c("mu = 0 (no friction)", _steady_at(mu=0.0)),
+    "mass-ratio-1e-3": _c("m2/m = 1e-3", _steady_at(m2=2e-8)),
+    "mass-ratio-1e6": _c("m2/m = 1e6", _steady_at(m2=20.0)),
     "phi0-lift-off-edge": _c("phi0 = lift-off edge + 1e-3",
-                             lambda c, full: _steady_case(c, _scene(phi0=_phi0_edges()[0] + 1e-3))),
+                             _steady_at(phi0=lambda: _phi0_edges()[0] + 1e-3)),
     "phi0-painleve-edge": _c("phi0 = Painlevé edge - 1e-3",
-                             lambda c, full: _steady_case(c, _scene(phi0=_phi0_edges()[1] - 1e-3))),
-    "coarse-N10": _c("10 steps per period (h = T/10)",
-                     lambda c, full: _steady_case(c, _scene(), steps=10)),
+                             _steady_at(phi0=lambda: _phi0_edges()[1] - 1e-3)),
+    "coarse-N10": _c("10 steps per period (h = T/10)", _steady_at(steps=10)),
     "long-1e7-steps": _c("10^7 steps at N = 1000 (10^6 in the quick catalogue)",
-                         lambda c, full: _long_case(c, _scene(), full)),
+                         lambda c, full, schemes, fast: _long_case(c, _scene(), full, schemes,
+                                                                   fast)),
 }
 
 
-def run_case(case, full=False):
-    """Rows (one per scheme of :data:`SCHEMES`) of one case of :data:`CASES`.
+def check_schemes(schemes):
+    """The column keys ``schemes`` (all of :data:`SCHEMES` for None), in the map's order.
 
     Examples
     --------
-    >>> [r["outcome"] for r in run_case("painleve-mu1.2")]
+    >>> check_schemes(["mj-1/2", "event-driven"])
+    ('event-driven', 'mj-1/2')
+    >>> check_schemes(["euler"])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `schemes` must hold keys of SCHEMES ('event-driven', 'mj-1', ...); got 'euler'
+    """
+    if schemes is None:
+        return SCHEMES
+    if isinstance(schemes, str):
+        schemes = [schemes]
+    for k in schemes:
+        if k not in SCHEMES:
+            raise InputError(f"`schemes` must hold keys of SCHEMES {SCHEMES}; got {k!r}")
+    if not schemes:
+        raise InputError("`schemes` must name at least one column")
+    return tuple(k for k in SCHEMES if k in schemes)
+
+
+def _check_fast(fast):
+    if fast not in ("auto", True, False):
+        raise InputError(f"`fast` must be 'auto', True or False, got {fast!r}")
+    return fast
+
+
+def run_case(case, full=False, schemes=None, fast="auto"):
+    """Rows (one per scheme of ``schemes``, all of :data:`SCHEMES` by default) of one case.
+
+    Parameters
+    ----------
+    case : str
+        A key of :data:`CASES`.
+    full : bool
+        See :func:`run_catalogue`.
+    schemes : sequence of str, optional
+        Column keys (of :data:`SCHEMES`); the rows follow the map's order.
+    fast : {"auto", True, False}
+        Passed to the time-stepping schemes that take it (compiled loop or
+        the generic step); Moreau–Jean's steady states always use its compiled
+        period map.
+
+    Examples
+    --------
+    >>> [r["outcome"] for r in run_case("painleve-mu1.2", schemes=CLASSIC)]
     ['failed', 'failed', 'failed']
     """
     if case not in CASES:
         raise InputError(f"`case` must be one of {list(CASES)}, got {case!r}")
-    rows = CASES[case]["run"](case, full)
+    schemes = check_schemes(schemes)
+    fast = _check_fast(fast)
+    rows = CASES[case]["run"](case, full, schemes, fast)
     for r in rows:
         r["title"] = CASES[case]["title"]
     return rows
 
 
-def run_catalogue(cases=None, full=False, progress=True, on_row=None):
+def run_catalogue(cases=None, full=False, progress=True, on_row=None, schemes=None,
+                  fast="auto"):
     """Run the stress catalogue.
 
     Parameters
@@ -358,22 +494,33 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None):
         tqdm progress bar over the cases.
     on_row : callable, optional
         Called with every finished row.
+    schemes : sequence of str, optional
+        Column keys of :data:`SCHEMES`; every one by default.
+    fast : {"auto", True, False}
+        See :func:`run_case`.
 
     Returns
     -------
     dict
         ``rows`` (``case``, ``title``, ``scheme``, ``outcome``, ``value``,
         ``reference``, ``error``, ``bound``, ``estimate``, ``mode``,
-        ``time_s``, ``message``), ``full`` and ``interrupted`` (an interrupted
-        catalogue keeps the finished cases).
+        ``time_s``, ``message``), ``schemes`` (the columns, with the
+        registered scheme and options of each), ``full`` and ``interrupted``
+        (an interrupted catalogue keeps the finished cases).
     """
     cases = list(CASES) if cases is None else list(cases)
     for c in cases:
         if c not in CASES:
             raise InputError(f"`cases` must hold keys of CASES ({list(CASES)}), got {c!r}")
-    report = {"full": bool(full), "bound": BOUND, "rows": [], "interrupted": False}
-    report["interrupted"] = collect_rows(cases, lambda c: run_case(c, full), report["rows"],
-                                         on_row, progress, desc="stress catalogue", unit="case")
+    schemes = check_schemes(schemes)
+    fast = _check_fast(fast)
+    report = {"full": bool(full), "bound": BOUND,
+              "schemes": [{"key": k, "scheme": _COLUMNS[k][0], "options": _COLUMNS[k][1]}
+                          for k in schemes],
+              "rows": [], "interrupted": False}
+    report["interrupted"] = collect_rows(cases, lambda c: run_case(c, full, schemes, fast),
+                                         report["rows"], on_row, progress,
+                                         desc="stress catalogue", unit="case")
     return report
 
 
@@ -408,6 +555,26 @@ def _cell_text(r):
     return r["outcome"]
 
 
+def column_label(key):
+    r"""The map's heading of column ``key``.
+
+    Examples
+    --------
+    >>> column_label("mj-1/2")
+    'Moreau–Jean\nθ=1/2'
+    >>> column_label("schatzman-paoli")
+    'schatzman-\npaoli'
+    """
+    name, opts = _COLUMNS[key]
+    if name == "moreau-jean":
+        return "Moreau\u2013Jean\n\u03b8=" + ("1" if opts["theta"] == 1.0 else "1/2")
+    if "theta" in opts:
+        return f"{name}\n\u03b8={opts['theta']:g}"
+    # one break after the first word keeps the long registry names readable
+    head, _, tail = name.partition("-")
+    return f"{head}-\n{tail}" if tail else head
+
+
 def plot_stability_map(report, path):
     """The stability map: cases (rows) against schemes (columns), coloured by outcome."""
     import matplotlib
@@ -417,20 +584,22 @@ def plot_stability_map(report, path):
     from matplotlib.patches import Patch
 
     cases = list(dict.fromkeys(r["case"] for r in report["rows"]))
+    present = {r["scheme"] for r in report["rows"]}
+    columns = [k for k in SCHEMES if k in present]
     names = list(OUTCOMES)
-    grid = np.full((len(cases), len(SCHEMES)), names.index("n/a"))
+    grid = np.full((len(cases), len(columns)), names.index("n/a"))
     text = {}
     for r in report["rows"]:
-        i, j = cases.index(r["case"]), SCHEMES.index(r["scheme"])
+        i, j = cases.index(r["case"]), columns.index(r["scheme"])
         grid[i, j] = names.index(r["outcome"])
         text[i, j] = _cell_text(r)
-    fig, ax = plt.subplots(figsize=(7.5, 0.42 * len(cases) + 1.6))
+    fig, ax = plt.subplots(figsize=(max(7.5, 1.25 * len(columns) + 2.0),
+                                    0.42 * len(cases) + 1.9))
     ax.imshow(grid, cmap=ListedColormap(list(OUTCOMES.values())), vmin=-0.5,
               vmax=len(names) - 0.5, aspect="auto")
     for (i, j), s in text.items():
         ax.text(j, i, s, ha="center", va="center", fontsize=6.5)
-    ax.set_xticks(range(len(SCHEMES)), ["event-driven", "Moreau–Jean θ=1", "Moreau–Jean θ=1/2"],
-                  fontsize=8)
+    ax.set_xticks(range(len(columns)), [column_label(k) for k in columns], fontsize=7)
     ax.set_yticks(range(len(cases)), cases, fontsize=7)
     ax.xaxis.tick_top()
     ax.legend(handles=[Patch(color=c, label=k) for k, c in OUTCOMES.items()], fontsize=7,
@@ -444,7 +613,7 @@ def plot_stability_map(report, path):
 
 def format_stress_table(report):
     """The catalogue as a fixed-width text table."""
-    lines = [f"{'case':<20} {'scheme':<13} {'outcome':<10} {'error':>8} {'bound':>7} "
+    lines = [f"{'case':<20} {'scheme':<28} {'outcome':<10} {'error':>8} {'bound':>7} "
              f"{'estimate':>8} {'mode':<6} message"]
 
     def g(x):
@@ -452,6 +621,6 @@ def format_stress_table(report):
 
     for r in report["rows"]:
         b = f"{r['bound']:7.0e}" if r["bound"] is not None else f"{'-':>7}"
-        lines.append(f"{r['case']:<20} {r['scheme']:<13} {r['outcome']:<10} {g(r['error'])} {b} "
+        lines.append(f"{r['case']:<20} {r['scheme']:<28} {r['outcome']:<10} {g(r['error'])} {b} "
                      f"{g(r['estimate'])} {r['mode'] or '-':<6} {r['message']}")
     return "\n".join(lines)
