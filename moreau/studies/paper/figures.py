@@ -21,16 +21,22 @@ from ...regimes import REGIME_LETTERS
 from ...scenes.friction_drive import FrictionDrive
 from .tables import PARAM_COLUMNS, SWEPT_COLUMN
 
-__all__ = ["MODE_COLORS", "REGIME_COLORS", "mode_color", "sweep_figure", "mode_figures",
-           "steady_period", "atlas_figure", "save"]
+__all__ = ["MODE_COLORS", "REGIME_COLORS", "BAND_ALPHA", "EXTRA_COLORS", "mode_color", "sweep_figure",
+           "draw_sweep", "mode_figures", "draw_mode", "mode_points", "steady_period",
+           "velocity_ratio", "atlas_figure", "save"]
 
 #: the paper's six operation modes, in its order
 PAPER_MODES = ("NS", "NSPS", "NPS", "NP", "NSP", "SP")
-MODE_COLORS = {"NS": "#4477aa", "NSPS": "#66ccee", "NPS": "#228833", "NP": "#ccbb44",
+# NSPS in orange: its bands are narrow and sit between NS and NPS, so it must differ from both
+MODE_COLORS = {"NS": "#4477aa", "NSPS": "#ee7733", "NPS": "#228833", "NP": "#ccbb44",
                "NSP": "#ee6677", "SP": "#aa3377"}
+#: opacity of the operation-mode bands
+BAND_ALPHA = 0.3
 REGIME_COLORS = {"N": "#4477aa", "S": "#228833", "P": "#ee6677", "F": "#bbbbbb"}
-# distinct from the six mode colours and from the grey/black/white of points without a mode
-_EXTRA = ["#999933", "#882255", "#44aa99", "#332288", "#e69f00", "#661100", "#cc79a7", "#56b4e9"]
+# distinct from the six mode colours and from the grey/black/white of points without a mode,
+# the most distinct first: flight and impact modes sit next to NP (e.g. NPF!P after NP)
+#: colours of the modes other than the paper's six, in the order they are handed out
+EXTRA_COLORS = ["#332288", "#009988", "#661100", "#33bbee", "#e69f00", "#882255", "#999933", "#cc79a7"]
 _LETTER_NAME = {"N": "negative slip", "S": "stick", "P": "positive slip", "F": "flight"}
 
 
@@ -49,7 +55,7 @@ def mode_color(mode, others=None):
         return "#000000"
     others = {} if others is None else others
     if mode not in others:
-        others[mode] = _EXTRA[len(others) % len(_EXTRA)]
+        others[mode] = EXTRA_COLORS[len(others) % len(EXTRA_COLORS)]
     return others[mode]
 
 
@@ -86,7 +92,7 @@ def _bands(ax, x, rows, others, log=False):
     seen = {}
     for m, a, b in runs:
         c = "#000000" if m == "failed" else mode_color(m, others)
-        h = ax.axvspan(a, b, color=c, alpha=0.22 if m != "failed" else 0.5, lw=0)
+        h = ax.axvspan(a, b, color=c, alpha=BAND_ALPHA if m != "failed" else 0.5, lw=0)
         seen.setdefault(m, h)
     return seen
 
@@ -106,6 +112,24 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
                  scheme_label="event-driven"):
     """Displacement per period and average velocity over a sweep (PNG + SVG).
 
+    Draws with :func:`draw_sweep` (same arguments, ``stem`` aside) and saves
+    ``stem.png`` and ``stem.svg``; returns both paths.
+    """
+    return save(draw_sweep(rows, parameter, frequency, extra, checks, title, log, scheme_label),
+                 stem)
+
+
+def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=None,
+               scheme_label="event-driven"):
+    """The figure of a sweep: displacement per period and average velocity, modes as bands.
+
+    Scales follow the data so that a new reader can read them: a velocity
+    that spans decades against a log frequency goes on a symmetric log scale
+    with its minimum marked and a ``v`` proportional to ``f`` guide; values of
+    one sign spanning more than :data:`LOG_Y_SPAN` go on a log scale; a
+    displacement whose smaller-signed side is flattened by the other gets an
+    second panel that zooms on that side (:func:`zoom_side`).
+
     Parameters
     ----------
     rows : list of dict
@@ -116,8 +140,6 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
     extra : dict
         Valid-range limits to mark: ``lift_off_edge``, ``painleve_edge``,
         ``inner_edges``, ``contact_loss_Hz``.
-    stem : path-like
-        File name without suffix.
     checks : tuple of Scheme
         Moreau–Jean cross-checks whose columns are overlaid.
     title : str, optional
@@ -125,19 +147,40 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
         Log-scaled x axis (default: for frequency sweeps over more than a decade).
     scheme_label : str
         Legend entry of the main curve (the scheme that computed it).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> rows = [{"mu": m, "displacement_per_period_m": 1e-6 * m, "average_velocity_m_per_s":
+    ...          2e-3 * m, "mode": "NP", "status": "ok"} for m in (0.1, 0.2, 0.3)]
+    >>> fig = draw_sweep(rows, "mu", 2000.0, {})
+    >>> [ax.get_yscale() for ax in fig.axes[:2]]
+    ['linear', 'linear']
     """
     plt = _plt()
     col = SWEPT_COLUMN.get(parameter, PARAM_COLUMNS.get(parameter, parameter))
     x = np.array([r[col] for r in rows], float)
     d = np.array([r["displacement_per_period_m"] for r in rows], float) * 1e6
     v = np.array([r["average_velocity_m_per_s"] for r in rows], float) * 1e3
-    fig, axes = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True)
+    zoom = None if log else zoom_side(d)
+    if zoom is None:
+        fig, axes = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True)
+    else:
+        fig, axes = plt.subplots(3, 1, figsize=(8, 8.4), sharex=True,
+                                 gridspec_kw={"height_ratios": [1.0, 0.8, 1.0]})
+    vax = axes[-1]
     others = {}
     if log is None:
         log = parameter == "frequency" and x.size > 1 and x.min() > 0 and x.max() / x.min() > 20
     handles, limit_h = {}, {}
-    for ax, y, lab in ((axes[0], d, "displacement per period [\u00b5m]"),
-                       (axes[1], v, "average rotor velocity [mm/s]")):
+    panels = [(axes[0], d, "displacement per period [\u00b5m]")]
+    if zoom is not None:
+        panels.append((axes[1], d, "displacement per period,\nzoom [\u00b5m]"))
+    panels.append((vax, v, "average rotor velocity [mm/s]"))
+    for ax, y, lab in panels:
         handles.update(_bands(ax, x, rows, others, log))
         # few points: show where they are
         ax.plot(x, y, "k.-" if x.size <= 40 else "k-", lw=1.3, label=scheme_label)
@@ -148,14 +191,17 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
             c = f"{chk.label}_displacement_per_period_m"
             if rows and c in rows[0]:
                 ym = np.array([r[c] for r in rows], float) * 1e6
-                if ax is axes[1]:
+                if ax is vax:
                     ym = ym * (x if parameter == "frequency" else frequency) * 1e-3
                 ax.plot(x, ym, mk, ms=3.2, mfc="none", mew=0.8, alpha=0.8,
                         color="#cc3311" if chk.theta == 1.0 else "#0077bb",
                         label=f"Moreau\u2013Jean \u03b8 = {chk.theta:g} "
                               f"({chk.steps_per_period} steps/period)")
     if log:
-        axes[1].set_xscale("log")
+        vax.set_xscale("log")
+    _y_scales((axes[0], vax), x, d, v, log)
+    if zoom is not None:
+        _zoom_panel(axes[1], x, d, zoom)
     limits = []
     if "lift_off_edge" in extra:
         limits.append((extra["lift_off_edge"], "lift-off edge", "--"))
@@ -171,19 +217,24 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
         # the valid range's edges are part of the picture
         lo, hi = min([lo] + [v for v, _, _ in limits]), max([hi] + [v for v, _, _ in limits])
         pad = 0.02 * (hi - lo)
-        axes[1].set_xlim(lo - pad, hi + pad)
+        vax.set_xlim(lo - pad, hi + pad)
     span = hi - lo
     for xv, lab, ls in limits:
         if log or lo - 0.05 * span <= xv <= hi + 0.05 * span:
             for ax in axes:
                 h = ax.axvline(xv, color="k", ls=ls, lw=1.1)
             limit_h[f"{lab} ({xv:.4g}{unit})"] = h
-    axes[1].set_xlabel(_XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
+    vax.set_xlabel(_XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
     lines, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(lines + list(limit_h.values()), labels + list(limit_h), fontsize=7.5,
                    loc="best")
-    axes[1].legend(list(handles.values()), list(handles), title="operation mode", fontsize=7.5,
-                   ncol=4, loc="best", title_fontsize=8)
+    mode_h, mode_l = list(handles.values()), list(handles)
+    if any("!" in m or "F" in m for m in mode_l):
+        # the letters of the flight and impact modes are not the paper's
+        mode_h.append(plt.Line2D([], [], color="none"))
+        mode_l.append("F: flight, !: contact entered by an impact")
+    vax.legend(mode_h, mode_l, title="operation mode", fontsize=7.5,
+                   ncol=min(4, len(mode_l)), loc="best", title_fontsize=8)
     if title is None:
         what = {"frequency": "drive frequency", "mu": "friction coefficient",
                 "phi0": "initial tilt angle"}.get(parameter) or \
@@ -193,8 +244,92 @@ def sweep_figure(rows, parameter, frequency, extra, stem, checks=(), title=None,
             title += f" at f = {frequency:g} Hz"
     axes[0].set_title(title, fontsize=11)
     # fixed margins: tight_layout would cost one more full draw of a dense figure
-    fig.subplots_adjust(left=0.09, right=0.98, top=0.94, bottom=0.08, hspace=0.08)
-    return save(fig, stem)
+    fig.subplots_adjust(left=0.105, right=0.98, top=0.95 if zoom is None else 0.96,
+                        bottom=0.08 if zoom is None else 0.06, hspace=0.08)
+    return fig
+
+
+#: values of one sign whose largest and smallest magnitudes differ by more than this go on
+#: a log scale
+LOG_Y_SPAN = 30.0
+#: the smaller-signed side of a displacement gets an inset when its peak is below this
+#: fraction of the other side's
+INSET_FRACTION = 0.2
+
+
+def _y_scales(axes, x, d, v, log):
+    """Log or symmetric-log y scales where a linear one would hide part of the data."""
+    ok = np.isfinite(d) & np.isfinite(v)
+    if ok.sum() < 2:
+        return
+    for ax, y in ((axes[0], d[ok]), (axes[1], v[ok])):
+        if np.all(y > 0) and y.max() / y.min() > LOG_Y_SPAN:
+            ax.set_yscale("log")
+    y = v[ok]
+    big = float(np.abs(y).max())
+    if log and np.any(y < 0) and np.any(y > 0) and big > 0:
+        # against a log f the velocity spans decades (it grows like f): a symmetric log
+        # scale shows the negative minimum and the slope-one growth together
+        lin = 10.0 ** (math.floor(math.log10(big)) - 3)
+        ax = axes[1]
+        ax.set_yscale("symlog", linthresh=lin, linscale=0.5)
+        i = int(np.argmin(y))
+        xs = x[ok]
+        ax.set_ylabel(f"average rotor velocity [mm/s]\n(symmetric log, linear within \u00b1{lin:g})",
+                      fontsize=9)
+        ax.annotate(f"minimum {y[i]:.3g} mm/s at {xs[i]:.4g} Hz", (xs[i], y[i]),
+                    xytext=(14, 8), textcoords="offset points", fontsize=7.5, va="bottom",
+                    arrowprops=dict(arrowstyle="-", lw=0.6))
+        ax.plot(xs[i], y[i], "v", color="k", ms=5)
+        if y[-1] > 0:
+            # a guide of slope one over the last decade and a half, set above the curve so
+            # that both stay visible
+            f_ref = np.geomspace(xs[-1] / 30.0, xs[-1], 20)
+            ax.plot(f_ref, 4.0 * y[-1] * f_ref / xs[-1], ls=(0, (4, 3)), color="0.3", lw=1.0)
+            ax.annotate("slope one: v \u221d f", (f_ref[0], 4.0 * y[-1] * f_ref[0] / xs[-1]),
+                        xytext=(-4, 0), textcoords="offset points", fontsize=7.5, ha="right",
+                        va="center", color="0.3")
+
+
+def zoom_side(d):
+    """The sign (-1 or +1) of the side of zero that the other side's range flattens, or None.
+
+    A displacement with values of both signs whose smaller-signed peak is
+    below :data:`INSET_FRACTION` of the other's gets a second panel on that
+    side (the 185 Hz phi0 sweep: -6.8 um before a rise to +88 um).
+
+    Examples
+    --------
+    >>> zoom_side([-6.8, -3.0, 10.0, 88.0]), zoom_side([-6.8, 1.9]), zoom_side([1.0, 90.0])
+    (-1, None, None)
+    """
+    d = np.asarray(d, float)
+    d = d[np.isfinite(d)]
+    if d.size < 3 or not (np.any(d < 0) and np.any(d > 0)):
+        return None
+    neg, pos = -float(d.min()), float(d.max())
+    if min(neg, pos) >= INSET_FRACTION * max(neg, pos):
+        return None
+    return -1 if neg < pos else 1
+
+
+def _zoom_panel(ax, x, d, small):
+    """Limit ``ax`` to the ``small``-signed side of the displacement and mark its sign changes."""
+    ok = np.isfinite(d)
+    xs, ds = x[ok], d[ok]
+    peak = float(np.abs(ds[small * ds > 0]).max())
+    ax.set_ylim(*sorted((small * 1.25 * peak, -small * 0.6 * peak)))
+    for k in np.flatnonzero(np.sign(ds[1:]) * np.sign(ds[:-1]) < 0):
+        xc = xs[k] - ds[k] * (xs[k + 1] - xs[k]) / (ds[k + 1] - ds[k])
+        ax.plot(xc, 0.0, "o", mfc="white", mec="k", ms=5, zorder=6)
+        # below and right of a rising crossing (above for a falling one): off the curve
+        ax.annotate(f"sign change near {xc:.4g}", (xc, 0.0), xytext=(9, small * 9),
+                    textcoords="offset points", fontsize=7.5,
+                    va="top" if small < 0 else "bottom")
+    i = int(np.argmax(small * ds))
+    ax.annotate(f"{'minimum' if small < 0 else 'maximum'} {ds[i]:.3g} \u00b5m", (xs[i], ds[i]),
+                xytext=(0, small * 10), textcoords="offset points", fontsize=7.5, ha="center",
+                va="bottom" if small > 0 else "top")
 
 
 def steady_period(params, frequency, samples=1200):
