@@ -16,14 +16,15 @@ import pathlib
 import numpy as np
 
 from ...analysis.steady_state import find_steady_state
+from ...errors import MoreauError
 from ...integrators import simulate
 from ...regimes import REGIME_LETTERS
 from ...scenes.friction_drive import FrictionDrive
 from .tables import PARAM_COLUMNS, SWEPT_COLUMN
 
 __all__ = ["MODE_COLORS", "REGIME_COLORS", "BAND_ALPHA", "EXTRA_COLORS", "mode_color", "sweep_figure",
-           "draw_sweep", "mode_figures", "draw_mode", "mode_points", "steady_period",
-           "velocity_ratio", "atlas_figure", "save"]
+           "draw_sweep", "zoom_side", "mode_figures", "draw_mode", "mode_points",
+           "round_candidates", "steady_period", "atlas_figure", "save"]
 
 #: the paper's six operation modes, in its order
 PAPER_MODES = ("NS", "NSPS", "NPS", "NP", "NSP", "SP")
@@ -355,7 +356,12 @@ PREFERRED_POINTS = {"NS": ("frequency", 20.0), "NSPS": ("frequency", 158.0),
 
 def _mode_points(results):
     """A parameter point for each paper mode: the paper's point where the data show that
-    mode there, else the middle of the mode's widest run in the studies."""
+    mode there, else the middle of the mode's widest run in the studies.
+
+    Returns ``{mode: (run length, parameter, value, row, lo, hi, preferred)}``: ``lo`` and
+    ``hi`` are the nearest grid values outside the run, ``preferred`` the paper's value or
+    None.
+    """
     best = {}
     for mode, (name, value) in PREFERRED_POINTS.items():
         rows = results.get(name) or []
@@ -365,7 +371,7 @@ def _mode_points(results):
         col = SWEPT_COLUMN[parameter]
         r = min(rows, key=lambda r: abs(r[col] - value))
         if r["status"] == "ok" and r["mode"] == mode and abs(r[col] / value - 1) < 0.05:
-            best[mode] = (math.inf, parameter, r[col], r)
+            best[mode] = (math.inf, parameter, r[col], r, value / 1.05, value * 1.05, value)
     for name, rows in results.items():
         if name.startswith("_") or not rows:
             continue
@@ -378,19 +384,67 @@ def _mode_points(results):
                 m = labels[start]
                 if m in PAPER_MODES and (m not in best or i - start > best[m][0]):
                     mid = rows[(start + i - 1) // 2]
-                    best[m] = (i - start, parameter, mid[col], mid)
+                    lo = rows[max(start - 1, 0)][col]
+                    hi = rows[min(i, len(rows) - 1)][col]
+                    best[m] = (i - start, parameter, mid[col], mid, lo, hi, None)
                 start = i
     return best
 
 
-def mode_figure_jobs(results, params, folder):
-    """``[(function, args), ...]`` drawing the six operation modes (the paper's Figs. 3–8)."""
-    jobs = []
-    for mode, (_, parameter, value, row) in sorted(_mode_points(results).items(),
-                                                   key=lambda kv: PAPER_MODES.index(kv[0])):
-        p = params.with_(mu=row["mu"], phi0=row["phi0_rad"])
-        jobs.append((mode_figure, (mode, p, row["frequency_Hz"], folder)))
-    return jobs
+def round_candidates(value, lo, hi, digits=4):
+    """``value`` rounded to 1, 2, ... ``digits`` significant figures, those strictly in
+    ``(lo, hi)``, without repeats.
+
+    Examples
+    --------
+    >>> round_candidates(19.8837, 10.0, 156.3)
+    [20.0, 19.9, 19.88]
+    >>> round_candidates(158.6, 156.3, 160.9)
+    [160.0, 159.0, 158.6]
+    """
+    out = []
+    for n in range(1, digits + 1):
+        c = float(f"{value:.{n}g}")
+        if lo < c < hi and c not in out:
+            out.append(c)
+    return out
+
+
+def mode_points(results, params):
+    """Where each of the paper's modes is drawn: ``{mode: (params, frequency_Hz)}``.
+
+    The point of :func:`_mode_points` moved to a round value of its swept
+    parameter (the paper's value, else the fewest significant figures inside
+    the mode's run) where the steady state is in that mode; the grid value
+    where no round value is.
+    """
+    out = {}
+    picks = _mode_points(results)
+    for mode in PAPER_MODES:
+        if mode not in picks:
+            continue
+        _, parameter, value, row, lo, hi, preferred = picks[mode]
+        base = params.with_(mu=row["mu"], phi0=row["phi0_rad"])
+        cands = ([preferred] if preferred is not None else []) + round_candidates(value, lo, hi)
+        chosen = (base, row["frequency_Hz"])
+        for c in cands:
+            p, f = (base, c) if parameter == "frequency" else \
+                (base.with_(**{parameter: c}), row["frequency_Hz"])
+            try:
+                if find_steady_state(FrictionDrive(p, f)).mode == mode:
+                    chosen = (p, f)
+                    break
+            except MoreauError:
+                continue
+        out[mode] = chosen
+    return out
+
+
+def mode_figure_jobs(results, params, folder, points=None):
+    """``[(function, args), ...]`` drawing the six operation modes (the paper's Figs. 3–8)
+    at the points of :func:`mode_points` (computed unless given)."""
+    points = mode_points(results, params) if points is None else points
+    return [(mode_figure, (mode, p, f, folder)) for mode, (p, f) in points.items()]
 
 
 def mode_figures(results, params, folder):
@@ -400,50 +454,93 @@ def mode_figures(results, params, folder):
 
 def mode_figure(mode, p, f, folder):
     """One steady period in ``mode`` at parameters ``p`` and frequency ``f`` (PNG + SVG)."""
+    return save(draw_mode(mode, p, f), pathlib.Path(folder) / f"mode_{mode}")
+
+
+#: regime segments shorter than this fraction of the period get a marker (else invisible)
+SHORT_SEGMENT = 0.03
+#: transitions closer than this (in tau) share one label, e.g. N\u2192S\u2192P
+_CLUSTER_TAU = 0.35
+
+
+def _clusters(events, t0):
+    """Transitions within a period grouped where they follow each other closely:
+    ``[(first tau, last tau, "N\u2192S\u2192P"), ...]``."""
+    groups = []
+    for e in events:
+        te = e.t - t0
+        if not 0.0 < te < 2 * math.pi:
+            continue
+        if groups and te - groups[-1][1] < _CLUSTER_TAU and groups[-1][2][-1] == \
+                REGIME_LETTERS[e.before]:
+            groups[-1][1] = te
+            groups[-1][2].append(REGIME_LETTERS[e.after])
+        else:
+            groups.append([te, te, [REGIME_LETTERS[e.before], REGIME_LETTERS[e.after]]])
+    return [(a, b, "\u2192".join(chain)) for a, b, chain in groups]
+
+
+def draw_mode(mode, p, f):
+    """The figure of one steady period: rotor displacement and slip velocity by regime.
+
+    Transitions that follow each other closely share one label (``N\u2192S\u2192P``), and a
+    regime that lasts less than :data:`SHORT_SEGMENT` of the period is marked
+    with a dot, so that a short stick stays visible.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> fig = draw_mode("NS", PAPER_DEFAULTS, 20.0)
+    >>> fig.axes[0].get_xlim()[1] == 2 * math.pi
+    True
+    """
     plt = _plt()
-    folder = pathlib.Path(folder)
-    if True:
-        ss, res = steady_period(p, f)
-        tau = res.t - res.t[0]
-        u2 = res.q[:, 1] - res.q[0, 1]
-        vt = res.slip_velocity[:, 0]
-        letters = np.array([REGIME_LETTERS[int(c)] for c in res.regime[:, 0]])
-        fig, axes = plt.subplots(1, 2, figsize=(10, 3.8))
-        for ax, y, lab in ((axes[0], u2, "rotor displacement u\u2082 \u2212 u\u2082(0) [-]"),
-                           (axes[1], vt, "tangential contact velocity d\u03b4_T/d\u03c4 [-]")):
-            ax.plot(tau, y, color="0.75", lw=0.8, zorder=1)
-            start = 0
-            used = set()
-            for i in range(1, len(tau) + 1):
-                if i == len(tau) or letters[i] != letters[start]:
-                    L = letters[start]
-                    sl = slice(start, min(i + 1, len(tau)))
-                    ax.plot(tau[sl], y[sl], color=REGIME_COLORS[L], lw=2.2, zorder=2,
-                            label=None if L in used else _LETTER_NAME[L])
-                    used.add(L)
-                    start = i
-            last_te, level = -1.0, 0
-            for e in res.events:
-                te = e.t - res.t[0]
-                if 0.0 < te < 2 * math.pi:
-                    ax.axvline(te, color="k", ls=":", lw=0.9, zorder=0)
-                    # stagger the labels of transitions that follow each other closely
-                    level = (level + 1) % 2 if te - last_te < 0.35 else 0
-                    last_te = te
-                    ax.annotate(f"{REGIME_LETTERS[e.before]}\u2192{REGIME_LETTERS[e.after]}",
-                                (te, 1.0 + 0.07 * level), xycoords=("data", "axes fraction"),
-                                fontsize=7.5, ha="center", va="bottom")
-            ax.set_xlabel("non-dimensional time \u03c4 \u2212 \u03c4\u2080 [-]")
-            ax.set_ylabel(lab)
-            ax.set_xlim(0, 2 * math.pi)
-            ax.grid(alpha=0.3, lw=0.5)
-        axes[1].axhline(0.0, color="0.5", lw=0.6)
-        axes[0].legend(title="regime", fontsize=8, title_fontsize=8)
-        fig.suptitle(f"Operation mode {mode}: one steady period at f = {f:g} Hz, "
-                     f"\u03bc = {p.mu:.3g}, \u03c6\u2080 = {p.phi0:.3f} rad "
-                     f"(\u03c4\u2080 = {ss.section_tau:.3f})", fontsize=10.5)
-        fig.subplots_adjust(left=0.08, right=0.99, top=0.80, bottom=0.13, wspace=0.25)
-        return save(fig, folder / f"mode_{mode}")
+    ss, res = steady_period(p, f)
+    tau = res.t - res.t[0]
+    u2 = res.q[:, 1] - res.q[0, 1]
+    vt = res.slip_velocity[:, 0]
+    letters = np.array([REGIME_LETTERS[int(c)] for c in res.regime[:, 0]])
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.0), layout="constrained")
+    clusters = _clusters(res.events, res.t[0])
+    for ax, y, lab in ((axes[0], u2, "rotor displacement u\u2082 \u2212 u\u2082(0) [-]"),
+                       (axes[1], vt, "tangential contact velocity d\u03b4_T/d\u03c4 [-]")):
+        ax.plot(tau, y, color="0.75", lw=0.8, zorder=1)
+        start = 0
+        used = set()
+        for i in range(1, len(tau) + 1):
+            if i == len(tau) or letters[i] != letters[start]:
+                L = letters[start]
+                sl = slice(start, min(i + 1, len(tau)))
+                ax.plot(tau[sl], y[sl], color=REGIME_COLORS[L], lw=2.2, zorder=2,
+                        label=None if L in used else _LETTER_NAME[L])
+                # a regime too short to see as a line: a dot at its middle
+                if 0 < start and i < len(tau) and tau[i] - tau[start] < SHORT_SEGMENT * 2 * math.pi:
+                    k = (start + i) // 2
+                    ax.plot(tau[k], y[k], "o", ms=7, mfc=REGIME_COLORS[L], mec="k", mew=0.8,
+                            zorder=4)
+                used.add(L)
+                start = i
+        for e in res.events:
+            if 0.0 < e.t - res.t[0] < 2 * math.pi:
+                ax.axvline(e.t - res.t[0], color="k", ls=":", lw=0.9, zorder=0)
+        for a, b, text in clusters:
+            ax.annotate(text, (0.5 * (a + b), 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(0, 2), textcoords="offset points", fontsize=7.5,
+                        ha="center", va="bottom")
+        ax.set_xlabel("non-dimensional time \u03c4 \u2212 \u03c4\u2080 [-]")
+        ax.set_ylabel(lab)
+        ax.set_xlim(0, 2 * math.pi)
+        ax.grid(alpha=0.3, lw=0.5)
+    axes[1].axhline(0.0, color="0.5", lw=0.6)
+    axes[0].legend(title="regime", fontsize=8, title_fontsize=8)
+    fig.suptitle(f"Operation mode {mode}: one steady period at f = {f:g} Hz, "
+                 f"\u03bc = {p.mu:.3g}, \u03c6\u2080 = {p.phi0:.4g} rad "
+                 f"(\u03c4\u2080 = {ss.section_tau:.3f})", fontsize=10.5)
+    return fig
 
 
 #: colours of atlas points without a steady mode
