@@ -127,7 +127,7 @@ def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=Non
     Scales follow the data so that a new reader can read them: a velocity
     that spans decades against a log frequency goes on a symmetric log scale
     with its minimum marked and a ``v`` proportional to ``f`` guide; values of
-    one sign spanning more than :data:`LOG_Y_SPAN` go on a log scale; a
+    one sign over a range where contact is lost (``inner_edges``) go on a log scale; a
     displacement whose smaller-signed side is flattened by the other gets an
     second panel that zooms on that side (:func:`zoom_side`).
 
@@ -200,7 +200,7 @@ def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=Non
                               f"({chk.steps_per_period} steps/period)")
     if log:
         vax.set_xscale("log")
-    _y_scales((axes[0], vax), x, d, v, log)
+    _y_scales((axes[0], vax), x, d, v, log, bool(extra.get("inner_edges")))
     if zoom is not None:
         _zoom_panel(axes[1], x, d, zoom)
     limits = []
@@ -245,26 +245,25 @@ def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=Non
             title += f" at f = {frequency:g} Hz"
     axes[0].set_title(title, fontsize=11)
     # fixed margins: tight_layout would cost one more full draw of a dense figure
-    fig.subplots_adjust(left=0.105, right=0.98, top=0.95 if zoom is None else 0.96,
+    fig.subplots_adjust(left=0.125, right=0.98, top=0.95 if zoom is None else 0.96,
                         bottom=0.08 if zoom is None else 0.06, hspace=0.08)
     return fig
 
 
-#: values of one sign whose largest and smallest magnitudes differ by more than this go on
-#: a log scale
-LOG_Y_SPAN = 30.0
 #: the smaller-signed side of a displacement gets an inset when its peak is below this
 #: fraction of the other side's
 INSET_FRACTION = 0.2
 
 
-def _y_scales(axes, x, d, v, log):
+def _y_scales(axes, x, d, v, log, contact_lost):
     """Log or symmetric-log y scales where a linear one would hide part of the data."""
     ok = np.isfinite(d) & np.isfinite(v)
     if ok.sum() < 2:
         return
     for ax, y in ((axes[0], d[ok]), (axes[1], v[ok])):
-        if np.all(y > 0) and y.max() / y.min() > LOG_Y_SPAN:
+        if contact_lost and np.all(y > 0):
+            # past the contact loss flight and impacts multiply the displacement: on a
+            # linear scale they would flatten the contact range
             ax.set_yscale("log")
     y = v[ok]
     big = float(np.abs(y).max())
