@@ -494,7 +494,7 @@ def draw_mode(mode, p, f):
     --------
     >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
     >>> fig = draw_mode("NS", PAPER_DEFAULTS, 20.0)
-    >>> fig.axes[0].get_xlim()[1] == 2 * math.pi
+    >>> bool(fig.axes[0].get_xlim()[1] == 2 * math.pi)
     True
     """
     plt = _plt()
