@@ -11,17 +11,22 @@ satisfy it at every point.
 import math
 
 import numpy as np
-from scipy.optimize import minimize_scalar
+from scipy.optimize import brentq, minimize_scalar
 
 from ... import __version__
 from ...analysis.engine import code_version
 from ...analysis.steady_state import find_steady_state
 from ...scenes.friction_drive import FrictionDrive
+from .figures import mode_points, steady_period
 from .tables import SWEPT_COLUMN
 
 ARROW = " \u2192 "
 
-__all__ = ["claims", "write_report", "mode_sequence", "refine_extremum"]
+__all__ = ["claims", "write_report", "mode_sequence", "refine_extremum", "velocity_ratio",
+           "stepping_claim", "impact_claim", "sign_change_claim", "sign_change"]
+
+#: a mode point moves uniformly when its velocity ratio (:func:`velocity_ratio`) is above this
+UNIFORM_RATIO = 0.5
 
 
 def mode_sequence(rows, col):
@@ -70,13 +75,142 @@ def refine_extremum(rows, col, parameter, params, frequency, kind="min"):
     return float(tr[1](r.x)), float(s * r.fun)
 
 
+def velocity_ratio(params, frequency):
+    """Smallest over largest rotor velocity, along the net direction, over one steady period.
+
+    At most 0: the rotor stops or runs back within every period (stepping
+    motion); near 1: nearly uniform motion.
+
+    Returns ``(ratio, steady state)``.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    >>> r, ss = velocity_ratio(PAPER_DEFAULTS, 20.0)
+    >>> r <= 0, ss.mode
+    (True, 'NS')
+    """
+    ss, res = steady_period(params, frequency)
+    v = res.v[:, 1] * math.copysign(1.0, ss.displacement_per_period)
+    return float(v.min() / v.max()), ss
+
+
+def stepping_claim(points):
+    """Row: "stepping motion in every mode" against the velocity ratio at each mode's point.
+
+    ``points`` is ``{mode: (params, frequency_Hz)}`` (:func:`~moreau.studies.paper.figures.mode_points`).
+    """
+    ratios = {m: velocity_ratio(p, f)[0] for m, (p, f) in points.items()}
+
+    def at(m):
+        p, f = points[m]
+        return f"{m} {ratios[m]:+.2f} (f = {f:g} Hz, \u03bc = {p.mu:g}, \u03c6\u2080 = {p.phi0:.4g})"
+
+    uniform = [m for m, r in ratios.items() if r > UNIFORM_RATIO]
+    note = ("Measure: smallest over largest rotor velocity along the net direction over one "
+            "steady period, at the point each mode is drawn (figures mode_*); \u2264 0: the "
+            "rotor stops or runs back in every period (stepping), near 1: uniform motion.")
+    if uniform:
+        note += (f" {', '.join(uniform)} never stop{'s' if len(uniform) == 1 else ''}: at "
+                 "high frequency the period is short, and the friction force (at most "
+                 "\u03bc f_N) changes the heavy rotor's velocity (m\u2082 = 100 m) by little "
+                 "within it compared with the velocity it has built up, so the rotor moves "
+                 "nearly uniformly.")
+    return _row("The rotor moves in steps in every operation mode (sec. 4.2)",
+                "stepping motion in each mode",
+                "; ".join(at(m) for m in ratios), not uniform, note,
+                f"mode_{uniform[0]}" if uniform else "")
+
+
+def impact_claim(rows):
+    """Row: impacts avoided by the Painlevé condition, against the impacts of a phi0 sweep.
+
+    ``rows`` are the tidy rows of a phi0 study (2000 Hz in the report): a mode
+    with ``!`` has an impact in its steady period.
+    """
+    ok = [r for r in rows if r["status"] == "ok"]
+    imp = [r for r in ok if "!" in r["mode"]]
+    free = [r for r in ok if "!" not in r["mode"]]
+    f = ok[0]["frequency_Hz"] if ok else math.nan
+    paper = "1 \u2212 \u03bc tan \u03c6 > 0 (eq. mu_constraint) keeps the system impact-free (sec. 5)"
+    if not imp:
+        return _row(f"Impacts avoided by the Painlev\u00e9 condition (\u03c6\u2080 sweep at {f:g} Hz)",
+                    paper, "no impact at any point of this sweep", True,
+                    "Nothing to compare on this grid.", "")
+    pm = [r["painleve_margin"] for r in imp]
+    lm = [r["lift_off_margin"] for r in imp]
+    lm_free = [r["lift_off_margin"] for r in free]
+    governed = min(lm) > 0 and (not lm_free or max(lm_free) < 0)
+    ours = (f"{len(imp)} of {len(ok)} points have impacts in their steady period (\u03c6\u2080 from "
+            f"{imp[0]['phi0_rad']:.4f} to {imp[-1]['phi0_rad']:.4f}; modes "
+            f"{', '.join(dict.fromkeys(r['mode'] for r in imp))}) while 1 \u2212 \u03bc tan \u03c6\u2080 is "
+            f"still {min(pm):.3f} to {max(pm):.3f}; all of them have max D > 0 (max D / u\u2081\u2080 "
+            f"{min(lm):.3g} to {max(lm):.3g}), "
+            + (f"all {len(free)} impact-free points max D < 0" if governed else
+               "but the impact-free points do not all have max D < 0"))
+    note = ("The Painlev\u00e9 condition only makes the contact problem well posed; whether the "
+            "rod leaves the stator, and so comes back with an impact, is decided by the free "
+            "normal acceleration D: max D < 0 over the period keeps the contact. Along the "
+            "contact \u03c6 \u2264 \u03c6\u2080, so 1 \u2212 \u03bc tan \u03c6\u2080 bounds the margin "
+            "over the period.")
+    return _row(f"Impacts avoided by the Painlev\u00e9 condition (\u03c6\u2080 sweep at {f:g} Hz)",
+                paper, ours, not imp, note if governed else note + " Here D alone does not "
+                "separate the points.", f"phi0_{f:g}Hz")
+
+
+def sign_change(rows, col, parameter, params, frequency):
+    """Where the displacement per period changes sign along a sweep, by root finding.
+
+    Brackets come from consecutive grid points of opposite sign; each root
+    is located with Brent's method on the event-driven steady state.
+
+    Returns ``[(x, mode below, mode above), ...]``.
+    """
+    ok = [r for r in rows if r["status"] == "ok"]
+    out = []
+    for a, b in zip(ok[:-1], ok[1:]):
+        da, db = a["displacement_per_period_m"], b["displacement_per_period_m"]
+        if da * db < 0:
+            x = brentq(lambda z: _disp(params, parameter, z, frequency), a[col], b[col],
+                       xtol=1e-10, rtol=1e-12)
+            out.append((float(x), a["mode"], b["mode"]))
+    return out
+
+
+def sign_change_claim(rows, params, frequency):
+    """Row: the direction of motion is set by the mode, against the sign change of a phi0 sweep."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    roots = sign_change(ok, "phi0_rad", "phi0", params, frequency)
+    paper = ("direction largely determined by the operation mode (sec. 5); at this "
+             "frequency the \u03c6\u2080 sweep is described by its minimum only (sec. 4.3)")
+    claim = f"Direction of motion along the \u03c6\u2080 sweep at {frequency:g} Hz"
+    if not roots:
+        return _row(claim, paper, "no sign change", True, "", f"phi0_{frequency:g}Hz")
+    d = np.array([r["displacement_per_period_m"] for r in ok])
+    within = [x for x, a, b in roots if a == b]
+    ours = ("; ".join(f"d changes sign at \u03c6\u2080 = {x:.4f} ({a} below, {b} above)"
+                      for x, a, b in roots)
+            + f"; d from {d.min() * 1e6:.2f} to {d.max() * 1e6:+.2f} \u00b5m per period")
+    note = ("Root of the event-driven displacement per period (Brent's method between the grid "
+            "points of opposite sign, tolerance 1e-10).")
+    if within:
+        note += (" The rotor reverses inside one mode: the direction follows from the balance "
+                 "of the positive- and negative-slip phases, which \u03c6\u2080 shifts, not from "
+                 "the mode alone (the paper notes the same for NP against f).")
+    return _row(claim, paper, ours, not within, note, f"phi0_{frequency:g}Hz")
+
+
 def _row(claim, paper, ours, ok, note="", fig=""):
     return {"claim": claim, "paper": paper, "ours": ours,
             "verdict": "agree" if ok else "differ", "note": note, "figure": fig}
 
 
-def claims(results, grids, params):
-    """The table rows: ``claim, paper, ours, verdict, note, figure``."""
+def claims(results, grids, params, points=None):
+    """The table rows: ``claim, paper, ours, verdict, note, figure``.
+
+    ``points`` (:func:`~moreau.studies.paper.figures.mode_points`, computed
+    unless given) are where the stepping claim looks at each mode.
+    """
     out = []
     fr = results["frequency"]
     okf = [r for r in fr if r["status"] == "ok"]
@@ -247,6 +381,13 @@ def claims(results, grids, params):
                         f"lift-off limit max D = 0 at {edge:.1f} Hz for \u03c6\u2080 = "
                         f"{params.phi0:.4f}", edge > 12500.0,
                         "The study ends 1 % below the limit.", "frequency"))
+    points = mode_points(results, params) if points is None else points
+    if points:
+        out.append(stepping_claim(points))
+    if results.get("phi0_2000Hz"):
+        out.append(impact_claim(results["phi0_2000Hz"]))
+    if results.get("phi0_185Hz"):
+        out.append(sign_change_claim(results["phi0_185Hz"], params, 185.0))
     # the valid parameter range (sec. 4.1, eq. mu_constraint)
     vr = grids["phi0_20Hz"][3]
     out.append(_row("Valid \u03c6\u2080 range (f_N > 0, D < 0, 1 \u2212 \u03bc tan \u03c6 > 0)",
@@ -293,9 +434,9 @@ def _md_table(rows, link):
     return "\n".join(lines)
 
 
-def write_report(results, grids, params, out, checks, wall_time=None, quick=False):
-    """Write ``out/report.md`` and return its path."""
-    rows = claims(results, grids, params)
+def write_report(results, grids, params, out, checks, wall_time=None, quick=False, points=None):
+    """Write ``out/report.md`` and return its path (``points``: see :func:`claims`)."""
+    rows = claims(results, grids, params, points)
     link = lambda name: f"figures/{name}.png"  # noqa: E731
     n_agree = sum(r["verdict"] == "agree" for r in rows)
     parts = [
