@@ -33,6 +33,9 @@ __all__ = ["EventDriven", "ContactState", "FrictionDriveWalker", "impact_impulse
 
 TWO_PI = 2.0 * math.pi
 _F, _P, _N, _S = Regime.FLIGHT, Regime.POSITIVE, Regime.NEGATIVE, Regime.STICK
+#: a recorded gap below -PENETRATION_TOL * u10 is a lost re-contact, an error (the
+#: contact pieces are closed-form: their gaps are zero to rounding, about 1e-16)
+PENETRATION_TOL = 1e-9
 
 
 class ContactState:
@@ -479,7 +482,15 @@ class FrictionDriveWalker:
         if self._rebound_skip is not None:
             skip, self._rebound_skip = self._rebound_skip, None
         if t0 + skip < tau_end:
-            pre = solve_ivp(self._flight_rhs, (t0, t0 + skip), y0, dense_output=dense, **opts)
+            pre = solve_ivp(self._flight_rhs, (t0, t0 + skip), y0, dense_output=True, **opts)
+            # the skip is half the flight time at the rebound's normal acceleration; a
+            # steeper pull (late in a Zeno sequence) can bring the rod back inside it
+            early = self._missed_recontact(pre)
+            if early is not None:
+                te, ye = early
+                out = st.copy()
+                out.tau, out.phi, out.dphi, out.u2, out.du2 = te, *map(float, ye)
+                return out, True, (pre.sol if dense else None)
             y0 = pre.y[:, -1]
             t0 = t0 + skip
         sol = solve_ivp(self._flight_rhs, (t0, tau_end), y0, events=gap, dense_output=True, **opts)
@@ -530,6 +541,11 @@ class FrictionDriveWalker:
         i = bad[0] + 1
         f = lambda tau: self._gap(tau, sol.sol(tau))  # noqa: E731
         if f(ts[i - 1]) <= 0.0:
+            if np.all(g[:i] <= tol):
+                # the rod never cleared the surface before sinking into it (a rebound
+                # whose height is below the gap's rounding, late in a Zeno sequence):
+                # the contact closes where the flight began
+                return ts[0], sol.sol(ts[0])
             return None  # started on the surface: not a return
         te = brentq(f, ts[i - 1], ts[i], xtol=1e-15, rtol=4 * np.finfo(float).eps, maxiter=200)
         self.counters["root_solves"] += 1
@@ -724,6 +740,12 @@ class EventDriven(Integrator):
             fN, fT = (float(x) for x in sc.contact_forces(st.tau, st.regime))
         slip = st.du2 + math.sin(st.phi) * st.dphi
         gap = sc.sin_phi0 - math.sin(st.phi) - float(sc.u1(st.tau))
+        if gap < -PENETRATION_TOL * max(sc.u10, 1e-300):
+            # a re-contact the flight's event search did not see: never record a state
+            # inside the rotor as if it were a solution
+            raise MoreauError(
+                f"the event-driven walker lost a re-contact: gap = {gap:.3g} < 0 at "
+                f"tau = {st.tau!r} in regime {Regime(int(st.regime)).name}")
         self._record(st.tau, (st.phi, st.u2), (st.dphi, st.du2), int(st.regime), fN, fT, slip, gap)
         self.t, self.q, self.v = st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2])
 

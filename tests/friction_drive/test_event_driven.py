@@ -11,6 +11,7 @@ from moreau.integrators import simulate
 from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
+from moreau.scenes.registry import make_scene
 
 TWO_PI = 2 * math.pi
 
@@ -310,3 +311,21 @@ def test_grazing_return_inside_one_flight_step_is_found():
         [np.arcsin(sc.sin_phi0 - sc.u1(np.asarray(t, float)) - 1e-6), 0 * np.asarray(t, float),
          0 * np.asarray(t, float), 0 * np.asarray(t, float)]))
     assert w._missed_recontact(FakeSolution) is None
+
+
+def test_a_zeno_sequence_closes_the_contact_instead_of_sinking_into_the_rotor():
+    # found by the bifurcation diagram across lift-off: 18 impacts accumulate at
+    # tau = 0.354255 (e = 0.5); the last rebound's height, vN^2 / 2|D| ~ 2e-17, is below
+    # the gap's rounding, so the flight after it never cleared the surface and, before
+    # the fix, sank to a gap of -7.3e-4 without a re-contact, recorded as flight
+    sc = make_scene("friction-drive", frequency=19932.0, restitution=0.5)
+    q = np.array([0.7853952788115945, 0.0])
+    v = np.array([-3.255885351047966e-05, 0.0001433357870032927])
+    r = simulate(sc, (0.0, 2 * np.pi), q, v, "event-driven", samples_per_period=4096)
+    assert r.success
+    assert r.gap[:, 0].min() > -1e-15
+    kinds = [e.kind for e in r.events]
+    assert kinds.count("impact") == 18 and kinds[18] == "touchdown"
+    assert r.events[18].t == pytest.approx(0.3542556, abs=1e-6)
+    # the rod then rides the stator until it lifts off again
+    assert kinds[19] == "liftoff" and r.events[19].t == pytest.approx(1.8043, abs=1e-3)
