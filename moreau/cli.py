@@ -1,4 +1,4 @@
-"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``run``, ``characteristic``.
+"""Command line interface: ``moreau reproduce``, ``steady``, ``sweep``, ``atlas``, ``bifurcation``, ``run``, ``characteristic``.
 
 Physical inputs and outputs are in SI units; the computation runs in the
 paper's dimensionless variables.
@@ -13,6 +13,7 @@ from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
 from .analysis.atlas import run_scene_atlas
+from .analysis.bifurcation import bifurcation_diagram
 from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
@@ -200,6 +201,46 @@ def _cmd_characteristic(args):
           f"{s['load_at_max_power_N']:.9e} N")
     print(f"  load convention        {s['load_convention']}")
     print(f"  beyond stall           {s['reversal']}")
+
+
+def _cmd_bifurcation(args):
+    """``moreau bifurcation``: section samples of the long-run motion against one parameter."""
+    entry = get_entry(args.scene)
+    scale = args.scale or ("log" if args.parameter == "frequency" else "linear")
+    values = sweep_values(args.start, args.stop, args.points, scale)
+    params = scene_parameters(args, entry)
+    if args.parameter in params:
+        raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
+    frequency = params.pop("frequency", None)
+    if args.theta is not None:
+        args.scheme_options = {**args.scheme_options, "theta": args.theta}
+    if args.rtol is not None:
+        raise InputError("`--rtol` does not act in `moreau bifurcation`; give a scheme's "
+                         "tolerance with `--option rtol=...`")
+    d = bifurcation_diagram(entry.name, args.parameter, values, fixed=params,
+                            frequency=frequency, scheme=args.scheme,
+                            scheme_options=args.scheme_options,
+                            steps_per_period=args.steps_per_period, transient=args.transient,
+                            samples=args.samples, lyapunov=not args.no_lyapunov,
+                            shoot=not args.no_shoot, quantities=args.quantity, out=args.out,
+                            progress=not args.quiet, plot=not args.no_plot, force=args.force,
+                            log=(lambda s: None) if args.json else print)
+    if args.json:
+        print(json.dumps({"scene": d["scene"], "scheme": d["scheme"],
+                          "parameter": d["parameter_column"],
+                          "points": [{k: p[k] for k in ("value", "period", "motion",
+                                                        "lyapunov_per_period",
+                                                        "lyapunov_is_bound", "flight", "start",
+                                                        "status")} for p in d["points"]],
+                          "marks": d["marks"]}))
+        return
+    for p in d["points"]:
+        print(f"  {p['value']:.6g}: {p['motion'] or p['status']}, Lyapunov "
+              f"{'<= ' if p['lyapunov_is_bound'] else ''}{p['lyapunov_per_period']:.3g} a period"
+              f"{', flight' if p['flight'] else ''}")
+    for m in d["marks"]:
+        print(f"  {m['kind']} ({m['from']} -> {m['to']}) between {m['between'][0]:.6g} and "
+              f"{m['between'][1]:.6g}")
 
 
 def _cmd_run(args):
@@ -523,6 +564,35 @@ def build_parser():
     _add_params(r, scheme_defaults=False)
     add_scene_options(r)
     r.set_defaults(func=_cmd_run)
+    b = sub.add_parser("bifurcation", help="stroboscopic section of the long-run motion against "
+                                          "one parameter, period, Lyapunov exponent and "
+                                          "bifurcation marks (CSV, JSON sidecar, figure)")
+    b.add_argument("parameter", metavar="PARAM",
+                   help="parameter to sweep: frequency [Hz] or a parameter of the scene")
+    b.add_argument("start", metavar="START", type=float, help="first value")
+    b.add_argument("stop", metavar="STOP", type=float, help="last value")
+    b.add_argument("--points", type=int, default=40, help="number of values (default 40)")
+    b.add_argument("--scale", choices=["log", "linear"], default=None,
+                   help="spacing of the values (default log for frequency, else linear)")
+    b.add_argument("--frequency", type=float, default=None,
+                   help="drive frequency [Hz] when PARAM is not frequency")
+    b.add_argument("--transient", type=int, default=200,
+                   help="periods run before sampling (default 200; fewer from a shot orbit)")
+    b.add_argument("--samples", type=int, default=50, help="periods sampled (default 50)")
+    b.add_argument("--quantity", action="append", metavar="COLUMN",
+                   help="section column drawn (repeatable; default displacement_per_period, q_0)")
+    b.add_argument("--no-lyapunov", action="store_true", help="skip the Lyapunov exponent")
+    b.add_argument("--no-shoot", action="store_true",
+                   help="do not start from a shot periodic orbit (only the transient)")
+    b.add_argument("--json", action="store_true", help="print one JSON object")
+    b.add_argument("--out", default="out", help="output folder (default ./out)")
+    b.add_argument("--quiet", action="store_true", help="no progress bar")
+    b.add_argument("--no-plot", action="store_true", help="skip the figure")
+    b.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier run with other settings (refused otherwise)")
+    _add_params(b, scheme_defaults=False)
+    add_scene_options(b)
+    b.set_defaults(func=_cmd_bifurcation)
     ch = sub.add_parser("characteristic", help="the motor's load characteristic: no-load "
                                                "velocity, stall force, maximum output power "
                                                "(CSV, JSON sidecar, figure)")
