@@ -27,7 +27,7 @@ def test_the_lyapunov_exponent_of_a_linear_oscillator_is_its_floquet_exponent():
                                                       1, True)
     assert not bound and flight      # its one contact never closes
     # the oscillator block is not a rotation in these coordinates: its per-period growth
-    # oscillates about |mu|, and 60 periods average it to a few per cent (measured 1.3 %)
+    # oscillates about |mu|, and 60 periods average it to a few per cent (measured 0.5 %)
     assert lyap == pytest.approx(exact, rel=0.05)
     # after 40 periods (a factor 1e-14) the section repeats: period 1
     data = np.array([[x for _, _, x in r] for r in rows])
