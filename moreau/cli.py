@@ -132,11 +132,18 @@ def _cmd_steady(args):
     print(f"  operation mode            {rep['mode']}")
     print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
     print(f"  average velocity          {rep['average_velocity_m_per_s']:.9e} m/s")
-    if not rep["periodic"]:
+    if rep["steady_state"] == "statistical":
+        lo, hi = rep["confidence_interval_m"]
+        print(f"  statistical steady state  mean over {rep['periods_used']} periods after a "
+              f"transient of {rep['transient_periods']}")
+        print(f"  {100 * rep['confidence_level']:g} % interval          [{lo:.9e}, {hi:.9e}] m")
+        print(f"  why not periodic          {rep['why_not_periodic']}")
+    elif not rep["periodic"]:
         print(f"  note                      {rep.get('message', '')}")
     if rep["min_normal_force_N"] is not None:
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
-    print(f"  periodic residual         {rep['periodic_residual']:.2e}")
+    if rep["periodic_residual"] is not None:
+        print(f"  periodic residual         {rep['periodic_residual']:.2e}")
     if rep["period"] != 1:
         print(f"  orbit period              {rep['period']} drive periods")
     if rep["floquet_multipliers"] is not None:
