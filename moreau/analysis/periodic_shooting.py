@@ -399,7 +399,9 @@ def bracket_scalar(fun, z0, tol, max_evals):
     the direction of ``fun(z0)``: the bracket is expanded from there by
     doubling, then closed by Illinois regula falsi. A map whose residual
     jumps over zero (switches locked to a step grid) ends with the bracket
-    shrunk to adjacent floats; the better end is returned with its residual.
+    shrunk to adjacent floats; the end with the smaller residual is returned
+    with it. A bracket still open after ``max_evals`` maps raises
+    :class:`~moreau.errors.ConvergenceError`.
 
     Returns
     -------
@@ -423,18 +425,15 @@ def bracket_scalar(fun, z0, tol, max_evals):
 
     ua = float(np.asarray(z0, float)[0])
     fa = f(ua)
-    best = (abs(fa), ua, fa)
     if abs(fa) <= tol:
         return np.array([ua]), np.array([fa]), evals[0]
     step = fa
     while True:
         if evals[0] >= max_evals:
             raise ConvergenceError(f"no sign change of the period-map residual found in "
-                                   f"{max_evals} period maps (last {best[2]:.3g})")
+                                   f"{max_evals} period maps (last {fa:.3g})")
         ub = ua + step
         fb = f(ub)
-        if abs(fb) < best[0]:
-            best = (abs(fb), ub, fb)
         if abs(fb) <= tol:
             return np.array([ub]), np.array([fb]), evals[0]
         if np.sign(fb) != np.sign(fa):
@@ -442,28 +441,31 @@ def bracket_scalar(fun, z0, tol, max_evals):
         ua, fa = ub, fb
         step *= 2.0
     side = 0
-    while evals[0] < max_evals:
+    ta, tb = fa, fb         # the true residuals at the ends (Illinois scales fa, fb)
+    while True:
         uc = (ua * fb - ub * fa) / (fb - fa)
         if not min(ua, ub) < uc < max(ua, ub):
             uc = 0.5 * (ua + ub)
         if uc in (ua, ub):
-            break          # the bracket is down to adjacent floats: a jump over zero
+            # the bracket is down to adjacent floats: the residual jumps over zero
+            u, fu = (ua, ta) if abs(ta) <= abs(tb) else (ub, tb)
+            return np.array([u]), np.array([fu]), evals[0]
+        if evals[0] >= max_evals:
+            raise ConvergenceError(f"the bracket [{ua:.17g}, {ub:.17g}] of the period map's "
+                                   f"fixed point did not close in {max_evals} period maps")
         fc = f(uc)
-        if abs(fc) < best[0]:
-            best = (abs(fc), uc, fc)
         if abs(fc) <= tol:
-            break
+            return np.array([uc]), np.array([fc]), evals[0]
         if np.sign(fc) == np.sign(fb):
-            ub, fb = uc, fc
+            ub, fb, tb = uc, fc, fc
             if side == -1:
                 fa *= 0.5
             side = -1
         else:
-            ua, fa = uc, fc
+            ua, fa, ta = uc, fc, fc
             if side == 1:
                 fb *= 0.5
             side = 1
-    return np.array([best[1]]), np.array([best[2]]), evals[0]
 
 
 @register_steady_solver("event-driven")
