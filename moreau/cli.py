@@ -462,7 +462,8 @@ def build_parser():
     parser = argparse.ArgumentParser(prog="moreau", description=__doc__.splitlines()[0])
     parser.add_argument("-V", "--version", action="version", version=f"moreau {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
+    p = sub.add_parser("steady", help="periodic steady state of a driven scene (a statistical "
+                                        "one, mean with interval, where no orbit exists)")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)

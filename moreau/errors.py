@@ -77,14 +77,16 @@ class BudgetExhaustedError(ConvergenceError):
 
     ``status`` is ``"budget-exhausted"``; ``periods`` the drive periods
     simulated; ``mean`` and ``half_width`` the estimate so far (None where
-    there was none), which is *not* a result: the run had not settled.
+    there was none), which is *not* a result: the run had not settled;
+    ``series`` the displacements per period (for a look at the drift).
     """
 
     status = "budget-exhausted"
 
-    def __init__(self, message, periods=0, mean=None, half_width=None):
+    def __init__(self, message, periods=0, mean=None, half_width=None, series=None):
         super().__init__(message)
         self.periods, self.mean, self.half_width = int(periods), mean, half_width
+        self.series = series
 
 
 class Interrupted(KeyboardInterrupt):

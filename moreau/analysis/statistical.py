@@ -301,7 +301,7 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         if d.size >= max_periods:
             raise BudgetExhaustedError(
                 f"statistical steady state: budget exhausted (`max_periods`={max_periods}): "
-                f"{why}", periods=d.size, mean=est[0], half_width=est[1])
+                f"{why}", periods=d.size, mean=est[0], half_width=est[1], series=d)
         target = min(max_periods, 2 * d.size)
 
     used = d.size - (d.size - cut) % BATCHES - cut

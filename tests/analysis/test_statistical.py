@@ -142,3 +142,35 @@ def test_schatzman_paoli_at_2000_hz_is_periodic():
     assert abs(ss.displacement_per_period / ref.displacement_per_period - 1) < 0.025
     assert abs(abs(ss.floquet_multipliers[0]) - abs(ref.floquet_multipliers[0])) < 1e-3
     assert math.isfinite(ss.displacement_per_period)
+
+
+# a chaotic flight case whose rotor is light enough (m2 = 2e-8 kg) to settle in ~100 periods:
+# 15 kHz (contact lost above 12.3 kHz), elastic impacts
+def _light_rotor_flight():
+    from moreau.scenes.friction_drive import PAPER_DEFAULTS
+    return FrictionDrive(PAPER_DEFAULTS.with_(restitution=1.0, m2=2e-8), 15000.0)
+
+
+def test_event_driven_and_moreau_jean_agree_within_their_intervals():
+    # measured (precision 2e-2): event-driven-generic 7.753e-3 +- 2.0 %, Moreau-Jean
+    # theta = 1/2 at N = 1000..16000 7.72e-3..7.85e-3 +- 1.5 %, Schatzman-Paoli 7.78e-3
+    sc = _light_rotor_flight()
+    with pytest.raises(ConvergenceError):
+        find_steady_state(sc, statistical=False)           # no periodic orbit
+    ed = statistical_steady_state(sc, "event-driven-generic", precision=5e-2)
+    mj = statistical_steady_state(sc, "moreau-jean", steps_per_period=2000, theta=0.5,
+                                  projection=True, precision=5e-2)
+    half = sum((s.confidence_interval[1] - s.confidence_interval[0]) / 2 for s in (ed, mj))
+    assert abs(ed.displacement_per_period - mj.displacement_per_period) <= half
+    assert ed.stats["lag1_autocorrelation"] < 0.5 and mj.stats["lag1_autocorrelation"] < 0.5
+
+
+@pytest.mark.xfail(strict=True, reason="the friction drive's walker (the 'event-driven' reference "
+                   "of the scene) gives 1.0406e-2 +- 1.2 % here, a third above every other "
+                   "scheme (event-driven-generic, Moreau-Jean, Schatzman-Paoli, generalized-alpha "
+                   "7.75e-3..7.83e-3): not a grid-of-events effect (grid 512 and 4096 agree); "
+                   "cause not found")
+def test_walker_agrees_with_the_generic_event_driven_scheme_in_flight():
+    sc = _light_rotor_flight()
+    walker = statistical_steady_state(sc, "event-driven", precision=2e-2)
+    assert walker.confidence_interval[0] <= 7.75e-3 <= walker.confidence_interval[1]
