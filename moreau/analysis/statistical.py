@@ -17,8 +17,9 @@ run the series is examined:
 1. **Transient**: MSER-5 (White 1997; Franklin and White 2008). The series
    is averaged in groups of 5; the truncation ``t`` minimises the marginal
    standard error ``sum_{i > t} (Y_i - mean_t)^2 / (n - t)^2`` over
-   ``t <= n/2``. A minimiser in the second half of that range means the
-   series is still drifting: the run is doubled, never averaged.
+   all ``t`` (the last few groups aside). A minimiser in the second half
+   of the series means it is still drifting (the rule of the method): the
+   run is doubled, never averaged.
 2. **Stationarity and interval**: the retained series is cut into
    :data:`BATCHES` batches of equal length (non-overlapping batch means,
    Schmeiser 1982). The half-width of the interval is
@@ -29,10 +30,12 @@ run the series is examined:
    its ``d_k`` are only as good as the scheme's event location and
    rounding: the walker's long run and its shot orbit differ by 4.5e-13
    relative at 185 Hz, a grid-locked Schatzman–Paoli map's long run and its
-   bracketed fixed point by 1.1e-9 at 2000 Hz). The batch
-   means must also look independent: their lag-1 autocorrelation must be
-   below ``z_{(1+c)/2} / sqrt(B)``; otherwise the batches are too short for
-   the correlation time of the motion and the run is doubled.
+   bracketed fixed point by 1.1e-9 at 2000 Hz). Batch means that are still
+   correlated understate the variance of their mean: with a positive lag-1
+   autocorrelation ``rho`` of the batch means the half-width is widened by
+   ``sqrt((1 + rho) / (1 - rho))`` (the variance factor of an AR(1)
+   series), and above :data:`MAX_LAG1` the batches are too short for the
+   correlation time of the motion and the run is doubled.
 3. **Stop**: when the half-width is at most ``precision`` times
    ``max(|mean|, 0.01 * 2 pi * velocity_scale)`` (the floor, 1 % of the
    displacement of the stator's speed over a period, keeps a zero mean
@@ -66,7 +69,7 @@ from ..integrators.result import SteadyState
 from .periodic_shooting import period_map_options
 
 __all__ = ["statistical_steady_state", "mser5_truncation", "batch_means", "METHOD",
-           "MAX_PERIODS", "BATCHES", "CHUNK", "RESOLUTION"]
+           "MAX_PERIODS", "BATCHES", "CHUNK", "RESOLUTION", "MAX_LAG1"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -78,11 +81,14 @@ MIN_PERIODS = 200
 BATCHES = 20
 #: most periods simulated in one call (the cyclic coordinate is reset between calls)
 CHUNK = 500
+#: largest lag-1 autocorrelation of the batch means accepted (then widened, see above)
+MAX_LAG1 = 0.7
 #: smallest half-width claimed, relative to ``max(|mean|, 0.01 * 2 pi * velocity_scale)``
 RESOLUTION = 1e-8
 #: the method, as the JSON states it
 METHOD = (f"MSER-5 transient truncation, {BATCHES} non-overlapping batch means, Student t "
-          f"interval, lag-1 autocorrelation check of the batch means")
+          f"interval widened by the AR(1) factor of their lag-1 autocorrelation (at most "
+          f"{MAX_LAG1})")
 
 
 def mser5_truncation(d):
@@ -96,9 +102,8 @@ def mser5_truncation(d):
     Returns
     -------
     int or None
-        A multiple of 5; None when the minimiser lies beyond the first
-        quarter of the series: the truncation would leave too little, and
-        the series is taken as not yet stationary.
+        A multiple of 5; None when the minimiser lies in the second half of
+        the series: the series is taken as not yet stationary.
 
     Examples
     --------
@@ -118,10 +123,10 @@ def mser5_truncation(d):
     cs2 = np.cumsum((y * y)[::-1])[::-1]
     m = nb - np.arange(nb)
     sse = cs2 - cs * cs / m
-    limit = nb // 2
+    limit = nb - 4          # leave at least a few groups to average
     stat = np.maximum(sse[:limit], 0.0) / m[:limit] ** 2
     t = int(np.argmin(stat))
-    if t > nb // 4:
+    if t > nb // 2:
         return None
     return 5 * t
 
@@ -284,20 +289,23 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         cut = mser5_truncation(d)
         if cut is None:
             why = (f"the running mean still drifts after {d.size} periods (MSER-5 puts the end "
-                   f"of the transient past the first quarter)")
+                   f"of the transient in its second half)")
         else:
             y = d[cut:]
             mean, half, lag1 = batch_means(y, BATCHES, confidence)
             ref_scale = max(abs(mean), floor_d)
+            if lag1 > 0.0:
+                half *= math.sqrt((1.0 + lag1) / (1.0 - lag1)) if lag1 < 1.0 else math.inf
             half = max(half, RESOLUTION * ref_scale)
             est = (mean, half)
             wanted = precision * ref_scale
-            indep = lag1 <= _stats.norm.ppf(0.5 * (1.0 + confidence)) / math.sqrt(BATCHES)
+            indep = lag1 <= MAX_LAG1
             if half <= wanted and indep:
                 break
             why = (f"after {d.size} periods (transient {cut}) the interval half-width is "
                    f"{half:.3g} against {wanted:.3g} wanted" +
-                   ("" if indep else f", and the batch means are correlated (lag 1: {lag1:.2f})"))
+                   ("" if indep else f", and the batch means are correlated (lag 1: {lag1:.2f}"
+                    f" > {MAX_LAG1})"))
         if d.size >= max_periods:
             raise BudgetExhaustedError(
                 f"statistical steady state: budget exhausted (`max_periods`={max_periods}): "
