@@ -124,7 +124,7 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     check_periodic(scene)
     settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = steady_of(scene, settings, max_period=max_period)
+    ss = steady_of(scene, settings, max_period=max_period, statistical=True)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:
