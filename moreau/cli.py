@@ -136,7 +136,8 @@ def _cmd_steady(args):
         lo, hi = rep["confidence_interval_m"]
         print(f"  statistical steady state  mean over {rep['periods_used']} periods after a "
               f"transient of {rep['transient_periods']}")
-        print(f"  {100 * rep['confidence_level']:g} % interval          [{lo:.9e}, {hi:.9e}] m")
+        label = f"{100 * rep['confidence_level']:g} % interval"
+        print(f"  {label:<26}[{lo:.9e}, {hi:.9e}] m")
         print(f"  why not periodic          {rep['why_not_periodic']}")
     elif not rep["periodic"]:
         print(f"  note                      {rep.get('message', '')}")
@@ -144,14 +145,15 @@ def _cmd_steady(args):
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
     if rep["periodic_residual"] is not None:
         print(f"  periodic residual         {rep['periodic_residual']:.2e}")
-    if rep["period"] != 1:
+    if rep["period"] > 1:
         print(f"  orbit period              {rep['period']} drive periods")
     if rep["floquet_multipliers"] is not None:
         mult = ", ".join(f"{re:.6g}{im:+.3g}j" if im else f"{re:.6g}"
                          for re, im in rep["floquet_multipliers"])
         print(f"  Floquet multipliers       {mult} ({'stable' if rep['stable'] else 'unstable'}, "
               f"margin {rep['stability_margin']:.3g})")
-    print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
+    if rep["regimes"]:
+        print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
     print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")
 
 
