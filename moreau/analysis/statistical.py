@@ -189,10 +189,7 @@ def _run_periods(scene, scheme, q, v, ts, m, cyclic, opts):
                                f"drive periods; a statistical steady state needs them")
     u = res.q[idx, cyclic]
     vmax = float(np.max(np.abs(res.v))) if res.v.size else 0.0
-    fN = np.asarray(res.force_N)
-    fmin = float(np.min(fN[np.asarray(res.regime) != 0])) if np.any(np.asarray(res.regime) != 0) \
-        else math.inf
-    return np.diff(u), res.q[-1].copy(), res.v[-1].copy(), vmax, fmin
+    return np.diff(u), res.q[-1].copy(), res.v[-1].copy(), vmax
 
 
 def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, section_tau=0.0,
@@ -233,7 +230,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         periods averaged, ``stats`` with ``transient_periods``,
         ``periods_simulated``, ``half_width``, ``lag1_autocorrelation``,
         ``method`` and ``status`` (``"converged"``); ``mode`` is
-        ``"non-periodic"``, ``period`` 0, no Floquet multipliers.
+        ``"non-periodic"``, ``period`` 0, no Floquet multipliers,
+        ``min_normal_force`` infinite (unknown: the runs are sampled once a
+        period) and ``periodic_residual`` infinite (no orbit closes).
 
     Raises
     ------
@@ -270,7 +269,7 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
 
     start = time.perf_counter()
     d = np.zeros(0)
-    vmax, fmin = 0.0, math.inf
+    vmax = 0.0
     vs = getattr(scene, "velocity_scale", None)
     target = MIN_PERIODS
     why = "no look yet"
@@ -278,9 +277,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
     while True:
         while d.size < target:
             m = min(CHUNK, target - d.size)
-            dk, q, v, vm, fm = _run_periods(scene, scheme, q, v, ts, m, cyclic, opts)
+            dk, q, v, vm = _run_periods(scene, scheme, q, v, ts, m, cyclic, opts)
             d = np.concatenate([d, dk])
-            vmax, fmin = max(vmax, vm), min(fmin, fm)
+            vmax = max(vmax, vm)
         if not np.all(np.isfinite(d)):
             raise ConvergenceError("the displacements per period are not finite: the run "
                                    "diverged")
@@ -321,7 +320,8 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         state0=np.concatenate([qs, v]),
         mode="non-periodic",
         regimes=[],
-        min_normal_force=fmin,
+        # the runs are sampled once a period: the forces within are not known
+        min_normal_force=math.inf,
         periodic_residual=math.inf,
         iterations=0,
         wall_time=time.perf_counter() - start,
