@@ -134,19 +134,28 @@ def _cmd_steady(args):
     print(f"  operation mode            {rep['mode']}")
     print(f"  displacement per period   {rep['displacement_per_period_m']:.9e} m")
     print(f"  average velocity          {rep['average_velocity_m_per_s']:.9e} m/s")
-    if not rep["periodic"]:
+    if rep["steady_state"] == "statistical":
+        lo, hi = rep["confidence_interval_m"]
+        print(f"  statistical steady state  mean over {rep['periods_used']} periods after a "
+              f"transient of {rep['transient_periods']}")
+        label = f"{100 * rep['confidence_level']:g} % interval"
+        print(f"  {label:<26}[{lo:.9e}, {hi:.9e}] m")
+        print(f"  why not periodic          {rep['why_not_periodic']}")
+    elif not rep["periodic"]:
         print(f"  note                      {rep.get('message', '')}")
     if rep["min_normal_force_N"] is not None:
         print(f"  min normal force          {rep['min_normal_force_N']:.6e} N")
-    print(f"  periodic residual         {rep['periodic_residual']:.2e}")
-    if rep["period"] != 1:
+    if rep["periodic_residual"] is not None:
+        print(f"  periodic residual         {rep['periodic_residual']:.2e}")
+    if rep["period"] > 1:
         print(f"  orbit period              {rep['period']} drive periods")
     if rep["floquet_multipliers"] is not None:
         mult = ", ".join(f"{re:.6g}{im:+.3g}j" if im else f"{re:.6g}"
                          for re, im in rep["floquet_multipliers"])
         print(f"  Floquet multipliers       {mult} ({'stable' if rep['stable'] else 'unstable'}, "
               f"margin {rep['stability_margin']:.3g})")
-    print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
+    if rep["regimes"]:
+        print("  regimes (tau start):      " + ", ".join(f"{r}@{t:.4f}" for t, r in rep["regimes"]))
     print(f"  wall time                 {rep['wall_time_s'] * 1e3:.1f} ms")
 
 
@@ -508,7 +517,8 @@ def build_parser():
                         help="show notes (a compile starting) on stderr also when it is not a "
                              "terminal, e.g. in a log file")
     sub = parser.add_subparsers(dest="command", required=True)
-    p = sub.add_parser("steady", help="periodic steady state of the paper's friction drive")
+    p = sub.add_parser("steady", help="periodic steady state of a driven scene (a statistical "
+                                        "one, mean with interval, where no orbit exists)")
     p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)

@@ -16,6 +16,8 @@ __all__ = [
     "LCPError",
     "ConvergenceError",
     "RunawayError",
+    "BudgetExhaustedError",
+    "ResidualFloorError",
     "Interrupted",
 ]
 
@@ -53,6 +55,38 @@ class ConvergenceError(MoreauError):
 
 class RunawayError(ConvergenceError):
     """No steady state exists: the driven body runs away (e.g. past the motor's stall load)."""
+
+
+class ResidualFloorError(ConvergenceError):
+    """A period map whose fixed point exists only to a residual above the tolerance.
+
+    A time-stepping scheme's period map is piecewise smooth (its switches
+    are locked to the step grid), so ``P(x) - x`` can jump over zero.
+    ``state`` is the best ``(q, v)`` found at the section (a start on or near
+    the attractor for a statistical steady state), ``residual`` its residual
+    relative to the velocity scale.
+    """
+
+    def __init__(self, message, state=None, residual=None):
+        super().__init__(message)
+        self.state, self.residual = state, residual
+
+
+class BudgetExhaustedError(ConvergenceError):
+    """A statistical steady state whose running mean was not stationary within its budget.
+
+    ``status`` is ``"budget-exhausted"``; ``periods`` the drive periods
+    simulated; ``mean`` and ``half_width`` the estimate so far (None where
+    there was none), which is *not* a result: the run had not settled;
+    ``series`` the displacements per period (for a look at the drift).
+    """
+
+    status = "budget-exhausted"
+
+    def __init__(self, message, periods=0, mean=None, half_width=None, series=None):
+        super().__init__(message)
+        self.periods, self.mean, self.half_width = int(periods), mean, half_width
+        self.series = series
 
 
 class Interrupted(KeyboardInterrupt):

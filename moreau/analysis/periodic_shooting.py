@@ -27,7 +27,7 @@ import numpy as np
 from scipy.linalg import null_space
 
 from .._validate import positive, positive_int
-from ..errors import ConvergenceError, InputError
+from ..errors import ConvergenceError, InputError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import check_options, scheme_options as options_of
 from ..integrators.event_driven_generic import project_positions
@@ -37,13 +37,17 @@ from ..regimes import REGIME_LETTERS, Regime
 from .floquet import period_map_jacobian, sorted_multipliers
 from .steady_solvers import register_steady_solver
 
-__all__ = ["shoot_periodic", "free_bases"]
+__all__ = ["shoot_periodic", "free_bases", "period_map_options", "bracket_scalar"]
 
 TWO_PI = 2.0 * math.pi
 
 
-#: periods of plain iteration tried after Newton stalls on a time-stepping scheme's period map
+#: periods of plain iteration (or period maps of the bracketing, one free direction) tried
+#: after Newton stalls on a time-stepping scheme's period map
 FIXED_POINT_PERIODS = 100
+
+#: below this slope of ``P - I`` (one free direction) a time-stepping map is on a flat step
+FLAT_SLOPE = 1e-6
 
 
 def _project(scene, t, q, v, touching):
@@ -89,9 +93,18 @@ def free_bases(scene, q, t, cyclic, touching):
     return Bq, null_space(WN)
 
 
-def _scheme_options(scheme, options):
-    # a time-stepping scheme (one that takes a step ``h``) is given its step as a
-    # number of steps per drive period; any other scheme refuses that setting
+def period_map_options(scheme, options):
+    """The scheme's options for one period map: ``steps_per_period`` becomes the step ``h``.
+
+    A time-stepping scheme (one that takes a step ``h``) is given its step as
+    a number of steps per drive period (2000 by default); any other scheme
+    refuses that setting.
+
+    Examples
+    --------
+    >>> round(period_map_options("moreau-jean", {"steps_per_period": 100})["h"], 6)
+    0.062832
+    """
     opts = dict(options)
     accepted = options_of(get_integrator(scheme)) or ()
     if "h" in accepted:
@@ -195,7 +208,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     clash = set(scheme_options or {}) & set(options)
     if clash:
         raise InputError(f"`{sorted(clash)[0]}` is given twice (in `scheme_options` and as a keyword)")
-    opts = _scheme_options(scheme, {**options, **(scheme_options or {})})
+    opts = period_map_options(scheme, {**options, **(scheme_options or {})})
     check_options(scheme, opts, scene)
     takes = options_of(get_integrator(scheme)) or ()
     ts = float(section_tau)
@@ -269,21 +282,44 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     best = (float(np.max(np.abs(r))), z.copy())
     while np.max(np.abs(r)) > rtol * vscale:
         it += 1
-        if it > max_iter:
+        J = None
+        if it <= max_iter:
+            J = period_map_jacobian(lambda zz: residual(*state(zz, base))[0], z,
+                                    1e-7 * np.maximum(vscale, np.abs(z)), f0=r, central=False)
+        # a time-stepping scheme's period map is only piecewise smooth (its index set
+        # changes on the grid): on a flat step of the map (slope of P - I about 0 in
+        # a one-dimensional free space) Newton is blind, and it may stall anyway
+        flat = J is not None and z.size == 1 and abs(J[0, 0]) < FLAT_SLOPE
+        if it > max_iter or ("h" in takes and flat):
             newton = (f"shooting did not converge in `max_iter`={max_iter} Newton steps "
-                      f"(residual {np.max(np.abs(r)) / vscale:.3g} relative)")
+                      f"(residual {np.max(np.abs(r)) / vscale:.3g} relative)" if not flat else
+                      f"Newton shooting met a flat step of the period map (slope of P - I "
+                      f"{J[0, 0]:.2g}) after {it - 1} steps")
             if "h" not in takes:
                 raise ConvergenceError(newton)
-            # a time-stepping scheme's period map is only piecewise smooth (its
-            # index set changes on the grid), which can stall Newton on a map that
-            # plain iteration contracts: iterate it from Newton's best state (the
-            # last one can be far off where a finite difference crossed a jump)
+            if z.size == 1:
+                # one free direction: P - I is non-increasing along it for a contracting
+                # map (slope of P in [0, 1]), so a bracket of its sign change holds the
+                # fixed point; start from Newton's best state
+                z1, r, evals = bracket_scalar(lambda zz: residual(*state(zz, base))[0],
+                                              best[1], rtol * vscale, FIXED_POINT_PERIODS)
+                fixed_point_periods = evals
+                qs, vs = state(z1, base)
+                if np.max(np.abs(r)) > rtol * vscale:
+                    raise ResidualFloorError(
+                        f"{newton}; the period map's fixed point exists only to a residual "
+                        f"{np.max(np.abs(r)) / vscale:.3g} relative (bracketed to rounding in "
+                        f"{evals} period maps; the tolerance is {rtol:.3g}): its switches are "
+                        f"locked to the step grid", state=(qs, vs),
+                        residual=float(np.max(np.abs(r)) / vscale))
+                break
+            # plain iteration from Newton's best state (the last one can be far off
+            # where a finite difference crossed a jump)
             qs, vs = state(best[1], base)
             qs, vs, r, fixed_point_periods = _iterate_period_map(
-                period, qs, vs, cyclic, Bq, Bv, rtol * vscale, FIXED_POINT_PERIODS, newton)
+                period, qs, vs, cyclic, Bq, Bv, rtol * vscale, FIXED_POINT_PERIODS, newton,
+                vscale)
             break
-        J = period_map_jacobian(lambda zz: residual(*state(zz, base))[0], z,
-                                1e-7 * np.maximum(vscale, np.abs(z)), f0=r, central=False)
         step = np.linalg.lstsq(J, -r, rcond=None)[0]
         lam = 1.0
         for _ in range(6):
@@ -339,7 +375,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     )
 
 
-def _iterate_period_map(period, q, v, cyclic, Bq, Bv, tol, max_periods, why):
+def _iterate_period_map(period, q, v, cyclic, Bq, Bv, tol, max_periods, why, vscale):
     """Iterate the period map from ``(q, v)`` until it repeats within ``tol`` (free directions)."""
     for k in range(1, max_periods + 1):
         res = period(q, v)
@@ -349,8 +385,87 @@ def _iterate_period_map(period, q, v, cyclic, Bq, Bv, tol, max_periods, why):
         q, v = qe, ve
         if np.max(np.abs(r)) <= tol:
             return q, v, r, k
-    raise ConvergenceError(f"{why}, and {max_periods} periods of plain iteration left a "
-                           f"residual of {np.max(np.abs(r)):.3g} (the tolerance is {tol:.3g})")
+    raise ResidualFloorError(f"{why}, and {max_periods} periods of plain iteration left a "
+                             f"residual of {np.max(np.abs(r)):.3g} (the tolerance is {tol:.3g})",
+                             state=(q, v), residual=float(np.max(np.abs(r)) / vscale))
+
+
+def bracket_scalar(fun, z0, tol, max_evals):
+    """Zero of a non-increasing scalar residual ``fun`` (one free direction) by bracketing.
+
+    ``fun(z)`` returns ``P(z) - z`` as a one-element array. For a
+    non-expansive map along the direction (slope of ``P`` in ``[0, 1]``,
+    friction's rotor velocity) the zero lies at least ``|fun(z0)|`` away in
+    the direction of ``fun(z0)``: the bracket is expanded from there by
+    doubling, then closed by Illinois regula falsi. A map whose residual
+    jumps over zero (switches locked to a step grid) ends with the bracket
+    shrunk to adjacent floats; the end with the smaller residual is returned
+    with it. A bracket still open after ``max_evals`` maps raises
+    :class:`~moreau.errors.ConvergenceError`.
+
+    Returns
+    -------
+    z : ndarray, shape (1,)
+    r : ndarray, shape (1,)
+        ``fun(z)``.
+    evals : int
+        Evaluations of ``fun`` (period maps).
+
+    Examples
+    --------
+    >>> z, r, n = bracket_scalar(lambda z: np.array([0.5 * (1.0 - z[0])]), np.zeros(1), 1e-12, 60)
+    >>> abs(z[0] - 1.0) < 1e-11
+    True
+    """
+    evals = [0]
+
+    def f(u):
+        evals[0] += 1
+        return float(np.asarray(fun(np.array([u])), float)[0])
+
+    ua = float(np.asarray(z0, float)[0])
+    fa = f(ua)
+    if abs(fa) <= tol:
+        return np.array([ua]), np.array([fa]), evals[0]
+    step = fa
+    while True:
+        if evals[0] >= max_evals:
+            raise ConvergenceError(f"no sign change of the period-map residual found in "
+                                   f"{max_evals} period maps (last {fa:.3g})")
+        ub = ua + step
+        fb = f(ub)
+        if abs(fb) <= tol:
+            return np.array([ub]), np.array([fb]), evals[0]
+        if np.sign(fb) != np.sign(fa):
+            break
+        ua, fa = ub, fb
+        step *= 2.0
+    side = 0
+    ta, tb = fa, fb         # the true residuals at the ends (Illinois scales fa, fb)
+    while True:
+        uc = (ua * fb - ub * fa) / (fb - fa)
+        if not min(ua, ub) < uc < max(ua, ub):
+            uc = 0.5 * (ua + ub)
+        if uc in (ua, ub):
+            # the bracket is down to adjacent floats: the residual jumps over zero
+            u, fu = (ua, ta) if abs(ta) <= abs(tb) else (ub, tb)
+            return np.array([u]), np.array([fu]), evals[0]
+        if evals[0] >= max_evals:
+            raise ConvergenceError(f"the bracket [{ua:.17g}, {ub:.17g}] of the period map's "
+                                   f"fixed point did not close in {max_evals} period maps")
+        fc = f(uc)
+        if abs(fc) <= tol:
+            return np.array([uc]), np.array([fc]), evals[0]
+        if np.sign(fc) == np.sign(fb):
+            ub, fb, tb = uc, fc, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            ua, fa, ta = uc, fc, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
 
 
 @register_steady_solver("event-driven")

@@ -173,8 +173,12 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     return Scheme(scheme, theta, steps_per_period, rtol, options)
 
 
-def steady_of(scene, scheme, max_period=1):
+def steady_of(scene, scheme, max_period=1, statistical=False):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
+
+    Sweeps, atlases and comparisons want a periodic orbit or a failure, so
+    the statistical steady state (:mod:`moreau.analysis.statistical`) is
+    only the fallback with ``statistical=True`` (``moreau steady``).
 
     Examples
     --------
@@ -187,7 +191,7 @@ def steady_of(scene, scheme, max_period=1):
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
         return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
                                  steps_per_period=scheme.steps_per_period, max_period=max_period,
-                                 **kw, **scheme.options)
+                                 statistical=statistical, **kw, **scheme.options)
     # an adaptive scheme's period map carries its own error tolerance: the shooting
     # aims above it unless told otherwise (a fixed-step map is deterministic)
     kw = {"rtol": scheme.rtol if scheme.rtol is not None else
@@ -198,4 +202,5 @@ def steady_of(scene, scheme, max_period=1):
         kw["theta"] = scheme.theta
     if scheme.options:
         kw["scheme_options"] = scheme.options
-    return find_steady_state(scene, scheme=scheme.name, max_period=max_period, **kw)
+    return find_steady_state(scene, scheme=scheme.name, max_period=max_period,
+                             statistical=statistical, **kw)

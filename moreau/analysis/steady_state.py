@@ -18,8 +18,9 @@ from ..integrators.result import SteadyState
 from ..scenes.base import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
 from . import mj_steady_state  # noqa: F401
-from .period_k import find_period_k
+from .period_k import find_period_k, full_state_of
 from .periodic_shooting import shoot_periodic
+from .statistical import MAX_PERIODS, statistical_steady_state
 from .steady_solvers import get_steady_solver, has_solver
 
 __all__ = ["SteadyState", "find_steady_state"]
@@ -29,7 +30,8 @@ TWO_PI = 2.0 * math.pi
 
 
 def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
-                      max_period=1, **options):
+                      max_period=1, statistical=True, statistical_budget=MAX_PERIODS,
+                      **options):
     """Periodic steady state of a periodically driven scene, found by shooting, and checked.
 
     The one entry point for every scheme and every caller: what the shooting
@@ -48,6 +50,17 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     stable one is returned (``period = k``). Without one the period-1
     result (or its error) stands.
 
+    With ``statistical`` (the default), where no periodic orbit was found
+    (the shootings failed with a :class:`~moreau.errors.ConvergenceError`
+    other than a runaway, or Moreau–Jean's discrete map settled on no
+    period-1 orbit), the result is the statistical steady state
+    (:func:`moreau.analysis.statistical.statistical_steady_state`): the
+    long-run mean displacement per period with its confidence interval,
+    from the best state the shooting reached (a time-stepping map's
+    residual floor) or the scene's initial state, within
+    ``statistical_budget`` drive periods (else
+    :class:`~moreau.errors.BudgetExhaustedError`).
+
     Examples
     --------
     >>> from moreau.scenes.friction_drive import FrictionDrive
@@ -63,13 +76,24 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     max_period = positive_int("max_period", max_period)
     if max_period > MAX_PERIOD:
         raise InputError(f"`max_period` must be at most {MAX_PERIOD}, got {max_period}")
+    if not isinstance(statistical, (bool, np.bool_)):
+        raise InputError(f"`statistical` must be True or False, got {statistical!r}")
+    statistical_budget = positive_int("statistical_budget", statistical_budget)
     try:
         ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
         failure = None
+    except RunawayError:
+        raise
     except ConvergenceError as exc:
-        if max_period == 1:
+        if max_period == 1 and not statistical:
             raise
         ss, failure = None, exc
+    if ss is not None and not (ss.stats or {}).get("periodic", True):
+        # Moreau-Jean's map settled on no period-1 orbit: its fixed-window average is
+        # replaced by the statistical steady state, from where that run ended
+        failure = ConvergenceError(ss.stats.get("message", "no period-1 orbit"))
+        failure.state = full_state_of(scene, ss.state0)
+        ss = None if statistical else ss
     if max_period > 1 and (ss is None or ss.stable is False):
         start = ss
         if start is None and options.get("q0") is not None and options.get("v0") is not None:
@@ -79,11 +103,34 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
                             rtol=max(rtol, 1e-10), options=_shooting_options(scheme, options))
         if alt is not None:
             ss = alt
-        elif failure is not None:
+        elif failure is not None and not statistical:
             raise failure
+    if ss is None:
+        ss = _statistical(scene, scheme, failure, statistical_budget, options)
     why = implausible_steady_state(scene, ss)
     if why:
         raise RunawayError(why)
+    return ss
+
+
+def _statistical(scene, scheme, failure, budget, options):
+    """The statistical steady state where the shooting found no orbit (``failure`` says why)."""
+    state = getattr(failure, "state", None)
+    if state is None and options.get("x_guess") is not None:
+        state = full_state_of(scene, options["x_guess"])
+    if state is None and options.get("q0") is not None and options.get("v0") is not None:
+        state = (options["q0"], options["v0"])
+    q0, v0 = state if state is not None else scene.initial_state()
+    own = getattr(scene, "reference_integrator", None)
+    run = own if scheme == "event-driven" and own is not None else scheme
+    opts = _shooting_options(scheme, options)
+    if scheme == "moreau-jean":
+        opts.setdefault("projection", options.get("projection", True))
+    ss = statistical_steady_state(scene, run, q0=q0, v0=v0,
+                                  section_tau=float(options.get("section_tau", 0.0)),
+                                  max_periods=budget, **opts)
+    ss.scheme = scheme
+    ss.stats["why_not_periodic"] = str(failure)
     return ss
 
 

@@ -22,7 +22,7 @@ from .floquet import floquet_report
 from .engine import audit_options
 from .scheme_settings import make_scheme, steady_of
 
-__all__ = ["steady_state_report", "check_periodic"]
+__all__ = ["steady_state_report", "check_periodic", "statistical_report"]
 
 #: steady-state statistics copied into the report of a Moreau–Jean steady state
 MJ_STATS = ("message", "steps", "lcp_solves", "fallbacks", "max_penetration", "period_map_slope",
@@ -39,6 +39,29 @@ def check_periodic(scene):
         if not hasattr(scene, attr):
             raise InputError(f"scene {name!r} has no `{attr}`: the SI report needs it")
     return scene
+
+
+def statistical_report(scene, ss):
+    """The JSON fields that say whether a steady state is periodic or statistical.
+
+    ``steady_state`` is ``"periodic"`` or ``"statistical"``; a statistical
+    one (:mod:`moreau.analysis.statistical`) adds ``confidence_interval_m``
+    (``[low, high]`` of the mean displacement per period, m),
+    ``confidence_level``, ``periods_used`` (periods averaged),
+    ``transient_periods`` (detected and dropped), ``statistical_status``,
+    ``statistical_method`` and ``why_not_periodic``.
+    """
+    if not getattr(ss, "statistical", False):
+        return {"steady_state": "periodic"}
+    lo, hi = ss.confidence_interval
+    st = ss.stats or {}
+    return {"steady_state": "statistical",
+            "confidence_interval_m": [float(scene.displacement_to_si(lo)),
+                                      float(scene.displacement_to_si(hi))],
+            "confidence_level": ss.confidence, "periods_used": int(ss.periods_used),
+            "transient_periods": st.get("transient_periods"),
+            "statistical_status": st.get("status"), "statistical_method": st.get("method"),
+            "why_not_periodic": st.get("why_not_periodic")}
 
 
 def _energy_of(scene, ss, settings):
@@ -86,7 +109,10 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         ``floquet_multipliers`` (``[re, im]`` pairs, largest modulus first),
         ``max_multiplier``, ``stable``, ``stability_margin`` (``1 - max
         |lambda|``) and ``floquet_method`` (:mod:`moreau.analysis.floquet`;
-        None where there is no periodic orbit), ``wall_time_s``,
+        None where there is no periodic orbit), ``steady_state``
+        (``"periodic"`` or ``"statistical"``, :func:`statistical_report`:
+        a statistical one's ``displacement_per_period_m`` is the long-run
+        mean, with ``confidence_interval_m`` and ``periods_used``), ``wall_time_s``,
         ``parameters``, ``provenance``
         (:func:`moreau.provenance.provenance`), ``energy`` (the energy audit of
         the steady period, :mod:`moreau.analysis.energy`: joules per period
@@ -98,7 +124,7 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     check_periodic(scene)
     settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = steady_of(scene, settings, max_period=max_period)
+    ss = steady_of(scene, settings, max_period=max_period, statistical=True)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:
@@ -117,10 +143,13 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "min_normal_force_N": (float(scene.force_to_si(ss.min_normal_force))
                                if math.isfinite(ss.min_normal_force) else None),
         "periodic": bool(ss.stats.get("periodic", True)) if ss.stats else True,
-        "periodic_residual": ss.periodic_residual,
+        # None where there is no orbit to close (a statistical steady state)
+        "periodic_residual": (ss.periodic_residual if math.isfinite(ss.periodic_residual)
+                              else None),
         "shooting_iterations": ss.iterations,
         "period": int(getattr(ss, "period", 1)),
         **floquet_report(ss),
+        **statistical_report(scene, ss),
         "wall_time_s": wall,
         "parameters": dict(parameters),
         "provenance": provenance(),
@@ -131,7 +160,10 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         out["theta"] = settings.theta
     if settings.options:
         out["options"] = settings.options
-    out["energy"], note = _energy_of(scene, ss, settings)
+    if getattr(ss, "statistical", False):
+        out["energy"], note = None, "no energy audit: a statistical steady state has no period"
+    else:
+        out["energy"], note = _energy_of(scene, ss, settings)
     if note:
         out["energy_note"] = note
     if scheme == "moreau-jean":

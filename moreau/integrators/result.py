@@ -149,6 +149,19 @@ class SteadyState:
         Drive periods after which the orbit repeats (1 for a period-1 orbit;
         ``k`` for one found on the ``k``-th iterate of the period map).
         ``displacement_per_period`` is per drive period in either case.
+    statistical : bool
+        True for a statistical steady state (no periodic orbit:
+        :mod:`moreau.analysis.statistical`): ``displacement_per_period`` is
+        then the long-run mean after the transient, ``state0`` the state at
+        the section after the last period simulated, and ``period`` 0.
+    confidence_interval : tuple of float or None
+        ``(low, high)`` of the long-run mean displacement per period at
+        the level ``confidence`` (statistical steady states only).
+    confidence : float or None
+        The level of ``confidence_interval`` (0.95 by default).
+    periods_used : int
+        Drive periods whose displacements make the mean (after the
+        transient, statistical steady states only).
     """
 
     scheme: str
@@ -165,6 +178,10 @@ class SteadyState:
     floquet_multipliers: np.ndarray = None
     floquet_method: str = ""
     period: int = 1
+    statistical: bool = False
+    confidence_interval: tuple = None
+    confidence: float = None
+    periods_used: int = 0
 
     @property
     def max_multiplier(self):

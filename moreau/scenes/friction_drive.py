@@ -408,12 +408,12 @@ class FrictionDriveCase(DriveCase):
         return dict(frequency=self.frequency, **self._params)
 
     def reference(self, rtol):
-        ss = find_steady_state(self.scene, rtol=rtol)
+        ss = find_steady_state(self.scene, rtol=rtol, statistical=False)
         return ss.displacement_per_period, regime_switches(ss.regimes)
 
     def _tight(self):
         if self._ref is None:
-            ss = find_steady_state(self.scene, rtol=self.tight_rtol)
+            ss = find_steady_state(self.scene, rtol=self.tight_rtol, statistical=False)
             q = np.array([ss.state0[0], 0.0])
             v = np.array(ss.state0[1:])
             tau_s = float(getattr(ss, "section_tau", 0.0) or 0.0)

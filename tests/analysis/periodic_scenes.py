@@ -87,3 +87,17 @@ class TableBall(Scene):
 
     def initial_state(self):
         return np.array([2.0, 0.0]), np.array([0.0, 0.0])
+
+
+class RotorTableBall(TableBall):
+    """The table ball with its rotor driven by the ball's height: ``r'' = -c (r' - x)``.
+
+    The rotor's mean speed is the ball's mean height, so the displacement per
+    period is ``2 pi <x>``: a long-run mean that exists for the chaotic
+    bouncing of a large ``Gamma`` as well, where no periodic orbit is stable.
+    """
+
+    name = "rotor-table-ball"
+
+    def forces(self, q, v, t):
+        return np.array([-self.g, -self.c * (v[1] - q[0])])
