@@ -24,7 +24,7 @@ def _subparsers():
 def test_every_command_that_takes_force_is_documented_with_it():
     takes = {name for name, p in _subparsers().items()
              if any("--force" in a.option_strings for a in p._actions)}
-    assert takes == {"sweep", "atlas", "run", "reproduce"}
+    assert takes == {"sweep", "atlas", "run", "reproduce", "bifurcation"}
     paragraphs = [p for p in re.split(r"\n\s*\n", README.read_text()) if "`--force`" in p]
     documented = {name for name in takes for p in paragraphs
                   if re.search(rf"`moreau\s+{name}`", p)}
@@ -67,6 +67,17 @@ COMMANDS = {
         (["moreau sweep mu --frequency 185 --scheme moreau-jean --theta 0.5 "
           "--steps-per-period 200 --points 2 --jobs 1"],
          ["out/sweep_mu_185Hz_mj_theta0.5_N200.csv", "out/sweep_mu_185Hz_mj_theta0.5_N200.json"]),
+    'moreau characteristic --frequency 185 --json':
+        (["moreau characteristic --frequency 185 --points 5 --json"],
+         ["out/characteristic_friction-drive_185Hz_event-driven.csv",
+          "out/characteristic_friction-drive_185Hz_event-driven.json",
+          "out/characteristic_friction-drive_185Hz_event-driven.png"]),
+    'moreau bifurcation frequency 1e4 5e4 --points 24 --set restitution=1':
+        (["moreau bifurcation frequency 1e4 5e4 --points 2 --transient 5 --samples 3 "
+          "--set restitution=1 --quiet"],
+         ["out/bifurcation_friction-drive_frequency_event-driven.csv",
+          "out/bifurcation_friction-drive_frequency_event-driven.json",
+          "out/bifurcation_friction-drive_frequency_event-driven.png"]),
     'moreau atlas':
         (["moreau atlas --f-points 3 --y-points 2 --jobs 1"],
          ["out/atlas_f-mu.csv", "out/atlas_f-mu.json", "out/atlas_f-mu.png",
