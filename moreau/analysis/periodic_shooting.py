@@ -414,7 +414,7 @@ def bracket_scalar(fun, z0, tol, max_evals):
     Examples
     --------
     >>> z, r, n = bracket_scalar(lambda z: np.array([0.5 * (1.0 - z[0])]), np.zeros(1), 1e-12, 60)
-    >>> abs(z[0] - 1.0) < 1e-11
+    >>> bool(abs(z[0] - 1.0) < 1e-11)
     True
     """
     evals = [0]

@@ -194,6 +194,23 @@ def _classify(pN, pT, mu):
 
 
 @njit(cache=True, inline="always")
+def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
+                  reg, pN, pT, h, slip, G, n, nc):
+    """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
+    forces (impulse / step), the slip velocity and the gap (column 0 of ``G``)."""
+    rec_t[nrec] = t
+    for j in range(n):
+        rec_q[nrec, j] = q[j]
+        rec_v[nrec, j] = v[j]
+    for i in range(nc):
+        rec_reg[nrec, i] = reg[i]
+        rec_fN[nrec, i] = pN[i] / h
+        rec_fT[nrec, i] = pT[i] / h
+        rec_slip[nrec, i] = slip[i]
+        rec_gap[nrec, i] = G[i, 0]
+
+
+@njit(cache=True, inline="always")
 def _invert_small(A, out, n):
     """``out = A^-1`` for ``n <= 3`` in closed form; False when ``A`` is singular.
 
@@ -1121,16 +1138,8 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                     stats[S_PEN] = -Gq[i, 0]
                 reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
-            rec_t[nrec] = tk
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
-            for i in range(nc):
-                rec_reg[nrec, i] = reg[i]
-                rec_fN[nrec, i] = pN[i] / hk
-                rec_fT[nrec, i] = pT[i] / hk
-                rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = G0[i, 0]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
             nrec += 1
             record_initial = False
         for i in range(nc):
@@ -1144,16 +1153,8 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
         if to_save == 0:
             to_save = save_every
         if to_save == save_every or last:
-            rec_t[nrec] = t1
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
-            for i in range(nc):
-                rec_reg[nrec, i] = reg[i]
-                rec_fN[nrec, i] = pN[i] / hk
-                rec_fT[nrec, i] = pT[i] / hk
-                rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = Gq[i, 0]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
             nrec += 1
         if last:
             break

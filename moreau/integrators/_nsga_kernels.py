@@ -17,7 +17,8 @@ import numpy as np
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _one_contact, _residual, lemke_workspace)
+                          _lcp_size, _lcp_step, _one_contact, _residual, lemke_workspace,
+                          record_sample)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
 
@@ -354,21 +355,13 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                     stats[S_PEN] = -Gq[i, 0]
                 reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
-            rec_t[nrec] = tk
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
             if nc > 0:
                 if HAS_GAPS:  # noqa: F821
                     gaps_fn(par, q, tk, G0)  # noqa: F821
                 else:
                     contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
-            for i in range(nc):
-                rec_reg[nrec, i] = reg[i]
-                rec_fN[nrec, i] = pN[i] / hk
-                rec_fT[nrec, i] = pT[i] / hk
-                rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = G0[i, 0]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
             nrec += 1
             record_initial = False
         for i in range(nc):
@@ -383,16 +376,8 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
         if to_save == 0:
             to_save = save_every
         if to_save == save_every or last:
-            rec_t[nrec] = t1
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
-            for i in range(nc):
-                rec_reg[nrec, i] = reg[i]
-                rec_fN[nrec, i] = pN[i] / hk
-                rec_fT[nrec, i] = pT[i] / hk
-                rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = Gq[i, 0]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
             nrec += 1
         if last:
             break

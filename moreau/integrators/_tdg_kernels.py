@@ -19,7 +19,7 @@ from numba import njit
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _classify, _invert_gj,
                           _invert_small, _lcp_size, _lcp_step, _one_contact, _residual,
-                          lemke_workspace)
+                          lemke_workspace, record_sample)
 
 __all__ = ["tdg_loop"]
 
@@ -205,7 +205,8 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
     idx = np.zeros(Lmax, dtype=np.int64)
     pcol = np.zeros(4 * ncm, dtype=np.int64)
     lw = (Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
-    gstart = np.zeros(ncm)
+    zreg = np.zeros(ncm, dtype=np.int64)
+    zf = np.zeros(ncm)
 
     have_Mi = False
     nrec = 0
@@ -245,7 +246,6 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
             else:
                 contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
             for i in range(nc):
-                gstart[i] = G0[i, 0]
                 acc = G0[i, 1]
                 for j in range(n):
                     acc += G0[i, 3 + j] * v[j]
@@ -451,16 +451,8 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
                     stats[S_PEN] = -Gi[i, 0]
                 reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
-            rec_t[nrec] = tk
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
-            for i in range(nc):
-                rec_reg[nrec, i] = 0
-                rec_fN[nrec, i] = 0.0
-                rec_fT[nrec, i] = 0.0
-                rec_slip[nrec, i] = 0.0
-                rec_gap[nrec, i] = gstart[i]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          tk, q, v, zreg, zf, zf, hk, zf, G0, n, nc)
             nrec += 1
             record_initial = False
         for i in range(nc):
@@ -473,16 +465,8 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
         if to_save == 0:
             to_save = save_every
         if to_save == save_every or last:
-            rec_t[nrec] = t1
-            for j in range(n):
-                rec_q[nrec, j] = q[j]
-                rec_v[nrec, j] = v[j]
-            for i in range(nc):
-                rec_reg[nrec, i] = reg[i]
-                rec_fN[nrec, i] = pN[i] / hk
-                rec_fT[nrec, i] = pT[i] / hk
-                rec_slip[nrec, i] = slip[i]
-                rec_gap[nrec, i] = Gi[i, 0]
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          t1, q, v, reg, pN, pT, hk, slip, Gi, n, nc)
             nrec += 1
         if last:
             break
