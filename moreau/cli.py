@@ -442,7 +442,11 @@ def _cmd_compare(args):
     if args.stress:
         # with --stress, --schemes names the map's columns (keys of stress.SCHEMES)
         cols = None if args.schemes in (None, "all") else args.schemes.split(",")
+        settings = claim_outputs(os.path.join(out, "stress"),
+                                 {"stress": True, "quick": bool(args.quick), "schemes": cols},
+                                 args.force)
         report = run_catalogue(progress=progress, full=not args.quick, schemes=cols)
+        report["settings"] = settings
         paths = write_stress_outputs(report, out, plot=not args.no_plot)
         if args.json:
             print(json.dumps(report))
@@ -466,8 +470,13 @@ def _cmd_compare(args):
         partial.append(row)
 
     schemes = [x.strip() for x in args.schemes.split(",") if x.strip()] if args.schemes else None
+    # a quick and a full comparison (or two with other settings) share file names
+    settings = claim_outputs(os.path.join(out, tag),
+                             {"scene": args.scene, "parameters": params,
+                              "quick": bool(args.quick), "schemes": schemes}, args.force)
     report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep,
                          schemes=schemes, **params)
+    report["settings"] = settings
     paths = cmp.write_outputs(report, out, tag=tag, plot=not args.no_plot)
     if args.json:
         print(json.dumps(report))
@@ -646,6 +655,9 @@ def build_parser():
     c.add_argument("--json", action="store_true", help="print one JSON object")
     c.add_argument("--quiet", action="store_true", help="no progress bar")
     c.add_argument("--no-plot", action="store_true", help="skip the figure")
+    c.add_argument("--force", action="store_true",
+                   help="replace the files of an earlier comparison with other settings "
+                        "(refused otherwise)")
     c.set_defaults(func=_cmd_compare)
     return parser
 

@@ -66,3 +66,19 @@ def test_a_run_of_another_length_is_refused_then_forced(tmp_path, capsys):
     assert main(argv[:3] + ["--duration", "0.2"] + argv[5:]) == 2
     assert capsys.readouterr().err == _refusal("history_bouncing-ball_event-driven", "duration")
     assert main(argv[:3] + ["--duration", "0.2"] + argv[5:] + ["--force"]) == 0
+
+
+def test_a_comparison_with_other_settings_is_refused_then_forced(tmp_path, capsys):
+    base = ["compare", "--scene", "bouncing-ball", "--quick", "--quiet", "--no-plot",
+            "--out", str(tmp_path)]
+    assert main(base) == 0
+    assert main(base) == 0  # the same settings: a rerun, allowed
+    first = (tmp_path / "compare_bouncing-ball.json").read_text()
+    assert json.loads(first)["settings"]["quick"] is True
+    capsys.readouterr()
+    assert main(base + ["--set", "restitution=0.8"]) == 2
+    assert capsys.readouterr().err == _refusal("compare_bouncing-ball", "parameters")
+    assert (tmp_path / "compare_bouncing-ball.json").read_text() == first
+    assert main(base + ["--set", "restitution=0.8", "--force"]) == 0
+    rep = json.loads((tmp_path / "compare_bouncing-ball.json").read_text())
+    assert rep["parameters"]["restitution"] == 0.8

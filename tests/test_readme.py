@@ -24,7 +24,7 @@ def _subparsers():
 def test_every_command_that_takes_force_is_documented_with_it():
     takes = {name for name, p in _subparsers().items()
              if any("--force" in a.option_strings for a in p._actions)}
-    assert takes == {"sweep", "atlas", "run", "reproduce", "bifurcation"}
+    assert takes == {"sweep", "atlas", "run", "reproduce", "bifurcation", "compare"}
     paragraphs = [p for p in re.split(r"\n\s*\n", README.read_text()) if "`--force`" in p]
     documented = {name for name in takes for p in paragraphs
                   if re.search(rf"`moreau\s+{name}`", p)}
