@@ -42,7 +42,7 @@ PREAMBLES = {
 #: what each snippet's last names must hold after it ran (a check that could fail)
 CHECKS = {
     "from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams":
-        "assert ss.mode == 'NP' and res.success and si['t'][-1] > 0",
+        "assert ss.mode == 'NP' and res.success and si['t'][-1] > 0 and len(df) == len(res.t)",
     "from moreau.integrators import simulate":
         "assert res.success and res.stats['lcp_solves'] > 0 and ss.mode",
     "from moreau.lcp import solve_lcp, build_friction_lcp":

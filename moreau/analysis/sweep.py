@@ -39,7 +39,7 @@ from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
-           "MAX_POINTS"]
+           "MAX_POINTS", "rows_to_xarray"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
@@ -282,3 +282,65 @@ def _figure(table, swept, scene, path):
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def _split_unit(column):
+    name, _, unit = column.partition(" [")
+    return name, unit[:-1] if unit.endswith("]") else ""
+
+
+def rows_to_xarray(rows, dims):
+    """A sweep's or an atlas's tidy rows as an :class:`xarray.Dataset` (xarray is optional).
+
+    Parameters
+    ----------
+    rows : list of dict
+        Rows as written to the CSV (``"name [unit]"`` column names).
+    dims : list of str
+        The swept columns (one for a sweep, two for an atlas), as named in
+        the rows; they become the dataset's coordinates, sorted.
+
+    Returns
+    -------
+    xarray.Dataset
+        One variable per other column on the grid of ``dims`` (NaN, or an
+        empty string, where a combination has no row), named without the
+        unit, which goes to the variable's ``units`` attribute.
+
+    Examples
+    --------
+    >>> rows = [{"mu": 0.1, "frequency [Hz]": f, "displacement_per_period_m": 2 * f,
+    ...          "mode": "NP"} for f in (10.0, 20.0)]
+    >>> ds = rows_to_xarray(rows, ["frequency [Hz]"])
+    >>> ds["displacement_per_period_m"].values.tolist(), ds["frequency"].attrs["units"]
+    ([20.0, 40.0], 'Hz')
+    """
+    try:
+        import xarray as xr
+    except ImportError:  # pragma: no cover - the message is the point
+        raise ImportError("`rows_to_xarray` needs xarray: pip install -e \".[data]\"") from None
+    if not rows:
+        raise InputError("`rows` must hold at least one row")
+    for d in dims:
+        if d not in rows[0]:
+            raise InputError(f"`dims` must name columns of the rows; {d!r} is not one of "
+                             f"{list(rows[0])}")
+    axes = [sorted({float(r[d]) for r in rows}) for d in dims]
+    index = [{v: k for k, v in enumerate(ax)} for ax in axes]
+    shape = tuple(len(ax) for ax in axes)
+    names = [_split_unit(d)[0] for d in dims]
+    coords = {}
+    for d, name, ax in zip(dims, names, axes):
+        coords[name] = xr.Variable(name, np.array(ax), attrs={"units": _split_unit(d)[1]})
+    data = {}
+    for col in rows[0]:
+        if col in dims:
+            continue
+        numeric = all(isinstance(r.get(col), (int, float, np.number)) and
+                      not isinstance(r.get(col), bool) for r in rows)
+        arr = np.full(shape, np.nan) if numeric else np.full(shape, "", dtype=object)
+        for r in rows:
+            arr[tuple(ix[float(r[d])] for ix, d in zip(index, dims))] = r.get(col)
+        name, unit = _split_unit(col)
+        data[name] = xr.Variable(names, arr, attrs={"units": unit} if unit else {})
+    return xr.Dataset(data, coords=coords)

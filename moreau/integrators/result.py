@@ -105,6 +105,61 @@ class SimulationResult:
         """Regime of one contact at each sample as a string of letters."""
         return "".join(REGIME_LETTERS[Regime(int(r))] for r in self.regime[:, contact])
 
+    def to_dataframe(self, scene=None):
+        """The time history as a :class:`pandas.DataFrame` (pandas is an optional extra).
+
+        Parameters
+        ----------
+        scene : Scene, optional
+            The scene that was run. A scene with SI units gives its SI columns
+            (``Scene.si_columns``: ``t [s]``, ``q_1 [m]``, ``force_N_0 [N]``,
+            ...); without it the columns are the scene's dimensionless ones,
+            named without units. Regimes are given by name (``stick``,
+            ``positive``, ``negative``, ``flight``).
+
+        Returns
+        -------
+        pandas.DataFrame
+            ``attrs`` holds ``scheme``, ``status``, ``message`` and ``units``
+            (column -> unit).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from moreau.scenes import BouncingBall
+        >>> from moreau.integrators import simulate
+        >>> ball = BouncingBall()
+        >>> res = simulate(ball, (0.0, 1.0), *ball.initial_state(), "moreau-jean", h=0.25)
+        >>> df = res.to_dataframe(ball)
+        >>> list(df.columns)[:3], df.attrs["units"]["t"]
+        (['t', 'q_0', 'v_0'], 's')
+        """
+        try:
+            import pandas as pd
+        except ImportError:  # pragma: no cover - the message is the point
+            raise ImportError("`to_dataframe` needs pandas: pip install -e \".[data]\"") from None
+        if scene is not None and hasattr(scene, "si_columns"):
+            cols = scene.si_columns(self)
+        else:
+            cols = [("t", "", self.t)]
+            for name in ("q", "v"):
+                arr = getattr(self, name)
+                cols += [(f"{name}_{i}", "", arr[:, i]) for i in range(arr.shape[1])]
+            for name in ("force_N", "force_T", "slip_velocity", "gap", "regime"):
+                arr = getattr(self, name)
+                cols += [(f"{name}_{i}", "", arr[:, i]) for i in range(arr.shape[1])]
+        data, units = {}, {}
+        for name, unit, col in cols:
+            col = np.asarray(col)
+            if name.startswith("regime"):
+                col = np.array([Regime(int(r)).name.lower() for r in col], dtype=object)
+            data[name] = col
+            units[name] = unit
+        df = pd.DataFrame(data)
+        df.attrs.update(scheme=self.scheme, status=int(self.status), message=self.message,
+                        units=units)
+        return df
+
 
 @dataclass
 class SteadyState:
