@@ -470,6 +470,8 @@ def _cmd_compare(args):
         partial.append(row)
 
     schemes = [x.strip() for x in args.schemes.split(",") if x.strip()] if args.schemes else None
+    # a bad parameter is named before a clash of file names is
+    cmp.make_case(args.scene, **params)
     # a quick and a full comparison (or two with other settings) share file names
     settings = claim_outputs(os.path.join(out, tag),
                              {"scene": args.scene, "parameters": params,

@@ -29,12 +29,12 @@ _ENV = {**os.environ,
         "PYTHONPATH": os.pathsep.join([str(PACKAGE.parent)]
                                       + [p for p in [os.environ.get("PYTHONPATH")] if p])}
 
-#: what a function may import where it needs it: optional dependencies (the [dask] and
+#: what a function may import where it needs it: optional dependencies (the [dask], [data] and
 #: [bench] extras, the tools of the tests and notebooks) and, as issue 17 lists them,
 #: matplotlib and tqdm, core dependencies in pyproject.toml that stay lazy: a figure
 #: function selects matplotlib's backend (Agg) when it draws, and pyplot costs ~0.5 s
 OPTIONAL = {"matplotlib", "tqdm", "dask", "distributed", "siconos", "quantecon", "IPython",
-            "nbformat", "nbclient", "hypothesis"}
+            "nbformat", "nbclient", "hypothesis", "pandas", "xarray"}
 
 # -- the import statements of the package's files ------------------------------------------------
 class _File:
