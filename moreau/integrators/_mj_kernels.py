@@ -194,6 +194,22 @@ def _classify(pN, pT, mu):
 
 
 @njit(cache=True, inline="always")
+def lcp_buffers(ncm):
+    """The buffers of one loop's contact LCPs for up to ``ncm`` contacts (see :func:`_lcp_step`).
+
+    Returns ``(Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)``; ``lay``
+    starts with ``-1`` (no layout assembled yet).
+    """
+    Lmax = 4 * ncm
+    work, iwork = lemke_workspace(Lmax)
+    lay = np.zeros(1 + ncm, dtype=np.int64)
+    lay[0] = -1
+    return (np.zeros((Lmax, Lmax)), np.zeros(Lmax), np.ones(Lmax), np.zeros(Lmax),
+            np.zeros(Lmax), np.zeros(Lmax + 1), work, iwork, lay, np.zeros((Lmax, Lmax)),
+            np.zeros(Lmax), np.zeros(Lmax, dtype=np.int64), np.zeros(4 * ncm, dtype=np.int64))
+
+
+@njit(cache=True, inline="always")
 def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
                   reg, pN, pT, h, slip, G, n, nc):
     """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
@@ -748,7 +764,6 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     rvel = np.zeros(2 * max(nc, 1))
-    pcol = np.zeros(4 * max(nc, 1), dtype=np.int64)
     th = theta
     M = np.zeros((n, n))
     Wh = np.empty((n, n))
@@ -801,20 +816,9 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     # LCP buffers at the largest size (four variables per contact), allocated
     # once: arrays reassigned inside the loop would be reference-counted on
     # every step, contact or not; _lcp_step uses their leading L x L block
-    Lmax = 4 * ncm
-    Ml = np.zeros((Lmax, Lmax))
-    ql = np.zeros(Lmax)
-    dl = np.ones(Lmax)
-    zl = np.zeros(Lmax)
-    wl = np.zeros(Lmax)
-    rayl = np.zeros(Lmax + 1)
-    work, iwork = lemke_workspace(Lmax)
-    # the layout Ml holds (na, ia...), and the warm start's subsystem
-    lay = np.zeros(1 + ncm, dtype=np.int64)
-    lay[0] = -1
-    Ab = np.zeros((Lmax, Lmax))
-    xb = np.zeros(Lmax)
-    idx = np.zeros(Lmax, dtype=np.int64)
+    # the LCP buffers; `lay` holds the layout Ml holds (na, ia...), Ab .. pcol the warm
+    # start's subsystem
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
 
     constant_W = const_mass and not has_jac
     have_Wi = False

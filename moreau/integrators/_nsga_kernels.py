@@ -17,7 +17,7 @@ import numpy as np
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _one_contact, _residual, lemke_workspace,
+                          _lcp_size, _lcp_step, _one_contact, _residual, lcp_buffers,
                           record_sample)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -85,20 +85,8 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     p = np.zeros(mrows)
     base = np.zeros(ncm, dtype=np.int64)
     trow = np.zeros(ncm, dtype=np.int64)
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
     Lmax = 4 * ncm
-    Ml = np.zeros((Lmax, Lmax))
-    ql = np.zeros(Lmax)
-    dl = np.ones(Lmax)
-    zl = np.zeros(Lmax)
-    wl = np.zeros(Lmax)
-    rayl = np.zeros(Lmax + 1)
-    work, iwork = lemke_workspace(Lmax)
-    lay = np.zeros(1 + ncm, dtype=np.int64)
-    lay[0] = -1
-    Ab = np.zeros((Lmax, Lmax))
-    xb = np.zeros(Lmax)
-    idx = np.zeros(Lmax, dtype=np.int64)
-    pcol = np.zeros(4 * ncm, dtype=np.int64)
     # the position correction's frictionless LCP: its own buffers and layout memory
     mu0 = np.zeros(ncm)
     Ml2 = np.zeros((Lmax, Lmax))

@@ -19,7 +19,7 @@ from numba import njit
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _classify, _invert_gj,
                           _invert_small, _lcp_size, _lcp_step, _one_contact, _residual,
-                          lemke_workspace, record_sample)
+                          lcp_buffers, record_sample)
 
 __all__ = ["tdg_loop"]
 
@@ -190,20 +190,7 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
     MW = np.zeros((n, ncm))
     base = np.zeros(ncm, dtype=np.int64)
     trow = np.zeros(ncm, dtype=np.int64)
-    Lmax = 4 * ncm
-    Ml = np.zeros((Lmax, Lmax))
-    ql = np.zeros(Lmax)
-    dl = np.ones(Lmax)
-    zl = np.zeros(Lmax)
-    wl = np.zeros(Lmax)
-    rayl = np.zeros(Lmax + 1)
-    work, iwork = lemke_workspace(Lmax)
-    lay = np.zeros(1 + ncm, dtype=np.int64)
-    lay[0] = -1
-    Ab = np.zeros((Lmax, Lmax))
-    xb = np.zeros(Lmax)
-    idx = np.zeros(Lmax, dtype=np.int64)
-    pcol = np.zeros(4 * ncm, dtype=np.int64)
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
     lw = (Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
     zreg = np.zeros(ncm, dtype=np.int64)
     zf = np.zeros(ncm)
