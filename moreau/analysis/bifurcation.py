@@ -65,7 +65,7 @@ from . import engine
 from ..integrators.event_driven_generic import project_positions
 from .engine import check_output_dir
 from .period_k import full_state_of
-from .periodic_shooting import free_bases
+from .periodic_shooting import free_bases, period_map_options, touching_contacts
 from .scheme_settings import make_scheme, steady_of
 from .sweep import MAX_POINTS, plan_points
 
@@ -161,14 +161,9 @@ def _one_period(scene, scheme, q, v, opts):
     return res
 
 
-def _touching(scene, q):
-    g = np.asarray(scene.gaps(q, 0.0), dtype=float)
-    return np.flatnonzero(g <= 1e-12 * max(1.0, float(np.max(np.abs(q)))))
-
-
 def _tangent(scene, q, cyclic):
     """Basis (2 n, m) of the state changes that keep the touching contacts closed (first order)."""
-    Bq, Bv = free_bases(scene, q, 0.0, cyclic, _touching(scene, q))
+    Bq, Bv = free_bases(scene, q, 0.0, cyclic, touching_contacts(scene, q, 0.0))
     n = q.size
     B = np.zeros((2 * n, Bq.shape[1] + Bv.shape[1]))
     B[:n, :Bq.shape[1]] = Bq
@@ -180,7 +175,7 @@ def _companion(scene, x, dz, B, cyclic):
     """``x`` moved by ``B dz``, its positions put back onto the touching contacts."""
     n = x.size // 2
     c = x + B @ dz
-    touching = _touching(scene, x[:n])
+    touching = touching_contacts(scene, x[:n], 0.0)
     if touching.size:
         c[:n] = project_positions(scene, 0.0, c[:n], touching)
     if cyclic is not None:
@@ -342,14 +337,12 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         cls = cls.resolve(probe)
     accepted = options_of(cls) or ()
     opts = dict(scheme_options or {})
-    if "h" in accepted:
-        n = positive_int("steps_per_period", 1000 if steps_per_period is None
-                         else steps_per_period)
-        opts["h"] = TWO_PI / n
-        opts.setdefault("save_every", n)
-    elif steps_per_period is not None:
-        raise InputError(f"`steps_per_period` applies to time-stepping schemes; {scheme!r} "
-                         "locates its events")
+    if steps_per_period is not None or "h" in accepted:
+        opts["steps_per_period"] = 1000 if steps_per_period is None else steps_per_period
+    opts = period_map_options(scheme, opts)
+    if "h" in opts:
+        # one sample a period: the section
+        opts.setdefault("save_every", round(TWO_PI / opts["h"]))
     elif "sample_dt" in accepted:
         opts.setdefault("sample_dt", TWO_PI)
     check_options(scheme, opts, probe)

@@ -61,6 +61,20 @@ def _project(scene, t, q, v, touching):
     return q, v
 
 
+def touching_contacts(scene, q, t):
+    """Indices of the contacts whose gap at ``(q, t)`` is closed (to 1e-12 of the state's scale).
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> touching_contacts(sc, sc.rest_state()[0], 0.0).tolist()
+    [0]
+    """
+    gap_tol = 1e-12 * max(1.0, float(np.max(np.abs(q))))
+    return np.flatnonzero(np.asarray(scene.gaps(q, t), dtype=float) <= gap_tol)
+
+
 def free_bases(scene, q, t, cyclic, touching):
     """Orthonormal bases ``(Bq, Bv)`` of the free directions of a state at a section.
 
@@ -242,8 +256,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         q, v = res.q[-1].copy(), res.v[-1].copy()
         q[cyclic] = 0.0
 
-    gap_tol = 1e-12 * max(1.0, float(np.max(np.abs(q))))
-    touching = np.flatnonzero(scene.gaps(q, ts) <= gap_tol)
+    touching = touching_contacts(scene, q, ts)
     q, v = _project(scene, ts, q, v, touching)
     Bq, Bv = free_bases(scene, q, ts, cyclic, touching)
     nz_q = Bq.shape[1]

@@ -382,11 +382,17 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
                 pT[fa[r]] = Ptot[na + r]
         if projection and nh > 0:
             # Newton steps onto g = 0 for the held contacts, in the metric of M(q_{n+1})
-            mass_fn(par, qi, M)  # noqa: F821
-            ok = _invert_small(M, Mi, n) if n <= 3 else _invert_gj(M, Mi, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
+            # (a constant mass matrix is inverted once, in Mi0)
+            if const_mass:
+                for i in range(n):
+                    for j in range(n):
+                        Mi[i, j] = Mi0[i, j]
+            else:
+                mass_fn(par, qi, M)  # noqa: F821
+                ok = _invert_small(M, Mi, n) if n <= 3 else _invert_gj(M, Mi, wk, n)
+                if not ok:
+                    status = SINGULAR
+                    break
             qmax = 1.0
             for j in range(n):
                 qmax = max(qmax, abs(qi[j]))

@@ -185,9 +185,13 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
 
     # -- the pieces of one step ----------------------------------------------
-    def _rows(self, ia, q, t):
-        """Stacked rows ``H`` (normal, then tangential of the frictional ones) and offsets ``w``."""
-        WN, wN, WT, wT = (np.asarray(x, dtype=float) for x in self.scene.contact_jacobians(q, t))
+    def _rows(self, ia, q, t, jac=None):
+        """Stacked rows ``H`` (normal, then tangential of the frictional ones) and offsets ``w``.
+
+        ``jac``: the scene's ``contact_jacobians(q, t)`` where the caller has them.
+        """
+        WN, wN, WT, wT = (np.asarray(x, dtype=float)
+                          for x in (jac if jac is not None else self.scene.contact_jacobians(q, t)))
         fa = ia[self._trow[ia] >= 0]
         tr = self._trow[fa]
         return np.vstack([WN[ia], WT[tr]]), np.concatenate([wN[ia], wT[tr]]), fa
@@ -228,8 +232,8 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         ia = np.zeros(0, dtype=int)
         if nc:
             g0 = np.asarray(sc.gaps(q, t0), dtype=float)
-            WN0, wN0, _, _ = sc.contact_jacobians(q, t0)
-            vN0 = np.asarray(WN0, dtype=float) @ v + np.asarray(wN0, dtype=float)
+            jac0 = sc.contact_jacobians(q, t0)
+            vN0 = np.asarray(jac0[0], dtype=float) @ v + np.asarray(jac0[1], dtype=float)
             ia = np.flatnonzero((g0 + 0.5 * h * vN0 <= 0.0) | self._closed)
         na = ia.size
         P_total = None
@@ -237,7 +241,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         M = np.asarray(sc.mass(q), dtype=float)
         if na:
             # the impulsive part at t_n+: Newton's law on the pre-step velocities
-            H, w, fa = self._rows(ia, q, t0)
+            H, w, fa = self._rows(ia, q, t0, jac0)
             MinvHT = np.linalg.solve(M, H.T)
             P, _ = self._solve(H, w, MinvHT, v, self.e_c[ia], vN0[ia], ia, t0)
             v = v + MinvHT @ P
