@@ -84,6 +84,16 @@ Event-driven reference (the friction drive's walker)
   (``p_T = J d u2'``, ``p_N = (sin phi p_T - d phi' / 3) / cos phi``).
   Closes to about 1e-12 of the input work.
 
+Event-driven reference (the generic scheme: the two-rod drive)
+  :class:`~moreau.integrators.event_driven_generic.GenericEventDriven`
+  redoes the period with its pieces kept: each smooth phase (one contact
+  mode) is integrated by one 16-point Gauss–Legendre rule per solver step
+  on its dense output, the forces of the mode solved at every node; each
+  velocity jump (an impact, or the projection that removes a phase's drift
+  from the closed contacts) enters through the impulses the scheme applied.
+  Two-rod drive at 185 Hz (``x10_b = 1e-6`` m, mode ``NSP|NP``): 1.0e-12;
+  on the friction drive it reproduces the walker's terms to 1e-12.
+
 Moreau–Jean (the discrete scheme's own audit)
   One period of steps from the discrete steady state. Step ``k`` carries
   the impulses ``p_N, p_T`` of its contact problem, whose local velocities
