@@ -371,7 +371,8 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
 
     Examples
     --------
-    >>> d = efficiency_vs_frequency("friction-drive", [2000.0], points=3, out=None, plot=False)
+    >>> d = efficiency_vs_frequency("friction-drive", [2000.0], points=3, out=None, plot=False,
+    ...                             log=lambda s: None)
     >>> 0.0 < d["rows"][0]["efficiency"] < 1.0
     True
     """
