@@ -526,6 +526,9 @@ def _efficiency_figure(rows, summary, path):
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     a1.plot(f, [100 * r["efficiency"] for r in ok], "C2o-", lw=0.8)
     a1.set_ylabel("efficiency at max. power [%]")
+    eff = np.array([r["efficiency"] for r in ok])
+    if eff.size and np.all(eff > 0) and eff.max() > 100 * eff.min():
+        a1.set_yscale("log")    # 0.05 % to 45 % on the paper's drive, 20 Hz to 2 kHz
     a1.set_title(f"{summary['scene']} ({summary['scheme']}): efficiency at the load of "
                  "maximum output power", fontsize=10)
     a2.plot(f, [1e6 * r["max_power_W"] for r in ok], "C0o-", lw=0.8, label="max. output power")
