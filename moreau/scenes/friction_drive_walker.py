@@ -240,7 +240,7 @@ class FrictionDriveWalker:
         dd1 = sc.u10 * cu
         dphi = -sc.u10 * su / c
         ddphi = dphi * dphi * s / c - dd1 / c
-        Fs = 0.5 * dd1 * c + ddphi / 3.0 - sc.P * c * (sc.sin_phi0 - s)
+        Fs = 0.5 * dd1 * c + ddphi / 3.0 - sc.P * c * (sc.sin_phi0 - s) - sc.fp * c
         return s, c, dphi, ddphi, Fs
 
     def fN(self, tau, regime):
@@ -452,7 +452,8 @@ class FrictionDriveWalker:
         sc = self.scene
         phi = y[0]
         c = math.cos(phi)
-        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(phi)) - 0.5 * sc.u10 * math.cos(t) * c)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(phi)) - 0.5 * sc.u10 * math.cos(t) * c
+                       + sc.fp * c)
         return [y[1], ddphi, y[3], -sc.fL / sc.J]
 
     def _gap(self, t, y):
