@@ -19,8 +19,7 @@ Smooth phases
     The state is integrated by DOP853 (``ode_method="Radau"`` for stiff scenes)
     at a tight tolerance.
 
-Events (terminal event functions of ``solve_ivp``, refined by its Brent
-root finder to a few ulps of time)
+Events (terminal event functions of ``solve_ivp``, refined by its Brent root finder to a few ulps of time)
     * an open contact's gap closing;
     * a closed contact's normal force vanishing (lift-off);
     * a sliding contact's slip velocity vanishing;
