@@ -180,3 +180,24 @@ def test_bad_events_are_named_errors():
     f.terminal, f.direction = True, "down"
     with pytest.raises(InputError, match=r"`events\[0\].direction` must be a real number"):
         simulate(BouncingBall(), (0.0, 1.0), [1.0], [0.0], "moreau-jean", h=0.1, events=f)
+
+
+@pytest.mark.parametrize("name", [n for n in SCHEMES if _exact(n)])
+def test_an_event_located_by_an_exact_scheme_is_a_zero_of_its_motion(name):
+    # independent of the root finder: a second run that simply ends at the event time
+    # must end on the event's zero
+    scene, (q0, v0), t1 = _case(name)
+    opts = _options(name)
+    own = simulate(scene, (0.0, t1), q0, v0, name, **opts)
+    target = float(own.q[len(own.t) // 2, 0])
+    scale = float(np.ptp(own.q[:, 0])) or 1.0
+
+    def cross(t, y):
+        return y[0] - target
+    cross.terminal = True
+    res = simulate(scene, (0.0, t1), q0, v0, name, events=cross, **opts)
+    assert res.status == 1, res.message
+    te = float(res.t_events[0][0])
+    assert res.t[-1] == te and abs(res.q[-1, 0] - target) <= 1e-12 * scale + 1e-15
+    again = simulate(scene, (0.0, te), q0, v0, name, **opts)
+    assert abs(again.q[-1, 0] - target) <= 1e-9 * scale
