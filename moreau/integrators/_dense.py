@@ -48,14 +48,22 @@ class Piece:
     sample : callable
         ``sample(t) -> (t, q, v, regime, force_N, force_T, slip, gap)``, the
         record of a :class:`~moreau.integrators.result.SimulationResult` row.
+    states : ndarray, optional
+        The states at the grid times, one row each, where they are at hand
+        (recorded samples): they spare an evaluation of ``state`` per step.
     """
 
-    __slots__ = ("grid", "state", "sample")
+    __slots__ = ("grid", "state", "sample", "states")
 
-    def __init__(self, grid, state, sample):
+    def __init__(self, grid, state, sample, states=None):
         self.grid = np.asarray(grid, dtype=float)
         self.state = state
         self.sample = sample
+        self.states = states
+
+    def state_at(self, k):
+        """The state at ``grid[k]``."""
+        return self.states[k] if self.states is not None else self.state(float(self.grid[k]))
 
 
 def interpolated_piece(t, q, v, regime, force_N, force_T, slip, gap):
@@ -93,7 +101,7 @@ def interpolated_piece(t, q, v, regime, force_N, force_T, slip, gap):
         return (s, c[:n], c[n:2 * n], regime[j].copy(), force_N[j].copy(), force_T[j].copy(),
                 c[2 * n:2 * n + nc], c[2 * n + nc:])
 
-    return Piece(t, state, sample)
+    return Piece(t, state, sample, y)
 
 
 def stack_rows(rows, n, nc):
@@ -260,7 +268,7 @@ class OutputTracker:
         # a jump between pieces (an impact changes the velocities): a sign change across
         # it is an event at the jump
         ta = float(grid[0])
-        ya = p.state(ta)
+        ya = p.state_at(0)
         prev = self._g_last
         ga = [self._g(i, ta, ya) for i in range(len(self.events))]
         found = self._crossings(prev, ga, lambda i: (ta, ya), (self._t_last, ta))
@@ -270,7 +278,7 @@ class OutputTracker:
             a, b = float(grid[k - 1]), float(grid[k])
             if b <= a:
                 continue
-            yb = p.state(b)
+            yb = p.state_at(k)
             gb = [self._g(i, b, yb) for i in range(len(self.events))]
 
             def root(i, a=a, b=b, ga=ga, gb=gb):
