@@ -19,8 +19,7 @@ Smooth phases
     The state is integrated by DOP853 (``ode_method="Radau"`` for stiff scenes)
     at a tight tolerance.
 
-Events (terminal event functions of ``solve_ivp``, refined by its Brent
-root finder to a few ulps of time)
+Events (terminal event functions of ``solve_ivp``, refined by its Brent root finder to a few ulps of time)
     * an open contact's gap closing;
     * a closed contact's normal force vanishing (lift-off);
     * a sliding contact's slip velocity vanishing;
@@ -278,6 +277,8 @@ class GenericEventDriven(Integrator):
     [1.0, 2.0]
     """
 
+    exact_motion = True
+
     def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
                  max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
                  max_impacts=10000, lcp_method="lemke", record_pieces=False):
@@ -343,12 +344,15 @@ class GenericEventDriven(Integrator):
         return self.vel_tol * max(self._vscale, 1e-300)
 
     # -- recording ---------------------------------------------------------------
-    def _record_state(self, t, q, v):
+    def _sample_row(self, t, q, v, mode):
         ms = self.ms
-        a, lamN, lamT, _, _, kin = ms.solve(t, q, v, self.mode)
+        a, lamN, lamT, _, _, kin = ms.solve(t, q, v, mode)
         slip = ms.slip_velocities(q, v, t, kin)
         gap = self.scene.gaps(q, t)
-        self._record(t, q, v, self.mode.copy(), lamN, lamT, slip, gap)
+        return t, q, v, mode.copy(), lamN, lamT, slip, gap
+
+    def _record_state(self, t, q, v):
+        self._record(*self._sample_row(t, q, v, self.mode))
         # the velocity scale of the tolerances also learns from the samples:
         # events may all fall where the scene is momentarily at rest
         self._update_vscale(q, v, t)
@@ -735,6 +739,14 @@ class GenericEventDriven(Integrator):
         t_end = float(sol.t[-1])
         if self.phases is not None:
             self.phases.append((self.t, t_end, sol.sol, self.mode.copy()))
+        if self._want_pieces:
+            # the phase's dense output is its exact motion (to the ODE tolerance), in the
+            # phase's mode; its steps are where an event function is checked
+            mode, dense = self.mode.copy(), sol.sol
+            grid = np.append(dense.ts[dense.ts < t_end], t_end)
+            self._add_piece(grid, dense,
+                            lambda t, mode=mode, dense=dense: self._sample_row(
+                                t, dense(t)[:n], dense(t)[n:], mode))
         # samples of the smooth phase
         while self._next_sample < t_end:
             ys = sol.sol(self._next_sample)
