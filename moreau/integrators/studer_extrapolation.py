@@ -53,7 +53,7 @@ from .._validate import in_open_interval, positive, positive_int
 from ..errors import InputError
 from ._blocks import FAST_BLOCK, CompiledRecording
 from ._loops import runner_for
-from ._mj_kernels import LCP_HANDBACK, PAINLEVE, S_PEN, SINGULAR, STAT_NAMES
+from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._studer_kernels import NOT_FINITE, STUDER_COUNTERS, TOO_MANY, studer_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
@@ -118,7 +118,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     compare_settings = ("tol", (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9), (1e-4, 1e-7), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
-                 lcp_method="auto", fast=False, max_steps=MAX_MACRO_STEPS):
+                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.tol = in_open_interval("tol", tol, 0.0, 1.0)
         if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
@@ -264,9 +264,10 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         return self._generic_step()
 
     def _fast_block(self):
-        q, v, closed, reg = self.q.copy(), self.v.copy(), self._closed.copy(), self._last_reg.copy()
-        th = np.array([self.t, self.h])
         n, nc = self.scene.ndof, self.scene.ncontacts
+        q, v, closed, reg = self.q.copy(), self.v.copy(), self._closed.copy(), self._last_reg.copy()
+        acc = np.zeros(n) if self._acc is None else self._acc.copy()
+        th = np.array([self.t, self.h, 0.0 if self._acc is None else 1.0])
         ns = FAST_BLOCK + 2
         buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
@@ -277,35 +278,35 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         m = self._model
         status, nacc, nrec = runner_for(m, studer_loop, self.scene)(
             m.par, self.mu_c, self.e_c, self.t_bound, self.tol, self.columns, self.h_min,
-            self.max_steps - self._macro, FAST_BLOCK, th, q, v, closed, reg, self._pending_initial,
-            self._lcp_ctl, *buf, st, cnt)
+            self.max_steps - self._macro, FAST_BLOCK, th, q, v, closed, reg, acc,
+            self._pending_initial, self._lcp_ctl, *buf, st, cnt)
         if nrec:
             self._blocks.append(tuple(b[:nrec].copy() for b in buf))
             self._pending_initial = False
         self.t, self.h = float(th[0]), float(th[1])
         self.q, self.v, self._closed, self._last_reg = q, v, closed, reg
+        self._acc = acc if th[2] else None
         c = self.counters
         for name, x in zip(STAT_NAMES, st):
             c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
         for name, x in zip(STUDER_COUNTERS, cnt):
-            c[name] += int(x)
-        self._macro += int(cnt[STUDER_COUNTERS.index("macro_steps")])
-        c["max_penetration"] = max(c["max_penetration"], float(st[S_PEN]))
-        c["steps"] += nacc - 1     # the base class counts one step per call of _step_impl
+            if name == "macro_steps":
+                self._macro += int(x)
+            else:
+                c[name] += int(x)
+        # the base class counts one step per call of _step_impl
+        c["steps"] += nacc - 1
         if status == TOO_MANY:
-            c["steps"] -= 1
             self._fail(-5, self._too_many())
         elif status == NOT_FINITE:
-            c["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {self.t!r}")
+        elif status == SINGULAR:
+            self._fail(-5, f"the mass matrix is singular near t = {self.t!r}")
         elif status in (LCP_HANDBACK, PAINLEVE):
             # the generic step takes the macro step the loop stopped at (QP fallback, or
             # the full diagnosis of a Painleve case)
             c["steps"] += 1
             self._generic_step()
-        elif status == SINGULAR:
-            c["steps"] -= 1
-            self._fail(-5, f"the mass matrix is singular near t = {self.t!r}")
 
     def _project(self, t, q, v, held):
         """The accepted state on the constraints of the contacts ``held`` (carrying a force).
