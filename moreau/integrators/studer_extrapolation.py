@@ -115,7 +115,13 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     True
     """
 
-    compare_settings = ("tol", (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9), (1e-4, 1e-7), {})
+    compare_settings = ("tol", (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11),
+                        (1e-4, 1e-7), {})
+    #: the option that sets the local error tolerance (the shooting's finite differences
+    #: step above it: :mod:`moreau.analysis.periodic_shooting`)
+    error_tolerance_option = "tol"
+    #: accepted macro steps per call of the compiled loop
+    _block_steps = FAST_BLOCK
 
     def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
                  lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS):
@@ -268,7 +274,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         q, v, closed, reg = self.q.copy(), self.v.copy(), self._closed.copy(), self._last_reg.copy()
         acc = np.zeros(n) if self._acc is None else self._acc.copy()
         th = np.array([self.t, self.h, 0.0 if self._acc is None else 1.0])
-        ns = FAST_BLOCK + 2
+        ns = self._block_steps + 2
         buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
                np.empty((ns, nc)), np.empty((ns, nc)))
@@ -278,7 +284,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         m = self._model
         status, nacc, nrec = runner_for(m, studer_loop, self.scene)(
             m.par, self.mu_c, self.e_c, self.t_bound, self.tol, self.columns, self.h_min,
-            self.max_steps - self._macro, FAST_BLOCK, th, q, v, closed, reg, acc,
+            self.max_steps - self._macro, self._block_steps, th, q, v, closed, reg, acc,
             self._pending_initial, self._lcp_ctl, *buf, st, cnt)
         if nrec:
             self._blocks.append(tuple(b[:nrec].copy() for b in buf))
