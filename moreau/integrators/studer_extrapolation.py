@@ -8,41 +8,82 @@ shrinking the step.
 The base step (Moreau's midpoint rule)
 --------------------------------------
 From ``(t, q, v)`` over ``h``: the midpoint ``t_M = t + h/2``,
-``q_M = q + (h/2) v``, the contacts closed at the midpoint
-(``g(q_M, t_M) <= 0``) form the index set, and::
+``q_M = q + (h/2) v``, and::
 
-    M(q_M) (v+ - v) = h h(q_M, v, t_M) + H^T P
+    M(q_M) (v+ - v) = h h(q_M, v, t_M) + H_M^T P
     q+ = q_M + (h/2) v+
 
-with Newton's impact law and 2D Coulomb friction on
-``U = H(q_M, t_M) v+ + w(t_M)`` (the problem of
-:func:`~moreau.integrators.contact_problem.solve_contact_problem`). It is
-first order, and in a phase where the contact configuration (the closed
-contacts and their stick/slip regimes) does not change, a smooth one-step
-method whose global error has an expansion in powers of ``h``.
+with Newton's impact law and 2D Coulomb friction (the problem of
+:func:`~moreau.integrators.contact_problem.solve_contact_problem`) on the
+local velocities at the step's end, ``U = H_E v+ + w_E``, where ``H_M`` are
+the contact rows at ``(q_M, t_M)`` and ``H_E, w_E`` those at the predicted
+end ``(q + h v, t + h)``. Three choices make the base step a smooth
+one-step map inside a contact configuration, which extrapolation needs:
+
+* *Index set.* A contact that carried a force in the last base step stays
+  in the index set while its force is positive; another one enters when its
+  midpoint gap is ``<= 0``. (With the gap test alone a persistent contact
+  under a curved constraint, the friction drive's stator near its top, has a
+  midpoint gap of ``O(h^2)`` and either sign, and the index set flickered:
+  the run from the steady state's section at ``tau = pi`` stalled at tol
+  1e-4.) Newton's law acts on a closing contact only (``e = 0`` on one that
+  stays closed).
+* *Rows at the end.* With ``U`` measured by the midpoint rows, a velocity
+  that satisfies the constraint at ``t`` gives the first base step a force
+  wrong by ``O(1)`` (half the constraint's curvature); the friction drive's
+  normal force falls to 3.7e-4 of its peak, where that error lifted the rod
+  off and the run crawled through thousands of steps. Measured at the end,
+  the force of every base step is ``O(h)`` right.
+* *Projection.* An accepted state has the contacts that carry a force put
+  back on ``g = 0`` and ``WN v + wN = 0`` (Newton steps in the metric of
+  ``M``): the extrapolated state satisfies them only to the tolerance.
+
+The base step is second order in a smooth phase of the friction drive
+(its forces do not depend on the velocity), first order in general.
 
 Step-size adjustment and extrapolation
 --------------------------------------
 A macro step of size ``H`` is taken with ``n_j = 1, 2, ..., K`` base steps
 (``K = columns``), giving ``T_{j,1}``. When every base step of every
-sequence sees the configuration of the first (no impact, no contact closing
-or opening, no stick/slip change), the step lies in a smooth phase and the
-Aitken–Neville table ::
+sequence keeps the regimes (flight, slip direction, stick) the last
+accepted step ended in and none closes a contact, the step lies in a smooth
+phase and the Aitken–Neville table ::
 
     T_{j,k} = T_{j,k-1} + (T_{j,k-1} - T_{j-1,k-1}) / (n_j / n_{j-k+1} - 1)
 
-extrapolates to order ``K``; the local error is estimated by
-``|T_{K,K} - T_{K,K-1}|``. Otherwise the step is non-smooth: the error of
-the two-step result ``T_{2,1}`` is estimated by ``|T_{2,1} - T_{1,1}|``
-(step halving) and ``T_{2,1}`` is kept. The error is measured as
+extrapolates to order ``K`` (for an error expansion in every power of
+``h``); the local error is estimated by ``|T_{K,K} - T_{K,K-1}|``.
+Otherwise the step is non-smooth: the error of the two-step result
+``T_{2,1}`` is estimated by ``|T_{2,1} - T_{1,1}|`` (step halving) and
+``T_{2,1}`` is kept. The error is measured as
 ``max |dy| / (tol (1 + |y|))`` over positions and velocities. A step is
 accepted when that is ``<= 1`` (or when ``H`` has reached ``h_min``,
 counted in ``stats["forced_steps"]``), and the next step is
 ``H * min(4, max(0.1, 0.9 err^(-1/(p+1))))`` with ``p = K`` in smooth phases
-and ``p = 1`` otherwise. A switching point (an impact or a change of
-regime) inside a step makes the halving error ``O(H)``, so the step shrinks
-around it until the error allows: that is how the switching points are
-located, to a time accuracy that follows ``tol``.
+and ``p = 1`` otherwise.
+
+Switching points
+----------------
+An impact inside a step makes the halving error ``O(H)``, so the step
+shrinks around it until the error allows; a contact that the midpoint step
+crosses unseen (open at the midpoint, closed at the end) has the step
+refused and quartered. A switch of the regimes without an impulse (a slip
+reversal, a stick, a lift-off) that falls in the first base step of every
+sequence is invisible to the halving: every sequence takes the new regime
+from its first step on. Such a step is located by the jump of the
+acceleration: with ``a_old`` the last accepted step's mean acceleration and
+``a_new`` that of ``T_{1,1}``, the velocities carry an error
+``|a_new - a_old| H``, which enters the error estimate (with ``p = 0``).
+Without that the friction drive's error stalled at 1e-3 for any tolerance.
+
+On a scene with a compiled model the macro steps run in
+:mod:`moreau.integrators._studer_kernels` (the same step, equal to the
+Python one to 1e-12 from the same state and step size).
+
+Measured (one period of the friction drive at 185 Hz from the walker's
+orbit, relative error of the displacement): 6.0e-3, 9.7e-6, 5.0e-7, 6.7e-8 at
+tol 1e-4, 1e-6, 1e-8, 1e-10 (767 base steps at 1e-8); the compiled loop
+takes about 1.4 ms for that period at tol 1e-9 (937 base steps).
 """
 
 import math
