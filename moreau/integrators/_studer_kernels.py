@@ -233,16 +233,18 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                         have_Mi = False
                     switch = False
                     miss = False
-                    if nc > 0:
+                    if na < nc:
+                        # only a contact open at the midpoint can be crossed unseen
                         if HAS_GAPS:  # noqa: F821
                             gaps_fn(par, qs, tb + hb, G1)  # noqa: F821
                         else:
                             contacts_fn(par, qs, tb + hb, G1, True, False)  # noqa: F821
+                        for c in range(nc):
+                            if G1[c, 0] < 0.0 and not act[c]:
+                                miss = True
                     for c in range(nc):
                         if pN[c] > 0.0 and not cl[c]:
                             switch = True
-                        if G1[c, 0] < 0.0 and not act[c]:
-                            miss = True
                         reg[c] = _classify(pN[c], pT[c], mu[c])
                         cl[c] = pN[c] > 0.0
                         sq_pN[j - 1, c] += pN[c]

@@ -132,6 +132,11 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         Smallest macro step (default: ``1e-12 (t_bound - t0)``); a step that
         meets no tolerance at ``h_min`` is accepted and counted.
     lcp_method : {"auto", "lemke", "qp"}
+    fast : {"auto", True, False}
+        Run the compiled loop (:mod:`moreau.integrators._studer_kernels`, the
+        same macro step) on a scene with a ``compiled_model()``; ``"auto"``
+        does so unless ``lcp_method="qp"``. A macro step whose contact problem
+        Lemke cannot solve is taken by the Python step (QP fallback).
     max_steps : int
         Bound on the macro steps (accepted and rejected) of the run.
 

@@ -72,6 +72,8 @@ def test_smooth_phases_are_extrapolated_to_the_order_of_the_columns():
     ({"h0": -1.0}, "`h0` must be"),
     ({"h_min": 0.0}, "`h_min` must be"),
     ({"lcp_method": "pgs"}, "`lcp_method` must be one of"),
+    ({"fast": "yes"}, "`fast` must be 'auto', True or False"),
+    ({"fast": True}, "`fast=True` needs a scene with a compiled model"),
     ({"h": 1e-3}, "`h` is not an option of scheme 'studer-extrapolation'"),
 ])
 def test_bad_options_are_refused_by_name(options, message):
