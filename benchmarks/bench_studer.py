@@ -1,4 +1,4 @@
-"""Studer's scheme against the event-driven walker on the friction drive's steady state, and its speed.
+"""Studer's scheme against the walker on the friction drive's steady state, and its speed.
 
 The goal of issue 18: on the friction drive's steady state at 185 Hz and
 2000 Hz, the fastest time-stepping scheme reaches a relative error of 1e-6

@@ -18,8 +18,8 @@ import math
 
 import numpy as np
 
-from ._mj_kernels import (LCP_HANDBACK, OK, PAINLEVE, S_PEN, SINGULAR,  # noqa: F401
-                          _classify, _invert_gj, _invert_small, lcp_buffers, record_sample)
+from ._mj_kernels import (OK, S_PEN, SINGULAR, _classify, _invert_gj, _invert_small, lcp_buffers,
+                          record_sample)
 from ._tdg_kernels import _solve_small, _stage_problem
 
 __all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY"]
@@ -43,8 +43,9 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     state, updated in place. ``budget`` bounds the macro steps tried. One
     sample is recorded per accepted step (and the start with
     ``record_initial``). Returns ``(status, accepted, samples)``. On
-    :data:`LCP_HANDBACK` or :data:`PAINLEVE` the state is the start of the
-    macro step that failed; the caller takes that step in Python.
+    ``LCP_HANDBACK`` or ``PAINLEVE`` (:mod:`moreau.integrators._mj_kernels`) the
+    state is the start of the macro step that failed; the caller takes that
+    step in Python.
     """
     n = NDOF  # noqa: F821  (the model's namespace)
     nc = NCONTACTS  # noqa: F821

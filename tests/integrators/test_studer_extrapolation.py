@@ -40,7 +40,9 @@ def test_bouncing_ball_impacts_are_located_to_the_tolerance():
     qx, vx = ball.exact_solution(np.array([2.0]), q0, v0)
 
     def run(tol):
-        r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=tol)
+        # the Python step (the compiled loop is held to it on the friction drive): one
+        # compile less in the suite
+        r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=tol, fast=False)
         assert r.stats["forced_steps"] == 0
         return max(abs(r.q[-1, 0] - qx[0, 0]), abs(r.v[-1, 0] - vx[0, 0]))
     # measured 6.9e-5, 4.4e-7, 4.7e-9, 3.7e-11 (Moreau-Jean at h = 1e-4: 1.6e-4)
@@ -122,7 +124,8 @@ def test_compiled_loop_equals_the_python_step():
         before = (a.counters["smooth_steps"], a.counters["rejected_steps"])
         a.step()
         b.step()
-        kinds.add((a.counters["smooth_steps"] - before[0], a.counters["rejected_steps"] > before[1]))
+        kinds.add((a.counters["smooth_steps"] - before[0],
+                   a.counters["rejected_steps"] > before[1]))
         assert abs(a.t - b.t) <= 1e-12
         np.testing.assert_allclose(a.q, b.q, rtol=0.0, atol=1e-12)
         np.testing.assert_allclose(a.v, b.v, rtol=0.0, atol=1e-12)
@@ -130,13 +133,3 @@ def test_compiled_loop_equals_the_python_step():
     assert a.status == "finished"
     # smooth and switching steps, with and without rejections
     assert kinds == {(0, False), (0, True), (1, False), (1, True)}, kinds
-
-
-def test_compiled_loop_on_the_bouncing_ball_equals_the_python_step():
-    ball = make_scene("bouncing-ball", restitution=0.5)
-    q0, v0 = ball.initial_state()
-    a = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=1e-9, fast=True)
-    b = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=1e-9, fast=False)
-    assert a.stats["steps"] == b.stats["steps"] and a.stats["base_steps"] == b.stats["base_steps"]
-    np.testing.assert_allclose(a.q, b.q, rtol=0.0, atol=1e-12)
-    np.testing.assert_allclose(a.v, b.v, rtol=0.0, atol=1e-12)
