@@ -20,6 +20,7 @@ period map: the generic event-driven reference, or Moreau–Jean (where the
 map is that of the discrete scheme).
 """
 
+import inspect
 import math
 import time
 
@@ -225,6 +226,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     opts = period_map_options(scheme, {**options, **(scheme_options or {})})
     check_options(scheme, opts, scene)
     takes = options_of(get_integrator(scheme)) or ()
+    fd_rel = _difference_step(get_integrator(scheme), opts)
     ts = float(section_tau)
     if q0 is None or v0 is None:
         if not hasattr(scene, "rest_state"):
@@ -298,7 +300,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         J = None
         if it <= max_iter:
             J = period_map_jacobian(lambda zz: residual(*state(zz, base))[0], z,
-                                    1e-7 * np.maximum(vscale, np.abs(z)), f0=r, central=False)
+                                    fd_rel * np.maximum(vscale, np.abs(z)), f0=r, central=False)
         # a time-stepping scheme's period map is only piecewise smooth (its index set
         # changes on the grid): on a flat step of the map (slope of P - I about 0 in
         # a one-dimensional free space) Newton is blind, and it may stall anyway
@@ -352,7 +354,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     multipliers = None
     if floquet:
         # the residual's Jacobian in the free directions is B^T DP B - I (orthonormal bases)
-        fd = 2.0 * math.sqrt(opts["h"]) if "h" in opts else 1e-6
+        fd = 2.0 * math.sqrt(opts["h"]) if "h" in opts else max(1e-6, fd_rel)
         Jr = period_map_jacobian(lambda zz: residual(*state(zz, (qs, vs)))[0],
                                  np.zeros(z.size), fd * vscale)
         multipliers = sorted_multipliers(np.linalg.eigvals(Jr + np.eye(z.size)))
@@ -386,6 +388,23 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         floquet_method="finite-differences" if floquet else "",
         period=periods,
     )
+
+
+def _difference_step(cls, opts):
+    """Relative step of the period map's finite differences for scheme class ``cls``.
+
+    ``1e-7``; for a scheme with an error tolerance (a class attribute
+    ``error_tolerance_option`` names the option), ``sqrt(tol)`` where that is
+    larger: its step sequence changes with the start, so its map is smooth
+    only on scales above its tolerance, and a narrower difference reads the
+    noise (Studer's scheme at 2000 Hz: a slope of P - I of 7e-3 under noise
+    of 1e-10 at a difference of 1e-10).
+    """
+    name = getattr(cls, "error_tolerance_option", None)
+    if not name:
+        return 1e-7
+    tol = opts.get(name, inspect.signature(cls.__init__).parameters[name].default)
+    return max(1e-7, math.sqrt(float(tol)))
 
 
 def _iterate_period_map(period, q, v, cyclic, Bq, Bv, tol, max_periods, why, vscale):

@@ -41,7 +41,8 @@ log = logging.getLogger(__name__)
 
 #: the schemes' names of the loop templates, for the compile note
 SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
-                      "nsga_loop": "nonsmooth generalized-alpha"}
+                      "nsga_loop": "nonsmooth generalized-alpha",
+                      "studer_loop": "Studer extrapolation"}
 #: what a first compile takes (README: 16-19 s for the first scene with Lemke and
 #: the QP path, 5-10 s for each later one)
 COMPILE_SECONDS = "5-20"

@@ -3,8 +3,10 @@
 import numpy as np
 import pytest
 
+from moreau.analysis.period_k import full_state_of
+from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
-from moreau.integrators import simulate
+from moreau.integrators import get_integrator, simulate
 from moreau.scenes.registry import make_scene
 
 from _toy_scenes import Block, Oscillator
@@ -38,7 +40,9 @@ def test_bouncing_ball_impacts_are_located_to_the_tolerance():
     qx, vx = ball.exact_solution(np.array([2.0]), q0, v0)
 
     def run(tol):
-        r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=tol)
+        # the Python step (the compiled loop is held to it on the friction drive): one
+        # compile less in the suite
+        r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=tol, fast=False)
         assert r.stats["forced_steps"] == 0
         return max(abs(r.q[-1, 0] - qx[0, 0]), abs(r.v[-1, 0] - vx[0, 0]))
     # measured 6.9e-5, 4.4e-7, 4.7e-9, 3.7e-11 (Moreau-Jean at h = 1e-4: 1.6e-4)
@@ -70,9 +74,62 @@ def test_smooth_phases_are_extrapolated_to_the_order_of_the_columns():
     ({"h0": -1.0}, "`h0` must be"),
     ({"h_min": 0.0}, "`h_min` must be"),
     ({"lcp_method": "pgs"}, "`lcp_method` must be one of"),
+    ({"fast": "yes"}, "`fast` must be 'auto', True or False"),
+    ({"fast": True}, "`fast=True` needs a scene with a compiled model"),
     ({"h": 1e-3}, "`h` is not an option of scheme 'studer-extrapolation'"),
 ])
 def test_bad_options_are_refused_by_name(options, message):
     with pytest.raises(InputError) as err:
         simulate(Block(), (0.0, 1.0), [0.0, 0.0], [1.0, 0.0], NAME, **options)
     assert message in str(err.value)
+
+
+def _friction_drive_orbit(frequency=185.0):
+    # the walker's periodic orbit: the state at its section, and one period later
+    sc = make_scene("friction-drive", frequency=frequency)
+    ss = find_steady_state(sc, rtol=1e-13, statistical=False)
+    q0, v0 = full_state_of(sc, ss.state0)
+    ts = ss.section_tau
+    ref = simulate(sc, (ts, ts + 2.0 * np.pi), q0, v0, "event-driven", rtol=1e-13)
+    return sc, (ts, ts + 2.0 * np.pi), q0, v0, ref, ss.displacement_per_period
+
+
+def test_friction_drive_error_falls_with_the_tolerance():
+    # one period from the orbit: continuous contact, two slip reversals and a normal
+    # force that falls to 3.7e-4 of its peak (where a first-order force lifts off)
+    sc, span, q0, v0, ref, disp = _friction_drive_orbit()
+
+    def run(tol):
+        r = simulate(sc, span, q0, v0, NAME, tol=tol)
+        assert r.success and r.stats["forced_steps"] == 0
+        return abs(r.q[-1, 1] - ref.q[-1, 1]) / abs(disp)
+    errs = _errors(run)
+    # measured 6.0e-3, 9.7e-6, 5.0e-7, 6.7e-8 (relative to the displacement 6.6e-3)
+    assert all(b < a for a, b in zip(errs, errs[1:])), errs
+    assert errs[-1] < 3e-7, errs
+
+
+def test_compiled_loop_equals_the_python_step():
+    # step by step from the same state and step size (a whole run drifts apart: the
+    # next step size follows an error estimate that is a difference near rounding)
+    sc, (ts, _), q0, v0, _, _ = _friction_drive_orbit()
+    a = get_integrator(NAME)(sc, ts, q0, v0, ts + 2.0 * np.pi, tol=1e-8, fast=True)
+    b = get_integrator(NAME)(sc, ts, q0, v0, ts + 2.0 * np.pi, tol=1e-8, fast=False)
+    a._block_steps = 1
+    kinds = set()
+    while a.status == "running":
+        b.t, b.q, b.v, b.h = a.t, a.q.copy(), a.v.copy(), a.h
+        b._closed, b._last_reg = a._closed.copy(), a._last_reg.copy()
+        b._acc = None if a._acc is None else a._acc.copy()
+        before = (a.counters["smooth_steps"], a.counters["rejected_steps"])
+        a.step()
+        b.step()
+        kinds.add((a.counters["smooth_steps"] - before[0],
+                   a.counters["rejected_steps"] > before[1]))
+        assert abs(a.t - b.t) <= 1e-12
+        np.testing.assert_allclose(a.q, b.q, rtol=0.0, atol=1e-12)
+        np.testing.assert_allclose(a.v, b.v, rtol=0.0, atol=1e-12)
+        assert np.array_equal(a._last_reg, b._last_reg)
+    assert a.status == "finished"
+    # smooth and switching steps, with and without rejections
+    assert kinds == {(0, False), (0, True), (1, False), (1, True)}, kinds
