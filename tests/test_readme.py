@@ -172,8 +172,12 @@ COMMANDS = {
     'moreau compare --scene sliding-box --set speed=2 --set mu=0.3':
         (["moreau compare --scene sliding-box --set speed=2 --set mu=0.3 --quick"],
          ["out/compare_sliding-box.csv", "out/compare_sliding-box.png"]),
+    # the map's first three columns: every other scheme's column on all 17 cases took 82 %
+    # of the command's time (and grows with each new scheme) while nothing here reads the
+    # rows; tests/test_stress.py holds every column's outcome, the default columns included
     'moreau compare --stress [--quick]':
-        (["moreau compare --stress --quick"], ["out/stress.csv", "out/stress.json"]),
+        (["moreau compare --stress --quick --schemes event-driven,mj-1,mj-1/2"],
+         ["out/stress.csv", "out/stress.json"]),
     'moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45':
         (["moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45 "
           "--quick"], ["out/compare_bouncing-ball.csv", "out/compare_bouncing-ball.json"]),

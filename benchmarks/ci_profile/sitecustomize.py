@@ -1,0 +1,46 @@
+"""Log every numba compile of every Python process, for profiling the test suite's cold start.
+
+Not part of the package: put this folder first on ``PYTHONPATH`` and name a log folder::
+
+    PYTHONPATH=benchmarks/ci_profile MOREAU_COMPILE_LOG=/tmp/clog bash .ci/run
+    python benchmarks/ci_profile/summarize.py /tmp/clog
+
+Python imports ``sitecustomize`` at start-up, so the xdist workers and the
+processes the tests start (README commands, notebooks) are all logged. One JSON
+line per compile (a disk-cache load is not a compile), written at once into
+``<pid>.jsonl``: the function, its argument types, wall and CPU seconds, the
+nesting depth and the test running (``PYTEST_CURRENT_TEST``, which child
+processes inherit).
+"""
+
+import json
+import os
+import sys
+import time
+
+LOG_DIR = os.environ.get("MOREAU_COMPILE_LOG")
+
+if LOG_DIR:
+    from numba.core import event
+
+    class CompileLog(event.Listener):
+        def __init__(self):
+            self.started = []
+
+        def on_start(self, ev):
+            self.started.append((time.perf_counter(), time.process_time()))
+
+        def on_end(self, ev):
+            wall0, cpu0 = self.started.pop()
+            data = ev.data or {}
+            py = getattr(data.get("dispatcher"), "py_func", None)
+            rec = {"pid": os.getpid(), "test": os.environ.get("PYTEST_CURRENT_TEST", ""),
+                   "argv": " ".join(sys.argv[:4])[:200],
+                   "fn": f"{getattr(py, '__module__', '?')}:{getattr(py, '__qualname__', '?')}",
+                   "args": str(data.get("args"))[:300], "wall": time.perf_counter() - wall0,
+                   "cpu": time.process_time() - cpu0, "depth": len(self.started),
+                   "t": time.time()}
+            with open(os.path.join(LOG_DIR, f"{os.getpid()}.jsonl"), "a") as fh:
+                fh.write(json.dumps(rec) + "\n")
+
+    event.register("numba:compile", CompileLog())
