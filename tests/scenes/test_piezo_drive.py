@@ -249,3 +249,22 @@ def test_near_resonance_the_motor_speed_follows_the_stroke():
     # the rotor in short flights, which the prescribed drive does not know
     for stroke, _, ratio, mode in (rows[0], rows[2]):
         assert mode == "NP" and abs(ratio - 1.0) < 0.05
+
+
+@pytest.mark.parametrize("kw, message", [
+    (dict(k1=-1.0), "`k1` must be > 0"),
+    (dict(gain=math.nan), "`gain` must be finite"),
+    (dict(c1=-0.1), "`c1` must be >= 0"),
+    (dict(alpha=1.0), r"`alpha` must be in \[0, 1\)"),
+    (dict(gamma=0.03), r"`gamma` must satisfy \|gamma\| <= beta"),
+    (dict(beta=0.0), "`beta` must be > 0"),
+    (dict(u_sat=-5.0), "`u_sat` must be > 0"),
+    (dict(preload=-1e-6), "`preload` must be >= 0"),
+    (dict(waveform="sawtooth"), "`waveform` must be one of 'sine', 'triangle', 'square'"),
+    (dict(smoothing=1.0), "`smoothing` must be in the open interval"),
+    (dict(stator="soft"), "`stator` must be 'dynamic' or 'rigid'"),
+    (dict(gain=2e-5), "the stack's free stroke .* must be < length"),
+])
+def test_bad_parameters_raise_named_errors(kw, message):
+    with pytest.raises(InputError, match=message):
+        PiezoDrive(**kw)
