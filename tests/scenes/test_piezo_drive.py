@@ -88,12 +88,12 @@ def _shoelace(U, x):
 def test_loop_area_against_the_integrated_bouc_wen_ode(u_sat):
     s = PiezoDrive(u_sat=u_sat)
     p = s.params
-    U, x = bouc_wen_loop(p.gain, p.alpha, p.beta, p.gamma, u_sat, p.voltage)
+    U, x = bouc_wen_loop(p.gain, p.alpha, p.beta, p.gamma, u_sat, p.voltage, n=16000)
     area = _shoelace(U, x)
-    # 4000 samples: the polygon misses O(n^-2) of the area
-    assert abs(s.loop_area() - area) <= 2e-6 * area
+    # the polygon misses O(n^-2) of the area: measured 4.1e-7 at n = 4000, 2.6e-8 at 16000
+    assert abs(s.loop_area() - area) <= 1e-7 * area
     # the loop itself, up to the offset taken out at U = 0
-    Us, xs = s.hysteresis_loop(4001)
+    Us, xs = s.hysteresis_loop(16001)
     assert np.allclose(Us, U, rtol=0, atol=1e-9)
     assert np.max(np.abs((xs - xs[0]) - (x - x[0]))) <= 1e-9 * s.stroke()
     # a real hysteresis: the area is several per cent of stroke x voltage
@@ -167,23 +167,27 @@ def test_identification_recovers_the_parameters_of_a_synthetic_loop(u_sat):
     U, x = bouc_wen_loop(TRUE["gain"], TRUE["alpha"], TRUE["beta"], TRUE["gamma"], u_sat, 120.0,
                          n=300)
     fit = identify_hysteresis(U[:-1], x[:-1] + 3e-7, u_sat=u_sat)
+    # measured: every parameter to 2e-12 or better
     for key, value in TRUE.items():
-        assert abs(getattr(fit, key) - value) <= 1e-6 * abs(value), (key, getattr(fit, key))
-    assert abs(fit.offset - 3e-7) <= 1e-12
-    assert fit.rms_residual <= 1e-14
+        assert abs(getattr(fit, key) - value) <= 1e-9 * abs(value), (key, getattr(fit, key))
+    assert abs(fit.offset - 3e-7) <= 1e-15
+    assert fit.rms_residual <= 1e-17
 
 
 def test_identification_fits_the_saturation_and_tolerates_noise():
     U, x = bouc_wen_loop(TRUE["gain"], TRUE["alpha"], TRUE["beta"], TRUE["gamma"], 150.0, 200.0,
                          n=400)
     fit = identify_hysteresis(U[:-1], x[:-1], u_sat="fit")
-    assert abs(fit.u_sat - 150.0) <= 1e-4 * 150.0
-    assert abs(fit.alpha - TRUE["alpha"]) <= 1e-4 * TRUE["alpha"]
+    # measured: u_sat to 5e-12, the others to 2e-10
+    assert abs(fit.u_sat - 150.0) <= 1e-8 * 150.0
+    for key, value in TRUE.items():
+        assert abs(getattr(fit, key) - value) <= 1e-7 * abs(value), (key, getattr(fit, key))
     rng = np.random.default_rng(7)
     noisy = x[:-1] + rng.normal(0.0, 1e-3 * np.ptp(x), x.size - 1)
     fit = identify_hysteresis(U[:-1], noisy, u_sat=150.0)
+    # 0.1 % noise: measured within 1.2 % (beta), the others within 0.4 %
     for key, value in TRUE.items():
-        assert abs(getattr(fit, key) - value) <= 0.05 * abs(value), (key, getattr(fit, key))
+        assert abs(getattr(fit, key) - value) <= 0.03 * abs(value), (key, getattr(fit, key))
 
 
 def test_identification_refuses_bad_input():
