@@ -5,6 +5,7 @@ Independent computations: the Bouc–Wen ODE integrated in time by
 forms), the prescribed-displacement friction drive, finite differences.
 """
 
+import csv
 import math
 
 import numpy as np
@@ -18,6 +19,7 @@ from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes.friction_drive import FrictionDrive
 from moreau.scenes.piezo_drive import PiezoDrive, identify_hysteresis
+from moreau.studies.piezo import loop_and_resonance as study
 
 TWO_PI = 2.0 * math.pi
 
@@ -285,3 +287,16 @@ def test_rigid_linear_stack_steady_state_equals_the_walkers():
     assert a.mode == b.mode == "NP"
     assert abs(a.displacement_per_period - b.displacement_per_period) <= 1e-9 * abs(
         b.displacement_per_period)
+
+
+def test_the_loop_and_resonance_study_writes_its_tables(tmp_path):
+    assert study.main([str(tmp_path), "--points", "2", "--no-plot"]) == 0
+    with open(tmp_path / "piezo_resonance.csv") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [float(r["frequency_Hz"]) for r in rows] == [1000.0, 3000.0]
+    # below resonance the stator moves more than far above it
+    assert float(rows[0]["stroke_m"]) > float(rows[1]["stroke_m"]) > 0.0
+    loops = (tmp_path / "piezo_loop.csv").read_text().splitlines()
+    assert loops[0] == "peak_voltage [V],U [V],x [m]" and len(loops) == 1 + 4 * 401
+    with pytest.raises(InputError, match="`out` already holds"):
+        study.main([str(tmp_path), "--points", "2", "--no-plot"])
