@@ -76,6 +76,15 @@ With ``alpha = 0`` (no hysteresis), ``u_sat = inf``, no preload and a sine,
 The paper's drive touches the rotor without force at the bottom of the
 stroke; a compliant stator then leaves the rotor there in brief flights
 every period. The preload (1 µm by default) keeps the tip pressed on.
+
+Identification and limits
+-------------------------
+:func:`identify_hysteresis` fits ``d, alpha, beta, gamma`` (and the offset,
+optionally ``U_sat``) to a measured loop by ``scipy.optimize.least_squares``,
+the model evaluated exactly along the samples from the state the loop
+returns to. The scene's waveforms rise once and fall once per period, so
+the loop has no minor loops; the hysteresis depends on the voltage alone
+(the stack's force does not feed back into ``h``), as in Low and Guo's model.
 """
 
 import math
@@ -340,7 +349,7 @@ class PiezoDrive(DriveUnits, Scene):
 
     Examples
     --------
-    >>> s = PiezoDrive(frequency=1000.0)
+    >>> s = PiezoDrive(frequency=1400.0)
     >>> s.ndof, s.ncontacts, round(s.resonance_hz(), -1)
     (3, 1, 2000.0)
     >>> q0, v0 = s.initial_state()
@@ -353,7 +362,7 @@ class PiezoDrive(DriveUnits, Scene):
     cyclic_coordinates = (1,)
     angle_coordinates = (0,)
 
-    def __init__(self, params=None, frequency=1000.0, waveform="sine", smoothing=0.2,
+    def __init__(self, params=None, frequency=1400.0, waveform="sine", smoothing=0.2,
                  stator="dynamic", **overrides):
         self.params = p = params_with(PiezoDriveParams, params, overrides)
         self.frequency = V.positive("frequency", frequency)
@@ -745,7 +754,7 @@ register_scene(SceneEntry(
     name="piezo-drive",
     factory=PiezoDrive,
     parameters=parameters_of(PiezoDriveParams, UNITS, extra=(
-        Parameter("frequency", "Hz", 1000.0, "drive frequency"),
+        Parameter("frequency", "Hz", 1400.0, "drive frequency"),
         Parameter("waveform", "choice", "sine", "voltage waveform: sine, triangle or square"),
         Parameter("smoothing", "", 0.2, "triangle corner / square edge smoothing, in (0, 1)"),
         Parameter("stator", "choice", "dynamic", "dynamic (mass-spring-damper) or rigid"))),
