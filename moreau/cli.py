@@ -14,7 +14,7 @@ from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
 from .analysis.atlas import run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
-from .analysis.characteristic import motor_characteristic
+from .analysis.characteristic import efficiency_vs_frequency, motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
@@ -195,8 +195,12 @@ def _cmd_characteristic(args):
     frequency = params.pop("frequency", None)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
                          args.scheme_options)
+    if args.efficiency_vs_frequency is not None:
+        _efficiency_vs_frequency(args, entry, params, frequency, scheme)
+        return
     ch = motor_characteristic(entry.name, frequency=frequency, fixed=params, scheme=scheme,
-                              points=args.points, out=args.out, plot=not args.no_plot,
+                              points=41 if args.points is None else args.points, out=args.out,
+                              plot=not args.no_plot,
                               log=(lambda s: None) if args.json else print)
     s = ch["summary"]
     if args.json:
@@ -210,6 +214,27 @@ def _cmd_characteristic(args):
           f"{s['load_at_max_power_N']:.9e} N")
     print(f"  load convention        {s['load_convention']}")
     print(f"  beyond stall           {s['reversal']}")
+
+
+def _efficiency_vs_frequency(args, entry, params, frequency, scheme):
+    if frequency is not None:
+        raise InputError("`--frequency` and `--efficiency-vs-frequency` exclude each other: "
+                         "the frequencies are the latter's values")
+    points = 9 if args.points is None else args.points
+    d = efficiency_vs_frequency(entry.name, args.efficiency_vs_frequency, fixed=params,
+                                scheme=scheme, points=points, out=args.out,
+                                plot=not args.no_plot, log=(lambda s: None) if args.json else print)
+    if args.json:
+        print(json.dumps(d, default=str))
+        return
+    print(f"{entry.name} ({scheme.name}): efficiency at the load of maximum output power")
+    print(f"  {'f [Hz]':>10} {'load [N]':>14} {'P_out [W]':>14} {'P_in [W]':>14} {'efficiency':>11}")
+    for r in d["rows"]:
+        if r["status"] != "ok":
+            print(f"  {r['frequency_Hz']:>10g}  {r['status']}")
+            continue
+        print(f"  {r['frequency_Hz']:>10g} {r['load_at_max_power_N']:>14.6e} "
+              f"{r['max_power_W']:>14.6e} {r['input_power_W']:>14.6e} {r['efficiency']:>11.6f}")
 
 
 def _cmd_bifurcation(args):
@@ -619,8 +644,13 @@ def build_parser():
                                                "(CSV, JSON sidecar, figure)")
     ch.add_argument("--frequency", type=float, default=None,
                     help="drive frequency [Hz] (default: the scene's)")
-    ch.add_argument("--points", type=int, default=41,
-                    help="loads from no load to 1.25 times the stall force (default 41)")
+    ch.add_argument("--points", type=int, default=None,
+                    help="loads from no load to 1.25 times the stall force (default 41; 9 with "
+                         "--efficiency-vs-frequency, where Brent's method refines the maximum)")
+    ch.add_argument("--efficiency-vs-frequency", type=float, nargs="+", default=None,
+                    metavar="F",
+                    help="instead of one characteristic: the efficiency at the load of maximum "
+                         "output power at each of these frequencies [Hz] (CSV, JSON, figure)")
     ch.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     ch.add_argument("--out", default="out", help="output folder (default ./out)")
     ch.add_argument("--no-plot", action="store_true", help="skip the figure")

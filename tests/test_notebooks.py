@@ -19,9 +19,13 @@ assert abs(res.v[-1, 1] - res.v[0, 1]) <= 1e-9 * abs(res.v[0, 1])
     "friction_drive_tour.ipynb": """
 assert len(rows) == 15 and all(r["status"] == "ok" for r in rows)
 assert atlas["label"].shape == (14, 8)
+assert not out.exists()     # the tour removed its temporary folder
 """,
     "scheme_comparison.ipynb": """
 assert {r["scheme"] for r in report["rows"]} == {"event-driven", "moreau-jean"}
+# the time histories: every scheme on the same t_eval, within a small distance of the reference
+assert len(runs) >= 4 and all(r.status == 0 and np.array_equal(r.t, t_eval) for r in runs.values())
+assert all(np.max(np.abs(r.q[:, 1] - ref.q[:, 1])) < 1e-3 for r in runs.values())
 """,
     "your_own_scene.ipynb": """
 assert report.ok and not moreau.check_scene(Broken()).ok
@@ -45,6 +49,10 @@ def test_notebook_runs(path, monkeypatch, tmp_path):
     for cell in nb.cells:
         if cell.cell_type == "code":
             assert not cell.outputs and cell.execution_count is None, f"{path.name}: strip outputs"
+            # a notebook shows figures drawn from returned data, not pictures saved on disk
+            assert "Image(" not in cell.source and ".png" not in cell.source, path.name
+        # every cell has an id (nbformat 4.5; a missing one is a warning today, an error later)
+        assert cell.get("id"), f"{path.name}: a cell without an id"
     if path.name in AFTER:
         nb.cells.append(nbformat.v4.new_code_cell(AFTER[path.name]))
     # the kernel imports the package from this checkout even where it is not installed

@@ -72,6 +72,11 @@ COMMANDS = {
          ["out/characteristic_friction-drive_185Hz_event-driven.csv",
           "out/characteristic_friction-drive_185Hz_event-driven.json",
           "out/characteristic_friction-drive_185Hz_event-driven.png"]),
+    'moreau characteristic --efficiency-vs-frequency 20 185 2000':
+        (["moreau characteristic --efficiency-vs-frequency 2000 --points 3 --json"],
+         ["out/efficiency_friction-drive_2000-2000Hz_event-driven.csv",
+          "out/efficiency_friction-drive_2000-2000Hz_event-driven.json",
+          "out/efficiency_friction-drive_2000-2000Hz_event-driven.png"]),
     'moreau bifurcation frequency 1e4 5e4 --points 24 --set restitution=1':
         (["moreau bifurcation frequency 1e4 5e4 --points 2 --transient 5 --samples 3 "
           "--set restitution=1 --quiet"],

@@ -25,7 +25,16 @@ pushed back through the slipping contact); those rows say so in their
 away (no steady state), which the rows report as their ``status``.
 
 With an energy audit (:mod:`moreau.analysis.energy`) each row also has the
-stators' input power and the efficiency ``P / P_in``.
+stators' input power and the efficiency ``P / P_in``, and the summary the
+efficiency at the load of maximum output power.
+
+Efficiency against frequency
+  :func:`efficiency_vs_frequency` (``moreau characteristic
+  --efficiency-vs-frequency F1 F2 ...``) traces the characteristic at each
+  frequency and reports the efficiency at the load of maximum output power
+  there (the operating point a designer sizes the motor for; at no load and
+  at stall the output power, hence the efficiency, is zero): ``eta = F* v(F*)
+  / P_in(F*)``, ``P_in`` the stators' mean input power from the energy audit.
 
 Examples
 --------
@@ -52,7 +61,8 @@ from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import ED_REFERENCE, steady_of
 from .steady_state import implausible_steady_state
 
-__all__ = ["motor_characteristic", "characteristic_tag", "COLUMNS", "MAX_POINTS"]
+__all__ = ["motor_characteristic", "characteristic_tag", "efficiency_vs_frequency",
+           "COLUMNS", "EFFICIENCY_COLUMNS", "MAX_POINTS"]
 
 #: bound on the grid of one characteristic (each point a steady state)
 MAX_POINTS = 10**4
@@ -60,6 +70,12 @@ MAX_POINTS = 10**4
 #: the CSV columns (SI units in the names)
 COLUMNS = ("load_N", "average_velocity_m_per_s", "output_power_W", "input_power_W",
            "efficiency", "motion", "mode", "status")
+
+#: the CSV columns of the efficiency against frequency (one row a frequency, at the load of
+#: maximum output power there)
+EFFICIENCY_COLUMNS = ("frequency_Hz", "no_load_velocity_m_per_s", "stall_force_N",
+                      "load_at_max_power_N", "max_power_W", "input_power_W", "efficiency",
+                      "mode", "status")
 
 #: first probe of the load, as a share of the scene's force unit
 _FIRST_PROBE = 1e-3
@@ -78,7 +94,11 @@ def characteristic_tag(scene, frequency, scheme):
     >>> characteristic_tag("friction-drive", 185.0, ED_REFERENCE)
     'characteristic_friction-drive_185Hz_event-driven'
     """
-    parts = [f"characteristic_{scene}", f"{frequency:g}Hz", scheme.name]
+    return "_".join([f"characteristic_{scene}", f"{frequency:g}Hz", _scheme_tag(scheme)])
+
+
+def _scheme_tag(scheme):
+    parts = [scheme.name]
     if scheme.theta is not None:
         parts.append(f"theta{scheme.theta:g}")
     if scheme.steps_per_period is not None:
@@ -258,6 +278,7 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
                           options={"xatol": 1e-10 * abs(stall)})
     f_best, p_best = (float(res.x), float(-res.fun)) if -res.fun >= power[i] else (
         float(loads[i]), float(power[i]))
+    best = _row(curve, f_best, v0, scheme)
     reversed_rows = [r for r in rows if r["motion"] == "reversed"]
     direction = "forward" if v0 > 0 else "backward"
     summary = {
@@ -268,6 +289,10 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
         "stall_force_N": stall,
         "max_power_W": p_best,
         "load_at_max_power_N": f_best,
+        # NaN (None in JSON) without an energy audit for the scheme
+        "input_power_at_max_power_W": _or_none(best["input_power_W"]),
+        "efficiency_at_max_power": _or_none(best["efficiency"]),
+        "mode_at_max_power": best["mode"],
         "no_load_direction": direction,
         "load_convention": ("a positive load pushes the rotor towards -x; a load opposing the "
                             f"no-load ({direction}) motion is {'positive' if v0 > 0 else 'negative'}"),
@@ -298,6 +323,133 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
         if plot:
             fig = stem.with_name(stem.name + ".png")
             if _figure(rows, summary, fig):
+                log(f"wrote {fig}")
+            else:
+                log("matplotlib is not installed: no figure (pip install matplotlib)")
+    return {"summary": summary, "rows": rows}
+
+
+def _or_none(x):
+    return None if x is None or (isinstance(x, float) and math.isnan(x)) else float(x)
+
+
+def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE, points=9,
+                            out="out", plot=True, log=print):
+    """Efficiency at the load of maximum output power against the drive frequency.
+
+    At each frequency the load characteristic (:func:`motor_characteristic`)
+    locates the stall force and the load ``F*`` of maximum output power; the
+    row gives ``F*``, the power ``F* v(F*)``, the stators' mean input power
+    ``P_in`` there from the energy audit and the efficiency ``F* v / P_in``
+    (module docstring). A frequency without a characteristic (no steady
+    state, no motion at no load, no stall) keeps its row with the cause in
+    ``status``.
+
+    Parameters
+    ----------
+    scene : str
+        A registered periodically driven scene with a ``load`` parameter and
+        an energy audit under ``scheme`` (the friction drive, the two-rod drive).
+    frequencies : sequence of float
+        Drive frequencies [Hz], each > 0, at most :data:`MAX_POINTS`.
+    fixed : dict, optional
+        Other parameters of the scene (SI).
+    scheme : moreau.analysis.engine.Scheme
+    points : int
+        Grid loads of each characteristic (the maximum is refined by Brent's
+        method from the grid's best point, so a coarse grid suffices).
+    out : path-like or None
+        Output folder for the CSV, its JSON sidecar and the figure; None
+        writes nothing.
+    plot : bool
+
+    Returns
+    -------
+    dict
+        ``summary`` (settings, the definition, the frequencies of the
+        largest efficiency and power) and ``rows`` (:data:`EFFICIENCY_COLUMNS`).
+
+    Examples
+    --------
+    >>> d = efficiency_vs_frequency("friction-drive", [2000.0], points=3, out=None, plot=False,
+    ...                             log=lambda s: None)
+    >>> 0.0 < d["rows"][0]["efficiency"] < 1.0
+    True
+    """
+    entry = registry.get_entry(scene)
+    try:
+        freqs = [positive("frequencies", f) for f in frequencies]
+    except TypeError:
+        raise InputError(f"`frequencies` must be a sequence of frequencies [Hz], got "
+                         f"{frequencies!r}") from None
+    if not 1 <= len(freqs) <= MAX_POINTS:
+        raise InputError(f"`frequencies` must hold 1 to {MAX_POINTS} values, got {len(freqs)}")
+    fixed = dict(fixed or {})
+    if "frequency" in fixed:
+        raise InputError("`frequency` is swept by the efficiency against frequency; do not fix it")
+    if "load" in fixed:
+        raise InputError("`load` is chosen at each frequency (the load of maximum output "
+                         "power); do not fix it")
+    sc0 = registry.make_scene(entry.name, frequency=freqs[0],
+                              **{k: v for k, v in fixed.items() if k != "load"})
+    if not has_energy_audit(sc0, scheme.name):
+        raise InputError(f"scene {entry.name!r} has no energy audit under scheme "
+                         f"{scheme.name!r}: the input power, hence the efficiency, is unknown")
+    if out is not None:
+        out = check_output_dir(out)
+    rows = []
+    for f in freqs:
+        row = dict.fromkeys(EFFICIENCY_COLUMNS, math.nan)
+        row.update(frequency_Hz=f, mode="", status="ok")
+        try:
+            s = motor_characteristic(entry.name, frequency=f, fixed=fixed, scheme=scheme,
+                                     points=points, out=None, plot=False)["summary"]
+        except MoreauError as exc:
+            row["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+            rows.append(row)
+            log(f"  {f:g} Hz: {row['status']}")
+            continue
+        eff = s["efficiency_at_max_power"]
+        row.update(no_load_velocity_m_per_s=s["no_load_velocity_m_per_s"],
+                   stall_force_N=s["stall_force_N"], load_at_max_power_N=s["load_at_max_power_N"],
+                   max_power_W=s["max_power_W"], mode=s["mode_at_max_power"],
+                   input_power_W=(s["input_power_at_max_power_W"]
+                                  if s["input_power_at_max_power_W"] is not None else math.nan),
+                   efficiency=eff if eff is not None else math.nan)
+        if eff is None:
+            row["status"] = "no energy audit at the load of maximum power"
+        rows.append(row)
+        log(f"  {f:g} Hz: efficiency {row['efficiency']:.6g} at {row['load_at_max_power_N']:.6g} N")
+    good = [r for r in rows if r["status"] == "ok"]
+    best = max(good, key=lambda r: r["efficiency"]) if good else None
+    summary = {
+        "scene": entry.name,
+        "scheme": scheme.name,
+        "frequencies_Hz": freqs,
+        "efficiency_definition": ("output power F* v(F*) over the stators' mean input power, at "
+                                  "the load F* of maximum output power at each frequency"),
+        "points_per_characteristic": points,
+        "best_efficiency": best["efficiency"] if best else None,
+        "frequency_of_best_efficiency_Hz": best["frequency_Hz"] if best else None,
+        "failed_frequencies": [r["frequency_Hz"] for r in rows if r["status"] != "ok"],
+        "parameters": {k: v for k, v in sc0.params.__dict__.items() if k != "load"}
+        if hasattr(sc0, "params") else dict(fixed),
+        "scheme_settings": {"theta": scheme.theta, "steps_per_period": scheme.steps_per_period,
+                            "rtol": scheme.rtol, "options": scheme.options},
+    }
+    if out is not None:
+        stem = out / f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_{_scheme_tag(scheme)}"
+        csv_path = stem.with_name(stem.name + ".csv")
+        with open(csv_path, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
+            w.writeheader()
+            w.writerows(rows)
+        side = dict(summary, provenance=provenance(), csv=csv_path.name)
+        stem.with_name(stem.name + ".json").write_text(json.dumps(side, indent=1, default=str))
+        log(f"wrote {csv_path} and {stem.name}.json")
+        if plot:
+            fig = stem.with_name(stem.name + ".png")
+            if _efficiency_figure(rows, summary, fig):
                 log(f"wrote {fig}")
             else:
                 log("matplotlib is not installed: no figure (pip install matplotlib)")
@@ -355,6 +507,40 @@ def _figure(rows, summary, path):
         ax.plot(f, eff * 100, "C2--", lw=0.8, label="efficiency")
         ax.set_ylabel("efficiency [%]", color="C2")
     a2.legend(fontsize=8, loc="lower left")
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
+
+
+def _efficiency_figure(rows, summary, path):
+    try:
+        import matplotlib  # noqa: PLC0415  (optional: figures only)
+    except ImportError:
+        return False
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt  # noqa: PLC0415
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    f = np.array([r["frequency_Hz"] for r in ok])
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    a1.plot(f, [100 * r["efficiency"] for r in ok], "C2o-", lw=0.8)
+    a1.set_ylabel("efficiency at max. power [%]")
+    eff = np.array([r["efficiency"] for r in ok])
+    if eff.size and np.all(eff > 0) and eff.max() > 100 * eff.min():
+        a1.set_yscale("log")    # 0.05 % to 45 % on the paper's drive, 20 Hz to 2 kHz
+    a1.set_title(f"{summary['scene']} ({summary['scheme']}): efficiency at the load of "
+                 "maximum output power", fontsize=10)
+    a2.plot(f, [1e6 * r["max_power_W"] for r in ok], "C0o-", lw=0.8, label="max. output power")
+    a2.plot(f, [1e6 * r["input_power_W"] for r in ok], "C3s--", lw=0.8, label="input power there")
+    a2.set_ylabel("power [uW]")
+    a2.set_xlabel("drive frequency [Hz]")
+    if ok and min(min(r["max_power_W"], r["input_power_W"]) for r in ok) > 0:
+        a2.set_yscale("log")    # the output is a small share of the input
+    a2.legend(fontsize=8)
+    for ax in (a1, a2):
+        ax.set_xscale("log")
+        ax.grid(True, which="both", lw=0.3, color="0.85")
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)

@@ -30,6 +30,7 @@ import time
 import warnings
 
 import joblib
+from joblib.externals.loky import get_reusable_executor
 
 from .. import __version__
 from ..errors import ConvergenceError, InputError, Interrupted
@@ -40,7 +41,7 @@ from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
+__all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -549,6 +550,8 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
         bar = tqdm(total=len(points), initial=n_cached, desc=desc, unit="pt",
                    disable=None, leave=False)
     done = n_cached
+    pooled = False
+    interrupted = False
     try:
         if todo:
             if scheduler is not None:
@@ -566,6 +569,7 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
                 with joblib.parallel_config("loky", initializer=_ignore_sigint):
                     par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
                                           batch_size=1)
+                pooled = True
                 rest = par(joblib.delayed(_indexed)(func, k, args[i])
                            for k, i in enumerate(todo) if k > 0)
                 results = itertools.chain([first], rest)
@@ -581,6 +585,7 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
                     bar.update(sizes[i])
                 done = n_cached + sum(sizes[j] for j in todo if out[j] is not None)
     except KeyboardInterrupt:
+        interrupted = True
         if bar is not None:
             bar.close()
             bar = None
@@ -590,9 +595,29 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
     finally:
         if bar is not None:
             bar.close()
+        if pooled:
+            end_worker_pool(kill=interrupted)
     rows = out if chunk == 1 else [r for part in out for r in part]
     rows = [{k: v for k, v in r.items() if k != INPUTS_KEY} for r in rows]
     return rows, {"cached": n_cached, "computed": len(points) - n_cached}
+
+
+def end_worker_pool(kill=False):
+    """Shut down joblib's reusable pool of local worker processes once a run is over.
+
+    joblib keeps its loky pool alive for the next call and leaves it to the
+    interpreter's exit, where the pool's queues and locks may be torn down
+    after loky's resource tracker has looked for them: it then reports
+    "leaked semlock objects" on stderr. Shutting the pool down when the run
+    ends releases them in order. ``kill=True`` ends workers still busy (after
+    an interrupt).
+
+    Examples
+    --------
+    >>> end_worker_pool()     # no pool: nothing to end
+    """
+    # reuse=True: the pool the run used, whatever its settings (a new, empty one if none)
+    get_reusable_executor(reuse=True).shutdown(wait=True, kill_workers=kill)
 
 
 def _indexed(func, k, a):

@@ -16,6 +16,7 @@ from ..errors import InputError
 from ._loops import runner_for
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
                           new_lcp_control, new_stats)
+from ._dense import join_to_last
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP"]
@@ -124,6 +125,17 @@ class CompiledRecording:
                              np.asarray(regime, np.int64).reshape(1, nc),
                              *(np.asarray(a, float).reshape(1, nc)
                                for a in (force_N, force_T, slip, gap))))
+
+    def _rows_since(self):
+        if not self._fast:
+            return super()._rows_since()
+        new = self._blocks[self._seen:]
+        self._seen = len(self._blocks)
+        if not new:
+            return None
+        rows = tuple(np.concatenate(c) for c in zip(*new))
+        rows = rows[:3] + (rows[3].astype(int),) + rows[4:]
+        return join_to_last(self, rows)
 
     def result(self):
         """Assemble the recorded samples into a :class:`SimulationResult`."""

@@ -14,6 +14,8 @@ import numpy as np
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
 from ..scenes import registry as scene_registry
+from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
+                     join_to_last, stack_rows)
 from .result import STATUS_MESSAGES, SimulationResult
 
 __all__ = ["Integrator", "simulate", "INTEGRATORS", "register_integrator", "get_integrator",
@@ -121,6 +123,11 @@ class Integrator:
     """
 
     scheme = ""
+    #: True where the scheme hands its exact motion between samples to :func:`simulate`
+    #: (event-driven schemes, through :meth:`_add_piece`); False where the motion between
+    #: recorded samples is their linear interpolation (time stepping): ``t_eval`` samples
+    #: and user events are then interpolated, events located to within one step
+    exact_motion = False
     #: how ``moreau compare`` runs this scheme beside the reference and Moreau–Jean, or
     #: None: ``(setting, values, quick_values, fixed_options)``, one row per value of the
     #: option ``setting`` (e.g. a compliant contact's stiffness)
@@ -142,6 +149,12 @@ class Integrator:
         self.counters = {"steps": 0}
         self.events = []
         self._samples = []
+        # the motion handed to simulate's t_eval and events, only while it asks for it
+        self._want_pieces = False
+        self._pieces = []
+        self._seen = 0
+        #: the last sample handed to simulate's output (time stepping)
+        self.last_handed = None
 
     # -- public API ---------------------------------------------------------
     def step(self):
@@ -183,6 +196,31 @@ class Integrator:
     def _step_impl(self):
         raise NotImplementedError
 
+    def _add_piece(self, grid, state, sample):
+        """Hand the exact motion over ``grid`` to :func:`simulate` (event-driven schemes).
+
+        See :class:`moreau.integrators._dense.Piece`; a no-op unless the run
+        asked for ``t_eval`` samples or events.
+        """
+        if self._want_pieces:
+            self._pieces.append(Piece(grid, state, sample))
+
+    def _take_pieces(self):
+        """The motion since the previous call, as a list of pieces."""
+        if self.exact_motion:
+            out, self._pieces = self._pieces, []
+            return out
+        rows = self._rows_since()
+        if rows is None:
+            return []
+        return [interpolated_piece(*rows)]
+
+    def _rows_since(self):
+        # the samples recorded since the previous call, after the last one of before
+        new = self._samples[self._seen:]
+        self._seen = len(self._samples)
+        return join_to_last(self, stack_rows(new, self.scene.ndof, self.scene.ncontacts))
+
     def _record(self, t, q, v, regime, force_N, force_T, slip, gap):
         self._samples.append((t, np.array(q, float), np.array(v, float),
                               np.atleast_1d(regime), np.atleast_1d(force_N),
@@ -221,7 +259,8 @@ def _state_vector(name, value, n):
     return a.copy()
 
 
-def simulate(scene, t_span, q0, v0, method, progress=False, **options):
+def simulate(scene, t_span, q0, v0, method, progress=False, t_eval=None, events=None,
+             **options):
     """Integrate ``scene`` over ``t_span`` with the scheme registered as ``method``.
 
     Parameters
@@ -235,6 +274,25 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
         A key of :data:`INTEGRATORS` (e.g. ``"moreau-jean"``).
     progress : bool
         Show a tqdm progress bar over simulated time.
+    t_eval : array_like, optional
+        Times at which to sample the result, increasing, inside ``t_span``
+        (as in :func:`scipy.integrate.solve_ivp`), for every scheme. An
+        event-driven scheme samples its exact motion; a time-stepping scheme
+        interpolates linearly between its step ends (the regime and forces
+        are those of the step containing the time). Without it the result
+        holds the scheme's own samples (set by ``h``, ``save_every``,
+        ``sample_dt``, ``samples_per_period``).
+    events : callable or list of callables, optional
+        Functions ``event(t, y)`` of the time and the state ``y = (q, v)``
+        (concatenated) whose zeros are located, as in ``solve_ivp``: an
+        attribute ``terminal`` (True, or the number of occurrences) stops the
+        run, ``direction`` (> 0 upwards, < 0 downwards, 0 both) selects the
+        crossings. Event-driven schemes find the root on their exact motion
+        (Brent's method); time-stepping schemes locate it to within one step
+        (the sign change between two step ends, ``t_events`` holding the root
+        of the linear interpolation). The times and states go to
+        ``result.t_events`` and ``result.y_events``; a terminal event ends
+        the run with status 1.
     **options
         Passed to the integrator's constructor.
 
@@ -242,12 +300,33 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
     -------
     SimulationResult
         Status ``-4`` if interrupted by ``KeyboardInterrupt``; the samples
-        recorded until then are kept.
+        recorded until then are kept. Status 1 if a terminal event stopped it.
+
+    Examples
+    --------
+    A ball dropped from height 1 (gravity 1) passes 0.5 going down at
+    ``t = 1``; the event-driven reference finds it on its dense output:
+
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> def half(t, y): return y[0] - 0.5
+    >>> half.terminal, half.direction = True, -1
+    >>> res = simulate(BouncingBall(), (0.0, 3.0), [1.0], [0.0], "event-driven", events=half,
+    ...                t_eval=[0.0, 0.5, 1.5])
+    >>> res.status, round(float(res.t_events[0][0]), 12), res.t.tolist()
+    (1, 1.0, [0.0, 0.5])
     """
     cls = get_integrator(method)
     check_options(method, options, scene)
     t0, t1 = t_span
+    if t_eval is not None:
+        t_eval = check_t_eval(t_eval, finite_scalar("t_span[0]", t0), finite_scalar("t_span[1]", t1))
+    funcs = check_events(events)
     integ = cls(scene, t0, q0, v0, t1, **options)
+    tracker = None
+    if t_eval is not None or funcs:
+        integ._want_pieces = True
+        tracker = OutputTracker(integ.t0, np.concatenate([integ.q, integ.v]), t_eval, funcs,
+                                integ.exact_motion)
     bar = None
     if progress:
         from tqdm.auto import tqdm
@@ -256,12 +335,20 @@ def simulate(scene, t_span, q0, v0, method, progress=False, **options):
     try:
         while integ.status == "running":
             integ.step()
+            if tracker is not None and tracker.feed(integ._take_pieces()):
+                break
             if bar is not None:
                 bar.update(integ.t - last)
                 last = integ.t
+        if tracker is not None and tracker.stop is None:
+            # what a failed step still recorded
+            tracker.feed(integ._take_pieces())
     except KeyboardInterrupt:
         integ.interrupt()
     finally:
         if bar is not None:
             bar.close()
-    return integ.result()
+    result = integ.result()
+    if tracker is not None:
+        tracker.finish(result)
+    return result

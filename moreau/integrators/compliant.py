@@ -124,6 +124,8 @@ def damping_for_restitution(e, stiffness, mass):
 class _Compliant(Integrator):
     """Common part of the compliant schemes (see the module docstring)."""
 
+    # the dense output of the ODE's steps is the scheme's motion (events as in solve_ivp)
+    exact_motion = True
     _solver = None
     # the model error falls as the contact stiffens (about as 1/sqrt(k) for an
     # impact); the integration error is held below it
@@ -237,6 +239,9 @@ class _Compliant(Integrator):
 
     # -- stepping -------------------------------------------------------------
     def _record_state(self, t, y):
+        self._record(*self._sample_row(t, y))
+
+    def _sample_row(self, t, y):
         n = self._n
         q, v = y[:n], y[n:]
         fN, fT, slip, g, _ = self._contact_forces(q, v, t)
@@ -246,7 +251,7 @@ class _Compliant(Integrator):
         reg[loaded & (slip > 0)] = int(Regime.POSITIVE)
         reg[loaded & (slip < 0)] = int(Regime.NEGATIVE)
         reg[stick] = int(Regime.STICK)
-        self._record(t, q, v, reg, fN, fT, slip, g)
+        return t, q, v, reg, fN, fT, slip, g
 
     def _step_impl(self):
         ode = self._ode
@@ -256,6 +261,11 @@ class _Compliant(Integrator):
         y = ode.y
         if not np.all(np.isfinite(y)):
             raise MoreauError(f"non-finite state at t = {ode.t!r}")
+        if self._want_pieces:
+            # the step's dense output: the ODE's own motion between its step ends
+            dense = ode.dense_output()
+            self._add_piece([ode.t_old, ode.t], dense,
+                            lambda t, dense=dense: self._sample_row(t, dense(t)))
         if self.sample_dt is None:
             self._record_state(ode.t, y)
         else:

@@ -19,8 +19,7 @@ Smooth phases
     The state is integrated by DOP853 (``ode_method="Radau"`` for stiff scenes)
     at a tight tolerance.
 
-Events (terminal event functions of ``solve_ivp``, refined by its Brent
-root finder to a few ulps of time)
+Events (terminal event functions of ``solve_ivp``, refined by its Brent root finder to a few ulps of time)
     * an open contact's gap closing;
     * a closed contact's normal force vanishing (lift-off);
     * a sliding contact's slip velocity vanishing;
@@ -259,6 +258,14 @@ class GenericEventDriven(Integrator):
         Impacts allowed in one run.
     lcp_method : str
         LCP solver for the contact problems (see :func:`moreau.lcp.solve_lcp`).
+    record_pieces : bool
+        Keep the pieces of the run for analyses that integrate along it (the
+        energy audit, :mod:`moreau.analysis.energy`): ``phases`` lists every
+        smooth phase as ``(t0, t1, dense_output, mode)``, ``jumps`` every
+        velocity jump at fixed positions as ``(t, q, v_pre, v_post, pN, pT,
+        kind)``, with the impulses of each contact (``M (v_post - v_pre) =
+        WN^T pN + WT^T pT``) and ``kind`` ``"impact"`` or ``"projection"``
+        (the removal of a phase's drift from the closed contacts).
 
     Examples
     --------
@@ -270,10 +277,14 @@ class GenericEventDriven(Integrator):
     [1.0, 2.0]
     """
 
+    exact_motion = True
+
     def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
                  max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
-                 max_impacts=10000, lcp_method="lemke"):
+                 max_impacts=10000, lcp_method="lemke", record_pieces=False):
         super().__init__(scene, t0, q0, v0, t_bound)
+        self.phases = [] if record_pieces else None
+        self.jumps = [] if record_pieces else None
         self.rtol = positive("rtol", rtol)
         self.atol = positive("atol", atol)
         if ode_method not in ("DOP853", "Radau"):
@@ -333,12 +344,15 @@ class GenericEventDriven(Integrator):
         return self.vel_tol * max(self._vscale, 1e-300)
 
     # -- recording ---------------------------------------------------------------
-    def _record_state(self, t, q, v):
+    def _sample_row(self, t, q, v, mode):
         ms = self.ms
-        a, lamN, lamT, _, _, kin = ms.solve(t, q, v, self.mode)
+        a, lamN, lamT, _, _, kin = ms.solve(t, q, v, mode)
         slip = ms.slip_velocities(q, v, t, kin)
         gap = self.scene.gaps(q, t)
-        self._record(t, q, v, self.mode.copy(), lamN, lamT, slip, gap)
+        return t, q, v, mode.copy(), lamN, lamT, slip, gap
+
+    def _record_state(self, t, q, v):
+        self._record(*self._sample_row(t, q, v, self.mode))
         # the velocity scale of the tolerances also learns from the samples:
         # events may all fall where the scene is momentarily at rest
         self._update_vscale(q, v, t)
@@ -358,8 +372,14 @@ class GenericEventDriven(Integrator):
         H = np.vstack([WN[closed]] + ([WT[self.ms.trow[stick]]] if stick else []))
         w = np.concatenate([wN[closed]] + ([wT[self.ms.trow[stick]]] if stick else []))
         MiH = np.linalg.solve(sc.mass(q), H.T)
-        v = v - MiH @ np.linalg.solve(H @ MiH, H @ v + w)
-        return q, v
+        lam = -np.linalg.solve(H @ MiH, H @ v + w)
+        v_post = v + MiH @ lam
+        if self.jumps is not None:
+            pN, pT = np.zeros(self.ms.nc), np.zeros(self.ms.nc)
+            pN[closed] = lam[:closed.size]
+            pT[stick] = lam[closed.size:]
+            self.jumps.append((t, q.copy(), v.copy(), v_post.copy(), pN, pT, "projection"))
+        return q, v_post
 
     # -- impacts ---------------------------------------------------------------------
     def _impact(self, t, q, v, touching):
@@ -404,7 +424,13 @@ class GenericEventDriven(Integrator):
         if self.counters["impacts"] > self.max_impacts:
             raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts "
                               f"(an accumulation the Zeno policy did not end?)")
-        return v + MiJ @ p
+        v_post = v + MiJ @ p
+        if self.jumps is not None:
+            pN, pT = np.zeros(ms.nc), np.zeros(ms.nc)
+            pN[touching] = p[:len(touching)]
+            pT[fr] = p[len(touching):]
+            self.jumps.append((t, q.copy(), v.copy(), v_post.copy(), pN, pT, "impact"))
+        return v_post
 
     # -- mode decision ------------------------------------------------------------------
     def _decide(self, t, q, v, forced):
@@ -711,6 +737,16 @@ class GenericEventDriven(Integrator):
                               f"{sol.message}")
         n = self.scene.ndof
         t_end = float(sol.t[-1])
+        if self.phases is not None:
+            self.phases.append((self.t, t_end, sol.sol, self.mode.copy()))
+        if self._want_pieces:
+            # the phase's dense output is its exact motion (to the ODE tolerance), in the
+            # phase's mode; its steps are where an event function is checked
+            mode, dense = self.mode.copy(), sol.sol
+            grid = np.append(dense.ts[dense.ts < t_end], t_end)
+            self._add_piece(grid, dense,
+                            lambda t, mode=mode, dense=dense: self._sample_row(
+                                t, dense(t)[:n], dense(t)[n:], mode))
         # samples of the smooth phase
         while self._next_sample < t_end:
             ys = sol.sol(self._next_sample)

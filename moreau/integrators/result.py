@@ -80,6 +80,11 @@ class SimulationResult:
         Name of the integration scheme.
     stats : dict
         Counters: steps, LCP solves, pivots, fallbacks, residuals, penetration.
+    t_events : list of ndarray
+        For each user event function of :func:`~moreau.integrators.simulate`
+        (``events=``), the times it occurred (empty without events).
+    y_events : list of ndarray
+        For each, the states ``(q, v)`` at those times, one row each.
     """
 
     t: np.ndarray
@@ -95,6 +100,8 @@ class SimulationResult:
     message: str = STATUS_MESSAGES[0]
     scheme: str = ""
     stats: dict = field(default_factory=dict)
+    t_events: list = field(default_factory=list)
+    y_events: list = field(default_factory=list)
 
     @property
     def success(self):

@@ -119,7 +119,7 @@ __all__ = [
 #: candidate without further checks
 PIVOT_TOL = 1e-9
 #: a smaller positive entry is a candidate when it exceeds this times its
-#: rounding scale sum_j |B^-1_ij| |A_ej|
+#: rounding scale ``sum_j |B^-1_ij| |A_ej|``
 NOISE_TOL = 1e3 * np.finfo(float).eps
 #: two ratios (or two lexicographic entries) tie within this relative difference
 TIE_TOL = 1e-9

@@ -43,6 +43,34 @@ the motion of the rod or the rotor, so it is not a parameter here.
 In contact the constraint ``g_N = 0`` fixes the rod: ``sin phi = sin phi0 - u1``.
 Everything in contact is then an explicit function of ``tau``, which the
 event-driven reference exploits.
+
+Preload (``preload = F_p``, default 0)
+--------------------------------------
+What a motor designer calls the preload: the normal force with which the rod
+tip and the rotor are pressed together at rest. Its mechanism is a preload
+spring of stiffness ``k_p``, compressed by ``delta_p = F_p / k_p`` at the rest
+position, that pushes the tip towards the rotor; like the rod's spring it acts
+on the tip height above the hinge, ``l sin phi``, so it moves with the
+stator and does not depend on ``x1``:
+
+    V_p = 1/2 k_p (delta_p + l sin phi0 - l sin phi)^2
+        = const + F_p l (sin phi0 - sin phi) + 1/2 k_p l^2 (sin phi0 - sin phi)^2.
+
+Its last term only adds ``k_p`` to ``k`` (give it there); the new parameter
+is the linear term, ``V_p = F_p l (sin phi0 - sin phi)``: a soft preload
+spring of large compression, whose force stays ``F_p`` over the rod's
+micrometre strokes. With ``f_p = F_p / (m l w^2)`` it adds the generalised
+force ``-dV_p/dphi = f_p cos phi`` to the rod, i.e. ``P (sin phi0 - sin phi)``
+becomes ``P (sin phi0 - sin phi) + f_p`` in ``h``, ``D``, ``E`` and ``F_s``:
+
+    D += -3 f_p cos^2 phi,    E += 3 f_p sin phi cos phi,    F_s += -f_p cos phi,
+
+and the energy gains ``f_p (sin phi0 - sin phi)`` (in ``m l^2 w^2``). At rest
+(``u1 = 0``, ``phi = phi0``) the rod equation ``0 = f_p cos phi0 - f_N cos
+phi0`` gives ``f_N = f_p``: the contact carries the preload. The contact
+manifold is unchanged, so the walker's contact pieces stay closed-form. Each
+preload term is added after the spring's (``+ f_p c``, ``+ 0.0`` without a
+preload), so with ``preload = 0`` every result is the same to the last bit.
 """
 
 import math
@@ -92,6 +120,10 @@ class FrictionDriveParams:
         Load ``F_L`` on the rotor [N].
     restitution : float
         Newton restitution coefficient ``e`` of the rod-rotor impacts, in [0, 1].
+    preload : float
+        Preload ``F_p`` [N], >= 0: the normal force pressing the rod tip on the
+        rotor at rest, from a soft pre-compressed preload spring (module
+        docstring, "Preload").
 
     Examples
     --------
@@ -109,6 +141,7 @@ class FrictionDriveParams:
     x10: float = 2.0e-6
     load: float = 0.0
     restitution: float = 0.0
+    preload: float = 0.0
 
     def __post_init__(self):
         for name in ("m", "m2", "k", "length", "x10"):
@@ -119,6 +152,7 @@ class FrictionDriveParams:
         object.__setattr__(self, "load", V.finite_scalar("load", self.load))
         object.__setattr__(self, "restitution",
                            V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        object.__setattr__(self, "preload", V.nonnegative("preload", self.preload))
         if not 2.0 * self.x10 < self.length * math.sin(self.phi0):
             raise InputError(
                 f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
@@ -176,6 +210,8 @@ class FrictionDrive(DriveUnits, Scene):
         self.u10 = p.x10 / p.length
         self.force_scale = p.m * p.length * self.omega ** 2
         self.fL = p.load / self.force_scale
+        #: dimensionless preload ``f_p = F_p / (m l w^2)`` (module docstring, "Preload")
+        self.fp = p.preload / self.force_scale
         self.phi0 = p.phi0
         self.sin_phi0 = math.sin(p.phi0)
         self.mu = np.array([p.mu])
@@ -224,6 +260,9 @@ class FrictionDrive(DriveUnits, Scene):
         C = 1.0 / self.J + 3.0 * s * s
         D = dphi * dphi * s - dd1 + 1.5 * dd1 * c * c - 3.0 * spring * c * c
         E = dphi * dphi * c - self.fL / self.J - 1.5 * dd1 * s * c + 3.0 * spring * s * c
+        # preload, added last so that a zero preload leaves every bit as it was
+        D = D - 3.0 * self.fp * c * c
+        E = E + 3.0 * self.fp * s * c
         return A, B, C, D, E
 
     def contact_forces(self, tau, regime):
@@ -239,6 +278,7 @@ class FrictionDrive(DriveUnits, Scene):
         s, c = np.sin(phi), np.cos(phi)
         # F_s of the paper: rod equation with the inertia moved to one side
         Fs = 0.5 * self.ddu1(tau) * c + ddphi / 3.0 - self.P * c * (self.sin_phi0 - s)
+        Fs = Fs - self.fp * c
         mu = float(self.mu[0])
         if regime == Regime.POSITIVE:
             fN = -Fs / (c + mu * s)
@@ -271,13 +311,13 @@ class FrictionDrive(DriveUnits, Scene):
     def forces(self, q, v, t):
         phi = q[0]
         return np.array([self.P * math.cos(phi) * (self.sin_phi0 - math.sin(phi))
-                         - 0.5 * self.ddu1(t) * math.cos(phi), -self.fL])
+                         - 0.5 * self.ddu1(t) * math.cos(phi) + self.fp * math.cos(phi), -self.fL])
 
     def force_jacobians(self, q, v, t):
         phi = q[0]
         s, c = math.sin(phi), math.cos(phi)
         K = np.zeros((2, 2))
-        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * self.ddu1(t) * s
+        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * self.ddu1(t) * s - self.fp * s
         return K, np.zeros((2, 2))
 
     def gaps(self, q, t):
@@ -310,7 +350,8 @@ class FrictionDrive(DriveUnits, Scene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
-        par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0], dtype=np.float64)
+        par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp],
+                       dtype=np.float64)
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
 
     # -- units ------------------------------------------------------------------
@@ -343,7 +384,7 @@ class FrictionDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0 -----------------
+# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0, fp -------------
 
 @njit(cache=True)
 def _mass(par, q, M):
@@ -353,7 +394,12 @@ def _mass(par, q, M):
 
 @njit(cache=True)
 def _forces(par, q, v, t, D, need_jac):
-    rod_forces(D, 0, par[1], par[4], par[2], math.sin(q[0]), math.cos(q[0]), math.cos(t), need_jac)
+    s, c = math.sin(q[0]), math.cos(q[0])
+    rod_forces(D, 0, par[1], par[4], par[2], s, c, math.cos(t), need_jac)
+    # the preload's torque f_p cos(phi) (module docstring); + 0.0 without one
+    D[0, 0] += par[5] * c
+    if need_jac:
+        D[0, 1] -= par[5] * s
     D[1, 0] = -par[3]
 
 
@@ -442,7 +488,7 @@ class FrictionDriveCase(DriveCase):
 
 #: SI units of the parameters of :class:`FrictionDriveParams`
 UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "", "x10": "m",
-         "load": "N", "restitution": ""}
+         "load": "N", "restitution": "", "preload": "N"}
 
 register_scene(SceneEntry(
     name="friction-drive",
@@ -452,7 +498,8 @@ register_scene(SceneEntry(
     description="the paper's friction drive of a piezoelectric motor (steady state)",
     case=FrictionDriveCase,
     reference="friction-drive-walker",
-    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution"),
+    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
+               "preload"),
     mj_tolerance=5e-3,
     # the paper's sweep, with its valid-range marks and default ranges
     sweep="moreau.studies.paper.sweeps:command",

@@ -97,7 +97,8 @@ class _Fields:
     def flight(self, st):
         sc = self.sc
         c = math.cos(st.phi)
-        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(st.phi)) - 0.5 * sc.ddu1(st.tau) * c)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(st.phi)) - 0.5 * sc.ddu1(st.tau) * c
+                       + sc.fp * c)
         return np.array([st.dphi, float(ddphi), -sc.fL / sc.J])
 
     def field(self, st):
@@ -166,8 +167,9 @@ def _flight_flow(walker, a, b):
         phi, dphi = y[0], y[1]
         s, c = math.sin(phi), math.cos(phi)
         dd1 = float(sc.ddu1(t))
-        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - s) - 0.5 * dd1 * c)
-        k = 3.0 * (-sc.P * s * (sc.sin_phi0 - s) - sc.P * c * c + 0.5 * dd1 * s)
+        # the preload's torque f_p cos(phi) last (friction_drive's "Preload")
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - s) - 0.5 * dd1 * c + sc.fp * c)
+        k = 3.0 * (-sc.P * s * (sc.sin_phi0 - s) - sc.P * c * c + 0.5 * dd1 * s - sc.fp * s)
         # the 2x2 variation [[p11, p12], [p21, p22]] of (phi, phi')
         return [dphi, ddphi, y[4], y[5], k * y[2], k * y[3]]
 

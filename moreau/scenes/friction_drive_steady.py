@@ -246,7 +246,7 @@ def _flight_power(sc, sol):
         y = np.asarray(sol(tau))
         phi, dphi, du2 = y[0], y[1], y[3]
         s, c = np.sin(phi), np.cos(phi)
-        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - s) - 0.5 * sc.ddu1(tau) * c)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - s) - 0.5 * sc.ddu1(tau) * c + sc.fp * c)
         stator = (sc.ddu1(tau) + 0.5 * (ddphi * c - dphi * dphi * s)) * sc.du1(tau)
         return np.vstack([stator, sc.fL * du2, np.zeros_like(tau)])
     return power

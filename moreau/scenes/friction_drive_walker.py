@@ -240,7 +240,7 @@ class FrictionDriveWalker:
         dd1 = sc.u10 * cu
         dphi = -sc.u10 * su / c
         ddphi = dphi * dphi * s / c - dd1 / c
-        Fs = 0.5 * dd1 * c + ddphi / 3.0 - sc.P * c * (sc.sin_phi0 - s)
+        Fs = 0.5 * dd1 * c + ddphi / 3.0 - sc.P * c * (sc.sin_phi0 - s) - sc.fp * c
         return s, c, dphi, ddphi, Fs
 
     def fN(self, tau, regime):
@@ -452,7 +452,8 @@ class FrictionDriveWalker:
         sc = self.scene
         phi = y[0]
         c = math.cos(phi)
-        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(phi)) - 0.5 * sc.u10 * math.cos(t) * c)
+        ddphi = 3.0 * (sc.P * c * (sc.sin_phi0 - math.sin(phi)) - 0.5 * sc.u10 * math.cos(t) * c
+                       + sc.fp * c)
         return [y[1], ddphi, y[3], -sc.fL / sc.J]
 
     def _gap(self, t, y):
@@ -716,6 +717,8 @@ class EventDriven(Integrator):
     True
     """
 
+    exact_motion = True
+
     def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, samples_per_period=128):
         super().__init__(scene, t0, q0, v0, t_bound)
         if scene.ncontacts != 1 or not hasattr(scene, "contact_angle"):
@@ -733,6 +736,10 @@ class EventDriven(Integrator):
         self._record_state(self.state)
 
     def _record_state(self, st):
+        self._record(*self._sample_row(st))
+        self.t, self.q, self.v = st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2])
+
+    def _sample_row(self, st):
         sc = self.scene
         if st.regime == _F:
             fN = fT = 0.0
@@ -746,10 +753,12 @@ class EventDriven(Integrator):
             raise MoreauError(
                 f"the event-driven walker lost a re-contact: gap = {gap:.3g} < 0 at "
                 f"tau = {st.tau!r} in regime {Regime(int(st.regime)).name}")
-        self._record(st.tau, (st.phi, st.u2), (st.dphi, st.du2), int(st.regime), fN, fT, slip, gap)
-        self.t, self.q, self.v = st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2])
+        return (st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2]), int(st.regime),
+                fN, fT, slip, gap)
 
     def _on_segment(self, start, end, sol):
+        if self._want_pieces and end.tau > start.tau:
+            self._hand_segment(start, end, sol)
         dt = TWO_PI / self.samples_per_period
         k0 = math.floor(start.tau / dt) + 1
         k1 = math.ceil(end.tau / dt) - 1
@@ -762,6 +771,27 @@ class EventDriven(Integrator):
                 s = self.walker.move_contact(start, tau)
             self._record_state(s)
         self._record_state(end)
+
+    def _hand_segment(self, start, end, sol):
+        # the segment's exact motion: the flight's dense output, or the closed form of a
+        # contact segment; an event function is checked on a grid of 64 points per period.
+        # The walk goes on changing its states after this call: keep copies
+        start, end = start.copy(), end.copy()
+
+        def at(tau):
+            if tau >= end.tau:
+                return end
+            if start.regime == _F:
+                return ContactState(tau, _F, *sol(tau))
+            return self.walker.move_contact(start, tau)
+
+        def state(tau):
+            st = at(tau)
+            return np.array([st.phi, st.u2, st.dphi, st.du2])
+
+        k = max(2, math.ceil((end.tau - start.tau) / (TWO_PI / 64)) + 1)
+        self._add_piece(np.linspace(start.tau, end.tau, k), state,
+                        lambda tau: self._sample_row(at(tau)))
 
     def _step_impl(self):
         w = self.walker

@@ -301,6 +301,7 @@ class StickSlipReference(Integrator):
     Event(t=0.531243578339, transition, S->P)
     """
 
+    exact_motion = True
     #: the scene's exact periodic steady state, for callers that know the scheme by name only
     steady_state = staticmethod(stick_slip_steady_state)
 
@@ -311,6 +312,7 @@ class StickSlipReference(Integrator):
             raise InputError(f"`q0` and `v0` must put the slider on the stator "
                              f"(q0[1] == 0 and v0[1] == 0), got {self.q[1]!r}, {self.v[1]!r}")
         self._walker = _Walker(scene)
+        self._node = None
         self._gen = self._walker.walk(self.t, self.q[0], self.v[0], self.t_bound)
         self.counters.update({"events": 0})
         first = next(self._gen)
@@ -318,6 +320,9 @@ class StickSlipReference(Integrator):
 
     def _take(self, node):
         tau, x, u, reg, events = node
+        if self._want_pieces and self._node is not None and tau > self._node[0]:
+            self._hand_piece(self._node, float(tau))
+        self._node = (float(tau), float(x), float(u), reg)
         for (te, before, after) in events:
             self.events.append(Event(t=te, kind="transition", before=_LETTER[before],
                                      after=_LETTER[after]))
@@ -328,6 +333,33 @@ class StickSlipReference(Integrator):
         fT = self._walker.friction_force(reg, tau)
         slip = u - float(self.scene.drive(tau)[1])
         self._record(self.t, self.q, self.v, int(_LETTER[reg]), self.scene.n, fT, slip, 0.0)
+
+    def _hand_piece(self, node, tb):
+        # the closed form between two nodes: the slider moves with the stator in stick,
+        # at the constant acceleration of sliding friction and the load in slip
+        ta, xa, ua, reg = node
+        drive, w = self.scene.drive, self._walker
+        acc = (-w.mun if reg == "P" else w.mun) - w.fL
+
+        def xu(t):
+            if reg == "S":
+                s = drive(t)
+                return xa + float(s[0]) - float(drive(ta)[0]), float(s[1])
+            dt = t - ta
+            return xa + ua * dt + 0.5 * acc * dt * dt, ua + acc * dt
+
+        def state(t):
+            x, u = xu(t)
+            return np.array([x, 0.0, u, 0.0])
+
+        def sample(t):
+            x, u = xu(t)
+            return (t, np.array([x, 0.0]), np.array([u, 0.0]), np.array([int(_LETTER[reg])]),
+                    np.array([self.scene.n]), np.array([w.friction_force(reg, t)]),
+                    np.array([u - float(drive(t)[1])]), np.zeros(1))
+
+        k = max(2, math.ceil((tb - ta) / (TWO_PI / 64)) + 1)
+        self._add_piece(np.linspace(ta, tb, k), state, sample)
 
     def _step_impl(self):
         node = next(self._gen, None)

@@ -325,7 +325,11 @@ def test_a_zeno_sequence_closes_the_contact_instead_of_sinking_into_the_rotor():
     assert r.success
     assert r.gap[:, 0].min() > -1e-15
     kinds = [e.kind for e in r.events]
-    assert kinds.count("impact") == 18 and kinds[18] == "touchdown"
-    assert r.events[18].t == pytest.approx(0.3542556, abs=1e-6)
+    # how many rebounds are resolved before the accumulation point depends on the
+    # last bits of the arithmetic (18 on one machine, 19 on another); the physics
+    # asserted is: a run of impacts, then a touchdown at the accumulation time
+    n = kinds.index("touchdown")
+    assert 15 <= n <= 25 and kinds[:n] == ["impact"] * n
+    assert r.events[n].t == pytest.approx(0.3542556, abs=5e-6)
     # the rod then rides the stator until it lifts off again
-    assert kinds[19] == "liftoff" and r.events[19].t == pytest.approx(1.8043, abs=1e-3)
+    assert kinds[n + 1] == "liftoff" and r.events[n + 1].t == pytest.approx(1.8043, abs=1e-3)

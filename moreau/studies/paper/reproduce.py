@@ -22,7 +22,7 @@ import time
 import joblib
 import numpy as np
 
-from ...analysis.engine import ED_REFERENCE, Scheme, check_output_dir, run_points
+from ...analysis.engine import ED_REFERENCE, Scheme, check_output_dir, end_worker_pool, run_points
 from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS
 from .figures import mode_figure_jobs, mode_points, sweep_figure
@@ -74,7 +74,12 @@ def run_jobs(jobs, n_jobs=-1):
     """Run ``[(function, args), ...]`` on local processes; concatenate the returned lists."""
     if n_jobs == 1:
         return [x for fn, args in jobs for x in fn(*args)]
-    done = joblib.Parallel(n_jobs=n_jobs)(joblib.delayed(fn)(*args) for fn, args in jobs)
+    try:
+        done = joblib.Parallel(n_jobs=n_jobs)(joblib.delayed(fn)(*args) for fn, args in jobs)
+    except KeyboardInterrupt:
+        end_worker_pool(kill=True)
+        raise
+    end_worker_pool()
     return [x for part in done for x in part]
 
 
