@@ -46,17 +46,19 @@ Coordinates ``(phi, x2, x1)``: rod angle, rotor, stator. As in the paper
     T = 1/2 (m + m1) x1'^2 + 1/2 m2 x2'^2 + 1/6 m l^2 phi'^2 + 1/2 m l x1' phi' cos phi
     V = 1/2 k l^2 (sin phi0 - sin phi)^2,   F_stack = k1 (x_p(t) - x1) - c1 x1'
 
-with gap ``g_N = l sin phi0 - delta - l sin phi - x1`` (the preload ``delta``
-lowers the rotor surface below the free rod's tip) and slip ``g_T = x2 - l cos phi``.
+plus the friction drive's preload ``V_p = F_p l (sin phi0 - sin phi)`` (a soft
+pre-compressed spring pressing the tip on with ``F_p``), gap
+``g_N = l sin phi0 - l sin phi - x1`` and slip ``g_T = x2 - l cos phi``.
 Lagrange's equations (``d/dt dT/dx1' = (m + m1) x1'' + 1/2 m l (phi'' cos phi
 - phi'^2 sin phi)``, ``d/dt dT/dphi' - dT/dphi = 1/3 m l^2 phi'' + 1/2 m l x1''
 cos phi``) in ``tau = w t``, ``u = x / l``, forces over ``m l w^2``, with
 ``J = m2 / m``, ``J1 = m1 / m``, ``P = k / (m w^2)``, ``K1 = k1 / (m w^2)``,
-``C1 = c1 / (m w)`` and ``w(tau) = x_p / l``, read ``M q'' = h + WN^T f_N + WT^T f_T``
+``C1 = c1 / (m w)``, ``f_p = F_p / (m l w^2)`` and ``w(tau) = x_p / l``, read ``M q'' = h + WN^T f_N + WT^T f_T``
 for ``q = (phi, u2, u1)``::
 
     M  = [[1/3, 0, 1/2 cos phi], [0, J, 0], [1/2 cos phi, 0, 1 + J1]]
-    h  = (P cos phi (sin phi0 - sin phi),  -f_L,  1/2 phi'^2 sin phi + K1 (w - u1) - C1 u1')
+    h  = (P cos phi (sin phi0 - sin phi) + f_p cos phi,  -f_L,
+          1/2 phi'^2 sin phi + K1 (w - u1) - C1 u1')
     WN = (-cos phi, 0, -1),  wN = 0,       WT = (sin phi, 1, 0),  wT = 0
     wNbar = phi'^2 sin phi,                wTbar = phi'^2 cos phi
 
@@ -67,15 +69,16 @@ Stator dynamics switched off (``stator="rigid"``) is the limit ``k1 -> oo``:
 ``u1 = w(tau)`` is prescribed, ``q = (phi, u2)`` and the equations are the
 friction drive's with ``u1`` replaced by ``w``::
 
-    h  = (P cos phi (sin phi0 - sin phi) - 1/2 w'' cos phi, -f_L)
+    h  = (P cos phi (sin phi0 - sin phi) - 1/2 w'' cos phi + f_p cos phi, -f_L)
     WN = (-cos phi, 0),  wN = -w',  wNbar = phi'^2 sin phi - w''
 
-With ``alpha = 0`` (no hysteresis), ``u_sat = inf``, no preload and a sine,
-``w = d U_pp / (2 l) (1 - cos tau)``: the friction drive with ``x10 = d U_pp / 2``.
+With ``alpha = 0`` (no hysteresis), ``u_sat = inf`` and a sine,
+``w = d U_pp / (2 l) (1 - cos tau)``: the friction drive with ``x10 = d U_pp / 2``
+and the same preload.
 
 The paper's drive touches the rotor without force at the bottom of the
 stroke; a compliant stator then leaves the rotor there in brief flights
-every period. The preload (1 µm by default) keeps the tip pressed on.
+every period. The preload (0.01 N by default) keeps the tip pressed on.
 
 Identification and limits
 -------------------------
@@ -120,8 +123,8 @@ class PiezoDriveParams:
         Rod, rotor, spring, friction, load and restitution as in
         :class:`~moreau.scenes.friction_drive.FrictionDriveParams`.
     preload : float
-        Depth ``delta`` [m] >= 0 of the rotor surface below the free rod's tip:
-        the rod's spring presses the tip on with ``k l delta cos phi`` at rest
+        Preload ``F_p`` [N], >= 0: the force pressing the rod tip on the rotor
+        at rest, as in :class:`~moreau.scenes.friction_drive.FrictionDriveParams`
         (0: the paper's drive, which touches without force at zero voltage).
     m1 : float
         Stator mass [kg], > 0.
@@ -156,7 +159,7 @@ class PiezoDriveParams:
     mu: float = 0.1
     load: float = 0.0
     restitution: float = 0.0
-    preload: float = 1.0e-6
+    preload: float = 0.01
     m1: float = 2.0e-3
     k1: float = 3.2e5
     c1: float = 15.0
@@ -203,7 +206,7 @@ PIEZO_DEFAULTS = PiezoDriveParams()
 # -- the stack's free displacement, dimensionless ------------------------------------
 # par: 0 J, 1 P, 2 sin phi0, 3 fL, 4 A = d U_pp / l, 5 alpha, 6 b = beta U_pp,
 # 7 g = gamma U_pp, 8 sigma = U_sat / U_pp (0: none), 9 waveform, 10 smoothing,
-# 11 eta_lo, 12 eta_hi, 13 vmax, 14 J1, 15 K1, 16 C1, 17 rotor surface sin phi0 - delta / l
+# 11 eta_lo, 12 eta_hi, 13 vmax, 14 J1, 15 K1, 16 C1, 17 f_p
 
 @njit(cache=True)
 def _stack(par, t):
@@ -241,11 +244,11 @@ def _forces_dyn(par, q, v, t, D, need_jac):
     s, c = math.sin(q[0]), math.cos(q[0])
     spring = par[2] - s
     w = _stroke(par, t)[0]
-    D[0, 0] = par[1] * c * spring
+    D[0, 0] = par[1] * c * spring + par[17] * c
     D[1, 0] = -par[3]
     D[2, 0] = 0.5 * v[0] * v[0] * s + par[15] * (w - q[2]) - par[16] * v[2]
     if need_jac:
-        D[0, 1] = par[1] * (-s * spring - c * c)
+        D[0, 1] = par[1] * (-s * spring - c * c) - par[17] * s
         D[2, 1] = 0.5 * v[0] * v[0] * c
         D[2, 3] = -par[15]
         D[2, 4] = v[0] * s
@@ -254,14 +257,14 @@ def _forces_dyn(par, q, v, t, D, need_jac):
 
 @njit(cache=True)
 def _gaps_dyn(par, q, t, G):
-    G[0, 0] = par[17] - math.sin(q[0]) - q[2]
+    G[0, 0] = par[2] - math.sin(q[0]) - q[2]
 
 
 @njit(cache=True)
 def _contacts_dyn(par, q, t, G, need_gap, need_T):
     s = math.sin(q[0])
     if need_gap:
-        G[0, 0] = par[17] - s - q[2]
+        G[0, 0] = par[2] - s - q[2]
     G[0, 3] = -math.cos(q[0])
     G[0, 5] = -1.0
     if need_T:
@@ -289,15 +292,15 @@ def _forces_rig(par, q, v, t, D, need_jac):
     s, c = math.sin(q[0]), math.cos(q[0])
     ddw = _stroke(par, t)[2]
     spring = par[2] - s
-    D[0, 0] = par[1] * c * spring - 0.5 * ddw * c
+    D[0, 0] = par[1] * c * spring - 0.5 * ddw * c + par[17] * c
     D[1, 0] = -par[3]
     if need_jac:
-        D[0, 1] = par[1] * (-s * spring - c * c) + 0.5 * ddw * s
+        D[0, 1] = par[1] * (-s * spring - c * c) + 0.5 * ddw * s - par[17] * s
 
 
 @njit(cache=True)
 def _gaps_rig(par, q, t, G):
-    G[0, 0] = par[17] - math.sin(q[0]) - _stroke(par, t)[0]
+    G[0, 0] = par[2] - math.sin(q[0]) - _stroke(par, t)[0]
 
 
 @njit(cache=True)
@@ -305,7 +308,7 @@ def _contacts_rig(par, q, t, G, need_gap, need_T):
     s = math.sin(q[0])
     w, dw, _ = _stroke(par, t)
     if need_gap:
-        G[0, 0] = par[17] - s - w
+        G[0, 0] = par[2] - s - w
     G[0, 1] = -dw
     G[0, 3] = -math.cos(q[0])
     if need_T:
@@ -385,8 +388,8 @@ class PiezoDrive(DriveUnits, Scene):
         self.fL = p.load / self.force_scale
         self.phi0 = p.phi0
         self.sin_phi0 = math.sin(p.phi0)
-        #: height of the rotor surface over l: the preload lowers it below the free rod's tip
-        self.surface = self.sin_phi0 - p.preload / p.length
+        #: dimensionless preload ``f_p = F_p / (m l w^2)``
+        self.fp = p.preload / self.force_scale
         self.mu = np.array([p.mu])
         self.restitution = np.array([p.restitution])
         self.sigma = 0.0 if p.u_sat == math.inf else p.u_sat / p.voltage
@@ -396,13 +399,13 @@ class PiezoDrive(DriveUnits, Scene):
         self._par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.A, p.alpha, self.b,
                               self.g, self.sigma, float(WAVEFORMS[waveform]), self.smoothing,
                               self.eta_lo, self.eta_hi, self.vmax, self.J1, self.K1, self.C1,
-                              self.surface])
+                              self.fp])
         half = 0.5 * self.A * (self.vmax - self.eta_hi + self.eta_lo)
-        if not 2.0 * half < self.surface:
+        if not 2.0 * half < self.sin_phi0:
             raise InputError(
                 f"the stack's free stroke {2 * half * p.length!r} m (`gain` * `voltage` through "
-                f"saturation and hysteresis) must be < length*sin(phi0) - preload = "
-                f"{p.length * self.surface!r} m so that the rod stays above the horizontal")
+                f"saturation and hysteresis) must be < length*sin(phi0) = "
+                f"{p.length * self.sin_phi0!r} m so that the rod stays above the horizontal")
         #: velocity scale of the motion (half the quasi-static stroke), for tolerances
         self.velocity_scale = half
         self.ndof = 3 if stator == "dynamic" else 2
@@ -474,7 +477,7 @@ class PiezoDrive(DriveUnits, Scene):
     def forces(self, q, v, t):
         s, c = math.sin(q[0]), math.cos(q[0])
         w, _, ddw = _stroke(self._par, float(t))
-        rod = self.P * c * (self.sin_phi0 - s)
+        rod = self.P * c * (self.sin_phi0 - s) + self.fp * c
         if self.ndof == 2:
             return np.array([rod - 0.5 * ddw * c, -self.fL])
         return np.array([rod, -self.fL,
@@ -484,7 +487,7 @@ class PiezoDrive(DriveUnits, Scene):
         s, c = math.sin(q[0]), math.cos(q[0])
         n = self.ndof
         K, C = np.zeros((n, n)), np.zeros((n, n))
-        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c)
+        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) - self.fp * s
         if n == 2:
             K[0, 0] += 0.5 * _stroke(self._par, float(t))[2] * s
             return K, C
@@ -502,7 +505,7 @@ class PiezoDrive(DriveUnits, Scene):
         return w, dw
 
     def gaps(self, q, t):
-        return np.array([self.surface - math.sin(q[0]) - self._stator(q, t)[0]])
+        return np.array([self.sin_phi0 - math.sin(q[0]) - self._stator(q, t)[0]])
 
     def contact_jacobians(self, q, t):
         n = self.ndof
@@ -549,7 +552,7 @@ class PiezoDrive(DriveUnits, Scene):
         tip drives the rotor (the steady-state solver's plausibility check).
         """
         w, dw, _ = self.free_stroke(tau)
-        s = self.surface - w
+        s = self.sin_phi0 - w
         return s * dw / np.sqrt(1.0 - s * s) * self.amplification()
 
     def slip_velocity(self, q, v):
@@ -559,17 +562,16 @@ class PiezoDrive(DriveUnits, Scene):
     def rest_state(self):
         """State at ``tau = 0``: at rest in static equilibrium at zero voltage, rod on the rotor.
 
-        With the preload ``delta = preload / l`` the contact force ``f_N =
-        P (sin phi0 - sin phi)`` balances the rod's spring and pushes the
-        stator down: ``K1 u1 = -f_N`` with the gap closed, so
-        ``u1 = -P delta / (K1 + P)`` and ``sin phi = sin phi0 - delta - u1``
-        (``u1 = 0`` for a rigid stator). Every waveform starts with zero
-        voltage rate, so this state is on the contact manifold.
+        The contact force ``f_N = f_p + P (sin phi0 - sin phi)`` balances the
+        preload and the rod's spring and pushes the stator down,
+        ``K1 u1 = -f_N``, with the gap closed (``sin phi = sin phi0 - u1``):
+        ``u1 = -f_p / (K1 + P)`` (``u1 = 0`` and ``phi = phi0`` for a rigid
+        stator). Every waveform starts with zero voltage rate, so this state
+        is on the contact manifold.
         """
         q, v = np.zeros(self.ndof), np.zeros(self.ndof)
-        delta = self.sin_phi0 - self.surface
-        u1 = -self.P * delta / (self.K1 + self.P) if self.ndof == 3 else 0.0
-        q[0] = math.asin(self.surface - u1)
+        u1 = -self.fp / (self.K1 + self.P) if self.ndof == 3 else 0.0
+        q[0] = math.asin(self.sin_phi0 - u1)
         if self.ndof == 3:
             q[2] = u1
         return q, v
@@ -747,7 +749,7 @@ class PiezoDriveCase(DriveCase):
 
 #: SI units of the parameters of :class:`PiezoDriveParams`
 UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "",
-         "load": "N", "restitution": "", "preload": "m", "m1": "kg", "k1": "N/m", "c1": "N s/m", "gain": "m/V",
+         "load": "N", "restitution": "", "preload": "N", "m1": "kg", "k1": "N/m", "c1": "N s/m", "gain": "m/V",
          "voltage": "V", "alpha": "", "beta": "1/V", "gamma": "1/V", "u_sat": "V"}
 
 register_scene(SceneEntry(

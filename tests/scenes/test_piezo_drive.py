@@ -79,6 +79,12 @@ def test_rigid_linear_stack_reproduces_the_friction_drive():
     ea = simulate(piezo, (0.0, TWO_PI), q0, v0, "event-driven-generic", rtol=1e-12)
     eb = simulate(fd, (0.0, TWO_PI), *fd.rest_state(), "event-driven-generic", rtol=1e-12)
     assert np.max(np.abs(ea.q[-1] - eb.q[-1])) <= 1e-9 * fd.u10
+    # the friction drive's preload is the same force here
+    piezo = PiezoDrive(frequency=185.0, **dict(LINEAR_RIGID, preload=0.01))
+    fd = FrictionDrive(frequency=185.0, preload=0.01)
+    a = simulate(piezo, (0.0, 2 * TWO_PI), *piezo.initial_state(), "moreau-jean", h=h)
+    b = simulate(fd, (0.0, 2 * TWO_PI), *fd.rest_state(), "moreau-jean", h=h)
+    assert np.max(np.abs(a.q - b.q)) <= 1e-9 * fd.u10
 
 
 # -- (2) the displacement-voltage loop: area and saturation ---------------------------------------
@@ -207,9 +213,10 @@ def test_identification_refuses_bad_input():
 # -- the stator: two-way coupling, resonance, the compiled model against the reference ---------------
 
 def test_the_contact_force_pushes_the_stator_down_at_rest():
-    s = PiezoDrive(preload=2e-6)
+    s = PiezoDrive(preload=0.02)
     q, v = s.rest_state()
-    fN = s.P * (s.sin_phi0 - math.sin(q[0]))
+    fN = s.fp + s.P * (s.sin_phi0 - math.sin(q[0]))
+    assert 0.0 < fN < s.fp      # K1 / (K1 + P) of the preload: the rod's spring takes the rest
     # static balance of the stator (the contact row's -1) and of the rod
     assert abs(s.K1 * q[2] + fN) <= 1e-12 * fN
     assert np.max(np.abs(s.forces(q, v, 0.0) + s.contact_jacobians(q, 0.0)[0][0] * fN)) <= 1e-9
@@ -230,7 +237,7 @@ def test_moreau_jean_converges_to_the_event_driven_run_with_a_dynamic_stator():
 
 def test_near_resonance_the_motor_speed_follows_the_stroke():
     # a linear stack (a sine force on the stator) on a heavy stator, resonance 2 kHz, zeta 0.3
-    stack = dict(alpha=0.0, u_sat=math.inf, m1=0.02, k1=3.2e6, c1=150.0, preload=1e-6)
+    stack = dict(alpha=0.0, u_sat=math.inf, m1=0.02, k1=3.2e6, c1=150.0, preload=0.01)
     n = 500
     rows = []
     for f in (1200.0, 1800.0, 2800.0):
@@ -266,7 +273,7 @@ def test_near_resonance_the_motor_speed_follows_the_stroke():
     (dict(gamma=0.03), r"`gamma` must satisfy \|gamma\| <= beta"),
     (dict(beta=0.0), "`beta` must be > 0"),
     (dict(u_sat=-5.0), "`u_sat` must be > 0"),
-    (dict(preload=-1e-6), "`preload` must be >= 0"),
+    (dict(preload=-0.01), "`preload` must be >= 0"),
     (dict(waveform="sawtooth"), "`waveform` must be one of 'sine', 'triangle', 'square'"),
     (dict(smoothing=1.0), "`smoothing` must be in the open interval"),
     (dict(stator="soft"), "`stator` must be 'dynamic' or 'rigid'"),

@@ -33,7 +33,7 @@ TWO_PI = 2.0 * math.pi
 
 #: a linear stack on a heavy stator (resonance 2 kHz, damping ratio 0.3), preloaded rotor:
 #: the setting of the resonance test
-RESONANCE_STACK = dict(alpha=0.0, u_sat=math.inf, m1=0.02, k1=3.2e6, c1=150.0, preload=1e-6)
+RESONANCE_STACK = dict(alpha=0.0, u_sat=math.inf, m1=0.02, k1=3.2e6, c1=150.0, preload=0.01)
 
 
 def loop_curves(voltages, n=401, **params):
