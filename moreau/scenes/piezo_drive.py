@@ -733,8 +733,8 @@ class PiezoDriveCase(DriveCase):
     """The piezo drive's steady state; Moreau–Jean against the generic event-driven reference.
 
     At 1400 Hz by default: mode NP in steady contact (the generic event-driven
-    steady state in about 35 s), where the motor runs forwards at
-    1.27e-3 l per period; near 1000 Hz its displacement crosses zero.
+    steady state in about 20 s), where the motor runs forwards at
+    1.28e-3 l per period; near 1000 Hz its displacement crosses zero.
     """
 
     def __init__(self, frequency=1400.0, **params):
@@ -766,7 +766,8 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "load", "restitution",
                "preload", "m1",
                "k1", "c1", "gain", "voltage", "alpha", "beta", "gamma", "u_sat", "smoothing"),
-    # Moreau-Jean theta = 1 at 1000 steps: 7.1 % off the reference at 1400 Hz (the stator's
-    # oscillation under first-order steps; 0.9 % at 4000 steps, theta = 1/2 at 8000: 0.04 %)
+    # Moreau-Jean theta = 1 at 1000 steps: 6.5 % off the reference at 1400 Hz (the stator's
+    # oscillation under first-order steps; with the 1 um depth preload of an earlier version:
+    # 7.1 %, 0.9 % at 4000 steps, theta = 1/2 at 8000: 0.04 %)
     mj_tolerance=0.1,
 ))
