@@ -27,6 +27,7 @@ def python_snippets():
 PREAMBLES = {
     "from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams": "",
     "from moreau.integrators import simulate": "",
+    "from moreau.scenes.piezo_drive import PiezoDrive, identify_hysteresis": "",
     "from moreau.lcp import solve_lcp, build_friction_lcp": (
         "import numpy as np\n"
         "M = np.array([[2.0, 1.0], [1.0, 2.0]])\n"
@@ -45,6 +46,8 @@ CHECKS = {
         "assert ss.mode == 'NP' and res.success and si['t'][-1] > 0 and len(df) == len(res.t)",
     "from moreau.integrators import simulate":
         "assert res.success and res.stats['lcp_solves'] > 0 and ss.mode",
+    "from moreau.scenes.piezo_drive import PiezoDrive, identify_hysteresis":
+        "assert abs(fit.alpha - 0.3) < 1e-6 and abs(fit.beta - 0.02) < 1e-8 and ss.mode",
     "from moreau.lcp import solve_lcp, build_friction_lcp":
         "assert res.success and abs(res.z @ res.w) < 1e-12",
     "import moreau":
