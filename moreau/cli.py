@@ -12,8 +12,9 @@ import sys
 from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
-from .analysis.atlas import run_scene_atlas
+from .analysis.atlas import classify_budget, run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
+from .analysis.classify import CLASSIFY_PERIODS
 from .analysis.characteristic import motor_characteristic
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
@@ -358,6 +359,13 @@ def _add_atlas(sub):
     p.add_argument("--force", action="store_true",
                    help="replace the files of an earlier atlas with other settings (refused "
                         "otherwise)")
+    p.add_argument("--cold", action="store_true",
+                   help="start every point's shooting from rest (default: from its "
+                        "neighbour's orbit, with a cold start where that fails)")
+    p.add_argument("--classify-periods", type=int, default=None, metavar="N",
+                   help="budget of the plain run that names the motion of a point without a "
+                        "periodic orbit (period-k, non-periodic with its mean, runaway); "
+                        "0: none (default %d)" % CLASSIFY_PERIODS)
     _add_params(p, scheme_defaults=False)
     add_scene_options(p, with_set=False)
     p.set_defaults(func=_cmd_atlas)
@@ -405,7 +413,8 @@ def _cmd_atlas(args):
     run_scene_atlas(entry.name, axes[0], axes[1], fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-                    force=args.force)
+                    force=args.force, continuation=not args.cold,
+                    classify=classify_budget(args))
 
 
 # -- moreau reproduce ---------------------------------------------------------------

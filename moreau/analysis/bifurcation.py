@@ -63,6 +63,7 @@ from ..regimes import Regime
 from ..scenes import registry
 from . import engine
 from ..integrators.event_driven_generic import project_positions
+from .classify import MAX_PERIOD_K, sequence_period
 from .engine import check_output_dir
 from .period_k import full_state_of
 from .periodic_shooting import free_bases, period_map_options, touching_contacts
@@ -73,8 +74,6 @@ __all__ = ["bifurcation_diagram", "section_samples", "sequence_period", "classif
            "bifurcation_marks", "bifurcation_tag", "bifurcation_figure", "MAX_PERIOD_K"]
 
 TWO_PI = 2.0 * math.pi
-#: the longest period the sampled sequence is tested for
-MAX_PERIOD_K = 8
 #: separation of the Lyapunov companion, relative to the state's scale
 LYAPUNOV_DELTA0 = 1e-7
 #: a separation collapsed below this fraction of delta0 counts as this (a stick erased it)
@@ -86,36 +85,6 @@ ORBIT_SETTLE = 10
 LYAPUNOV_THRESHOLD = 1e-3
 #: bound on transient + sampled periods of one point
 MAX_PERIODS = 10**6
-
-
-def sequence_period(samples, rtol=1e-6, kmax=MAX_PERIOD_K):
-    """The smallest ``k <= kmax`` with ``x_{j+k} = x_j`` over the samples, or 0.
-
-    Parameters
-    ----------
-    samples : ndarray, shape (m, d)
-        Section states, one row per period.
-    rtol : float
-        Tolerance relative to each column's scale (its largest magnitude
-        over the samples, at least the largest column scale times 1e-12).
-
-    Examples
-    --------
-    >>> x = np.array([[1.0], [2.0], [1.0], [2.0], [1.0], [2.0]])
-    >>> sequence_period(x), sequence_period(x[:, 0][:, None] * [1, 0] + [0, 1])
-    (2, 2)
-    >>> sequence_period(np.arange(6.0)[:, None])
-    0
-    """
-    x = np.asarray(samples, dtype=float)
-    if x.ndim != 2 or x.shape[0] < 2:
-        raise InputError(f"`samples` must have shape (m, d) with m >= 2, got {x.shape}")
-    scale = np.max(np.abs(x), axis=0)
-    scale = np.maximum(scale, 1e-12 * max(float(np.max(scale)), 1e-300))
-    for k in range(1, min(kmax, x.shape[0] - 1) + 1):
-        if np.all(np.abs(x[k:] - x[:-k]) <= rtol * scale):
-            return k
-    return 0
 
 
 def bifurcation_tag(scene, parameter, frequency, scheme, options=None):

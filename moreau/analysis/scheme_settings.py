@@ -173,12 +173,14 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     return Scheme(scheme, theta, steps_per_period, rtol, options)
 
 
-def steady_of(scene, scheme, max_period=1, statistical=False):
+def steady_of(scene, scheme, max_period=1, statistical=False, guess=None):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
 
     Sweeps, atlases and comparisons want a periodic orbit or a failure, so
     the statistical steady state (:mod:`moreau.analysis.statistical`) is
     only the fallback with ``statistical=True`` (``moreau steady``).
+    ``guess`` is a neighbouring point's period-1 orbit to start the
+    shooting from (continuation, :mod:`moreau.analysis.continuation`).
 
     Examples
     --------
@@ -191,7 +193,7 @@ def steady_of(scene, scheme, max_period=1, statistical=False):
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
         return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
                                  steps_per_period=scheme.steps_per_period, max_period=max_period,
-                                 statistical=statistical, **kw, **scheme.options)
+                                 statistical=statistical, guess=guess, **kw, **scheme.options)
     # an adaptive scheme's period map carries its own error tolerance: the shooting
     # aims above it unless told otherwise (a fixed-step map is deterministic)
     kw = {"rtol": scheme.rtol if scheme.rtol is not None else
@@ -203,4 +205,4 @@ def steady_of(scene, scheme, max_period=1, statistical=False):
     if scheme.options:
         kw["scheme_options"] = scheme.options
     return find_steady_state(scene, scheme=scheme.name, max_period=max_period,
-                             statistical=statistical, **kw)
+                             statistical=statistical, guess=guess, **kw)
