@@ -341,7 +341,9 @@ def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive
         ss = rec["steady"]
         steady = (scenes[id(ss)], ss) if ss is not None else rec["error"]
         if _painleve_margin(p) <= 0:
+            # ill-posed before any shooting: nothing was continued or started
             steady = None
+            rec.update(start="cold", solves=0)
         row, ss = _evaluate(p, f, scheme, checks, version, scene, energy, steady=steady)
         row["compute_time_s"] += rec["seconds"]
         row["start"] = rec["start"]
