@@ -37,6 +37,7 @@ from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
 from .classify import CLASSIFY_COLUMNS, classification_columns
+from .floquet import floquet_report
 from .continuation import solve_line
 from .steady_state import implausible_steady_state
 
@@ -176,6 +177,8 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     dict
         ``mode``, ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``min_normal_force_N``, ``periodic_residual``, ``shooting_iterations``,
+        ``max_multiplier`` (the largest Floquet multiplier's modulus, NaN where
+        none was computed) and ``stable`` (True, False, or "" where unknown),
         ``compute_time_s``, ``status`` (``"ok"`` or the cause of the failure)
         and the cross-check columns. Never raises for a failed point.
 
@@ -215,7 +218,7 @@ def _evaluate(params, frequency, scheme, checks=(), version="", scene="friction-
     t0 = time.perf_counter()
     row = {"mode": "", "displacement_per_period_m": math.nan, "average_velocity_m_per_s": math.nan,
            "min_normal_force_N": math.nan, "periodic_residual": math.nan,
-           "shooting_iterations": 0, "status": "ok"}
+           "shooting_iterations": 0, "max_multiplier": math.nan, "stable": "", "status": "ok"}
     ref = math.nan
     _check_scene(scene)
     margin = _painleve_margin(params)
@@ -242,6 +245,10 @@ def _evaluate(params, frequency, scheme, checks=(), version="", scene="friction-
         else:
             sc, ss = steady
         ref = sc.displacement_to_si(ss.displacement_per_period)
+        rep = floquet_report(ss)
+        row.update(max_multiplier=math.nan if rep["max_multiplier"] is None
+                   else rep["max_multiplier"],
+                   stable="" if rep["stable"] is None else bool(rep["stable"]))
         row.update(mode=ss.mode, displacement_per_period_m=ref,
                    average_velocity_m_per_s=ref * frequency,
                    min_normal_force_N=sc.force_to_si(ss.min_normal_force),
