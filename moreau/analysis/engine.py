@@ -121,9 +121,15 @@ def _make_scene(params, frequency, scene):
     return registry.make_scene(_check_scene(scene).name, frequency=frequency, **params)
 
 
+#: shooting iterations of a continued point: a neighbour's orbit converges in a few, and a
+#: step that does not is halved or started cold rather than iterated on
+CONTINUED_MAX_ITER = 12
+
+
 def _steady(params, frequency, scheme, scene="friction-drive", guess=None):
     scene = _make_scene(params, frequency, scene)
-    return scene, steady_of(scene, scheme, guess=guess)
+    return scene, steady_of(scene, scheme, guess=guess,
+                            max_iter=None if guess is None else CONTINUED_MAX_ITER)
 
 
 def _implausible(params, scene, ss):

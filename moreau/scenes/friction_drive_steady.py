@@ -65,12 +65,15 @@ def _min_normal_force(walker, segments):
 _FLIGHT_SEARCH_PERIODS = 50
 
 
-def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
+def _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope=None):
     """Safeguarded secant iteration on the scalar period map ``u2'(tau_s) -> u2'(tau_s + 2 pi)``.
 
     Returns ``(start_state, iterations, last_end_state)``; ``start_state`` is
     ``None`` when the rod is in flight at the section, where the map is not
-    scalar.
+    scalar. ``slope``, an estimate of ``P' - 1`` (a neighbouring orbit's
+    multiplier minus 1), makes the first step a Newton step instead of a
+    fixed-point step, which covers only ``1 - P'`` of the distance on a
+    barely contracting map.
     """
     vs = walker.vscale
     phi_s, dphi_s = walker.manifold(tau_s)
@@ -87,6 +90,8 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     if fa == 0.0:
         return st, it, end
     xb = end.du2
+    if slope is not None and -2.5 < slope < -1e-6:
+        xb = v0 - fa / slope
     while True:
         if end.regime == Regime.FLIGHT:
             return None, it, end
@@ -146,10 +151,15 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
     phig, dphig = walker.g_phi, walker.g_dphi
     Dg = scene.coefficients(phig, dphig, tg)[3]
     tau_s = 0.0 if Dg[0] <= 0.5 * Dg.min() else float(tg[int(np.argmin(Dg))])
+    slope = None
     if v_guess is None and guess is not None:
         v_guess = float(np.asarray(guess.state0, float)[-1])
+        m = getattr(guess, "floquet_multipliers", None)
+        if m is not None and len(m) == 1 and abs(complex(m[0]).imag) == 0.0:
+            # the neighbour's multiplier: the slope of this point's scalar map, nearly
+            slope = complex(m[0]).real - 1.0
     v0 = walker.vtip(tau_s) if v_guess is None else float(v_guess)
-    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter)
+    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope)
     if st0 is None:
         # the rod is in flight at this section in the steady state: move the
         # section into the longest contact segment of the settled motion
