@@ -266,7 +266,8 @@ def classification_columns(row, params, frequency, scheme, scene, steady=None,
     steady : SteadyState, optional
         The point's steady state, where it has one.
     budget : int
-        Periods run for a point without one (:func:`classify_long_run`).
+        Periods run for a point without one (:func:`classify_long_run`);
+        0: no run, the point stays ``failed``.
 
     Returns
     -------
@@ -299,6 +300,10 @@ def classification_columns(row, params, frequency, scheme, scene, steady=None,
     label = _label_of_status(status)
     if label is not None:
         out.update(classification=label, classification_detail=status)
+        return out
+    if not budget:
+        out.update(classification="failed",
+                   classification_detail=f"{status}; not run (a budget of 0 periods)")
         return out
     try:
         sc = registry.make_scene(scene, frequency=frequency, **params)

@@ -313,7 +313,7 @@ def audit_options(scheme):
 
 
 def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive",
-                    energy=False, continuation=True, classify=0):
+                    energy=False, continuation=True, classify=None):
     """:func:`evaluate_point` over a line of ``(params, frequency)``: one cache entry for many points.
 
     With ``continuation`` the points are neighbours in this order and each
@@ -322,7 +322,7 @@ def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive
     start where that fails). Every row says how it started (``start``, one
     of :data:`~moreau.analysis.continuation.START_VALUES`, and
     ``continuation_solves``). With ``classify`` (a budget of drive periods,
-    0 for none) every row gets the :data:`CLASSIFY_COLUMNS`
+    0 for no run; None for no columns) every row gets the :data:`CLASSIFY_COLUMNS`
     (:mod:`moreau.analysis.classify`): a point without a periodic orbit is
     named period-k, non-periodic (with its mean), runaway, ... instead of
     only failed, from a plain run of at most ``classify`` periods.
@@ -361,7 +361,7 @@ def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive
         row["compute_time_s"] += rec["seconds"]
         row["start"] = rec["start"]
         row["continuation_solves"] = rec["solves"]
-        if classify:
+        if classify is not None:
             t0 = time.perf_counter()
             row.update(classification_columns(row, p, f, scheme, scene, ss,
                                               budget=int(classify)))
@@ -522,7 +522,7 @@ def _memory(cache_dir):
 
 def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
                progress=False, desc="points", chunk=1, scene="friction-drive", energy=False,
-               continuation=True, classify=0):
+               continuation=True, classify=None):
     """Evaluate many points, reusing cached ones, in parallel.
 
     Parameters
@@ -549,9 +549,10 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     continuation : bool
         With ``chunk`` > 1: the points of a chunk are neighbours, each
         shot from the previous one's orbit (:func:`evaluate_points`).
-    classify : int
-        With ``chunk`` > 1: name the long-run motion of every point without
-        an orbit from a plain run of at most this many periods (0: none).
+    classify : int, optional
+        With ``chunk`` > 1: the classification columns, naming the long-run
+        motion of every point without an orbit from a plain run of at most
+        this many periods (0: no run).
 
     Returns
     -------
@@ -583,7 +584,7 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
 
 
 def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, desc, chunk,
-                scene, energy, continuation=True, classify=0):
+                scene, energy, continuation=True, classify=None):
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
@@ -595,7 +596,8 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
         func = _memory(cache_dir).cache(evaluate_points, ignore=[])
         groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
         args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene,
-                 bool(energy), bool(continuation), int(classify)) for g in groups]
+                 bool(energy), bool(continuation), None if classify is None else int(classify))
+                for g in groups]
         sizes = [len(g) for g in groups]
     out = [None] * len(args)
     todo = []

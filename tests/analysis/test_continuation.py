@@ -115,3 +115,24 @@ def test_classification_columns_of_rows():
     assert "shooting did not converge" in cols["classification_detail"]
     assert point_label({"status": failed["status"], "classification": "period-2"}) == "period-2"
     assert point_label({"status": failed["status"], "classification": "failed"}) == "failed"
+
+
+def test_atlas_command_cold_and_classify_options(tmp_path):
+    from moreau import cli
+    from moreau.studies.paper.tables import read_table
+
+    args = ["atlas", "--plane", "f-mu", "--f-points", "2", "--y-points", "2", "--fmin", "185",
+            "--fmax", "2000", "--no-plot", "--quiet", "--jobs", "1", "--out", str(tmp_path)]
+    assert cli.main(args + ["--cold", "--classify-periods", "0"]) in (0, None)
+    rows = read_table(tmp_path / "atlas_f-mu.csv")
+    assert [r["start"] for r in rows] == ["cold"] * 4
+    assert {r["classification"] for r in rows} == {"period-1"}
+    # other settings: refused without --force, the rule named
+    assert cli.main(args) == 2
+    assert cli.main(args + ["--force"]) in (0, None)
+    # each line of constant frequency (mu 0.01 and 0.99) starts cold; its second point is
+    # continued, or at 2000 Hz, where NP turns SP over that step, falls back to a cold start
+    starts = [r["start"] for r in read_table(tmp_path / "atlas_f-mu.csv")]
+    assert starts[0::2] == ["cold", "cold"] and starts[1] == "continued"
+    assert starts[3] in ("continued", "cold-fallback")
+    assert cli.main(args + ["--classify-periods", "-1", "--force"]) == 2
