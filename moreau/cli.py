@@ -234,7 +234,8 @@ def _cmd_bifurcation(args):
                             samples=args.samples, lyapunov=not args.no_lyapunov,
                             shoot=not args.no_shoot, quantities=args.quantity, out=args.out,
                             progress=not args.quiet, plot=not args.no_plot, force=args.force,
-                            log=(lambda s: None) if args.json else print)
+                            log=(lambda s: None) if args.json else print,
+                            refine=args.refine)
     if args.json:
         print(json.dumps({"scene": d["scene"], "scheme": d["scheme"],
                           "parameter": d["parameter_column"],
@@ -612,6 +613,9 @@ def build_parser():
     b.add_argument("--quantity", action="append", metavar="COLUMN",
                    help="section column drawn (repeatable; default displacement_per_period, q_0)")
     b.add_argument("--no-lyapunov", action="store_true", help="skip the Lyapunov exponent")
+    b.add_argument("--refine", action="store_true",
+                   help="locate every mark between its neighbours by root finding on the "
+                        "period-1 orbit (up to 40 more shootings a mark)")
     b.add_argument("--no-shoot", action="store_true",
                    help="do not start from a shot periodic orbit (only the transient)")
     b.add_argument("--json", action="store_true", help="print one JSON object")

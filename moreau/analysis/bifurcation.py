@@ -32,7 +32,7 @@ Between neighbouring points, a change of ``k`` from ``k`` to ``2 k`` is
 marked as a period doubling, another change of ``k`` as a period change, a
 change of the flight flag as grazing (contact lost or regained), first at
 the midpoint of the two values. Where the period-1 orbit can be shot there
-(``refine``, :func:`refine_mark`), each mark is then located by root finding
+(``refine``, ``--refine``, :func:`refine_mark`), each mark is then located by root finding
 between the two values on the orbit: regula falsi on ``lambda + 1`` of its
 most negative real multiplier (period doubling), on ``lambda - 1`` of its
 largest positive one or bisection on its existence (saddle-node: named apart
@@ -248,7 +248,7 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                         scheme="event-driven", scheme_options=None, steps_per_period=None,
                         transient=200, samples=50, lyapunov=True, shoot=True, period_rtol=1e-6,
                         quantities=None, out="out", progress=True, plot=True, force=False,
-                        log=print, refine=True):
+                        log=print, refine=False):
     """Section samples of the long-run motion of ``scene`` against ``parameter``.
 
     Parameters
@@ -288,7 +288,8 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         With ``shoot``: locate every grazing, period doubling and period
         change between its grid neighbours by root finding on the
         period-1 orbit (:func:`refine_mark`), and name a saddle-node apart
-        from other period changes.
+        from other period changes. Off by default: up to
+        :data:`REFINE_EVALS` shootings a mark, seconds each above lift-off.
 
     Returns
     -------
