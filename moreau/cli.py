@@ -12,9 +12,10 @@ import sys
 from . import __version__
 from .analysis import compare as cmp
 from .analysis.engine import check_jobs, check_output_dir, check_scheduler, make_scheme
-from .analysis.atlas import run_scene_atlas
+from .analysis.atlas import classify_budget, run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
 from .analysis.characteristic import efficiency_vs_frequency, motor_characteristic
+from .analysis.classify import CLASSIFY_PERIODS
 from .analysis.sweep import run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
@@ -258,7 +259,8 @@ def _cmd_bifurcation(args):
                             samples=args.samples, lyapunov=not args.no_lyapunov,
                             shoot=not args.no_shoot, quantities=args.quantity, out=args.out,
                             progress=not args.quiet, plot=not args.no_plot, force=args.force,
-                            log=(lambda s: None) if args.json else print)
+                            log=(lambda s: None) if args.json else print,
+                            refine=args.refine)
     if args.json:
         print(json.dumps({"scene": d["scene"], "scheme": d["scheme"],
                           "parameter": d["parameter_column"],
@@ -383,6 +385,13 @@ def _add_atlas(sub):
     p.add_argument("--force", action="store_true",
                    help="replace the files of an earlier atlas with other settings (refused "
                         "otherwise)")
+    p.add_argument("--cold", action="store_true",
+                   help="start every point's shooting from rest (default: from its "
+                        "neighbour's orbit, with a cold start where that fails)")
+    p.add_argument("--classify-periods", type=int, default=None, metavar="N",
+                   help="budget of the plain run that names the motion of a point without a "
+                        "periodic orbit (period-k, non-periodic with its mean, runaway); "
+                        "0: none (default %d)" % CLASSIFY_PERIODS)
     _add_params(p, scheme_defaults=False)
     add_scene_options(p, with_set=False)
     p.set_defaults(func=_cmd_atlas)
@@ -430,7 +439,8 @@ def _cmd_atlas(args):
     run_scene_atlas(entry.name, axes[0], axes[1], fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-                    force=args.force)
+                    force=args.force, continuation=not args.cold,
+                    classify=classify_budget(args))
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -628,6 +638,9 @@ def build_parser():
     b.add_argument("--quantity", action="append", metavar="COLUMN",
                    help="section column drawn (repeatable; default displacement_per_period, q_0)")
     b.add_argument("--no-lyapunov", action="store_true", help="skip the Lyapunov exponent")
+    b.add_argument("--refine", action="store_true",
+                   help="locate every mark between its neighbours by root finding on the "
+                        "period-1 orbit (up to 40 more shootings a mark)")
     b.add_argument("--no-shoot", action="store_true",
                    help="do not start from a shot periodic orbit (only the transient)")
     b.add_argument("--json", action="store_true", help="print one JSON object")

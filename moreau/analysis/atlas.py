@@ -33,10 +33,35 @@ from ..errors import InputError
 from ..outputs import claim_outputs
 from ..provenance import provenance
 from . import engine
+from .classify import CLASSIFY_COLUMNS, CLASSIFY_PERIODS
 from .engine import ED_REFERENCE, check_output_dir
 from .sweep import VALUE_COLUMNS, MAX_POINTS, plan_points, sweep_tag
 
-__all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure"]
+__all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure", "classify_budget", "ATLAS_COLUMNS"]
+
+#: the columns of an atlas row beyond the sweep's: how the point started and what it does
+ATLAS_COLUMNS = ("start", "continuation_solves") + CLASSIFY_COLUMNS
+
+
+def classify_budget(args):
+    """The ``--classify-periods`` of parsed arguments, checked (default :data:`CLASSIFY_PERIODS`).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> classify_budget(SimpleNamespace(classify_periods=None)) == CLASSIFY_PERIODS
+    True
+    >>> classify_budget(SimpleNamespace(classify_periods=-1))
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `--classify-periods` must be a whole number >= 0 (0: no run), got -1
+    """
+    n = getattr(args, "classify_periods", None)
+    if n is None:
+        return CLASSIFY_PERIODS
+    if isinstance(n, bool) or not isinstance(n, int) or n < 0:
+        raise InputError(f"`--classify-periods` must be a whole number >= 0 (0: no run), got {n!r}")
+    return n
 
 
 def atlas_tag(scene, x, y, frequency, scheme):
@@ -56,7 +81,7 @@ def atlas_tag(scene, x, y, frequency, scheme):
 
 def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE, out="out",
                     cache_dir=None, n_jobs=-1, scheduler=None, progress=True, plot=True,
-                    log=print, force=False):
+                    log=print, force=False, continuation=True, classify=CLASSIFY_PERIODS):
     """Steady states of the registered scene ``scene`` on the grid ``x`` by ``y``.
 
     Parameters
@@ -78,11 +103,23 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
     force : bool
         Replace the files of an earlier atlas with other settings; refused
         otherwise, before any work (:func:`moreau.outputs.claim_outputs`).
+    continuation : bool
+        Along each line of constant ``y``, every point's shooting starts
+        from its neighbour's orbit (:mod:`moreau.analysis.continuation`),
+        with halved steps and a cold start where that fails; False: every
+        point starts cold.
+    classify : int
+        Budget of drive periods of the plain run that names the long-run
+        motion of a point without an orbit (:mod:`moreau.analysis.classify`);
+        0: none.
 
     Returns
     -------
     list of dict
-        One tidy row per point, ``x`` varying fastest.
+        One tidy row per point, ``x`` varying fastest, with the
+        :data:`ATLAS_COLUMNS` (``start``: continued, cold or
+        cold-fallback; ``classification``: period-k, non-periodic,
+        runaway, ..., with its detail and displacement).
     """
     (xname, xv), (yname, yv) = x, y
     if xname == yname:
@@ -105,10 +142,14 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
             "frequency_Hz": frequency,
             "fixed": {k: v for k, v in points[0][0].items() if k not in (xname, yname)},
             "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                       scheme.options]}, force)
+                       scheme.options], "continuation": bool(continuation),
+            "classify_periods": int(classify)}, force)
+    # a line of constant y is one task: its points are continued one from the next
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"atlas {xname}-{yname}", scene=entry.name)
+                                    desc=f"atlas {xname}-{yname}", scene=entry.name,
+                                    chunk=xv.size, continuation=continuation,
+                                    classify=classify)
     table = []
     for (a, b), (p, f), row in zip(grid, points, rows):
         r = {columns[xname]: float(a), columns[yname]: float(b), "scene": entry.name,
@@ -118,8 +159,9 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         for name, val in p.items():
             if name not in (xname, yname):
                 r[columns[name]] = val
-        for c in VALUE_COLUMNS:
-            r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
+        for c in VALUE_COLUMNS + ATLAS_COLUMNS:
+            r[c] = row.get(c, "" if c in ("mode", "status", "start", "classification",
+                                          "classification_detail") else math.nan)
         table.append(r)
     if out is None:
         return table
@@ -140,6 +182,8 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
                        "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
                        "options": scheme.options},
             "modes": _mode_counts(table),
+            "continuation": bool(continuation), "classify_periods": int(classify),
+            "starts": _counts(table, "start"), "classifications": _counts(table, "classification"),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
     json_path = stem.with_name(stem.name + ".json")
@@ -155,7 +199,17 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
 
 
 def _label(row):
-    return row["mode"] if row["status"] == "ok" else "failed"
+    if row["status"] == "ok":
+        return row["mode"]
+    cls = row.get("classification", "")
+    return cls if cls and cls != "failed" else "failed"
+
+
+def _counts(table, key):
+    counts = {}
+    for r in table:
+        counts[r.get(key, "")] = counts.get(r.get(key, ""), 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
 
 def _mode_counts(table):

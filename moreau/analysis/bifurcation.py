@@ -30,8 +30,13 @@ For every point it reports:
 
 Between neighbouring points, a change of ``k`` from ``k`` to ``2 k`` is
 marked as a period doubling, another change of ``k`` as a period change, a
-change of the flight flag as grazing (contact lost or regained), located by
-the midpoint of the two values (the grid's resolution is stated with it).
+change of the flight flag as grazing (contact lost or regained), first at
+the midpoint of the two values. Where the period-1 orbit can be shot there
+(``refine``, ``--refine``, :func:`refine_mark`), each mark is then located by root finding
+between the two values on the orbit: regula falsi on ``lambda + 1`` of its
+most negative real multiplier (period doubling), on ``lambda - 1`` of its
+largest positive one or bisection on its existence (saddle-node: named apart
+from other period changes), bisection on flight in the orbit (grazing).
 
 Outputs: ``OUT/bifurcation_SCENE_P[_FREQ]_SCHEME.csv`` (one row per section
 sample, units in the column names, the point's ``period``,
@@ -63,6 +68,7 @@ from ..regimes import Regime
 from ..scenes import registry
 from . import engine
 from ..integrators.event_driven_generic import project_positions
+from .classify import MAX_PERIOD_K, sequence_period
 from .engine import check_output_dir
 from .period_k import full_state_of
 from .periodic_shooting import free_bases, period_map_options, touching_contacts
@@ -70,11 +76,10 @@ from .scheme_settings import make_scheme, steady_of
 from .sweep import MAX_POINTS, plan_points
 
 __all__ = ["bifurcation_diagram", "section_samples", "sequence_period", "classify_motion",
-           "bifurcation_marks", "bifurcation_tag", "bifurcation_figure", "MAX_PERIOD_K"]
+           "bifurcation_marks", "bifurcation_tag", "bifurcation_figure", "MAX_PERIOD_K",
+           "refine_mark", "flip_scalar", "fold_scalar"]
 
 TWO_PI = 2.0 * math.pi
-#: the longest period the sampled sequence is tested for
-MAX_PERIOD_K = 8
 #: separation of the Lyapunov companion, relative to the state's scale
 LYAPUNOV_DELTA0 = 1e-7
 #: a separation collapsed below this fraction of delta0 counts as this (a stick erased it)
@@ -86,36 +91,6 @@ ORBIT_SETTLE = 10
 LYAPUNOV_THRESHOLD = 1e-3
 #: bound on transient + sampled periods of one point
 MAX_PERIODS = 10**6
-
-
-def sequence_period(samples, rtol=1e-6, kmax=MAX_PERIOD_K):
-    """The smallest ``k <= kmax`` with ``x_{j+k} = x_j`` over the samples, or 0.
-
-    Parameters
-    ----------
-    samples : ndarray, shape (m, d)
-        Section states, one row per period.
-    rtol : float
-        Tolerance relative to each column's scale (its largest magnitude
-        over the samples, at least the largest column scale times 1e-12).
-
-    Examples
-    --------
-    >>> x = np.array([[1.0], [2.0], [1.0], [2.0], [1.0], [2.0]])
-    >>> sequence_period(x), sequence_period(x[:, 0][:, None] * [1, 0] + [0, 1])
-    (2, 2)
-    >>> sequence_period(np.arange(6.0)[:, None])
-    0
-    """
-    x = np.asarray(samples, dtype=float)
-    if x.ndim != 2 or x.shape[0] < 2:
-        raise InputError(f"`samples` must have shape (m, d) with m >= 2, got {x.shape}")
-    scale = np.max(np.abs(x), axis=0)
-    scale = np.maximum(scale, 1e-12 * max(float(np.max(scale)), 1e-300))
-    for k in range(1, min(kmax, x.shape[0] - 1) + 1):
-        if np.all(np.abs(x[k:] - x[:-k]) <= rtol * scale):
-            return k
-    return 0
 
 
 def bifurcation_tag(scene, parameter, frequency, scheme, options=None):
@@ -273,7 +248,7 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                         scheme="event-driven", scheme_options=None, steps_per_period=None,
                         transient=200, samples=50, lyapunov=True, shoot=True, period_rtol=1e-6,
                         quantities=None, out="out", progress=True, plot=True, force=False,
-                        log=print):
+                        log=print, refine=False):
     """Section samples of the long-run motion of ``scene`` against ``parameter``.
 
     Parameters
@@ -309,6 +284,12 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         Output folder, checked writable before any work; None writes nothing.
     force : bool
         Replace the files of an earlier diagram with other settings.
+    refine : bool
+        With ``shoot``: locate every grazing, period doubling and period
+        change between its grid neighbours by root finding on the
+        period-1 orbit (:func:`refine_mark`), and name a saddle-node apart
+        from other period changes. Off by default: up to
+        :data:`REFINE_EVALS` shootings a mark, seconds each above lift-off.
 
     Returns
     -------
@@ -412,6 +393,12 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         if bar is not None:
             bar.close()
     marks = bifurcation_marks(points, parameter)
+    if refine and steady_scheme is not None and not interrupted:
+        def orbit_at(val):
+            p, f = point({parameter: val})
+            return steady_of(registry.make_scene(entry.name, frequency=f, **p), steady_scheme)
+        marks = [refine_mark(m, orbit_at) if m["kind"] != "period halving" else m
+                 for m in marks]
     result = {"points": points, "marks": marks, "columns": unit_of,
               "parameter_column": columns[parameter], "scene": entry.name, "scheme": scheme,
               "interrupted": interrupted}
@@ -485,6 +472,174 @@ def bifurcation_marks(points, parameter):
             marks.append({"kind": "grazing", "from": "flight" if a["flight"] else "contact",
                           "to": "flight" if b["flight"] else "contact", **where})
     return marks
+
+
+#: a refined mark's bracket, relative to the grid interval it was found in
+REFINE_XTOL = 1e-6
+#: evaluations (orbits shot) a refinement may spend
+REFINE_EVALS = 40
+
+
+def _real_multipliers(ss):
+    m = ss.floquet_multipliers
+    if m is None:
+        return np.zeros(0)
+    m = np.asarray(m, dtype=complex)
+    return m[np.abs(m.imag) <= 1e-9 * np.maximum(1.0, np.abs(m))].real
+
+
+def flip_scalar(ss):
+    """``lambda + 1`` for the most negative real Floquet multiplier of an orbit (NaN without one).
+
+    It changes sign where the multiplier crosses -1: a period doubling.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> flip_scalar(SimpleNamespace(floquet_multipliers=np.array([0.3, -1.2])))
+    -0.19999999999999996
+    """
+    r = _real_multipliers(ss)
+    r = r[r < 0]
+    return float(np.min(r)) + 1.0 if r.size else math.nan
+
+
+def fold_scalar(ss):
+    """``lambda - 1`` for the largest positive real Floquet multiplier (NaN without one).
+
+    It reaches 0 where the multiplier reaches +1: a saddle-node (fold), where
+    the orbit meets another and both disappear.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> fold_scalar(SimpleNamespace(floquet_multipliers=np.array([0.5, -0.2])))
+    -0.5
+    """
+    r = _real_multipliers(ss)
+    r = r[r > 0]
+    return float(np.max(r)) - 1.0 if r.size else math.nan
+
+
+def _try(orbit_at, v):
+    try:
+        return orbit_at(v)
+    except MoreauError:
+        return None
+
+
+def _bisect(pred, a, b, pa, xtol, evals):
+    # the last a with pred == pa and the first b without, to xtol (pred(b) != pa)
+    n = 0
+    while abs(b - a) > xtol and n < evals:
+        m = 0.5 * (a + b)
+        if pred(m) == pa:
+            a = m
+        else:
+            b = m
+        n += 1
+    return a, b, n
+
+
+def _brent(fun, a, b, fa, fb, xtol, evals):
+    # Illinois regula falsi on a sign change of fun over [a, b]
+    n, side = 0, 0
+    while abs(b - a) > xtol and n < evals:
+        c = (a * fb - b * fa) / (fb - fa)
+        if not min(a, b) < c < max(a, b):
+            c = 0.5 * (a + b)
+        fc = fun(c)
+        n += 1
+        if not math.isfinite(fc):
+            return a, b, n, False
+        if fc == 0.0:
+            return c, c, n, True
+        if (fc > 0) == (fb > 0):
+            b, fb = c, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            a, fa = c, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
+    return a, b, n, True
+
+
+def refine_mark(mark, orbit_at, xtol=REFINE_XTOL, evals=REFINE_EVALS):
+    """A mark located by root finding on the period-1 orbit between its grid neighbours.
+
+    Parameters
+    ----------
+    mark : dict
+        A mark of :func:`bifurcation_marks` (``kind``, ``between``, ``at``).
+    orbit_at : callable
+        ``orbit_at(value)``: the period-1 orbit (a SteadyState with its
+        Floquet multipliers, stable or not) at a parameter value; raises
+        :class:`~moreau.errors.MoreauError` where there is none.
+    xtol : float
+        Wanted bracket, relative to the grid interval.
+    evals : int
+        Orbits shot at most.
+
+    Returns
+    -------
+    dict
+        The mark with ``at`` the located point, ``bracket`` (the final
+        interval), ``refined`` (the scalar whose sign change was followed,
+        or why the midpoint stays), ``evaluations``; a period change whose
+        period-1 orbit loses stability through +1, or ends, is renamed
+        ``saddle-node``, one through -1 ``period doubling``.
+
+    Notes
+    -----
+    * period doubling: ``flip_scalar`` (``lambda + 1``) changes sign between
+      the neighbours; regula falsi on it;
+    * saddle-node: ``fold_scalar`` (``lambda - 1``) changes sign, or the
+      orbit exists on one side only; regula falsi, or bisection on its
+      existence;
+    * grazing: bisection on whether the orbit has flight (``F`` in its mode).
+    """
+    out = dict(mark)
+    a, b = (float(x) for x in mark["between"])
+    tol = xtol * abs(b - a)
+    kind = mark["kind"]
+    if kind == "grazing":
+        def flies(v):
+            ss = _try(orbit_at, v)
+            return None if ss is None else "F" in ss.mode
+        fa, fb = flies(a), flies(b)
+        if fa is None or fb is None or fa == fb:
+            out["refined"] = "midpoint: the period-1 orbits at the neighbours do not show the change"
+            return out
+        lo, hi, n = _bisect(flies, a, b, fa, tol, evals)
+        out.update(at=0.5 * (lo + hi), bracket=[lo, hi], evaluations=n + 2,
+                   refined="bisection on flight in the period-1 orbit")
+        return out
+    sa, sb = _try(orbit_at, a), _try(orbit_at, b)
+    if sa is None and sb is None:
+        out["refined"] = "midpoint: no period-1 orbit at either neighbour"
+        return out
+    if sa is not None and sb is not None:
+        for scalar, name in ((flip_scalar, "period doubling"), (fold_scalar, "saddle-node")):
+            fa, fb = scalar(sa), scalar(sb)
+            if math.isfinite(fa) and math.isfinite(fb) and (fa > 0) != (fb > 0):
+                lo, hi, n, ok = _brent(lambda v: scalar(orbit_at(v)), a, b, fa, fb, tol, evals)
+                if ok:
+                    out.update(kind=name, at=0.5 * (lo + hi), bracket=[lo, hi],
+                               evaluations=n + 2,
+                               refined=f"regula falsi on {scalar.__name__} "
+                                       f"({'lambda + 1' if name == 'period doubling' else 'lambda - 1'})")
+                    return out
+        out["refined"] = "midpoint: no multiplier crosses the unit circle at a real +1 or -1"
+        return out
+    # the orbit exists on one side only: it ends at a fold
+    exists = sa is not None
+    lo, hi, n = _bisect(lambda v: _try(orbit_at, v) is not None, a, b, exists, tol, evals)
+    out.update(kind="saddle-node", at=0.5 * (lo + hi), bracket=[lo, hi], evaluations=n + 2,
+               refined="bisection on the existence of the period-1 orbit")
+    return out
 
 
 def _write(result, stem, entry, parameter, values, frequency, fixed, scheme, opts, transient,

@@ -33,10 +33,13 @@ import joblib
 from joblib.externals.loky import get_reusable_executor
 
 from .. import __version__
-from ..errors import ConvergenceError, InputError, Interrupted
+from ..errors import ConvergenceError, InputError, Interrupted, PainleveError
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
+from .classify import CLASSIFY_COLUMNS, classification_columns
+from .floquet import floquet_report
+from .continuation import solve_line
 from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
@@ -119,9 +122,15 @@ def _make_scene(params, frequency, scene):
     return registry.make_scene(_check_scene(scene).name, frequency=frequency, **params)
 
 
-def _steady(params, frequency, scheme, scene="friction-drive"):
+#: shooting iterations of a continued point: a neighbour's orbit converges in a few, and a
+#: step that does not is halved or started cold rather than iterated on
+CONTINUED_MAX_ITER = 12
+
+
+def _steady(params, frequency, scheme, scene="friction-drive", guess=None):
     scene = _make_scene(params, frequency, scene)
-    return scene, steady_of(scene, scheme)
+    return scene, steady_of(scene, scheme, guess=guess,
+                            max_iter=None if guess is None else CONTINUED_MAX_ITER)
 
 
 def _implausible(params, scene, ss):
@@ -129,9 +138,9 @@ def _implausible(params, scene, ss):
     return implausible_steady_state(scene, ss)
 
 
-def _checked_steady(params, frequency, scheme, scene):
+def _checked_steady(params, frequency, scheme, scene, guess=None):
     """:func:`_steady`, refusing a steady state that cannot be right."""
-    sc, ss = _steady(params, frequency, scheme, scene=scene)
+    sc, ss = _steady(params, frequency, scheme, scene=scene, guess=guess)
     why = _implausible(params, sc, ss)
     if why:
         raise ConvergenceError(why)
@@ -175,6 +184,8 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     dict
         ``mode``, ``displacement_per_period_m``, ``average_velocity_m_per_s``,
         ``min_normal_force_N``, ``periodic_residual``, ``shooting_iterations``,
+        ``max_multiplier`` (the largest Floquet multiplier's modulus, NaN where
+        none was computed) and ``stable`` (True, False, or "" where unknown),
         ``compute_time_s``, ``status`` (``"ok"`` or the cause of the failure)
         and the cross-check columns. Never raises for a failed point.
 
@@ -194,15 +205,30 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     >>> two["status"], two["displacement_per_period_m"] > 0     # rod a alone: forward at 2 kHz
     ('ok', True)
     """
+    return _evaluate(params, frequency, scheme, checks, version, scene, energy)[0]
+
+
+def _painleve_margin(params):
+    # both rods of the bidirectional drive share mu and phi0: one margin for either scene
+    return (1.0 - params["mu"] * math.tan(params["phi0"]) if "mu" in params and "phi0" in params
+            else 1.0)
+
+
+def _evaluate(params, frequency, scheme, checks=(), version="", scene="friction-drive",
+              energy=False, steady=None):
+    """:func:`evaluate_point`, and its steady state (None where it failed).
+
+    ``steady`` is the point's steady state ``(scene, SteadyState)`` or the
+    exception that stopped it, when already computed (continuation);
+    otherwise it is computed from a cold start here.
+    """
     t0 = time.perf_counter()
     row = {"mode": "", "displacement_per_period_m": math.nan, "average_velocity_m_per_s": math.nan,
            "min_normal_force_N": math.nan, "periodic_residual": math.nan,
-           "shooting_iterations": 0, "status": "ok"}
+           "shooting_iterations": 0, "max_multiplier": math.nan, "stable": "", "status": "ok"}
     ref = math.nan
     _check_scene(scene)
-    # both rods of the bidirectional drive share mu and phi0: one margin for either scene
-    margin = (1.0 - params["mu"] * math.tan(params["phi0"]) if "mu" in params and "phi0" in params
-              else 1.0)
+    margin = _painleve_margin(params)
     if margin <= 0:
         # in contact phi <= phi0 (the stator only lifts the rod's hinge), so the rest angle
         # is the worst case; saying so here spares building an integrator for nothing
@@ -216,11 +242,20 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
         if energy:
             row.update(_energy_columns(None, None, scheme, row["status"]))
         row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene, energy)
-        return row
+        return row, None
     sc = ss = None
     try:
-        sc, ss = _checked_steady(params, frequency, scheme, scene)
+        if steady is None:
+            sc, ss = _checked_steady(params, frequency, scheme, scene)
+        elif isinstance(steady, BaseException):
+            raise steady
+        else:
+            sc, ss = steady
         ref = sc.displacement_to_si(ss.displacement_per_period)
+        rep = floquet_report(ss)
+        row.update(max_multiplier=math.nan if rep["max_multiplier"] is None
+                   else rep["max_multiplier"],
+                   stable="" if rep["stable"] is None else bool(rep["stable"]))
         row.update(mode=ss.mode, displacement_per_period_m=ref,
                    average_velocity_m_per_s=ref * frequency,
                    min_normal_force_N=sc.force_to_si(ss.min_normal_force),
@@ -228,6 +263,7 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     except Exception as exc:  # any failure becomes the status of this point
         row["status"] = _status_of(exc)
         sc = ss = None
+    found = ss
     if energy:
         row.update(_energy_columns(sc, ss, scheme, row["status"]))
     for chk in checks:
@@ -243,7 +279,7 @@ def evaluate_point(params, frequency, scheme, checks=(), version="", scene="fric
     row["compute_time_s"] = time.perf_counter() - t0
     # the row carries what it was computed for: a cache entry is checked against it when read
     row[INPUTS_KEY] = inputs_digest(params, frequency, scheme, checks, version, scene, energy)
-    return row
+    return row, found
 
 
 def _energy_columns(sc, ss, scheme, status):
@@ -278,17 +314,61 @@ def audit_options(scheme):
 
 
 def evaluate_points(points, scheme, checks=(), version="", scene="friction-drive",
-                    energy=False):
-    """:func:`evaluate_point` over a list of ``(params, frequency)``: one cache entry for many points.
+                    energy=False, continuation=True, classify=None):
+    """:func:`evaluate_point` over a line of ``(params, frequency)``: one cache entry for many points.
+
+    With ``continuation`` the points are neighbours in this order and each
+    one's shooting starts from the previous one's orbit
+    (:func:`moreau.analysis.continuation.solve_line`: halved steps, a cold
+    start where that fails). Every row says how it started (``start``, one
+    of :data:`~moreau.analysis.continuation.START_VALUES`, and
+    ``continuation_solves``). With ``classify`` (a budget of drive periods,
+    0 for no run; None for no columns) every row gets the :data:`CLASSIFY_COLUMNS`
+    (:mod:`moreau.analysis.classify`): a point without a periodic orbit is
+    named period-k, non-periodic (with its mean), runaway, ... instead of
+    only failed, from a plain run of at most ``classify`` periods.
 
     Examples
     --------
     >>> from moreau.scenes.friction_drive import PAPER_DEFAULTS
     >>> from dataclasses import asdict
-    >>> [r["mode"] for r in evaluate_points([(asdict(PAPER_DEFAULTS), 20.0)] * 2, ED_REFERENCE)]
-    ['NS', 'NS']
+    >>> rows = evaluate_points([(asdict(PAPER_DEFAULTS), 20.0)] * 2, ED_REFERENCE)
+    >>> [(r["mode"], r["start"]) for r in rows]
+    [('NS', 'cold'), ('NS', 'continued')]
     """
-    return [evaluate_point(p, f, scheme, checks, version, scene, energy) for p, f in points]
+    points = [(dict(p), float(f)) for p, f in points]
+
+    scenes = {}
+
+    def solve(point, guess):
+        p, f = point
+        if _painleve_margin(p) <= 0:
+            # _evaluate says so without building a scene
+            raise PainleveError("1 - mu*tan(phi0) <= 0")
+        sc, ss = _checked_steady(p, f, scheme, scene, guess=guess)
+        scenes[id(ss)] = sc
+        return ss
+
+    rows = []
+    for point, rec in zip(points, solve_line(points, solve, continuation)):
+        p, f = point
+        ss = rec["steady"]
+        steady = (scenes[id(ss)], ss) if ss is not None else rec["error"]
+        if _painleve_margin(p) <= 0:
+            # ill-posed before any shooting: nothing was continued or started
+            steady = None
+            rec.update(start="cold", solves=0)
+        row, ss = _evaluate(p, f, scheme, checks, version, scene, energy, steady=steady)
+        row["compute_time_s"] += rec["seconds"]
+        row["start"] = rec["start"]
+        row["continuation_solves"] = rec["solves"]
+        if classify is not None:
+            t0 = time.perf_counter()
+            row.update(classification_columns(row, p, f, scheme, scene, ss,
+                                              budget=int(classify)))
+            row["compute_time_s"] += time.perf_counter() - t0
+        rows.append(row)
+    return rows
 
 
 def check_output_dir(path, option="--out"):
@@ -423,7 +503,7 @@ def _entry_matches(res, a, chunk):
     # the rows an entry holds against the inputs they are to answer
     if chunk == 1:
         return isinstance(res, dict) and res.get(INPUTS_KEY) == inputs_digest(*a)
-    pts, rest = a[0], a[1:]
+    pts, rest = a[0], a[1:6]
     return (isinstance(res, list) and len(res) == len(pts)
             and all(isinstance(r, dict) and r.get(INPUTS_KEY) == inputs_digest(p, f, *rest)
                     for r, (p, f) in zip(res, pts)))
@@ -442,7 +522,8 @@ def _memory(cache_dir):
 
 
 def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1, scheduler=None,
-               progress=False, desc="points", chunk=1, scene="friction-drive", energy=False):
+               progress=False, desc="points", chunk=1, scene="friction-drive", energy=False,
+               continuation=True, classify=None):
     """Evaluate many points, reusing cached ones, in parallel.
 
     Parameters
@@ -466,6 +547,13 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
         would cost more in files and scheduling than in computing.
     energy : bool
         Add the energy audit's columns to every row (:func:`evaluate_point`).
+    continuation : bool
+        With ``chunk`` > 1: the points of a chunk are neighbours, each
+        shot from the previous one's orbit (:func:`evaluate_points`).
+    classify : int, optional
+        With ``chunk`` > 1: the classification columns, naming the long-run
+        motion of every point without an orbit from a plain run of at most
+        this many periods (0: no run).
 
     Returns
     -------
@@ -490,14 +578,14 @@ def run_points(points, scheme=ED_REFERENCE, checks=(), cache_dir=None, n_jobs=-1
     client, own_client = connect_scheduler(scheduler)
     try:
         return _run_points(points, scheme, checks, cache_dir, n_jobs, client, progress, desc,
-                           chunk, scene, energy)
+                           chunk, scene, energy, continuation, classify)
     finally:
         if own_client:
             client.close()
 
 
 def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, desc, chunk,
-                scene, energy):
+                scene, energy, continuation=True, classify=None):
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
@@ -509,7 +597,8 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
         func = _memory(cache_dir).cache(evaluate_points, ignore=[])
         groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
         args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene,
-                 bool(energy)) for g in groups]
+                 bool(energy), bool(continuation), None if classify is None else int(classify))
+                for g in groups]
         sizes = [len(g) for g in groups]
     out = [None] * len(args)
     todo = []

@@ -702,7 +702,15 @@ def _jacobian(pm, x, closed, scale, rel, y1=None, central=False):
 
 
 @register_steady_solver("moreau-jean")
-def _steady_solver(scene, rtol=None, v_guess=None, max_iter=None, **options):
+def _steady_solver(scene, rtol=None, v_guess=None, max_iter=None, guess=None, **options):
     # find_steady_state's entry: the discrete map takes its own tolerance (`tol`),
-    # iteration bound and guess (`x_guess`) in `options`
+    # iteration bound and guess (`x_guess`) in `options`; a neighbour's orbit
+    # (continuation) is a guess close enough to skip the cold start's transient
+    if guess is not None and options.get("x_guess") is None:
+        options["x_guess"] = np.asarray(guess.state0, float)
+        options.setdefault("transient_periods", CONTINUED_TRANSIENT)
     return moreau_jean_steady_state(scene, **options)
+
+
+#: periods of the map run from a neighbour's orbit before Newton (a cold start runs 300)
+CONTINUED_TRANSIENT = 5

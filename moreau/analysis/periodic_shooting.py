@@ -38,7 +38,8 @@ from ..regimes import REGIME_LETTERS, Regime
 from .floquet import period_map_jacobian, sorted_multipliers
 from .steady_solvers import register_steady_solver
 
-__all__ = ["shoot_periodic", "free_bases", "period_map_options", "bracket_scalar"]
+__all__ = ["shoot_periodic", "free_bases", "period_map_options", "bracket_scalar",
+           "guess_options"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -500,8 +501,39 @@ def bracket_scalar(fun, z0, tol, max_evals):
             side = 1
 
 
+def guess_options(scene, options):
+    """``options`` with a neighbour's steady state ``guess`` turned into the shooting's start.
+
+    The ``guess`` entry (a :class:`SteadyState`, continuation) becomes
+    ``q0``, ``v0`` and ``section_tau``, unless those are given.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> ss = SteadyState("event-driven", 0.1, np.array([0.7, 0.0, 0.0, -0.2]), "NP", [], 1.0,
+    ...                  0.0, 1, 0.0, section_tau=0.5)
+    >>> o = guess_options(sc, {"guess": ss})
+    >>> o["q0"].tolist(), o["v0"].tolist(), o["section_tau"]
+    ([0.7, 0.0], [0.0, -0.2], 0.5)
+    """
+    out = dict(options)
+    guess = out.pop("guess", None)
+    if guess is None or out.get("q0") is not None or out.get("v0") is not None:
+        return out
+    x = np.asarray(guess.state0, float)
+    n = scene.ndof
+    if x.size != 2 * n:
+        raise InputError(f"`guess` has a state of {x.size} entries; the shooting of this scene "
+                         f"needs the full state (q, v), {2 * n} entries")
+    out["q0"], out["v0"] = x[:n].copy(), x[n:].copy()
+    out.setdefault("section_tau", float(getattr(guess, "section_tau", 0.0) or 0.0))
+    return out
+
+
 @register_steady_solver("event-driven")
 def _steady_solver(scene, rtol=1e-10, v_guess=None, max_iter=30, **options):
     # find_steady_state's entry for any periodic scene: Newton shooting on the period
     # map of the event-driven reference the scene resolves to
-    return shoot_periodic(scene, "event-driven", rtol=rtol, max_iter=max_iter, **options)
+    return shoot_periodic(scene, "event-driven", rtol=rtol, max_iter=max_iter,
+                          **guess_options(scene, options))

@@ -186,12 +186,15 @@ def _adaptive_rtol(scheme):
     return ADAPTIVE_SHOOTING_RTOL
 
 
-def steady_of(scene, scheme, max_period=1, statistical=False):
+def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_iter=None):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
 
     Sweeps, atlases and comparisons want a periodic orbit or a failure, so
     the statistical steady state (:mod:`moreau.analysis.statistical`) is
     only the fallback with ``statistical=True`` (``moreau steady``).
+    ``guess`` is a neighbouring point's period-1 orbit to start the
+    shooting from (continuation, :mod:`moreau.analysis.continuation`);
+    ``max_iter`` bounds its iterations (the solver's default otherwise).
 
     Examples
     --------
@@ -202,9 +205,11 @@ def steady_of(scene, scheme, max_period=1, statistical=False):
     if scheme.name == "moreau-jean":
         # the compiled discrete period map names its tolerance `tol`
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
+        if max_iter is not None:
+            kw["max_iter"] = max_iter
         return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
                                  steps_per_period=scheme.steps_per_period, max_period=max_period,
-                                 statistical=statistical, **kw, **scheme.options)
+                                 statistical=statistical, guess=guess, **kw, **scheme.options)
     # an adaptive scheme's period map carries its own error tolerance: the shooting
     # aims above it unless told otherwise (a fixed-step map is deterministic)
     kw = {"rtol": scheme.rtol if scheme.rtol is not None else
@@ -213,7 +218,9 @@ def steady_of(scene, scheme, max_period=1, statistical=False):
         kw["steps_per_period"] = scheme.steps_per_period
     if scheme.theta is not None:
         kw["theta"] = scheme.theta
+    if max_iter is not None:
+        kw["max_iter"] = max_iter
     if scheme.options:
         kw["scheme_options"] = scheme.options
     return find_steady_state(scene, scheme=scheme.name, max_period=max_period,
-                             statistical=statistical, **kw)
+                             statistical=statistical, guess=guess, **kw)

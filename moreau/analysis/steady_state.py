@@ -19,7 +19,7 @@ from ..scenes.base import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
 from . import mj_steady_state  # noqa: F401
 from .period_k import find_period_k, full_state_of
-from .periodic_shooting import shoot_periodic
+from .periodic_shooting import guess_options, shoot_periodic
 from .statistical import MAX_PERIODS, statistical_steady_state
 from .steady_solvers import get_steady_solver, has_solver
 
@@ -31,7 +31,7 @@ TWO_PI = 2.0 * math.pi
 
 def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
                       max_period=1, statistical=True, statistical_budget=MAX_PERIODS,
-                      **options):
+                      guess=None, **options):
     """Periodic steady state of a periodically driven scene, found by shooting, and checked.
 
     The one entry point for every scheme and every caller: what the shooting
@@ -79,6 +79,9 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     if not isinstance(statistical, (bool, np.bool_)):
         raise InputError(f"`statistical` must be True or False, got {statistical!r}")
     statistical_budget = positive_int("statistical_budget", statistical_budget)
+    if guess is not None:
+        _check_guess(scene, guess)
+        options["guess"] = guess
     try:
         ss = _find_steady_state(scene, scheme, rtol, v_guess, max_iter, **options)
         failure = None
@@ -113,6 +116,18 @@ def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, ma
     return ss
 
 
+def _check_guess(scene, guess):
+    # a continuation starts only from a period-1 orbit whose state fits this scene
+    state = getattr(guess, "state0", None)
+    if state is None or getattr(guess, "statistical", False) or getattr(guess, "period", 1) != 1:
+        raise InputError("`guess` must be the period-1 SteadyState of a neighbouring point, got "
+                         + (type(guess).__name__ if state is None else
+                            f"a steady state of period {getattr(guess, 'period', '?')}"))
+    full_state_of(scene, state)   # the right size for the scene, else a clear error
+    if not np.all(np.isfinite(np.asarray(state, float))):
+        raise InputError("`guess` must have a finite state")
+
+
 def _statistical(scene, scheme, failure, budget, options):
     """The statistical steady state where the shooting found no orbit (``failure`` says why)."""
     state = getattr(failure, "state", None)
@@ -139,7 +154,7 @@ MAX_PERIOD = 8
 
 #: options of the steady-state solvers that are not options of the scheme itself
 _SOLVER_ONLY = ("tol", "x_guess", "transient_periods", "fast", "section_tau", "q0", "v0",
-                "cyclic", "scheme_options")
+                "cyclic", "scheme_options", "guess")
 
 
 def _shooting_options(scheme, options):
@@ -210,6 +225,7 @@ def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, m
         if v_guess is not None:
             raise InputError(f"`v_guess` is not taken by the shooting of scheme {scheme!r}; "
                              "give `q0` and `v0`")
+        options = guess_options(scene, options)
         return shoot_periodic(scene, scheme, rtol=rtol, max_iter=max_iter, **options)
     solver = get_steady_solver(scheme)
     return solver(scene, rtol=rtol, v_guess=v_guess, max_iter=max_iter, **options)

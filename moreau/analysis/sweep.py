@@ -39,15 +39,15 @@ from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
-           "MAX_POINTS", "rows_to_xarray"]
+           "MAX_POINTS", "rows_to_xarray", "stability_panel"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
 
 #: the steady-state columns of a sweep row (SI units in the names)
 VALUE_COLUMNS = ("mode", "displacement_per_period_m", "average_velocity_m_per_s",
-                 "min_normal_force_N", "periodic_residual", "shooting_iterations", "status",
-                 "compute_time_s")
+                 "min_normal_force_N", "periodic_residual", "shooting_iterations",
+                 "max_multiplier", "stable", "status", "compute_time_s")
 
 
 def sweep_values(start, stop, points, scale="linear"):
@@ -231,7 +231,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             if name != parameter:
                 r[columns[name]] = val
         for c in VALUE_COLUMNS:
-            r[c] = row.get(c, "" if c in ("mode", "status") else math.nan)
+            r[c] = row.get(c, "" if c in ("mode", "status", "stable") else math.nan)
         for c in ENERGY_COLUMNS:
             r[c] = row.get(c, "" if c == "energy_status" else math.nan)
         table.append(r)
@@ -269,19 +269,53 @@ def _figure(table, swept, scene, path):
     x = np.array([r[swept] for r in table])
     d = np.array([r["displacement_per_period_m"] for r in table], dtype=float)
     modes = [r["mode"] if r["status"] == "ok" else "failed" for r in table]
-    fig, ax = plt.subplots(figsize=(7, 4))
+    fig, (ax, sax) = plt.subplots(2, 1, figsize=(7, 6), sharex=True,
+                                  gridspec_kw={"height_ratios": [1.6, 1.0]})
+    stability_panel(sax, x, table)
     ax.plot(x, d * 1e6, "k-", lw=0.8)
     for m in sorted(set(modes)):
         sel = np.array([mm == m for mm in modes])
         ax.plot(x[sel], np.where(np.isfinite(d[sel]), d[sel] * 1e6, 0.0), "o", ms=4, label=m)
     ax.axhline(0.0, color="0.7", lw=0.5)
-    ax.set_xlabel(swept)
+    sax.set_xlabel(swept)
     ax.set_ylabel("displacement per period [um]")
     ax.set_title(f"{scene}: steady state")
     ax.legend(title="mode", fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
+
+
+def stability_panel(ax, x, rows):
+    """Draw the largest Floquet multiplier's modulus of every point against ``x`` on ``ax``.
+
+    The unit circle is the line at 1: a point above it is unstable (drawn
+    red), the distance below it the stability margin. Points without
+    multipliers are left out.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots()
+    >>> rows = [{"max_multiplier": m, "stable": m < 1} for m in (0.05, 0.99, 1.2)]
+    >>> stability_panel(ax, np.array([1.0, 2.0, 3.0]), rows)
+    2
+    >>> plt.close(fig)
+    """
+    m = np.array([r.get("max_multiplier", math.nan) for r in rows], dtype=float)
+    stable = np.array([r.get("stable") is True or r.get("stable") == "True" for r in rows])
+    ok = np.isfinite(m)
+    ax.axhline(1.0, color="k", lw=0.8, ls="--", label="|λ| = 1 (unit circle)")
+    ax.plot(x[ok], m[ok], "-", color="0.6", lw=0.8)
+    ax.plot(x[ok & stable], m[ok & stable], "o", ms=3, color="#0077bb", label="stable")
+    ax.plot(x[ok & ~stable], m[ok & ~stable], "o", ms=3, color="#cc3311", label="unstable")
+    ax.set_ylabel("largest |Floquet multiplier|")
+    ax.set_ylim(0.0, max(1.1, float(np.nanmax(m)) * 1.05) if ok.any() else 1.1)
+    ax.legend(fontsize=7, loc="best")
+    ax.grid(alpha=0.3, lw=0.5)
+    return int(np.count_nonzero(ok & stable))
 
 
 def _split_unit(column):

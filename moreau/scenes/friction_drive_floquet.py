@@ -50,7 +50,7 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..errors import ConvergenceError, MoreauError
+from ..errors import ConvergenceError, InputError, MoreauError
 from ..regimes import Regime
 from .friction_drive_walker import ContactState, FrictionDriveWalker, impact_impulses
 
@@ -186,7 +186,7 @@ def _flight_flow(walker, a, b):
     return out
 
 
-def walker_monodromy(scene, steady, rtol=1e-12):
+def walker_monodromy(scene, steady, rtol=1e-12, walker=None):
     """Monodromy matrix of the walker's steady period, from saltation matrices.
 
     Parameters
@@ -203,12 +203,16 @@ def walker_monodromy(scene, steady, rtol=1e-12):
         ``(1, 1)`` for a section in contact (the free direction ``u2'``);
         ``(3, 3)`` in ``(phi, phi', u2')`` for one in flight.
 
+    walker : FrictionDriveWalker, optional
+        A walker of ``scene`` at ``rtol`` to walk the period with (its
+        tables are reused: building them costs as much as the walk).
+
     Raises
     ------
     GrazingEvent
         An event of the period is tangent to its surface.
     """
-    walker = FrictionDriveWalker(scene, rtol=rtol)
+    walker = _walker_of(scene, rtol, walker)
     fields = _Fields(walker)
     vs = walker.vscale
     st0 = _section_start(walker, steady)
@@ -250,13 +254,23 @@ def walker_monodromy(scene, steady, rtol=1e-12):
     return M
 
 
-def walker_period_map_slope(scene, steady, step=1e-5, rtol=1e-12):
+def _walker_of(scene, rtol, walker):
+    # a given walker must walk this scene at this tolerance; it starts a fresh walk
+    if walker is None:
+        return FrictionDriveWalker(scene, rtol=rtol)
+    if walker.scene is not scene or walker.rtol != rtol:
+        raise InputError("`walker` must be a walker of `scene` at tolerance `rtol`")
+    walker.reset()
+    return walker
+
+
+def walker_period_map_slope(scene, steady, step=1e-5, rtol=1e-12, walker=None):
     """``dP/du2'`` of the walker's scalar period map by central differences (the check).
 
     ``step`` is relative to the walker's velocity scale (the largest tip
-    speed).
+    speed); ``walker`` as in :func:`walker_monodromy`.
     """
-    walker = FrictionDriveWalker(scene, rtol=rtol)
+    walker = _walker_of(scene, rtol, walker)
     st0 = _section_start(walker, steady)
     if st0.regime == _F:
         raise MoreauError("the section is in flight: the walker's period map is not scalar there")

@@ -65,12 +65,15 @@ def _min_normal_force(walker, segments):
 _FLIGHT_SEARCH_PERIODS = 50
 
 
-def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
+def _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope=None):
     """Safeguarded secant iteration on the scalar period map ``u2'(tau_s) -> u2'(tau_s + 2 pi)``.
 
     Returns ``(start_state, iterations, last_end_state)``; ``start_state`` is
     ``None`` when the rod is in flight at the section, where the map is not
-    scalar.
+    scalar. ``slope``, an estimate of ``P' - 1`` (a neighbouring orbit's
+    multiplier minus 1), makes the first step a Newton step instead of a
+    fixed-point step, which covers only ``1 - P'`` of the distance on a
+    barely contracting map.
     """
     vs = walker.vscale
     phi_s, dphi_s = walker.manifold(tau_s)
@@ -87,6 +90,8 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
     if fa == 0.0:
         return st, it, end
     xb = end.du2
+    if slope is not None and -2.5 < slope < -1e-6:
+        xb = v0 - fa / slope
     while True:
         if end.regime == Regime.FLIGHT:
             return None, it, end
@@ -118,7 +123,7 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter):
 
 
 @register_steady_solver("friction-drive-walker")
-def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options):
+def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None, **options):
     """Event-driven periodic steady state of the friction drive (see ``find_steady_state``).
 
     The rotor position ``u2`` does not enter the dynamics, so the period map
@@ -127,7 +132,9 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
     scalar map of ``u2'``. Its fixed point is found by a safeguarded secant
     iteration (the map is contracting, often barely so at high frequency).
     ``rtol`` bounds the estimated distance of ``u2'`` from the fixed point
-    relative to the tip-velocity scale; ``v_guess`` is the first ``u2'``.
+    relative to the tip-velocity scale; ``v_guess`` is the first ``u2'``,
+    by default the rotor velocity of ``guess`` (a neighbouring point's
+    steady state, continuation) or else the tip's velocity.
     The Floquet multiplier of the map comes from the saltation matrices of
     the period's events (:mod:`moreau.scenes.friction_drive_floquet`).
     """
@@ -144,8 +151,15 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
     phig, dphig = walker.g_phi, walker.g_dphi
     Dg = scene.coefficients(phig, dphig, tg)[3]
     tau_s = 0.0 if Dg[0] <= 0.5 * Dg.min() else float(tg[int(np.argmin(Dg))])
+    slope = None
+    if v_guess is None and guess is not None:
+        v_guess = float(np.asarray(guess.state0, float)[-1])
+        m = getattr(guess, "floquet_multipliers", None)
+        if m is not None and len(m) == 1 and abs(complex(m[0]).imag) == 0.0:
+            # the neighbour's multiplier: the slope of this point's scalar map, nearly
+            slope = complex(m[0]).real - 1.0
     v0 = walker.vtip(tau_s) if v_guess is None else float(v_guess)
-    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter)
+    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope)
     if st0 is None:
         # the rod is in flight at this section in the steady state: move the
         # section into the longest contact segment of the settled motion
@@ -208,10 +222,10 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, **options)
     # or where an event grazes its surface (no derivative exists there) the map's own
     # central differences, which then measure its slope on a 1e-5 scale
     try:
-        M = walker_monodromy(scene, ss, rtol=walker.rtol)
+        M = walker_monodromy(scene, ss, rtol=walker.rtol, walker=walker)
         ss.floquet_method = "saltation"
     except GrazingEvent:
-        M = np.array([[walker_period_map_slope(scene, ss, rtol=walker.rtol)]])
+        M = np.array([[walker_period_map_slope(scene, ss, rtol=walker.rtol, walker=walker)]])
         ss.floquet_method = "finite-differences"
     ss.floquet_multipliers = sorted_multipliers(np.linalg.eigvals(M))
     ss.wall_time = time.perf_counter() - t_start

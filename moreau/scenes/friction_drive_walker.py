@@ -92,6 +92,18 @@ class _SlipSeries:
             zk *= z
         return acc.real
 
+    def A_uniform(self, n):
+        """``A`` at ``tau = 2 pi j / n``, ``j = 0 .. n-1``, by one inverse FFT.
+
+        On that grid ``exp(i k tau_j)`` depends on ``k mod n`` only: the
+        coefficients are folded onto ``n`` bins (exact, aliasing included),
+        instead of an ``n`` by ``K`` table of exponentials (``K`` is in the
+        thousands at high frequency).
+        """
+        folded = np.zeros(n, dtype=complex)
+        np.add.at(folded, self.k.astype(np.int64) % n, self.cA)
+        return (n * np.fft.ifft(folded)).real
+
     def _basis(self, tau):
         return np.exp(1j * np.multiply.outer(np.asarray(tau, float), self.k))
 
@@ -210,7 +222,7 @@ class FrictionDriveWalker:
         phi, dphi, ddphi = sc.contact_angle(tg)
         self.g_phi, self.g_dphi = phi, dphi
         self.g_vtip = -np.sin(phi) * dphi
-        self.g_A = {r: self.series[r].A(tg) for r in (_P, _N)}
+        self.g_A = {r: self.series[r].A_uniform(n) for r in (_P, _N)}
         self.g_fN = {r: sc.contact_forces(tg, r)[0] for r in (_P, _N, _S)}
         fNs, fTs = sc.contact_forces(tg, _S)
         self.g_stick_fT = fTs
@@ -219,6 +231,11 @@ class FrictionDriveWalker:
         # scale of the slip velocity, for tolerances
         self.vscale = float(np.max(np.abs(self.g_vtip))) + 1e-300
         self.fscale = float(np.max(np.abs(self.g_fN[_S]))) + 1e-300
+
+    def reset(self):
+        """Forget the impacts counted and a pending rebound skip: a new walk on the same tables."""
+        self.n_impacts = 0
+        self._rebound_skip = None
 
     # -- explicit contact quantities ------------------------------------------
     def vtip(self, tau):

@@ -31,6 +31,8 @@ from ... import _validate as V
 # the module, not its function: a test (or a user) that replaces
 # engine.run_points reaches the atlas too
 from ...analysis import engine
+from ...analysis.atlas import classify_budget
+from ...analysis.classify import CLASSIFY_PERIODS
 from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version, make_scheme
 from ...errors import InputError
 from ...outputs import claim_outputs
@@ -59,6 +61,11 @@ NO_CONTACT, ILL_POSED, FAILED = "no contact", "ill-posed (Painlev\u00e9)", "fail
 def point_label(row):
     """The atlas label of one engine row: its mode, or why it has none.
 
+    A point without a periodic orbit that was classified
+    (:mod:`moreau.analysis.classify`) is labelled by its class
+    (``period-2``, ``non-periodic``, ``runaway``); ``failed`` is left for
+    the genuine failures.
+
     Examples
     --------
     >>> point_label({"status": "ok", "mode": "NS"})
@@ -73,12 +80,15 @@ def point_label(row):
         return ILL_POSED
     if "does not touch the rotor" in status:
         return NO_CONTACT
+    cls = row.get("classification", "")
+    if cls.startswith("period-") or cls in ("non-periodic", "runaway"):
+        return cls
     return FAILED
 
 
 def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_points=200,
                   y_points=100, scheme=None, cache_dir=None, n_jobs=-1, scheduler=None,
-                  progress=False):
+                  progress=False, continuation=True, classify=CLASSIFY_PERIODS):
     """Steady states over one parameter plane.
 
     Parameters
@@ -95,6 +105,14 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
         Event-driven (shooting tolerance 1e-10) by default.
     cache_dir, n_jobs, scheduler, progress
         As in :func:`moreau.analysis.engine.run_points`.
+    continuation : bool
+        Along each line of constant frequency, every point's shooting
+        starts from its neighbour's orbit (:mod:`moreau.analysis.continuation`);
+        False: every point starts cold.
+    classify : int
+        Budget of drive periods of the plain run that names the long-run
+        motion of a point without an orbit (:mod:`moreau.analysis.classify`);
+        0: no run (such points stay ``failed``).
 
     Returns
     -------
@@ -102,7 +120,8 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
         ``frequency_Hz`` (f_points,), ``y`` (y_points,), and arrays of shape
         ``(f_points, y_points)``: ``mode``, ``label`` (mode or why none, see
         :func:`point_label`), ``status``, ``displacement_per_period_m``,
-        ``min_normal_force_N``, and the boundary fields whose zero level is
+        ``min_normal_force_N``, ``start`` (continued or cold),
+        ``classification`` and ``classification_detail``, and the boundary fields whose zero level is
         the curve: ``lift_off_field`` (``max D / u10``), ``painleve_field``
         (``1 - mu tan phi0``), ``contact_loss_field`` (+1 with flight or no
         contact, -1 in permanent contact, NaN where ill-posed or failed).
@@ -138,18 +157,22 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
     points = [(asdict(p), float(f)) for f in freqs for p in line]
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"atlas {plane}", chunk=y_points)
+                                    desc=f"atlas {plane}", chunk=y_points,
+                                    continuation=continuation, classify=classify)
     shape = (f_points, y_points)
     pick = np.empty(shape, dtype=object)
     out = {k: np.full(shape, np.nan) for k in ("displacement_per_period_m", "min_normal_force_N",
                                               "average_velocity_m_per_s", "compute_time_s")}
-    mode = np.empty(shape, dtype=object)
-    status = np.empty(shape, dtype=object)
+    for key in ("classified_displacement_per_period_m", "classified_half_width_m"):
+        out[key] = np.full(shape, np.nan)
+    text = {k: np.full(shape, "", dtype=object)
+            for k in ("mode", "status", "start", "classification", "classification_detail")}
+    mode, status = text["mode"], text["status"]
     for k, r in enumerate(rows):
         i, j = divmod(k, y_points)
         pick[i, j] = point_label(r)
-        mode[i, j] = r.get("mode", "")
-        status[i, j] = r.get("status", "")
+        for key in text:
+            text[key][i, j] = r.get(key, "")
         for key in out:
             out[key][i, j] = r.get(key, math.nan)
     painleve = np.array([[1.0 - p.mu * math.tan(p.phi0) for p in line] for _ in freqs])
@@ -164,7 +187,7 @@ def compute_atlas(plane, params=None, f_range=(10.0, 12500.0), y_range=None, f_p
         elif status[i, j] == "ok":
             loss[i, j] = -1.0
     return {"plane": plane, "frequency_Hz": freqs, "y": ys, "y_name": y_name, "y_label": y_label,
-            "y_column": y_col, "mode": mode, "label": pick, "status": status, **out,
+            "y_column": y_col, "label": pick, **text, **out,
             "lift_off_field": lift, "painleve_field": painleve, "contact_loss_field": loss,
             "scheme": scheme, "params": params, "stats": stats,
             "wall_time_s": time.perf_counter() - t0}
@@ -186,6 +209,12 @@ def atlas_rows(atlas):
                 "painleve_margin": float(atlas["painleve_field"][i, j]),
                 "lift_off_margin": float(atlas["lift_off_field"][i, j]),
                 "status": atlas["status"][i, j],
+                "start": atlas["start"][i, j],
+                "classification": atlas["classification"][i, j],
+                "classification_detail": atlas["classification_detail"][i, j],
+                "classified_displacement_per_period_m":
+                    float(atlas["classified_displacement_per_period_m"][i, j]),
+                "classified_half_width_m": float(atlas["classified_half_width_m"][i, j]),
                 "compute_time_s": float(atlas["compute_time_s"][i, j])})
             rows.append(r)
     return rows
@@ -193,14 +222,16 @@ def atlas_rows(atlas):
 
 def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 12500.0),
               f_points=200, y_points=100, scheme=None, cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print, force=False):
+              progress=True, plot=True, log=print, force=False, continuation=True,
+              classify=CLASSIFY_PERIODS):
     """The ``moreau atlas`` command: for each plane a tidy CSV, a JSON sidecar and a figure.
 
     Files: ``OUT/atlas_f-mu.csv`` (``.json``, ``.png``, ``.svg``) and the
     same for ``f-phi0``; a scheme other than the event-driven reference's
     default adds its tag (``atlas_f-mu_mj_theta1_N1000``). Files of an earlier
     atlas with other settings are not replaced unless ``force``. The cache lives in ``cache_dir`` (``OUT/cache`` by
-    default). The output folder is checked before any work.
+    default). The output folder is checked before any work. ``continuation``
+    and ``classify`` as in :func:`compute_atlas`.
 
     Returns
     -------
@@ -219,12 +250,13 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
         "plane": plane, "f_range": list(f_range), "grid": [f_points, y_points],
         "parameters_SI": asdict(PAPER_DEFAULTS if params is None else params),
         "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                   scheme.options]}, force) for plane in planes}
+                   scheme.options], "continuation": bool(continuation),
+        "classify_periods": int(classify)}, force) for plane in planes}
     results = {}
     for plane in planes:
         a = compute_atlas(plane, params, f_range=f_range, f_points=f_points, y_points=y_points,
                           scheme=scheme, cache_dir=cache_dir, n_jobs=n_jobs, scheduler=scheduler,
-                          progress=progress)
+                          progress=progress, continuation=continuation, classify=classify)
         stem = stems[plane]
         s = a["scheme"]
         rows = atlas_rows(a)
@@ -240,6 +272,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
                 "package_version": __version__, "code_version": code_version(),
                 "python": sys.version.split()[0], "engine": a["stats"],
                 "wall_time_s": a["wall_time_s"], "scheduler": scheduler,
+                "continuation": bool(continuation), "classify_periods": int(classify),
+                "starts": _counts(a["start"]), "classifications": _counts(a["classification"]),
                 "provenance": provenance(code_version()), "settings": settings[plane]}
         (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
         counts = {}
@@ -254,6 +288,13 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
             log(f"wrote {paths[0]}")
         results[plane] = a
     return results
+
+
+def _counts(arr):
+    counts = {}
+    for v in np.asarray(arr, dtype=object).ravel():
+        counts[v] = counts.get(v, 0) + 1
+    return dict(sorted(counts.items(), key=lambda kv: -kv[1]))
 
 
 def command(args):
@@ -281,4 +322,6 @@ def command(args):
     run_atlas(planes, params, out=args.out, f_range=f_range, f_points=f_points,
               y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-              force=args.force)
+              force=args.force, continuation=not getattr(args, "cold", False),
+              classify=classify_budget(args))
+

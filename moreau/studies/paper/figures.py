@@ -16,6 +16,7 @@ import pathlib
 import numpy as np
 
 from ...analysis.steady_state import find_steady_state
+from ...analysis.sweep import stability_panel
 from ...errors import MoreauError
 from ...integrators import simulate
 from ...regimes import REGIME_LETTERS
@@ -167,11 +168,14 @@ def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=Non
     d = np.array([r["displacement_per_period_m"] for r in rows], float) * 1e6
     v = np.array([r["average_velocity_m_per_s"] for r in rows], float) * 1e3
     zoom = None if log else zoom_side(d)
-    if zoom is None:
-        fig, axes = plt.subplots(2, 1, figsize=(8, 6.2), sharex=True)
-    else:
-        fig, axes = plt.subplots(3, 1, figsize=(8, 8.4), sharex=True,
-                                 gridspec_kw={"height_ratios": [1.0, 0.8, 1.0]})
+    # a stability panel where the rows carry the orbits' multipliers (moreau sweep)
+    mult = np.array([r.get("max_multiplier", np.nan) for r in rows], float)
+    stab = bool(np.isfinite(mult).any())
+    ratios = [1.0] + ([0.8] if zoom is not None else []) + [1.0] + ([0.7] if stab else [])
+    fig, axes = plt.subplots(len(ratios), 1, figsize=(8, 2.2 + 2.0 * sum(ratios)),
+                             sharex=True, gridspec_kw={"height_ratios": ratios})
+    axes = list(axes)
+    sax = axes.pop() if stab else None
     vax = axes[-1]
     others = {}
     if log is None:
@@ -225,7 +229,13 @@ def draw_sweep(rows, parameter, frequency, extra, checks=(), title=None, log=Non
             for ax in axes:
                 h = ax.axvline(xv, color="k", ls=ls, lw=1.1)
             limit_h[f"{lab} ({xv:.4g}{unit})"] = h
-    vax.set_xlabel(_XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
+    if sax is not None:
+        stability_panel(sax, x, rows)
+        for xv, _, ls in limits:
+            if log or lo - 0.05 * span <= xv <= hi + 0.05 * span:
+                sax.axvline(xv, color="k", ls=ls, lw=1.1)
+    (sax if sax is not None else vax).set_xlabel(
+        _XLABEL.get(parameter, PARAM_COLUMNS.get(parameter, parameter)))
     lines, labels = axes[0].get_legend_handles_labels()
     axes[0].legend(lines + list(limit_h.values()), labels + list(limit_h), fontsize=7.5,
                    loc="best")

@@ -30,7 +30,7 @@ PARAM_COLUMNS = {"frequency": "frequency_Hz", "m": "m_kg", "m2": "m2_kg", "k": "
                  "balance": "balance"}
 VALUE_COLUMNS = ["mode", "displacement_per_period_m", "average_velocity_m_per_s",
                  "min_normal_force_N", "painleve_margin", "lift_off_margin", "periodic_residual",
-                 "shooting_iterations", "status"]
+                 "shooting_iterations", "max_multiplier", "stable", "status"]
 
 
 def sweep_point(params, parameter, value, frequency):
@@ -63,7 +63,7 @@ def tidy_rows(parameter, values, frequency, params, rows, checks, steps=None):
         r["lift_off_margin"] = lift_off_margin(p, f)
         for c in VALUE_COLUMNS:
             if c not in r:
-                r[c] = row.get(c, math.nan if c != "mode" else "")
+                r[c] = row.get(c, "" if c in ("mode", "stable") else math.nan)
         if checks:
             r["mj_steps_per_period"] = steps
             for chk in checks:
