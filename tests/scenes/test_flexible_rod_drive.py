@@ -7,6 +7,7 @@ of the displacement field, the closed-form Euler–Bernoulli eigenvalues and
 the rigid scene.
 """
 
+import json
 import math
 
 import numpy as np
@@ -14,6 +15,7 @@ import pytest
 
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
 from moreau.check import check_scene
+from moreau.cli import main
 from moreau.compiled import evaluate_compiled
 from moreau.errors import InputError
 from moreau.integrators import simulate
@@ -213,3 +215,31 @@ def test_to_si_gives_the_tip_deflection():
                        rtol=1e-15)
     assert np.array_equal(si["x2"], si["q"][:, -1])
     assert np.max(np.abs(si["tip_deflection"])) > 0.0
+
+
+def test_steady_state_converges_to_the_rigid_rods_as_one_over_EI():
+    # the static deflection under the contact force falls as 1/EI, so does the
+    # difference of the steady displacements; Moreau–Jean at a step that resolves
+    # the bending mode (W1 h <= 0.4), against the rigid rod at the same step
+    steps = 8000
+    rigid = moreau_jean_steady_state(FrictionDrive(), steps).displacement_per_period
+    EI = np.array([3e-6, 3e-5])
+    diff = []
+    for e in EI:
+        scene = FlexibleRodDrive(EI=e)
+        assert scene.Omega[0] * 2 * math.pi / steps <= 0.41
+        d = moreau_jean_steady_state(scene, steps).displacement_per_period
+        diff.append(abs(d - rigid) / abs(rigid))
+    slope = math.log(diff[1] / diff[0]) / math.log(EI[1] / EI[0])
+    assert -1.15 < slope < -0.85, (diff, slope)
+    assert diff[0] < 0.02
+
+
+def test_steady_json_reports_the_bending_frequencies(capsys):
+    assert main(["steady", "--scene", "flexible-rod-drive", "--frequency", "185", "--scheme",
+                 "moreau-jean", "--steps-per-period", "1000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    p = FlexibleRodDrive().params
+    f1 = 3.926602312 ** 2 / (2 * math.pi) * math.sqrt(p.EI / (p.m * p.length ** 3))
+    assert abs(out["derived"]["first_bending_frequency_Hz"] / f1 - 1) < 1e-9
+    assert out["parameters"]["modes"] == 1 and out["mode"] == "NP"
