@@ -166,9 +166,9 @@ def mode_shape(xi, b, c, r):
 
 
 def _modes(name, value):
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise InputError(f"`{name}` must be an integer in 0..{MAX_MODES}, got {value!r}")
-    if not 0 <= value <= MAX_MODES:
+    # a whole float is taken: the command line and the sweeps pass numbers as floats
+    ok = isinstance(value, (int, np.integer, float, np.floating)) and not isinstance(value, bool)
+    if not ok or not math.isfinite(value) or value != int(value) or not 0 <= value <= MAX_MODES:
         raise InputError(f"`{name}` must be an integer in 0..{MAX_MODES}, got {value!r}")
     return int(value)
 

@@ -198,12 +198,17 @@ def test_rigid_limit_reproduces_the_rigid_trajectory():
 
 @pytest.mark.parametrize("bad, word", [
     (dict(modes=-1), "`modes`"), (dict(modes=MAX_MODES + 1), "`modes`"),
-    (dict(modes=1.0), "`modes`"), (dict(EI=0.0), "`EI`"), (dict(EI=float("nan")), "`EI`"),
+    (dict(modes=1.5), "`modes`"), (dict(modes=float("nan")), "`modes`"), (dict(EI=0.0), "`EI`"), (dict(EI=float("nan")), "`EI`"),
     (dict(damping=-0.1), "`damping`"), (dict(mu=-1.0), "`mu`"), (dict(x10=1e-3), "`x10`"),
 ])
 def test_bad_parameters_raise_named_errors(bad, word):
     with pytest.raises(InputError, match=word):
         FlexibleRodDrive(**bad)
+
+
+def test_a_whole_float_is_a_number_of_modes():
+    # the command line passes --set modes=2 as 2.0
+    assert FlexibleRodDrive(modes=2.0).N == 2
 
 
 def test_to_si_gives_the_tip_deflection():
