@@ -127,7 +127,7 @@ def pinned_free_modes(n):
     Examples
     --------
     >>> b, c, r, psi, beta = pinned_free_modes(2)
-    >>> [round(x, 4) for x in b]
+    >>> [round(float(x), 4) for x in b]
     [3.9266, 7.0686]
     """
     n = _modes("n", n)
