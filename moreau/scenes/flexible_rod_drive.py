@@ -636,7 +636,7 @@ register_scene(SceneEntry(
                 "bending modes",
     case=FlexibleRodDriveCase,
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
-               "EI", "damping"),
+               "modes", "EI", "damping"),
     mj_tolerance=5e-3,
     stress="moreau.scenes.flexible_rod_drive:stress_cases",
 ))
