@@ -72,8 +72,9 @@ over the drive's, ``W_i = b_i^2 sqrt(EI / (m l^3)) / w``, and
     wNbar = phi'^2 (sin phi + d cos phi) + 2 phi' d' sin phi - u1''
     wTbar = phi'^2 (cos phi - d sin phi) + 2 phi' d' cos phi
 
-(``d' = psi . eta'``). With ``N = 0`` these are the rigid scene's equations
-term by term.
+(``d' = psi . eta'``). A preload ``F_p`` acts, as in the rigid scene, on the
+rigid rotation: ``h_phi += f_p cos phi`` with ``f_p = F_p / (m l w^2)``. With
+``N = 0`` these are the rigid scene's equations term by term.
 
 The bending frequencies
 -----------------------
@@ -189,6 +190,9 @@ class FlexibleRodDriveParams:
         Bending stiffness [N m^2], > 0.
     damping : float
         Modal damping ratio ``zeta`` of every bending mode, >= 0.
+    preload : float
+        Preload ``F_p`` [N], >= 0, on the rigid rotation as in the rigid scene
+        (the generalised force ``f_p cos phi``).
 
     Examples
     --------
@@ -209,17 +213,23 @@ class FlexibleRodDriveParams:
     modes: int = 1
     EI: float = 1.0e-6
     damping: float = 0.02
+    preload: float = 0.0
 
     def __post_init__(self):
         # the rigid rod's parameters are checked by the rigid rod's own rules
         self.rigid()
+        object.__setattr__(self, "preload", V.nonnegative("preload", self.preload))
         object.__setattr__(self, "modes", _modes("modes", self.modes))
         object.__setattr__(self, "EI", V.positive("EI", self.EI))
         object.__setattr__(self, "damping", V.nonnegative("damping", self.damping))
 
     def rigid(self):
         """The rigid rod's :class:`FrictionDriveParams` (these parameters without the beam's)."""
-        names = [f.name for f in fields(FrictionDriveParams)]
+        names = [f.name for f in fields(FrictionDriveParams) if hasattr(self, f.name)]
+        # a rigid rod without a preload parameter takes none (it must then be 0)
+        if self.preload and "preload" not in names:
+            raise InputError("`preload` needs a rigid rod with a preload: FrictionDriveParams "
+                             "has none here")
         return FrictionDriveParams(**{k: getattr(self, k) for k in names})
 
     def with_(self, **changes):
@@ -280,6 +290,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         self.u10 = p.x10 / p.length
         self.force_scale = p.m * p.length * self.omega ** 2
         self.fL = p.load / self.force_scale
+        self.fp = p.preload / self.force_scale
         self.phi0 = p.phi0
         self.sin_phi0 = math.sin(p.phi0)
         self.mu = np.array([p.mu])
@@ -344,6 +355,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         dd1 = self.ddu1(t)
         h = np.empty(n + 2)
         h[0] = self.P * c * (self.sin_phi0 - s) - dd1 * (0.5 * c - s * float(self.beta @ eta))
+        h[0] += self.fp * c
         h[1:1 + n] = (-dd1 * c * self.beta - self.Omega ** 2 * eta
                       - 2.0 * self.zeta * self.Omega * deta)
         h[n + 1] = -self.fL
@@ -357,7 +369,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         K = np.zeros((n + 2, n + 2))
         C = np.zeros((n + 2, n + 2))
         K[0, 0] = (self.P * (-s * (self.sin_phi0 - s) - c * c)
-                   + dd1 * (0.5 * s + c * float(self.beta @ eta)))
+                   + dd1 * (0.5 * s + c * float(self.beta @ eta)) - self.fp * s)
         K[0, 1:1 + n] = dd1 * s * self.beta
         K[1:1 + n, 0] = dd1 * s * self.beta
         K[1:1 + n, 1:1 + n] = np.diag(-self.Omega ** 2)
@@ -445,7 +457,8 @@ class FlexibleRodDrive(DriveUnits, Scene):
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         n = self.N
-        par = np.concatenate([[self.J, self.P, self.u10, self.fL, self.sin_phi0, float(n)],
+        par = np.concatenate([[self.J, self.P, self.u10, self.fL, self.sin_phi0, float(n),
+                               self.fp],
                               self.Omega ** 2, self.beta, self.psi,
                               2.0 * self.zeta * self.Omega]).astype(np.float64)
         return CompiledModel(_mass, _forces, _contacts, _drift, par, n + 2, 1, True, True,
@@ -476,7 +489,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
 
 
 # -- compiled model (moreau.compiled) -----------------------------------------------------
-# par: J, P, u10, fL, sin_phi0, N, then W_i^2, beta_i, psi_i, 2 zeta W_i (N each);
+# par: J, P, u10, fL, sin_phi0, N, fp, then W_i^2, beta_i, psi_i, 2 zeta W_i (N each);
 # q = (phi, eta_1 .. eta_N, u2)
 
 @njit(cache=True)
@@ -503,25 +516,26 @@ def _forces(par, q, v, t, D, need_jac):
     s, c = math.sin(q[0]), math.cos(q[0])
     dd1 = par[2] * math.cos(t)
     spring = par[4] - s
-    beta_eta = _dot(par, 6 + n, n, q, 1)
+    beta_eta = _dot(par, 7 + n, n, q, 1)
     D[0, 0] = par[1] * c * spring - dd1 * (0.5 * c - s * beta_eta)
+    D[0, 0] += par[6] * c
     for i in range(n):
-        D[1 + i, 0] = (-dd1 * c * par[6 + n + i] - par[6 + i] * q[1 + i]
-                       - par[6 + 3 * n + i] * v[1 + i])
+        D[1 + i, 0] = (-dd1 * c * par[7 + n + i] - par[7 + i] * q[1 + i]
+                       - par[7 + 3 * n + i] * v[1 + i])
     D[n + 1, 0] = -par[3]
     if need_jac:
-        D[0, 1] = par[1] * (-s * spring - c * c) + dd1 * (0.5 * s + c * beta_eta)
+        D[0, 1] = par[1] * (-s * spring - c * c) + dd1 * (0.5 * s + c * beta_eta) - par[6] * s
         for i in range(n):
-            D[0, 2 + i] = dd1 * s * par[6 + n + i]
-            D[1 + i, 1] = dd1 * s * par[6 + n + i]
-            D[1 + i, 2 + i] = -par[6 + i]
-            D[1 + i, 1 + nd + 1 + i] = -par[6 + 3 * n + i]
+            D[0, 2 + i] = dd1 * s * par[7 + n + i]
+            D[1 + i, 1] = dd1 * s * par[7 + n + i]
+            D[1 + i, 2 + i] = -par[7 + i]
+            D[1 + i, 1 + nd + 1 + i] = -par[7 + 3 * n + i]
 
 
 @njit(cache=True)
 def _gaps(par, q, t, G):
     n = int(par[5])
-    d = _dot(par, 6 + 2 * n, n, q, 1)
+    d = _dot(par, 7 + 2 * n, n, q, 1)
     G[0, 0] = par[4] - math.sin(q[0]) - d * math.cos(q[0]) - par[2] * (1.0 - math.cos(t))
 
 
@@ -530,17 +544,17 @@ def _contacts(par, q, t, G, need_gap, need_T):
     n = int(par[5])
     nd = n + 2
     s, c = math.sin(q[0]), math.cos(q[0])
-    d = _dot(par, 6 + 2 * n, n, q, 1)
+    d = _dot(par, 7 + 2 * n, n, q, 1)
     if need_gap:
         G[0, 0] = par[4] - s - d * c - par[2] * (1.0 - math.cos(t))
     G[0, 1] = -par[2] * math.sin(t)
     G[0, 3] = -c + d * s
     for i in range(n):
-        G[0, 4 + i] = -par[6 + 2 * n + i] * c
+        G[0, 4 + i] = -par[7 + 2 * n + i] * c
     if need_T:
         G[0, 3 + nd] = s + d * c
         for i in range(n):
-            G[0, 4 + nd + i] = par[6 + 2 * n + i] * s
+            G[0, 4 + nd + i] = par[7 + 2 * n + i] * s
         G[0, 3 + nd + n + 1] = 1.0
 
 
@@ -548,8 +562,8 @@ def _contacts(par, q, t, G, need_gap, need_T):
 def _drift(par, q, v, t, Dr):
     n = int(par[5])
     s, c = math.sin(q[0]), math.cos(q[0])
-    d = _dot(par, 6 + 2 * n, n, q, 1)
-    dd = _dot(par, 6 + 2 * n, n, v, 1)
+    d = _dot(par, 7 + 2 * n, n, q, 1)
+    dd = _dot(par, 7 + 2 * n, n, v, 1)
     w = v[0]
     Dr[0, 0] = w * w * (s + d * c) + 2.0 * w * dd * s - par[2] * math.cos(t)
     Dr[0, 1] = w * w * (c - d * s) + 2.0 * w * dd * c
@@ -622,7 +636,8 @@ STEPS_STIFF = 1000
 
 #: SI units of the parameters of :class:`FlexibleRodDriveParams`
 UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "", "x10": "m",
-         "load": "N", "restitution": "", "modes": "", "EI": "N m^2", "damping": ""}
+         "load": "N", "restitution": "", "modes": "", "EI": "N m^2", "damping": "",
+         "preload": "N"}
 
 DOCS = {"modes": f"number of bending modes (0 = rigid rod, at most {MAX_MODES})",
         "EI": "bending stiffness of the rod", "damping": "modal damping ratio of every mode"}
@@ -636,7 +651,7 @@ register_scene(SceneEntry(
                 "bending modes",
     case=FlexibleRodDriveCase,
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
-               "modes", "EI", "damping"),
+               "modes", "EI", "damping", "preload"),
     mj_tolerance=5e-3,
     stress="moreau.scenes.flexible_rod_drive:stress_cases",
 ))

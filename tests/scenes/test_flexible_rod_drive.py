@@ -9,6 +9,7 @@ the rigid scene.
 
 import json
 import math
+from dataclasses import fields
 
 import numpy as np
 import pytest
@@ -21,7 +22,7 @@ from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes.flexible_rod_drive import (MAX_MODES, FlexibleRodDrive, mode_shape,
                                               pinned_free_modes)
-from moreau.scenes.friction_drive import FrictionDrive
+from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
 
 # roots of tan b = tanh b (hinged-free beam; Blevins, Formulas for natural frequency, table 8-1)
 LITERATURE = [3.926602312, 7.068582745, 10.21017612, 13.35176878, 16.49336143, 19.63495408]
@@ -184,6 +185,23 @@ def test_rigid_limit_has_the_rigid_scenes_compiled_model():
         b = evaluate_compiled(rigid.compiled_model(), q, v, t)
         for key in a:
             assert np.allclose(a[key], b[key], rtol=1e-15, atol=1e-15), key
+
+
+def test_preload_acts_on_the_rigid_rotation_as_in_the_rigid_scene():
+    if "preload" not in {f.name for f in fields(FrictionDriveParams)}:
+        # a rigid rod without a preload: the flexible one refuses one, by name
+        with pytest.raises(InputError, match="`preload`"):
+            FlexibleRodDrive(preload=1e-3)
+        return
+    flex = FlexibleRodDrive(modes=0, preload=1e-3)
+    rigid = FrictionDrive(frequency=185.0, preload=1e-3)
+    q, v = np.array([0.7, 0.1]), np.array([0.2, -0.1])
+    a = evaluate_compiled(flex.compiled_model(), q, v, 0.3)
+    b = evaluate_compiled(rigid.compiled_model(), q, v, 0.3)
+    for key in a:
+        assert np.allclose(a[key], b[key], rtol=1e-15, atol=1e-15), key
+    rep = check_scene(FlexibleRodDrive(modes=2, preload=1e-3), fd_tol=1e-5)
+    assert rep.ok, rep.summary()
 
 
 def test_rigid_limit_reproduces_the_rigid_trajectory():
