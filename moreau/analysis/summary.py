@@ -117,7 +117,8 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         (:func:`moreau.provenance.provenance`), ``energy`` (the energy audit of
         the steady period, :mod:`moreau.analysis.energy`: joules per period
         and ``closing_error``; None with an ``energy_note`` where the scheme
-        has no audit); with
+        has no audit), ``derived`` where the scene gives ``derived_quantities()``
+        (SI quantities it computes from its parameters); with
         Moreau–Jean also ``steps_per_period``, ``theta`` and the scheme's
         statistics.
     """
@@ -154,6 +155,10 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
         "parameters": dict(parameters),
         "provenance": provenance(),
     }
+    derived = getattr(scene, "derived_quantities", None)
+    if derived is not None:
+        # what a scene computes from its parameters (a flexible rod's bending frequencies)
+        out["derived"] = derived()
     if settings.steps_per_period is not None:
         out["steps_per_period"] = settings.steps_per_period
     if settings.theta is not None:

@@ -43,6 +43,13 @@ An entry holds:
     --scene NAME`` runs with its parsed arguments when no plane is given
     (``--x``, ``--y``: the generic atlas, :mod:`moreau.analysis.atlas`); None
     where the scene has none.
+``stress``
+    ``"module:function"`` returning the scene's cases for the stress
+    catalogue (:mod:`moreau.studies.paper.stress`): ``{case_id: {"title",
+    "scene", "steps", "bound"}}`` with ``scene`` a callable building the
+    scene, and optionally ``reference`` (a callable returning the steady
+    state that stands for the event-driven one) with ``note`` saying what it
+    is; None where the scene adds none.
 
 Examples
 --------
@@ -99,6 +106,7 @@ class SceneEntry:
     sweep: Optional[str] = None
     default: bool = False
     atlas: Optional[str] = None
+    stress: Optional[str] = None
 
     def parameter_names(self):
         return tuple(p.name for p in self.parameters)

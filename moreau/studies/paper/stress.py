@@ -40,6 +40,9 @@ floor, 1 % of the stator amplitude, keeps a motion with ``d_ref = 0``, a
 permanent stick, measurable). The stated bound is ``BOUND = 0.05`` unless a
 case says otherwise.
 
+A registered scene adds its own steady-state cases through its entry's
+``stress`` hook (:mod:`moreau.scenes.registry`); they join :data:`CASES`.
+
 The 10^7-step case runs 10^7 steps in the command (``full=True``) and 10^6
 in the quick catalogue that the tests run.
 
@@ -67,6 +70,7 @@ from ...analysis.steady_state import find_steady_state
 from ...errors import ConvergenceError, InputError, MoreauError
 from ...integrators import INTEGRATORS, simulate
 from ...integrators.base import scheme_options
+from ...scenes import registry
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
 from .valid_range import phi0_valid_range
 
@@ -177,16 +181,22 @@ def _stepping(schemes):
 
 
 # -- steady-state cases -----------------------------------------------------------------------
-def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note=""):
-    """Event-driven steady state as reference; each time-stepping scheme's at ``steps`` and 2x."""
+def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note="", reference=None):
+    """Event-driven steady state as reference; each time-stepping scheme's at ``steps`` and 2x.
+
+    ``reference``, where given, is a callable returning the steady state that
+    stands for the event-driven one (a case whose own event-driven run is out
+    of reach) and ``note`` says what it is.
+    """
     rows = []
     ref = {}
 
     def ed():
-        ss = find_steady_state(scene, rtol=1e-12)
+        ss = reference() if reference is not None else find_steady_state(scene, rtol=1e-12)
         ref.update(value=ss.displacement_per_period, mode=ss.mode)
         return _row(case, "event-driven", "stable", value=ss.displacement_per_period,
-                    mode=ss.mode, message="reference (shooting rtol 1e-12)" + note)
+                    mode=ss.mode, message=(note if reference is not None else
+                                           "reference (shooting rtol 1e-12)" + note))
 
     # the reference is needed by every column, shown only where asked for
     ed_row = _guard(case, "event-driven", ed)
@@ -436,6 +446,35 @@ CASES = {
                          lambda c, full, schemes, fast: _long_case(c, _scene(), full, schemes,
                                                                    fast)),
 }
+
+
+def _scene_case(spec):
+    """A steady-state case of a scene's own (its registry entry's ``stress`` hook)."""
+    make = spec["scene"]
+    steps = int(spec.get("steps", STEPS))
+    bound = float(spec.get("bound", BOUND))
+
+    def run(c, full, schemes, fast):
+        return _steady_case(c, make(), schemes, fast, steps=steps, bound=bound,
+                            note=spec.get("note", ""), reference=spec.get("reference"))
+    return _c(spec["title"], run)
+
+
+def _scene_cases():
+    """The cases the registered scenes add (``stress`` of their entries), by case id."""
+    out = {}
+    for entry in registry.entries():
+        if entry.stress is None:
+            continue
+        for key, spec in registry.resolve_hook(entry.stress)().items():
+            if key in CASES or key in out:
+                raise InputError(f"scene {entry.name!r} adds the stress case {key!r}, "
+                                 "which exists already")
+            out[key] = _scene_case(spec)
+    return out
+
+
+CASES.update(_scene_cases())
 
 
 def check_schemes(schemes):
