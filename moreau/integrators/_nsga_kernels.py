@@ -3,10 +3,12 @@
 The same step as :class:`moreau.integrators.nonsmooth_generalized_alpha.NonsmoothGeneralizedAlpha`
 (see its module docstring), on the functions of a
 :class:`moreau.compiled.CompiledModel`: the smooth generalized-α Newton
-iteration on the model's forces and Jacobians, the velocity-level contact
-problem of :mod:`moreau.integrators._mj_kernels` (the one-contact
-enumeration, Lemke for several) and the position correction (a scalar
-complementarity for one contact, a frictionless LCP by Lemke for several).
+iteration on the model's forces and Jacobians with the closed contacts'
+smooth forces solved inside each iteration, the velocity-level impulse
+problem (both with the contact problem of :mod:`moreau.integrators._mj_kernels`:
+the one-contact enumeration, Lemke for several) and the position correction
+(closed form for one contact; for several, the held contacts' equalities
+eliminated by a Schur complement and a frictionless LCP by Lemke for the rest).
 Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
 :func:`moreau.integrators._loops.runner_for` compiles in the model's namespace.
 """

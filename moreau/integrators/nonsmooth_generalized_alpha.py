@@ -192,7 +192,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
     """
 
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000),
-                        (100, 1000), {})
+                        (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
                  lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS):

@@ -162,8 +162,9 @@ def test_friction_drive_steady_state_against_the_reference():
     sc = make_scene("friction-drive", frequency=185.0)
     ref = steady_of(sc, ED_REFERENCE).displacement_per_period
     ss = steady_of(sc, make_scheme(NAME, steps_per_period=1600))
-    # measured 2.0e-3 (3.3e-2 at 400): the persistent contact is first order
-    assert abs(ss.displacement_per_period / ref - 1.0) < 5e-3
+    # measured -1.04e-3 (-4.8e-3 at 400, -1.6e-4 at 6400); before the smooth contact force
+    # 2.0e-3 (3.3e-2 at 400). The slip reversals inside a step keep it near first order
+    assert abs(ss.displacement_per_period / ref - 1.0) < 2e-3
 
 
 @pytest.mark.parametrize("options, message", [
