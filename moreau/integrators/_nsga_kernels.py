@@ -147,6 +147,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
         for i in range(nc):
             lamN[i] = 0.0
             lamT[i] = 0.0
+            slip[i] = 0.0
             if closed[i]:
                 ib[nb] = i
                 nb += 1
@@ -247,6 +248,12 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                     for c in range(mb):
                         acc_v += JiHT[i, c] * lam[c]
                     dx0[i] = acc_v
+                # the slip at v*: the impulse stage replaces it where it runs
+                for rr in range(nfb):
+                    acc_v = Uf[nb + rr]
+                    for c in range(mb):
+                        acc_v += Wd[nb + rr, c] * lam[c]
+                    slip[fb[rr]] = acc_v
             dmax = 0.0
             xmax = 0.0
             for i in range(n):
@@ -273,7 +280,6 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
         for i in range(nc):
             pN[i] = 0.0
             pT[i] = 0.0
-            slip[i] = 0.0
         if nc > 0:
             if HAS_GAPS:  # noqa: F821
                 gaps_fn(par, qs, t1, Gs)  # noqa: F821
@@ -287,103 +293,112 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                         fa[nfa] = i
                         nfa += 1
         if na > 0:
-            contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
-            for i in range(nc):
-                acc_v = G0[i, 1]
-                for j in range(n):
-                    acc_v += G0[i, 3 + j] * v[j]
-                vN0[i] = acc_v
-            mass_fn(par, qs, M)  # noqa: F821
-            if n <= 3:
-                ok = _invert_small(M, Mi, n)
-            else:
-                ok = _invert_gj(M, Mi, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
-            contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
-            m = na + nfa
+            # a contact carrying a smooth normal force meets its law at v* already: the
+            # impulse problem is solved only when an active contact carries none
+            need = False
             for rr in range(na):
-                i = ia[rr]
-                for j in range(n):
-                    H[rr, j] = Gs[i, 3 + j]
-                w[rr] = Gs[i, 1]
-            for rr in range(nfa):
-                i = fa[rr]
-                for j in range(n):
-                    H[na + rr, j] = Gs[i, 3 + n + j]
-                w[na + rr] = Gs[i, 2]
-            for c in range(m):
-                for i in range(n):
-                    acc_v = 0.0
+                if not lamN[ia[rr]] > 0.0:
+                    need = True
+            have_mi = False
+            if need:
+                contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
+                for i in range(nc):
+                    acc_v = G0[i, 1]
                     for j in range(n):
-                        acc_v += Mi[i, j] * H[c, j]
-                    MiHT[i, c] = acc_v
-            for rr in range(m):
-                acc_v = w[rr]
-                for j in range(n):
-                    acc_v += H[rr, j] * vs[j]
-                Uf[rr] = acc_v
-                for c in range(m):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += H[rr, j] * MiHT[j, c]
-                    Wd[rr, c] = acc_v
-            if na == 1 and not force_lemke:
-                i = ia[0]
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-                if nfa == 1:
-                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                              Uf[1], mu[i], e[i], vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
-                                    e[i], vN0[i], pn, pt)
-                    p[0] = pn
-                    p[1] = pt
+                        acc_v += G0[i, 3 + j] * v[j]
+                    vN0[i] = acc_v
+                mass_fn(par, qs, M)  # noqa: F821
+                if n <= 3:
+                    ok = _invert_small(M, Mi, n)
                 else:
-                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
-                                              vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
-                                    0.0)
-                    p[0] = pn
-                pN[i] = pn
-                pT[i] = pt
-            else:
+                    ok = _invert_gj(M, Mi, wk, n)
+                have_mi = True
+                if not ok:
+                    status = SINGULAR
+                    break
+                contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
+                m = na + nfa
                 for rr in range(na):
                     i = ia[rr]
-                    if e[i] > 0.0:
-                        Uf[rr] += e[i] * min(vN0[i], 0.0)
-                L = _lcp_size(na, ia, mu, base, trow)
-                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                                Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                                lcp_ctl, Ab, xb, idx, pcol, False)
-                if lst != 0:
-                    status = LCP_HANDBACK
-                    break
-                stats[S_PIVOTS] += piv
-                stats[S_LCP] += 1.0
-                for rr in range(na):
-                    if e[ia[rr]] > 0.0:
-                        Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
-            if res > stats[S_RES]:
-                stats[S_RES] = res
-            for i in range(n):
-                acc_v = vs[i]
+                    for j in range(n):
+                        H[rr, j] = Gs[i, 3 + j]
+                    w[rr] = Gs[i, 1]
+                for rr in range(nfa):
+                    i = fa[rr]
+                    for j in range(n):
+                        H[na + rr, j] = Gs[i, 3 + n + j]
+                    w[na + rr] = Gs[i, 2]
                 for c in range(m):
-                    acc_v += MiHT[i, c] * p[c]
-                v1[i] = acc_v
-            for rr in range(nfa):
-                tr = na + rr
-                acc_v = Uf[tr]
-                for c in range(m):
-                    acc_v += Wd[tr, c] * p[c]
-                slip[fa[rr]] = acc_v
+                    for i in range(n):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += Mi[i, j] * H[c, j]
+                        MiHT[i, c] = acc_v
+                for rr in range(m):
+                    acc_v = w[rr]
+                    for j in range(n):
+                        acc_v += H[rr, j] * vs[j]
+                    Uf[rr] = acc_v
+                    for c in range(m):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += H[rr, j] * MiHT[j, c]
+                        Wd[rr, c] = acc_v
+                if na == 1 and not force_lemke:
+                    i = ia[0]
+                    stats[S_LCP] += 1.0
+                    stats[S_DIRECT] += 1.0
+                    if nfa == 1:
+                        pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                                  Uf[1], mu[i], e[i], vN0[i])
+                        if not ok:
+                            status = PAINLEVE
+                            break
+                        res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
+                                        e[i], vN0[i], pn, pt)
+                        p[0] = pn
+                        p[1] = pt
+                    else:
+                        pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
+                                                  vN0[i])
+                        if not ok:
+                            status = PAINLEVE
+                            break
+                        res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
+                                        0.0)
+                        p[0] = pn
+                    pN[i] = pn
+                    pT[i] = pt
+                else:
+                    for rr in range(na):
+                        i = ia[rr]
+                        if e[i] > 0.0:
+                            Uf[rr] += e[i] * min(vN0[i], 0.0)
+                    L = _lcp_size(na, ia, mu, base, trow)
+                    lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                                    Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                                    lcp_ctl, Ab, xb, idx, pcol, False)
+                    if lst != 0:
+                        status = LCP_HANDBACK
+                        break
+                    stats[S_PIVOTS] += piv
+                    stats[S_LCP] += 1.0
+                    for rr in range(na):
+                        if e[ia[rr]] > 0.0:
+                            Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
+                if res > stats[S_RES]:
+                    stats[S_RES] = res
+                for i in range(n):
+                    acc_v = vs[i]
+                    for c in range(m):
+                        acc_v += MiHT[i, c] * p[c]
+                    v1[i] = acc_v
+                for rr in range(nfa):
+                    tr = na + rr
+                    acc_v = Uf[tr]
+                    for c in range(m):
+                        acc_v += Wd[tr, c] * p[c]
+                    slip[fa[rr]] = acc_v
             if position_level:
                 # Gauss-Newton with complementarity on the active contacts' gaps
                 for _ in range(POSITION_MAXITER):
@@ -400,6 +415,16 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                             gheld = max(gheld, abs(Gq[ia[rr], 0]))
                     if gmin >= -POSITION_TOL and gheld <= POSITION_TOL:
                         break
+                    if not have_mi:
+                        mass_fn(par, qs, M)  # noqa: F821
+                        if n <= 3:
+                            ok = _invert_small(M, Mi, n)
+                        else:
+                            ok = _invert_gj(M, Mi, wk, n)
+                        have_mi = True
+                        if not ok:
+                            status = SINGULAR
+                            break
                     if n > 0:
                         contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
                     for c in range(na):

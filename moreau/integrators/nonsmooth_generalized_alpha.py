@@ -56,7 +56,8 @@ problem with Newton's law and Coulomb friction on ``U = H v_{n+1} + w``,
 ``WN(q_n) v_n + wN(t_n)`` in the restitution term, Jacobians at
 ``(q*, t_{n+1})``. On a persistent contact ``v*`` already satisfies it, and
 ``Lambda = 0``: an impulse appears only at an impact (or at a closing
-contact), which is therefore first order.
+contact), which is therefore first order. The stage is skipped when every
+active contact carries a smooth normal force.
 
 *3. Position stage* (``position_level=True``, unknowns ``nu``):
 ``q_{n+1} = q* + M^-1 WN^T nu`` with ``g(q_{n+1}) = 0`` on the contacts that
@@ -237,8 +238,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
     def _smooth(self, q, v, a, acc, t1, h, closed):
         """The smooth stage: Newton on ``acc_{n+1}`` with the smooth contact forces of ``closed``.
 
-        Returns ``(q*, v*, a_{n+1}, acc_{n+1}, lamN, lamT)``, the smooth forces per
-        contact (zero outside ``closed``).
+        Returns ``(q*, v*, a_{n+1}, acc_{n+1}, lamN, lamT, slip)``: the smooth forces
+        per contact (zero outside ``closed``) and the slip velocities at ``v*``.
         """
         sc = self.scene
         am, af, gamma, beta = self.am, self.af, self.gamma, self.beta
@@ -250,6 +251,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         tr = self._trow[fb]
         lamN = np.zeros(nc)
         lamT = np.zeros(nc)
+        slip = np.zeros(nc)
         x = acc.copy()
         for it in range(1, NEWTON_MAXITER + 1):
             a1 = c * x + (af * acc - am * a) / (1.0 - am)
@@ -273,13 +275,14 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                                                     counters=self.counters, t=self.t)
                 dx = dx + JiHT @ lam
                 lamN[ib], lamT[ib] = ln, lt
+                slip[fb] = (U_free + W @ lam)[ib.size:]
             x = x + dx
             self.counters["newton_iterations"] += 1
             if np.max(np.abs(dx)) <= NEWTON_RTOL * max(1.0, np.max(np.abs(x))):
                 a1 = c * x + (af * acc - am * a) / (1.0 - am)
                 qs = q + h * v + h * h * (0.5 - beta) * a + h * h * beta * a1
                 vs = v + h * (1.0 - gamma) * a + h * gamma * a1
-                return qs, vs, a1, x, lamN, lamT
+                return qs, vs, a1, x, lamN, lamT, slip
         raise ConvergenceError(f"the smooth Newton iteration did not converge in "
                                f"{NEWTON_MAXITER} iterations at t = {self.t!r}")
 
@@ -315,17 +318,19 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
-        qs, vs, a1, acc1, lamN, lamT = self._smooth(q, v, self._a, self._acc, t1, h,
-                                                    self._closed)
+        qs, vs, a1, acc1, lamN, lamT, slip = self._smooth(q, v, self._a, self._acc, t1, h,
+                                                          self._closed)
         nc = sc.ncontacts
         pN = np.zeros(nc)
         pT = np.zeros(nc)
-        slip = np.zeros(nc)
         v1, q1 = vs, qs
         if nc:
             gs = np.asarray(sc.gaps(qs, t1), float)
             active = (gs <= CONTACT_TOL) | self._closed
-            if active.any():
+            held = lamN > 0.0
+            # a contact carrying a smooth normal force meets its law at v* already: the
+            # impulse problem is solved only when an active contact carries none
+            if (active & ~held).any():
                 ia = np.flatnonzero(active)
                 fa = ia[self._trow[ia] >= 0]
                 tr = self._trow[fa]
@@ -342,8 +347,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                 pN[ia], pT[ia] = pn, pt
                 v1 = vs + MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]
-                if self.position_level:
-                    q1 = self._correct_positions(qs, t1, active, lamN > 0.0)
+            if self.position_level and active.any():
+                q1 = self._correct_positions(qs, t1, active, held)
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")
@@ -407,13 +412,13 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
 
     Examples
     --------
-    A block resting on the ground carries its weight:
+    A block sliding on level ground: the contact carries its weight and brakes it by mu = 0.3:
 
     >>> from moreau.scenes.registry import make_scene
     >>> acc, lamN = consistent_acceleration(make_scene("sliding-block"), np.zeros(2),
     ...                                     np.array([1.0, 0.0]), 0.0)
     >>> acc.round(12).tolist(), lamN.round(12).tolist()
-    [[-0.3, 0.0], [1.0]]
+    ([-0.3, 0.0], [1.0])
     """
     M = np.asarray(scene.mass(q), float)
     f = np.asarray(scene.forces(q, v, t), float)
