@@ -3,10 +3,12 @@
 The same step as :class:`moreau.integrators.nonsmooth_generalized_alpha.NonsmoothGeneralizedAlpha`
 (see its module docstring), on the functions of a
 :class:`moreau.compiled.CompiledModel`: the smooth generalized-α Newton
-iteration on the model's forces and Jacobians, the velocity-level contact
-problem of :mod:`moreau.integrators._mj_kernels` (the one-contact
-enumeration, Lemke for several) and the position correction (a scalar
-complementarity for one contact, a frictionless LCP by Lemke for several).
+iteration on the model's forces and Jacobians with the closed contacts'
+smooth forces solved inside each iteration, the velocity-level impulse
+problem (both with the contact problem of :mod:`moreau.integrators._mj_kernels`:
+the one-contact enumeration, Lemke for several) and the position correction
+(closed form for one contact; for several, the held contacts' equalities
+eliminated by a Schur complement and a frictionless LCP by Lemke for the rest).
 Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
 :func:`moreau.integrators._loops.runner_for` compiles in the model's namespace.
 """
@@ -98,6 +100,30 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     nuN = np.zeros(ncm)
     nuT = np.zeros(ncm)
     X = np.zeros((n, ncm))
+    # the smooth stage: the closed contacts' forces, their Delassus matrix over J^-1
+    ib = np.zeros(ncm, dtype=np.int64)
+    fb = np.zeros(ncm, dtype=np.int64)
+    lamN = np.zeros(ncm)
+    lamT = np.zeros(ncm)
+    lam = np.zeros(mrows)
+    dx0 = np.zeros(n)
+    JiHT = np.zeros((n, mrows))
+    Ml3 = np.zeros((Lmax, Lmax))
+    lay3 = np.zeros(1 + ncm, dtype=np.int64)
+    lay3[0] = -1
+    PN = np.zeros(ncm)
+    PT = np.zeros(ncm)
+    # the mixed position correction: equality rows (held contacts) eliminated
+    eqr = np.zeros(ncm, dtype=np.int64)
+    unr = np.zeros(ncm, dtype=np.int64)
+    iu = np.zeros(ncm, dtype=np.int64)
+    Wee = np.zeros((ncm, ncm))
+    Weei = np.zeros((ncm, ncm))
+    wke = np.zeros((ncm, ncm))
+    Ws = np.zeros((mrows, mrows))
+    gs2 = np.zeros(mrows)
+    nuu = np.zeros(mrows)
+    tmpe = np.zeros(ncm)
 
     nrec = 0
     k = k0
@@ -114,7 +140,21 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             last = True
         if tk >= t_bound:
             break
-        # -- the smooth step: Newton on acc_{n+1}
+        # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
+        kv = hk * gamma * cfac
+        nb = 0
+        nfb = 0
+        for i in range(nc):
+            lamN[i] = 0.0
+            lamT[i] = 0.0
+            slip[i] = 0.0
+            if closed[i]:
+                ib[nb] = i
+                nb += 1
+                if mu[i] > 0.0:
+                    fb[nfb] = i
+                    nfb += 1
+        mb = nb + nfb
         for i in range(n):
             x[i] = acc[i]
         converged = False
@@ -141,14 +181,84 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             if not ok:
                 status = SINGULAR
                 break
-            dmax = 0.0
-            xmax = 0.0
             for i in range(n):
                 dx = 0.0
                 for j in range(n):
                     dx -= Ji[i, j] * r[j]
-                x[i] += dx
-                dmax = max(dmax, abs(dx))
+                dx0[i] = dx
+            if nb > 0:
+                # the contact velocities at v*(x + dx) are affine in the smooth forces:
+                # U = U_free + kv H J^-1 H^T lam
+                contacts_fn(par, qs, t1, Gs, False, True)  # noqa: F821
+                for rr in range(nb):
+                    i = ib[rr]
+                    for j in range(n):
+                        H[rr, j] = Gs[i, 3 + j]
+                    w[rr] = Gs[i, 1]
+                for rr in range(nfb):
+                    i = fb[rr]
+                    for j in range(n):
+                        H[nb + rr, j] = Gs[i, 3 + n + j]
+                    w[nb + rr] = Gs[i, 2]
+                for c in range(mb):
+                    for i in range(n):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += Ji[i, j] * H[c, j]
+                        JiHT[i, c] = acc_v
+                for rr in range(mb):
+                    acc_v = w[rr]
+                    for j in range(n):
+                        acc_v += H[rr, j] * (vs[j] + kv * dx0[j])
+                    Uf[rr] = acc_v
+                    for c in range(mb):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += H[rr, j] * JiHT[j, c]
+                        Wd[rr, c] = kv * acc_v
+                if nb == 1 and not force_lemke:
+                    i = ib[0]
+                    stats[S_LCP] += 1.0
+                    stats[S_DIRECT] += 1.0
+                    if nfb == 1:
+                        ln, lt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                                  Uf[1], mu[i], 0.0, 0.0)
+                        lam[1] = lt
+                    else:
+                        ln, lt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, 0.0,
+                                                  0.0)
+                    if not ok:
+                        status = PAINLEVE
+                        break
+                    lam[0] = ln
+                    lamN[i] = ln
+                    lamT[i] = lt
+                else:
+                    L = _lcp_size(nb, ib, mu, base, trow)
+                    lst, piv, res, warm = _lcp_step(Wd, Uf, nb, ib, mu, lam, lamN, lamT, L, base,
+                                                    trow, Ml3, ql, dl, zl, wl, rayl, work, iwork,
+                                                    lay3, lcp_ctl, Ab, xb, idx, pcol, False)
+                    if lst != 0:
+                        status = LCP_HANDBACK
+                        break
+                    stats[S_PIVOTS] += piv
+                    stats[S_LCP] += 1.0
+                for i in range(n):
+                    acc_v = dx0[i]
+                    for c in range(mb):
+                        acc_v += JiHT[i, c] * lam[c]
+                    dx0[i] = acc_v
+                # the slip at v*: the impulse stage replaces it where it runs
+                for rr in range(nfb):
+                    acc_v = Uf[nb + rr]
+                    for c in range(mb):
+                        acc_v += Wd[nb + rr, c] * lam[c]
+                    slip[fb[rr]] = acc_v
+            dmax = 0.0
+            xmax = 0.0
+            for i in range(n):
+                x[i] += dx0[i]
+                dmax = max(dmax, abs(dx0[i]))
                 xmax = max(xmax, abs(x[i]))
             if dmax <= NEWTON_RTOL * max(1.0, xmax):
                 converged = True
@@ -170,7 +280,6 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
         for i in range(nc):
             pN[i] = 0.0
             pT[i] = 0.0
-            slip[i] = 0.0
         if nc > 0:
             if HAS_GAPS:  # noqa: F821
                 gaps_fn(par, qs, t1, Gs)  # noqa: F821
@@ -184,103 +293,112 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                         fa[nfa] = i
                         nfa += 1
         if na > 0:
-            contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
-            for i in range(nc):
-                acc_v = G0[i, 1]
-                for j in range(n):
-                    acc_v += G0[i, 3 + j] * v[j]
-                vN0[i] = acc_v
-            mass_fn(par, qs, M)  # noqa: F821
-            if n <= 3:
-                ok = _invert_small(M, Mi, n)
-            else:
-                ok = _invert_gj(M, Mi, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
-            contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
-            m = na + nfa
+            # a contact carrying a smooth normal force meets its law at v* already: the
+            # impulse problem is solved only when an active contact carries none
+            need = False
             for rr in range(na):
-                i = ia[rr]
-                for j in range(n):
-                    H[rr, j] = Gs[i, 3 + j]
-                w[rr] = Gs[i, 1]
-            for rr in range(nfa):
-                i = fa[rr]
-                for j in range(n):
-                    H[na + rr, j] = Gs[i, 3 + n + j]
-                w[na + rr] = Gs[i, 2]
-            for c in range(m):
-                for i in range(n):
-                    acc_v = 0.0
+                if not lamN[ia[rr]] > 0.0:
+                    need = True
+            have_mi = False
+            if need:
+                contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
+                for i in range(nc):
+                    acc_v = G0[i, 1]
                     for j in range(n):
-                        acc_v += Mi[i, j] * H[c, j]
-                    MiHT[i, c] = acc_v
-            for rr in range(m):
-                acc_v = w[rr]
-                for j in range(n):
-                    acc_v += H[rr, j] * vs[j]
-                Uf[rr] = acc_v
-                for c in range(m):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += H[rr, j] * MiHT[j, c]
-                    Wd[rr, c] = acc_v
-            if na == 1 and not force_lemke:
-                i = ia[0]
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-                if nfa == 1:
-                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                              Uf[1], mu[i], e[i], vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
-                                    e[i], vN0[i], pn, pt)
-                    p[0] = pn
-                    p[1] = pt
+                        acc_v += G0[i, 3 + j] * v[j]
+                    vN0[i] = acc_v
+                mass_fn(par, qs, M)  # noqa: F821
+                if n <= 3:
+                    ok = _invert_small(M, Mi, n)
                 else:
-                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
-                                              vN0[i])
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
-                                    0.0)
-                    p[0] = pn
-                pN[i] = pn
-                pT[i] = pt
-            else:
+                    ok = _invert_gj(M, Mi, wk, n)
+                have_mi = True
+                if not ok:
+                    status = SINGULAR
+                    break
+                contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
+                m = na + nfa
                 for rr in range(na):
                     i = ia[rr]
-                    if e[i] > 0.0:
-                        Uf[rr] += e[i] * min(vN0[i], 0.0)
-                L = _lcp_size(na, ia, mu, base, trow)
-                lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                                Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                                lcp_ctl, Ab, xb, idx, pcol, False)
-                if lst != 0:
-                    status = LCP_HANDBACK
-                    break
-                stats[S_PIVOTS] += piv
-                stats[S_LCP] += 1.0
-                for rr in range(na):
-                    if e[ia[rr]] > 0.0:
-                        Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
-            if res > stats[S_RES]:
-                stats[S_RES] = res
-            for i in range(n):
-                acc_v = vs[i]
+                    for j in range(n):
+                        H[rr, j] = Gs[i, 3 + j]
+                    w[rr] = Gs[i, 1]
+                for rr in range(nfa):
+                    i = fa[rr]
+                    for j in range(n):
+                        H[na + rr, j] = Gs[i, 3 + n + j]
+                    w[na + rr] = Gs[i, 2]
                 for c in range(m):
-                    acc_v += MiHT[i, c] * p[c]
-                v1[i] = acc_v
-            for rr in range(nfa):
-                tr = na + rr
-                acc_v = Uf[tr]
-                for c in range(m):
-                    acc_v += Wd[tr, c] * p[c]
-                slip[fa[rr]] = acc_v
+                    for i in range(n):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += Mi[i, j] * H[c, j]
+                        MiHT[i, c] = acc_v
+                for rr in range(m):
+                    acc_v = w[rr]
+                    for j in range(n):
+                        acc_v += H[rr, j] * vs[j]
+                    Uf[rr] = acc_v
+                    for c in range(m):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += H[rr, j] * MiHT[j, c]
+                        Wd[rr, c] = acc_v
+                if na == 1 and not force_lemke:
+                    i = ia[0]
+                    stats[S_LCP] += 1.0
+                    stats[S_DIRECT] += 1.0
+                    if nfa == 1:
+                        pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                                  Uf[1], mu[i], e[i], vN0[i])
+                        if not ok:
+                            status = PAINLEVE
+                            break
+                        res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
+                                        e[i], vN0[i], pn, pt)
+                        p[0] = pn
+                        p[1] = pt
+                    else:
+                        pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
+                                                  vN0[i])
+                        if not ok:
+                            status = PAINLEVE
+                            break
+                        res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
+                                        0.0)
+                        p[0] = pn
+                    pN[i] = pn
+                    pT[i] = pt
+                else:
+                    for rr in range(na):
+                        i = ia[rr]
+                        if e[i] > 0.0:
+                            Uf[rr] += e[i] * min(vN0[i], 0.0)
+                    L = _lcp_size(na, ia, mu, base, trow)
+                    lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                                    Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                                    lcp_ctl, Ab, xb, idx, pcol, False)
+                    if lst != 0:
+                        status = LCP_HANDBACK
+                        break
+                    stats[S_PIVOTS] += piv
+                    stats[S_LCP] += 1.0
+                    for rr in range(na):
+                        if e[ia[rr]] > 0.0:
+                            Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
+                if res > stats[S_RES]:
+                    stats[S_RES] = res
+                for i in range(n):
+                    acc_v = vs[i]
+                    for c in range(m):
+                        acc_v += MiHT[i, c] * p[c]
+                    v1[i] = acc_v
+                for rr in range(nfa):
+                    tr = na + rr
+                    acc_v = Uf[tr]
+                    for c in range(m):
+                        acc_v += Wd[tr, c] * p[c]
+                    slip[fa[rr]] = acc_v
             if position_level:
                 # Gauss-Newton with complementarity on the active contacts' gaps
                 for _ in range(POSITION_MAXITER):
@@ -288,11 +406,25 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                         gaps_fn(par, q1, t1, Gq)  # noqa: F821
                     else:
                         contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                    # done when no gap is negative and every held contact's gap is zero
                     gmin = 0.0
+                    gheld = 0.0
                     for rr in range(na):
                         gmin = min(gmin, Gq[ia[rr], 0])
-                    if gmin >= -POSITION_TOL:
+                        if lamN[ia[rr]] > 0.0:
+                            gheld = max(gheld, abs(Gq[ia[rr], 0]))
+                    if gmin >= -POSITION_TOL and gheld <= POSITION_TOL:
                         break
+                    if not have_mi:
+                        mass_fn(par, qs, M)  # noqa: F821
+                        if n <= 3:
+                            ok = _invert_small(M, Mi, n)
+                        else:
+                            ok = _invert_gj(M, Mi, wk, n)
+                        have_mi = True
+                        if not ok:
+                            status = SINGULAR
+                            break
                     if n > 0:
                         contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
                     for c in range(na):
@@ -308,9 +440,22 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                             for j in range(n):
                                 acc_v += Gq[ia[rr], 3 + j] * X[j, c]
                             Wn[rr, c] = acc_v
+                    ne = 0
+                    nun = 0
+                    for rr in range(na):
+                        if lamN[ia[rr]] > 0.0:
+                            eqr[ne] = rr
+                            ne += 1
+                        else:
+                            unr[nun] = rr
+                            iu[nun] = ia[rr]
+                            nun += 1
                     if na == 1:
-                        nu[0] = max(0.0, -gn[0] / Wn[0, 0])
-                    else:
+                        if ne == 1:
+                            nu[0] = -gn[0] / Wn[0, 0]
+                        else:
+                            nu[0] = max(0.0, -gn[0] / Wn[0, 0])
+                    elif ne == 0:
                         L2 = _lcp_size(na, ia, mu0, base, trow)
                         lst, piv, res, warm = _lcp_step(Wn, gn, na, ia, mu0, nu, nuN, nuT, L2,
                                                         base, trow, Ml2, ql, dl, zl, wl, rayl,
@@ -319,6 +464,55 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                         if lst != 0:
                             status = LCP_HANDBACK
                             break
+                    else:
+                        # g = 0 on the held rows (nu of either sign): their nu eliminated
+                        for a_ in range(ne):
+                            for b_ in range(ne):
+                                Wee[a_, b_] = Wn[eqr[a_], eqr[b_]]
+                        if ne <= 3:
+                            ok = _invert_small(Wee, Weei, ne)
+                        else:
+                            ok = _invert_gj(Wee, Weei, wke, ne)
+                        if not ok:
+                            status = SINGULAR
+                            break
+                        if nun > 0:
+                            for a_ in range(nun):
+                                ra = unr[a_]
+                                for b_ in range(ne):
+                                    acc_v = 0.0
+                                    for c_ in range(ne):
+                                        acc_v += Wn[ra, eqr[c_]] * Weei[c_, b_]
+                                    tmpe[b_] = acc_v
+                                acc_v = gn[ra]
+                                for b_ in range(ne):
+                                    acc_v -= tmpe[b_] * gn[eqr[b_]]
+                                gs2[a_] = acc_v
+                                for c in range(nun):
+                                    acc_v = Wn[ra, unr[c]]
+                                    for b_ in range(ne):
+                                        acc_v -= tmpe[b_] * Wn[eqr[b_], unr[c]]
+                                    Ws[a_, c] = acc_v
+                            L2 = _lcp_size(nun, iu, mu0, base, trow)
+                            lst, piv, res, warm = _lcp_step(Ws, gs2, nun, iu, mu0, nuu, nuN, nuT,
+                                                            L2, base, trow, Ml2, ql, dl, zl, wl,
+                                                            rayl, work, iwork, lay2, lcp_ctl, Ab,
+                                                            xb, idx, pcol, False)
+                            if lst != 0:
+                                status = LCP_HANDBACK
+                                break
+                            for a_ in range(nun):
+                                nu[unr[a_]] = nuu[a_]
+                        for a_ in range(ne):
+                            acc_v = gn[eqr[a_]]
+                            for c in range(nun):
+                                acc_v += Wn[eqr[a_], unr[c]] * nuu[c]
+                            tmpe[a_] = acc_v
+                        for a_ in range(ne):
+                            acc_v = 0.0
+                            for b_ in range(ne):
+                                acc_v -= Weei[a_, b_] * tmpe[b_]
+                            nu[eqr[a_]] = acc_v
                     for i in range(n):
                         acc_v = 0.0
                         for c in range(na):
@@ -341,7 +535,10 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             for i in range(nc):
                 if -Gq[i, 0] > stats[S_PEN]:
                     stats[S_PEN] = -Gq[i, 0]
-                reg[i] = _classify(pN[i], pT[i], mu[i])
+                # the step's whole percussion: smooth force over the step plus the impulse
+                PN[i] = hk * lamN[i] + pN[i]
+                PT[i] = hk * lamT[i] + pT[i]
+                reg[i] = _classify(PN[i], PT[i], mu[i])
         if record_initial:
             if nc > 0:
                 if HAS_GAPS:  # noqa: F821
@@ -349,11 +546,11 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                 else:
                     contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
+                          tk, q, v, reg, PN, PT, hk, slip, G0, n, nc)
             nrec += 1
             record_initial = False
         for i in range(nc):
-            closed[i] = pN[i] > 0.0
+            closed[i] = pN[i] > 0.0 or lamN[i] > 0.0
         for j in range(n):
             q[j] = q1[j]
             v[j] = v1[j]
@@ -365,7 +562,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             to_save = save_every
         if to_save == save_every or last:
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
+                          t1, q, v, reg, PN, PT, hk, slip, Gq, n, nc)
             nrec += 1
         if last:
             break

@@ -133,7 +133,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
     """
 
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000),
-                        (100, 1000), {})
+                        (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, lcp_method="auto",
                  lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS):

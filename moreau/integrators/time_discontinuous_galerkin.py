@@ -156,7 +156,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
     """
 
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000),
-                        (100, 1000), {"degree": 2})
+                        (100, 300, 1000), {"degree": 2})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, degree=2, lcp_method="auto",
                  lemke_max_iter=None, save_every=1, projection=True, fast="auto",
