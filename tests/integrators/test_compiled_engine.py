@@ -255,3 +255,14 @@ def test_no_period_one_orbit_is_said_plainly():
     assert "long-run average" in ss.stats["message"]
     assert math.isfinite(ss.displacement_per_period) and ss.displacement_per_period > 0.0
     assert ss.periodic_residual > 1e-6 and ss.regimes == []
+
+
+def test_a_caller_that_wants_an_orbit_gets_a_failure_not_a_window_average():
+    # sweeps and atlases call find_steady_state(statistical=False): where the
+    # Moreau-Jean map has no period-1 orbit, a fixed window's average is not an
+    # answer (it can sit inside a slow transient), so the point fails and says why
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.errors import ConvergenceError
+    sc = FrictionDrive(FrictionDriveParams(restitution=1.0), frequency=15000.0)
+    with pytest.raises(ConvergenceError, match="no period-1 orbit"):
+        find_steady_state(sc, "moreau-jean", steps_per_period=2000, statistical=False)
