@@ -30,9 +30,14 @@ Examples
 bouncing-ball: every check passed (4 states)
 """
 
+
+from __future__ import annotations
+
 import dataclasses
+from typing import Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .errors import InputError
 from .compiled import check_compiled_model
@@ -98,7 +103,9 @@ def _overrides(scene, method):
     return getattr(type(scene), method) is not getattr(Scene, method)
 
 
-def check_scene(scene, states=None, t=0.3, fd_tol=1e-6, compiled_tol=1e-12, seed=0):
+def check_scene(scene: Scene, states: Sequence[tuple[ArrayLike, ArrayLike]] | None = None,
+                t: float = 0.3, fd_tol: float = 1e-6, compiled_tol: float = 1e-12,
+                seed: int = 0) -> SceneReport:
     """Check ``scene``'s model methods against independent computations.
 
     Parameters

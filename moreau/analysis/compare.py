@@ -94,6 +94,9 @@ Examples
 1.0
 """
 
+
+from __future__ import annotations
+
 import csv
 import inspect
 import json
@@ -101,8 +104,10 @@ import math
 import os
 import statistics
 import time
+from typing import Any, Callable, Sequence
 
 import numpy as np
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from .._validate import in_closed_interval, positive_int
@@ -244,9 +249,13 @@ def plateaus(rows, rel=0.02, min_error=1e-6):
     return notes
 
 
-def compare(scene, steps=None, lcp_steps=None, thetas=(0.5, 1.0), repeat=3, quick=False,
-            progress=True, on_row=None, *, t_span=None, q0=None, v0=None, schemes=None,
-            **params):
+def compare(scene: str | Scene, steps: Sequence[int] | None = None,
+            lcp_steps: Sequence[int] | None = None, thetas: Sequence[float] = (0.5, 1.0),
+            repeat: int = 3, quick: bool = False, progress: bool = True,
+            on_row: Callable[[dict], None] | None = None, *,
+            t_span: tuple[float, float] | None = None, q0: ArrayLike | None = None,
+            v0: ArrayLike | None = None, schemes: Sequence[str] | None = None,
+            **params: Any) -> dict:
     """Error against run time of every scheme on one scene.
 
     Parameters

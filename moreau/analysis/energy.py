@@ -14,7 +14,7 @@ Take the full coordinates ``(x1_r, phi_r, x2)`` of the paper's Lagrangian
 ``x1_r`` treated as coordinates held on their prescribed motion by the
 stator forces ``F_r``. In the scenes' dimensionless units (``tau = w t``,
 ``u = x / l``, forces over ``m l w^2``, energies over ``m l^2 w^2``) the energy
-of the rods, the springs and the rotor (the stator's own mass left out) is
+of the rods, the springs and the rotor (the stator's own mass left out) is::
 
     E = sum_r [1/2 u1r'^2 + 1/2 u1r' phi_r' cos phi_r + 1/6 phi_r'^2
                + 1/2 P (sin phi0 - sin phi_r)^2 + f_p (sin phi0 - sin phi_r)]

@@ -5,9 +5,14 @@ rotor position of the friction drive) has a period map on the remaining
 state; its fixed point is the periodic steady state, found by shooting.
 """
 
+
+from __future__ import annotations
+
 import math
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import positive_int
 from ..errors import ConvergenceError, InputError, RunawayError
@@ -29,9 +34,10 @@ __all__ = ["SteadyState", "find_steady_state"]
 TWO_PI = 2.0 * math.pi
 
 
-def find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, max_iter=60,
-                      max_period=1, statistical=True, statistical_budget=MAX_PERIODS,
-                      guess=None, **options):
+def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 1e-10,
+                      v_guess: float | None = None, max_iter: int = 60, max_period: int = 1,
+                      statistical: bool = True, statistical_budget: int = MAX_PERIODS,
+                      guess: ArrayLike | None = None, **options: Any) -> SteadyState:
     """Periodic steady state of a periodically driven scene, found by shooting, and checked.
 
     The one entry point for every scheme and every caller: what the shooting

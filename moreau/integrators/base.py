@@ -7,9 +7,14 @@ to the end of the interval and returns a :class:`SimulationResult`; an
 interrupted run (Ctrl-C) keeps what it had finished.
 """
 
+
+from __future__ import annotations
+
 import inspect
+from typing import Any, Callable, Sequence, TYPE_CHECKING
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
@@ -17,6 +22,9 @@ from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
 from .result import STATUS_MESSAGES, SimulationResult
+
+if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
+    from ..scenes.base import Scene
 
 __all__ = ["Integrator", "simulate", "INTEGRATORS", "register_integrator", "get_integrator",
            "check_options"]
@@ -259,8 +267,10 @@ def _state_vector(name, value, n):
     return a.copy()
 
 
-def simulate(scene, t_span, q0, v0, method, progress=False, t_eval=None, events=None,
-             **options):
+def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: ArrayLike,
+             method: str, progress: bool = False, t_eval: ArrayLike | None = None,
+             events: Callable | Sequence[Callable] | None = None,
+             **options: Any) -> SimulationResult:
     """Integrate ``scene`` over ``t_span`` with the scheme registered as ``method``.
 
     Parameters

@@ -38,3 +38,15 @@ def test_json_outputs_carry_their_provenance(tmp_path):
     rep = json.loads(run.stdout)
     assert rep["provenance"]["moreau_version"] == moreau.__version__
     assert "median wall time" in rep["time_s_meaning"]
+
+
+def test_the_public_front_ends_are_annotated():
+    # py.typed promises type hints: every parameter and the return of the front
+    # ends that `import moreau` offers carry an annotation
+    import inspect
+    import moreau
+    for name in ("simulate", "compare", "find_steady_state", "check_scene"):
+        sig = inspect.signature(getattr(moreau, name))
+        missing = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty]
+        assert not missing, f"{name}: no annotation on {missing}"
+        assert sig.return_annotation is not inspect.Signature.empty, f"{name}: no return annotation"
