@@ -294,8 +294,10 @@ def test_phi0_2000Hz_figure_log_scale_and_impact_note(quick_run):
     rows = read_table(quick_run / "data" / "phi0_2000Hz.csv")
     extra = study_grids(quick=True)["phi0_2000Hz"][3]
     fig = draw_sweep(rows, "phi0", 2000.0, extra)
-    assert len(fig.axes) == 2
-    assert [ax.get_yscale() for ax in fig.axes] == ["log", "log"]
+    # the two log panels, and the stability panel of every sweep figure
+    assert len(fig.axes) == 3
+    assert [ax.get_yscale() for ax in fig.axes[:2]] == ["log", "log"]
+    assert "Floquet multiplier" in fig.axes[2].get_ylabel()
     labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
     assert "F: flight, !: contact entered by an impact" in labels
     assert "NP" in labels and any("!" in m for m in labels[:-1])

@@ -76,7 +76,7 @@ def check_options(name, options, scene=None):
     >>> check_options("event-driven-generic", {"theta": 0.5})
     Traceback (most recent call last):
     ...
-    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, ode_method, max_step, sample_dt, gap_tol, vel_tol, zeno_rtol, max_impacts, lcp_method
+    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, ode_method, max_step, sample_dt, gap_tol, vel_tol, zeno_rtol, max_impacts, lcp_method, record_pieces
     """
     cls = get_integrator(name)
     if scene is not None and hasattr(cls, "resolve"):

@@ -56,6 +56,7 @@ def test_motion_names_and_marks():
         ("grazing", [2.0, 3.0]), ("period change", [3.0, 4.0])]
 
 
+@pytest.mark.slow
 def test_each_point_samples_the_steady_state_it_continues_to():
     # the stick-slip motor is period 1 at every load: its sampled displacement per period
     # is the steady state's, found independently by shooting

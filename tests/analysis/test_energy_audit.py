@@ -100,6 +100,7 @@ def test_moreau_jean_midpoint_audit_closes_tighter():
     assert abs(a["closing_error"]) < 0.5 / 1000
 
 
+@pytest.mark.slow
 def test_two_rod_drive_moreau_jean_audit():
     sc = BidirectionalDrive(frequency=185.0, x10_b=1e-6)
     a = _mj(sc, 1000)

@@ -71,6 +71,7 @@ def test_periodic_orbit_displacement_is_inside_the_interval():
     assert ss.periods_used >= 100 and ss.stats["transient_periods"] < 50
 
 
+@pytest.mark.slow
 def test_different_initial_states_same_mean():
     # Schatzman-Paoli at 2000 Hz, N = 800: from rest (a long, linear spin-down of the
     # rotor on a flat step of the map) and from a rotor twice as fast
@@ -151,6 +152,7 @@ def _light_rotor_flight():
     return FrictionDrive(PAPER_DEFAULTS.with_(restitution=1.0, m2=2e-8), 15000.0)
 
 
+@pytest.mark.slow
 def test_event_driven_and_moreau_jean_agree_within_their_intervals():
     # measured (precision 2e-2): event-driven-generic 7.753e-3 +- 2.0 %, Moreau-Jean
     # theta = 1/2 at N = 1000..16000 7.72e-3..7.85e-3 +- 1.5 %, Schatzman-Paoli 7.78e-3
@@ -170,6 +172,7 @@ def test_event_driven_and_moreau_jean_agree_within_their_intervals():
 # inside the rotor. With that fixed it gives 7.77e-3 in [7.62e-3, 7.92e-3], with every
 # other scheme (event-driven-generic, Moreau-Jean, Schatzman-Paoli, generalized-alpha:
 # 7.75e-3 .. 7.83e-3).
+@pytest.mark.slow
 def test_walker_agrees_with_the_generic_event_driven_scheme_in_flight():
     sc = _light_rotor_flight()
     walker = statistical_steady_state(sc, "event-driven", precision=2e-2)

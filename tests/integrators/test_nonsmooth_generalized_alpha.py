@@ -41,6 +41,7 @@ def test_second_order_in_free_flight():
     assert _order(NAME, rho_inf=0.5) == pytest.approx(2.0, abs=0.1)
 
 
+@pytest.mark.slow
 def test_bouncing_ball_converges_without_penetration():
     ball = make_scene("bouncing-ball", restitution=0.5)
     q0, v0 = ball.initial_state()
@@ -158,6 +159,7 @@ def test_the_elastic_ball_loses_energy_only_through_the_position_correction():
     assert np.max(np.abs(e_free - e_free[0])) < 1e-12
 
 
+@pytest.mark.slow
 def test_friction_drive_steady_state_against_the_reference():
     sc = make_scene("friction-drive", frequency=185.0)
     ref = steady_of(sc, ED_REFERENCE).displacement_per_period
@@ -207,6 +209,7 @@ def test_the_compiled_loop_is_the_generic_step(scene_name):
     assert np.max(np.abs(fast.force_T.sum(axis=1) - slow.force_T.sum(axis=1))) <= 1e-9
 
 
+@pytest.mark.slow
 def test_second_order_on_the_painleve_rod_sliding_on_its_tip():
     # a registered scene, compiled loop: the rod slides on its tip for the whole window
     # (persistent frictional contact, mu = 2); against the sliding ODE at rtol 1e-12:
