@@ -37,10 +37,14 @@ EXPECTED = {
     "coarse-N10": ("stable", "inaccurate", "inaccurate"),
     "long-1e7-steps": ("n/a", "stable", "stable"),
     # added by the flexible-rod-drive scene (its entry's stress hook); the reference is the
-    # rigid rod's. theta = 1/2 keeps the undamped modes' energy: the discrete Painlevé
-    # condition fails and says so; 50 steps: theta = 1 damps too much (5 % error)
+    # rigid rod's. theta = 1/2 keeps the undamped modes' energy, so they ring for ever: on
+    # some CPUs the ringing reaches the discrete Painlevé condition, which fails and says so;
+    # on others (another FMA contraction of the compiled loop: seen on an AMD EPYC) it does
+    # not, and the statistical steady state is within the bound. Both are honest outcomes;
+    # which one is a matter of rounding in a chaotic undamped motion (see UNDAMPED below).
+    # 50 steps: theta = 1 damps too much (5 % error)
     "flexible-rod-stiff": ("stable", "stable", "stable"),
-    "flexible-rod-stiff-undamped": ("stable", "stable", "failed"),
+    "flexible-rod-stiff-undamped": ("stable", "stable", {"failed", "stable"}),
     "flexible-rod-stiff-N50": ("stable", "inaccurate", "stable"),
 }
 
@@ -84,7 +88,9 @@ def test_case(case):
     # the first three columns; the other schemes' columns are tested below on cheap cases
     rows = run_case(case, schemes=CLASSIC)
     _check_common(rows)
-    assert tuple(r["outcome"] for r in rows) == EXPECTED[case], [r["message"] for r in rows]
+    outcomes = tuple(r["outcome"] for r in rows)
+    assert all(o in want if isinstance(want, set) else o == want
+               for o, want in zip(outcomes, EXPECTED[case])), [r["message"] for r in rows]
     ed, mj1, mj05 = rows
     if case in MODES:
         ref_mode, mj_mode = MODES[case]
@@ -108,6 +114,13 @@ def test_case(case):
             assert all(r["message"].startswith("BudgetExhaustedError: statistical steady "
                                                "state: budget exhausted (`max_periods`=400)")
                        for r in rows)
+    if case == "flexible-rod-stiff-undamped":
+        # UNDAMPED: either the discrete Painlevé failure, named, or no period-1 orbit (the
+        # modes never settle) and a statistical mean within the bound
+        if mj05["outcome"] == "failed":
+            assert "Painlev" in mj05["message"]
+        else:
+            assert "no period-1 orbit" in mj05["message"] and mj05["error"] < 2e-3
     if case == "coarse-N10":
         # h = T/10: both step sizes still give the right mode, theta = 1/2 within 6 %
         assert mj1["error"] < 1.0 and mj05["error"] < 0.06
