@@ -100,7 +100,7 @@ def new_stats():
     return np.zeros(len(STAT_NAMES))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
     # returns (pN, pT, ok); ok = False when the discrete Painlevé condition
     # fails and the problem has no solution or several (see moreau_jean.py)
@@ -163,7 +163,7 @@ def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
     return -b / Wnn, 0.0, True
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
     b = uN + e * min(vN_pre, 0.0)
     vN = b + Wnn * pN + Wnt * pT
@@ -180,7 +180,7 @@ def _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
     return num / scale
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _classify(pN, pT, mu):
     if not pN > 0.0:
         return 0
@@ -193,7 +193,7 @@ def _classify(pN, pT, mu):
     return 3
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def lcp_buffers(ncm):
     """The buffers of one loop's contact LCPs for up to ``ncm`` contacts (see :func:`_lcp_step`).
 
@@ -209,7 +209,7 @@ def lcp_buffers(ncm):
             np.zeros(Lmax), np.zeros(Lmax, dtype=np.int64), np.zeros(4 * ncm, dtype=np.int64))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
                   reg, pN, pT, h, slip, G, n, nc):
     """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
@@ -226,14 +226,14 @@ def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_ga
         rec_gap[nrec, i] = G[i, 0]
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _invert_small(A, out, n):
     """``out = A^-1`` for ``n <= 3`` in closed form; False when ``A`` is singular.
 
     Singular means to working precision: a 1-norm condition number of 1e14 or
-    more, or a non-finite entry. Loop-free and call-free on purpose: numba
-    reference-counts the arrays of an inlined function, and LLVM prunes those
-    counts only around straight-line code.
+    more, or a non-finite entry. Loop-free and call-free on purpose: LLVM
+    inlines it into the loops and prunes the arrays' reference counts only
+    around straight-line code.
     """
     ok = True
     na = 0.0

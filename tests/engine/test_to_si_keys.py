@@ -20,8 +20,10 @@ COMMON = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap", "regime")
 
 def _short_run(scene):
     q0, v0 = scene.initial_state()
-    # a few hundred compiled steps: shapes and scales, not accuracy
-    return simulate(scene, (0.0, 0.5), q0, v0, "moreau-jean", h=0.5 / 200)
+    # a few hundred steps: shapes and scales, not accuracy. The generic step, because the
+    # compiled loop returns the same result object (tests/integrators/test_compiled_engine.py)
+    # and compiling it for every scene here cost a minute of CI
+    return simulate(scene, (0.0, 0.5), q0, v0, "moreau-jean", h=0.5 / 200, fast=False)
 
 
 @pytest.mark.parametrize("name", NAMES)
