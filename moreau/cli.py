@@ -183,7 +183,7 @@ def _cmd_sweep(args):
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-                    force=args.force)
+                    force=args.force, continuation=not args.cold)
 
 
 def _cmd_characteristic(args):
@@ -599,6 +599,9 @@ def build_parser():
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
     s.add_argument("--force", action="store_true",
                    help="replace the files of an earlier run with other settings (refused otherwise)")
+    s.add_argument("--cold", action="store_true",
+                   help="start every point's shooting from rest (default: from its "
+                        "neighbour's orbit, with a cold start where that fails)")
     _add_params(s, scheme_defaults=False)
     add_scene_options(s, with_set=False)
     s.set_defaults(func=_cmd_sweep)

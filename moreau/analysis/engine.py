@@ -425,6 +425,39 @@ def check_jobs(n_jobs, points):
     return max(1, min(cores if n_jobs == -1 else n_jobs, points))
 
 
+#: the columns a line of continued points adds to its rows (:func:`evaluate_points`)
+LINE_COLUMNS = ("start", "continuation_solves")
+
+
+def line_columns(row):
+    """``{start, continuation_solves}`` of a row; a point run alone (a task of one) started cold.
+
+    Examples
+    --------
+    >>> line_columns({"mode": "NP"})
+    {'start': 'cold', 'continuation_solves': 0}
+    """
+    return {"start": row.get("start", "cold"),
+            "continuation_solves": row.get("continuation_solves", 0)}
+
+
+def line_chunk(points, n_jobs=-1):
+    """Points per task when ``points`` neighbours on a line are continued one from the next.
+
+    A task's points are shot in order, each from the previous one's orbit;
+    its first point starts cold. Two tasks per worker: fewer cold starts than
+    one task per point, and a worker that drew the costly segment (flight,
+    points without an orbit) is not left alone at the end of the run.
+
+    Examples
+    --------
+    >>> line_chunk(99, 2), line_chunk(3, 2), line_chunk(1)
+    (25, 1, 1)
+    """
+    workers = check_jobs(n_jobs, max(1, int(points)))
+    return max(1, math.ceil(int(points) / (2 * workers)))
+
+
 def check_scheduler(scheduler):
     """Refuse a Dask scheduler address that cannot work, before any work.
 

@@ -1,8 +1,10 @@
 """Steady states of any periodically driven scene over one of its parameters.
 
-The generic ``moreau sweep``: every point is one call of the sweep engine
+The generic ``moreau sweep``: the points go through the sweep engine
 (:func:`moreau.analysis.engine.run_points`: cached, in parallel, a failed
-point kept as its ``status``), for any registered scene with a periodic
+point kept as its ``status``) in segments of neighbours, each point's
+shooting started from the previous one's orbit (continuation, with a cold
+start where that fails; the ``start`` column), for any registered scene with a periodic
 drive (:func:`moreau.analysis.engine.periodic_scene_names`) and any of its
 numeric parameters. A scene whose study has its own sweep (the paper's
 friction drive, with its valid-range marks) names it in its registry entry
@@ -175,7 +177,7 @@ def plan_points(scene, swept, values, fixed=None, frequency=None):
 
 def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme=ED_REFERENCE,
                     out="out", cache_dir=None, n_jobs=-1, scheduler=None, progress=True,
-                    plot=True, log=print, force=False):
+                    plot=True, log=print, force=False, continuation=True):
     """Steady states of the registered scene ``scene`` over ``values`` of ``parameter``.
 
     Parameters
@@ -198,6 +200,12 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     force : bool
         Replace the files of an earlier sweep with other settings
         (:func:`moreau.outputs.claim_outputs`); refused otherwise, before any work.
+    continuation : bool
+        True (default): the values are neighbours, and each point's shooting
+        starts from the previous point's orbit (:mod:`moreau.analysis.continuation`:
+        a halved step, then a cold start where that fails), in segments of
+        :func:`moreau.analysis.engine.line_chunk` points; False: every point
+        starts cold. The ``start`` column says which it was.
 
     Returns
     -------
@@ -217,10 +225,12 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             "frequency_Hz": frequency,
             "fixed": {k: v for k, v in points[0][0].items() if k != parameter},
             "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                       scheme.options]}, force)
+                       scheme.options], "continuation": bool(continuation)}, force)
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"sweep {parameter}", scene=entry.name, energy=True)
+                                    desc=f"sweep {parameter}", scene=entry.name, energy=True,
+                                    chunk=engine.line_chunk(len(points), n_jobs),
+                                    continuation=bool(continuation))
     swept = columns[parameter]
     table = []
     for x, (p, f), row in zip(values, points, rows):
@@ -232,6 +242,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
                 r[columns[name]] = val
         for c in VALUE_COLUMNS:
             r[c] = row.get(c, "" if c in ("mode", "status", "stable") else math.nan)
+        r.update(engine.line_columns(row))
         for c in ENERGY_COLUMNS:
             r[c] = row.get(c, "" if c == "energy_status" else math.nan)
         table.append(r)
@@ -248,6 +259,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             "scheme": {"name": scheme.name, "theta": scheme.theta,
                        "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
                        "options": scheme.options},
+            "continuation": bool(continuation),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
     json_path = stem.with_name(stem.name + ".json")

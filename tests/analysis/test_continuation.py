@@ -136,3 +136,37 @@ def test_atlas_command_cold_and_classify_options(tmp_path):
     assert starts[0::2] == ["cold", "cold"] and starts[1] == "continued"
     assert starts[3] in ("continued", "cold-fallback")
     assert cli.main(args + ["--classify-periods", "-1", "--force"]) == 2
+
+
+@pytest.mark.parametrize("scene, parameter, values, fixed", [
+    # the paper's drive through its own study sweep (moreau sweep mu)
+    ("friction-drive", "mu", (0.1, 0.3, 7), None),
+    # any registered periodic scene through the generic sweep
+    ("stick-slip-motor", "load", (0.0, 0.1, 5), None),
+])
+def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, values, fixed):
+    import csv
+
+    from moreau.cli import main
+
+    def run(out, *extra):
+        argv = ["sweep", parameter, str(values[0]), str(values[1]), "--points", str(values[2]),
+                "--scene", scene, "--set", "frequency=185", "--out", str(tmp_path / out),
+                "--quiet", "--no-plot", "--jobs", "1"] + list(extra)
+        if scene == "stick-slip-motor":
+            argv[argv.index("frequency=185")] = "frequency=1000"
+        assert main(argv) == 0
+        (path,) = (tmp_path / out).glob("*.csv")
+        return list(csv.DictReader(open(path)))
+
+    warm, cold = run("warm"), run("cold", "--cold")
+    # one task of neighbours with one worker (two tasks per worker: ceil(n / 2) points each)
+    n = values[2]
+    assert [r["start"] for r in warm] == [
+        "cold" if i % math.ceil(n / 2) == 0 else "continued" for i in range(n)]
+    assert {r["start"] for r in cold} == {"cold"}
+    assert all(int(r["continuation_solves"]) >= 1 for r in warm if r["start"] == "continued")
+    for w, c in zip(warm, cold):
+        assert w["mode"] == c["mode"] and w["status"] == c["status"] == "ok"
+        assert float(w["displacement_per_period_m"]) == pytest.approx(
+            float(c["displacement_per_period_m"]), rel=1e-8, abs=1e-15)

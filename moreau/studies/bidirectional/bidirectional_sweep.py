@@ -123,7 +123,7 @@ def tidy_rows(parameter, values, frequency, params, rows):
 def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, stop=None,
                             points=None, scale="linear", scheme=None, out="out", cache_dir=None,
                             n_jobs=-1, scheduler=None, progress=True, plot=True, log=print,
-                            force=False):
+                            force=False, continuation=True):
     """Steady states of the bidirectional drive over one parameter, through the sweep engine.
 
     Writes ``OUT/sweep_bidirectional_TAG.csv`` (tidy, units in the column
@@ -182,15 +182,19 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
         "frequency_Hz": frequency, "parameters_SI": asdict(params),
         "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                   scheme.options]}, force)
+                   scheme.options], "continuation": bool(continuation)}, force)
 
     pts = [(asdict(point_params(params, parameter, x)),
             float(x) if parameter == "frequency" else frequency) for x in values]
+    # neighbours in segments, each point shot from the previous one's orbit
     rows, stats = engine.run_points(pts, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", scene="bidirectional",
-                                    energy=True)
+                                    energy=True, chunk=engine.line_chunk(len(pts), n_jobs),
+                                    continuation=bool(continuation))
     table = tidy_rows(parameter, values, frequency, params, rows)
+    for r, row in zip(table, rows):
+        r.update(engine.line_columns(row))
     for r in table:
         r["scheme"] = scheme.name
     write_table(table, (stem.parent / (stem.name + ".csv")))
@@ -298,4 +302,5 @@ def command(args):
                             points=args.points if args.points is not None else args.num,
                             scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
                             n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
-                            plot=not args.no_plot, force=args.force)
+                            plot=not args.no_plot, force=args.force,
+                            continuation=not args.cold)

@@ -188,7 +188,7 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
 
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print, force=False):
+              progress=True, plot=True, log=print, force=False, continuation=True):
     """The ``moreau sweep`` command: steady states over one parameter through the sweep engine.
 
     Every point goes through :func:`moreau.analysis.engine.run_points`: cached
@@ -252,13 +252,18 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
         "frequency_Hz": frequency, "parameters_SI": asdict(params),
         "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                   scheme.options]}, force)
+                   scheme.options], "continuation": bool(continuation)}, force)
 
     points_ = [sweep_point(params, parameter, x, frequency) for x in values]
+    # neighbours in segments, each point shot from the previous one's orbit
     rows, stats = engine.run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
-                                    desc=f"sweep {parameter}", energy=True)
+                                    desc=f"sweep {parameter}", energy=True,
+                                    chunk=engine.line_chunk(len(points_), n_jobs),
+                                    continuation=bool(continuation))
     table = tidy_rows(parameter, values, frequency, params, rows, ())
+    for r, row in zip(table, rows):
+        r.update(engine.line_columns(row))
     for r in table:
         r["scheme"] = scheme.name
     write_table(table, _with(stem, ".csv"))
@@ -336,4 +341,4 @@ def command(args):
               points=args.points if args.points is not None else args.num, scale=scale,
               scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-              force=args.force)
+              force=args.force, continuation=not args.cold)
