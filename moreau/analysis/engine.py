@@ -386,6 +386,10 @@ def check_output_dir(path, option="--out"):
     True
     """
     p = pathlib.Path(path)
+    if p.exists() and not p.is_dir():
+        # mkdir's "File exists" would not say that the name is taken by a file
+        raise InputError(f"`{option}` folder {str(p)!r} is not writable: it is a file, not a "
+                         "folder")
     try:
         p.mkdir(parents=True, exist_ok=True)
         probe = p / f".moreau-write-test-{os.getpid()}"

@@ -20,6 +20,50 @@ def test_shared_options_are_refused_before_work(extra, message, tmp_path, capsys
     assert not list(tmp_path.glob("*.csv"))
 
 
+def _no_work(monkeypatch):
+    from moreau import cli
+    from moreau.analysis import engine
+
+    def no_work(*a, **k):
+        raise AssertionError("work started before the folder was checked")
+
+    monkeypatch.setattr(engine, "run_points", no_work)
+    monkeypatch.setattr(cli, "run_history", no_work)
+
+
+@pytest.mark.parametrize("command", [
+    ["sweep", "mu", "0.1", "0.2", "--points", "2", "--frequency", "185"],
+    ["atlas", "--quick"],
+])
+def test_a_cache_that_is_a_file_is_refused_in_one_line(command, tmp_path, capsys, monkeypatch):
+    _no_work(monkeypatch)
+    taken = tmp_path / "cache"
+    taken.write_text("not a folder")
+    argv = command + ["--out", str(tmp_path / "out"), "--cache", str(taken), "--quiet",
+                      "--no-plot"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (f"moreau: error: `--cache` folder {str(taken)!r} is not writable: it is a "
+                   "file, not a folder\n")
+    assert taken.read_text() == "not a folder"
+
+
+@pytest.mark.parametrize("where, reason", [
+    ("/proc/x", "No such file or directory"),
+    ("FILE", "it is a file, not a folder"),
+])
+def test_run_refuses_an_out_it_cannot_write_in_one_line(where, reason, tmp_path, capsys,
+                                                        monkeypatch):
+    _no_work(monkeypatch)
+    if where == "FILE":
+        where = tmp_path / "taken"
+        where.write_text("x")
+    argv = ["run", "--frequency", "185", "--periods", "1", "--out", str(where), "--quiet"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (f"moreau: error: `--out` folder {str(where)!r} is not "
+                                       f"writable: {reason}\n")
+
+
 def test_reproduce_refuses_zero_jobs(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--jobs", "0", "--out", str(tmp_path)]) == 2
     assert "`--jobs`" in capsys.readouterr().err
