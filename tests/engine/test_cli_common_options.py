@@ -108,6 +108,47 @@ def test_progress_bars_stay_out_of_logs(tmp_path):
     assert "%|" not in log.read_text()
 
 
+def _run_with_stderr(stderr, out):
+    import subprocess
+    import sys
+    return subprocess.run([sys.executable, "-m", "moreau", "run", "--frequency", "185",
+                           "--periods", "2", "--no-plot", "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=stderr, text=True, timeout=600)
+
+
+def test_run_shows_its_progress_bar_on_a_terminal_only(tmp_path):
+    import fcntl
+    import os
+    import pty
+    import struct
+    import termios
+
+    # stderr a terminal: the bar is drawn (so the check below can see one)
+    leader, follower = pty.openpty()
+    try:
+        # a new pseudo-terminal is 0 columns wide, where tqdm draws nothing
+        fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+        assert _run_with_stderr(follower, tmp_path / "tty").returncode == 0
+        os.close(follower)
+        drawn = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:  # the terminal is closed once everything is read
+                break
+            if not chunk:
+                break
+            drawn += chunk
+    finally:
+        os.close(leader)
+    assert b"%|" in drawn
+    # stderr a file, as a log would be: no bar in it
+    log = tmp_path / "log.txt"
+    with open(log, "w") as fh:
+        assert _run_with_stderr(fh, tmp_path / "log").returncode == 0
+    assert "%|" not in log.read_text() and "t/s" not in log.read_text()
+
+
 def _free_port():
     import socket
     with socket.socket() as s:

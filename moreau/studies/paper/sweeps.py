@@ -75,7 +75,7 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
     it = values
     if progress:
         from tqdm.auto import tqdm
-        it = tqdm(values, desc=f"sweep {parameter}", unit="pt")
+        it = tqdm(values, desc=f"sweep {parameter}", unit="pt", disable=None)  # terminals only
     rows = []
     try:
         for x in it:
