@@ -16,7 +16,7 @@ from .analysis.atlas import classify_budget, run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
 from .analysis.characteristic import efficiency_vs_frequency, motor_characteristic
 from .analysis.classify import CLASSIFY_PERIODS
-from .analysis.sweep import run_scene_sweep, sweep_values
+from .analysis.sweep import require_xarray, run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
@@ -183,7 +183,7 @@ def _cmd_sweep(args):
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-                    force=args.force)
+                    force=args.force, netcdf=args.netcdf)
 
 
 def _cmd_characteristic(args):
@@ -382,6 +382,9 @@ def _add_atlas(sub):
     p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    p.add_argument("--netcdf", action="store_true",
+                   help="also write each table as NetCDF (.nc next to the CSV, on the plane's "
+                        "grid, units as attributes; needs pip install -e \".[data]\")")
     p.add_argument("--force", action="store_true",
                    help="replace the files of an earlier atlas with other settings (refused "
                         "otherwise)")
@@ -440,7 +443,7 @@ def _cmd_atlas(args):
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
                     force=args.force, continuation=not args.cold,
-                    classify=classify_budget(args))
+                    classify=classify_budget(args), netcdf=args.netcdf)
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -597,6 +600,9 @@ def build_parser():
     s.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
+    s.add_argument("--netcdf", action="store_true",
+                   help="also write the table as NetCDF (.nc next to the CSV: the swept parameter "
+                        "as coordinate, units as attributes; needs pip install -e \".[data]\")")
     s.add_argument("--force", action="store_true",
                    help="replace the files of an earlier run with other settings (refused otherwise)")
     _add_params(s, scheme_defaults=False)
@@ -714,6 +720,11 @@ def _check_common(args):
     check_scheduler(getattr(args, "scheduler", None))
     if getattr(args, "cache", None) is not None:
         check_output_dir(args.cache, "--cache")
+    if getattr(args, "netcdf", False):
+        try:
+            require_xarray("`--netcdf`")
+        except ImportError as exc:
+            raise InputError(str(exc)) from None
     if hasattr(args, "option"):
         # `--option NAME=VALUE` of the scheme, parsed once for every command (and study hook)
         args.scheme_options = parse_settings(args.option or [], "--option")

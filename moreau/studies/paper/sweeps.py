@@ -188,7 +188,7 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
 
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print, force=False):
+              progress=True, plot=True, log=print, force=False, netcdf=False):
     """The ``moreau sweep`` command: steady states over one parameter through the sweep engine.
 
     Every point goes through :func:`moreau.analysis.engine.run_points`: cached
@@ -214,6 +214,10 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         From :func:`make_scheme` (event-driven, shooting tolerance 1e-10).
     out : path-like
         Output folder, checked writable before any work.
+    netcdf : bool
+        Also write the table as NetCDF next to its CSV
+        (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray, the
+        ``[data]`` extra, checked before any work).
 
     Returns
     -------
@@ -221,6 +225,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         The tidy rows.
     """
     params = PAPER_DEFAULTS if params is None else params
+    if netcdf:
+        scene_sweep.require_xarray("`netcdf`")
     if parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
     d0, d1, dn, dlog = SWEEP_DEFAULTS.get(parameter, (None, None, 50, False))
@@ -267,6 +273,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
                   marks, (), None, stats, scheme=scheme, settings=settings)
     log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
+    if netcdf:
+        scene_sweep.write_netcdf_beside(stem, table, [list(table[0])[0]], log)
     if plot:
         label = scheme.description
         paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",
@@ -336,4 +344,4 @@ def command(args):
               points=args.points if args.points is not None else args.num, scale=scale,
               scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-              force=args.force)
+              force=args.force, netcdf=getattr(args, "netcdf", False))
