@@ -7,7 +7,9 @@ paper's dimensionless variables.
 import argparse
 import json
 import os
+import signal
 import sys
+import threading
 
 from . import __version__
 from .analysis import compare as cmp
@@ -730,10 +732,26 @@ def _check_common(args):
         args.scheme_options = parse_settings(args.option or [], "--option")
 
 
+def _stop_on_sigterm():
+    """Make SIGTERM (``kill PID``, ``timeout``, a batch system's time limit) stop a command as
+    Ctrl-C does: workers ended, the finished points kept, one line. Returns what to restore
+    and the record of the signal."""
+    seen = {"signal": None}
+    if threading.current_thread() is not threading.main_thread():
+        return None, seen  # handlers can be set in the main thread only
+
+    def stop(signum, frame):
+        seen["signal"] = signum
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, stop), seen
+
+
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     configure_cli(args.verbose)
+    previous, seen = _stop_on_sigterm()
     try:
         _check_common(args)
         args.func(args)
@@ -743,13 +761,19 @@ def main(argv=None):
     except MoreauError as exc:
         print(f"moreau: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
         return 1
-    except Interrupted as exc:
-        resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
-        print(f"\nmoreau: interrupted: {exc}{resume}", file=sys.stderr)
-        return 130
-    except KeyboardInterrupt:
-        print("\nmoreau: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        # 128 + the signal, as a shell reports a command stopped by it
+        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM) if seen["signal"]
+                       else ("interrupted", 130))
+        if isinstance(exc, Interrupted):
+            resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
+            print(f"\nmoreau: {how}: {exc}{resume}", file=sys.stderr)
+        else:
+            print(f"\nmoreau: {how}", file=sys.stderr)
+        return status
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

@@ -22,8 +22,8 @@ import time
 import joblib
 import numpy as np
 
-from ...analysis.engine import (ED_REFERENCE, Scheme, _ignore_sigint, check_output_dir,
-                                end_worker_pool, run_points)
+from ...analysis.engine import (ED_REFERENCE, Scheme, check_output_dir, end_worker_pool,
+                                run_points, worker_pool_config)
 from ...errors import Interrupted
 from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS
@@ -78,7 +78,7 @@ def run_jobs(jobs, n_jobs=-1):
         return [x for fn, args in jobs for x in fn(*args)]
     try:
         # as in the sweep engine: the workers ignore Ctrl-C, the parent alone ends them
-        with joblib.parallel_config("loky", initializer=_ignore_sigint):
+        with worker_pool_config():
             done = joblib.Parallel(n_jobs=n_jobs)(joblib.delayed(fn)(*args) for fn, args in jobs)
     except KeyboardInterrupt:
         end_worker_pool(kill=True)
