@@ -64,6 +64,18 @@ def test_run_refuses_an_out_it_cannot_write_in_one_line(where, reason, tmp_path,
                                        f"writable: {reason}\n")
 
 
+def test_workers_are_capped_at_the_points_and_the_cores(monkeypatch):
+    import os
+
+    from moreau.analysis.engine import MAX_JOBS_PER_CORE, check_jobs
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 4)
+    assert check_jobs(-1, 100) == 4 and check_jobs(-1, 2) == 2
+    assert check_jobs(16, 100) == 16 == MAX_JOBS_PER_CORE * 4 and check_jobs(16, 3) == 3
+    with pytest.raises(ValueError, match="from 1 to 16"):
+        check_jobs(17, 100)
+
+
 def test_reproduce_refuses_zero_jobs(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--jobs", "0", "--out", str(tmp_path)]) == 2
     assert "`--jobs`" in capsys.readouterr().err
