@@ -7,7 +7,9 @@ paper's dimensionless variables.
 import argparse
 import json
 import os
+import signal
 import sys
+import threading
 
 from . import __version__
 from .analysis import compare as cmp
@@ -16,7 +18,7 @@ from .analysis.atlas import classify_budget, run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
 from .analysis.characteristic import efficiency_vs_frequency, motor_characteristic
 from .analysis.classify import CLASSIFY_PERIODS
-from .analysis.sweep import run_scene_sweep, sweep_values
+from .analysis.sweep import require_xarray, run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
@@ -183,7 +185,8 @@ def _cmd_sweep(args):
     run_scene_sweep(entry.name, args.parameter, values, fixed=params, frequency=frequency,
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-                    force=args.force, continuation=not args.cold)
+                    force=args.force, continuation=not args.cold,
+                    netcdf=args.netcdf)
 
 
 def _cmd_characteristic(args):
@@ -382,6 +385,9 @@ def _add_atlas(sub):
     p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--no-plot", action="store_true", help="skip the figures")
+    p.add_argument("--netcdf", action="store_true",
+                   help="also write each table as NetCDF (.nc next to the CSV, on the plane's "
+                        "grid, units as attributes; needs pip install -e \".[data]\")")
     p.add_argument("--force", action="store_true",
                    help="replace the files of an earlier atlas with other settings (refused "
                         "otherwise)")
@@ -440,7 +446,7 @@ def _cmd_atlas(args):
                     scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
                     scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
                     force=args.force, continuation=not args.cold,
-                    classify=classify_budget(args))
+                    classify=classify_budget(args), netcdf=args.netcdf)
 
 
 # -- moreau reproduce ---------------------------------------------------------------
@@ -597,6 +603,9 @@ def build_parser():
     s.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figure")
+    s.add_argument("--netcdf", action="store_true",
+                   help="also write the table as NetCDF (.nc next to the CSV: the swept parameter "
+                        "as coordinate, units as attributes; needs pip install -e \".[data]\")")
     s.add_argument("--force", action="store_true",
                    help="replace the files of an earlier run with other settings (refused otherwise)")
     s.add_argument("--cold", action="store_true",
@@ -717,15 +726,36 @@ def _check_common(args):
     check_scheduler(getattr(args, "scheduler", None))
     if getattr(args, "cache", None) is not None:
         check_output_dir(args.cache, "--cache")
+    if getattr(args, "netcdf", False):
+        try:
+            require_xarray("`--netcdf`")
+        except ImportError as exc:
+            raise InputError(str(exc)) from None
     if hasattr(args, "option"):
         # `--option NAME=VALUE` of the scheme, parsed once for every command (and study hook)
         args.scheme_options = parse_settings(args.option or [], "--option")
+
+
+def _stop_on_sigterm():
+    """Make SIGTERM (``kill PID``, ``timeout``, a batch system's time limit) stop a command as
+    Ctrl-C does: workers ended, the finished points kept, one line. Returns what to restore
+    and the record of the signal."""
+    seen = {"signal": None}
+    if threading.current_thread() is not threading.main_thread():
+        return None, seen  # handlers can be set in the main thread only
+
+    def stop(signum, frame):
+        seen["signal"] = signum
+        raise KeyboardInterrupt
+
+    return signal.signal(signal.SIGTERM, stop), seen
 
 
 def main(argv=None):
     parser = build_parser()
     args = parser.parse_args(argv)
     configure_cli(args.verbose)
+    previous, seen = _stop_on_sigterm()
     try:
         _check_common(args)
         args.func(args)
@@ -735,13 +765,19 @@ def main(argv=None):
     except MoreauError as exc:
         print(f"moreau: failed: {type(exc).__name__}: {exc}", file=sys.stderr)
         return 1
-    except Interrupted as exc:
-        resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
-        print(f"\nmoreau: interrupted: {exc}{resume}", file=sys.stderr)
-        return 130
-    except KeyboardInterrupt:
-        print("\nmoreau: interrupted", file=sys.stderr)
-        return 130
+    except KeyboardInterrupt as exc:
+        # 128 + the signal, as a shell reports a command stopped by it
+        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM) if seen["signal"]
+                       else ("interrupted", 130))
+        if isinstance(exc, Interrupted):
+            resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
+            print(f"\nmoreau: {how}: {exc}{resume}", file=sys.stderr)
+        else:
+            print(f"\nmoreau: {how}", file=sys.stderr)
+        return status
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
     return 0
 
 

@@ -18,6 +18,7 @@ __all__ = [
     "RunawayError",
     "BudgetExhaustedError",
     "ResidualFloorError",
+    "WorkerError",
     "Interrupted",
 ]
 
@@ -87,6 +88,33 @@ class BudgetExhaustedError(ConvergenceError):
         super().__init__(message)
         self.periods, self.mean, self.half_width = int(periods), mean, half_width
         self.series = series
+
+
+class WorkerError(MoreauError):
+    """A local worker process of a parallel run ended unexpectedly (a signal, out of memory).
+
+    The run stops (its pool is broken); the points finished before are kept
+    in the cache, so that the same command resumes.
+
+    Attributes
+    ----------
+    done, total : int
+        Points finished (computed or read from the cache) and asked for.
+    cache_dir : str or None
+        Where the finished points are kept.
+
+    Examples
+    --------
+    >>> str(WorkerError("exit codes {SIGKILL(-9)}", 3, 10, "out/cache", "sweep mu"))
+    'sweep mu: a worker process ended unexpectedly (exit codes {SIGKILL(-9)}; killed, or out of memory?): 3 of 10 points finished, kept in out/cache; run the same command again to resume'
+    """
+
+    def __init__(self, why, done, total, cache_dir=None, what="run"):
+        self.done, self.total, self.cache_dir = int(done), int(total), cache_dir
+        kept = (f", kept in {cache_dir}; run the same command again to resume"
+                if cache_dir is not None else " (no cache: nothing kept)")
+        super().__init__(f"{what}: a worker process ended unexpectedly ({why}; killed, or out "
+                         f"of memory?): {self.done} of {self.total} points finished{kept}")
 
 
 class Interrupted(KeyboardInterrupt):

@@ -23,7 +23,7 @@ import sys
 
 from . import __version__
 
-__all__ = ["provenance"]
+__all__ = ["provenance", "machine"]
 
 
 def _version(dist):
@@ -52,6 +52,28 @@ def _threads():
     if numba is not None:
         out["numba"] = int(numba.config.NUMBA_NUM_THREADS)
     return out
+
+
+def machine():
+    """What identifies the machine that takes a timing, without its host name.
+
+    Two runs on the same hardware give the same dict (a timing history is
+    kept per machine: :mod:`moreau.analysis.regression`); the host name is
+    left out, so that a rebuilt container or a renamed host keeps its history.
+
+    Returns
+    -------
+    dict
+        ``cpu`` (model name), ``cpu_count``, ``architecture`` (``x86_64``,
+        ``arm64`` ...) and ``system`` (``Linux`` ...).
+
+    Examples
+    --------
+    >>> sorted(machine())
+    ['architecture', 'cpu', 'cpu_count', 'system']
+    """
+    return {"cpu": _cpu_name(), "cpu_count": os.cpu_count(),
+            "architecture": platform.machine(), "system": platform.system()}
 
 
 def provenance(code_version=None):

@@ -54,3 +54,112 @@ def test_an_atlas_as_an_xarray_dataset_on_its_grid():
 def test_a_column_that_is_not_there_is_refused():
     with pytest.raises(InputError, match="`dims` must name columns of the rows"):
         rows_to_xarray([{"a": 1.0, "b": 2.0}], ["c"])
+
+
+# -- NetCDF (issue 21): `--netcdf` on sweep and atlas, units as attributes ------------------
+
+import csv  # noqa: E402
+import json  # noqa: E402
+import sys  # noqa: E402
+
+from moreau.analysis.sweep import netcdf_attrs, rows_to_netcdf  # noqa: E402
+from moreau.cli import main  # noqa: E402
+
+
+def _csv_rows(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _same(text, value):
+    # a CSV cell against the NetCDF value at the same grid point
+    try:
+        x = float(text)
+    except ValueError:
+        return text == str(value)
+    return (np.isnan(x) and np.isnan(float(value))) or x == float(value)
+
+
+def test_a_sweep_s_netcdf_holds_the_csv_s_values_and_units(tmp_path, capsys):
+    argv = ["sweep", "frequency", "500", "2000", "--points", "3", "--scene", "stick-slip-motor",
+            "--jobs", "1", "--quiet", "--no-plot", "--netcdf", "--out", str(tmp_path)]
+    assert main(argv) == 0
+    stem = tmp_path / "sweep_stick-slip-motor_frequency_event-driven"
+    assert f"wrote {stem}.nc" in capsys.readouterr().out
+    rows = _csv_rows(f"{stem}.csv")
+    side = json.loads((stem.parent / (stem.name + ".json")).read_text())
+    with xr.open_dataset(f"{stem}.nc") as ds:
+        assert ds["frequency"].attrs["units"] == "Hz"
+        assert ds["frequency"].values.tolist() == [float(r["frequency [Hz]"]) for r in rows]
+        units = {"displacement_per_period_m": "m", "average_velocity_m_per_s": "m/s",
+                 "min_normal_force_N": "N", "compute_time_s": "s", "stator_work_J": "J"}
+        for name, unit in units.items():
+            assert ds[name].attrs["units"] == unit, name
+        assert "units" not in ds["mode"].attrs and "units" not in ds["periodic_residual"].attrs
+        for k, r in enumerate(rows):
+            for col, text in r.items():
+                if col == "frequency [Hz]":
+                    continue
+                name = col.partition(" [")[0]
+                assert _same(text, ds[name].values[k]), (col, text, ds[name].values[k])
+        # the sidecar's record, provenance included, as global attributes
+        assert ds.attrs["scene"] == "stick-slip-motor"
+        assert json.loads(ds.attrs["provenance"]) == side["provenance"]
+        assert json.loads(ds.attrs["settings"]) == side["settings"]
+
+
+def test_an_atlas_s_netcdf_is_on_its_grid(tmp_path):
+    argv = ["atlas", "--plane", "f-mu", "--fmin", "20", "--fmax", "40", "--f-points", "2",
+            "--y-points", "3", "--jobs", "1", "--quiet", "--no-plot", "--netcdf", "--out",
+            str(tmp_path)]
+    assert main(argv) == 0
+    rows = _csv_rows(tmp_path / "atlas_f-mu.csv")
+    with xr.open_dataset(tmp_path / "atlas_f-mu.nc") as ds:
+        assert ds["displacement_per_period_m"].dims == ("frequency_Hz", "mu")
+        assert ds["displacement_per_period_m"].shape == (2, 3)
+        assert ds["frequency_Hz"].attrs["units"] == "Hz" and ds["phi0_rad"].attrs["units"] == "rad"
+        for r in rows:
+            cell = ds.sel(frequency_Hz=float(r["frequency_Hz"]), mu=float(r["mu"]))
+            for col in ("displacement_per_period_m", "min_normal_force_N", "mode", "status"):
+                assert _same(r[col], cell[col].values), col
+        assert ds.attrs["plane"] == "f-mu" and ds.attrs["grid"].tolist() == [2.0, 3.0]
+
+
+def test_netcdf_attributes_are_legal_and_read_back(tmp_path):
+    meta = {"points": 3, "big": 2**40, "range": [0.5, 1], "flag": True, "none": None,
+            "nested": {"a": [1, "x"]}, "text": "Painlevé – 2 µm", "np": np.float64(2.5),
+            "odd key [Hz]": 1.0}
+    attrs = netcdf_attrs(meta)
+    for v in attrs.values():
+        assert isinstance(v, (str, int, float, np.ndarray)) and not isinstance(v, bool)
+    path = rows_to_netcdf([{"x [s]": 1.0, "y_m": 2.0, "word": "ok"},
+                           {"x [s]": 2.0, "y_m": np.nan, "word": "é"}], ["x [s]"],
+                          tmp_path / "t.nc", meta)
+    with xr.open_dataset(path) as ds:
+        assert ds.attrs["points"] == 3 and json.loads(ds.attrs["big"]) == 2**40
+        assert ds.attrs["range"].tolist() == [0.5, 1.0]
+        assert json.loads(ds.attrs["flag"]) is True and json.loads(ds.attrs["none"]) is None
+        assert json.loads(ds.attrs["nested"]) == {"a": [1, "x"]}
+        assert ds.attrs["text"] == "Painlevé – 2 µm" and ds.attrs["odd_key__Hz_"] == 1.0
+        assert ds["x"].attrs["units"] == "s" and ds["y_m"].attrs["units"] == "m"
+        assert ds["word"].values.tolist() == ["ok", "é"]
+        assert np.isnan(ds["y_m"].values[1])
+    assert [p.name for p in tmp_path.iterdir()] == ["t.nc"]   # no temporary file left
+
+
+def test_netcdf_without_xarray_names_the_extra(tmp_path, capsys, monkeypatch):
+    from moreau.analysis import engine
+
+    def no_work(*a, **k):
+        raise AssertionError("work started before xarray was looked for")
+
+    monkeypatch.setattr(engine, "run_points", no_work)
+    monkeypatch.setitem(sys.modules, "xarray", None)   # as if the [data] extra were not installed
+    for argv in (["sweep", "mu", "0.1", "0.2", "--points", "2", "--frequency", "185"],
+                 ["atlas", "--quick"]):
+        assert main(argv + ["--netcdf", "--quiet", "--no-plot", "--out", str(tmp_path)]) == 2
+        assert capsys.readouterr().err == ("moreau: error: `--netcdf` needs xarray, which is "
+                                           "not installed: pip install -e \".[data]\"\n")
+    with pytest.raises(ImportError, match=r"`rows_to_netcdf` needs xarray.*\.\[data\]"):
+        rows_to_netcdf([{"x": 1.0}], ["x"], tmp_path / "t.nc")
+    assert not list(tmp_path.iterdir())

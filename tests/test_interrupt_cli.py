@@ -14,23 +14,25 @@ def test_an_interrupt_says_what_was_kept_and_a_rerun_resumes(tmp_path, capsys, m
     real = engine._checked_steady
     calls = {"n": 0}
 
-    def stop_at_third(*a, **k):
+    def stop_at_fourth(*a, **k):
+        # the sweep's 5 neighbours are two continued segments (3 and 2 points, one worker);
+        # the cache keeps whole segments: call 4 is the first point of the second
         calls["n"] += 1
-        if calls["n"] == 3:
+        if calls["n"] == 4:
             raise KeyboardInterrupt
         return real(*a, **k)
 
     argv = ["sweep", "frequency", "20", "40", "--points", "5", "--out", str(tmp_path), "--jobs",
             "1", "--quiet", "--no-plot"]
-    monkeypatch.setattr(engine, "_checked_steady", stop_at_third)
+    monkeypatch.setattr(engine, "_checked_steady", stop_at_fourth)
     assert main(argv) == 130
     err = capsys.readouterr().err
-    assert err.strip() == (f"moreau: interrupted: sweep frequency: 2 of 5 points finished, kept in "
+    assert err.strip() == (f"moreau: interrupted: sweep frequency: 3 of 5 points finished, kept in "
                            f"{tmp_path / 'cache'}; run the same command again to resume")
     assert not list(tmp_path.glob("*.csv"))
     monkeypatch.setattr(engine, "_checked_steady", real)
     assert main(argv) == 0
-    assert "(5 points: 3 computed, 2 from the cache)" in capsys.readouterr().out
+    assert "(5 points: 2 computed, 3 from the cache)" in capsys.readouterr().out
 
 
 def test_ctrl_c_on_a_parallel_run_leaves_no_traceback_and_no_worker(tmp_path):
@@ -63,3 +65,90 @@ def test_ctrl_c_on_a_parallel_run_leaves_no_traceback_and_no_worker(tmp_path):
             break
         time.sleep(0.1)
     assert left.strip() == ""
+
+
+def _interrupt_when(monkeypatch, stop):
+    # Ctrl-C in the middle of a point's steady state, where `stop(params, frequency)` says
+    real = engine._checked_steady
+    calls = {"n": 0}
+
+    def steady(params, frequency, *a, **k):
+        calls["n"] += 1
+        if stop(calls["n"], params, frequency):
+            raise KeyboardInterrupt
+        return real(params, frequency, *a, **k)
+
+    monkeypatch.setattr(engine, "_checked_steady", steady)
+    return real
+
+
+def _one_line(err):
+    assert "Traceback" not in err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+def test_ctrl_c_on_reproduce_says_what_was_kept(tmp_path, capsys, monkeypatch):
+    # every point runs the reference and two Moreau-Jean cross-checks: call 7 is point 3's first
+    _interrupt_when(monkeypatch, lambda n, p, f: n == 7)
+    argv = ["reproduce", "--quick", "--jobs", "1", "--quiet", "--out", str(tmp_path)]
+    assert main(argv) == 130
+    line = _one_line(capsys.readouterr().err)
+    assert line == (f"moreau: interrupted: reproduce: 2 of 60 points finished, kept in "
+                    f"{tmp_path / 'cache'}; run the same command again to resume")
+    # the two finished points are the cache's entries, and no table claims to be complete
+    assert sum(1 for _ in (tmp_path / "cache").rglob("output.pkl")) == 2
+    assert not list((tmp_path / "data").glob("*.csv"))
+
+
+def test_ctrl_c_on_the_scene_s_own_atlas_says_what_was_kept(tmp_path, capsys, monkeypatch):
+    # the first point of the second line of constant frequency
+    _interrupt_when(monkeypatch, lambda n, p, f: f > 30.0)
+    argv = ["atlas", "--plane", "f-mu", "--fmin", "20", "--fmax", "40", "--f-points", "2",
+            "--y-points", "3", "--jobs", "1", "--quiet", "--no-plot", "--out", str(tmp_path)]
+    assert main(argv) == 130
+    line = _one_line(capsys.readouterr().err)
+    assert line == (f"moreau: interrupted: atlas f-mu: 3 of 6 points finished, kept in "
+                    f"{tmp_path / 'cache'}; run the same command again to resume")
+    assert not list(tmp_path.glob("*.csv"))
+
+
+def test_ctrl_c_on_an_atlas_says_what_was_kept_and_a_rerun_resumes(tmp_path, capsys,
+                                                                     monkeypatch):
+    # the first point of the second grid line (mu = 0.2)
+    real = _interrupt_when(monkeypatch, lambda n, p, f: p["mu"] > 0.15)
+    argv = ["atlas", "--x", "frequency", "20", "40", "--x-points", "3", "--y", "mu", "0.1",
+            "0.2", "--y-points", "2", "--jobs", "1", "--quiet", "--no-plot", "--out",
+            str(tmp_path)]
+    assert main(argv) == 130
+    line = _one_line(capsys.readouterr().err)
+    assert line == (f"moreau: interrupted: atlas frequency-mu: 3 of 6 points finished, kept in "
+                    f"{tmp_path / 'cache'}; run the same command again to resume")
+    monkeypatch.setattr(engine, "_checked_steady", real)
+    assert main(argv) == 0
+    assert "(6 points: 3 computed, 3 from the cache)" in capsys.readouterr().out
+
+
+def test_ctrl_c_while_reproduce_draws_says_the_tables_are_written(tmp_path, capsys, monkeypatch):
+    from moreau.studies.paper import reproduce
+
+    real_grids = reproduce.study_grids
+
+    def two_points_each(params=None, quick=False):
+        # the quick studies cut to two points each: the points stage takes seconds
+        return {name: (par, values[:2], f, extra)
+                for name, (par, values, f, extra) in real_grids(params, quick).items()}
+
+    def ctrl_c(*a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(reproduce, "study_grids", two_points_each)
+    monkeypatch.setattr(reproduce, "sweep_figure", ctrl_c)
+    argv = ["reproduce", "--quick", "--jobs", "1", "--quiet", "--out", str(tmp_path)]
+    assert main(argv) == 130
+    line = _one_line(capsys.readouterr().err)
+    assert line == (f"moreau: interrupted: reproduce (tables written to {tmp_path / 'data'}, "
+                    f"figures unfinished): 14 of 14 points finished, kept in "
+                    f"{tmp_path / 'cache'}; run the same command again to resume")
+    assert len(list((tmp_path / "data").glob("*.csv"))) == 7

@@ -35,7 +35,8 @@ from ..provenance import provenance
 from . import engine
 from .classify import CLASSIFY_COLUMNS, CLASSIFY_PERIODS
 from .engine import ED_REFERENCE, check_output_dir
-from .sweep import VALUE_COLUMNS, MAX_POINTS, plan_points, sweep_tag
+from .sweep import (VALUE_COLUMNS, MAX_POINTS, plan_points, require_xarray, sweep_tag,
+                    write_netcdf_beside)
 
 __all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure", "classify_budget", "ATLAS_COLUMNS"]
 
@@ -81,7 +82,8 @@ def atlas_tag(scene, x, y, frequency, scheme):
 
 def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE, out="out",
                     cache_dir=None, n_jobs=-1, scheduler=None, progress=True, plot=True,
-                    log=print, force=False, continuation=True, classify=CLASSIFY_PERIODS):
+                    log=print, force=False, continuation=True, classify=CLASSIFY_PERIODS,
+                    netcdf=False):
     """Steady states of the registered scene ``scene`` on the grid ``x`` by ``y``.
 
     Parameters
@@ -112,6 +114,10 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         Budget of drive periods of the plain run that names the long-run
         motion of a point without an orbit (:mod:`moreau.analysis.classify`);
         0: none.
+    netcdf : bool
+        Also write the table as ``STEM.nc`` on the ``x`` by ``y`` grid
+        (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray,
+        the ``[data]`` extra, checked before any work).
 
     Returns
     -------
@@ -126,6 +132,10 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         raise InputError(f"`--x` and `--y` must be two different parameters, got {xname!r} twice")
     xv = np.asarray(xv, dtype=float).reshape(-1)
     yv = np.asarray(yv, dtype=float).reshape(-1)
+    if netcdf:
+        if out is None:
+            raise InputError("`netcdf` writes a file next to the CSV: give `out`")
+        require_xarray("`netcdf`")
     if xv.size * yv.size > MAX_POINTS:
         raise InputError(f"the grid has {xv.size * yv.size} points, more than the limit "
                          f"{MAX_POINTS:.0e} of one atlas")
@@ -190,6 +200,8 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
     json_path.write_text(json.dumps(meta, indent=1, default=str))
     log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache) and {json_path.name}")
+    if netcdf:
+        write_netcdf_beside(stem, table, [columns[xname], columns[yname]], log)
     if plot:
         fig_path = stem.with_name(stem.name + ".png")
         mode_map_figure(table, columns[xname], columns[yname], xv, yv,

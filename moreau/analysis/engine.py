@@ -19,21 +19,27 @@ A point that fails (ill-posed model, no convergence, anything else) becomes a
 row whose ``status`` names the cause; it never stops the run.
 """
 
+import ctypes
+import ctypes.util
+import functools
 import hashlib
 import itertools
 import logging
 import math
 import os
 import pathlib
+import re
 import signal
+import sys
 import time
 import warnings
 
 import joblib
 from joblib.externals.loky import get_reusable_executor
+from joblib.externals.loky.process_executor import BrokenProcessPool
 
 from .. import __version__
-from ..errors import ConvergenceError, InputError, Interrupted, PainleveError
+from ..errors import ConvergenceError, InputError, Interrupted, PainleveError, WorkerError
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
@@ -44,7 +50,7 @@ from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of",
+__all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of", "worker_init", "worker_pool_config",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -386,6 +392,10 @@ def check_output_dir(path, option="--out"):
     True
     """
     p = pathlib.Path(path)
+    if p.exists() and not p.is_dir():
+        # mkdir's "File exists" would not say that the name is taken by a file
+        raise InputError(f"`{option}` folder {str(p)!r} is not writable: it is a file, not a "
+                         "folder")
     try:
         p.mkdir(parents=True, exist_ok=True)
         probe = p / f".moreau-write-test-{os.getpid()}"
@@ -441,21 +451,30 @@ def line_columns(row):
             "continuation_solves": row.get("continuation_solves", 0)}
 
 
-def line_chunk(points, n_jobs=-1):
+#: most points of a continued segment: a task is also the unit that an interrupted run keeps
+LINE_CHUNK_MAX = 10
+
+
+def line_chunk(points, n_jobs=-1, continuation=True):
     """Points per task when ``points`` neighbours on a line are continued one from the next.
 
     A task's points are shot in order, each from the previous one's orbit;
-    its first point starts cold. Two tasks per worker: fewer cold starts than
-    one task per point, and a worker that drew the costly segment (flight,
-    points without an orbit) is not left alone at the end of the run.
+    its first point starts cold. Two tasks per worker at least: fewer cold
+    starts than one task per point, and a worker that drew the costly segment
+    (flight, points without an orbit) is not left alone at the end of the
+    run. At most :data:`LINE_CHUNK_MAX` points, because the cache keeps whole
+    tasks: an interrupted run loses the unfinished part of at most one
+    segment per worker. Without continuation every point is its own task.
 
     Examples
     --------
-    >>> line_chunk(99, 2), line_chunk(3, 2), line_chunk(1)
-    (25, 1, 1)
+    >>> line_chunk(99, 2), line_chunk(15, 2), line_chunk(3, 2), line_chunk(99, 2, False)
+    (10, 4, 1, 1)
     """
+    if not continuation:
+        return 1
     workers = check_jobs(n_jobs, max(1, int(points)))
-    return max(1, math.ceil(int(points) / (2 * workers)))
+    return max(1, min(LINE_CHUNK_MAX, math.ceil(int(points) / (2 * workers))))
 
 
 def check_scheduler(scheduler):
@@ -686,9 +705,10 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
                 # instead of each compiling the same kernels at the same time
                 first = (0, func(*args[todo[0]]))
                 done += sizes[todo[0]]
-                # the workers ignore Ctrl-C: the parent alone stops the run and ends them,
-                # so that an interrupt prints no worker tracebacks and leaves no orphans
-                with joblib.parallel_config("loky", initializer=_ignore_sigint):
+                # the workers ignore Ctrl-C and SIGTERM: the parent alone stops the run and
+                # ends them, so that an interrupt prints no worker tracebacks and leaves no
+                # orphans; they die with a parent that is killed outright
+                with worker_pool_config():
                     par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered",
                                           batch_size=1)
                 pooled = True
@@ -714,6 +734,20 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
         _end_workers(locals().get("rest"))
         raise Interrupted(done, len(points), None if cache_dir is None else str(cache_dir),
                           desc) from None
+    except BaseException as exc:
+        # an error ends the run now: busy workers are not waited for, and joblib is told
+        # to stop handing out tasks (it would report each one refused by the closed pool)
+        interrupted = True
+        if bar is not None:
+            bar.close()
+            bar = None
+        _end_workers(locals().get("rest"))
+        if isinstance(exc, BrokenProcessPool):
+            codes = re.search(r"exit codes of the workers are (\{[^}]*\})", str(exc))
+            raise WorkerError(f"exit codes {codes.group(1)}" if codes else type(exc).__name__,
+                              done, len(points), None if cache_dir is None else str(cache_dir),
+                              desc) from None
+        raise
     finally:
         if bar is not None:
             bar.close()
@@ -746,9 +780,47 @@ def _indexed(func, k, a):
     return k, func(*a)
 
 
-def _ignore_sigint():
-    # a loky worker's initializer: Ctrl-C on a terminal reaches the whole process group
+#: prctl's option that sends the calling process a signal when its parent dies (Linux)
+_PR_SET_PDEATHSIG = 1
+
+
+def worker_pool_config():
+    """joblib's settings for a local worker pool: loky, each worker set up by :func:`worker_init`.
+
+    Examples
+    --------
+    >>> with worker_pool_config():
+    ...     joblib.Parallel(n_jobs=1)(joblib.delayed(abs)(x) for x in (-1, -2))
+    [1, 2]
+    """
+    return joblib.parallel_config("loky", initializer=functools.partial(worker_init, os.getpid()))
+
+
+def worker_init(parent_pid=None):
+    """Initializer of a local worker process: the parent alone decides when it ends.
+
+    Ctrl-C on a terminal and ``timeout``'s SIGTERM reach the whole process
+    group; the workers ignore both, and the parent (which turns them into
+    :class:`~moreau.errors.Interrupted`) ends its pool. On Linux a worker
+    also asks to be killed when its parent dies without ending it (SIGKILL,
+    a crash), instead of computing on as an orphan.
+
+    Parameters
+    ----------
+    parent_pid : int, optional
+        The process that starts the pool: a worker whose parent is already
+        another one (the starter died before the request) ends at once.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+            libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+        except (OSError, AttributeError) as exc:  # no libc to ask: the parent still ends us
+            log.debug("worker: no parent-death signal: %s", exc)
+        if parent_pid is not None and os.getppid() != parent_pid:
+            os._exit(1)  # the parent died before the request was made
 
 
 def _end_workers(results):

@@ -28,6 +28,8 @@ Examples
 import csv
 import json
 import math
+import os
+import pathlib
 
 import numpy as np
 
@@ -41,7 +43,8 @@ from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
-           "MAX_POINTS", "rows_to_xarray", "stability_panel"]
+           "MAX_POINTS", "rows_to_xarray", "rows_to_netcdf", "netcdf_attrs", "require_xarray",
+           "write_netcdf_beside", "UNIT_SUFFIXES", "stability_panel"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
@@ -177,7 +180,7 @@ def plan_points(scene, swept, values, fixed=None, frequency=None):
 
 def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme=ED_REFERENCE,
                     out="out", cache_dir=None, n_jobs=-1, scheduler=None, progress=True,
-                    plot=True, log=print, force=False, continuation=True):
+                    plot=True, log=print, force=False, continuation=True, netcdf=False):
     """Steady states of the registered scene ``scene`` over ``values`` of ``parameter``.
 
     Parameters
@@ -207,12 +210,20 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
         :func:`moreau.analysis.engine.line_chunk` points; False: every point
         starts cold. The ``start`` column says which it was.
 
+    netcdf : bool
+        Also write the table as ``STEM.nc`` (:func:`write_netcdf_beside`;
+        needs xarray, the ``[data]`` extra, checked before any work).
+
     Returns
     -------
     list of dict
         One tidy row per value.
     """
     values = np.asarray(values, dtype=float).reshape(-1)
+    if netcdf:
+        if out is None:
+            raise InputError("`netcdf` writes a file next to the CSV: give `out`")
+        require_xarray("`netcdf`")
     entry, columns, point, frequency = plan_points(scene, (parameter,), (values,), fixed,
                                                    frequency)
     points = [point({parameter: x}) for x in values]
@@ -229,7 +240,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     rows, stats = engine.run_points(points, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", scene=entry.name, energy=True,
-                                    chunk=engine.line_chunk(len(points), n_jobs),
+                                    chunk=engine.line_chunk(len(points), n_jobs, continuation),
                                     continuation=bool(continuation))
     swept = columns[parameter]
     table = []
@@ -266,6 +277,8 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     json_path.write_text(json.dumps(meta, indent=1, default=str))
     log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache) and {json_path.name}")
+    if netcdf:
+        write_netcdf_beside(stem, table, [swept], log)
     if plot:
         fig_path = stem.with_name(stem.name + ".png")
         _figure(table, swept, entry.name, fig_path)
@@ -330,9 +343,144 @@ def stability_panel(ax, x, rows):
     return int(np.count_nonzero(ok & stable))
 
 
+#: units of the columns named with their unit at the end (``displacement_per_period_m``)
+UNIT_SUFFIXES = (("_m_per_s", "m/s"), ("_Hz", "Hz"), ("_rad", "rad"), ("_N", "N"),
+                 ("_J", "J"), ("_W", "W"), ("_s", "s"), ("_m", "m"))
+
+
 def _split_unit(column):
+    """``(name, unit)`` of a column: ``"load [N]"`` -> ``("load", "N")``,
+    ``"min_normal_force_N"`` -> ``("min_normal_force_N", "N")``, ``"mu"`` -> ``("mu", "")``."""
     name, _, unit = column.partition(" [")
-    return name, unit[:-1] if unit.endswith("]") else ""
+    if unit.endswith("]"):
+        return name, unit[:-1]
+    for suffix, unit in UNIT_SUFFIXES:
+        if column.endswith(suffix):
+            return column, unit
+    return column, ""
+
+
+def require_xarray(what="`rows_to_netcdf`"):
+    """The xarray module, or an ImportError naming ``what`` and the extra that installs it.
+
+    Raises
+    ------
+    ImportError
+        xarray is not installed (the command line turns it into a refusal
+        of its option before any work).
+    """
+    try:
+        import xarray  # noqa: PLC0415  (optional: the [data] extra)
+    except ImportError:
+        raise ImportError(f"{what} needs xarray, which is not installed: "
+                          "pip install -e \".[data]\"") from None
+    return xarray
+
+
+def netcdf_attrs(meta):
+    """``meta`` (a sidecar's dict) as attributes a NetCDF file can hold.
+
+    NetCDF attributes are text, numbers or flat numeric arrays (in the
+    classic format that scipy writes: no 64-bit integers, no booleans, no
+    None). Text, floats and 32-bit integers stay; a list of numbers becomes
+    a float array; anything else (dicts, None, booleans, mixed lists, large
+    integers) becomes its JSON text, which :func:`json.loads` reads back.
+    Names are kept to letters, digits and ``_.@+-``.
+
+    Examples
+    --------
+    >>> netcdf_attrs({"points": 3, "range": [1, 2], "stable": True, "fixed": {"mu": 0.1},
+    ...               "rtol": None, "scene": "friction-drive", "bad key": 2**40})
+    {'points': 3, 'range': array([1., 2.]), 'stable': 'true', 'fixed': '{"mu": 0.1}', 'rtol': 'null', 'scene': 'friction-drive', 'bad_key': '1099511627776'}
+    """
+    out = {}
+    for key, val in meta.items():
+        name = "".join(c if c.isalnum() or c in "_.@+-" else "_" for c in str(key))
+        if isinstance(val, (bool, np.bool_)) or val is None:
+            out[name] = json.dumps(bool(val) if val is not None else None)
+        elif isinstance(val, str):
+            out[name] = val
+        elif isinstance(val, (int, np.integer)):
+            out[name] = int(val) if -2**31 <= val < 2**31 else json.dumps(int(val))
+        elif isinstance(val, (float, np.floating)):
+            out[name] = float(val)
+        elif isinstance(val, (list, tuple)) and val and all(
+                isinstance(v, (int, float, np.number)) and not isinstance(v, (bool, np.bool_))
+                for v in val):
+            out[name] = np.asarray(val, dtype=float)
+        else:
+            out[name] = json.dumps(val, default=str)
+    return out
+
+
+def rows_to_netcdf(rows, dims, path, attrs=None):
+    """Write a sweep's or an atlas's rows as a NetCDF file (xarray, the ``[data]`` extra).
+
+    Parameters
+    ----------
+    rows, dims
+        As in :func:`rows_to_xarray`: the swept columns become coordinates,
+        every other column a variable with its ``units`` attribute.
+    path : path-like
+        The file, replaced as a whole (written to a temporary name first).
+    attrs : dict, optional
+        Global attributes, e.g. the JSON sidecar's content (scene, scheme,
+        settings, provenance), made NetCDF-legal by :func:`netcdf_attrs`.
+
+    Returns
+    -------
+    pathlib.Path
+
+    Notes
+    -----
+    xarray picks its engine: netCDF4 or h5netcdf where installed, else
+    scipy's writer of the classic format (NetCDF 3), which needs no other
+    package. Text columns are written as UTF-8 characters.
+
+    Examples
+    --------
+    >>> import pathlib, tempfile, xarray
+    >>> rows = [{"frequency [Hz]": f, "displacement_per_period_m": 2e-6 * f, "mode": "NP"}
+    ...         for f in (10.0, 20.0)]
+    >>> p = rows_to_netcdf(rows, ["frequency [Hz]"], pathlib.Path(tempfile.mkdtemp()) / "s.nc",
+    ...                    {"scene": "friction-drive", "points": 2})
+    >>> with xarray.open_dataset(p) as ds:
+    ...     ds["displacement_per_period_m"].attrs["units"], ds.attrs["scene"], str(ds["mode"][1].values)
+    ('m', 'friction-drive', 'NP')
+    """
+    require_xarray("`rows_to_netcdf`")
+    ds = rows_to_xarray(rows, dims)
+    for name in list(ds.data_vars):
+        var = ds[name]
+        if var.dtype == object:
+            # text columns may hold True/False (``stable``) next to "": all written as text
+            text = np.vectorize(str, otypes=[object])(var.values)
+            ds[name] = var.copy(data=text)
+    ds.attrs = netcdf_attrs(attrs or {})
+    path = pathlib.Path(path)
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        ds.to_netcdf(tmp)
+        os.replace(tmp, path)
+    finally:
+        if tmp.exists():
+            tmp.unlink()
+    return path
+
+
+def write_netcdf_beside(stem, rows, dims, log=print):
+    """Write ``STEM.nc`` from a table's rows, ``STEM.json``'s content as its global attributes.
+
+    The NetCDF twin of a command's CSV (``--netcdf``): the same rows on the
+    grid of ``dims`` (:func:`rows_to_netcdf`), with the sidecar's scene,
+    scheme, settings and provenance. Returns the path.
+    """
+    stem = pathlib.Path(stem)
+    side = stem.with_name(stem.name + ".json")
+    attrs = json.loads(side.read_text()) if side.exists() else {}
+    path = rows_to_netcdf(rows, dims, stem.with_name(stem.name + ".nc"), attrs)
+    log(f"wrote {path}")
+    return path
 
 
 def rows_to_xarray(rows, dims):
@@ -351,7 +499,9 @@ def rows_to_xarray(rows, dims):
     xarray.Dataset
         One variable per other column on the grid of ``dims`` (NaN, or an
         empty string, where a combination has no row), named without the
-        unit, which goes to the variable's ``units`` attribute.
+        unit, which goes to the variable's ``units`` attribute; a column
+        named with its unit at the end (``min_normal_force_N``,
+        :data:`UNIT_SUFFIXES`) keeps its name and gets the attribute too.
 
     Examples
     --------
@@ -361,10 +511,7 @@ def rows_to_xarray(rows, dims):
     >>> ds["displacement_per_period_m"].values.tolist(), ds["frequency"].attrs["units"]
     ([20.0, 40.0], 'Hz')
     """
-    try:
-        import xarray as xr
-    except ImportError:  # pragma: no cover - the message is the point
-        raise ImportError("`rows_to_xarray` needs xarray: pip install -e \".[data]\"") from None
+    xr = require_xarray("`rows_to_xarray`")
     if not rows:
         raise InputError("`rows` must hold at least one row")
     for d in dims:
@@ -377,7 +524,8 @@ def rows_to_xarray(rows, dims):
     names = [_split_unit(d)[0] for d in dims]
     coords = {}
     for d, name, ax in zip(dims, names, axes):
-        coords[name] = xr.Variable(name, np.array(ax), attrs={"units": _split_unit(d)[1]})
+        unit = _split_unit(d)[1]
+        coords[name] = xr.Variable(name, np.array(ax), attrs={"units": unit} if unit else {})
     data = {}
     for col in rows[0]:
         if col in dims:

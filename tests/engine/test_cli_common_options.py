@@ -20,6 +20,62 @@ def test_shared_options_are_refused_before_work(extra, message, tmp_path, capsys
     assert not list(tmp_path.glob("*.csv"))
 
 
+def _no_work(monkeypatch):
+    from moreau import cli
+    from moreau.analysis import engine
+
+    def no_work(*a, **k):
+        raise AssertionError("work started before the folder was checked")
+
+    monkeypatch.setattr(engine, "run_points", no_work)
+    monkeypatch.setattr(cli, "run_history", no_work)
+
+
+@pytest.mark.parametrize("command", [
+    ["sweep", "mu", "0.1", "0.2", "--points", "2", "--frequency", "185"],
+    ["atlas", "--quick"],
+])
+def test_a_cache_that_is_a_file_is_refused_in_one_line(command, tmp_path, capsys, monkeypatch):
+    _no_work(monkeypatch)
+    taken = tmp_path / "cache"
+    taken.write_text("not a folder")
+    argv = command + ["--out", str(tmp_path / "out"), "--cache", str(taken), "--quiet",
+                      "--no-plot"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err == (f"moreau: error: `--cache` folder {str(taken)!r} is not writable: it is a "
+                   "file, not a folder\n")
+    assert taken.read_text() == "not a folder"
+
+
+@pytest.mark.parametrize("where, reason", [
+    ("/proc/x", "No such file or directory"),
+    ("FILE", "it is a file, not a folder"),
+])
+def test_run_refuses_an_out_it_cannot_write_in_one_line(where, reason, tmp_path, capsys,
+                                                        monkeypatch):
+    _no_work(monkeypatch)
+    if where == "FILE":
+        where = tmp_path / "taken"
+        where.write_text("x")
+    argv = ["run", "--frequency", "185", "--periods", "1", "--out", str(where), "--quiet"]
+    assert main(argv) == 2
+    assert capsys.readouterr().err == (f"moreau: error: `--out` folder {str(where)!r} is not "
+                                       f"writable: {reason}\n")
+
+
+def test_workers_are_capped_at_the_points_and_the_cores(monkeypatch):
+    import os
+
+    from moreau.analysis.engine import MAX_JOBS_PER_CORE, check_jobs
+
+    monkeypatch.setattr(os, "cpu_count", lambda: 4)
+    assert check_jobs(-1, 100) == 4 and check_jobs(-1, 2) == 2
+    assert check_jobs(16, 100) == 16 == MAX_JOBS_PER_CORE * 4 and check_jobs(16, 3) == 3
+    with pytest.raises(ValueError, match="from 1 to 16"):
+        check_jobs(17, 100)
+
+
 def test_reproduce_refuses_zero_jobs(tmp_path, capsys):
     assert main(["reproduce", "--quick", "--jobs", "0", "--out", str(tmp_path)]) == 2
     assert "`--jobs`" in capsys.readouterr().err
@@ -62,6 +118,47 @@ def test_progress_bars_stay_out_of_logs(tmp_path):
     assert run.returncode == 0
     assert "it/s" not in log.read_text() and "run/s" not in log.read_text()
     assert "%|" not in log.read_text()
+
+
+def _run_with_stderr(stderr, out):
+    import subprocess
+    import sys
+    return subprocess.run([sys.executable, "-m", "moreau", "run", "--frequency", "185",
+                           "--periods", "2", "--no-plot", "--out", str(out)],
+                          stdout=subprocess.PIPE, stderr=stderr, text=True, timeout=600)
+
+
+def test_run_shows_its_progress_bar_on_a_terminal_only(tmp_path):
+    import fcntl
+    import os
+    import pty
+    import struct
+    import termios
+
+    # stderr a terminal: the bar is drawn (so the check below can see one)
+    leader, follower = pty.openpty()
+    try:
+        # a new pseudo-terminal is 0 columns wide, where tqdm draws nothing
+        fcntl.ioctl(follower, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+        assert _run_with_stderr(follower, tmp_path / "tty").returncode == 0
+        os.close(follower)
+        drawn = b""
+        while True:
+            try:
+                chunk = os.read(leader, 4096)
+            except OSError:  # the terminal is closed once everything is read
+                break
+            if not chunk:
+                break
+            drawn += chunk
+    finally:
+        os.close(leader)
+    assert b"%|" in drawn
+    # stderr a file, as a log would be: no bar in it
+    log = tmp_path / "log.txt"
+    with open(log, "w") as fh:
+        assert _run_with_stderr(fh, tmp_path / "log").returncode == 0
+    assert "%|" not in log.read_text() and "t/s" not in log.read_text()
 
 
 def _free_port():

@@ -50,3 +50,19 @@ def test_the_public_front_ends_are_annotated():
         missing = [p for p, v in sig.parameters.items() if v.annotation is inspect.Parameter.empty]
         assert not missing, f"{name}: no annotation on {missing}"
         assert sig.return_annotation is not inspect.Signature.empty, f"{name}: no return annotation"
+
+
+def test_changelog_notebook_extra_and_guide_links():
+    # issue 21's packaging items: a changelog, a [notebook] extra with jupyter that the
+    # notebooks name (not the empty [plot]), the tutorial and every notebook in the reference
+    import tomllib
+    assert (ROOT / "CHANGELOG.md").read_text().startswith("# Changelog")
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"][
+        "optional-dependencies"]
+    assert any(d.startswith("jupyter") for d in extras["notebook"])
+    index = (ROOT / "docs" / "index.md").read_text()
+    assert "\ntutorial\n" in index
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        text = nb.read_text()
+        assert '.[plot]' not in text, nb.name
+        assert f"notebooks/{nb.stem}\n" in index, nb.name

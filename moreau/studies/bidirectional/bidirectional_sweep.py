@@ -25,6 +25,7 @@ from ..._validate import positive
 from ...analysis import engine
 from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import check_output_dir, code_version
+from ...analysis.sweep import require_xarray, write_netcdf_beside
 from ...errors import InputError
 from ...outputs import claim_outputs
 from ...provenance import provenance
@@ -123,7 +124,7 @@ def tidy_rows(parameter, values, frequency, params, rows):
 def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, stop=None,
                             points=None, scale="linear", scheme=None, out="out", cache_dir=None,
                             n_jobs=-1, scheduler=None, progress=True, plot=True, log=print,
-                            force=False, continuation=True):
+                            force=False, continuation=True, netcdf=False):
     """Steady states of the bidirectional drive over one parameter, through the sweep engine.
 
     Writes ``OUT/sweep_bidirectional_TAG.csv`` (tidy, units in the column
@@ -144,6 +145,10 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         From :func:`moreau.studies.paper.sweeps.make_scheme` (event-driven by default).
     out : path-like
         Output folder, checked writable before any work.
+    netcdf : bool
+        Also write the table as NetCDF next to its CSV
+        (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray, the
+        ``[data]`` extra, checked before any work).
 
     Returns
     -------
@@ -151,6 +156,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         The tidy rows.
     """
     params = BidirectionalDriveParams() if params is None else params
+    if netcdf:
+        require_xarray("`netcdf`")
     if parameter not in BIDIRECTIONAL_SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(BIDIRECTIONAL_SWEEPABLE)} for the "
                          f"bidirectional drive, got {parameter!r}")
@@ -190,7 +197,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     rows, stats = engine.run_points(pts, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", scene="bidirectional",
-                                    energy=True, chunk=engine.line_chunk(len(pts), n_jobs),
+                                    energy=True,
+                                    chunk=engine.line_chunk(len(pts), n_jobs, continuation),
                                     continuation=bool(continuation))
     table = tidy_rows(parameter, values, frequency, params, rows)
     for r, row in zip(table, rows):
@@ -222,6 +230,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     (stem.parent / (stem.name + ".json")).write_text(json.dumps(meta, indent=2))
     log(f"wrote {(stem.parent / (stem.name + '.csv'))} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
+    if netcdf:
+        write_netcdf_beside(stem, table, [BIDIRECTIONAL_COLUMNS[parameter]], log)
     if plot:
         label = scheme.description
         title = f"Bidirectional drive: steady state against {parameter}" + (
@@ -303,4 +313,4 @@ def command(args):
                             scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
                             n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
                             plot=not args.no_plot, force=args.force,
-                            continuation=not args.cold)
+                            continuation=not args.cold, netcdf=getattr(args, "netcdf", False))

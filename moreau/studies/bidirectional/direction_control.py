@@ -83,7 +83,7 @@ def direction_sweep(knob, values, frequency=185.0, base=None, scheme="event-driv
     it = zip(vals, pts)
     if progress:
         from tqdm.auto import tqdm
-        it = tqdm(list(it), desc=f"{knob} sweep", leave=False)
+        it = tqdm(list(it), desc=f"{knob} sweep", leave=False, disable=None)  # terminals only
     rows = []
     for v, p in it:
         sc = BidirectionalDrive(p, frequency=frequency)

@@ -33,6 +33,7 @@ from ... import _validate as V
 from ...analysis import engine
 from ...analysis.atlas import classify_budget
 from ...analysis.classify import CLASSIFY_PERIODS
+from ...analysis.sweep import require_xarray, write_netcdf_beside
 from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version, make_scheme
 from ...errors import InputError
 from ...outputs import claim_outputs
@@ -223,7 +224,7 @@ def atlas_rows(atlas):
 def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 12500.0),
               f_points=200, y_points=100, scheme=None, cache_dir=None, n_jobs=-1, scheduler=None,
               progress=True, plot=True, log=print, force=False, continuation=True,
-              classify=CLASSIFY_PERIODS):
+              classify=CLASSIFY_PERIODS, netcdf=False):
     """The ``moreau atlas`` command: for each plane a tidy CSV, a JSON sidecar and a figure.
 
     Files: ``OUT/atlas_f-mu.csv`` (``.json``, ``.png``, ``.svg``) and the
@@ -231,7 +232,10 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
     default adds its tag (``atlas_f-mu_mj_theta1_N1000``). Files of an earlier
     atlas with other settings are not replaced unless ``force``. The cache lives in ``cache_dir`` (``OUT/cache`` by
     default). The output folder is checked before any work. ``continuation``
-    and ``classify`` as in :func:`compute_atlas`.
+    and ``classify`` as in :func:`compute_atlas`. ``netcdf``: also
+    ``OUT/atlas_PLANE.nc`` on the plane's grid
+    (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray, the
+    ``[data]`` extra, checked before any work).
 
     Returns
     -------
@@ -241,6 +245,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
     for plane in planes:
         if plane not in PLANES:
             raise InputError(f"`plane` must be one of {list(PLANES)}, got {plane!r}")
+    if netcdf:
+        require_xarray("`netcdf`")
     out = check_output_dir(out)
     cache_dir = out / "cache" if cache_dir is None else cache_dir
     scheme = ED_REFERENCE if scheme is None else scheme
@@ -283,6 +289,8 @@ def run_atlas(planes=("f-mu", "f-phi0"), params=None, out="out", f_range=(10.0, 
             f"{a['stats']['cached']} from the cache) in {a['wall_time_s']:.1f} s; "
             + ", ".join(f"{k} {v}" for k, v in sorted(counts.items(), key=lambda kv: -kv[1])))
         log(f"wrote {(stem.parent / (stem.name + '.csv'))}")
+        if netcdf:
+            write_netcdf_beside(stem, rows, ["frequency_Hz", a["y_column"]], log)
         if plot:
             paths = atlas_figure(a, stem)
             log(f"wrote {paths[0]}")
@@ -323,5 +331,5 @@ def command(args):
               y_points=y_points, scheme=scheme, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
               force=args.force, continuation=not getattr(args, "cold", False),
-              classify=classify_budget(args))
+              classify=classify_budget(args), netcdf=getattr(args, "netcdf", False))
 

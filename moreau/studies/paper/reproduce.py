@@ -22,7 +22,9 @@ import time
 import joblib
 import numpy as np
 
-from ...analysis.engine import ED_REFERENCE, Scheme, check_output_dir, end_worker_pool, run_points
+from ...analysis.engine import (ED_REFERENCE, Scheme, check_output_dir, end_worker_pool,
+                                run_points, worker_pool_config)
+from ...errors import Interrupted
 from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS
 from .figures import mode_figure_jobs, mode_points, sweep_figure
@@ -75,7 +77,9 @@ def run_jobs(jobs, n_jobs=-1):
     if n_jobs == 1:
         return [x for fn, args in jobs for x in fn(*args)]
     try:
-        done = joblib.Parallel(n_jobs=n_jobs)(joblib.delayed(fn)(*args) for fn, args in jobs)
+        # as in the sweep engine: the workers ignore Ctrl-C, the parent alone ends them
+        with worker_pool_config():
+            done = joblib.Parallel(n_jobs=n_jobs)(joblib.delayed(fn)(*args) for fn, args in jobs)
     except KeyboardInterrupt:
         end_worker_pool(kill=True)
         raise
@@ -148,7 +152,13 @@ def reproduce(out="moreau-results", quick=False, scheduler=None, n_jobs=-1, prog
                                 out / "figures" / name, checks))
                 for name, (parameter, values, frequency, extra) in grids.items()]
         jobs += mode_figure_jobs(results, params, out / "figures", points)
-        paths += run_jobs(jobs, n_jobs)
+        try:
+            paths += run_jobs(jobs, n_jobs)
+        except KeyboardInterrupt:
+            # every point is computed and every table written: only the figures are missing
+            raise Interrupted(len(rows), len(rows), out / "cache",
+                              f"reproduce (tables written to {out / 'data'}, figures "
+                              "unfinished)") from None
     wall = time.perf_counter() - t0
     timings["figures_s"] = wall - sum(timings.values())
     if report:

@@ -75,7 +75,7 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
     it = values
     if progress:
         from tqdm.auto import tqdm
-        it = tqdm(values, desc=f"sweep {parameter}", unit="pt")
+        it = tqdm(values, desc=f"sweep {parameter}", unit="pt", disable=None)  # terminals only
     rows = []
     try:
         for x in it:
@@ -188,7 +188,7 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
 
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
-              progress=True, plot=True, log=print, force=False, continuation=True):
+              progress=True, plot=True, log=print, force=False, continuation=True, netcdf=False):
     """The ``moreau sweep`` command: steady states over one parameter through the sweep engine.
 
     Every point goes through :func:`moreau.analysis.engine.run_points`: cached
@@ -214,6 +214,10 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         From :func:`make_scheme` (event-driven, shooting tolerance 1e-10).
     out : path-like
         Output folder, checked writable before any work.
+    netcdf : bool
+        Also write the table as NetCDF next to its CSV
+        (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray, the
+        ``[data]`` extra, checked before any work).
 
     Returns
     -------
@@ -221,6 +225,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         The tidy rows.
     """
     params = PAPER_DEFAULTS if params is None else params
+    if netcdf:
+        scene_sweep.require_xarray("`netcdf`")
     if parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
     d0, d1, dn, dlog = SWEEP_DEFAULTS.get(parameter, (None, None, 50, False))
@@ -259,7 +265,7 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     rows, stats = engine.run_points(points_, scheme, cache_dir=cache_dir, n_jobs=n_jobs,
                                     scheduler=scheduler, progress=progress,
                                     desc=f"sweep {parameter}", energy=True,
-                                    chunk=engine.line_chunk(len(points_), n_jobs),
+                                    chunk=engine.line_chunk(len(points_), n_jobs, continuation),
                                     continuation=bool(continuation))
     table = tidy_rows(parameter, values, frequency, params, rows, ())
     for r, row in zip(table, rows):
@@ -272,6 +278,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
                   marks, (), None, stats, scheme=scheme, settings=settings)
     log(f"wrote {_with(stem, '.csv')} ({len(table)} points: {stats['computed']} computed, "
         f"{stats['cached']} from the cache)")
+    if netcdf:
+        scene_sweep.write_netcdf_beside(stem, table, [list(table[0])[0]], log)
     if plot:
         label = scheme.description
         paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",
@@ -341,4 +349,5 @@ def command(args):
               points=args.points if args.points is not None else args.num, scale=scale,
               scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
-              force=args.force, continuation=not args.cold)
+              force=args.force, continuation=not args.cold,
+              netcdf=getattr(args, "netcdf", False))
