@@ -1,5 +1,6 @@
 """Every notebook runs top to bottom in a Jupyter kernel (nbclient), outputs not committed."""
 
+import json
 import os
 import pathlib
 
@@ -62,6 +63,20 @@ def test_notebook_runs(path, monkeypatch, tmp_path):
     client = nbclient.NotebookClient(nb, timeout=600, kernel_name="python3",
                                      resources={"metadata": {"path": str(tmp_path)}})
     client.execute()
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_every_code_cell_follows_prose(path):
+    """Each code cell comes after a markdown cell that says what it does (issue 21)."""
+    cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+    bare = []
+    for i, cell in enumerate(cells):
+        if cell["cell_type"] != "code":
+            continue
+        before = cells[i - 1] if i > 0 else None
+        if not (before and before["cell_type"] == "markdown" and "".join(before["source"]).strip()):
+            bare.append(f"cell {i} ({cell.get('id')}): " + "".join(cell["source"]).split("\n")[0])
+    assert not bare, f"{path.name}: code cells with no markdown cell before them: {bare}"
 
 
 def test_every_notebook_has_its_checks():
