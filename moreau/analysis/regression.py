@@ -55,6 +55,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from ..provenance import machine, provenance
 from .compare import make_case, run_row
+from .engine import code_version
 
 __all__ = ["CASES", "measure", "check_accuracy", "time_ratio_flag", "calibration_time",
            "load_baselines", "save_baselines", "load_time_history", "machine_id",
@@ -341,7 +342,6 @@ def record_times(machines, ratios, info=None, run_provenance=None, keep=HISTORY_
     mine = out.setdefault(mid, {"machine": info, "runs": []})
     mine["machine"] = info
     if run_provenance is None:
-        from .engine import code_version  # noqa: PLC0415  (the engine imports the schemes)
         run_provenance = provenance(code_version())
     mine["runs"].append({"provenance": run_provenance,
                          "time_ratios": dict(sorted(ratios.items()))})
