@@ -219,6 +219,9 @@ class PeriodMap:
         self.lcp_solves = 0
         self.fallbacks = 0
         self.last = None
+        #: the map whose finite differences stand for this one's derivative (itself; a
+        #: forced-QP map's is its Lemke twin, see :func:`moreau_jean_steady_state`)
+        self.derivative_map = self
 
     def state(self, q, v):
         """``x`` of a full state ``(q, v)``."""
@@ -317,7 +320,14 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         Use the compiled loop (every scene with a compiled model).
     lcp_method : {"auto", "lemke", "qp"}
         The contact solver of every step (Moreau–Jean's option); ``"qp"``
-        takes the generic Python step.
+        takes the generic Python step. The fixed point is that of this
+        map, but with ``"qp"`` the finite differences (Newton's matrix, the
+        reported slopes and multipliers) are those of the same map with
+        Lemke's solve, compiled where the scene has a model: the two solve
+        the same contact problems, Lemke exactly and in a fraction of the
+        time, and a difference quotient of step 1e-7 would read the QP
+        solver's tolerance as slope. Newton with that matrix still converges
+        to the QP map's own fixed point, because its residual is the QP map's.
     transient_periods : int
         When shooting stalls (e.g. the rod in flight at the section, where the
         discrete map has no usable derivative), up to this many periods are
@@ -369,6 +379,8 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     max_iter = positive_int("max_iter", max_iter)
     transient_periods = positive_int("transient_periods", transient_periods)
     pm = PeriodMap(scene, steps_per_period, theta, projection, fast, lcp_method)
+    if lcp_method == "qp":
+        pm.derivative_map = PeriodMap(scene, steps_per_period, theta, projection, fast, "auto")
     vs = float(getattr(scene, "velocity_scale", 1.0))
     nk = len(pm.kept)
     scale = np.concatenate([np.ones(nk), np.full(scene.ndof, vs)])
@@ -399,11 +411,12 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     last = pm.last
     # perturbations on the scale of the motion (the velocity scale), not of a radian
     fd_scale = np.full(pm.dim, vs)
-    J_sec = _jacobian(pm, x, closed, fd_scale, 20.0 * pm.h, central=True)
-    J_loc = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
+    dm = pm.derivative_map
+    J_sec = _jacobian(dm, x, closed, fd_scale, 20.0 * pm.h, central=True)
+    J_loc = _jacobian(dm, x, closed, fd_scale, 1e-7, y1=y1 if dm is pm else dm(x, closed)[0])
     eig = np.linalg.eigvals(J_sec)
     eig_loc = np.linalg.eigvals(J_loc)
-    multipliers = _floquet(pm, x, closed, 2.0 * math.sqrt(pm.h) * vs)
+    multipliers = _floquet(dm, x, closed, 2.0 * math.sqrt(pm.h) * vs)
     mode, merged, fmin = _modes_of_run(scene, pm, last)
     return SteadyState(
         scheme="moreau-jean",
@@ -429,6 +442,9 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
             "theta": pm.theta,
             "projection": pm.projection,
             "period_maps": pm.evaluations,
+            # period maps run for finite differences by the forced-QP map's Lemke twin
+            "derivative_period_maps": (pm.derivative_map.evaluations
+                                       if pm.derivative_map is not pm else 0),
             # the index-set memory at the section: with state0 it reproduces the steady period
             "closed_at_section": [bool(c) for c in np.atleast_1d(closed)],
         },
@@ -583,7 +599,8 @@ def _shoot(pm, x, closed, scale, tol, max_iter):
             raise ConvergenceError(
                 f"Moreau–Jean shooting did not converge in `max_iter` Newton iterations "
                 f"(periodic residual {r:.3g} > `tol`={tol:g})")
-        J = _jacobian(pm, x, closed, fd_scale, 1e-7, y1=y1)
+        dm = pm.derivative_map
+        J = _jacobian(dm, x, closed, fd_scale, 1e-7, y1=y1 if dm is pm else dm(x, closed)[0])
         A = J - np.eye(len(x))
         pinned = float(np.max(np.abs(F[others]) / scale[others])) <= tol
         stalled = abs(A[j, j]) < 1e-6
