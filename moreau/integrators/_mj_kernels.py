@@ -886,7 +886,9 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
             v1[i] = vf[i]
 
         # -- contacts
-        na = 0
+        # int64, not the literal 0: numba types a call by its first-seen argument types, and
+        # a literal would compile the contact solves a second time for it
+        na = np.int64(0)
         nfa = 0
         for i in range(nc):
             pN[i] = 0.0

@@ -142,7 +142,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             break
         # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
         kv = hk * gamma * cfac
-        nb = 0
+        nb = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
         nfb = 0
         for i in range(nc):
             lamN[i] = 0.0
@@ -275,7 +275,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
             v1[i] = vs[i]
             q1[i] = qs[i]
         # -- contacts at the predicted position
-        na = 0
+        na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
         nfa = 0
         for i in range(nc):
             pN[i] = 0.0
@@ -441,7 +441,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                                 acc_v += Gq[ia[rr], 3 + j] * X[j, c]
                             Wn[rr, c] = acc_v
                     ne = 0
-                    nun = 0
+                    nun = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
                     for rr in range(na):
                         if lamN[ia[rr]] > 0.0:
                             eqr[ne] = rr

@@ -103,7 +103,7 @@ def sp_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, vv, closed, save_every, 
             um[i] = vv[i] - 0.5 * hk * acc
             vh[i] = up[i]
             dvc[i] = 0.0
-        na = 0
+        na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
         nfa = 0
         for i in range(nc):
             pN[i] = 0.0

@@ -164,7 +164,7 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                             a += Mi[k, l] * D[l, 0]
                         vf[k] = vs[k] + hb * a
                         v1[k] = vf[k]
-                    na = 0
+                    na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
                     nfa = 0
                     for c in range(nc):
                         pN[c] = 0.0

@@ -220,7 +220,7 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
             have_Mi = True
         for j in range(n):
             v0[j] = v[j]
-        na = 0
+        na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
         nfa = 0
         for i in range(nc):
             pN[i] = 0.0
