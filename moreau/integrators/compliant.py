@@ -333,6 +333,11 @@ class CompliantRadau(_Compliant):
     ``velocity_scale``), ``rtol``, ``atol``,
     ``max_step`` (default a tenth of a contact's duration), ``sample_dt``
     (default: every step).
+
+    The velocities' absolute tolerance is ``max(atol, floor)``, the floor
+    being the least one Radau's Newton iteration can certify against the
+    contact spring's rounding (:meth:`_velocity_atol_floor`; the value used
+    is the attribute ``velocity_atol``). Positions keep ``atol``.
     """
 
     _solver = Radau
