@@ -242,9 +242,9 @@ def plateaus(rows, rel=0.02, min_error=1e-6):
                 notes.append({
                     "theta": theta, "lcp": lcp, "steps_per_period": n, "signed_error": e,
                     "text": (f"theta={theta:g}: the headline error stays at {e:+.3g} for N = "
-                             + ", ".join(map(str, n)) + ": the discrete steady state puts a "
-                             "slip reversal on a grid time that these N share (see "
-                             "moreau.analysis.compare, 'Plateaus')")})
+                             + ", ".join(map(str, n)) + ": a switch of the discrete motion "
+                             "(a slip reversal, an impact) falls at the same place on the "
+                             "grids of these N (see moreau.analysis.compare, 'Plateaus')")})
             run = [r] if r is not None else []
     return notes
 

@@ -114,6 +114,26 @@ class Scene:
         """Return ``(wNbar, wTbar)``, the velocity-dependent parts of the contact accelerations."""
         raise NotImplementedError
 
+    def forcing_breakpoints(self, t0, t1):
+        """Times in ``(t0, t1)`` where the prescribed motion or forcing is not smooth.
+
+        A piecewise drive (a sawtooth's acceleration jumps) has them. An
+        adaptive scheme ends its steps there: a step that spans a jump of the
+        forcing can hide a whole stick–slip excursion between its samples.
+        The default: none.
+
+        Parameters
+        ----------
+        t0, t1 : float
+            The open interval searched.
+
+        Returns
+        -------
+        numpy.ndarray
+            Sorted times, shape (k,).
+        """
+        return np.zeros(0)
+
     # -- defaults and compiled form ---------------------------------------
     def initial_state(self):
         """A sensible default ``(q0, v0)``: the rest state or the scene's documented start."""

@@ -390,6 +390,16 @@ class StickSlipMotor(SIUnits, Scene):
         _, _, dds = self.drive(t)
         return np.zeros(1), np.array([-float(dds)])
 
+    def forcing_breakpoints(self, t0, t1):
+        """The drive's breakpoints (where ``s''`` jumps) in ``(t0, t1)``, every period."""
+        b = np.asarray(getattr(self.drive, "breakpoints", ()), float)
+        if b.size == 0 or not t1 > t0:
+            return np.zeros(0)
+        k0 = math.floor((t0 - float(np.max(b))) / TWO_PI)
+        k1 = math.ceil((t1 - float(np.min(b))) / TWO_PI)
+        ts = (b[None, :] + TWO_PI * np.arange(k0, k1 + 1)[:, None]).ravel()
+        return np.sort(ts[(ts > t0) & (ts < t1)])
+
     def initial_state(self):
         """Slider on the stator at ``x = 0``, moving with it (sticking) at ``tau = 0``."""
         _, ds, _ = self.drive(0.0)

@@ -124,3 +124,85 @@ def test_clamped_restitution_matches_the_one_dof_contact_and_is_bounded_below():
         assert clamped_restitution(zeta) > math.exp(-zeta * math.pi / math.sqrt(1 - zeta**2))
     # no clamped Kelvin-Voigt contact is fully plastic: critical damping below ~0.136
     assert damping_for_restitution(0.0, 1e6, 1.0) == pytest.approx(2.0 * 1e3)
+
+
+# -- the stuck phase under Radau: the velocity tolerance's rounding floor ------------------
+
+_BOX_OPTS = dict(stiffness=1e3, rtol=1e-9, atol=1e-12, friction_velocity=1e-3)
+
+
+def _box_at_rest():
+    # the sliding box's rest state under the compliant model: both corners pressed in by
+    # their share of the weight (no tilt, no motion)
+    from moreau.integrators.compliant import CompliantRadau
+    box = make_scene("sliding-box", mu=0.4)
+    q0, v0 = box.initial_state()
+    scheme = CompliantRadau(box, 0.0, q0, 0.0 * v0, 1.0, **_BOX_OPTS)
+    return box, scheme
+
+
+def test_one_rounding_of_a_coordinate_moves_the_acceleration_by_at_most_the_floors_bound():
+    # the floor assumes that one ulp of a coordinate changes the acceleration by at most
+    # (k / m_min) ulp(q); measured on the right-hand side itself, at the box's rest state
+    box, scheme = _box_at_rest()
+    n = box.ndof
+    q = np.array([0.0, box.b - 0.25e-3, 0.0])          # each corner carries 1/4 of weight/k
+    y = np.concatenate([q, np.zeros(n)])
+    a0 = scheme._rhs(0.0, y)[n:]
+    WN = box.contact_jacobians(q, 0.0)[0]
+    m_min = 1.0 / np.max(np.einsum("ij,jk,ik->i", WN, np.linalg.inv(box.mass(q)), WN))
+    bound = scheme.stiffness / m_min * np.spacing(np.max(np.abs(q)))
+    jumps = []
+    for j in range(n):
+        yj = y.copy()
+        yj[j] = np.nextafter(yj[j], np.inf)
+        jumps.append(np.max(np.abs(scheme._rhs(0.0, yj)[n:] - a0)))
+    # the height's rounding is what the spring sees: a jump of the bound's size, not zero
+    assert 0.05 * bound < jumps[1] <= bound
+    assert max(jumps) <= bound
+
+
+def test_radau_velocity_tolerance_is_floored_only_where_rounding_exceeds_it():
+    box, scheme = _box_at_rest()
+    # floor = 10 h omega^2 ulp(q) / newton_tol, recomputed here from its parts
+    WN = box.contact_jacobians(box.initial_state()[0], 0.0)[0]
+    m_min = 1.0 / np.max(np.einsum("ij,jk,ik->i", WN, np.linalg.inv(box.mass(None)), WN))
+    w2 = 1e3 / m_min
+    h = min(scheme.max_step, 1.0 / math.sqrt(w2))
+    newton_tol = max(10 * np.finfo(float).eps / 1e-9, min(0.03, math.sqrt(1e-9)))
+    assert scheme.velocity_atol == pytest.approx(10 * h * w2 * np.spacing(box.b) / newton_tol,
+                                                 rel=1e-12)
+    # a looser tolerance than the floor is kept as given
+    from moreau.integrators.compliant import CompliantRadau
+    loose = CompliantRadau(box, 0.0, *box.initial_state(), 1.0, **dict(_BOX_OPTS, atol=1e-6))
+    assert loose.velocity_atol == 1e-6
+
+
+def test_radau_sliding_box_comes_to_rest_without_rebuilding_its_jacobian_every_step():
+    # the defect: with atol 1e-12 on the velocities, Radau's Newton iteration saw only the
+    # rounding of the contact spring once the box stopped (t > 3.1), failed nearly every step,
+    # rebuilt its Jacobian and halved the step: 12 015 Jacobians for the window (t <= 3.75),
+    # 51 s. Counted, not timed.
+    box = make_scene("sliding-box", mu=0.4)
+    q0, v0 = box.initial_state()
+    r = simulate(box, (0.0, 3.75), q0, v0, "compliant-radau", **_BOX_OPTS)
+    assert r.success
+    assert r.stats["jacobian_evaluations"] < 200, r.stats
+    # stopped where the rigid box stops (v0^2 / (2 mu) = 1.25), up to the compliant model's
+    # error, and at rest
+    assert abs(r.q[-1, 0] - 1.25) < 1e-3
+    assert np.max(np.abs(r.v[-1])) < 1e-9
+
+
+@pytest.mark.slow
+def test_radau_rest_phase_answer_is_unchanged_by_the_floor(monkeypatch):
+    # the same stuck phase without the floor (slow: thousands of Jacobians) gives the same
+    # stopping distance to the integrator's tolerance
+    from moreau.integrators import compliant
+    box = make_scene("sliding-box", mu=0.4)
+    q0, v0 = box.initial_state()
+    with_floor = simulate(box, (0.0, 3.3), q0, v0, "compliant-radau", **_BOX_OPTS)
+    monkeypatch.setattr(compliant._Compliant, "_velocity_atol_floor", lambda self, m, q: 0.0)
+    without = simulate(box, (0.0, 3.3), q0, v0, "compliant-radau", **_BOX_OPTS)
+    assert without.stats["jacobian_evaluations"] > 10 * with_floor.stats["jacobian_evaluations"]
+    assert abs(with_floor.q[-1, 0] - without.q[-1, 0]) < 1e-9 * 1.25
