@@ -243,8 +243,8 @@ def plateaus(rows, rel=0.02, min_error=1e-6):
                     "theta": theta, "lcp": lcp, "steps_per_period": n, "signed_error": e,
                     "text": (f"theta={theta:g}: the headline error stays at {e:+.3g} for N = "
                              + ", ".join(map(str, n)) + ": a switch of the discrete motion "
-                             "(a slip reversal, an impact) falls at the same place on the "
-                             "grids of these N (see moreau.analysis.compare, 'Plateaus')")})
+                             "(a slip reversal, an impact) falls on a grid time that these N "
+                             "share (see moreau.analysis.compare, 'Plateaus')")})
             run = [r] if r is not None else []
     return notes
 
