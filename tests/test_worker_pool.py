@@ -45,7 +45,8 @@ import time  # noqa: E402
 
 import pytest  # noqa: E402
 
-psutil = pytest.importorskip("psutil")
+# a test dependency ([test] extra): a missing psutil must fail here, not skip the module
+import psutil  # noqa: E402
 
 
 def _workers(pid=None):
