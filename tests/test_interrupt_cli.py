@@ -152,3 +152,33 @@ def test_ctrl_c_while_reproduce_draws_says_the_tables_are_written(tmp_path, caps
                     f"figures unfinished): 14 of 14 points finished, kept in "
                     f"{tmp_path / 'cache'}; run the same command again to resume")
     assert len(list((tmp_path / "data").glob("*.csv"))) == 7
+
+
+def test_ctrl_c_inside_a_batch_run_stops_the_batch_and_keeps_its_rows():
+    # moreau compare --stress went on to its next case after Ctrl-C: simulate() returned the
+    # interrupted run as status -4 and the catalogue continued; collect_rows (compare's and
+    # the catalogue's loop) now lets the interrupt through and keeps the finished rows
+    from moreau.analysis.compare import collect_rows
+    from moreau.integrators import simulate
+    from moreau.scenes.bouncing_ball import BouncingBall
+
+    class Interrupting(BouncingBall):
+        def forces(self, q, v, t):
+            if t > 0.05:
+                raise KeyboardInterrupt
+            return super().forces(q, v, t)
+
+    ran = []
+
+    def run(item):
+        ran.append(item)
+        scene = Interrupting() if item == "b" else BouncingBall()
+        res = simulate(scene, (0.0, 0.1), [1.0], [0.0], "moreau-jean", h=0.01, fast=False)
+        return [{"item": item, "status": res.status}]
+
+    rows = []
+    assert collect_rows(["a", "b", "c"], run, rows) is True
+    assert ran == ["a", "b"] and rows == [{"item": "a", "status": 0}]
+    # a lone simulate still returns what it had, with the interrupted status
+    res = simulate(Interrupting(), (0.0, 0.1), [1.0], [0.0], "moreau-jean", h=0.01, fast=False)
+    assert res.status == -4 and res.t[-1] > 0.0

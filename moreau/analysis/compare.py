@@ -112,7 +112,7 @@ from tqdm import tqdm
 
 from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
-from ..integrators.base import INTEGRATORS
+from ..integrators.base import INTEGRATORS, propagate_interrupts
 from ..provenance import provenance
 from ..scenes.base import Scene
 from ..scenes.registry import get_entry
@@ -406,13 +406,15 @@ def collect_rows(items, run, rows, on_row=None, progress=False, desc="", unit="i
         # disable=None: a bar on a terminal only, never in a log file
         bar = tqdm(total=len(items), desc=desc, unit=unit, disable=None)
     try:
-        for item in items:
-            for row in run(item):
-                rows.append(row)
-                if on_row is not None:
-                    on_row(row)
-            if bar is not None:
-                bar.update(1)
+        # a run's own Ctrl-C handling (simulate's status -4) would let the batch go on
+        with propagate_interrupts():
+            for item in items:
+                for row in run(item):
+                    rows.append(row)
+                    if on_row is not None:
+                        on_row(row)
+                if bar is not None:
+                    bar.update(1)
     except KeyboardInterrupt:
         return True
     finally:

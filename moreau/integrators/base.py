@@ -10,6 +10,8 @@ interrupted run (Ctrl-C) keeps what it had finished.
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import inspect
 from typing import Any, Callable, Sequence, TYPE_CHECKING
 
@@ -26,7 +28,7 @@ from .result import STATUS_MESSAGES, SimulationResult
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
     from ..scenes.base import Scene
 
-__all__ = ["Integrator", "simulate", "INTEGRATORS", "register_integrator", "get_integrator",
+__all__ = ["Integrator", "simulate", "propagate_interrupts", "INTEGRATORS", "register_integrator", "get_integrator",
            "check_options"]
 
 #: registry name -> Integrator subclass, filled by :func:`register_integrator`
@@ -354,6 +356,8 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
             # what a failed step still recorded
             tracker.feed(integ._take_pieces())
     except KeyboardInterrupt:
+        if _PROPAGATE_INTERRUPTS.get():
+            raise
         integ.interrupt()
     finally:
         if bar is not None:
@@ -362,3 +366,32 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     if tracker is not None:
         tracker.finish(result)
     return result
+
+
+#: inside :func:`propagate_interrupts`: :func:`simulate` lets Ctrl-C through
+_PROPAGATE_INTERRUPTS = contextvars.ContextVar("moreau_propagate_interrupts", default=False)
+
+
+@contextlib.contextmanager
+def propagate_interrupts():
+    """Within this block, Ctrl-C stops :func:`simulate`'s caller too.
+
+    A lone :func:`simulate` turns ``KeyboardInterrupt`` into its result's
+    status ``-4`` and returns what it had: the run was the whole job. A batch
+    of runs (a comparison table, the stress catalogue) must stop instead of
+    going on to its next run with the interrupt swallowed; it runs its loop in
+    this block and keeps its finished rows where it catches the interrupt.
+
+    Examples
+    --------
+    >>> with propagate_interrupts():
+    ...     _PROPAGATE_INTERRUPTS.get()
+    True
+    >>> _PROPAGATE_INTERRUPTS.get()
+    False
+    """
+    token = _PROPAGATE_INTERRUPTS.set(True)
+    try:
+        yield
+    finally:
+        _PROPAGATE_INTERRUPTS.reset(token)
