@@ -1,10 +1,12 @@
 """A first compile says so: one INFO note, on a terminal or through ``logging``; never a compile here.
 
-The note is made by :func:`moreau.integrators._loops.runner_for`, the one
-place a compiled loop is built, when its first call will compile (nothing in
-the process, nothing fresh in numba's disk cache). The tests replace that
+The note is made in :mod:`moreau.integrators._loops`, the one place a
+compiled loop is built, when a loop will compile (nothing in the process,
+nothing fresh in numba's disk cache): a scheme's shared loop at its first
+call, a model's specialised loop when it is chosen. The tests replace that
 answer (``_jit_cache.has_cached_code``) instead of compiling, and never call
-the loop, except the command-line test, which loads a cached loop.
+a loop that is not cached, except the command-line test, which loads the
+shared Moreau–Jean loop (compiled once by any other test).
 """
 
 import importlib.util
@@ -18,8 +20,9 @@ from moreau.cli import main
 from moreau.integrators import _loops
 from moreau.scenes import BouncingBall, FrictionDrive
 
-NOTE = ("compiling the Moreau–Jean loop for scene friction-drive (first use on this machine, "
-        "about 5-20 s)...")
+NOTE = "compiling the Moreau–Jean loop specialised to scene friction-drive (about 5-20 s)..."
+SHARED_NOTE = ("compiling the Moreau–Jean loop (first use on this machine, once for every scene, "
+               "about 5-20 s)...")
 
 
 class _Terminal(io.StringIO):
@@ -30,8 +33,25 @@ class _Terminal(io.StringIO):
 @pytest.fixture
 def fresh_loops(monkeypatch):
     # a process that has built no loop yet (the built loops are not compiled here)
-    monkeypatch.setattr(_loops, "_RUNNERS", {})
-    monkeypatch.setattr(_loops, "_NOTED", set())
+    for name in ("_RUNNERS", "_CHOSEN", "_CORES"):
+        monkeypatch.setattr(_loops, name, {})
+
+
+class _FakeCore:
+    # stands for a shared loop that is not compiled: records what the runner asks of it
+    def __init__(self):
+        self.signatures, self.compiled, self.calls = [], [], 0
+
+    def compile(self, sig):
+        self.compiled.append(sig)
+        self.signatures.append(sig)
+
+    def disable_compile(self):
+        pass
+
+    def __call__(self, *args):
+        self.calls += 1
+        return args
 
 
 @pytest.fixture
@@ -49,12 +69,30 @@ def test_a_loop_that_will_compile_is_announced_once(fresh_loops, monkeypatch, ca
     monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
     scene = FrictionDrive(frequency=185.0)
     with caplog.at_level(logging.INFO, logger="moreau"):
-        run = _loops.runner_for(scene.compiled_model(), scene=scene)
-        again = _loops.runner_for(scene.compiled_model(), scene=scene)
+        run = _loops.runner_for(scene.compiled_model(), scene=scene, specialise=True)
+        again = _loops.runner_for(scene.compiled_model(), scene=scene, specialise=True)
     assert again is run and not run.signatures          # built, not compiled
     assert [r.getMessage() for r in caplog.records] == [NOTE]
     assert caplog.records[0].name == "moreau.integrators._loops"
     assert caplog.records[0].levelno == logging.INFO
+
+
+def test_the_shared_loop_is_announced_at_its_first_call_once(fresh_loops, monkeypatch, caplog):
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    fake = _FakeCore()
+    monkeypatch.setattr(_loops, "shared_core", lambda template, argtypes: fake)
+    scene = FrictionDrive(frequency=185.0)
+    with caplog.at_level(logging.INFO, logger="moreau"):
+        run = _loops.runner_for(scene.compiled_model(), scene=scene)
+        assert isinstance(run, _loops.SharedRunner)
+        assert caplog.records == []                     # nothing before the first call
+        run(1.0, 2)
+        run(1.0, 2)
+        # another scene uses the same shared loop: no second note, no second compile
+        other = BouncingBall()
+        _loops.runner_for(other.compiled_model(), scene=other)(1.0, 2)
+    assert [r.getMessage() for r in caplog.records] == [SHARED_NOTE]
+    assert len(fake.compiled) == 1 and fake.calls == 3
 
 
 def test_a_cached_loop_is_not_announced(fresh_loops, monkeypatch, caplog):
@@ -70,32 +108,33 @@ def test_without_logging_configured_a_terminal_gets_one_line(fresh_loops, monkey
     monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
     scene = FrictionDrive(frequency=185.0)
     monkeypatch.setattr("sys.stderr", _Terminal())
-    _loops.runner_for(scene.compiled_model(), scene=scene)
-    _loops.runner_for(scene.compiled_model(), scene=scene)
+    _loops.runner_for(scene.compiled_model(), scene=scene, specialise=True)
+    _loops.runner_for(scene.compiled_model(), scene=scene, specialise=True)
     assert __import__("sys").stderr.getvalue() == "moreau: " + NOTE + "\n"
     # and nothing where stderr is a file (a log)
-    monkeypatch.setattr(_loops, "_NOTED", set())
+    for name in ("_RUNNERS", "_CHOSEN"):
+        monkeypatch.setattr(_loops, name, {})
     log_file = io.StringIO()
     monkeypatch.setattr("sys.stderr", log_file)
-    _loops.runner_for(scene.compiled_model(), scene=scene)
+    _loops.runner_for(scene.compiled_model(), scene=scene, specialise=True)
     assert log_file.getvalue() == ""
 
 
 def test_the_command_line_shows_the_note_with_verbose_only_in_a_log(fresh_loops, monkeypatch,
                                                                     capsys, tmp_path,
                                                                     quiet_moreau_logger):
-    # the run loads the bouncing ball's cached loop (compiled once by the other tests)
+    # the run loads the shared Moreau-Jean loop from the cache (compiled once by any
+    # other test, or by the first run here)
     monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
     args = ["run", "--scene", "bouncing-ball", "--scheme", "moreau-jean", "--duration", "0.05",
             "--steps", "50", "--no-plot", "--quiet", "--out", str(tmp_path)]
     assert main(args) == 0
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr(_loops, "_RUNNERS", {})
-    monkeypatch.setattr(_loops, "_NOTED", set())
+    for name in ("_RUNNERS", "_CHOSEN", "_CORES"):
+        monkeypatch.setattr(_loops, name, {})
     assert main(["-v"] + args + ["--force"]) == 0
     err = capsys.readouterr().err
-    assert err == ("moreau: compiling the Moreau–Jean loop for scene bouncing-ball (first use "
-                   "on this machine, about 5-20 s)...\n")
+    assert err == "moreau: " + SHARED_NOTE + "\n"
 
 
 def _load(path, name):

@@ -111,10 +111,36 @@ def test_a_scene_runner_is_tied_to_its_model_and_kernel_sources(monkeypatch):
 
     model = friction_drive.FrictionDrive(frequency=185.0).compiled_model()
     monkeypatch.setattr(_loops, "_RUNNERS", {})
-    run = _loops.runner_for(model)
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    run = _loops.runner_for(model, specialise=True)
     deps = _loops.dependency_files(list(model.functions().values()))
     # the model's module and the rod pieces it calls (another file) are both tracked
     assert {"friction_drive.py", "_rod.py"} <= {os.path.basename(p) for p in deps}
     digest = _jit_cache.sources_digest(list(mk.KERNEL_SOURCES) + deps)
     stamp = run._cache._cache_file._source_stamp
     assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
+
+
+def test_the_shared_loop_is_tied_to_the_kernels_and_each_model_function_to_its_files(monkeypatch):
+    import numba
+
+    from moreau.integrators import _loops
+    from moreau.integrators import _mj_kernels as mk
+    from moreau.scenes import friction_drive
+
+    monkeypatch.setattr(_loops, "_CORES", {})
+    core = _loops.shared_core(mk.mj_loop, (numba.int64,))   # built, never compiled here
+    stamp = core._cache._cache_file._source_stamp
+    assert stamp[0] == "moreau-deps"
+    assert stamp[1][1] == _jit_cache.sources_digest(list(mk.KERNEL_SOURCES))
+    # a model function called through a pointer is compiled on its own: its cache must
+    # follow the rod pieces it calls in another file, which numba alone would not see
+    src = friction_drive._forces.py_func.__code__.co_filename
+    fresh = numba.njit(cache=True)(friction_drive._forces.py_func)   # not compiled yet
+    monkeypatch.setattr(friction_drive, "_forces", fresh)
+    model = friction_drive.FrictionDrive(frequency=185.0).compiled_model()
+    assert model.forces is fresh
+    _loops._model_prefix(model)
+    deps = _loops.dependency_files([fresh])
+    assert src in deps and any(os.path.basename(p) == "_rod.py" for p in deps)
+    assert fresh._cache._cache_file._source_stamp[1][1] == _jit_cache.sources_digest(deps)

@@ -18,14 +18,27 @@ notebook give a loop compiled in memory, again in each process: their names
 do not identify them across processes.
 """
 
+import ast
+import contextlib
 import hashlib
 import importlib
+import inspect
 import logging
+import os
 import sys
+import textwrap
 import threading
+import time
 import types
 
+try:
+    import fcntl
+except ImportError:  # Windows: the shared loops' compile lock is skipped
+    fcntl = None
+
+import numba
 from numba import njit
+from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from .._log import note
@@ -36,13 +49,14 @@ __all__ = ["runner_for", "dependency_files"]
 
 _RUNNERS = {}
 _LOCK = threading.Lock()
-_NOTED = set()
 log = logging.getLogger(__name__)
 
 #: the schemes' names of the loop templates, for the compile note
 SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
                       "nsga_loop": "nonsmooth generalized-alpha",
                       "studer_loop": "Studer extrapolation"}
+#: seconds of a shared loop after which a model's own loop is compiled (about its cost)
+TIER_UP_SECONDS = 10.0
 #: what a first compile takes (README: 16-19 s for the first scene with Lemke and
 #: the QP path, 5-10 s for each later one)
 COMPILE_SECONDS = "5-20"
@@ -126,32 +140,222 @@ def _build(model, template):
     return run
 
 
-def runner_for(model, template=None, scene=None):
-    """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`), built once.
+#: the leading parameters of a scheme's shared loop: the model as run-time values, in
+#: the order :func:`_model_prefix` gives them
+SHARED_PARAMETERS = ("mass_fn", "forces_fn", "contacts_fn", "gaps_fn", "NDOF", "NCONTACTS",
+                     "CONST_MASS", "HAS_JAC", "HAS_GAPS")
+
+_F1 = nbtypes.float64[::1]
+_F2 = nbtypes.float64[:, ::1]
+_B = nbtypes.boolean
+#: the numba signatures of a model's functions (:mod:`moreau.compiled`), as the loops call them
+MODEL_SIGNATURES = {
+    "mass": nbtypes.void(_F1, _F1, _F2),
+    "forces": nbtypes.void(_F1, _F1, _F1, nbtypes.float64, _F2, _B),
+    "contacts": nbtypes.void(_F1, _F1, nbtypes.float64, _F2, _B, _B),
+    "gaps": nbtypes.void(_F1, _F1, nbtypes.float64, _F2),
+}
+_PREFIX_TYPES = tuple(nbtypes.FunctionType(MODEL_SIGNATURES[k])
+                      for k in ("mass", "forces", "contacts", "gaps")) + (
+    nbtypes.int64, nbtypes.int64, _B, _B, _B)
+_CORES = {}
+
+
+def _shared_function(template):
+    """``template`` rewritten to take the model as its leading arguments (:data:`SHARED_PARAMETERS`).
+
+    The same source as the specialised loop, so both compile the same
+    arithmetic; the shared one reads the model's functions and sizes at run
+    time, which lets one compiled loop serve every model.
+    """
+    source = textwrap.dedent(inspect.getsource(template))
+    tree = ast.parse(source)
+    fdef = tree.body[0]
+    fdef.decorator_list = []
+    fdef.name = template.__name__ + "_shared"
+    fdef.args.args = [ast.arg(arg=name) for name in SHARED_PARAMETERS] + fdef.args.args
+    ast.fix_missing_locations(tree)
+    ast.increment_lineno(tree, template.__code__.co_firstlineno - 1)
+    code = compile(tree, template.__code__.co_filename, "exec")
+    module = sys.modules[template.__module__]
+    namespace = dict(vars(module))
+    exec(code, namespace)  # noqa: S102  (the package's own template, transformed above)
+    fn = namespace[fdef.name]
+    fn.__module__ = template.__module__
+    fn.__qualname__ = fdef.name
+    return fn
+
+
+def shared_core(template, argtypes):
+    """The loop of ``template`` compiled once for every model, for the loop arguments ``argtypes``.
+
+    Its first arguments are :data:`SHARED_PARAMETERS`; the model's functions
+    are passed as numba first-class functions (:data:`MODEL_SIGNATURES`), so
+    no model is compiled into it and numba's disk cache serves every scene,
+    a user's included. Returns a dispatcher with exactly one signature.
+    """
+    key = (template.__module__, template.__name__, tuple(argtypes))
+    with _LOCK:
+        core = _CORES.get(key)
+        if core is None:
+            module = sys.modules[template.__module__]
+            core = njit(cache=True, error_model="numpy")(_shared_function(template))
+            sources = list(_mj_kernels.KERNEL_SOURCES)
+            if module.__file__ not in sources:
+                sources.append(module.__file__)
+            _jit_cache.bind_cache_to_sources([core], sources)
+            _CORES[key] = core
+    return core
+
+
+def _model_prefix(model):
+    for f in model.functions().values():
+        if not f.signatures and _import_path(f) is not None:
+            # called through a pointer, each function is compiled (or loaded) on its own:
+            # tie its cache to every file it calls into, as the specialised loop's is
+            _jit_cache.bind_cache_to_sources([f], dependency_files([f]))
+    return (model.mass, model.forces, model.contacts, model.gaps or no_gaps, model.ndof,
+            model.ncontacts, model.const_mass, model.has_jacobians, model.gaps is not None)
+
+
+class SharedRunner:
+    """A model bound to its scheme's shared loop: called with the template's own arguments.
+
+    It keeps the time spent in the shared loop. Once that passes
+    :data:`TIER_UP_SECONDS` (about what a specialised compile costs), it
+    compiles the model's specialised loop and runs that from then on: a
+    long run pays at most about twice what it would have with the best
+    choice made in advance, and a short one pays no compile beyond the
+    scheme's. Both loops give the same numbers to the last bit.
+    """
+
+    def __init__(self, model, template, scene=None):
+        self.model, self.template, self.scene = model, template, scene
+        self._prefix = _model_prefix(model)
+        self._core = None
+        self._special = None
+        self.seconds = 0.0
+
+    def _bind(self, args):
+        argtypes = tuple(numba.typeof(a) for a in args)
+        core = shared_core(self.template, argtypes)
+        if not core.signatures:
+            with _compile_lock(core):
+                if not _jit_cache.has_cached_code(core):
+                    _note_compile(self.template, self.scene, shared=True)
+                core.compile(_PREFIX_TYPES + argtypes)
+            # one signature: a call with other argument types is an error, not a silent
+            # compile of a loop specialised on the model's functions
+            core.disable_compile()
+        self._core = core
+
+    def __call__(self, *args):
+        if self._special is not None:
+            return self._special(*args)
+        if self._core is None:
+            self._bind(args)
+        t0 = time.perf_counter()
+        out = self._core(*self._prefix, *args)
+        self.seconds += time.perf_counter() - t0
+        if self.seconds > TIER_UP_SECONDS:
+            self._special = runner_for(self.model, self.template, self.scene, specialise=True)
+        return out
+
+
+@contextlib.contextmanager
+def _compile_lock(dispatcher):
+    """Hold a lock file next to ``dispatcher``'s disk cache while it compiles.
+
+    Processes that start together (pytest-xdist workers, a sweep's workers)
+    would each compile the same shared loop; with the lock the later ones
+    wait and then load the first one's machine code from the cache. Without
+    a writable cache folder or ``fcntl`` (Windows) it holds nothing.
+    """
+    fh = None
+    try:
+        folder = dispatcher._cache._cache_path
+        name = dispatcher.py_func.__qualname__
+        fh = open(os.path.join(folder, f"{name}.moreau-lock"), "a")
+        fcntl.flock(fh, fcntl.LOCK_EX)
+    except Exception:
+        # no lock to be had (read-only install, no fcntl, other numba internals):
+        # compiling twice is slower, never wrong
+        if fh is not None:
+            fh.close()
+        fh = None
+    try:
+        yield
+    finally:
+        if fh is not None:
+            fh.close()
+
+
+#: environment variable: "1" compiles every (model, scheme) pair's own loop on first use
+SPECIALISE_ENV = "MOREAU_SPECIALISE"
+_CHOSEN = {}
+
+
+def specialise_default():
+    """Whether loops are specialised to each model by default (:data:`SPECIALISE_ENV` set to 1)."""
+    return os.environ.get(SPECIALISE_ENV, "").strip().lower() in ("1", "true", "yes", "on")
+
+
+def runner_for(model, template=None, scene=None, specialise=None):
+    """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`).
 
     ``template`` is the loop of a scheme, written against the model's
     globals (default :func:`moreau.integrators._mj_kernels.mj_loop`, the
-    Moreau–Jean loop); a scheme module passes its own. Returns a numba
-    function with the template's arguments. When its first call will compile
-    (nothing in this process, nothing fresh in numba's disk cache), one INFO
-    note says so (:func:`moreau._log.note`: on a terminal, or through
-    ``logging``), naming ``scene`` (the scene being run, for the note only).
+    Moreau–Jean loop); a scheme module passes its own. Two compiled forms
+    run the same source:
+
+    - the scheme's *shared* loop (:func:`shared_core`), compiled once for
+      every model and kept in numba's disk cache: the model's functions are
+      called through pointers. This is the default, so a new scene costs no
+      compile of the loop;
+    - the model's *specialised* loop (``template`` compiled with the model's
+      functions and sizes frozen in), which numba inlines and unrolls:
+      faster per step (``benchmarks/bench_moreau_jean.py`` measures both),
+      at a compile of 5-20 s per (model, scheme) pair. It is used when
+      ``specialise`` is true (default: :func:`specialise_default`), and
+      whenever it is already compiled in this process or fresh in the disk
+      cache.
+
+    Both give the same numbers to the last bit (tested). Returns a callable
+    with the template's arguments. When its first call will compile, one
+    INFO note says so (:func:`moreau._log.note`), naming ``scene`` (for the
+    note only).
     """
     template = template or _mj_kernels.mj_loop
+    if specialise is None:
+        specialise = specialise_default()
     key = (template.__module__, template.__name__,
            tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
            tuple(sorted(_constants(model).items())))
+    chosen = _CHOSEN.get((key, bool(specialise)))
+    if chosen is not None:
+        return chosen
     with _LOCK:
         run = _RUNNERS.get(key)
         if run is None:
             run = _RUNNERS[key] = _build(model, template)
-    if id(run) not in _NOTED:
-        _NOTED.add(id(run))
+    if specialise or _jit_cache.has_cached_code(run):
         if not _jit_cache.has_cached_code(run):
-            scheme = SCHEME_OF_TEMPLATE.get(template.__name__, template.__name__)
-            note(log, "compiling the %s loop for scene %s (first use on this machine, about "
-                 "%s s)...", scheme, _scene_label(scene), COMPILE_SECONDS)
-    return run
+            _note_compile(template, scene, shared=False)
+        chosen = run
+    else:
+        chosen = SharedRunner(model, template, scene)
+    _CHOSEN[(key, bool(specialise))] = chosen
+    return chosen
+
+
+def _note_compile(template, scene, shared):
+    scheme = SCHEME_OF_TEMPLATE.get(template.__name__, template.__name__)
+    if shared:
+        note(log, "compiling the %s loop (first use on this machine, once for every scene, "
+             "about %s s)...", scheme, COMPILE_SECONDS)
+    else:
+        note(log, "compiling the %s loop specialised to scene %s (about %s s)...", scheme,
+             _scene_label(scene), COMPILE_SECONDS)
 
 
 def _scene_label(scene):

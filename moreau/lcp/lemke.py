@@ -251,6 +251,14 @@ def _pivot(T, b, col, n, r, s):
 
 
 @njit(cache=True)
+def _copy_into(dst, src):
+    # an explicit loop: a slice assignment (dst[:] = src) makes numba compile its
+    # shape-mismatch error path, about 3 s of every cold start
+    for k in range(dst.shape[0]):
+        dst[k] = src[k]
+
+
+@njit(cache=True)
 def _extract_z(b, pos, n, z_out):
     for j in range(n):
         p = pos[n + j]
@@ -608,8 +616,8 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
         if ok and res2 <= tol:
             residual = res2
         else:
-            z_out[:] = zsave
-            w_out[:] = wsave
+            _copy_into(z_out, zsave)
+            _copy_into(w_out, wsave)
             status = BREAKDOWN
     if not residual < np.inf:
         for k in range(n):
@@ -948,9 +956,9 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         if residual2 < residual:
             status, residual = status2, residual2
         else:
-            z_out[:] = z1
-            w_out[:] = w1
-            ray_out[:] = r1
+            _copy_into(z_out, z1)
+            _copy_into(w_out, w1)
+            _copy_into(ray_out, r1)
     return status, pivots, residual
 
 

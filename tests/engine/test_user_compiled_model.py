@@ -62,7 +62,7 @@ def test_the_compiled_loop_runs_the_generic_step_to_rounding(theta):
     assert len(np.unique(res.regime)) >= 2
 
 
-def test_functions_defined_in_a_function_run_compiled_in_memory():
+def test_functions_defined_in_a_function_run_compiled_in_memory(monkeypatch):
     # a notebook's or script's functions cannot be imported again by name: the loop is
     # compiled for this process only, and still runs the model's equations. Compiled in
     # every run of the suite: Schatzman-Paoli's loop, the quickest to compile (15 s
@@ -79,6 +79,8 @@ def test_functions_defined_in_a_function_run_compiled_in_memory():
 
     model = Local().compiled_model()
     assert _loops._import_path(mass) is None
+    # the model's own loop is what this test is about (the shared one needs no compile)
+    monkeypatch.setenv(_loops.SPECIALISE_ENV, "1")
     run = _loops.runner_for(model, _sp_kernels.sp_loop)
     assert type(run._cache).__name__ == "NullCache"
     sc = Local()
@@ -113,13 +115,14 @@ def test_an_importable_model_is_cached_and_an_edit_recompiles(tmp_path):
         sc = CompiledBeltBlock()
         q0, v0 = sc.initial_state()
         r = simulate(sc, (0.0, 2.0), q0, v0, "schatzman-paoli", h=0.01, fast=True)
-        run = _loops.runner_for(sc.compiled_model(), _sp_kernels.sp_loop)
+        run = _loops.runner_for(sc.compiled_model(), _sp_kernels.sp_loop, specialise=True)
         print(json.dumps({{"hits": sum(run.stats.cache_hits.values()),
                           "misses": sum(run.stats.cache_misses.values()),
                           "x": float(r.q[-1, 0]), "name": run.__qualname__,
                           "cache": getattr(run._cache, "_cache_path", None)}}))
     """)
-    env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    env = dict(os.environ, PYTHONPATH=str(tmp_path) + os.pathsep + os.environ.get("PYTHONPATH", ""),
+               **{_loops.SPECIALISE_ENV: "1"})
 
     def run():
         out = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,

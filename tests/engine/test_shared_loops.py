@@ -1,0 +1,84 @@
+"""One compiled loop per scheme serves every model; a long run moves to the model's own loop.
+
+:mod:`moreau.integrators._loops` runs a model in its scheme's *shared* loop
+(the model's functions called through pointers, compiled once for all
+scenes) until the time spent there passes ``TIER_UP_SECONDS``, then in the
+model's *specialised* loop (the same source, the model compiled in). The
+two must give the same numbers to the last bit, so that where a run
+switches never shows in its answer.
+"""
+
+import numpy as np
+import pytest
+from numba import njit
+
+from moreau.compiled import CompiledModel
+from moreau.integrators import _blocks, _loops, simulate
+from moreau.scenes.registry import make_scene
+
+from belt_scene import CompiledBeltBlock
+
+
+def _run(scene, t_end, h):
+    q0, v0 = scene.initial_state()
+    return simulate(scene, (0.0, t_end), q0, v0, "moreau-jean", h=h, fast=True)
+
+
+@pytest.mark.parametrize("name, t_end, h", [("friction-drive", 40.0, 2e-3),
+                                            ("bidirectional-drive", 40.0, 2e-3)])
+def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatch, name, t_end, h):
+    # small blocks so that the switch falls inside the run, after the first block
+    monkeypatch.setattr(_blocks, "FAST_BLOCK", 2000)
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops, "TIER_UP_SECONDS", float("inf"))
+    shared = _run(make_scene(name), t_end, h)
+    runner = _loops.runner_for(make_scene(name).compiled_model())
+    assert isinstance(runner, _loops.SharedRunner) and runner._special is None
+
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops, "TIER_UP_SECONDS", 0.0)
+    tiered = _run(make_scene(name), t_end, h)
+    runner = _loops.runner_for(make_scene(name).compiled_model())
+    assert runner._special is not None and runner._special.signatures   # it did move
+    assert shared.success and tiered.success
+    assert shared.stats["steps"] == tiered.stats["steps"] > 3 * 2000
+    for field in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
+        np.testing.assert_array_equal(getattr(tiered, field), getattr(shared, field), field)
+    # the run crosses regimes: stick or slip changes and, on the two-rod drive, both rods
+    assert len(np.unique(shared.regime)) >= 2
+
+
+def test_a_scene_defined_in_a_function_needs_no_loop_compile(monkeypatch):
+    # a notebook's model: its functions compile on their own (small), the loop is the
+    # scheme's shared one, already compiled for the other scenes
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+
+    @njit
+    def mass(par, q, M):
+        M[0, 0] = 1.0
+        M[1, 1] = 1.0
+
+    class Local(CompiledBeltBlock):
+        def compiled_model(self):
+            m = super().compiled_model()
+            return CompiledModel(mass, m.forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+
+    a = _run(Local(), 3.0, 0.01)
+    runner = _loops.runner_for(Local().compiled_model())
+    assert isinstance(runner, _loops.SharedRunner)
+    specialised = _loops._RUNNERS[next(k for k in _loops._RUNNERS if k[1] == "mj_loop"
+                                       and dict(k[2])["mass"] is mass)]
+    assert not specialised.signatures                 # the model's own loop never compiled
+    q0, v0 = Local().initial_state()
+    b = simulate(Local(), (0.0, 3.0), q0, v0, "moreau-jean", h=0.01, fast=False)
+    assert a.success and b.success
+    np.testing.assert_allclose(a.q, b.q, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(a.regime, b.regime)
+
+
+def test_the_specialise_setting_is_read_from_the_environment(monkeypatch):
+    monkeypatch.delenv(_loops.SPECIALISE_ENV, raising=False)
+    assert _loops.specialise_default() is False
+    for value, expected in (("1", True), ("yes", True), ("0", False), ("", False)):
+        monkeypatch.setenv(_loops.SPECIALISE_ENV, value)
+        assert _loops.specialise_default() is expected
