@@ -1,10 +1,13 @@
 """Speed of the compiled Moreau–Jean engine on every shipped scene, side by side with Siconos.
 
 For each scene: the warm rate of the compiled loop (steps per second through
-``simulate``, one sample kept), the rate of the generic Python path of the
-same scheme (``fast=False``, the in-process baseline), and the first call in
-a fresh process (import, then the numba cache load or compilation of the
-first run, timed separately). The peer is Siconos's Moreau–Jean on the
+``simulate``, one sample kept) in both of its forms, the scheme's shared loop
+(the model called through pointers, compiled once for every scene; what a
+first use runs) and the model's specialised loop (compiled for the scene;
+what a long run moves to, see ``moreau.integrators._loops``), the rate of the
+generic Python path of the same scheme (``fast=False``, the in-process
+baseline), and the first call in a fresh process (import, then the numba
+cache load or compilation of the first run, timed separately). The peer is Siconos's Moreau–Jean on the
 bouncing ball (``benchmarks/siconos_peer.py`` under ``/usr/bin/python3``;
 skipped with a note when Siconos is absent). The goal of issue 9 is every
 scene at >= 10x Siconos's bouncing-ball rate.
@@ -33,7 +36,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
-from moreau.integrators import simulate
+from moreau.integrators import _loops, simulate
 # the user scene of the test suite (tests/engine/belt_scene.py), imported as a user would
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
                                 "tests", "engine"))
@@ -107,7 +110,9 @@ q0, v0 = sc.initial_state()
 t2 = time.perf_counter()
 res = simulate(sc, (0.0, 10 * {h!r}), q0, v0, "moreau-jean", h={h!r})
 t3 = time.perf_counter()
-hits = sum(_loops.runner_for(sc.compiled_model()).stats.cache_hits.values())
+run = _loops.runner_for(sc.compiled_model())
+disp = getattr(run, "dispatcher", run)
+hits = sum(disp.stats.cache_hits.values())
 print(json.dumps({{"import_s": t1 - t0, "first_call_s": t3 - t2, "cache_hit": hits > 0,
                   "ok": bool(res.success)}}))
 """
@@ -203,7 +208,7 @@ def main(argv=None):
             print(f"  failed: {cold['error']}")
         else:
             print(f"  friction-drive 185 Hz      import {cold['import_s']:6.2f} s   first run "
-                  f"{cold['first_call_s']:6.2f} s   (compiled: this scene's loop, Lemke, the QP path)")
+                  f"{cold['first_call_s']:6.2f} s   (compiled: the shared Moreau-Jean loop and Lemke)")
         print("first call in a fresh process (import; first 10-step run = cache load or compile)")
         for name, (ctor, h) in SCENES.items():
             fc = first_call(ctor, h)
@@ -233,15 +238,20 @@ def main(argv=None):
             print(f"Siconos {peer['version']} Moreau-Jean, friction drive {label}: "
                   f"{r['steps_per_s']:.3e} steps/s")
     print()
-    print(f"{'scene':26s} {'compiled/s':>11s} {'generic/s':>10s} {'x generic':>9s} "
-          f"{'x Siconos BB':>12s} {'LCP solves':>10s} {'Lemke':>7s} {'warm':>7s}")
+    print(f"{'scene':26s} {'shared/s':>10s} {'specialised/s':>13s} {'generic/s':>10s} "
+          f"{'x generic':>9s} {'x Siconos BB':>12s} {'LCP solves':>10s} {'Lemke':>7s} {'warm':>7s}")
     n_gen = 2000
+    saved = os.environ.get(_loops.SPECIALISE_ENV)
     for name, (ctor, h) in SCENES.items():
         sc = eval(ctor, NAMESPACE)
+        os.environ[_loops.SPECIALISE_ENV] = "0"       # the shared loop, never moving on
+        shared, _ = rate(sc, h, args.steps, R)
+        os.environ[_loops.SPECIALISE_ENV] = "1"       # the scene's own loop
         fast, st = rate(sc, h, args.steps, R)
         slow, _ = rate(sc, h, n_gen, max(1, R // 2), fast=False)
         row = out["scenes"].setdefault(name, {})
-        row.update({"steps_per_s": fast, "generic_steps_per_s": slow,
+        row.update({"steps_per_s": fast, "shared_steps_per_s": shared,
+                    "shared_over_specialised": shared / fast, "generic_steps_per_s": slow,
                     "speedup_vs_generic": fast / slow,
                     "ratio_to_siconos_ball": (fast / sic) if sic else None,
                     "lcp_solves": st["lcp_solves"], "direct_solves": st["direct_solves"]})
@@ -251,8 +261,12 @@ def main(argv=None):
         lemke = st["lcp_solves"] - st["direct_solves"] - warm
         row["warm_starts"] = warm
         ratio = f"{fast / sic:12.1f}" if sic else f"{'n/a':>12s}"
-        print(f"{name:26s} {fast:11.3e} {slow:10.3e} {fast / slow:9.0f} {ratio} "
+        print(f"{name:26s} {shared:10.3e} {fast:13.3e} {slow:10.3e} {fast / slow:9.0f} {ratio} "
               f"{st['lcp_solves']:10d} {lemke:7d} {warm:7d}")
+    if saved is None:
+        os.environ.pop(_loops.SPECIALISE_ENV, None)
+    else:
+        os.environ[_loops.SPECIALISE_ENV] = saved
     user = out["scenes"][USER_SCENE]["steps_per_s"]
     out["goal_user_scene_1e6_met"] = bool(user >= 1e6)
     print(f"\ngoal: a user scene through the compiled hook >= 1e6 steps/s: "
@@ -264,6 +278,11 @@ def main(argv=None):
         out["goal_10x_siconos_met"] = bool(met)
         print(f"\ngoal: every scene >= 10x Siconos's bouncing-ball rate: "
               f"{'met' if met else 'MISSED'} (worst ratio {worst:.1f})")
+        worst_sh = min(r["shared_steps_per_s"] / sic for r in out["scenes"].values()
+                       if "shared_steps_per_s" in r)
+        out["shared_worst_ratio_to_siconos_ball"] = worst_sh
+        print(f"the shared loops (a first use, no compile of the scene's own): worst ratio "
+              f"{worst_sh:.1f}")
 
     print()
     print(f"friction drive vs Siconos's friction drive (h = 2 pi/1000, theta = 1, "

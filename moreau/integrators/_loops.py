@@ -229,8 +229,9 @@ class SharedRunner:
     scheme's. Both loops give the same numbers to the last bit.
     """
 
-    def __init__(self, model, template, scene=None):
+    def __init__(self, model, template, scene=None, tier_up=True):
         self.model, self.template, self.scene = model, template, scene
+        self.tier_up = tier_up
         self._prefix = _model_prefix(model)
         self._core = None
         self._special = None
@@ -257,9 +258,14 @@ class SharedRunner:
         t0 = time.perf_counter()
         out = self._core(*self._prefix, *args)
         self.seconds += time.perf_counter() - t0
-        if self.seconds > TIER_UP_SECONDS:
+        if self.tier_up and self.seconds > TIER_UP_SECONDS:
             self._special = runner_for(self.model, self.template, self.scene, specialise=True)
         return out
+
+    @property
+    def dispatcher(self):
+        """The numba dispatcher that runs now (None before the first call)."""
+        return self._special if self._special is not None else self._core
 
 
 @contextlib.contextmanager
@@ -290,14 +296,20 @@ def _compile_lock(dispatcher):
             fh.close()
 
 
-#: environment variable: "1" compiles every (model, scheme) pair's own loop on first use
+#: environment variable: "1" runs every model in its own specialised loop, "0" always
+#: in the scheme's shared loop; unset (or "auto"), :func:`runner_for` chooses
 SPECIALISE_ENV = "MOREAU_SPECIALISE"
 _CHOSEN = {}
 
 
 def specialise_default():
-    """Whether loops are specialised to each model by default (:data:`SPECIALISE_ENV` set to 1)."""
-    return os.environ.get(SPECIALISE_ENV, "").strip().lower() in ("1", "true", "yes", "on")
+    """The setting of :data:`SPECIALISE_ENV`: True, False, or None (let :func:`runner_for` choose)."""
+    value = os.environ.get(SPECIALISE_ENV, "").strip().lower()
+    if value in ("1", "true", "yes", "on"):
+        return True
+    if value in ("0", "false", "no", "off"):
+        return False
+    return None
 
 
 def runner_for(model, template=None, scene=None, specialise=None):
@@ -316,9 +328,11 @@ def runner_for(model, template=None, scene=None, specialise=None):
       functions and sizes frozen in), which numba inlines and unrolls:
       faster per step (``benchmarks/bench_moreau_jean.py`` measures both),
       at a compile of 5-20 s per (model, scheme) pair. It is used when
-      ``specialise`` is true (default: :func:`specialise_default`), and
-      whenever it is already compiled in this process or fresh in the disk
-      cache.
+      ``specialise`` is True, whenever it is already compiled in this
+      process or fresh in the disk cache (unless ``specialise`` is False),
+      and once a run has spent :data:`TIER_UP_SECONDS` in the shared loop
+      (:class:`SharedRunner`). ``specialise=None`` (default) takes
+      :func:`specialise_default`.
 
     Both give the same numbers to the last bit (tested). Returns a callable
     with the template's arguments. When its first call will compile, one
@@ -331,20 +345,23 @@ def runner_for(model, template=None, scene=None, specialise=None):
     key = (template.__module__, template.__name__,
            tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
            tuple(sorted(_constants(model).items())))
-    chosen = _CHOSEN.get((key, bool(specialise)))
+    chosen = _CHOSEN.get((key, specialise))
     if chosen is not None:
         return chosen
-    with _LOCK:
-        run = _RUNNERS.get(key)
-        if run is None:
-            run = _RUNNERS[key] = _build(model, template)
-    if specialise or _jit_cache.has_cached_code(run):
-        if not _jit_cache.has_cached_code(run):
-            _note_compile(template, scene, shared=False)
-        chosen = run
+    if specialise is False:
+        chosen = SharedRunner(model, template, scene, tier_up=False)
     else:
-        chosen = SharedRunner(model, template, scene)
-    _CHOSEN[(key, bool(specialise))] = chosen
+        with _LOCK:
+            run = _RUNNERS.get(key)
+            if run is None:
+                run = _RUNNERS[key] = _build(model, template)
+        if specialise or _jit_cache.has_cached_code(run):
+            if not _jit_cache.has_cached_code(run):
+                _note_compile(template, scene, shared=False)
+            chosen = run
+        else:
+            chosen = SharedRunner(model, template, scene)
+    _CHOSEN[(key, specialise)] = chosen
     return chosen
 
 

@@ -78,7 +78,17 @@ def test_a_scene_defined_in_a_function_needs_no_loop_compile(monkeypatch):
 
 def test_the_specialise_setting_is_read_from_the_environment(monkeypatch):
     monkeypatch.delenv(_loops.SPECIALISE_ENV, raising=False)
-    assert _loops.specialise_default() is False
-    for value, expected in (("1", True), ("yes", True), ("0", False), ("", False)):
+    assert _loops.specialise_default() is None
+    for value, expected in (("1", True), ("yes", True), ("0", False), ("off", False),
+                            ("", None), ("auto", None)):
         monkeypatch.setenv(_loops.SPECIALISE_ENV, value)
         assert _loops.specialise_default() is expected
+
+
+def test_specialise_false_keeps_the_shared_loop_even_when_the_model_s_own_is_cached(monkeypatch):
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: True)
+    model = make_scene("bouncing-ball").compiled_model()
+    assert not isinstance(_loops.runner_for(model), _loops.SharedRunner)   # cached: its own
+    shared = _loops.runner_for(model, specialise=False)
+    assert isinstance(shared, _loops.SharedRunner) and not shared.tier_up
