@@ -3,12 +3,13 @@
 A scene's Python methods (``mass``, ``forces``, ``gaps``, ...) define its
 model. To run Moreau–Jean at compiled speed, a scene's ``compiled_model()``
 also returns a :class:`CompiledModel`: the same equations as a few
-``numba.njit`` functions and a float vector ``par`` of parameters. The
-engine builds one compiled step loop per model, the first time it is used
-(``moreau.integrators._loops``), and keeps the machine code on disk when the
-functions live in an importable module: the next process loads it in a
-fraction of a second. Functions defined in ``__main__`` or a notebook work
-too; their loop is compiled again in each process.
+``numba.njit`` functions and a float vector ``par`` of parameters. Each
+scheme's compiled step loop takes these functions as arguments, so it is
+compiled once for every model (``moreau.integrators._loops``) and kept in
+numba's disk cache; a long run moves on to a loop compiled for the model
+itself, kept on disk too when the functions live in an importable module.
+Functions defined in ``__main__`` or a notebook work too; their own loop is
+compiled again in each process.
 
 Nothing in the package has to change for a new scene: the shipped scenes
 use this same hook, each in its own module.

@@ -1,21 +1,36 @@
-"""One compiled loop per (model, scheme), built when the pair is first used.
+"""The compiled loops of the schemes: one shared by every model, and one per model for long runs.
 
-:func:`runner_for` compiles a scheme's loop template (Moreau–Jean's
-:func:`moreau.integrators._mj_kernels.mj_loop` by default) for one
-:class:`moreau.compiled.CompiledModel`: in a namespace that holds the
-model's functions, sizes and flags as globals, which numba freezes as
-constants. A process compiles only the models it runs, and each model once.
+A scheme's loop is a template (Moreau–Jean's
+:func:`moreau.integrators._mj_kernels.mj_loop` by default) written against a
+model's functions and sizes as globals (``mass_fn``, ``NDOF``, ...). It is
+compiled in two forms from the same source:
+
+- **shared** (:func:`shared_core`): the template rewritten to take the model
+  as its leading arguments, with the model's functions as numba first-class
+  functions (:data:`MODEL_SIGNATURES`). One compile per scheme serves every
+  :class:`moreau.compiled.CompiledModel`, a user's included, and numba's disk
+  cache keeps it: a new scene costs no compile of the loop.
+- **specialised** (:func:`runner_for` with ``specialise=True``): the template
+  compiled in a namespace that holds one model's functions, sizes and flags
+  as globals, which numba freezes as constants, inlines and unrolls; faster
+  per step, at a compile of 5-20 s per (model, scheme) pair.
+
+:func:`runner_for` picks one (the specialised loop when asked, or when it
+costs nothing because it is compiled already; the shared loop otherwise), and
+a :class:`SharedRunner` moves a long run on to the specialised loop. Both
+give the same numbers to the last bit.
 
 Where the model's functions can be imported by name (every shipped scene,
-and a user's scene kept in their own module), the compiled loop goes to
+and a user's scene kept in their own module), the specialised loop goes to
 numba's disk cache under a name derived from those import paths, and later
-processes load it in a fraction of a second. The cache entry is tied to the
-contents of every source file the loop depends on (:mod:`moreau._jit_cache`):
-the loop, Lemke, the model's module and the modules of the compiled
-functions it calls. An edit to any of them compiles the loop again instead
+processes load it in a fraction of a second. Every cache entry is tied to
+the contents of every source file its machine code depends on
+(:mod:`moreau._jit_cache`): the loop, Lemke, and for the specialised loop
+and the model's own functions, the model's module and the modules of the
+compiled functions it calls. An edit to any of them compiles again instead
 of running stale machine code. Functions defined in ``__main__`` or a
-notebook give a loop compiled in memory, again in each process: their names
-do not identify them across processes.
+notebook give a specialised loop compiled in memory, again in each process:
+their names do not identify them across processes.
 """
 
 import ast
@@ -55,8 +70,11 @@ log = logging.getLogger(__name__)
 SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
                       "nsga_loop": "nonsmooth generalized-alpha",
                       "studer_loop": "Studer extrapolation"}
-#: seconds of a shared loop after which a model's own loop is compiled (about its cost)
-TIER_UP_SECONDS = 10.0
+#: seconds in a shared loop after which a model's own loop is compiled: with a compile
+#: of C ~ 10 s and the specialised loop taking r ~ 1/2 of the shared one's time, the
+#: compile pays for itself after C / (1 - r) more seconds of work; moving there bounds
+#: a run's cost by about twice that of the best choice made in advance
+TIER_UP_SECONDS = 20.0
 #: what a first compile takes (README: 16-19 s for the first scene with Lemke and
 #: the QP path, 5-10 s for each later one)
 COMPILE_SECONDS = "5-20"
@@ -222,11 +240,11 @@ class SharedRunner:
     """A model bound to its scheme's shared loop: called with the template's own arguments.
 
     It keeps the time spent in the shared loop. Once that passes
-    :data:`TIER_UP_SECONDS` (about what a specialised compile costs), it
-    compiles the model's specialised loop and runs that from then on: a
-    long run pays at most about twice what it would have with the best
-    choice made in advance, and a short one pays no compile beyond the
-    scheme's. Both loops give the same numbers to the last bit.
+    :data:`TIER_UP_SECONDS`, it compiles the model's specialised loop and
+    runs that from then on: a long run pays at most about twice what it
+    would have with the best choice made in advance, and a short one pays
+    no compile beyond the scheme's. Both loops give the same numbers to the
+    last bit.
     """
 
     def __init__(self, model, template, scene=None, tier_up=True):
@@ -259,7 +277,12 @@ class SharedRunner:
         out = self._core(*self._prefix, *args)
         self.seconds += time.perf_counter() - t0
         if self.tier_up and self.seconds > TIER_UP_SECONDS:
-            self._special = runner_for(self.model, self.template, self.scene, specialise=True)
+            special = runner_for(self.model, self.template, self.scene, specialise=True)
+            if not special.signatures:
+                # a sweep's workers reach this together: one compiles, the others load
+                with _compile_lock(special):
+                    special.compile(tuple(numba.typeof(a) for a in args))
+            self._special = special
         return out
 
     @property

@@ -24,8 +24,9 @@ def _run(scene, t_end, h):
     return simulate(scene, (0.0, t_end), q0, v0, "moreau-jean", h=h, fast=True)
 
 
-@pytest.mark.parametrize("name, t_end, h", [("friction-drive", 40.0, 2e-3),
-                                            ("bidirectional-drive", 40.0, 2e-3)])
+# the two-rod drive: two frictional contacts, Lemke's pivoting, the warm start and the
+# closed-form single-contact solve all run (a second scene would cost 14 CPU s of CI)
+@pytest.mark.parametrize("name, t_end, h", [("bidirectional-drive", 40.0, 2e-3)])
 def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatch, name, t_end, h):
     # small blocks so that the switch falls inside the run, after the first block
     monkeypatch.setattr(_blocks, "FAST_BLOCK", 2000)
@@ -39,7 +40,8 @@ def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatc
     monkeypatch.setattr(_loops, "TIER_UP_SECONDS", 0.0)
     tiered = _run(make_scene(name), t_end, h)
     runner = _loops.runner_for(make_scene(name).compiled_model())
-    assert runner._special is not None and runner._special.signatures   # it did move
+    assert runner._special is not None
+    assert len(runner._special.signatures) == 1        # it did move, compiled once
     assert shared.success and tiered.success
     assert shared.stats["steps"] == tiered.stats["steps"] > 3 * 2000
     for field in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
