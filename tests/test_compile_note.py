@@ -10,6 +10,7 @@ shared Moreau–Jean loop (compiled once by any other test).
 """
 
 import importlib.util
+import inspect
 import io
 import logging
 
@@ -18,6 +19,7 @@ import pytest
 from moreau import _jit_cache, _log
 from moreau.cli import main
 from moreau.integrators import _loops
+from moreau.integrators._mj_kernels import mj_loop, new_lcp_control
 from moreau.scenes import BouncingBall, FrictionDrive
 
 NOTE = "compiling the Moreau–Jean loop specialised to scene friction-drive (about 5-20 s)..."
@@ -82,15 +84,19 @@ def test_the_shared_loop_is_announced_at_its_first_call_once(fresh_loops, monkey
     fake = _FakeCore()
     monkeypatch.setattr(_loops, "shared_core", lambda template, argtypes: fake)
     scene = FrictionDrive(frequency=185.0)
+    # stand-ins for the loop's arguments: only the contact problem's options are read
+    names = list(inspect.signature(mj_loop).parameters)
+    args = [0.0] * len(names)
+    args[names.index("lcp_ctl")] = new_lcp_control(1)
     with caplog.at_level(logging.INFO, logger="moreau"):
         run = _loops.runner_for(scene.compiled_model(), scene=scene)
         assert isinstance(run, _loops.SharedRunner)
         assert caplog.records == []                     # nothing before the first call
-        run(1.0, 2)
-        run(1.0, 2)
+        run(*args)
+        run(*args)
         # another scene uses the same shared loop: no second note, no second compile
         other = BouncingBall()
-        _loops.runner_for(other.compiled_model(), scene=other)(1.0, 2)
+        _loops.runner_for(other.compiled_model(), scene=other)(*args)
     assert [r.getMessage() for r in caplog.records] == [SHARED_NOTE]
     assert len(fake.compiled) == 1 and fake.calls == 3
 

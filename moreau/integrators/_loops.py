@@ -179,6 +179,11 @@ _PREFIX_TYPES = tuple(nbtypes.FunctionType(MODEL_SIGNATURES[k])
 _CORES = {}
 
 
+def _indirect(template):
+    """The template module's kernels passed to its shared loop as arguments (name -> spec)."""
+    return getattr(sys.modules[template.__module__], "SHARED_INDIRECT", {})
+
+
 def _shared_function(template):
     """``template`` rewritten to take the model as its leading arguments (:data:`SHARED_PARAMETERS`).
 
@@ -191,7 +196,8 @@ def _shared_function(template):
     fdef = tree.body[0]
     fdef.decorator_list = []
     fdef.name = template.__name__ + "_shared"
-    fdef.args.args = [ast.arg(arg=name) for name in SHARED_PARAMETERS] + fdef.args.args
+    names = SHARED_PARAMETERS + tuple(_indirect(template))
+    fdef.args.args = [ast.arg(arg=name) for name in names] + fdef.args.args
     ast.fix_missing_locations(tree)
     ast.increment_lineno(tree, template.__code__.co_firstlineno - 1)
     code = compile(tree, template.__code__.co_filename, "exec")
@@ -207,10 +213,14 @@ def _shared_function(template):
 def shared_core(template, argtypes):
     """The loop of ``template`` compiled once for every model, for the loop arguments ``argtypes``.
 
-    Its first arguments are :data:`SHARED_PARAMETERS`; the model's functions
+    Its first arguments are :data:`SHARED_PARAMETERS`, then the kernels the
+    template's module lists in ``SHARED_INDIRECT``; the model's functions
     are passed as numba first-class functions (:data:`MODEL_SIGNATURES`), so
     no model is compiled into it and numba's disk cache serves every scene,
-    a user's included. Returns a dispatcher with exactly one signature.
+    a user's included. A kernel passed as an argument is compiled on its
+    own, only when a run can call it (a single-contact scene never compiles
+    Lemke), and is not optimised again inside the loop. Returns a
+    dispatcher, compiled by :class:`SharedRunner` for one signature.
     """
     key = (template.__module__, template.__name__, tuple(argtypes))
     with _LOCK:
@@ -250,7 +260,15 @@ class SharedRunner:
     def __init__(self, model, template, scene=None, tier_up=True):
         self.model, self.template, self.scene = model, template, scene
         self.tier_up = tier_up
-        self._prefix = _model_prefix(model)
+        base = _model_prefix(model)
+        module = sys.modules[template.__module__]
+        indirect = _indirect(template)
+        self._kernel_types = tuple(nbtypes.FunctionType(spec[0]) for spec in indirect.values())
+        # the kernels as the loop calls them, and their stand-ins for runs that cannot
+        self._prefix = base + tuple(getattr(module, name) for name in indirect)
+        self._stub_prefix = base + tuple(getattr(module, spec[1]) for spec in indirect.values())
+        params = list(inspect.signature(template).parameters)
+        self._deciders = tuple((spec[2], params.index(spec[3])) for spec in indirect.values())
         self._core = None
         self._special = None
         self.seconds = 0.0
@@ -262,19 +280,26 @@ class SharedRunner:
             with _compile_lock(core):
                 if not _jit_cache.has_cached_code(core):
                     _note_compile(self.template, self.scene, shared=True)
-                core.compile(_PREFIX_TYPES + argtypes)
+                core.compile(_PREFIX_TYPES + self._kernel_types + argtypes)
             # one signature: a call with other argument types is an error, not a silent
             # compile of a loop specialised on the model's functions
             core.disable_compile()
         self._core = core
+
+    def _prefix_for(self, args):
+        nc = self.model.ncontacts
+        if self._deciders and not any(needed(nc, args[i]) for needed, i in self._deciders):
+            return self._stub_prefix
+        return self._prefix
 
     def __call__(self, *args):
         if self._special is not None:
             return self._special(*args)
         if self._core is None:
             self._bind(args)
+        prefix = self._prefix_for(args)
         t0 = time.perf_counter()
-        out = self._core(*self._prefix, *args)
+        out = self._core(*prefix, *args)
         self.seconds += time.perf_counter() - t0
         if self.tier_up and self.seconds > TIER_UP_SECONDS:
             special = runner_for(self.model, self.template, self.scene, specialise=True)

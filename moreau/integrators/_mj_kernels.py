@@ -48,6 +48,7 @@ import math
 
 import numpy as np
 from numba import njit
+from numba.core import types as _nbt
 
 from .. import _jit_cache
 from ..lcp import _certified
@@ -692,6 +693,43 @@ def _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, 
                     else:
                         ctl[off + br + 1] = 0
     return status, pivots, res, used
+
+
+_A1 = _nbt.float64[::1]
+_A2 = _nbt.float64[:, ::1]
+_I1 = _nbt.int64[::1]
+_INT = _nbt.int64
+#: the numba signature of :func:`_lcp_step`, for the shared loop, which calls it
+#: through a pointer (:data:`SHARED_INDIRECT`)
+LCP_STEP_SIGNATURE = _nbt.Tuple((_INT, _INT, _nbt.float64, _nbt.boolean))(
+    _A2, _A1, _INT, _I1, _A1, _A1, _A1, _A1, _INT, _I1, _I1, _A2, _A1, _A1, _A1, _A1, _A1, _A2,
+    _I1, _I1, _I1, _A2, _A1, _I1, _I1, _nbt.boolean)
+
+
+@njit(cache=True)
+def _lcp_step_unused(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
+                     work, iwork, lay, ctl, Ab, xb, idx, pcol, use_memory):
+    # stands in for _lcp_step where no contact LCP can arise (one contact, Lemke not
+    # forced): a run of a single-contact scene then compiles neither Lemke nor the
+    # LCP's assembly (about 11 of a first call's 28 s). Were it reached, its status
+    # hands the step to the generic step, which solves it: slower, never wrong
+    return np.int64(1), np.int64(0), np.inf, False
+
+
+def lcp_needed(ncontacts, lcp_ctl):
+    """Whether a Moreau–Jean run of ``ncontacts`` contacts with ``lcp_ctl`` can reach the LCP solve.
+
+    With one contact the step is solved in closed form unless Lemke is
+    forced (``mj_loop``: ``na == 1 and not force_lemke``).
+    """
+    return ncontacts >= 2 or bool(lcp_ctl[CTL_FORCE])
+
+
+#: kernels the shared Moreau–Jean loop takes as arguments instead of linking them in
+#: (:func:`moreau.integrators._loops.shared_core`): name -> (signature, stand-in where
+#: :func:`lcp_needed` says it cannot be called, the name of the loop's argument
+#: that decides)
+SHARED_INDIRECT = {"_lcp_step": (LCP_STEP_SIGNATURE, "_lcp_step_unused", lcp_needed, "lcp_ctl")}
 
 
 def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, save_every,

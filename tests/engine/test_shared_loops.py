@@ -31,6 +31,8 @@ def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatc
     # small blocks so that the switch falls inside the run, after the first block
     monkeypatch.setattr(_blocks, "FAST_BLOCK", 2000)
     monkeypatch.setattr(_loops, "_CHOSEN", {})
+    # start in the shared loop even where an earlier run left the specialised one on disk
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
     monkeypatch.setattr(_loops, "TIER_UP_SECONDS", float("inf"))
     shared = _run(make_scene(name), t_end, h)
     runner = _loops.runner_for(make_scene(name).compiled_model())
@@ -94,3 +96,30 @@ def test_specialise_false_keeps_the_shared_loop_even_when_the_model_s_own_is_cac
     assert not isinstance(_loops.runner_for(model), _loops.SharedRunner)   # cached: its own
     shared = _loops.runner_for(model, specialise=False)
     assert isinstance(shared, _loops.SharedRunner) and not shared.tier_up
+
+
+def test_a_single_contact_run_passes_a_stand_in_for_lemke_unless_lemke_is_forced(monkeypatch):
+    from moreau.integrators import _mj_kernels as mk
+
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setenv(_loops.SPECIALISE_ENV, "0")
+    one = _loops.runner_for(make_scene("friction-drive").compiled_model())
+    two = _loops.runner_for(make_scene("bidirectional-drive").compiled_model())
+    names = list(__import__("inspect").signature(mk.mj_loop).parameters)
+    args = [0.0] * len(names)
+    slot = names.index("lcp_ctl")
+    for runner, nc, force, expected in ((one, 1, False, mk._lcp_step_unused),
+                                        (one, 1, True, mk._lcp_step),
+                                        (two, 2, False, mk._lcp_step)):
+        args[slot] = mk.new_lcp_control(nc, force_lemke=force)
+        assert runner._prefix_for(args)[-1] is expected
+    # forced Lemke on one contact runs the real pivoting, and agrees with the closed form
+    sc = make_scene("friction-drive")
+    q0, v0 = sc.initial_state()
+    closed = simulate(sc, (0.0, 6.3), q0, v0, "moreau-jean", h=6.3e-3, fast=True)
+    lemke = simulate(sc, (0.0, 6.3), q0, v0, "moreau-jean", h=6.3e-3, fast=True,
+                     lcp_method="lemke")
+    assert closed.stats["direct_solves"] > 0 and lemke.stats["direct_solves"] == 0
+    assert lemke.stats["pivots"] > 0 and lemke.stats["fallbacks"] == 0
+    np.testing.assert_allclose(lemke.q, closed.q, rtol=0, atol=1e-10)
+    np.testing.assert_array_equal(lemke.regime, closed.regime)
