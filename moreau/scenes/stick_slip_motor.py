@@ -27,6 +27,7 @@ force ``-mu n`` on the slider. In slip the slider acceleration is
 possible while ``|s'' + fL| <= mu n``.
 """
 
+import bisect
 import math
 from dataclasses import dataclass
 
@@ -237,9 +238,12 @@ class SawtoothDrive(_Drive):
             keep[0] = False
             starts, acc, vel, pos = starts[keep], acc[keep], vel[keep], pos[keep]
         self._starts, self._acc, self._vel, self._pos = starts, acc, vel, pos
+        self._lists = None
         self.breakpoints = tuple(float(x) for x in starts)
 
     def _eval(self, t):
+        if isinstance(t, (float, int, np.floating, np.integer)):
+            return self._eval_scalar(float(t))
         tm = np.mod(t, TWO_PI)
         k = np.searchsorted(self._starts, tm, side="right") - 1
         k = np.where(k < 0, len(self._starts) - 1, k)
@@ -248,6 +252,22 @@ class SawtoothDrive(_Drive):
         v = self._vel[k] + a * dt
         s = self._pos[k] + self._vel[k] * dt + 0.5 * a * dt * dt
         return s, v, a
+
+    def _eval_scalar(self, t):
+        # the event-driven schemes ask for one time at a time (twice per right-hand
+        # side): plain floats here take 2 us against 37 us through the array path
+        if self._lists is None:
+            self._lists = tuple([float(x) for x in a]
+                                for a in (self._starts, self._acc, self._vel, self._pos))
+        starts, acc, vel, pos = self._lists
+        tm = t % TWO_PI
+        k = bisect.bisect_right(starts, tm) - 1
+        if k < 0:
+            k = len(starts) - 1
+        dt = tm - starts[k] if tm >= starts[k] else tm + TWO_PI - starts[k]
+        a = acc[k]
+        return (np.float64(pos[k] + vel[k] * dt + 0.5 * a * dt * dt), np.float64(vel[k] + a * dt),
+                np.float64(a))
 
     def _crossings(self, level):
         # s'' is piecewise constant: it can change sides only at breakpoints

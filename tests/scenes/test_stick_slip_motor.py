@@ -111,6 +111,19 @@ def test_drive_derivatives_periodicity_and_range(drive):
         assert max(abs(a) for a in drive.acceleration_range()) == pytest.approx(drive.A)
 
 
+@pytest.mark.parametrize("drive", [SawtoothDrive(0.9, 0.5), SawtoothDrive(0.3, 1.0),
+                                   SawtoothDrive(0.75, 0.2), SawtoothDrive()])
+def test_a_sawtooth_at_one_time_equals_its_array_evaluation_to_the_bit(drive):
+    # the scalar path (used by the event-driven schemes, one time per call) and the
+    # array path compute the same expression: same segment, same numbers
+    tau = np.concatenate([np.linspace(-20.0, 20.0, 4001), drive._starts,
+                          drive._starts + TWO_PI, np.nextafter(drive._starts, -1.0), [0.0, TWO_PI]])
+    arrays = np.array(drive(tau))
+    ones = np.array([drive(float(t)) for t in tau]).T
+    np.testing.assert_array_equal(ones, arrays)
+    assert all(type(x) is np.float64 for x in drive(1.0))
+
+
 def test_sine_acceleration_crossings_are_all_found():
     drive = SineDrive(0.3, 0.7)
     tau = np.linspace(0.0, TWO_PI, 200001)
