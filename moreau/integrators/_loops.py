@@ -132,7 +132,7 @@ def _constants(model):
             "HAS_JAC": model.has_jacobians, "HAS_GAPS": model.gaps is not None}
 
 
-def _build(model, template):
+def _build(model, template, stub=False):
     consts = _constants(model)
     fns = model.functions()
     paths = {k: _import_path(f) for k, f in fns.items()}
@@ -141,9 +141,13 @@ def _build(model, template):
     namespace = dict(vars(module))
     namespace.update(consts, mass_fn=model.mass, forces_fn=model.forces,
                      contacts_fn=model.contacts, gaps_fn=model.gaps or no_gaps)
+    if stub:
+        # the variant for runs that cannot reach these kernels (see SHARED_INDIRECT)
+        namespace.update({name: getattr(module, spec[1])
+                          for name, spec in _indirect(template).items()})
     # numba names a function's disk-cache files after its qualified name: one
     # per model, from the import paths of its functions and its constants
-    tag = repr(sorted(paths.items())) + repr(sorted(consts.items()))
+    tag = repr(sorted(paths.items())) + repr(sorted(consts.items())) + ("stub" if stub else "")
     name = template.__name__ + "_" + hashlib.sha256(tag.encode()).hexdigest()[:16]
     fn = types.FunctionType(template.__code__, namespace, name, template.__defaults__)
     fn.__qualname__ = name
@@ -270,8 +274,8 @@ class SharedRunner:
         params = list(inspect.signature(template).parameters)
         self._deciders = tuple((spec[2], params.index(spec[3])) for spec in indirect.values())
         self._core = None
-        self._special = None
-        self.seconds = 0.0
+        self._specials = {}     # variant (stand-ins or not) -> the model's own loop
+        self.seconds = {False: 0.0, True: 0.0}   # in the shared loop, per variant
 
     def _bind(self, args):
         argtypes = tuple(numba.typeof(a) for a in args)
@@ -293,22 +297,34 @@ class SharedRunner:
         return self._prefix
 
     def __call__(self, *args):
-        if self._special is not None:
-            return self._special(*args)
+        prefix = self._prefix_for(args) if self._core is not None else None
+        stub = prefix is self._stub_prefix
+        special = self._specials.get(stub)
+        if special is not None:
+            return special(*args)
         if self._core is None:
             self._bind(args)
-        prefix = self._prefix_for(args)
+            prefix = self._prefix_for(args)
+            stub = prefix is self._stub_prefix
         t0 = time.perf_counter()
         out = self._core(*prefix, *args)
-        self.seconds += time.perf_counter() - t0
-        if self.tier_up and self.seconds > TIER_UP_SECONDS:
-            special = runner_for(self.model, self.template, self.scene, specialise=True)
+        self.seconds[stub] += time.perf_counter() - t0
+        if self.tier_up and self.seconds[stub] > TIER_UP_SECONDS:
+            # the model's own loop, with the same stand-ins as this call (a single-contact
+            # run's compiles no Lemke either); a run that needs them gets the other variant
+            special = runner_for(self.model, self.template, self.scene, specialise=True,
+                                 stub=stub)
             if not special.signatures:
                 # a sweep's workers reach this together: one compiles, the others load
                 with _compile_lock(special):
                     special.compile(tuple(numba.typeof(a) for a in args))
-            self._special = special
+            self._specials[stub] = special
         return out
+
+    @property
+    def _special(self):
+        # the model's own loop that runs now, if any (the full variant first)
+        return self._specials.get(False) or self._specials.get(True)
 
     @property
     def dispatcher(self):
@@ -360,7 +376,7 @@ def specialise_default():
     return None
 
 
-def runner_for(model, template=None, scene=None, specialise=None):
+def runner_for(model, template=None, scene=None, specialise=None, stub=False):
     """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`).
 
     ``template`` is the loop of a scheme, written against the model's
@@ -392,7 +408,7 @@ def runner_for(model, template=None, scene=None, specialise=None):
         specialise = specialise_default()
     key = (template.__module__, template.__name__,
            tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
-           tuple(sorted(_constants(model).items())))
+           tuple(sorted(_constants(model).items())), bool(stub))
     chosen = _CHOSEN.get((key, specialise))
     if chosen is not None:
         return chosen
@@ -402,7 +418,7 @@ def runner_for(model, template=None, scene=None, specialise=None):
         with _LOCK:
             run = _RUNNERS.get(key)
             if run is None:
-                run = _RUNNERS[key] = _build(model, template)
+                run = _RUNNERS[key] = _build(model, template, stub)
         if specialise or _jit_cache.has_cached_code(run):
             if not _jit_cache.has_cached_code(run):
                 _note_compile(template, scene, shared=False)

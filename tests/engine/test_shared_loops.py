@@ -25,9 +25,12 @@ def _run(scene, t_end, h):
 
 
 # the two-rod drive: two frictional contacts, Lemke's pivoting, the warm start and the
-# closed-form single-contact solve all run (a second scene would cost 14 CPU s of CI)
-@pytest.mark.parametrize("name, t_end, h", [("bidirectional-drive", 40.0, 2e-3)])
-def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatch, name, t_end, h):
+# closed-form single-contact solve all run; the friction drive: one contact, whose own
+# loop is the variant with the stand-in for the LCP step (no Lemke compiled)
+@pytest.mark.parametrize("name, t_end, h, stub", [("bidirectional-drive", 40.0, 2e-3, False),
+                                                  ("friction-drive", 40.0, 2e-3, True)])
+def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatch, name, t_end, h,
+                                                                      stub):
     # small blocks so that the switch falls inside the run, after the first block
     monkeypatch.setattr(_blocks, "FAST_BLOCK", 2000)
     monkeypatch.setattr(_loops, "_CHOSEN", {})
@@ -42,8 +45,8 @@ def test_a_run_that_moves_to_the_specialised_loop_gives_the_same_bits(monkeypatc
     monkeypatch.setattr(_loops, "TIER_UP_SECONDS", 0.0)
     tiered = _run(make_scene(name), t_end, h)
     runner = _loops.runner_for(make_scene(name).compiled_model())
-    assert runner._special is not None
-    assert len(runner._special.signatures) == 1        # it did move, compiled once
+    assert list(runner._specials) == [stub]             # it did move, to the right variant
+    assert len(runner._special.signatures) == 1        # compiled once
     assert shared.success and tiered.success
     assert shared.stats["steps"] == tiered.stats["steps"] > 3 * 2000
     for field in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
