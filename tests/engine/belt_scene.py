@@ -87,3 +87,22 @@ class CompiledBeltBlock(BeltBlock):
         return CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift,
                              par=[self.k, self.vb], ndof=2, ncontacts=1, const_mass=True,
                              has_jacobians=True)
+
+
+def local_belt_block():
+    """``(scene class, its mass function)`` defined inside this call, as a notebook's would be.
+
+    The mass function cannot be imported again by name (a new one each
+    call), which is what the tests of notebook-defined models need.
+    """
+    @njit
+    def mass(par, q, M):
+        M[0, 0] = 1.0
+        M[1, 1] = 1.0
+
+    class Local(CompiledBeltBlock):
+        def compiled_model(self):
+            m = super().compiled_model()
+            return CompiledModel(mass, m.forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+
+    return Local, mass

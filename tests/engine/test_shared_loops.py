@@ -10,13 +10,11 @@ switches never shows in its answer.
 
 import numpy as np
 import pytest
-from numba import njit
 
-from moreau.compiled import CompiledModel
 from moreau.integrators import _blocks, _loops, simulate
 from moreau.scenes.registry import make_scene
 
-from belt_scene import CompiledBeltBlock
+from belt_scene import local_belt_block
 
 
 def _run(scene, t_end, h):
@@ -60,15 +58,7 @@ def test_a_scene_defined_in_a_function_needs_no_loop_compile(monkeypatch):
     # scheme's shared one, already compiled for the other scenes
     monkeypatch.setattr(_loops, "_CHOSEN", {})
 
-    @njit
-    def mass(par, q, M):
-        M[0, 0] = 1.0
-        M[1, 1] = 1.0
-
-    class Local(CompiledBeltBlock):
-        def compiled_model(self):
-            m = super().compiled_model()
-            return CompiledModel(mass, m.forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+    Local, mass = local_belt_block()
 
     a = _run(Local(), 3.0, 0.01)
     runner = _loops.runner_for(Local().compiled_model())

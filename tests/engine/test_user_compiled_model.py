@@ -17,7 +17,8 @@ from moreau.errors import InputError
 from moreau.integrators import _loops, _sp_kernels, simulate
 from moreau.integrators.moreau_jean import MoreauJean
 
-from belt_scene import BeltBlock, CompiledBeltBlock, belt_contacts, belt_drift, belt_forces, belt_mass
+from belt_scene import (BeltBlock, CompiledBeltBlock, belt_contacts, belt_drift, belt_forces,
+                        belt_mass, local_belt_block)
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 
@@ -67,15 +68,7 @@ def test_functions_defined_in_a_function_run_compiled_in_memory(monkeypatch):
     # compiled for this process only, and still runs the model's equations. Compiled in
     # every run of the suite: Schatzman-Paoli's loop, the quickest to compile (15 s
     # against Moreau-Jean's 27 s), held to its generic step
-    @njit
-    def mass(par, q, M):
-        M[0, 0] = 1.0
-        M[1, 1] = 1.0
-
-    class Local(CompiledBeltBlock):
-        def compiled_model(self):
-            m = super().compiled_model()
-            return CompiledModel(mass, m.forces, m.contacts, m.drift, m.par, 2, 1, True, True)
+    Local, mass = local_belt_block()
 
     model = Local().compiled_model()
     assert _loops._import_path(mass) is None
