@@ -275,6 +275,7 @@ class SharedRunner:
         self._deciders = tuple((spec[2], params.index(spec[3])) for spec in indirect.values())
         self._core = None
         self._specials = {}     # variant (stand-ins or not) -> the model's own loop
+        self._kernels_ready = not self._deciders
         self.seconds = {False: 0.0, True: 0.0}   # in the shared loop, per variant
 
     def _bind(self, args):
@@ -306,6 +307,8 @@ class SharedRunner:
             self._bind(args)
             prefix = self._prefix_for(args)
             stub = prefix is self._stub_prefix
+        if not stub and not self._kernels_ready:
+            self._compile_kernels()
         t0 = time.perf_counter()
         out = self._core(*prefix, *args)
         self.seconds[stub] += time.perf_counter() - t0
@@ -320,6 +323,17 @@ class SharedRunner:
                     special.compile(tuple(numba.typeof(a) for a in args))
             self._specials[stub] = special
         return out
+
+    def _compile_kernels(self):
+        # the kernels passed as arguments compile on their own, at their first use; under
+        # the lock, so that a sweep's (or pytest's) workers compile Lemke once, not each
+        module = sys.modules[self.template.__module__]
+        for name, spec in _indirect(self.template).items():
+            fn = getattr(module, name)
+            if spec[0].args not in fn.overloads:
+                with _compile_lock(fn):
+                    fn.compile(spec[0])
+        self._kernels_ready = True
 
     @property
     def _special(self):
