@@ -16,8 +16,9 @@ import numpy as np
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _one_contact, _residual, lcp_buffers,
-                          record_sample)
+                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual,
+                          lcp_buffers, record_sample)
+from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["sp_loop"]
 
