@@ -20,7 +20,7 @@ from moreau import _jit_cache, _log
 from moreau.cli import main
 from moreau.integrators import _loops
 from moreau.integrators._mj_kernels import mj_loop, new_lcp_control
-from moreau.scenes import BouncingBall, FrictionDrive
+from moreau.scenes import BidirectionalDrive, BouncingBall, FrictionDrive
 
 NOTE = "compiling the Moreau–Jean loop specialised to scene friction-drive (about 5-20 s)..."
 SHARED_NOTE = ("compiling the Moreau–Jean loop (first use on this machine, once for every scene, "
@@ -159,3 +159,25 @@ def test_has_cached_code_sees_numba_disk_cache(tmp_path):
     second = _load(src, "toy_kernel")                # a new dispatcher, as in a new process
     assert not second.f.signatures
     assert _jit_cache.has_cached_code(second.f)
+
+
+def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monkeypatch, caplog):
+    # passed to the shared loop as an argument, the LCP step compiles on its own: one note
+    from moreau.integrators import _mj_kernels as mk
+    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    compiled = []
+    monkeypatch.setattr(mk._lcp_step, "compile", lambda sig: compiled.append(sig))
+    monkeypatch.setattr(mk._lcp_step, "overloads", {})     # as in a fresh process
+    monkeypatch.setattr(_loops, "shared_core", lambda template, argtypes: _FakeCore())
+    scene = BidirectionalDrive()
+    names = list(inspect.signature(mj_loop).parameters)
+    args = [0.0] * len(names)
+    args[names.index("lcp_ctl")] = new_lcp_control(2)
+    with caplog.at_level(logging.INFO, logger="moreau"):
+        run = _loops.runner_for(scene.compiled_model(), scene=scene)
+        run(*args)
+        run(*args)
+    assert [r.getMessage() for r in caplog.records] == [
+        SHARED_NOTE, "compiling the contact problem's LCP step (Lemke; first use on this "
+        "machine, about 5-20 s)..."]
+    assert compiled == [mk.LCP_STEP_SIGNATURE]

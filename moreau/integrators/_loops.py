@@ -332,6 +332,9 @@ class SharedRunner:
             fn = getattr(module, name)
             if spec[0].args not in fn.overloads:
                 with _compile_lock(fn):
+                    if not _jit_cache.has_cached_code(fn):
+                        note(log, "compiling the contact problem's LCP step (Lemke; first "
+                             "use on this machine, about %s s)...", COMPILE_SECONDS)
                     fn.compile(spec[0])
         self._kernels_ready = True
 
