@@ -37,6 +37,7 @@ def fresh_loops(monkeypatch):
     # a process that has built no loop yet (the built loops are not compiled here)
     for name in ("_RUNNERS", "_CHOSEN", "_CORES"):
         monkeypatch.setattr(_loops, name, {})
+    monkeypatch.setattr(_loops, "_ANNOUNCED", set())
 
 
 class _FakeCore:

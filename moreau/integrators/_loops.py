@@ -251,19 +251,31 @@ def _model_prefix(model):
 
 
 class SharedRunner:
-    """A model bound to its scheme's shared loop: called with the template's own arguments.
+    """A model bound to its scheme's compiled loops: called with the template's own arguments.
 
-    It keeps the time spent in the shared loop. Once that passes
-    :data:`TIER_UP_SECONDS`, it compiles the model's specialised loop and
-    runs that from then on: a long run pays at most about twice what it
-    would have with the best choice made in advance, and a short one pays
-    no compile beyond the scheme's. Both loops give the same numbers to the
-    last bit.
+    ``mode`` is ``"auto"``, ``"shared"`` or ``"specialised"``. Each call
+    first picks its variant: with the stand-ins of the template's
+    ``SHARED_INDIRECT`` kernels where the call cannot reach them (one
+    contact, Lemke not forced), with the kernels otherwise. Then:
+
+    - ``"specialised"``: the model's own loop of that variant, compiled at
+      its first call;
+    - ``"shared"``: the scheme's shared loop, always;
+    - ``"auto"``: the model's own loop where it costs nothing (compiled in
+      this process or fresh in numba's disk cache), else the shared loop,
+      keeping the time spent there. Once that passes
+      :data:`TIER_UP_SECONDS`, it compiles the model's own loop and runs
+      that from then on: a long run pays at most about twice what it would
+      have with the best choice made in advance, and a short one pays no
+      compile beyond the scheme's.
+
+    All of them give the same numbers to the last bit.
     """
 
-    def __init__(self, model, template, scene=None, tier_up=True):
-        self.model, self.template, self.scene = model, template, scene
-        self.tier_up = tier_up
+    def __init__(self, model, template, scene=None, mode="auto"):
+        if mode not in ("auto", "shared", "specialised"):
+            raise ValueError(f"`mode` must be 'auto', 'shared' or 'specialised', got {mode!r}")
+        self.model, self.template, self.scene, self.mode = model, template, scene, mode
         base = _model_prefix(model)
         module = sys.modules[template.__module__]
         indirect = _indirect(template)
@@ -275,8 +287,14 @@ class SharedRunner:
         self._deciders = tuple((spec[2], params.index(spec[3])) for spec in indirect.values())
         self._core = None
         self._specials = {}     # variant (stand-ins or not) -> the model's own loop
+        self._looked = set()    # variants whose own loop has been considered
         self._kernels_ready = not self._deciders
         self.seconds = {False: 0.0, True: 0.0}   # in the shared loop, per variant
+
+    @property
+    def tier_up(self):
+        """Whether a long run moves on to the model's own loop (``mode="auto"``)."""
+        return self.mode == "auto"
 
     def _bind(self, args):
         argtypes = tuple(numba.typeof(a) for a in args)
@@ -291,37 +309,52 @@ class SharedRunner:
             core.disable_compile()
         self._core = core
 
-    def _prefix_for(self, args):
+    def _stub(self, args):
+        """Whether this call cannot reach the kernels passed as arguments."""
         nc = self.model.ncontacts
-        if self._deciders and not any(needed(nc, args[i]) for needed, i in self._deciders):
-            return self._stub_prefix
-        return self._prefix
+        return bool(self._deciders) and not any(needed(nc, args[i])
+                                                for needed, i in self._deciders)
+
+    def _prefix_for(self, args):
+        return self._stub_prefix if self._stub(args) else self._prefix
+
+    def _wants_own(self, stub):
+        """At a variant's first call: run the model's own loop from the start?"""
+        if self.mode != "auto":
+            return self.mode == "specialised"
+        own = runner_for(self.model, self.template, self.scene, specialise=True, stub=stub,
+                         announce=False)
+        return _jit_cache.has_cached_code(own)
+
+    def _specialise(self, stub, args):
+        own = runner_for(self.model, self.template, self.scene, specialise=True, stub=stub)
+        if not own.signatures:
+            # a sweep's workers reach this together: one compiles, the others load
+            with _compile_lock(own):
+                own.compile(tuple(numba.typeof(a) for a in args))
+        self._specials[stub] = own
+        return own
 
     def __call__(self, *args):
-        prefix = self._prefix_for(args) if self._core is not None else None
-        stub = prefix is self._stub_prefix
-        special = self._specials.get(stub)
-        if special is not None:
-            return special(*args)
+        stub = self._stub(args)
+        own = self._specials.get(stub)
+        if own is None and stub not in self._looked:
+            self._looked.add(stub)
+            if self._wants_own(stub):
+                own = self._specialise(stub, args)
+        if own is not None:
+            return own(*args)
         if self._core is None:
             self._bind(args)
-            prefix = self._prefix_for(args)
-            stub = prefix is self._stub_prefix
         if not stub and not self._kernels_ready:
             self._compile_kernels()
         t0 = time.perf_counter()
-        out = self._core(*prefix, *args)
+        out = self._core(*(self._stub_prefix if stub else self._prefix), *args)
         self.seconds[stub] += time.perf_counter() - t0
         if self.tier_up and self.seconds[stub] > TIER_UP_SECONDS:
             # the model's own loop, with the same stand-ins as this call (a single-contact
             # run's compiles no Lemke either); a run that needs them gets the other variant
-            special = runner_for(self.model, self.template, self.scene, specialise=True,
-                                 stub=stub)
-            if not special.signatures:
-                # a sweep's workers reach this together: one compiles, the others load
-                with _compile_lock(special):
-                    special.compile(tuple(numba.typeof(a) for a in args))
-            self._specials[stub] = special
+            self._specialise(stub, args)
         return out
 
     def _compile_kernels(self):
@@ -381,6 +414,7 @@ def _compile_lock(dispatcher):
 #: in the scheme's shared loop; unset (or "auto"), :func:`runner_for` chooses
 SPECIALISE_ENV = "MOREAU_SPECIALISE"
 _CHOSEN = {}
+_ANNOUNCED = set()
 
 
 def specialise_default():
@@ -393,7 +427,34 @@ def specialise_default():
     return None
 
 
-def runner_for(model, template=None, scene=None, specialise=None, stub=False):
+@contextlib.contextmanager
+def specialised_loops():
+    """Within this block, models run their own specialised loops from their first call.
+
+    For work known in advance to be long, where the scene's own loop pays
+    for its compile many times over (``moreau reproduce``: 1700 Moreau–Jean
+    steady states of one scene). Worker processes started inside inherit
+    it. A setting of :data:`SPECIALISE_ENV` by the user is left alone.
+
+    Examples
+    --------
+    >>> import os
+    >>> with specialised_loops():
+    ...     inside = specialise_default()
+    >>> inside or os.environ.get(SPECIALISE_ENV) is not None
+    True
+    """
+    if os.environ.get(SPECIALISE_ENV) is not None:
+        yield
+        return
+    os.environ[SPECIALISE_ENV] = "1"
+    try:
+        yield
+    finally:
+        os.environ.pop(SPECIALISE_ENV, None)
+
+
+def runner_for(model, template=None, scene=None, specialise=None, stub=False, announce=True):
     """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`).
 
     ``template`` is the loop of a scheme, written against the model's
@@ -403,46 +464,46 @@ def runner_for(model, template=None, scene=None, specialise=None, stub=False):
 
     - the scheme's *shared* loop (:func:`shared_core`), compiled once for
       every model and kept in numba's disk cache: the model's functions are
-      called through pointers. This is the default, so a new scene costs no
-      compile of the loop;
+      called through pointers, so a new scene costs no compile of the loop;
     - the model's *specialised* loop (``template`` compiled with the model's
       functions and sizes frozen in), which numba inlines and unrolls:
       faster per step (``benchmarks/bench_moreau_jean.py`` measures both),
-      at a compile of 5-20 s per (model, scheme) pair. It is used when
-      ``specialise`` is True, whenever it is already compiled in this
-      process or fresh in the disk cache (unless ``specialise`` is False),
-      and once a run has spent :data:`TIER_UP_SECONDS` in the shared loop
-      (:class:`SharedRunner`). ``specialise=None`` (default) takes
-      :func:`specialise_default`.
+      at a compile of 5-20 s per (model, scheme) pair.
 
-    Both give the same numbers to the last bit (tested). Returns a callable
-    with the template's arguments. When its first call will compile, one
-    INFO note says so (:func:`moreau._log.note`), naming ``scene`` (for the
-    note only).
+    ``specialise=None`` (default) returns a :class:`SharedRunner` in the
+    mode :func:`specialise_default` names (``"auto"`` unless
+    :data:`SPECIALISE_ENV` says otherwise), which picks between the two at
+    each call; ``False`` one that keeps the shared loop. ``specialise=True``
+    returns the specialised loop's numba dispatcher itself, with the
+    stand-ins of ``SHARED_INDIRECT`` compiled in where ``stub`` (for runs
+    that cannot reach those kernels). Both forms give the same numbers to
+    the last bit (tested). Where a specialised loop will compile, one INFO
+    note says so (:func:`moreau._log.note`), naming ``scene`` (for the note
+    only), unless ``announce`` is false.
     """
     template = template or _mj_kernels.mj_loop
     if specialise is None:
         specialise = specialise_default()
+        mode = {None: "auto", True: "specialised", False: "shared"}[specialise]
+    else:
+        mode = "dispatcher" if specialise else "shared"
     key = (template.__module__, template.__name__,
            tuple(sorted(model.functions().items(), key=lambda kv: kv[0])),
            tuple(sorted(_constants(model).items())), bool(stub))
-    chosen = _CHOSEN.get((key, specialise))
-    if chosen is not None:
-        return chosen
-    if specialise is False:
-        chosen = SharedRunner(model, template, scene, tier_up=False)
-    else:
-        with _LOCK:
-            run = _RUNNERS.get(key)
-            if run is None:
-                run = _RUNNERS[key] = _build(model, template, stub)
-        if specialise or _jit_cache.has_cached_code(run):
-            if not _jit_cache.has_cached_code(run):
-                _note_compile(template, scene, shared=False)
-            chosen = run
+    chosen = _CHOSEN.get((key, mode))
+    if chosen is None:
+        if mode == "dispatcher":
+            with _LOCK:
+                chosen = _RUNNERS.get(key)
+                if chosen is None:
+                    chosen = _RUNNERS[key] = _build(model, template, stub)
         else:
-            chosen = SharedRunner(model, template, scene)
-    _CHOSEN[(key, specialise)] = chosen
+            chosen = SharedRunner(model, template, scene, mode=mode)
+        _CHOSEN[(key, mode)] = chosen
+    if mode == "dispatcher" and announce and id(chosen) not in _ANNOUNCED:
+        _ANNOUNCED.add(id(chosen))
+        if not _jit_cache.has_cached_code(chosen):
+            _note_compile(template, scene, shared=False)
     return chosen
 
 

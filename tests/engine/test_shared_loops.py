@@ -84,11 +84,15 @@ def test_the_specialise_setting_is_read_from_the_environment(monkeypatch):
 
 def test_specialise_false_keeps_the_shared_loop_even_when_the_model_s_own_is_cached(monkeypatch):
     monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.delenv(_loops.SPECIALISE_ENV, raising=False)
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: True)
     model = make_scene("bouncing-ball").compiled_model()
-    assert not isinstance(_loops.runner_for(model), _loops.SharedRunner)   # cached: its own
+    auto = _loops.runner_for(model)
+    assert auto.mode == "auto" and auto._wants_own(True)       # cached: its own, at once
     shared = _loops.runner_for(model, specialise=False)
-    assert isinstance(shared, _loops.SharedRunner) and not shared.tier_up
+    assert shared.mode == "shared" and not shared.tier_up and not shared._wants_own(True)
+    monkeypatch.setenv(_loops.SPECIALISE_ENV, "1")
+    assert _loops.runner_for(model).mode == "specialised"
 
 
 def test_a_single_contact_run_passes_a_stand_in_for_lemke_unless_lemke_is_forced(monkeypatch):
@@ -116,3 +120,17 @@ def test_a_single_contact_run_passes_a_stand_in_for_lemke_unless_lemke_is_forced
     assert lemke.stats["pivots"] > 0 and lemke.stats["fallbacks"] == 0
     np.testing.assert_allclose(lemke.q, closed.q, rtol=0, atol=1e-10)
     np.testing.assert_array_equal(lemke.regime, closed.regime)
+
+
+def test_specialised_loops_holds_for_its_block_and_leaves_a_user_setting_alone(monkeypatch):
+    from moreau.integrators import specialised_loops
+
+    monkeypatch.delenv(_loops.SPECIALISE_ENV, raising=False)
+    with specialised_loops():
+        assert _loops.specialise_default() is True
+        assert _loops.runner_for(make_scene("bouncing-ball").compiled_model()).mode == "specialised"
+    assert _loops.SPECIALISE_ENV not in __import__("os").environ
+    monkeypatch.setenv(_loops.SPECIALISE_ENV, "0")
+    with specialised_loops():
+        assert _loops.specialise_default() is False
+    assert __import__("os").environ[_loops.SPECIALISE_ENV] == "0"
