@@ -486,13 +486,23 @@ def _cmd_compare(args):
         settings = claim_outputs(os.path.join(out, "stress"),
                                  {"stress": True, "quick": bool(args.quick), "schemes": cols},
                                  args.force)
-        report = run_catalogue(progress=progress, full=not args.quick, schemes=cols)
+        # every cell is kept in OUT/cache as it finishes: the same command resumes
+        cache = os.path.join(out, "cache")
+        report = run_catalogue(progress=progress, full=not args.quick, schemes=cols,
+                               cache_dir=cache)
+        cells = report["cells"]
+        if report["interrupted"]:
+            # no table that would claim to be the whole catalogue
+            raise Interrupted(cells["cached"] + cells["computed"], cells["total"], cache,
+                              "stress catalogue", unit="cells")
         report["settings"] = settings
         paths = write_stress_outputs(report, out, plot=not args.no_plot)
         if args.json:
             print(json.dumps(report))
         else:
             print(format_stress_table(report))
+            print(f"({cells['total']} cells: {cells['computed']} computed, {cells['cached']} "
+                  f"from the cache)")
             print("wrote " + ", ".join(p for p in paths.values() if p))
         return
     if args.scene is None:

@@ -127,7 +127,7 @@ class Interrupted(KeyboardInterrupt):
     Attributes
     ----------
     done, total : int
-        Points finished (computed or read from the cache) and asked for.
+        Points (or ``unit``) finished (computed or read from the cache) and asked for.
     cache_dir : str or None
         Where the finished points are kept; a rerun with the same cache
         reads them instead of computing them again.
@@ -136,9 +136,11 @@ class Interrupted(KeyboardInterrupt):
     --------
     >>> str(Interrupted(3, 10, "out/cache", "sweep mu"))
     'sweep mu: 3 of 10 points finished, kept in out/cache'
+    >>> str(Interrupted(4, 6, "out/cache", "stress catalogue", unit="cells"))
+    'stress catalogue: 4 of 6 cells finished, kept in out/cache'
     """
 
-    def __init__(self, done, total, cache_dir=None, what="run"):
+    def __init__(self, done, total, cache_dir=None, what="run", unit="points"):
         self.done, self.total, self.cache_dir = int(done), int(total), cache_dir
         kept = f", kept in {cache_dir}" if cache_dir is not None else " (no cache: nothing kept)"
-        super().__init__(f"{what}: {self.done} of {self.total} points finished{kept}")
+        super().__init__(f"{what}: {self.done} of {self.total} {unit} finished{kept}")

@@ -228,3 +228,19 @@ def test_a_quick_comparison_fits_the_order_of_every_step_count_scheme():
     # measured 1.93: the smooth contact force keeps the slide second order, and the block
     # sticks where its velocity reaches zero
     assert order is not None and 1.7 < order < 2.2
+
+
+def test_an_adaptive_scheme_s_trajectory_error_is_measured_at_its_own_samples():
+    # Studer's extrapolation has no sample_dt: its samples are its adaptive steps (81 over
+    # the period at tol 1e-9, up to 0.29 apart), and interpolating them onto the grid gave a
+    # trajectory error of 6.6e-3 (tol 1e-9) and 6.1e-4 (tol 1e-11) for a run whose headline
+    # is within 6e-7 and 8e-9: the error is now taken at its own samples
+    case = make_case("friction-drive", frequency=185.0)
+    coarse = case.measure_scheme("studer-extrapolation", {"tol": 1e-9}, None)
+    fine = case.measure_scheme("studer-extrapolation", {"tol": 1e-11}, None)
+    assert coarse < 1e-5 and fine < coarse / 10
+    # a run with a sample at every grid time is measured on the grid as before
+    res = case.run_scheme("schatzman-paoli", {"steps_per_period": 1000})
+    assert case._on_grid(res)
+    assert case.measure_scheme("schatzman-paoli", {"steps_per_period": 1000}, None) == \
+        case._trajectory_error(res)

@@ -182,3 +182,55 @@ def test_ctrl_c_inside_a_batch_run_stops_the_batch_and_keeps_its_rows():
     # a lone simulate still returns what it had, with the interrupted status
     res = simulate(Interrupting(), (0.0, 0.1), [1.0], [0.0], "moreau-jean", h=0.01, fast=False)
     assert res.status == -4 and res.t[-1] > 0.0
+
+
+def test_ctrl_c_on_the_stress_catalogue_keeps_its_cells_and_a_rerun_resumes(tmp_path, capsys,
+                                                                            monkeypatch):
+    # moreau compare --stress ran > 35 min and kept nothing when interrupted: every finished
+    # (case, scheme) cell is now kept in OUT/cache as it finishes, and a rerun reads it
+    import json
+
+    import moreau.studies.paper.stress as st
+    monkeypatch.setattr(st, "CASES", {k: st.CASES[k] for k in ("mu-zero", "painleve-mu1.2")})
+    real = st._guard
+    computed = []
+
+    def counted(stop_at=None):
+        def guard(case, scheme, fn):
+            # every computed cell of these cases runs through _guard once
+            computed.append((case, scheme))
+            if len(computed) == stop_at:
+                raise KeyboardInterrupt
+            return real(case, scheme, fn)
+        return guard
+
+    def argv(out):
+        return ["compare", "--stress", "--quick", "--schemes", "event-driven,mj-1,mj-1/2",
+                "--quiet", "--no-plot", "--json", "--out", str(out)]
+
+    # Ctrl-C inside the second case, after its reference: the cells finished so far are kept
+    monkeypatch.setattr(st, "_guard", counted(stop_at=5))
+    assert main(argv(tmp_path / "a")) == 130
+    line = _one_line(capsys.readouterr().err)
+    assert line == (f"moreau: interrupted: stress catalogue: 4 of 6 cells finished, kept in "
+                    f"{tmp_path / 'a' / 'cache'}; run the same command again to resume")
+    assert not list((tmp_path / "a").glob("stress.*"))
+    # the rerun computes the two missing cells only and reads the four others
+    computed.clear()
+    monkeypatch.setattr(st, "_guard", counted())
+    assert main(argv(tmp_path / "a")) == 0
+    resumed = json.loads(capsys.readouterr().out)
+    assert computed == [("painleve-mu1.2", "mj-1"), ("painleve-mu1.2", "mj-1/2")]
+    assert resumed["cells"]["computed"] == 2 and resumed["cells"]["cached"] == 4
+    assert not resumed["interrupted"]
+    # the resumed table is an uninterrupted run's (the run times aside)
+    computed.clear()
+    assert main(argv(tmp_path / "b")) == 0
+    whole = json.loads(capsys.readouterr().out)
+    assert len(computed) == 6
+
+    def cells(rep):
+        return [{k: v for k, v in r.items() if k != "time_s"} for r in rep["rows"]]
+
+    assert cells(resumed) == cells(whole) and len(whole["rows"]) == 6
+    assert (tmp_path / "a" / "stress.csv").read_text().count("\n") == 7

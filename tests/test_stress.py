@@ -212,3 +212,27 @@ def test_unknown_column_is_refused():
         run_case("mu-zero", schemes=["euler"])
     with pytest.raises(InputError, match="`fast` must be"):
         run_case("mu-zero", fast="yes")
+
+
+def test_kept_cells_are_keyed_by_case_scheme_and_code_version(tmp_path, monkeypatch, caplog):
+    import logging
+
+    from moreau.analysis import engine
+    with caplog.at_level(logging.INFO, logger="moreau.studies.paper.stress"):
+        first = run_catalogue(cases=["mu-zero"], schemes=["mj-1"], progress=False,
+                              cache_dir=tmp_path)
+    # a computed cell is logged (a log file's progress); the hidden reference is kept too
+    assert "stress catalogue: mu-zero / mj-1: stable" in caplog.text
+    assert first["cells"] == {"total": 1, "cached": 0, "computed": 1,
+                              "cache_dir": str(tmp_path)}
+    # the reference the mj-1 cell was measured against is not computed again
+    more = run_catalogue(cases=["mu-zero"], schemes=CLASSIC, progress=False, cache_dir=tmp_path)
+    assert (more["cells"]["cached"], more["cells"]["computed"]) == (2, 1)
+    assert more["rows"][1] == first["rows"][0]
+    # another code version (an edit of the computing code) computes every cell anew
+    monkeypatch.setattr(engine, "code_version", lambda: "0.0+other")
+    again = run_catalogue(cases=["mu-zero"], schemes=CLASSIC, progress=False, cache_dir=tmp_path)
+    assert (again["cells"]["cached"], again["cells"]["computed"]) == (0, 3)
+    # without a cache nothing is kept
+    none = run_catalogue(cases=["mu-zero"], schemes=["mj-1"], progress=False)
+    assert none["cells"]["computed"] == 1 and none["cells"]["cache_dir"] is None

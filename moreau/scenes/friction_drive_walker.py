@@ -647,8 +647,12 @@ class FrictionDriveWalker:
             # remaining time of the geometric (Zeno) bounce sequence; below the
             # threshold the accumulation point is taken as reached
             zeno = (2.0 * vN_post / (-D * (1.0 - self.e))) if (D < 0 and self.e < 1) else math.inf
+            # a flight that met the surface where it began (its rebound never cleared the
+            # gap's rounding, see _missed_recontact) is at the accumulation point too: a
+            # new rebound would start the same flight again, for ever (found at 15 kHz,
+            # e = 0.5: vN_post = 4.7e-12 after a rebound of zero length, at every step)
             if (self.e > 0 and vN_post > 1e-12 * self.vscale and zeno > self.zeno_time
-                    and self.n_impacts < self.max_impacts):
+                    and self.n_impacts < self.max_impacts and end.tau > st.tau):
                 end.regime = _F
                 self._rebound_skip = 0.5 * vN_post / -D if D < 0 else None
             else:
@@ -810,8 +814,12 @@ class EventDriven(Integrator):
         self._add_piece(np.linspace(start.tau, end.tau, k), state,
                         lambda tau: self._sample_row(at(tau)))
 
+    #: events in a row at one time after which a walk that makes no progress stops
+    MAX_EVENTS_AT_ONE_TIME = 1000
+
     def _step_impl(self):
         w = self.walker
+        start = self.state.tau
         end, ev = w.segment(self.state, self.t_bound, self._on_segment)
         if ev is not None:
             self.events.append(ev)
@@ -819,3 +827,12 @@ class EventDriven(Integrator):
         self.state = end
         self.t = end.tau
         self.counters.update(w.counters)
+        # a walk whose events stop advancing time would record a sample and an event each
+        # step for ever (found: the stress catalogue's flight at e = 0.5 grew past 10 GB)
+        self._stalled = 0 if end.tau > start else getattr(self, "_stalled", 0) + 1
+        if self._stalled > self.MAX_EVENTS_AT_ONE_TIME:
+            raise MoreauError(
+                f"the event-driven walk makes no progress: {self._stalled} events in a row at "
+                f"tau = {end.tau!r} (last: {ev.kind if ev is not None else 'none'}, regime "
+                f"{Regime(int(end.regime)).name}); an accumulation of impacts it does not "
+                "resolve")

@@ -8,6 +8,7 @@ import pytest
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import PainleveError, InputError
 from moreau.integrators import simulate
+from moreau.integrators.result import Event
 from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
@@ -333,3 +334,40 @@ def test_a_zeno_sequence_closes_the_contact_instead_of_sinking_into_the_rotor():
     assert r.events[n].t == pytest.approx(0.3542556, abs=5e-6)
     # the rod then rides the stator until it lifts off again
     assert kinds[n + 1] == "liftoff" and r.events[n + 1].t == pytest.approx(1.8043, abs=1e-3)
+
+
+def test_a_walk_that_stops_advancing_time_fails_instead_of_growing_for_ever(monkeypatch):
+    # the stress catalogue's flight at 15 kHz, e = 0.5 (full budget): the walk came back to
+    # one time step after step, recording a sample and an event each time, and grew past
+    # 10 GB; a run whose events stop advancing time now fails and says where
+    sc = make_scene("friction-drive", frequency=185.0)
+    q0, v0 = sc.rest_state()
+    real = FrictionDriveWalker.segment
+
+    def stuck(self, st, tau_end, on_segment=None):
+        if st.tau > 1.0:
+            # an event that leaves the state where it was
+            return st.copy(), Event(st.tau, "touchdown", Regime(int(st.regime)), st.regime)
+        return real(self, st, tau_end, on_segment)
+
+    monkeypatch.setattr(FrictionDriveWalker, "segment", stuck)
+    r = simulate(sc, (0.0, 2 * np.pi), q0, v0, "event-driven")
+    assert not r.success
+    assert "makes no progress: 1001 events in a row at tau = " in r.message
+    assert len(r.events) < 1100
+
+
+def test_a_rebound_of_zero_length_closes_the_contact_instead_of_starting_again():
+    # the state where the stress catalogue's flight (15 kHz, e = 0.5, 80000-period budget)
+    # stuck after 1574 impacts: the flight after the rebound met the surface where it began
+    # (gap -6e-17), leaving vN = +4.7e-12, which started the same rebound again at every step
+    sc = make_scene("friction-drive", frequency=15000.0, restitution=0.5)
+    w = FrictionDriveWalker(sc)
+    w._rebound_skip, w.n_impacts = 1.2773964195003628e-07, 1574
+    st = ContactState(1434.6198036658463, Regime.FLIGHT, 0.7812652437144626,
+                      -0.0024948997538827874, 1.6235401166723877, 0.0011394734980324718)
+    end, ev = w.segment(st, 3141.592653589793)
+    assert ev.kind == "touchdown" and end.tau == st.tau and end.regime != Regime.FLIGHT
+    # and the walk goes on: a whole period, with its flights and impacts
+    later = w.advance(end, end.tau + TWO_PI)
+    assert later.tau == pytest.approx(end.tau + TWO_PI) and w.counters["impacts"] >= 1

@@ -57,12 +57,15 @@ Examples
 
 import csv
 import json
+import logging
 import math
 import os
 import time
 
 import numpy as np
+from tqdm import tqdm
 
+from ...analysis import engine
 from ...analysis.compare import collect_rows
 from ...analysis.mj_steady_state import moreau_jean_steady_state
 from ...analysis.statistical import statistical_steady_state
@@ -75,10 +78,12 @@ from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
 from .valid_range import phi0_valid_range
 
 __all__ = ["CASES", "SCHEMES", "CLASSIC", "check_schemes", "OUTCOMES", "BOUND", "run_case",
-           "run_catalogue", "column_label",
+           "run_catalogue", "CellStore", "column_label",
            "write_stress_outputs", "format_stress_table", "plot_stability_map"]
 
 TWO_PI = 2.0 * math.pi
+
+log = logging.getLogger(__name__)
 
 
 def _columns():
@@ -181,25 +186,37 @@ def _stepping(schemes):
 
 
 # -- steady-state cases -----------------------------------------------------------------------
-def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note="", reference=None):
+def _no_cache(case, scheme, compute, shown=True):
+    """The cell store of a catalogue without a cache: compute every cell."""
+    return compute()
+
+
+def _reference_of(ed_row, *keys):
+    """The event-driven row's ``keys`` where it has a value (else ``{}``: no reference)."""
+    return {k: ed_row[k] for k in keys} if ed_row["value"] is not None else {}
+
+
+def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note="", reference=None,
+                 cell=_no_cache):
     """Event-driven steady state as reference; each time-stepping scheme's at ``steps`` and 2x.
 
     ``reference``, where given, is a callable returning the steady state that
     stands for the event-driven one (a case whose own event-driven run is out
-    of reach) and ``note`` says what it is.
+    of reach) and ``note`` says what it is. ``cell(case, scheme, compute,
+    shown)`` gives each cell's row (:func:`run_case`).
     """
     rows = []
-    ref = {}
 
     def ed():
         ss = reference() if reference is not None else find_steady_state(scene, rtol=1e-12)
-        ref.update(value=ss.displacement_per_period, mode=ss.mode)
         return _row(case, "event-driven", "stable", value=ss.displacement_per_period,
                     mode=ss.mode, message=(note if reference is not None else
                                            "reference (shooting rtol 1e-12)" + note))
 
-    # the reference is needed by every column, shown only where asked for
-    ed_row = _guard(case, "event-driven", ed)
+    # the reference is needed by every column, shown only where asked for (and kept either way)
+    ed_row = cell(case, "event-driven", lambda: _guard(case, "event-driven", ed),
+                  shown="event-driven" in schemes)
+    ref = _reference_of(ed_row, "value", "mode")
     if "event-driven" in schemes:
         rows.append(ed_row)
     for scheme in _stepping(schemes):
@@ -224,11 +241,11 @@ def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note="", 
             row["message"] = msg
             return row
 
-        rows.append(_guard(case, scheme, ts))
+        rows.append(cell(case, scheme, lambda ts=ts, scheme=scheme: _guard(case, scheme, ts)))
     return rows
 
 
-def _ill_posed_case(case, scene, schemes, fast):
+def _ill_posed_case(case, scene, schemes, fast, cell=_no_cache):
     """Beyond the Painlevé limit: every scheme must fail and name the cause."""
     def expect_failure(fn, scheme):
         def run():
@@ -240,11 +257,11 @@ def _ill_posed_case(case, scene, schemes, fast):
 
     rows = []
     if "event-driven" in schemes:
-        rows.append(_guard(case, "event-driven", expect_failure(
-            lambda: find_steady_state(scene, rtol=1e-12), "event-driven")))
+        ed = expect_failure(lambda: find_steady_state(scene, rtol=1e-12), "event-driven")
+        rows.append(cell(case, "event-driven", lambda: _guard(case, "event-driven", ed)))
     for scheme in _stepping(schemes):
-        rows.append(_guard(case, scheme, expect_failure(
-            lambda scheme=scheme: _steady(scene, scheme, STEPS, fast), scheme)))
+        rows.append(cell(case, scheme, lambda scheme=scheme: _guard(case, scheme, expect_failure(
+            lambda: _steady(scene, scheme, STEPS, fast), scheme))))
     return rows
 
 
@@ -267,7 +284,7 @@ def _statistical_row(case, scheme, scene, note, full, run, **opts):
     return row
 
 
-def _flight_case(case, scene, full, schemes, fast, steps=2000, bound=0.05):
+def _flight_case(case, scene, full, schemes, fast, steps=2000, bound=0.05, cell=_no_cache):
     """Above the contact-loss limit: the periodic steady state where one exists, else the
     statistical one (:mod:`moreau.analysis.statistical`), never a fixed window of a transient.
 
@@ -275,21 +292,18 @@ def _flight_case(case, scene, full, schemes, fast, steps=2000, bound=0.05):
     periods; the quick one 5 % and 400 periods, which the spin-up of the restitution cases
     outlasts: those rows fail with the budget-exhausted status.
     """
-    ref = {}
-
     def ed():
         try:
             ss = find_steady_state(scene, rtol=1e-10, statistical=False)
-            ref.update(value=ss.displacement_per_period, interval=None)
             return _row(case, "event-driven", "averaged", value=ss.displacement_per_period,
                         mode=ss.mode, message=f"periodic steady state {ss.mode}")
         except ConvergenceError as exc:
             note = f"no periodic steady state ({str(exc).split(':')[0]}); "
-        row = _statistical_row(case, "event-driven", scene, note, full, "event-driven")
-        ref.update(value=row["value"], interval=row["interval"])
-        return row
+        return _statistical_row(case, "event-driven", scene, note, full, "event-driven")
 
-    ed_row = _guard(case, "event-driven", ed)
+    ed_row = cell(case, "event-driven", lambda: _guard(case, "event-driven", ed),
+                  shown="event-driven" in schemes)
+    ref = _reference_of(ed_row, "value", "interval")
     rows = [ed_row] if "event-driven" in schemes else []
     for scheme in _stepping(schemes):
         def ts(scheme=scheme):
@@ -329,7 +343,7 @@ def _flight_case(case, scene, full, schemes, fast, steps=2000, bound=0.05):
                 row["message"] += msg
             return row
 
-        rows.append(_guard(case, scheme, ts))
+        rows.append(cell(case, scheme, lambda ts=ts, scheme=scheme: _guard(case, scheme, ts)))
     return rows
 
 
@@ -353,14 +367,14 @@ def _section_state(ss):
     return q0, x[n:].copy()
 
 
-def _long_case(case, scene, full, schemes, fast, steps=1000, bound=1e-6):
+def _long_case(case, scene, full, schemes, fast, steps=1000, bound=1e-6, cell=_no_cache):
     total = 10 ** 7 if full else 10 ** 6
     periods = total // steps
     rows = []
     if "event-driven" in schemes:
-        rows.append(_row(case, "event-driven", "n/a", time_s=0.0,
-                         message="event-driven takes no time steps; its error does not grow "
-                                 "with them"))
+        rows.append(cell(case, "event-driven", lambda: _row(
+            case, "event-driven", "n/a", time_s=0.0,
+            message="event-driven takes no time steps; its error does not grow with them")))
     for scheme in _stepping(schemes):
         def ts(scheme=scheme):
             name = _COLUMNS[scheme][0]
@@ -391,7 +405,7 @@ def _long_case(case, scene, full, schemes, fast, steps=1000, bound=1e-6):
                                  f"at period starts {e_spread:.1e}, max penetration / u10 "
                                  f"{pen:.1e}"))
 
-        rows.append(_guard(case, scheme, ts))
+        rows.append(cell(case, scheme, lambda ts=ts, scheme=scheme: _guard(case, scheme, ts)))
     return rows
 
 
@@ -408,18 +422,19 @@ def _c(title, fn):
 def _steady_at(frequency=185.0, steps=STEPS, **params):
     """A steady-state case of ``_scene(frequency, **params)``; a callable parameter is
     evaluated when the case runs (the phi0 edges cost a computation)."""
-    def run(c, full, schemes, fast):
+    def run(c, full, schemes, fast, cell=_no_cache):
         values = {k: v() if callable(v) else v for k, v in params.items()}
-        return _steady_case(c, _scene(frequency, **values), schemes, fast, steps=steps)
+        return _steady_case(c, _scene(frequency, **values), schemes, fast, steps=steps,
+                            cell=cell)
     return run
 
 
 def _flight(e):
-    return lambda c, full, schemes, fast: _flight_case(c, _scene(15000.0, restitution=e), full,
-                                                       schemes, fast)
+    return lambda c, full, schemes, fast, cell=_no_cache: _flight_case(
+        c, _scene(15000.0, restitution=e), full, schemes, fast, cell=cell)
 
 
-#: case id -> {"title", "run": callable(case_id, full, schemes, fast) -> rows}
+#: case id -> {"title", "run": callable(case_id, full, schemes, fast, cell) -> rows}
 CASES = {
     "stiff-1Hz-N50": _c("f = 1 Hz (P = 1.3e7), 50 steps per period",
                         _steady_at(1.0, steps=50)),
@@ -432,8 +447,8 @@ CASES = {
     "painleve-mu0.99": _c("mu = 0.99", _steady_at(mu=0.99)),
     "painleve-mu0.999": _c("mu = 0.999", _steady_at(mu=0.999)),
     "painleve-mu1.2": _c("mu = 1.2, beyond the limit (ill-posed)",
-                         lambda c, full, schemes, fast: _ill_posed_case(c, _scene(mu=1.2),
-                                                                        schemes, fast)),
+                         lambda c, full, schemes, fast, cell=_no_cache: _ill_posed_case(
+                             c, _scene(mu=1.2), schemes, fast, cell=cell)),
     "mu-zero": _c("mu = 0 (no friction)", _steady_at(mu=0.0)),
     "mass-ratio-1e-3": _c("m2/m = 1e-3", _steady_at(m2=2e-8)),
     "mass-ratio-1e6": _c("m2/m = 1e6", _steady_at(m2=20.0)),
@@ -443,8 +458,8 @@ CASES = {
                              _steady_at(phi0=lambda: _phi0_edges()[1] - 1e-3)),
     "coarse-N10": _c("10 steps per period (h = T/10)", _steady_at(steps=10)),
     "long-1e7-steps": _c("10^7 steps at N = 1000 (10^6 in the quick catalogue)",
-                         lambda c, full, schemes, fast: _long_case(c, _scene(), full, schemes,
-                                                                   fast)),
+                         lambda c, full, schemes, fast, cell=_no_cache: _long_case(
+                             c, _scene(), full, schemes, fast, cell=cell)),
 }
 
 
@@ -454,9 +469,9 @@ def _scene_case(spec):
     steps = int(spec.get("steps", STEPS))
     bound = float(spec.get("bound", BOUND))
 
-    def run(c, full, schemes, fast):
+    def run(c, full, schemes, fast, cell=_no_cache):
         return _steady_case(c, make(), schemes, fast, steps=steps, bound=bound,
-                            note=spec.get("note", ""), reference=spec.get("reference"))
+                            note=spec.get("note", ""), reference=spec.get("reference"), cell=cell)
     return _c(spec["title"], run)
 
 
@@ -507,7 +522,7 @@ def _check_fast(fast):
     return fast
 
 
-def run_case(case, full=False, schemes=None, fast="auto"):
+def run_case(case, full=False, schemes=None, fast="auto", cell=None):
     """Rows (one per scheme of ``schemes``, all of :data:`SCHEMES` by default) of one case.
 
     Parameters
@@ -522,6 +537,12 @@ def run_case(case, full=False, schemes=None, fast="auto"):
         Passed to the time-stepping schemes that take it (compiled loop or
         the generic step); Moreau–Jean's steady states always use its compiled
         period map.
+    cell : callable, optional
+        ``cell(case, scheme, compute, shown=True) -> row`` gives the row of
+        one cell, ``compute()`` being what computes it: the catalogue's
+        :class:`CellStore` reads a kept cell instead. ``shown`` is False for
+        the event-driven reference of a case that does not show its column
+        (computed, and kept, all the same). Every cell is computed by default.
 
     Examples
     --------
@@ -532,14 +553,81 @@ def run_case(case, full=False, schemes=None, fast="auto"):
         raise InputError(f"`case` must be one of {list(CASES)}, got {case!r}")
     schemes = check_schemes(schemes)
     fast = _check_fast(fast)
-    rows = CASES[case]["run"](case, full, schemes, fast)
+    rows = CASES[case]["run"](case, full, schemes, fast, cell=cell or _no_cache)
     for r in rows:
         r["title"] = CASES[case]["title"]
     return rows
 
 
+def _kept_cell(case, scheme, full, fast, version, compute):
+    """The row of one cell, ``compute()``: memoised on disk by :class:`CellStore`, keyed by
+    everything but ``compute`` (the case, the column, ``full``, ``fast``, the code version)."""
+    return compute()
+
+
+class CellStore:
+    """The cells of a catalogue run, each kept on disk as it finishes (``moreau compare --stress``).
+
+    The cache is the sweep engine's (:mod:`moreau.analysis.engine`): a
+    :class:`joblib.Memory` in ``cache_dir``, keyed by the case id, the column
+    key, ``full``, ``fast`` and :func:`~moreau.analysis.engine.code_version`,
+    so that a rerun of the same catalogue reads the cells it finished before
+    (an interrupted run resumes), and an edit of the computing code computes
+    them anew. Without ``cache_dir`` every cell is computed.
+
+    Counts the cells it gives (``cached``, ``computed``), drives a tqdm bar
+    over ``total`` cells (on a terminal only) and logs each computed cell at
+    INFO (shown in a log file with ``moreau -v``).
+    """
+
+    def __init__(self, cache_dir=None, full=False, fast="auto", total=0, progress=False):
+        self.cache_dir = None if cache_dir is None else str(cache_dir)
+        if self.cache_dir is not None:
+            engine.check_output_dir(self.cache_dir, "--out")
+        self.func = engine._memory(self.cache_dir).cache(_kept_cell, ignore=["compute"])
+        self.full, self.fast, self.total = bool(full), fast, int(total)
+        self.version = engine.code_version()
+        self.cached = self.computed = 0
+        # disable=None: a bar on a terminal only, never in a log file
+        self.bar = (tqdm(total=self.total, desc="stress catalogue", unit="cell", disable=None)
+                    if progress else None)
+
+    @property
+    def done(self):
+        """Cells finished (computed or read from the cache)."""
+        return self.cached + self.computed
+
+    def __call__(self, case, scheme, compute, shown=True):
+        ran = []
+
+        def run():
+            ran.append(True)
+            if self.bar is not None and shown:
+                self.bar.set_postfix_str(f"{case} / {scheme}", refresh=True)
+            t0 = time.perf_counter()
+            row = compute()
+            log.info("stress catalogue: %s / %s: %s (%.1f s)", case, scheme, row["outcome"],
+                     time.perf_counter() - t0)
+            return row
+
+        row = dict(self.func(case, scheme, self.full, self.fast, self.version, run))
+        if shown:
+            if ran:
+                self.computed += 1
+            else:
+                self.cached += 1
+            if self.bar is not None:
+                self.bar.update(1)
+        return row
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+
 def run_catalogue(cases=None, full=False, progress=True, on_row=None, schemes=None,
-                  fast="auto"):
+                  fast="auto", cache_dir=None):
     """Run the stress catalogue.
 
     Parameters
@@ -557,15 +645,23 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None, schemes=No
         Column keys of :data:`SCHEMES`; every one by default.
     fast : {"auto", True, False}
         See :func:`run_case`.
+    cache_dir : path-like, optional
+        Keep every finished cell (case, column) here as it finishes
+        (:class:`CellStore`): a rerun with the same cache reads the cells
+        instead of computing them, so an interrupted catalogue resumes.
+        None (the default) keeps nothing.
 
     Returns
     -------
     dict
         ``rows`` (``case``, ``title``, ``scheme``, ``outcome``, ``value``,
         ``reference``, ``error``, ``bound``, ``estimate``, ``mode``,
-        ``time_s``, ``message``), ``schemes`` (the columns, with the
-        registered scheme and options of each), ``full`` and ``interrupted``
-        (an interrupted catalogue keeps the finished cases).
+        ``time_s``, ``message``; a cell read from the cache has the time it
+        took when it was computed), ``schemes`` (the columns, with the
+        registered scheme and options of each), ``full``, ``cells``
+        (``total``, ``cached``, ``computed``, ``cache_dir``) and
+        ``interrupted`` (an interrupted catalogue keeps the finished cases in
+        ``rows``, and with ``cache_dir`` every finished cell on disk).
     """
     cases = list(CASES) if cases is None else list(cases)
     for c in cases:
@@ -577,9 +673,16 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None, schemes=No
               "schemes": [{"key": k, "scheme": _COLUMNS[k][0], "options": _COLUMNS[k][1]}
                           for k in schemes],
               "rows": [], "interrupted": False}
-    report["interrupted"] = collect_rows(cases, lambda c: run_case(c, full, schemes, fast),
-                                         report["rows"], on_row, progress,
-                                         desc="stress catalogue", unit="case")
+    # every case gives one row per column
+    store = CellStore(cache_dir, full, fast, total=len(cases) * len(schemes), progress=progress)
+    try:
+        report["interrupted"] = collect_rows(
+            cases, lambda c: run_case(c, full, schemes, fast, cell=store), report["rows"],
+            on_row)
+    finally:
+        store.close()
+    report["cells"] = {"total": store.total, "cached": store.cached,
+                       "computed": store.computed, "cache_dir": store.cache_dir}
     return report
 
 
