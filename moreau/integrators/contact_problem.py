@@ -14,6 +14,8 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 :class:`~moreau.errors.LCPError`; no false solution is returned.
 """
 
+import math
+
 import numpy as np
 
 from ..errors import LCPError, PainleveError
@@ -149,6 +151,10 @@ def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
         the problem has no solution or several. Where the condition fails but
         the contact slides the harmless way and the solution is unique, it is
         returned.
+    FloatingPointError
+        The contact must act and ``W_NN`` is not positive and finite, or the
+        data are not finite: a diverged state or a mass matrix that is no
+        longer positive definite, named as such and not as a Painlevé case.
 
     Notes
     -----
@@ -172,6 +178,8 @@ def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
     W = np.asarray(W, dtype=float)
     u = np.asarray(u_free, dtype=float).reshape(-1)
     mu, e, vN_pre = float(mu), float(e), float(vN_pre)
+    if not (np.all(np.isfinite(W)) and np.all(np.isfinite(u))):
+        raise FloatingPointError(_broken_delassus(float(W[0, 0])))
     if mu > 0.0:
         pN, pT = _one_contact(*(float(x) for x in (W[0, 0], W[0, 1], W[1, 0], W[1, 1], u[0], u[1])),
                               mu, e, vN_pre)
@@ -183,9 +191,18 @@ def _one_contact_frictionless(Wnn, uN, e, vN_pre):
     b = uN + e * min(vN_pre, 0.0)
     if b >= 0.0:
         return 0.0
-    if not Wnn > 0.0:
-        raise PainleveError(f"the contact's Delassus entry W_NN = {Wnn!r} must be > 0")
+    if not Wnn > 0.0 or not math.isfinite(Wnn):
+        raise FloatingPointError(_broken_delassus(Wnn))
     return -b / Wnn
+
+
+def _broken_delassus(Wnn):
+    # W_NN = w_N M^-1 w_N^T > 0 for every positive definite M and nonzero contact row:
+    # anything else is the state or the mass matrix breaking down, not a paradox
+    return (f"the contact's Delassus entry W_NN = {Wnn!r} is not positive and finite: the "
+            f"mass matrix has lost positive definiteness or the state has diverged (a step "
+            f"`h` too large for the stiffest force, or a zero contact row); this is not a "
+            f"Painlevé case, which needs W_NN > 0")
 
 
 def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
@@ -194,6 +211,8 @@ def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
     pN, pT, ok = _kernels._one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre)
     if ok:
         return pN, pT
+    if not (Wnn > 0.0 and all(math.isfinite(x) for x in (Wnn, Wnt, Wtn, Wtt, uN, uT))):
+        raise FloatingPointError(_broken_delassus(Wnn))
     if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
         # one slip branch has a non-increasing normal velocity and the step would
         # slide along it: the only way out is an impulsive jam whose size does not

@@ -486,3 +486,27 @@ def test_module_docstring_example_runs():
     import doctest
     fails, _ = doctest.testmod(mjmod, verbose=False)
     assert fails == 0
+
+
+@pytest.mark.parametrize("W, u, mu", [
+    ([[-4.8e17, 0.0], [0.0, 1.0]], [-1.0, 0.5], 0.3),     # a diverged step's Delassus entry
+    ([[np.inf, 0.0], [0.0, 1.0]], [-1.0, 0.5], 0.3),
+    ([[1e75, np.nan], [0.0, 1.0]], [-1.0, 0.5], 0.3),
+    ([[-1.0]], [-1.0], 0.0),                                # frictionless
+    ([[0.0]], [-1.0], 0.0),                                 # a zero contact row
+])
+def test_a_broken_delassus_entry_is_a_numerical_failure_not_a_painleve_case(W, u, mu):
+    # W_NN = w_N M^-1 w_N^T > 0 for every positive definite mass matrix: where it is not,
+    # the state or the mass matrix broke down (found on the stress catalogue's stiff
+    # flexible rod under SP and TDG, reported as Painlevé with W_NN = -4.8e17, inf, 1e75)
+    from moreau.integrators.contact_problem import one_contact_impulse
+    with pytest.raises(FloatingPointError, match=r"not a Painlevé case"):
+        one_contact_impulse(W, u, mu)
+
+
+def test_a_genuine_painleve_case_is_still_named_so():
+    from moreau.errors import PainleveError
+    from moreau.integrators.contact_problem import one_contact_impulse
+    # W_NN > 0 but W_NN - mu W_NT < 0, sliding the paradoxical way
+    with pytest.raises(PainleveError, match="discrete Painlevé condition"):
+        one_contact_impulse([[1.0, 2.0], [2.0, 5.0]], [-1.0, 1.0], 0.9)
