@@ -47,7 +47,7 @@ against the parameter, the Lyapunov exponent below, the marks as lines.
 Examples
 --------
 >>> d = bifurcation_diagram("stick-slip-motor", "load", [0.0, 0.05], frequency=1000.0,
-...                         transient=20, samples=8, out=None, progress=False)
+...                         transient=10, samples=4, out=None, progress=False)
 >>> [p["period"] for p in d["points"]], d["points"][0]["status"]
 ([1, 1], 'ok')
 """
