@@ -144,3 +144,14 @@ def test_the_shared_loop_is_tied_to_the_kernels_and_each_model_function_to_its_f
     deps = _loops.dependency_files([fresh])
     assert src in deps and any(os.path.basename(p) == "_rod.py" for p in deps)
     assert fresh._cache._cache_file._source_stamp[1][1] == _jit_cache.sources_digest(deps)
+
+
+def test_a_loop_is_tied_to_the_kernels_of_other_schemes_it_calls():
+    # Studer's loop calls the TDG module's stage solve: an edit there must compile it again
+    from moreau.integrators import _loops, _studer_kernels
+
+    names = [os.path.basename(p) for p in _loops._template_sources(_studer_kernels.studer_loop)]
+    assert {"_studer_kernels.py", "_tdg_kernels.py", "_mj_kernels.py", "lemke.py"} <= set(names)
+    core = _loops.shared_core(_studer_kernels.studer_loop, ())      # built, never compiled here
+    digest = _jit_cache.sources_digest(_loops._template_sources(_studer_kernels.studer_loop))
+    assert core._cache._cache_file._source_stamp[1][1] == digest

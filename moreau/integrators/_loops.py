@@ -155,11 +155,19 @@ def _build(model, template, stub=False):
     fn.__doc__ = template.__doc__
     run = njit(cache=cacheable, error_model="numpy")(fn)
     if cacheable:
-        sources = list(_mj_kernels.KERNEL_SOURCES)
-        if module.__file__ not in sources:
-            sources.append(module.__file__)
-        _jit_cache.bind_cache_to_sources([run], sources + dependency_files(list(fns.values())))
+        _jit_cache.bind_cache_to_sources(
+            [run], _template_sources(template) + dependency_files(list(fns.values())))
     return run
+
+
+def _template_sources(template):
+    """Every source file a loop of ``template`` compiles in: Lemke's, the template's
+    module and the modules of every compiled kernel it calls (another scheme's, too)."""
+    sources = list(_mj_kernels.KERNEL_SOURCES)
+    for path in dependency_files([types.SimpleNamespace(py_func=template)]):
+        if path not in sources:
+            sources.append(path)
+    return sources
 
 
 #: the leading parameters of a scheme's shared loop: the model as run-time values, in
@@ -230,12 +238,8 @@ def shared_core(template, argtypes):
     with _LOCK:
         core = _CORES.get(key)
         if core is None:
-            module = sys.modules[template.__module__]
             core = njit(cache=True, error_model="numpy")(_shared_function(template))
-            sources = list(_mj_kernels.KERNEL_SOURCES)
-            if module.__file__ not in sources:
-                sources.append(module.__file__)
-            _jit_cache.bind_cache_to_sources([core], sources)
+            _jit_cache.bind_cache_to_sources([core], _template_sources(template))
             _CORES[key] = core
     return core
 
