@@ -50,7 +50,7 @@ from .steady_state import implausible_steady_state
 
 log = logging.getLogger(__name__)
 
-__all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "Scheme", "steady_of", "worker_init", "worker_pool_config",
+__all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "cache_memory", "Scheme", "steady_of", "worker_init", "worker_pool_config",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
@@ -569,7 +569,12 @@ def _recompute(func, a):
     return out
 
 
-def _memory(cache_dir):
+def cache_memory(cache_dir):
+    """The on-disk cache of computed results in ``cache_dir`` (None: nothing is kept).
+
+    One :class:`joblib.Memory` for the points of sweeps and atlases and the
+    cells of the stress catalogue.
+    """
     return joblib.Memory(location=None if cache_dir is None else str(cache_dir), verbose=0)
 
 
@@ -641,12 +646,12 @@ def _run_points(points, scheme, checks, cache_dir, n_jobs, scheduler, progress, 
     version = code_version()
     chunk = max(1, int(chunk))
     if chunk == 1:
-        func = _memory(cache_dir).cache(evaluate_point, ignore=[])
+        func = cache_memory(cache_dir).cache(evaluate_point, ignore=[])
         args = [(dict(p), float(f), scheme, tuple(checks), version, scene, bool(energy))
                 for p, f in points]
         sizes = [1] * len(args)
     else:
-        func = _memory(cache_dir).cache(evaluate_points, ignore=[])
+        func = cache_memory(cache_dir).cache(evaluate_points, ignore=[])
         groups = [points[i:i + chunk] for i in range(0, len(points), chunk)]
         args = [(tuple((dict(p), float(f)) for p, f in g), scheme, tuple(checks), version, scene,
                  bool(energy), bool(continuation), None if classify is None else int(classify))

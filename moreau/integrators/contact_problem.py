@@ -14,8 +14,6 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 :class:`~moreau.errors.LCPError`; no false solution is returned.
 """
 
-import math
-
 import numpy as np
 
 from ..errors import LCPError, PainleveError
@@ -191,7 +189,7 @@ def _one_contact_frictionless(Wnn, uN, e, vN_pre):
     b = uN + e * min(vN_pre, 0.0)
     if b >= 0.0:
         return 0.0
-    if not Wnn > 0.0 or not math.isfinite(Wnn):
+    if not Wnn > 0.0:
         raise FloatingPointError(_broken_delassus(Wnn))
     return -b / Wnn
 
@@ -211,7 +209,8 @@ def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
     pN, pT, ok = _kernels._one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre)
     if ok:
         return pN, pT
-    if not (Wnn > 0.0 and all(math.isfinite(x) for x in (Wnn, Wnt, Wtn, Wtt, uN, uT))):
+    if not Wnn > 0.0:
+        # (non-finite data never get here: one_contact_impulse refuses them first)
         raise FloatingPointError(_broken_delassus(Wnn))
     if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
         # one slip branch has a non-increasing normal velocity and the step would

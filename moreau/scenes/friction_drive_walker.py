@@ -746,6 +746,7 @@ class EventDriven(Integrator):
             raise InputError("`scene` must be a FrictionDrive for the event-driven reference")
         self.walker = FrictionDriveWalker(scene, rtol=rtol)
         self.samples_per_period = positive_int("samples_per_period", samples_per_period)
+        self._stalled = 0       # events in a row that did not advance time
         st = ContactState(self.t, _F, self.q[0], self.v[0], self.q[1], self.v[1])
         try:
             self.state = self.walker.classify(st)
@@ -829,7 +830,7 @@ class EventDriven(Integrator):
         self.counters.update(w.counters)
         # a walk whose events stop advancing time would record a sample and an event each
         # step for ever (found: the stress catalogue's flight at e = 0.5 grew past 10 GB)
-        self._stalled = 0 if end.tau > start else getattr(self, "_stalled", 0) + 1
+        self._stalled = 0 if end.tau > start else self._stalled + 1
         if self._stalled > self.MAX_EVENTS_AT_ONE_TIME:
             raise MoreauError(
                 f"the event-driven walk makes no progress: {self._stalled} events in a row at "

@@ -585,7 +585,7 @@ class CellStore:
         self.cache_dir = None if cache_dir is None else str(cache_dir)
         if self.cache_dir is not None:
             engine.check_output_dir(self.cache_dir, "--out")
-        self.func = engine._memory(self.cache_dir).cache(_kept_cell, ignore=["compute"])
+        self.func = engine.cache_memory(self.cache_dir).cache(_kept_cell, ignore=["compute"])
         self.full, self.fast, self.total = bool(full), fast, int(total)
         self.version = engine.code_version()
         self.cached = self.computed = 0
