@@ -13,8 +13,9 @@ explicit, ``2 pi``-periodic functions of ``tau``. The rotor acceleration of
 each slip regime is expanded once in a Fourier series whose truncation error
 is below round-off; its first and second antiderivatives are then exact, so
 slip segments are integrated in closed form. Flight segments (the rod swings
-freely) are integrated with DOP853 at tight tolerance; re-contact is an
-impact with Newton's restitution coefficient and Coulomb friction.
+freely) are integrated with compiled Taylor series at tight tolerance
+(:mod:`moreau.scenes._flight_taylor`; SciPy's DOP853 on request); re-contact
+is an impact with Newton's restitution coefficient and Coulomb friction.
 """
 
 import math
@@ -28,11 +29,21 @@ from ..errors import InputError, MoreauError, PainleveError
 from ..regimes import Regime
 from ..integrators.base import Integrator, register_integrator
 from ..integrators.result import Event
+from ._flight_taylor import CAPACITY as FLIGHT_CAPACITY, ORDER as FLIGHT_ORDER
+from ._flight_taylor import FAILED as _FT_FAILED, FULL as _FT_FULL
+from ._flight_taylor import NEVER_CLEARED as _FT_NEVER_CLEARED, RECONTACT as _FT_RECONTACT
+from ._flight_taylor import DenseFlight, flight_steps
 
 __all__ = ["EventDriven", "ContactState", "FrictionDriveWalker", "impact_impulses"]
 
 TWO_PI = 2.0 * math.pi
 _F, _P, _N, _S = Regime.FLIGHT, Regime.POSITIVE, Regime.NEGATIVE, Regime.STICK
+#: events in a row at one time after which a walk that makes no progress stops
+MAX_EVENTS_AT_ONE_TIME = 1000
+#: how flight segments are integrated: compiled Taylor series, or SciPy's DOP853
+FLIGHT_METHODS = ("taylor", "dop853")
+#: the longest Taylor step of a flight (its gap is sampled 16 times a step)
+FLIGHT_HMAX = TWO_PI / 32
 #: a recorded gap below -PENETRATION_TOL * u10 is a lost re-contact, an error (the
 #: contact pieces are closed-form: their gaps are zero to rounding, about 1e-16)
 PENETRATION_TOL = 1e-9
@@ -184,6 +195,10 @@ class FrictionDriveWalker:
     max_impacts : int
         Impacts allowed per run before an accumulation (Zeno) is declared and
         the contact is closed.
+    flight_method : {"taylor", "dop853"}
+        Flight segments by the compiled Taylor series (the default, see
+        :mod:`moreau.scenes._flight_taylor`) or by SciPy's DOP853 at ``rtol``
+        (slower by about two orders; kept as the cross-check).
 
     Notes
     -----
@@ -195,7 +210,7 @@ class FrictionDriveWalker:
     ``|D| zeno_time^2``.
     """
 
-    def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000):
+    def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000, flight_method="taylor"):
         self.scene = scene
         self.rtol = positive("rtol", rtol)
         self.grid = positive_int("grid", grid)
@@ -206,6 +221,13 @@ class FrictionDriveWalker:
         self.zeno_time = 1e-6
         self._rebound_skip = None
         self.counters = {"events": 0, "impacts": 0, "flight_segments": 0, "root_solves": 0}
+        if flight_method not in FLIGHT_METHODS:
+            raise InputError(f"`flight_method` must be one of {list(FLIGHT_METHODS)}, "
+                             f"got {flight_method!r}")
+        self.flight_method = flight_method
+        self._flight_a = float(scene.P) * float(scene.sin_phi0) + float(scene.fp)
+        self._flight_buffers = (np.empty((FLIGHT_CAPACITY, FLIGHT_ORDER + 1)),
+                                np.empty(FLIGHT_CAPACITY), np.empty(FLIGHT_CAPACITY))
         self._build_tables()
 
     # -- tables over one period -----------------------------------------------
@@ -481,9 +503,59 @@ class FrictionDriveWalker:
         """Integrate a flight segment up to re-contact or ``tau_end``.
 
         Returns ``(state_at_end, recontact, sol)``; ``sol`` is the dense output
-        when requested.
+        when requested. The compiled Taylor series of
+        :mod:`moreau.scenes._flight_taylor` by default; with
+        ``flight_method="dop853"`` SciPy's DOP853 (the cross-check).
         """
         self.counters["flight_segments"] += 1
+        if self.flight_method == "dop853":
+            return self._flight_dop853(st, tau_end, dense)
+        sc = self.scene
+        t0 = st.tau
+        # a flight starts on a zero of the gap (lift-off or rebound): only a dip below
+        # the gap's tolerance counts as a return before the skip
+        skip = 1e-9 * max(1.0, abs(t0))
+        if self._rebound_skip is not None:
+            skip, self._rebound_skip = self._rebound_skip, None
+        u10 = float(sc.u10)
+        eps = 1e-3 * self.rtol * max(u10, 1e-12)
+        tol = 1e-13 * max(u10, 1e-300)
+        tau, phi, dphi, cleared = t0, st.phi, st.dphi, False
+        coef, starts, widths = self._flight_buffers
+        pieces = []
+        while True:
+            code, tau, phi, dphi, n, cleared = flight_steps(
+                tau, phi, dphi, tau_end, t0 + skip - tau, cleared, self._flight_a, float(sc.P),
+                0.5 * u10, float(sc.sin_phi0), u10, eps, FLIGHT_HMAX, tol, coef, starts, widths)
+            if dense:
+                pieces.append((coef[:n].copy(), starts[:n].copy(), widths[:n].copy()))
+            if code != _FT_FULL:
+                break
+        if code == _FT_FAILED:
+            raise MoreauError(f"flight integration failed: the Taylor step collapsed at "
+                              f"tau = {tau!r}")
+        out = st.copy()
+        if code == _FT_NEVER_CLEARED:
+            # the rebound never cleared the gap's rounding: the contact closes where the
+            # flight began (late in a Zeno sequence)
+            tau, phi, dphi = t0, st.phi, st.dphi
+        s = tau - t0
+        accel = -float(sc.fL) / float(sc.J)
+        out.tau, out.phi, out.dphi = float(tau), float(phi), float(dphi)
+        out.u2 = st.u2 + st.du2 * s + 0.5 * accel * s * s
+        out.du2 = st.du2 + accel * s
+        sol = None
+        if dense:
+            sol = DenseFlight(np.concatenate([p[0] for p in pieces]),
+                              np.concatenate([p[1] for p in pieces]),
+                              np.concatenate([p[2] for p in pieces]), t0, st.u2, st.du2, accel)
+        if code in (_FT_RECONTACT, _FT_NEVER_CLEARED):
+            self.counters["root_solves"] += 1
+            return out, True, sol
+        return out, False, sol
+
+    def _flight_dop853(self, st, tau_end, dense=False):
+        # the former integration of a flight, kept as the independent cross-check
         def gap(t, y):
             return self._gap(t, y)
 
@@ -688,8 +760,9 @@ class FrictionDriveWalker:
     def advance(self, st, tau_end, on_segment=None, on_event=None, max_events=100000):
         """Advance ``st`` to ``tau_end`` through all events; return the final state."""
         st = st.copy()
-        n = 0
+        n = stalled = 0
         while st.tau < tau_end:
+            start = st.tau
             st, ev = self.segment(st, tau_end, on_segment)
             if ev is not None:
                 n += 1
@@ -698,6 +771,12 @@ class FrictionDriveWalker:
                 if n > max_events:
                     raise MoreauError(f"more than {max_events} events before tau={tau_end:.6g} "
                                       "(an accumulation of events?)")
+                # a walk stuck at one time would otherwise run to max_events first
+                stalled = 0 if st.tau > start else stalled + 1
+                if stalled > MAX_EVENTS_AT_ONE_TIME:
+                    raise MoreauError(
+                        f"the event-driven walk makes no progress: {stalled} events in a row "
+                        f"at tau = {st.tau!r} (last: {ev.kind}); an accumulation of events")
         return st
 
 
@@ -816,7 +895,7 @@ class EventDriven(Integrator):
                         lambda tau: self._sample_row(at(tau)))
 
     #: events in a row at one time after which a walk that makes no progress stops
-    MAX_EVENTS_AT_ONE_TIME = 1000
+    MAX_EVENTS_AT_ONE_TIME = MAX_EVENTS_AT_ONE_TIME
 
     def _step_impl(self):
         w = self.walker
