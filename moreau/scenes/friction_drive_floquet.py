@@ -186,7 +186,7 @@ def _flight_flow(walker, a, b):
     return out
 
 
-def walker_monodromy(scene, steady, rtol=1e-12, walker=None):
+def walker_monodromy(scene, steady, rtol=1e-12, walker=None, walk=None):
     """Monodromy matrix of the walker's steady period, from saltation matrices.
 
     Parameters
@@ -196,16 +196,19 @@ def walker_monodromy(scene, steady, rtol=1e-12, walker=None):
         The walker's steady state (:func:`walker_steady_state`).
     rtol : float
         Tolerance of the flights and their variational equations.
+    walker : FrictionDriveWalker, optional
+        A walker of ``scene`` at ``rtol`` to walk the period with (its
+        tables are reused: building them costs as much as the walk).
+    walk : (list, list), optional
+        The steady period already walked from its section state by
+        ``walker``: its pieces ``(start, end)`` (copies) and its events. Not
+        walked again then.
 
     Returns
     -------
     ndarray
         ``(1, 1)`` for a section in contact (the free direction ``u2'``);
         ``(3, 3)`` in ``(phi, phi', u2')`` for one in flight.
-
-    walker : FrictionDriveWalker, optional
-        A walker of ``scene`` at ``rtol`` to walk the period with (its
-        tables are reused: building them costs as much as the walk).
 
     Raises
     ------
@@ -216,10 +219,13 @@ def walker_monodromy(scene, steady, rtol=1e-12, walker=None):
     fields = _Fields(walker)
     vs = walker.vscale
     st0 = _section_start(walker, steady)
-    pieces, events = [], []
-    # the walker changes a finished piece's end state in place (impact, manifold): copy
-    walker.advance(st0, st0.tau + TWO_PI, on_event=events.append,
-                   on_segment=lambda a, b, sol: pieces.append((a.copy(), b.copy())))
+    if walk is not None:
+        pieces, events = walk
+    else:
+        pieces, events = [], []
+        # the walker changes a finished piece's end state in place (impact, manifold): copy
+        walker.advance(st0, st0.tau + TWO_PI, on_event=events.append,
+                       on_segment=lambda a, b, sol: pieces.append((a.copy(), b.copy())))
     M = np.eye(3 if st0.regime == _F else 1)
     ev = iter(events)
     pending = next(ev, None)

@@ -14,6 +14,7 @@ from scipy.optimize import minimize_scalar
 
 from .._validate import positive, positive_int
 from ..analysis.energy import RodEnergy, balance, gauss_legendre, register_energy_audit
+from ..analysis.classify import register_section_run
 from ..analysis.steady_solvers import register_steady_solver
 from ..errors import ConvergenceError
 from ..integrators.result import SteadyState
@@ -21,7 +22,7 @@ from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
 from ..analysis.floquet import sorted_multipliers
 from .friction_drive_floquet import GrazingEvent, walker_monodromy, walker_period_map_slope
-from .friction_drive_walker import ContactState, FrictionDriveWalker
+from .friction_drive_walker import PENETRATION_TOL, ContactState, FrictionDriveWalker
 
 __all__ = ["walker_steady_state", "walker_energy_audit"]
 
@@ -31,7 +32,8 @@ TWO_PI = 2.0 * math.pi
 def _period_run(walker, state, record=False):
     """Advance one period from ``state``; return (end_state, segments, events)."""
     segs, evs = [], []
-    on_seg = (lambda a, b, sol: segs.append((a, b))) if record else None
+    # the walker changes a finished piece's end state in place (impact, manifold): copy
+    on_seg = (lambda a, b, sol: segs.append((a.copy(), b.copy()))) if record else None
     end = walker.advance(state, state.tau + TWO_PI, on_segment=on_seg,
                          on_event=evs.append if record else None)
     return end, segs, evs
@@ -68,9 +70,12 @@ _FLIGHT_SEARCH_PERIODS = 50
 def _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope=None):
     """Safeguarded secant iteration on the scalar period map ``u2'(tau_s) -> u2'(tau_s + 2 pi)``.
 
-    Returns ``(start_state, iterations, last_end_state)``; ``start_state`` is
-    ``None`` when the rod is in flight at the section, where the map is not
-    scalar. ``slope``, an estimate of ``P' - 1`` (a neighbouring orbit's
+    Returns ``(start_state, iterations, last_end_state, walk)``;
+    ``start_state`` is ``None`` when the rod is in flight at the section,
+    where the map is not scalar. ``walk`` is the last period map's
+    ``(segments, events)`` (:func:`_period_run` with ``record``): for a
+    converged shooting, the steady period itself, which is then not walked
+    again. ``slope``, an estimate of ``P' - 1`` (a neighbouring orbit's
     multiplier minus 1), makes the first step a Newton step instead of a
     fixed-point step, which covers only ``1 - P'`` of the distance on a
     barely contracting map.
@@ -83,34 +88,34 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope=None):
 
     st = start_state(v0)
     if st.regime == Regime.FLIGHT:
-        return None, 0, st
-    end, _, _ = _period_run(walker, st)
+        return None, 0, st, None
+    end, *walk = _period_run(walker, st, record=True)
     it = 1
     xa, fa = v0, end.du2 - v0
     if fa == 0.0:
-        return st, it, end
+        return st, it, end, walk
     xb = end.du2
     if slope is not None and -2.5 < slope < -1e-6:
         xb = v0 - fa / slope
     while True:
         if end.regime == Regime.FLIGHT:
-            return None, it, end
+            return None, it, end, walk
         it += 1
         if it > max_iter:
             raise ConvergenceError(
                 f"shooting did not converge in `max_iter`={max_iter} period maps "
                 f"(residual {abs(fa) / vs:.3g} relative)")
         st = start_state(xb)
-        end, _, _ = _period_run(walker, st)
+        end, *walk = _period_run(walker, st, record=True)
         if end.regime == Regime.FLIGHT:
-            return None, it, end
+            return None, it, end, walk
         fb = end.du2 - xb
         denom = fb - fa
         slope = denom / (xb - xa) if xb != xa else -1.0
         # stop on the estimated distance to the fixed point, |F| / |F'|: near a
         # barely contracting map (P' -> 1) the residual alone would understate it
         if abs(fb) <= rtol * vs * min(1.0, abs(slope)):
-            return st, it, end
+            return st, it, end, walk
         xn = xb - fb * (xb - xa) / denom if denom != 0.0 else xb + fb
         # the map is contracting, so F(x) = P(x) - x has slope in (-2, 0): a
         # secant slope far outside that range is a kink of the map; take a
@@ -120,6 +125,44 @@ def _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope=None):
         xa, fa, xb = xb, fb, xn
 
 
+
+
+@register_section_run("friction-drive-walker")
+def walker_section_states(scene, q, v, tau0, periods, options):
+    """The walker's states at the ends of ``periods`` drive periods from ``(q, v)`` at ``tau0``.
+
+    The run of :func:`moreau.analysis.classify.classify_long_run`, without
+    the integrator's recording of every event and sample: the same walk
+    (one walker for the whole run, as the integrator has), read at the
+    sections only.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> from moreau.integrators import simulate
+    >>> sc = FrictionDrive(frequency=185.0)
+    >>> qs, vs = walker_section_states(sc, *sc.rest_state(), 0.0, 3, {})
+    >>> r = simulate(sc, (0.0, 6 * np.pi), *sc.rest_state(), "event-driven")
+    >>> qs.shape, bool(np.allclose(qs[3], r.q[-1], rtol=0, atol=1e-14))
+    ((4, 2), True)
+    """
+    opts = dict(options)
+    opts.pop("samples_per_period", None)
+    walker = FrictionDriveWalker(scene, **opts)
+    st = walker.classify(ContactState(tau0, Regime.FLIGHT, q[0], v[0], q[1], v[1]))
+    qs = np.empty((periods + 1, 2))
+    vs = np.empty((periods + 1, 2))
+    qs[0], vs[0] = (st.phi, st.u2), (st.dphi, st.du2)
+    tol = PENETRATION_TOL * max(scene.u10, 1e-300)
+    for k in range(1, periods + 1):
+        st = walker.advance(st, tau0 + k * TWO_PI)
+        gap = scene.sin_phi0 - math.sin(st.phi) - float(scene.u1(st.tau))
+        if gap < -tol:
+            # never hand on a state inside the rotor as if it were a solution
+            raise ConvergenceError(f"the event-driven walker lost a re-contact: gap = {gap:.3g} "
+                                   f"< 0 at tau = {st.tau!r}")
+        qs[k], vs[k] = (st.phi, st.u2), (st.dphi, st.du2)
+    return qs, vs
 
 
 @register_steady_solver("friction-drive-walker")
@@ -159,7 +202,7 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
             # the neighbour's multiplier: the slope of this point's scalar map, nearly
             slope = complex(m[0]).real - 1.0
     v0 = walker.vtip(tau_s) if v_guess is None else float(v_guess)
-    st0, it, last = _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope)
+    st0, it, last, walk = _shoot_scalar(walker, tau_s, v0, rtol, max_iter, slope)
     if st0 is None:
         # the rod is in flight at this section in the steady state: move the
         # section into the longest contact segment of the settled motion
@@ -178,13 +221,15 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
                 "shooting's last state: no steady contact motion was found")
         _, ta, tb = max(contact)
         tau_s = 0.5 * (ta + tb) % TWO_PI
-        st0, it2, last = _shoot_scalar(walker, tau_s, walker.vtip(tau_s), rtol, max_iter)
+        st0, it2, last, walk = _shoot_scalar(walker, tau_s, walker.vtip(tau_s), rtol, max_iter)
         it += it2
         if st0 is None:
             raise ConvergenceError(
                 f"no Poincare section with the rod in contact was found (last tried tau = "
                 f"{tau_s:.4g}); the motion may not be 2 pi-periodic")
-    end, segs, evs = _period_run(walker, st0, record=True)
+    # the converged shooting's last map walked the steady period from st0
+    end = last
+    segs, evs = walk
     residual = abs(end.du2 - st0.du2) / vs
     runs = []  # [tau_start, letter, entered_by_impact]
     impact_at = {e.t for e in evs if e.kind == "impact"}
@@ -222,7 +267,8 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
     # or where an event grazes its surface (no derivative exists there) the map's own
     # central differences, which then measure its slope on a 1e-5 scale
     try:
-        M = walker_monodromy(scene, ss, rtol=walker.rtol, walker=walker)
+        # the period just walked from st0 is the one the monodromy walks: hand it on
+        M = walker_monodromy(scene, ss, rtol=walker.rtol, walker=walker, walk=(segs, evs))
         ss.floquet_method = "saltation"
     except GrazingEvent:
         M = np.array([[walker_period_map_slope(scene, ss, rtol=walker.rtol, walker=walker)]])

@@ -170,3 +170,30 @@ def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, value
         assert w["mode"] == c["mode"] and w["status"] == c["status"] == "ok"
         assert float(w["displacement_per_period_m"]) == pytest.approx(
             float(c["displacement_per_period_m"]), rel=1e-8, abs=1e-15)
+
+
+def test_the_secant_predictor_saves_shootings_and_lands_on_the_same_orbits():
+    # one 1 kHz line of the f-mu atlas: the prediction from the two previous orbits starts
+    # each shooting one order closer than the neighbour's orbit does
+    from dataclasses import asdict
+    from moreau.analysis.continuation import solve_line
+    from moreau.analysis.scheme_settings import ED_REFERENCE, steady_of
+    from moreau.scenes import make_scene
+    from moreau.scenes.friction_drive import PAPER_DEFAULTS
+
+    pts = [(asdict(PAPER_DEFAULTS.with_(mu=m)), 1000.0) for m in np.linspace(0.3, 0.5, 12)]
+
+    def solve(point, guess):
+        p, f = point
+        return steady_of(make_scene("friction-drive", frequency=f, **p), ED_REFERENCE,
+                         guess=guess)
+
+    a = solve_line(pts, solve, predict=True)
+    b = solve_line(pts, solve, predict=False)
+    assert [r["start"] for r in a] == ["cold"] + ["continued"] * 11
+    its = [sum(r["steady"].iterations for r in x[1:]) for x in (a, b)]
+    assert its[0] < its[1]
+    for ra, rb in zip(a, b):
+        assert ra["steady"].mode == rb["steady"].mode
+        assert ra["steady"].displacement_per_period == pytest.approx(
+            rb["steady"].displacement_per_period, rel=1e-8)

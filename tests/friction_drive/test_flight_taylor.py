@@ -129,3 +129,17 @@ def test_a_walk_stuck_at_one_time_stops_at_once_not_after_its_event_budget(monke
 def test_an_unknown_flight_method_is_refused_by_name():
     with pytest.raises(ValueError, match="`flight_method` must be one of"):
         FrictionDriveWalker(make_scene("friction-drive", frequency=185.0), flight_method="rk4")
+
+
+def test_the_walker_s_section_run_is_the_integrator_s_run_read_at_the_sections():
+    # the classification's own run (no recording) against simulate's samples, in flight
+    from moreau.integrators import simulate
+    from moreau.scenes.friction_drive_steady import walker_section_states
+    sc = make_scene("friction-drive", frequency=15000.0)
+    q0, v0 = sc.rest_state()
+    qs, vs = walker_section_states(sc, q0, v0, 0.0, 20, {})
+    r = simulate(sc, (0.0, 20 * TWO_PI), q0, v0, "event-driven", samples_per_period=1)
+    at = [int(np.argmin(abs(r.t - k * TWO_PI))) for k in range(21)]
+    np.testing.assert_allclose(r.t[at], TWO_PI * np.arange(21), rtol=0, atol=1e-12)
+    np.testing.assert_allclose(qs, r.q[at], rtol=0, atol=1e-13)
+    np.testing.assert_allclose(vs, r.v[at], rtol=0, atol=1e-13)
