@@ -43,14 +43,15 @@ import numpy as np
 
 from .._validate import positive_int
 from ..errors import InputError, MoreauError
-from ..integrators import get_integrator, simulate
+from ..integrators import get_integrator
 from ..integrators.base import scheme_options as options_of
 from ..scenes import registry
 from .periodic_shooting import period_map_options
+from .section_runs import section_states
 from .statistical import BATCHES, MAX_LAG1, batch_means, mser5_truncation
 
 __all__ = ["classify_long_run", "classification_columns", "sequence_period", "CLASSIFY_COLUMNS",
-           "CLASSIFY_PERIODS", "MAX_PERIOD_K", "RUNAWAY_FACTOR", "register_section_run"]
+           "CLASSIFY_PERIODS", "MAX_PERIOD_K", "RUNAWAY_FACTOR"]
 
 TWO_PI = 2.0 * math.pi
 #: the longest period the sampled sequence is tested for
@@ -104,45 +105,6 @@ def _state_period(x, rtol):
         if np.all(np.abs(x[k:] - x[:-k]) <= scale):
             return k
     return 0
-
-
-#: scheme name -> its own section run (register_section_run)
-_SECTION_RUNS = {}
-
-
-def register_section_run(scheme):
-    """Decorator registering a scheme's own run from section to section.
-
-    The registered function is called as ``fn(scene, q, v, tau0, periods,
-    options)`` and returns ``(qs, vs)``, the states at ``tau0 + 2 pi k`` for
-    ``k = 0 .. periods`` (arrays of shape ``(periods + 1, ndof)``), or
-    raises a :class:`~moreau.errors.MoreauError` naming why the run failed.
-    A scheme without one is run through :func:`moreau.integrators.simulate`
-    and sampled once a period; a scheme with one (the friction drive's
-    walker) spares the integrator's recording of every event.
-    """
-    def deco(fn):
-        _SECTION_RUNS[scheme] = fn
-        return fn
-    return deco
-
-
-def _section_states(scene, run, opts, ts, q, v, m):
-    # the states at the ends of m drive periods from (q, v) at ts
-    registry.discover()
-    own = _SECTION_RUNS.get(run)
-    if own is not None:
-        return own(scene, q, v, ts, m, opts)
-    res = simulate(scene, (ts, ts + m * TWO_PI), q, v, run, **_sampled_options(run, opts))
-    if not res.success:
-        raise MoreauError(f"{run}: {res.message}")
-    bounds = ts + TWO_PI * np.arange(m + 1)
-    tol = 1e-9 * (1.0 + np.abs(bounds))
-    idx = np.searchsorted(res.t, bounds + tol, side="right") - 1
-    if np.any(idx < 0) or np.any(np.abs(res.t[idx] - bounds) > tol):
-        raise MoreauError(f"scheme {run!r} did not sample the run at the ends of the drive "
-                          "periods")
-    return res.q[idx], res.v[idx]
 
 
 def _run_scheme(scene, scheme):
@@ -231,7 +193,7 @@ def classify_long_run(scene, scheme="event-driven", options=None, start=None, se
         m = min(CHUNK, budget - d.size)
         q[cyclic] = 0.0
         try:
-            qs, vs_ = _section_states(scene, run, opts, ts, q, v, m)
+            qs, vs_, _ = section_states(scene, run, _sampled_options(run, opts), ts, q, v, m)
         except MoreauError as exc:
             raise MoreauError(f"the run failed after {d.size} periods ({exc})") from exc
         d = np.concatenate([d, np.diff(qs[:, cyclic])])

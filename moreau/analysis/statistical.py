@@ -62,11 +62,12 @@ import numpy as np
 from scipy import stats as _stats
 
 from .._validate import positive, positive_int
-from ..errors import BudgetExhaustedError, ConvergenceError, InputError
-from ..integrators import get_integrator, simulate
+from ..errors import BudgetExhaustedError, ConvergenceError, InputError, MoreauError
+from ..integrators import get_integrator
 from ..integrators.base import check_options, scheme_options as options_of
 from ..integrators.result import SteadyState
 from .periodic_shooting import period_map_options
+from .section_runs import section_states
 
 __all__ = ["statistical_steady_state", "mser5_truncation", "batch_means", "METHOD",
            "MAX_PERIODS", "BATCHES", "CHUNK", "RESOLUTION", "MAX_LAG1"]
@@ -176,20 +177,11 @@ def _run_periods(scene, scheme, q, v, ts, m, cyclic, opts):
     """Displacements over ``m`` periods from ``(q, v)`` at ``ts``, and the end state."""
     q = np.array(q, float)
     q[cyclic] = 0.0
-    res = simulate(scene, (ts, ts + m * TWO_PI), q, np.array(v, float), scheme, **opts)
-    if not res.success:
-        raise ConvergenceError(f"the run of the statistical steady state failed ({scheme}): "
-                               f"{res.message}")
-    bounds = ts + TWO_PI * np.arange(m + 1)
-    tol = 1e-9 * (1.0 + np.abs(bounds))
-    # the last sample at each period's end (an event exactly there records it twice)
-    idx = np.searchsorted(res.t, bounds + tol, side="right") - 1
-    if np.any(idx < 0) or np.any(np.abs(res.t[idx] - bounds) > tol):
-        raise ConvergenceError(f"scheme {scheme!r} did not sample the run at the ends of the "
-                               f"drive periods; a statistical steady state needs them")
-    u = res.q[idx, cyclic]
-    vmax = float(np.max(np.abs(res.v))) if res.v.size else 0.0
-    return np.diff(u), res.q[-1].copy(), res.v[-1].copy(), vmax
+    try:
+        qs, vs, vmax = section_states(scene, scheme, opts, ts, q, np.array(v, float), m)
+    except MoreauError as exc:
+        raise ConvergenceError(f"the run of the statistical steady state failed: {exc}") from exc
+    return np.diff(qs[:, cyclic]), qs[-1].copy(), vs[-1].copy(), vmax
 
 
 def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, section_tau=0.0,
