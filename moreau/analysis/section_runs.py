@@ -81,6 +81,9 @@ def section_states(scene, scheme, options, tau0, q, v, periods):
     """
     registry.discover()
     own = _SECTION_RUNS.get(scheme)
+    if own is None and scheme == "event-driven":
+        # "event-driven" runs a scene's own reference where it has one (simulate does so)
+        own = _SECTION_RUNS.get(getattr(scene, "reference_integrator", None))
     if own is not None:
         qs, vs = own(scene, q, v, tau0, periods, options)
         return qs, vs, float(np.max(np.abs(vs))) if vs.size else 0.0

@@ -68,7 +68,10 @@ def test_periodic_orbit_displacement_is_inside_the_interval():
     assert lo <= orbit.displacement_per_period <= hi
     # a converged series claims no more than the resolution
     assert hi - lo == pytest.approx(2 * RESOLUTION * abs(ss.displacement_per_period), rel=1e-6)
-    assert ss.periods_used >= 100 and ss.stats["transient_periods"] < 50
+    # the orbit is reached to 1e-8 within 6 periods; after that the series is constant to
+    # rounding (3e-15), where MSER-5's cut is set by the rounding: the walker's section run
+    # and simulate's samples agree to 3e-15 and cut at 70 and below 50
+    assert ss.periods_used >= 100 and ss.stats["transient_periods"] < 100
 
 
 @pytest.mark.slow

@@ -143,3 +143,18 @@ def test_the_walker_s_section_run_is_the_integrator_s_run_read_at_the_sections()
     np.testing.assert_allclose(r.t[at], TWO_PI * np.arange(21), rtol=0, atol=1e-12)
     np.testing.assert_allclose(qs, r.q[at], rtol=0, atol=1e-13)
     np.testing.assert_allclose(vs, r.v[at], rtol=0, atol=1e-13)
+
+
+def test_event_driven_section_runs_of_the_friction_drive_use_the_walker_s_own_run(monkeypatch):
+    # "event-driven" names the scene's own reference: the statistical steady state and the
+    # classification read the walker at the sections instead of simulate's recording
+    import moreau.analysis.section_runs as runs
+
+    def refuse(*a, **k):
+        raise AssertionError("simulate was called")
+
+    monkeypatch.setattr(runs, "simulate", refuse)
+    sc = make_scene("friction-drive", frequency=15000.0)
+    qs, vs, vmax = runs.section_states(sc, "event-driven", {"samples_per_period": 1}, 0.0,
+                                       *sc.rest_state(), 5)
+    assert qs.shape == vs.shape == (6, 2) and vmax == np.max(np.abs(vs))
