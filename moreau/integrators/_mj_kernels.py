@@ -886,11 +886,14 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
         # the gaps at (q_k, t_k) were computed at the end of the step before
         if not (const_mass and k > k0):
             mass_fn(par, q, M)
-        forces_fn(par, q, v, t1, D, has_jac)
-        if th != 1.0:
-            forces_fn(par, q, v, tk, D0, False)
+        # the model is evaluated in the order of its times: t_k (where the step before
+        # ended), then t_k+1, so that a model which keeps its last transcendentals
+        # (the friction drive's sines and cosines of the phase) finds them still current
         if nc > 0:
             contacts_fn(par, q, tk, G0, k == k0, False)
+        if th != 1.0:
+            forces_fn(par, q, v, tk, D0, False)
+        forces_fn(par, q, v, t1, D, has_jac)
         if th != 1.0:
             for i in range(n):
                 D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
