@@ -197,18 +197,6 @@ def _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
     return num / scale
 
 
-@njit(cache=True)
-def _max_residual(stats, num, scale):
-    # stats[S_RES] = max(stats[S_RES], num / scale), dividing only where the quotient can
-    # exceed it: fl(num / scale) > r implies num > r scale exactly, hence num >=
-    # fl(r scale) for the double num, so the test skips no update. On most steps the
-    # largest residual stands, and the division is skipped (2 % of a friction-drive step)
-    if num >= stats[S_RES] * scale:
-        res = num / scale
-        if res > stats[S_RES]:
-            stats[S_RES] = res
-
-
 #: the frictional one-contact solve and its residual, as the loops call them; a model's
 #: own loop inlines them instead (SPECIALISED)
 _one_contact_fr = _one_contact
@@ -1046,7 +1034,15 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                                                pn, 0.0)
             pN[i] = pn
             pT[i] = pt
-            _max_residual(stats, rnum, rscale)
+            # stats[S_RES] = max(stats[S_RES], rnum / rscale), dividing only where the
+            # quotient can exceed it: fl(rnum / rscale) > r implies rnum > r rscale exactly,
+            # hence rnum >= fl(r rscale) for the double rnum, so the test skips no update.
+            # On most steps the largest residual stands and the division is skipped
+            # (2 % of a friction-drive step)
+            if rnum >= stats[S_RES] * rscale:
+                res = rnum / rscale
+                if res > stats[S_RES]:
+                    stats[S_RES] = res
             for j in range(n):
                 v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
         elif na > 0:
