@@ -141,6 +141,8 @@ def _build(model, template, stub=False):
     namespace = dict(vars(module))
     namespace.update(consts, mass_fn=model.mass, forces_fn=model.forces,
                      contacts_fn=model.contacts, gaps_fn=model.gaps or no_gaps)
+    # kernels the template's module binds otherwise in a model's own loop (inlined ones)
+    namespace.update(getattr(module, "SPECIALISED", {}))
     if stub:
         # the variant for runs that cannot reach these kernels (see SHARED_INDIRECT)
         namespace.update({name: getattr(module, spec[1])

@@ -72,7 +72,7 @@ from ._units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from ._rod import rod_forces, rod_gap, rod_rows
+from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
 from .base import Scene, params_with
 from .friction_drive import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
@@ -170,8 +170,11 @@ class BidirectionalDriveParams:
 
 
 # -- compiled model (moreau.compiled) ---------------------------------------------------
-# par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b; rod r (angle q[r], stator phase
-# delta_r) on the rotor q[2], the second rod mirrored (sgn = -1)
+# par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b, then the memory of memo_sincos:
+# rod r's angle at MEMO + 6 r, its phase at MEMO + 6 r + 3; rod r (angle q[r], stator
+# phase delta_r) on the rotor q[2], the second rod mirrored (sgn = -1)
+MEMO = 8
+
 
 @njit(cache=True)
 def _mass(par, q, M):
@@ -183,33 +186,38 @@ def _mass(par, q, M):
 @njit(cache=True)
 def _forces(par, q, v, t, D, need_jac):
     for r in range(2):
-        rod_forces(D, r, par[1], par[2], par[4 + r], math.sin(q[r]), math.cos(q[r]),
-                   math.cos(t - par[6 + r]), need_jac)
+        s, c = memo_sincos(par, MEMO + 6 * r, q[r])
+        ct = memo_sincos(par, MEMO + 6 * r + 3, t - par[6 + r])[1]
+        rod_forces(D, r, par[1], par[2], par[4 + r], s, c, ct, need_jac)
     D[2, 0] = -par[3]
 
 
 @njit(cache=True)
 def _gaps(par, q, t, G):
     for r in range(2):
-        G[r, 0] = rod_gap(par[2], par[4 + r], math.sin(q[r]), math.cos(t - par[6 + r]))
+        s = memo_sincos(par, MEMO + 6 * r, q[r])[0]
+        ct = memo_sincos(par, MEMO + 6 * r + 3, t - par[6 + r])[1]
+        G[r, 0] = rod_gap(par[2], par[4 + r], s, ct)
 
 
 @njit(cache=True)
 def _contacts(par, q, t, G, need_gap, need_T):
     for r in range(2):
-        s = math.sin(q[r])
+        s, c = memo_sincos(par, MEMO + 6 * r, q[r])
+        st, ct = memo_sincos(par, MEMO + 6 * r + 3, t - par[6 + r])
         if need_gap:
-            G[r, 0] = rod_gap(par[2], par[4 + r], s, math.cos(t - par[6 + r]))
-        rod_rows(G, r, r, 2, 3, 1.0 - 2.0 * r, par[4 + r], s, math.cos(q[r]),
-                 math.sin(t - par[6 + r]), need_T)
+            G[r, 0] = rod_gap(par[2], par[4 + r], s, ct)
+        rod_rows(G, r, r, 2, 3, 1.0 - 2.0 * r, par[4 + r], s, c, st, need_T)
 
 
 @njit(cache=True)
 def _drift(par, q, v, t, Dr):
     for r in range(2):
         w2 = v[r] * v[r]
-        Dr[r, 0] = w2 * math.sin(q[r]) - par[4 + r] * math.cos(t - par[6 + r])
-        Dr[r, 1] = (1.0 - 2.0 * r) * w2 * math.cos(q[r])
+        s, c = memo_sincos(par, MEMO + 6 * r, q[r])
+        ct = memo_sincos(par, MEMO + 6 * r + 3, t - par[6 + r])[1]
+        Dr[r, 0] = w2 * s - par[4 + r] * ct
+        Dr[r, 1] = (1.0 - 2.0 * r) * w2 * c
 
 
 def params_from_kwargs(**kwargs):
@@ -354,8 +362,10 @@ class BidirectionalDrive(DriveUnits, Scene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
+        # the parameters, then per rod the memory of its angle's and its phase's sines
+        # and cosines (MEMO)
         par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.u10[0], self.u10[1],
-                        self.delta[0], self.delta[1]], dtype=np.float64)
+                        self.delta[0], self.delta[1], *(MEMO_SLOTS * 4)], dtype=np.float64)
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 3, 2, True, True, gaps=_gaps)
 
     def single_rod(self, which):

@@ -85,7 +85,7 @@ from ._units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from ._rod import rod_forces, rod_gap, rod_rows
+from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
 from .base import Scene, params_with
 from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ..analysis.steady_state import find_steady_state
@@ -350,8 +350,10 @@ class FrictionDrive(DriveUnits, Scene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
-        par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp],
-                       dtype=np.float64)
+        # the parameters, then the memory of the last angle's and phase's sines and
+        # cosines (PHI_MEMO, PHASE_MEMO)
+        par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp,
+                        *MEMO_SLOTS, *MEMO_SLOTS], dtype=np.float64)
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
 
     # -- units ------------------------------------------------------------------
@@ -384,7 +386,11 @@ class FrictionDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0, fp -------------
+# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0, fp, then the memory of
+# memo_sincos: angle phi, sin, cos; phase tau, sin, cos -----------------------------------
+PHI_MEMO = 6
+PHASE_MEMO = 9
+
 
 @njit(cache=True)
 def _mass(par, q, M):
@@ -394,8 +400,9 @@ def _mass(par, q, M):
 
 @njit(cache=True)
 def _forces(par, q, v, t, D, need_jac):
-    s, c = math.sin(q[0]), math.cos(q[0])
-    rod_forces(D, 0, par[1], par[4], par[2], s, c, math.cos(t), need_jac)
+    s, c = memo_sincos(par, PHI_MEMO, q[0])
+    ct = memo_sincos(par, PHASE_MEMO, t)[1]
+    rod_forces(D, 0, par[1], par[4], par[2], s, c, ct, need_jac)
     # the preload's torque f_p cos(phi) (module docstring); + 0.0 without one
     D[0, 0] += par[5] * c
     if need_jac:
@@ -405,22 +412,25 @@ def _forces(par, q, v, t, D, need_jac):
 
 @njit(cache=True)
 def _gaps(par, q, t, G):
-    G[0, 0] = rod_gap(par[4], par[2], math.sin(q[0]), math.cos(t))
+    s = memo_sincos(par, PHI_MEMO, q[0])[0]
+    G[0, 0] = rod_gap(par[4], par[2], s, memo_sincos(par, PHASE_MEMO, t)[1])
 
 
 @njit(cache=True)
 def _contacts(par, q, t, G, need_gap, need_T):
-    s = math.sin(q[0])
+    s, c = memo_sincos(par, PHI_MEMO, q[0])
+    st, ct = memo_sincos(par, PHASE_MEMO, t)
     if need_gap:
-        G[0, 0] = rod_gap(par[4], par[2], s, math.cos(t))
-    rod_rows(G, 0, 0, 1, 2, 1.0, par[2], s, math.cos(q[0]), math.sin(t), need_T)
+        G[0, 0] = rod_gap(par[4], par[2], s, ct)
+    rod_rows(G, 0, 0, 1, 2, 1.0, par[2], s, c, st, need_T)
 
 
 @njit(cache=True)
 def _drift(par, q, v, t, Dr):
     w2 = v[0] * v[0]
-    Dr[0, 0] = w2 * math.sin(q[0]) - par[2] * math.cos(t)
-    Dr[0, 1] = w2 * math.cos(q[0])
+    s, c = memo_sincos(par, PHI_MEMO, q[0])
+    Dr[0, 0] = w2 * s - par[2] * memo_sincos(par, PHASE_MEMO, t)[1]
+    Dr[0, 1] = w2 * c
 
 
 def params_from_kwargs(**kwargs):
