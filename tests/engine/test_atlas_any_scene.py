@@ -19,7 +19,9 @@ def test_every_point_is_the_scenes_steady_state():
                                                        (0.05, 0.3)]
     for r in rows:
         motor = make_scene("stick-slip-motor", frequency=1000.0, load=r["load [N]"], mu=r["mu"])
-        ss = find_steady_state(motor)
+        # the mode and displacement only: the multipliers come after them (2 period maps
+        # of the 8 that are not needed here)
+        ss = find_steady_state(motor, floquet=False)
         assert r["status"] == "ok" and r["mode"] == ss.mode
         assert r["displacement_per_period_m"] == pytest.approx(
             motor.displacement_to_si(ss.displacement_per_period), rel=1e-9)
