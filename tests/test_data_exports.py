@@ -45,7 +45,7 @@ def test_an_atlas_as_an_xarray_dataset_on_its_grid():
     # so a cell read from the wrong row shows
     rows = run_scene_atlas("friction-drive", ("load", [-2e-4, -1e-4, 0.0]), ("mu", [0.1, 0.6]),
                            frequency=185.0, out=None, progress=False, plot=False,
-                           log=lambda s: None)
+                           n_jobs=1, log=lambda s: None)
     assert len({r["displacement_per_period_m"] for r in rows}) == 6
     assert {r["mode"] for r in rows} == {"NP", "NS"}
     ds = rows_to_xarray(rows, ["load [N]", "mu"])
