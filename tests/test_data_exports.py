@@ -39,12 +39,18 @@ def test_a_history_without_a_scene_keeps_its_own_units():
 
 
 def test_an_atlas_as_an_xarray_dataset_on_its_grid():
-    rows = run_scene_atlas("stick-slip-motor", ("load", [0.0, 0.05, 0.1]), ("mu", [0.2, 0.3]),
-                           frequency=1000.0, out=None, progress=False, plot=False,
-                           log=lambda s: None)
+    # the generic atlas on the friction drive: its steady states (the walker's) take 0.3 s
+    # for the grid, against 6 s for the stick-slip motor's event-driven shooting; every cell
+    # has a displacement of its own and the mu axis changes the mode (NP at 0.1, NS at 0.6),
+    # so a cell read from the wrong row shows
+    rows = run_scene_atlas("friction-drive", ("load", [-2e-4, -1e-4, 0.0]), ("mu", [0.1, 0.6]),
+                           frequency=185.0, out=None, progress=False, plot=False,
+                           n_jobs=1, log=lambda s: None)
+    assert len({r["displacement_per_period_m"] for r in rows}) == 6
+    assert {r["mode"] for r in rows} == {"NP", "NS"}
     ds = rows_to_xarray(rows, ["load [N]", "mu"])
     assert ds["displacement_per_period_m"].shape == (3, 2)
-    assert ds["load"].attrs["units"] == "N" and ds["load"].values.tolist() == [0.0, 0.05, 0.1]
+    assert ds["load"].attrs["units"] == "N" and ds["load"].values.tolist() == [-2e-4, -1e-4, 0.0]
     for r in rows:
         cell = ds.sel(load=r["load [N]"], mu=r["mu"])
         assert float(cell["displacement_per_period_m"]) == r["displacement_per_period_m"]

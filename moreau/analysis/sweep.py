@@ -20,7 +20,7 @@ figure of the displacement per period and the operation mode.
 Examples
 --------
 >>> rows = run_scene_sweep("stick-slip-motor", "load", [0.0, 0.1], frequency=1000.0,
-...                        out=None, progress=False, plot=False, log=lambda s: None)
+...                        out=None, progress=False, plot=False, n_jobs=1, log=lambda s: None)
 >>> [r["status"] for r in rows], rows[0]["displacement_per_period_m"] > rows[1]["displacement_per_period_m"]
 (['ok', 'ok'], True)
 """

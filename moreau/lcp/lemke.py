@@ -1232,8 +1232,11 @@ def _solve(M, q, max_iter, tol, check_input, covering):
             M, q, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
     else:
+        # scale_d given, not left to its default: an omitted argument is typed as its own
+        # specialisation, a second compile of the whole solver (6 CPU s on a cold cache)
+        # where the covering-of-ones path already compiled it for a boolean
         status, pivots, residual = _solve_packed(
-            M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol,
+            M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
         )
     if status == SOLVED:
         return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")

@@ -64,8 +64,11 @@ class _Drive:
 
     def __call__(self, tau):
         """``(s, s', s'')`` at ``tau``; right-continuous where ``s''`` jumps."""
-        t = np.asarray(tau, dtype=float)
-        return self._eval(t)
+        if isinstance(tau, (float, int, np.floating, np.integer)):
+            # one time (the event-driven schemes ask for one per call): a subclass's
+            # `_eval` may take the scalar path; np.asarray would make it a 0-d array
+            return self._eval(tau)
+        return self._eval(np.asarray(tau, dtype=float))
 
     def acceleration_crossings(self, level):
         """Sorted points of ``[0, 2 pi)`` where ``s''`` crosses or touches ``level``,

@@ -252,8 +252,10 @@ def test_bad_covering_vector():
 # -- the compiled kernel -------------------------------------------------------
 
 @njit(cache=True)
-def _many_small_lcps(Ms, qs, zs, ws):
-    # what a compiled time stepper does: many LCPs, no Python per pivot
+def _many_small_lcps(Ms, qs, zs, ws, max_iter):
+    # what a compiled time stepper does: many LCPs, no Python per pivot. max_iter is an
+    # argument, as in the steppers: a constant 1000 would be typed as a literal and make
+    # lemke_kernel a specialisation of its own, compiled again for the calls from Python
     n = qs.shape[1]
     statuses = np.empty(qs.shape[0], dtype=np.int64)
     d = np.ones(n)
@@ -261,9 +263,10 @@ def _many_small_lcps(Ms, qs, zs, ws):
     work, iwork = lemke_workspace(n)
     for k in range(qs.shape[0]):
         if k % 2 == 0:
-            st, piv, res = lemke_kernel(Ms[k], qs[k], zs[k], ws[k], 1000, 1e-9)
+            st, piv, res = lemke_kernel(Ms[k], qs[k], zs[k], ws[k], max_iter, 1e-9)
         else:
-            st, piv, res = lemke_core(Ms[k], qs[k], d, zs[k], ws[k], ray, work, iwork, 1000, 1e-9)
+            st, piv, res = lemke_core(Ms[k], qs[k], d, zs[k], ws[k], ray, work, iwork, max_iter,
+                                      1e-9)
         statuses[k] = st
     return statuses
 
@@ -275,7 +278,7 @@ def test_kernel_is_callable_from_compiled_code():
     qs = rng.standard_normal((K, n))
     zs = np.empty((K, n))
     ws = np.empty((K, n))
-    st = _many_small_lcps(Ms, qs, zs, ws)
+    st = _many_small_lcps(Ms, qs, zs, ws, 1000)
     assert np.all(st == SOLVED)
     for k in range(K):
         ref = solve_lcp(Ms[k], qs[k])
