@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from moreau.analysis.steady_state import find_steady_state
-from moreau.errors import PainleveError, InputError
+from moreau.errors import InputError, MoreauError, PainleveError
 from moreau.integrators import simulate
 from moreau.integrators.result import Event
 from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
@@ -355,6 +355,14 @@ def test_a_walk_that_stops_advancing_time_fails_instead_of_growing_for_ever(monk
     assert not r.success
     assert "makes no progress: 1001 events in a row at tau = " in r.message
     assert len(r.events) < 1100
+    # the walker's own advance (shooting, section runs) stops the same way, not after
+    # its budget of 100 000 events
+    w = FrictionDriveWalker(sc)
+    st = w.classify(ContactState(0.0, Regime.FLIGHT, q0[0], v0[0], q0[1], v0[1]))
+    seen = []
+    with pytest.raises(MoreauError, match="makes no progress: 1001 events in a row"):
+        w.advance(st, 2 * np.pi, on_event=seen.append)
+    assert len(seen) < 1100
 
 
 def test_a_rebound_of_zero_length_closes_the_contact_instead_of_starting_again():

@@ -14,8 +14,6 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from moreau.errors import MoreauError
-from moreau.integrators.result import Event
 from moreau.regimes import Regime
 from moreau.scenes import make_scene
 from moreau.scenes.friction_drive import PAPER_DEFAULTS
@@ -105,25 +103,6 @@ def test_a_lift_off_that_dop853_took_for_a_touchdown_for_ever_is_a_hop():
     kinds = [e.kind for e in evs]
     assert kinds[:38] == ["liftoff", "impact"] * 19 and set(kinds[38:]) <= {"liftoff"}
     assert all(b.t - a.t > 1.0 for a, b in zip(evs, evs[1:]))
-
-
-def test_a_walk_stuck_at_one_time_stops_at_once_not_after_its_event_budget(monkeypatch):
-    sc = make_scene("friction-drive", frequency=185.0)
-    q0, v0 = sc.rest_state()
-    real = FrictionDriveWalker.segment
-
-    def stuck(self, st, tau_end, on_segment=None):
-        if st.tau > 1.0:
-            return st.copy(), Event(st.tau, "touchdown", Regime(int(st.regime)), st.regime)
-        return real(self, st, tau_end, on_segment)
-
-    monkeypatch.setattr(FrictionDriveWalker, "segment", stuck)
-    w = FrictionDriveWalker(sc)
-    st = w.classify(ContactState(0.0, F, q0[0], v0[0], q0[1], v0[1]))
-    seen = []
-    with pytest.raises(MoreauError, match="makes no progress: 1001 events in a row"):
-        w.advance(st, TWO_PI, on_event=seen.append)
-    assert len(seen) < 1100
 
 
 def test_an_unknown_flight_method_is_refused_by_name():
