@@ -180,8 +180,8 @@ def classify_long_run(scene, scheme="event-driven", options=None, start=None, se
         raise InputError(f"`scene` must have one cyclic coordinate, got {cyc!r}")
     cyclic = int(cyc[0])
     run = _run_scheme(scene, scheme)
-    opts = dict(options or {})
-    _sampled_options(run, opts)     # refuses a setting the scheme does not take, before work
+    # refuses a setting the scheme does not take, before any work
+    opts = _sampled_options(run, options or {})
     q, v = _start(scene, start)
     ts = float(section_tau)
     keep = [i for i in range(scene.ndof) if i != cyclic]
@@ -193,7 +193,7 @@ def classify_long_run(scene, scheme="event-driven", options=None, start=None, se
         m = min(CHUNK, budget - d.size)
         q[cyclic] = 0.0
         try:
-            qs, vs_, _ = section_states(scene, run, _sampled_options(run, opts), ts, q, v, m)
+            qs, vs_, _ = section_states(scene, run, opts, ts, q, v, m)
         except MoreauError as exc:
             raise MoreauError(f"the run failed after {d.size} periods ({exc})") from exc
         d = np.concatenate([d, np.diff(qs[:, cyclic])])

@@ -160,7 +160,7 @@ def flight_steps(tau, phi, dphi, tau_end, skip, cleared, a, P, b, sin_phi0, u10,
     C = np.empty(n + 1)
     cs = np.empty(n + 1)
     g0 = sin_phi0 - u10
-    tau_start = tau - 0.0
+    tau_start = tau
     armed_at = tau + skip
     steps = 0
     while tau < tau_end:

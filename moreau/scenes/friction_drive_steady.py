@@ -22,7 +22,7 @@ from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
 from ..analysis.floquet import sorted_multipliers
 from .friction_drive_floquet import GrazingEvent, walker_monodromy, walker_period_map_slope
-from .friction_drive_walker import PENETRATION_TOL, ContactState, FrictionDriveWalker
+from .friction_drive_walker import ContactState, FrictionDriveWalker
 
 __all__ = ["walker_steady_state", "walker_energy_audit"]
 
@@ -153,14 +153,9 @@ def walker_section_states(scene, q, v, tau0, periods, options):
     qs = np.empty((periods + 1, 2))
     vs = np.empty((periods + 1, 2))
     qs[0], vs[0] = (st.phi, st.u2), (st.dphi, st.du2)
-    tol = PENETRATION_TOL * max(scene.u10, 1e-300)
     for k in range(1, periods + 1):
         st = walker.advance(st, tau0 + k * TWO_PI)
-        gap = scene.sin_phi0 - math.sin(st.phi) - float(scene.u1(st.tau))
-        if gap < -tol:
-            # never hand on a state inside the rotor as if it were a solution
-            raise ConvergenceError(f"the event-driven walker lost a re-contact: gap = {gap:.3g} "
-                                   f"< 0 at tau = {st.tau!r}")
+        walker.checked_gap(st)
         qs[k], vs[k] = (st.phi, st.u2), (st.dphi, st.du2)
     return qs, vs
 

@@ -225,7 +225,13 @@ class FrictionDriveWalker:
             raise InputError(f"`flight_method` must be one of {list(FLIGHT_METHODS)}, "
                              f"got {flight_method!r}")
         self.flight_method = flight_method
-        self._flight_a = float(scene.P) * float(scene.sin_phi0) + float(scene.fp)
+        u10 = float(scene.u10)
+        # the flight's constant arguments: a, P and b of the equation of motion, sin phi0,
+        # u10, the Taylor terms' tolerance, the longest step and the gap's tolerance
+        self._flight_args = (float(scene.P) * float(scene.sin_phi0) + float(scene.fp),
+                             float(scene.P), 0.5 * u10, float(scene.sin_phi0), u10,
+                             1e-3 * self.rtol * max(u10, 1e-12), FLIGHT_HMAX,
+                             1e-13 * max(u10, 1e-300))
         self._flight_buffers = (np.empty((FLIGHT_CAPACITY, FLIGHT_ORDER + 1)),
                                 np.empty(FLIGHT_CAPACITY), np.empty(FLIGHT_CAPACITY))
         self._build_tables()
@@ -253,6 +259,20 @@ class FrictionDriveWalker:
         # scale of the slip velocity, for tolerances
         self.vscale = float(np.max(np.abs(self.g_vtip))) + 1e-300
         self.fscale = float(np.max(np.abs(self.g_fN[_S]))) + 1e-300
+
+    def checked_gap(self, st):
+        """The gap of ``st``; raises where it is below ``-PENETRATION_TOL * u10``.
+
+        Such a state is a re-contact the flight's event search did not see:
+        it is never recorded or handed on as if it were a solution.
+        """
+        sc = self.scene
+        gap = sc.sin_phi0 - math.sin(st.phi) - float(sc.u1(st.tau))
+        if gap < -PENETRATION_TOL * max(sc.u10, 1e-300):
+            raise MoreauError(
+                f"the event-driven walker lost a re-contact: gap = {gap:.3g} < 0 at "
+                f"tau = {st.tau!r} in regime {Regime(int(st.regime)).name}")
+        return gap
 
     def reset(self):
         """Forget the impacts counted and a pending rebound skip: a new walk on the same tables."""
@@ -517,16 +537,13 @@ class FrictionDriveWalker:
         skip = 1e-9 * max(1.0, abs(t0))
         if self._rebound_skip is not None:
             skip, self._rebound_skip = self._rebound_skip, None
-        u10 = float(sc.u10)
-        eps = 1e-3 * self.rtol * max(u10, 1e-12)
-        tol = 1e-13 * max(u10, 1e-300)
         tau, phi, dphi, cleared = t0, st.phi, st.dphi, False
         coef, starts, widths = self._flight_buffers
         pieces = []
         while True:
             code, tau, phi, dphi, n, cleared = flight_steps(
-                tau, phi, dphi, tau_end, t0 + skip - tau, cleared, self._flight_a, float(sc.P),
-                0.5 * u10, float(sc.sin_phi0), u10, eps, FLIGHT_HMAX, tol, coef, starts, widths)
+                tau, phi, dphi, tau_end, t0 + skip - tau, cleared, *self._flight_args,
+                coef, starts, widths)
             if dense:
                 pieces.append((coef[:n].copy(), starts[:n].copy(), widths[:n].copy()))
             if code != _FT_FULL:
@@ -847,13 +864,7 @@ class EventDriven(Integrator):
         else:
             fN, fT = (float(x) for x in sc.contact_forces(st.tau, st.regime))
         slip = st.du2 + math.sin(st.phi) * st.dphi
-        gap = sc.sin_phi0 - math.sin(st.phi) - float(sc.u1(st.tau))
-        if gap < -PENETRATION_TOL * max(sc.u10, 1e-300):
-            # a re-contact the flight's event search did not see: never record a state
-            # inside the rotor as if it were a solution
-            raise MoreauError(
-                f"the event-driven walker lost a re-contact: gap = {gap:.3g} < 0 at "
-                f"tau = {st.tau!r} in regime {Regime(int(st.regime)).name}")
+        gap = self.walker.checked_gap(st)
         return (st.tau, np.array([st.phi, st.u2]), np.array([st.dphi, st.du2]), int(st.regime),
                 fN, fT, slip, gap)
 
