@@ -193,8 +193,10 @@ class FrictionDriveWalker:
     grid : int
         Samples per period used to bracket events before Brent's method.
     max_impacts : int
-        Impacts allowed per run before an accumulation (Zeno) is declared and
-        the contact is closed.
+        Impacts allowed within one drive period (``2 pi`` in tau) before an
+        accumulation (Zeno) is declared and the contact is closed; one more
+        in that period is an error. The count is per period, not per run:
+        an elastic rod that bounces once a period runs for as long as asked.
     flight_method : {"taylor", "dop853"}
         Flight segments by the compiled Taylor series (the default, see
         :mod:`moreau.scenes._flight_taylor`) or by SciPy's DOP853 at ``rtol``
@@ -218,6 +220,7 @@ class FrictionDriveWalker:
         self.mu = float(scene.mu[0])
         self.e = float(scene.restitution[0])
         self.n_impacts = 0
+        self._burst_start = -math.inf
         self.zeno_time = 1e-6
         self._rebound_skip = None
         self.counters = {"events": 0, "impacts": 0, "flight_segments": 0, "root_solves": 0}
@@ -277,6 +280,7 @@ class FrictionDriveWalker:
     def reset(self):
         """Forget the impacts counted and a pending rebound skip: a new walk on the same tables."""
         self.n_impacts = 0
+        self._burst_start = -math.inf
         self._rebound_skip = None
 
     # -- explicit contact quantities ------------------------------------------
@@ -669,10 +673,15 @@ class FrictionDriveWalker:
         out = st.copy()
         out.dphi = st.dphi + 3.0 * (-c * pN + s * pT)
         out.du2 = st.du2 + pT / sc.J
+        if st.tau - self._burst_start > TWO_PI:
+            # a new drive period of impacts: an accumulation is counted within one
+            self._burst_start = st.tau
+            self.n_impacts = 0
         self.n_impacts += 1
         self.counters["impacts"] += 1
         if self.n_impacts > self.max_impacts:
-            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts")
+            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts within one "
+                              f"drive period before tau = {st.tau:.12g}")
         return out, pN, pT
 
     # -- entering a regime ------------------------------------------------------------

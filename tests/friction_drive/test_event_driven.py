@@ -379,3 +379,20 @@ def test_a_rebound_of_zero_length_closes_the_contact_instead_of_starting_again()
     # and the walk goes on: a whole period, with its flights and impacts
     later = w.advance(end, end.tau + TWO_PI)
     assert later.tau == pytest.approx(end.tau + TWO_PI) and w.counters["impacts"] >= 1
+
+
+def test_an_elastic_rod_that_bounces_every_period_runs_past_max_impacts():
+    # 15 kHz, e = 1: one impact a drive period. The walker used to count `max_impacts`
+    # over the whole run, so a walk of more than 10 000 periods failed (and its 10 000th
+    # impact was silently made plastic); the count is now per drive period
+    sc = make_scene("friction-drive", frequency=15000.0, restitution=1.0)
+    q0, v0 = sc.rest_state()
+    capped = FrictionDriveWalker(sc, max_impacts=3)
+    free = FrictionDriveWalker(sc)
+    a = capped.classify(ContactState(0.0, Regime.FLIGHT, q0[0], v0[0], q0[1], v0[1]))
+    b = free.classify(ContactState(0.0, Regime.FLIGHT, q0[0], v0[0], q0[1], v0[1]))
+    a = capped.advance(a, 40 * 2 * np.pi)
+    b = free.advance(b, 40 * 2 * np.pi)
+    assert capped.counters["impacts"] > 35
+    assert capped.counters["impacts"] == free.counters["impacts"]
+    assert (a.phi, a.dphi, a.u2, a.du2) == (b.phi, b.dphi, b.u2, b.du2)
