@@ -10,9 +10,6 @@ the files the functions depend on to the stamp that numba stores in each
 cache index and compares on load: when any of them changes, the index no
 longer matches, numba compiles again and overwrites the stale entry.
 
-The digest also carries numba's optimisation level (``NUMBA_OPT``), so that
-machine code built at one level is never loaded by a process at another.
-
 Nothing is written or removed here, so a read-only install is unaffected. If
 numba's cache internals are not what this module expects (another numba
 version), the functions fall back to compiling in memory each process:
@@ -21,8 +18,6 @@ slower, never stale.
 
 import hashlib
 import os
-
-from numba.core import config as numba_config
 
 try:
     # numba's internal cache classes: another numba version may not have this one
@@ -79,9 +74,7 @@ def bind_cache_to_sources(dispatchers, paths):
     >>> bind_cache_to_sources([f], [__file__]) in ("bound", "memory")
     True
     """
-    # the optimisation level too: code cached by a run at NUMBA_OPT=1 (the test suite's)
-    # must not be loaded as the default level's by the next run, which would be slower
-    digest = f"{sources_digest(paths)}-opt{int(numba_config.OPT)}"
+    digest = sources_digest(paths)
     mode = "bound"
     for disp in dispatchers:
         cache = getattr(disp, "_cache", None)
