@@ -236,3 +236,31 @@ def test_kept_cells_are_keyed_by_case_scheme_and_code_version(tmp_path, monkeypa
     # without a cache nothing is kept
     none = run_catalogue(cases=["mu-zero"], schemes=["mj-1"], progress=False)
     assert none["cells"]["computed"] == 1 and none["cells"]["cache_dir"] is None
+
+
+def test_a_flight_mean_on_another_attractor_is_said_so_not_called_inaccurate():
+    # 15 kHz, e = 1 has two attractors (benchmarks/statistical_agreement.py): the reference
+    # from rest spins the rotor up onto a chaotic one (9.7e-6 m a period), Moreau-Jean's runs
+    # from rest end on a regular one, which the reference keeps when started there (5.66e-6
+    # m a period). The catalogue runs the reference from the stepping run's last state and
+    # names the attractor instead of reporting a 43 % "error"
+    from moreau.analysis.statistical import statistical_steady_state
+    from moreau.studies.paper.stress import _other_attractor, _scene, _statistical_row
+
+    scene = _scene(15000.0, restitution=1.0)
+    start = statistical_steady_state(scene, "moreau-jean", precision=1e-2, max_periods=4000,
+                                     steps_per_period=2000).state0
+    # the full catalogue's statistics (1 %, 80 000 periods): the quick one's 400 periods do
+    # not see the end of the transient from that start
+    row = _statistical_row("flight-15kHz-e1", "mj-1", scene, "", True, "moreau-jean",
+                           q0=start[:2], v0=start[2:], steps_per_period=2000)
+    msg, same = _other_attractor("flight-15kHz-e1", scene, True, row, 0.05)
+    assert same and msg.startswith("; another attractor: the reference from this run's last")
+    # Moreau-Jean at 2000 steps a period is 2.5 % below the reference on that attractor
+    assert 0.01 < row["attractor_error"] < 0.04
+    assert scene.displacement_to_si(row["attractor_reference"]) == pytest.approx(5.65e-6,
+                                                                                 rel=0.01)
+    # a mean that is on neither attractor stays what it is
+    row["value"] *= 1.3
+    msg, same = _other_attractor("flight-15kHz-e1", scene, True, row, 0.05)
+    assert not same and "another attractor" not in msg and "error 0.2" in msg
