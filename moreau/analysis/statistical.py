@@ -46,6 +46,18 @@ run the series is examined:
 The interval is statistical: it covers the sampling error of the scheme's
 own long-run mean, not the scheme's discretisation error.
 
+The mean is that of the attractor the run from the given state ends on. A
+drive may have several: at 15 kHz with ``e = 1`` the friction drive's
+reference from rest spins the rotor up, over about 20 000 periods, onto a
+chaotic attractor (9.7e-6 m a period), while from the state where
+Moreau–Jean's run from rest ends it stays on a regular one, one impact a
+period (5.66e-6 m). Moreau–Jean there converges to the reference at first
+order in the step; started on the chaotic attractor it leaves it for the
+regular one after a number of periods that grows as the step shrinks
+(``benchmarks/statistical_agreement.py`` measures all of this). Compare
+schemes from the same state, and check which attractor a run ended on
+(its ``state0``) before comparing means.
+
 Examples
 --------
 >>> from moreau.scenes.friction_drive import FrictionDrive
