@@ -56,8 +56,10 @@ Accumulation of impacts (Zeno) policy
     closes. For a ball under gravity with restitution ``e`` and first impact
     speed ``V`` the remaining bounce time thus cut off is below
     ``2 zeno_rtol V / (1 - e)`` (``zeno_rtol = 1e-10`` by default). Independently,
-    more than ``max_impacts`` impacts in one run stop it with a
-    :class:`~moreau.errors.MoreauError` (status ``-5``).
+    more than ``max_impacts`` impacts within one ``max_step`` of time stop the
+    run with a :class:`~moreau.errors.MoreauError` (status ``-5``): an
+    accumulation the policy did not end. A long run of well-separated
+    impacts (an elastic ball bouncing for ever) is not one.
 
 Known limits: a gap that dips below zero and comes back inside one
 integrator step is not seen (``max_step`` bounds the step); scenes with
@@ -255,7 +257,7 @@ class GenericEventDriven(Integrator):
         Rebound velocity, relative to the contact's largest approach speed,
         below which an impact sequence is taken as accumulated (contact closes).
     max_impacts : int
-        Impacts allowed in one run.
+        Impacts allowed within one ``max_step`` of time (an accumulation).
     lcp_method : str
         LCP solver for the contact problems (see :func:`moreau.lcp.solve_lcp`).
     record_pieces : bool
@@ -304,6 +306,7 @@ class GenericEventDriven(Integrator):
         self._vscale = 0.0
         self._approach = np.zeros(nc)
         self._last_event_t, self._stalled = None, 0
+        self._burst_t0, self._burst = -math.inf, 0
         self.counters.update({"events": 0, "impacts": 0, "lcp_solves": 0, "rhs": 0,
                               "segments": 0})
         self._next_sample = self.t0 + self.sample_dt
@@ -421,9 +424,13 @@ class GenericEventDriven(Integrator):
                 continue
             break
         self.counters["impacts"] += 1
-        if self.counters["impacts"] > self.max_impacts:
-            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts "
-                              f"(an accumulation the Zeno policy did not end?)")
+        if t - self._burst_t0 > self.max_step:
+            self._burst_t0, self._burst = t, 0
+        self._burst += 1
+        if self._burst > self.max_impacts:
+            raise MoreauError(f"more than `max_impacts`={self.max_impacts} impacts within "
+                              f"`max_step`={self.max_step:g} of time before t = {t:.12g} (an "
+                              "accumulation the Zeno policy did not end?)")
         v_post = v + MiJ @ p
         if self.jumps is not None:
             pN, pT = np.zeros(ms.nc), np.zeros(ms.nc)

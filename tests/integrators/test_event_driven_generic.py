@@ -59,6 +59,19 @@ def test_perfectly_elastic_ball_keeps_its_energy():
     assert len(t_imp) == 5
 
 
+def test_an_elastic_ball_bounces_past_max_impacts_but_an_accumulation_stops():
+    # `max_impacts` counts the impacts within one `max_step` of time (an accumulation),
+    # not in the run: an elastic ball bounces as long as asked (it used to stop with
+    # "more than `max_impacts` impacts" once it had bounced that often)
+    ball = BouncingBall(restitution=1.0, radius=0.1)
+    res = simulate(ball, (0.0, 10.5), [0.6], [0.0], GEN, max_impacts=2)
+    assert res.status == 0 and res.stats["impacts"] == 5
+    # dropped from 1e-4 above the floor it bounces every 0.028: three impacts in 0.1
+    low = simulate(ball, (0.0, 1.0), [0.1001], [0.0], GEN, max_impacts=2, max_step=0.1)
+    assert low.status == -5 and "more than `max_impacts`=2 impacts within `max_step`=0.1" \
+        in low.message
+
+
 # -- sliding block -------------------------------------------------------------------
 
 @pytest.mark.parametrize("mu, incline, u0", [(0.5, 0.0, 2.0), (0.3, 0.2, -2.0), (0.6, 0.3, 1.5),
