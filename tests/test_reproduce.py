@@ -22,9 +22,20 @@ MODES = ["NS", "NP", "NSP", "SP"]  # NSPS and NPS bands are too narrow for the q
 def quick_run(tmp_path_factory):
     pytest.importorskip("matplotlib")
     out = tmp_path_factory.mktemp("repro")
-    rc = main(["reproduce", "--quick", "--out", str(out), "--quiet"])
+    # one process: the quick run's 60 points and 20 figures take 12 CPU s in one process and
+    # 26 in a pool of two (each worker imports and loads the package again); the pool's
+    # paths are checked by test_worker_pool (the points) and test_figure_jobs_run_on_a_pool
+    rc = main(["reproduce", "--quick", "--out", str(out), "--quiet", "--jobs", "1"])
     assert rc == 0
     return out
+
+
+def test_figure_jobs_run_on_a_pool():
+    # reproduce's figures on local processes, in order, through the same call as a full run
+    from moreau.studies.paper.reproduce import run_jobs
+    jobs = [(list, ("ab",)), (sorted, ("dc",)), (list, ("",)), (list, ("e",))]
+    assert run_jobs(jobs, 2) == ["a", "b", "c", "d", "e"]
+    assert run_jobs(jobs, 1) == ["a", "b", "c", "d", "e"]
 
 
 def test_quick_run_writes_every_file(quick_run):

@@ -172,9 +172,13 @@ def test_every_time_stepping_scheme_has_a_column():
 
 @pytest.fixture(scope="module")
 def new_columns():
-    # the generic steps (fast=False): cheap on these two cases and no compile
+    # the compiled loops (fast="auto"): the generic Python steps took 9 s on the mu = 0
+    # steady states, the compiled ones 0.15 s; each scheme's shared loop has one signature
+    # in the whole suite, compiled by its own tests anyway (test_nonsmooth_generalized_alpha,
+    # test_time_discontinuous_galerkin, test_statistical). Rows, outcomes and messages are
+    # the same as the generic steps' (checked once, both ways)
     rep = run_catalogue(cases=["painleve-mu1.2", "mu-zero"], schemes=("event-driven",) + NEW,
-                        progress=False, fast=False)
+                        progress=False, fast="auto")
     return rep
 
 

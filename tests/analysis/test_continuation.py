@@ -142,7 +142,7 @@ def test_atlas_command_cold_and_classify_options(tmp_path):
     # the paper's drive through its own study sweep (moreau sweep mu)
     ("friction-drive", "mu", (0.1, 0.3, 7), None),
     # any registered periodic scene through the generic sweep
-    ("stick-slip-motor", "load", (0.0, 0.1, 4), None),
+    ("stick-slip-motor", "load", (0.0, 0.1, 3), None),
 ])
 def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, values, fixed):
     import csv

@@ -12,12 +12,14 @@ from moreau.scenes import registry
 
 
 def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):
-    assert main(["sweep", "load", "0", "0.1", "--points", "3", "--scene", "stick-slip-motor",
+    # two points (the generic event-driven steady states of the motor cost about a second
+    # each, and each is computed twice here): the ends of the range
+    assert main(["sweep", "load", "0", "0.1", "--points", "2", "--scene", "stick-slip-motor",
                  "--frequency", "1000", "--out", str(tmp_path), "--quiet", "--jobs", "1"]) == 0
     stem = tmp_path / "sweep_stick-slip-motor_load_1000Hz_event-driven"
     with open(stem.with_suffix(".csv")) as fh:
         rows = list(csv.DictReader(fh))
-    assert [float(r["load [N]"]) for r in rows] == [0.0, 0.05, 0.1]
+    assert [float(r["load [N]"]) for r in rows] == [0.0, 0.1]
     assert all(r["status"] == "ok" and r["scene"] == "stick-slip-motor" for r in rows)
     assert all(float(r["frequency [Hz]"]) == 1000.0 and r["drive"] == "sawtooth" for r in rows)
     # each point is the steady state computed on its own
@@ -28,10 +30,10 @@ def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_
             sc.displacement_to_si(ss.displacement_per_period), rel=1e-9)
         assert r["mode"] == ss.mode
     d = [float(r["displacement_per_period_m"]) for r in rows]
-    assert d[0] > d[1] > d[2]          # a load slows the slider
+    assert d[0] > d[1]                 # a load slows the slider
     meta = json.loads(stem.with_suffix(".json").read_text())
     assert meta["scene"] == "stick-slip-motor" and meta["swept_parameter"] == "load [N]"
-    assert meta["engine"]["computed"] == 3 and meta["provenance"]["moreau_version"]
+    assert meta["engine"]["computed"] == 2 and meta["provenance"]["moreau_version"]
     assert stem.with_suffix(".png").exists()
 
 
