@@ -161,7 +161,8 @@ def walker_section_states(scene, q, v, tau0, periods, options):
 
 
 @register_steady_solver("friction-drive-walker")
-def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None, **options):
+def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None, floquet=True,
+                        **options):
     """Event-driven periodic steady state of the friction drive (see ``find_steady_state``).
 
     The rotor position ``u2`` does not enter the dynamics, so the period map
@@ -174,7 +175,8 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
     by default the rotor velocity of ``guess`` (a neighbouring point's
     steady state, continuation) or else the tip's velocity.
     The Floquet multiplier of the map comes from the saltation matrices of
-    the period's events (:mod:`moreau.scenes.friction_drive_floquet`).
+    the period's events (:mod:`moreau.scenes.friction_drive_floquet`);
+    ``floquet=False`` skips them (``floquet_multipliers`` stays unset).
     """
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
@@ -261,6 +263,10 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
     # the multiplier of the scalar map: saltation matrices through the period's events,
     # or where an event grazes its surface (no derivative exists there) the map's own
     # central differences, which then measure its slope on a 1e-5 scale
+    if not floquet:
+        # the caller wants the orbit only (a reference value): no multipliers
+        ss.wall_time = time.perf_counter() - t_start
+        return ss
     try:
         # the period just walked from st0 is the one the monodromy walks: hand it on
         M = walker_monodromy(scene, ss, rtol=walker.rtol, walker=walker, walk=(segs, evs))

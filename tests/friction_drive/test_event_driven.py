@@ -396,3 +396,14 @@ def test_an_elastic_rod_that_bounces_every_period_runs_past_max_impacts():
     assert capped.counters["impacts"] > 35
     assert capped.counters["impacts"] == free.counters["impacts"]
     assert (a.phi, a.dphi, a.u2, a.du2) == (b.phi, b.dphi, b.u2, b.du2)
+
+
+def test_the_walker_steady_state_without_multipliers_is_the_same_orbit():
+    # `floquet=False` (compare's references, which need the value only) used to reach the
+    # walker's constructor as an unknown option: a bare TypeError
+    sc = FrictionDrive(frequency=185.0)
+    a = find_steady_state(sc)
+    b = find_steady_state(sc, floquet=False)
+    assert a.floquet_multipliers is not None and b.floquet_multipliers is None
+    assert b.displacement_per_period == a.displacement_per_period
+    np.testing.assert_array_equal(b.state0, a.state0)
