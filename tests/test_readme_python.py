@@ -1,4 +1,4 @@
-"""Every Python snippet of the README runs, in a fresh interpreter.
+"""Every Python snippet of the README runs, each in its own fresh copy of an interpreter.
 
 A snippet that names what an earlier paragraph defines (an LCP's ``M`` and
 ``q``, a user's ``scene``) gets those names from a preamble here; a snippet
@@ -6,6 +6,8 @@ added to the README without an entry fails
 ``test_the_table_covers_every_python_snippet``.
 """
 
+import json
+import os
 import pathlib
 import re
 import subprocess
@@ -61,11 +63,64 @@ def test_the_table_covers_every_python_snippet():
     assert sorted(firsts) == sorted(PREAMBLES) == sorted(CHECKS)
 
 
+# One interpreter imports the package and its libraries once (0.8 s of every fresh start),
+# then forks a child per snippet: each snippet runs in a copy of that interpreter, which
+# holds nothing a snippet or a test made (import-order bugs of a really fresh interpreter
+# are tests/engine/test_fresh_processes.py's).
+_FORK_SERVER = """
+import json, os, sys, traceback
+import moreau, moreau.analysis.steady_state, moreau.integrators, moreau.lcp
+import moreau.scenes.friction_drive, moreau.scenes.piezo_drive
+for line in sys.stdin:
+    code = json.loads(line)
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:
+        os.close(r)
+        os.dup2(w, 2)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 1)
+        try:
+            exec(compile(code, "<snippet>", "exec"), {"__name__": "__main__"})
+            rc = 0
+        except BaseException:
+            traceback.print_exc()
+            rc = 1
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(rc)
+    os.close(w)
+    with os.fdopen(r, "rb") as fh:
+        err = fh.read().decode(errors="replace")
+    status = os.waitpid(pid, 0)[1]
+    print(json.dumps([status, err]), flush=True)
+"""
+
+
+@pytest.fixture(scope="module")
+def run_snippet():
+    if not hasattr(os, "fork"):
+        def run(code):
+            run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                 timeout=600, cwd=ROOT)
+            return run.returncode, run.stderr
+        yield run
+        return
+    server = subprocess.Popen([sys.executable, "-c", _FORK_SERVER], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True, cwd=ROOT)
+
+    def run(code):
+        server.stdin.write(json.dumps(code) + "\n")
+        server.stdin.flush()
+        return json.loads(server.stdout.readline())
+    yield run
+    server.stdin.close()
+    server.wait(timeout=60)
+
+
 @pytest.mark.parametrize("i", range(len(python_snippets())))
-def test_every_python_snippet_runs(i):
+def test_every_python_snippet_runs(i, run_snippet):
     snippet = python_snippets()[i]
     first = snippet.splitlines()[0]
     code = PREAMBLES[first] + snippet + "\n" + CHECKS[first] + "\n"
-    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         timeout=600, cwd=ROOT)
-    assert run.returncode == 0, run.stderr[-3000:]
+    status, stderr = run_snippet(code)      # exit status: 0 only if the snippet ran through
+    assert status == 0, stderr[-3000:]
