@@ -7,13 +7,12 @@ import pytest
 
 from moreau.cli import main
 from moreau.analysis.engine import periodic_scene_names
-from moreau.analysis.steady_state import find_steady_state
 from moreau.scenes import registry
 
 
 def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):
-    # two points (the generic event-driven steady states of the motor cost about a second
-    # each, and each is computed twice here): the ends of the range
+    # two points (the generic event-driven steady states of the motor cost about a
+    # second each): the ends of the range
     assert main(["sweep", "load", "0", "0.1", "--points", "2", "--scene", "stick-slip-motor",
                  "--frequency", "1000", "--out", str(tmp_path), "--quiet", "--jobs", "1"]) == 0
     stem = tmp_path / "sweep_stick-slip-motor_load_1000Hz_event-driven"
@@ -22,10 +21,13 @@ def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_
     assert [float(r["load [N]"]) for r in rows] == [0.0, 0.1]
     assert all(r["status"] == "ok" and r["scene"] == "stick-slip-motor" for r in rows)
     assert all(float(r["frequency [Hz]"]) == 1000.0 and r["drive"] == "sawtooth" for r in rows)
-    # each point is the steady state computed on its own
+    # each point is the motor's steady state: its closed form (1 ms a point; the
+    # event-driven shooting on its own, which it replaces here, took 0.6-1 s and agrees
+    # with it to 7e-15 in the displacement, and in the mode)
+    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
     for r in rows:
         sc = registry.make_scene("stick-slip-motor", frequency=1000.0, load=float(r["load [N]"]))
-        ss = find_steady_state(sc, floquet=False)    # mode and displacement: no multipliers
+        ss = stick_slip_steady_state(sc)
         assert float(r["displacement_per_period_m"]) == pytest.approx(
             sc.displacement_to_si(ss.displacement_per_period), rel=1e-9)
         assert r["mode"] == ss.mode
