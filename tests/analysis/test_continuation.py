@@ -172,10 +172,12 @@ def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, value
         # the generic sweep's `--cold` reaches run_scene_sweep as continuation=False (the
         # engine's cold chunks are the ones the friction drive's case runs above); its
         # cold-started points are those of the warm run (points 0 and 2 here, the same
-        # deterministic call), so only the continued one is computed cold again, directly:
-        # 1 steady state instead of a second sweep of 3 (3 of 6 CPU s)
+        # deterministic call), so the continued one is checked against the motor's
+        # closed-form steady state (1 ms; a cold shooting agrees with it to 7e-15) instead
+        # of a second sweep of 3 (3 of 6 CPU s)
         from moreau import cli
         from moreau.scenes.registry import make_scene
+        from moreau.scenes.stick_slip_exact import stick_slip_steady_state
         seen = {}
         orig = cli.run_scene_sweep
         try:
@@ -192,7 +194,7 @@ def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, value
                 cold.append(w)
                 continue
             motor = make_scene(scene, frequency=1000.0, **{parameter: float(w["load [N]"])})
-            ss = find_steady_state(motor, floquet=False)
+            ss = stick_slip_steady_state(motor)
             cold.append({"mode": ss.mode, "status": "ok", "displacement_per_period_m":
                          motor.displacement_to_si(ss.displacement_per_period)})
     for w, c in zip(warm, cold):
