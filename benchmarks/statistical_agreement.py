@@ -32,7 +32,7 @@ script checks that mean three ways, at ``--frequency`` and ``--restitution``:
 Writes ``statistical_agreement.json``, ``.csv`` and ``.png`` into ``--out``.
 
 Run: ``python benchmarks/statistical_agreement.py --out DIR [--quick]``
-(about 6 CPU minutes; ``--quick``: a coarse subset, under one minute).
+(about 4 CPU minutes for ``e = 1``; ``--quick``: a coarse subset, about 12 s).
 """
 
 import argparse

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from moreau.studies.paper.reproduce import study_grids
+from moreau.studies.paper.reproduce import run_jobs, study_grids
 from moreau.studies.paper.report import refine_extremum
 from moreau.studies.paper.tables import read_table
 from moreau.studies.paper.valid_range import lift_off_margin, phi0_valid_range
@@ -32,7 +32,6 @@ def quick_run(tmp_path_factory):
 
 def test_figure_jobs_run_on_a_pool():
     # reproduce's figures on local processes, in order, through the same call as a full run
-    from moreau.studies.paper.reproduce import run_jobs
     jobs = [(list, ("ab",)), (sorted, ("dc",)), (list, ("",)), (list, ("e",))]
     assert run_jobs(jobs, 2) == ["a", "b", "c", "d", "e"]
     assert run_jobs(jobs, 1) == ["a", "b", "c", "d", "e"]

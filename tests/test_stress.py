@@ -9,9 +9,11 @@ import math
 
 import pytest
 
+from moreau.analysis.statistical import statistical_steady_state
 from moreau.integrators import INTEGRATORS
 from moreau.integrators.base import scheme_options
-from moreau.studies.paper.stress import CASES, CLASSIC, SCHEMES, run_case, run_catalogue
+from moreau.studies.paper.stress import (CASES, CLASSIC, SCHEMES, _other_attractor, _scene,
+                                         _statistical_row, run_case, run_catalogue)
 from moreau.cli import main
 from moreau.errors import InputError
 
@@ -248,9 +250,6 @@ def test_a_flight_mean_on_another_attractor_is_said_so_not_called_inaccurate():
     # from rest end on a regular one, which the reference keeps when started there (5.66e-6
     # m a period). The catalogue runs the reference from the stepping run's last state and
     # names the attractor instead of reporting a 43 % "error"
-    from moreau.analysis.statistical import statistical_steady_state
-    from moreau.studies.paper.stress import _other_attractor, _scene, _statistical_row
-
     scene = _scene(15000.0, restitution=1.0)
     start = statistical_steady_state(scene, "moreau-jean", precision=1e-2, max_periods=4000,
                                      steps_per_period=2000).state0

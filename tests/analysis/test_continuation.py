@@ -1,5 +1,6 @@
 """Continuation along atlas lines and the classification of points without a periodic orbit."""
 
+import csv
 import math
 from dataclasses import asdict
 
@@ -8,14 +9,19 @@ import pytest
 
 from periodic_scenes import TableBall
 
+from moreau import cli
 from moreau.analysis.classify import classification_columns, classify_long_run
 from moreau.analysis.continuation import continue_point, midpoint, solve_line
 from moreau.analysis.engine import ED_REFERENCE, evaluate_points
-from moreau.analysis.scheme_settings import Scheme
+from moreau.analysis.scheme_settings import Scheme, steady_of
 from moreau.analysis.steady_state import find_steady_state
+from moreau.cli import main
 from moreau.errors import ConvergenceError, InputError
 from moreau.scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
+from moreau.scenes.registry import make_scene
+from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 from moreau.studies.paper.atlas import compute_atlas, point_label
+from moreau.studies.paper.tables import read_table
 
 
 def test_continued_atlas_equals_the_cold_one(tmp_path):
@@ -118,9 +124,6 @@ def test_classification_columns_of_rows():
 
 
 def test_atlas_command_cold_and_classify_options(tmp_path):
-    from moreau import cli
-    from moreau.studies.paper.tables import read_table
-
     args = ["atlas", "--plane", "f-mu", "--f-points", "2", "--y-points", "2", "--fmin", "185",
             "--fmax", "2000", "--no-plot", "--quiet", "--jobs", "1", "--out", str(tmp_path)]
     assert cli.main(args + ["--cold", "--classify-periods", "0"]) in (0, None)
@@ -144,11 +147,8 @@ def test_atlas_command_cold_and_classify_options(tmp_path):
     # any registered periodic scene through the generic sweep
     ("stick-slip-motor", "load", (0.0, 0.1, 3), None),
 ])
-def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, values, fixed):
-    import csv
-
-    from moreau.cli import main
-
+def test_a_continued_sweep_equals_the_cold_one(tmp_path, monkeypatch, scene, parameter, values,
+                                              fixed):
     def run(out, *extra):
         argv = ["sweep", parameter, str(values[0]), str(values[1]), "--points", str(values[2]),
                 "--scene", scene, "--set", "frequency=185", "--out", str(tmp_path / out),
@@ -175,19 +175,13 @@ def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, value
         # deterministic call), so the continued one is checked against the motor's
         # closed-form steady state (1 ms; a cold shooting agrees with it to 7e-15) instead
         # of a second sweep of 3 (3 of 6 CPU s)
-        from moreau import cli
-        from moreau.scenes.registry import make_scene
-        from moreau.scenes.stick_slip_exact import stick_slip_steady_state
         seen = {}
-        orig = cli.run_scene_sweep
-        try:
-            cli.run_scene_sweep = lambda *a, **kw: seen.update(kw)
+        with monkeypatch.context() as m:
+            m.setattr(cli, "run_scene_sweep", lambda *a, **kw: seen.update(kw))
             run_args = ["sweep", parameter, "0", "1", "--points", "3", "--scene", scene,
                         "--out", str(tmp_path / "plumbing"), "--quiet", "--jobs", "1"]
             assert main(run_args + ["--cold"]) == 0 and seen["continuation"] is False
             assert main(run_args) == 0 and seen["continuation"] is True
-        finally:
-            cli.run_scene_sweep = orig
         cold = []
         for w in warm:
             if w["start"] == "cold":
@@ -206,12 +200,6 @@ def test_a_continued_sweep_equals_the_cold_one(tmp_path, scene, parameter, value
 def test_the_secant_predictor_saves_shootings_and_lands_on_the_same_orbits():
     # one 1 kHz line of the f-mu atlas: the prediction from the two previous orbits starts
     # each shooting one order closer than the neighbour's orbit does
-    from dataclasses import asdict
-    from moreau.analysis.continuation import solve_line
-    from moreau.analysis.scheme_settings import ED_REFERENCE, steady_of
-    from moreau.scenes import make_scene
-    from moreau.scenes.friction_drive import PAPER_DEFAULTS
-
     pts = [(asdict(PAPER_DEFAULTS.with_(mu=m)), 1000.0) for m in np.linspace(0.3, 0.5, 12)]
 
     def solve(point, guess):

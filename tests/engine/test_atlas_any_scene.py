@@ -7,10 +7,10 @@ import pytest
 from moreau.analysis.atlas import run_scene_atlas
 from moreau.cli import main
 from moreau.scenes.registry import make_scene
+from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 
 
 def test_every_point_is_the_scenes_steady_state():
-    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
     rows = run_scene_atlas("stick-slip-motor", ("load", [0.0, 0.05]), ("mu", [0.2, 0.3]),
                            frequency=1000.0, out=None, progress=False, plot=False,
                            n_jobs=1, log=lambda s: None)

@@ -8,6 +8,7 @@ import pytest
 from moreau.cli import main
 from moreau.analysis.engine import periodic_scene_names
 from moreau.scenes import registry
+from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 
 
 def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):
@@ -24,7 +25,6 @@ def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_
     # each point is the motor's steady state: its closed form (1 ms a point; the
     # event-driven shooting on its own, which it replaces here, took 0.6-1 s and agrees
     # with it to 7e-15 in the displacement, and in the mode)
-    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
     for r in rows:
         sc = registry.make_scene("stick-slip-motor", frequency=1000.0, load=float(r["load [N]"]))
         ss = stick_slip_steady_state(sc)

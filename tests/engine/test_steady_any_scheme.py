@@ -13,6 +13,7 @@ from moreau.analysis.steady_state import find_steady_state
 from moreau.analysis.sweep import sweep_tag
 from moreau.cli import main
 from moreau.scenes.registry import make_scene
+from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 
 
 @pytest.fixture(scope="module")
@@ -84,7 +85,6 @@ def test_sweep_runs_a_scheme_beyond_the_two(tmp_path, capsys):
     rows = [dict(zip(header, line.split(","))) for line in lines[1:]]
     assert [r["scheme"] for r in rows] == ["event-driven-generic"] * 2
     assert all(r["status"] == "ok" for r in rows)
-    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
     for r in rows:
         motor = make_scene("stick-slip-motor", frequency=1000.0, mu=float(r["mu"]))
         # against the motor's closed-form steady state (1 ms; the event-driven shooting it

@@ -273,7 +273,8 @@ FLIGHT_STATISTICS = {True: (1e-2, 80000), False: (5e-2, 400)}
 
 
 def _statistical_row(case, scheme, scene, note, full, run, **opts):
-    """A flight case's statistical steady state from rest as a row (value = the mean).
+    """A flight case's statistical steady state as a row (value = the mean), from rest unless
+    ``opts`` give ``q0`` and ``v0``.
 
     ``end_state`` is the run's last state at the section, ``(q, v)`` flattened
     (dimensionless), from which :func:`_other_attractor` starts the reference.
