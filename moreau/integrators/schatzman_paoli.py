@@ -153,41 +153,45 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         self._pending_initial = True
         # the Verlet velocity that carries the two-step recursion (see the module docstring)
         self._v_verlet = self.v.copy()
+        self._v_force = self.v.copy()
+        self._node = None
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
 
     def _step_impl(self):
         if self._fast:
+            self._node = None       # the compiled loop keeps its node solutions to itself
             return self._fast_block()
         return self._generic_step()
 
     def _fast_block(self):
-        q, v, vv, closed = self.q.copy(), self.v.copy(), self._v_verlet.copy(), self._closed.copy()
-        status = self._run_block(sp_loop, (q, v, vv, closed), (self._lcp_ctl,))
-        self.q, self.v, self._v_verlet, self._closed = q, v, vv, closed
+        q, v, vv, vf = self.q.copy(), self.v.copy(), self._v_verlet.copy(), self._v_force.copy()
+        closed = self._closed.copy()
+        status = self._run_block(sp_loop, (q, v, vv, vf, closed), (self._lcp_ctl,))
+        self.q, self.v, self._v_verlet, self._v_force, self._closed = q, v, vv, vf, closed
         self._after_block(status, numerical=EXPLICIT_BLOWUP)
 
-    def _generic_step(self):
+    def _solve_node(self, t, q, vv, a, M, closed, g, h, count):
+        """The contact impulse of the node ``(t, q)`` for the step ``h`` that leaves it.
+
+        Returns ``(u_plus, dv_contact, pN, pT, slip)``: the Verlet velocity
+        ``vv + (h/2) a``, the velocity jump ``M^-1 H^T p`` of the node's
+        impulse, the impulses and the slip velocities. ``count`` says whether
+        the solve enters the statistics (not when a node is solved again).
+        """
         sc = self.scene
-        t0, q, v = self.t, self.q, self.v
-        vv = self._v_verlet
-        t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
-        M = np.asarray(sc.mass(q), dtype=float)
-        a = np.linalg.solve(M, np.asarray(sc.forces(q, v, t0), dtype=float))
-        u_plus = vv + 0.5 * h * a
         nc = sc.ncontacts
+        u_plus = vv + 0.5 * h * a
         pN = np.zeros(nc)
         pT = np.zeros(nc)
         slip = np.zeros(nc)
-        v_half = u_plus
         dv_contact = 0.0
         if nc:
-            g = np.asarray(sc.gaps(q, t0), dtype=float)
             WN, wN, WT, wT = (np.asarray(x, dtype=float)
-                              for x in sc.contact_jacobians(q, t0 + 0.5 * h))
+                              for x in sc.contact_jacobians(q, t + 0.5 * h))
             u_minus = vv - 0.5 * h * a
             e = self.e_c
             UN_free = (1.0 + e) * g / h + (WN @ u_plus + wN) - e * (WN @ u_minus + wN)
-            active = (UN_free <= 0.0) | self._closed
+            active = (UN_free <= 0.0) | closed
             if active.any():
                 ia = np.flatnonzero(active)
                 fa = ia[self._trow[ia] >= 0]
@@ -198,18 +202,36 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
                 U_free = np.concatenate([UN_free[ia], WT[tr] @ u_plus + wT[tr]])
                 p, pn, pt = solve_contact_problem(
                     W, U_free, self.mu_c[ia], np.zeros(ia.size), np.zeros(ia.size),
-                    lcp_method=self.lcp_method, counters=self.counters,
-                    lemke_max_iter=self.lemke_max_iter, t=t0)
+                    lcp_method=self.lcp_method,
+                    counters=self.counters if count else new_contact_counters(),
+                    lemke_max_iter=self.lemke_max_iter, t=t)
                 pN[ia], pT[ia] = pn, pt
                 dv_contact = MinvHT @ p
-                v_half = u_plus + dv_contact
                 slip[fa] = (U_free + W @ p)[ia.size:]
+        return u_plus, dv_contact, pN, pT, slip
+
+    def _generic_step(self):
+        sc = self.scene
+        nc = sc.ncontacts
+        t0, q = self.t, self.q
+        t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
+        node = self._node
+        if node is None:
+            # the run's first node, or a node the compiled loop solved (taken again here)
+            M = np.asarray(sc.mass(q), dtype=float)
+            a = np.linalg.solve(M, np.asarray(sc.forces(q, self._v_force, t0), dtype=float))
+            g = np.asarray(sc.gaps(q, t0), dtype=float) if nc else np.zeros(0)
+            node = (a, M, g) + self._solve_node(t0, q, self._v_verlet, a, M, self._closed, g, h,
+                                                self._pending_initial)
+        a, M, g0, u_plus, dv_contact, pN, pT, slip = node
+        v_half = u_plus + dv_contact
         q1 = q + h * v_half
+        # what the forces see at the next node (module docstring): an explicit predictor
+        v_force = v_half + 0.5 * h * a + 0.5 * dv_contact
         M1 = np.asarray(sc.mass(q1), dtype=float)
-        vv1 = v_half + 0.5 * h * np.linalg.solve(M1, np.asarray(sc.forces(q1, v_half, t1),
-                                                                 dtype=float))
-        v1 = vv1 + 0.5 * dv_contact
-        if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
+        a1 = np.linalg.solve(M1, np.asarray(sc.forces(q1, v_force, t1), dtype=float))
+        vv1 = v_half + 0.5 * h * a1
+        if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(vv1))):
             self.counters["steps"] -= 1     # the base class counts this failed step
             self._fail(-5, EXPLICIT_BLOWUP.format(t=t0, h=h))
             return
@@ -218,13 +240,19 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
-        self._closed = pN > 0.0
-        self._k += 1
         fN, fT = pN / h, pT / h
         if self._pending_initial:
-            g0 = np.asarray(sc.gaps(q, t0), dtype=float) if nc else gap
-            self._record(t0, q, v, regime, fN, fT, slip, g0)
+            self._record(t0, q, self.v, regime, fN, fT, slip, g0)
             self._pending_initial = False
-        self.t, self.q, self.v, self._v_verlet = t1, q1, v1, vv1
+        # the next node's impulse completes its velocity; the run's last node is solved
+        # with the nominal step, for its velocity only
+        h1 = self.h if t1 >= self.t_bound else next_time(self.t0, self._k + 1, self.h,
+                                                          self.t_bound)[1]
+        closed1 = pN > 0.0
+        node1 = (a1, M1, gap) + self._solve_node(t1, q1, vv1, a1, M1, closed1, gap, h1, True)
+        v1 = vv1 + 0.5 * node1[4]
+        self._k += 1
+        self.t, self.q, self.v, self._v_verlet, self._v_force = t1, q1, v1, vv1, v_force
+        self._closed, self._node = closed1, node1
         if self._k % self.save_every == 0 or t1 >= self.t_bound:
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
