@@ -73,8 +73,11 @@ smooth, and exactly 0 on a contact at rest (``q`` constant). On a node with
 an impact it is the mean of the velocities of the steps that arrive and
 leave, so it lies between them, and its kinetic energy is at most the
 larger of theirs. The node's impulse is solved at the end of the step that
-reaches the node (one contact problem per node, as before); the run's last
-node is solved with the nominal step for its velocity only. The sample of
+reaches the node (one contact problem per node); the run's last node is
+solved with the nominal step for its velocity only. A run restarted from a
+recorded state takes ``V_0 = v_k``, which is the run's own ``V_k`` where
+the node carries no impulse and differs by ``dv_k / 2`` where it does (on a
+contact at rest, the start offset described above). The sample of
 node ``k + 1`` carries the forces of the step that reaches it, ``p_k / h``,
 like every scheme's sample.
 
@@ -88,12 +91,12 @@ an Euler step of the node's central velocity with its whole acceleration,
 forces and contact reaction (``w_0 = v_0``). It is ``v(t_{k+1}) + O(h^2)``
 where the motion is smooth, contact phases included (0 on a contact at
 rest), so that the scheme stays second order there with velocity-dependent
-forces (measured slope 2.00 on a ball with a linear damper in flight). On
-the node after an impact it carries a part of the impact's velocity jump:
-the forces see a velocity off by ``O(1)`` over one step, which moves the
-solution by ``O(h)``, the order of the scheme through an impact anyway
-(the damped ball converges with order 1 through its impacts; the tests
-measure both). For forces that do not depend on the velocity none of
+forces (measured slope 2.00 on a ball with a linear damper in flight). At
+the node after an impact it exceeds the departing velocity ``u_k`` by half
+the impact's jump ``dv_k``: the forces see a velocity off by ``O(1)`` over
+one step, which moves the solution by ``O(h)``, the order of the scheme
+through an impact anyway (the damped ball converges with order 1 through
+its impacts; the tests measure both). For forces that do not depend on the velocity none of
 this touches the positions: they are the two-step recursion above.
 
 *Index set.* Contact ``i`` enters the step's problem when its free ``U_N``
