@@ -193,7 +193,9 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         self._k = 0
         self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0}
         self._pending_initial = True
-        # the Verlet velocity that carries the two-step recursion (see the module docstring)
+        # the Verlet velocity that carries the two-step recursion, the velocity the forces
+        # see at the current node, and that node's solved contact problem where the
+        # generic step has it (see the module docstring)
         self._v_verlet = self.v.copy()
         self._v_force = self.v.copy()
         self._node = None
