@@ -123,7 +123,8 @@ def _cmd_steady(args):
     _scheme_args(args)
     entry = get_entry(args.scene)
     params = scene_parameters(args, entry)
-    if "frequency" in entry.parameter_names() and "frequency" not in params:
+    if ("frequency" in entry.parameter_names() and "frequency" not in params
+            and entry.defaults().get("frequency") is None):
         raise InputError("`--frequency` is required (drive frequency in Hz)")
     scene = entry.factory(**params)
     check_periodic(scene)
@@ -437,7 +438,8 @@ def _cmd_atlas(args):
             raise InputError("`--quick` sets the grid; leave out `--x-points`/`--y-points`")
         n = (8 if flag == "--x" else 6) if args.quick else (20 if points is None else points)
         scale = scale or ("log" if name == "frequency" else "linear")
-        axes.append((name, sweep_values(start, stop, n, scale)))
+        axes.append((name, sweep_values(start, stop, n, scale,
+                                        names=(f"{flag} START", f"{flag} STOP", f"{flag}-points"))))
     params = scene_parameters(args, entry)
     frequency = params.pop("frequency", None)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
@@ -581,7 +583,8 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("steady", help="periodic steady state of a driven scene (a statistical "
                                         "one, mean with interval, where no orbit exists)")
-    p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
+    p.add_argument("--frequency", type=float, default=None,
+                   help="drive frequency [Hz] (default: the scene's)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)
     p.add_argument("--max-period", type=int, default=1,
@@ -633,7 +636,8 @@ def build_parser():
                    help="time to simulate [s] (or the scene's time unit if it has no SI units)")
     r.add_argument("--steps", type=int, default=None,
                    help="time-stepping schemes: steps over the whole run")
-    r.add_argument("--samples", type=int, default=2000, help="samples kept (default 2000)")
+    r.add_argument("--samples", type=int, default=2000,
+                   help="samples written, evenly spaced in time (default 2000)")
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")

@@ -305,6 +305,9 @@ def _energy_columns(sc, ss, scheme, status):
         return cols
     for (_, si), col in zip(ENERGY_TERMS, ENERGY_COLUMNS):
         cols[col] = audit[si]
+    if audit["closing_error"] is None:
+        cols["energy_status"] = audit["note"]
+        return cols
     cols["energy_closing_error"] = audit["closing_error"]
     cols["energy_status"] = "ok"
     return cols
