@@ -24,7 +24,8 @@ from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
 from .errors import InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
-from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
+from .integrators.base import (INTEGRATORS, check_options, get_integrator,
+                               propagate_interrupts, scheme_options)
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
 from .studies.paper.reproduce import reproduce
@@ -319,16 +320,25 @@ def _cmd_run(args):
             raise InputError(f"scheme {args.scheme!r} steps in time: give `--steps`")
         steps = int(round(1000 * periods))
     check_options(args.scheme, options, scene)
-    res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
-                            steps=steps, samples=args.samples,
-                            progress=not args.quiet, **options)
+    # the one run is the whole job: an interrupt ends it with what it had (status -4)
+    with propagate_interrupts(False):
+        res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
+                                steps=steps, samples=args.samples,
+                                progress=not args.quiet, **options)
     shown = dict(options)
     if stepping and steps is not None:
         shown["steps"] = steps
     tag = history_tag(entry.name, params, args.scheme, shown)
-    settings = claim_outputs(os.path.join(args.out, tag), {
-        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
-        "periods": periods, "duration": duration, "samples": args.samples}, args.force)
+    interrupted = res.status == -4
+    run_settings = {"scene": entry.name, "parameters": params, "scheme": args.scheme,
+                    "options": shown, "periods": periods, "duration": duration,
+                    "samples": args.samples}
+    if interrupted:
+        # never under the names of a finished run: the history is marked partial
+        tag += ".partial"
+        settings = run_settings
+    else:
+        settings = claim_outputs(os.path.join(args.out, tag), run_settings, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
     names = getattr(scene, "coordinate_names", None)
@@ -337,7 +347,11 @@ def _cmd_run(args):
         "coordinates": None if names is None else {f"q_{i}": n for i, n in enumerate(names)},
         "scheme": args.scheme, "options": shown,
         "periods": periods, "duration": duration, "status": res.status, "message": res.message,
-        "command": "moreau run", "settings": settings})
+        "partial": interrupted, "command": "moreau run", "settings": settings})
+    if interrupted:
+        end = cols[0][2][-1] if len(cols[0][2]) else 0.0
+        raise KeyboardInterrupt(f"run: stopped at {cols[0][0]} = {end:.6g} {cols[0][1]}; the "
+                                f"partial history ({len(cols[0][2])} samples) is in {path}")
     print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
           f"{res.message}")
     if not args.no_plot:
@@ -772,7 +786,9 @@ def main(argv=None):
     previous, seen = _stop_on_sigterm()
     try:
         _check_common(args)
-        args.func(args)
+        # a command is one job: an interrupt inside any of its runs stops it, not only the run
+        with propagate_interrupts():
+            args.func(args)
     except InputError as exc:
         print(f"moreau: error: {exc}", file=sys.stderr)
         return 2
@@ -786,6 +802,9 @@ def main(argv=None):
         if isinstance(exc, Interrupted):
             resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
             print(f"\nmoreau: {how}: {exc}{resume}", file=sys.stderr)
+        elif str(exc):
+            # what the command kept (a partial history, the finished points)
+            print(f"\nmoreau: {how}: {exc}", file=sys.stderr)
         else:
             print(f"\nmoreau: {how}", file=sys.stderr)
         return status
