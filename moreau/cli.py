@@ -220,6 +220,8 @@ def _cmd_characteristic(args):
           f"{s['load_at_max_power_N']:.9e} N")
     print(f"  load convention        {s['load_convention']}")
     print(f"  beyond stall           {s['reversal']}")
+    if s.get("note"):
+        print(f"  note                   {s['note']}")
 
 
 def _efficiency_vs_frequency(args, entry, params, frequency, scheme):
@@ -231,16 +233,24 @@ def _efficiency_vs_frequency(args, entry, params, frequency, scheme):
                                 scheme=scheme, points=points, out=args.out,
                                 plot=not args.no_plot, log=(lambda s: None) if args.json else print)
     if args.json:
-        print(json.dumps(d, default=str))
-        return
-    print(f"{entry.name} ({scheme.name}): efficiency at the load of maximum output power")
-    print(f"  {'f [Hz]':>10} {'load [N]':>14} {'P_out [W]':>14} {'P_in [W]':>14} {'efficiency':>11}")
-    for r in d["rows"]:
-        if r["status"] != "ok":
-            print(f"  {r['frequency_Hz']:>10g}  {r['status']}")
-            continue
-        print(f"  {r['frequency_Hz']:>10g} {r['load_at_max_power_N']:>14.6e} "
-              f"{r['max_power_W']:>14.6e} {r['input_power_W']:>14.6e} {r['efficiency']:>11.6f}")
+        # JSON has no NaN: a value a failed row lacks is null
+        rows = [{k: None if isinstance(v, float) and v != v else v for k, v in r.items()}
+                for r in d["rows"]]
+        print(json.dumps(dict(d, rows=rows), default=str))
+    else:
+        print(f"{entry.name} ({scheme.name}): efficiency at the load of maximum output power")
+        print(f"  {'f [Hz]':>10} {'load [N]':>14} {'P_out [W]':>14} {'P_in [W]':>14} "
+              f"{'efficiency':>11}")
+        for r in d["rows"]:
+            if r["status"] != "ok":
+                print(f"  {r['frequency_Hz']:>10g}  {r['status']}")
+                continue
+            print(f"  {r['frequency_Hz']:>10g} {r['load_at_max_power_N']:>14.6e} "
+                  f"{r['max_power_W']:>14.6e} {r['input_power_W']:>14.6e} "
+                  f"{r['efficiency']:>11.6f}")
+    if not any(r["status"] == "ok" for r in d["rows"]):
+        raise MoreauError(f"no frequency has a characteristic: all {len(d['rows'])} failed "
+                          f"(first: {d['rows'][0]['status']})")
 
 
 def _cmd_bifurcation(args):
