@@ -776,17 +776,22 @@ def _check_common(args):
 
 def _stop_on_sigterm():
     """Make SIGTERM (``kill PID``, ``timeout``, a batch system's time limit) stop a command as
-    Ctrl-C does: workers ended, the finished points kept, one line. Returns what to restore
-    and the record of the signal."""
+    Ctrl-C does: workers ended, the finished points kept, one line. Returns the handlers to
+    restore and the record of the signal."""
     seen = {"signal": None}
     if threading.current_thread() is not threading.main_thread():
-        return None, seen  # handlers can be set in the main thread only
+        return {}, seen  # handlers can be set in the main thread only
 
     def stop(signum, frame):
         seen["signal"] = signum
         raise KeyboardInterrupt
 
-    return signal.signal(signal.SIGTERM, stop), seen
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, stop)}
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        # Ctrl-C as before, but recorded: an error it causes where an interrupt cannot pass
+        # (inside numba's compiler) is still the interruption (an ignored SIGINT stays so)
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, stop)
+    return previous, seen
 
 
 def main(argv=None):
@@ -795,10 +800,17 @@ def main(argv=None):
     configure_cli(args.verbose)
     previous, seen = _stop_on_sigterm()
     try:
-        _check_common(args)
-        # a command is one job: an interrupt inside any of its runs stops it, not only the run
-        with propagate_interrupts():
-            args.func(args)
+        try:
+            _check_common(args)
+            # a command is one job: an interrupt inside any of its runs stops it, not only
+            # the run
+            with propagate_interrupts():
+                args.func(args)
+        except Exception as exc:
+            if seen["signal"] is not None:
+                # numba's compiler, interrupted, fails with its own error: it is the signal's
+                raise KeyboardInterrupt from exc
+            raise
     except InputError as exc:
         print(f"moreau: error: {exc}", file=sys.stderr)
         return 2
@@ -807,8 +819,8 @@ def main(argv=None):
         return 1
     except KeyboardInterrupt as exc:
         # 128 + the signal, as a shell reports a command stopped by it
-        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM) if seen["signal"]
-                       else ("interrupted", 130))
+        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM)
+                       if seen["signal"] == signal.SIGTERM else ("interrupted", 130))
         if isinstance(exc, Interrupted):
             resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
             print(f"\nmoreau: {how}: {exc}{resume}", file=sys.stderr)
@@ -819,8 +831,8 @@ def main(argv=None):
             print(f"\nmoreau: {how}", file=sys.stderr)
         return status
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     return 0
 
 

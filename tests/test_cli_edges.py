@@ -135,3 +135,62 @@ def test_a_rotor_still_to_rounding_at_no_load_has_no_characteristic():
                        rf"velocity -?\d\.\d+e-\d+ m/s is below {NO_MOTION_RTOL:g} of the "
                        r"velocity scale \(0.00232 m/s\)"):
         motor_characteristic("bidirectional-drive", out=None, plot=False)
+
+
+def test_a_failed_load_inside_the_stall_bracket_leaves_an_interpolated_stall():
+    # Brent's search hit a load without a steady state and the whole characteristic
+    # failed; the stall is now interpolated across the tightest sign change around it
+    from moreau.analysis.characteristic import _stall
+
+    class Curve:
+        # v(F) = -1e-3 (1 + F / 7.5e-4) m/s, without a steady state within 1e-5 N of stall
+        stall = -7.5e-4
+
+        def at(self, load):
+            if abs(load - self.stall) < 1e-5:
+                return None, "ConvergenceError: no orbit", None, None
+            return -1e-3 * (1.0 + load / -self.stall), "ok", None, None
+
+        def velocity(self, load):
+            v, status, _, _ = self.at(load)
+            if v is None:
+                raise MoreauError(f"no steady state at load {load:.6g} N ({status})")
+            return v
+
+    stall, how = _stall(Curve(), -1e-3, 1.0)
+    # linear: the interpolation is exact to rounding
+    assert stall == pytest.approx(Curve.stall, rel=1e-12)
+    # the first probe (-1e-3 N) brackets the stall; Brent's first secant lands on it
+    assert how == ("linear interpolation between the loads 0 and -0.001 N (not refined: no "
+                   "steady state at load -0.00075 N (ConvergenceError: no orbit))")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("scheme, refined", [
+    # the power maximum's Brent search meets a load without an orbit (before: exit 1)
+    ("schatzman-paoli", "max_power_located_by"),
+    # a load inside the stall bracket has no orbit (before: exit 1)
+    ("nonsmooth-generalized-alpha", "stall_located_by"),
+])
+def test_the_characteristic_keeps_its_points_where_one_load_fails(scheme, refined, tmp_path,
+                                                                   capsys):
+    argv = ["characteristic", "--scheme", scheme, "--json", "--out", str(tmp_path),
+            "--no-plot"]
+    assert main(argv) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert "not refined" in s[refined]
+    assert s["stall_force_N"] == pytest.approx(-7.9e-4, rel=0.01)
+    with open(next(tmp_path.glob("*.csv"))) as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 41
+    assert sum(r["status"] != "ok" for r in rows) == s["failed_points"]
+
+
+@pytest.mark.slow
+def test_studer_s_no_load_shooting_reaches_its_tolerance(capsys, tmp_path):
+    # it aimed at 1e-8 with a map accurate to its tol = 1e-6 and stalled at 6.3e-7
+    from moreau.analysis.scheme_settings import make_scheme, steady_of
+    sc = FrictionDrive(frequency=185.0)
+    ss = steady_of(sc, make_scheme("studer-extrapolation"))
+    ref = find_steady_state(sc, statistical=False)
+    assert ss.displacement_per_period == pytest.approx(ref.displacement_per_period, rel=1e-4)

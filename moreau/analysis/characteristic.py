@@ -210,8 +210,8 @@ def _stall(curve, v0, unit):
                 lo = max((p for p in seen if p[1] * s > 0.0), key=lambda p: abs(p[0]))
                 hi = min((p for p in seen if p[1] * s <= 0.0), key=lambda p: abs(p[0]))
                 root = lo[0] - lo[1] * (hi[0] - lo[0]) / (hi[1] - lo[1])
-                return float(root), (f"linear interpolation between the loads {lo[0]:.6g} and "
-                                     f"{hi[0]:.6g} N (not refined: "
+                return float(root), (f"linear interpolation between the loads {lo[0]:.9g} and "
+                                     f"{hi[0]:.9g} N (not refined: "
                                      f"{' '.join(str(exc).split())})")
         # the secant's zero, overshot by a tenth, at most _MAX_GROWTH times further out
         slope = (v - va) / (f - fa)
