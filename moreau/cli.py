@@ -24,6 +24,7 @@ from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
 from .errors import InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
+from .provenance import provenance
 from .integrators.base import (INTEGRATORS, check_options, get_integrator,
                                propagate_interrupts, scheme_options)
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
@@ -283,7 +284,7 @@ def _cmd_bifurcation(args):
                                                         "lyapunov_per_period",
                                                         "lyapunov_is_bound", "flight", "start",
                                                         "status")} for p in d["points"]],
-                          "marks": d["marks"]}))
+                          "marks": d["marks"], "provenance": provenance()}))
         return
     for p in d["points"]:
         print(f"  {p['value']:.6g}: {p['motion'] or p['status']}, Lyapunov "

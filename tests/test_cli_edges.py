@@ -194,3 +194,46 @@ def test_studer_s_no_load_shooting_reaches_its_tolerance(capsys, tmp_path):
     ss = steady_of(sc, make_scheme("studer-extrapolation"))
     ref = find_steady_state(sc, statistical=False)
     assert ss.displacement_per_period == pytest.approx(ref.displacement_per_period, rel=1e-4)
+
+
+def test_the_stress_map_and_the_bifurcation_json_carry_the_provenance(tmp_path, capsys,
+                                                                       monkeypatch):
+    # compare --stress's JSON had no provenance; bifurcation --json printed none
+    import moreau.studies.paper.stress as st
+    monkeypatch.setattr(st, "CASES", {"mu-zero": st.CASES["mu-zero"]})
+    assert main(["compare", "--stress", "--quick", "--schemes", "event-driven", "--quiet",
+                 "--no-plot", "--json", "--out", str(tmp_path / "s")]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert _code_version_ok(rep["provenance"])
+    assert json.loads((tmp_path / "s" / "stress.json").read_text())["provenance"] == \
+        rep["provenance"]
+    assert main(["bifurcation", "frequency", "1e4", "2e4", "--points", "2", "--transient", "2",
+                 "--samples", "2", "--no-lyapunov", "--no-shoot", "--quiet", "--no-plot",
+                 "--json", "--out", str(tmp_path / "b")]) == 0
+    assert _code_version_ok(json.loads(capsys.readouterr().out)["provenance"])
+
+
+def test_an_interrupted_efficiency_sweep_keeps_its_finished_frequencies(tmp_path, capsys,
+                                                                        monkeypatch):
+    import moreau.analysis.characteristic as ch
+    real, calls = ch.motor_characteristic, []
+
+    def second_interrupted(*a, **k):
+        calls.append(k["frequency"])
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(ch, "motor_characteristic", second_interrupted)
+    assert main(["characteristic", "--efficiency-vs-frequency", "2000", "1000", "--points", "3",
+                 "--out", str(tmp_path), "--no-plot", "--json"]) == 130
+    table = tmp_path / "efficiency_friction-drive_1000-2000Hz_event-driven.partial.csv"
+    assert capsys.readouterr().err.strip() == (
+        f"moreau: interrupted: efficiency against frequency: 1 of 2 frequencies finished, "
+        f"kept in {table}")
+    with open(table) as fh:
+        (row,) = list(csv.DictReader(fh))
+    assert float(row["frequency_Hz"]) == 2000.0 and row["status"] == "ok"
+    assert json.loads(table.with_suffix(".json").read_text())["partial"] is True
+    assert sorted(p.name for p in tmp_path.iterdir()) == [table.name,
+                                                          table.with_suffix(".json").name]

@@ -470,6 +470,23 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
         except InputError:
             # the settings, not the frequency (a scheme that does not take the scene)
             raise
+        except KeyboardInterrupt:
+            if out is None or not rows:
+                raise
+            stem = out / (f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_"
+                          f"{_scheme_tag(scheme)}.partial")
+            csv_path = stem.with_name(stem.name + ".csv")
+            with open(csv_path, "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
+                w.writeheader()
+                w.writerows(rows)
+            stem.with_name(stem.name + ".json").write_text(json.dumps(
+                {"scene": entry.name, "scheme": scheme.name, "frequencies_Hz": freqs,
+                 "partial": True, "frequencies_finished": len(rows), "csv": csv_path.name,
+                 "provenance": provenance()}, indent=1, default=str))
+            raise KeyboardInterrupt(f"efficiency against frequency: {len(rows)} of "
+                                    f"{len(freqs)} frequencies finished, kept in "
+                                    f"{csv_path}") from None
         except MoreauError as exc:
             row["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
             rows.append(row)
