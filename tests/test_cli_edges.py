@@ -237,3 +237,28 @@ def test_an_interrupted_efficiency_sweep_keeps_its_finished_frequencies(tmp_path
     assert json.loads(table.with_suffix(".json").read_text())["partial"] is True
     assert sorted(p.name for p in tmp_path.iterdir()) == [table.name,
                                                           table.with_suffix(".json").name]
+
+
+def test_an_interrupted_bifurcation_keeps_its_points_under_partial_names(tmp_path, capsys,
+                                                                          monkeypatch):
+    import moreau.analysis.bifurcation as bif
+    real, calls = bif.section_samples, []
+
+    def second_interrupted(*a, **k):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(bif, "section_samples", second_interrupted)
+    assert main(["bifurcation", "frequency", "1e4", "2e4", "--points", "3", "--transient", "2",
+                 "--samples", "2", "--no-lyapunov", "--no-shoot", "--quiet", "--out",
+                 str(tmp_path)]) == 130
+    (table,) = tmp_path.glob("*.csv")
+    assert table.name.endswith(".partial.csv")
+    assert capsys.readouterr().err.strip() == (
+        f"moreau: interrupted: bifurcation: 1 of 3 points finished, kept in {table}")
+    side = json.loads(table.with_suffix(".json").read_text())
+    assert side["partial"] is True and side["interrupted"] is True
+    # no figure drawn after the signal
+    assert not list(tmp_path.glob("*.png"))

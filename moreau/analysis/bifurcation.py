@@ -430,6 +430,9 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
     result = {"points": points, "marks": marks, "columns": unit_of,
               "parameter_column": columns[parameter], "scene": entry.name, "scheme": scheme,
               "interrupted": interrupted}
+    if interrupted and stem is not None:
+        # never under the names of a finished diagram; no figure (work after the signal)
+        stem, plot = stem.with_name(stem.name + ".partial"), False
     if stem is not None and points:
         _write(result, stem, entry, parameter, values, fixed_frequency, fixed, scheme, opts,
                transient, samples, settings, log)
@@ -698,6 +701,7 @@ def _write(result, stem, entry, parameter, values, frequency, fixed, scheme, opt
             "sampled_periods": samples, "section": "tau = 0 (mod 2 pi), after the transient",
             "continuation": "each point starts from the previous point's last section state",
             "marks": result["marks"], "interrupted": result["interrupted"],
+            "partial": result["interrupted"],
             "lyapunov": {"delta0_relative": LYAPUNOV_DELTA0, "floor": LYAPUNOV_FLOOR,
                          "unit": "per drive period"},
             "motions": {str(p["value"]): p["motion"] for p in result["points"]},
