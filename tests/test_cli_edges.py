@@ -262,3 +262,12 @@ def test_an_interrupted_bifurcation_keeps_its_points_under_partial_names(tmp_pat
     assert side["partial"] is True and side["interrupted"] is True
     # no figure drawn after the signal
     assert not list(tmp_path.glob("*.png"))
+
+
+@pytest.mark.slow
+def test_the_two_rod_drive_without_friction_exchanges_no_work(capsys):
+    # at rest at the ends of its phases: the rounding bound samples the energy inside them
+    assert main(["steady", "--scene", "bidirectional-drive", "--set", "mu=0", "--json"]) == 0
+    e = json.loads(capsys.readouterr().out)["energy"]
+    assert e["closing_error"] is None and e["note"].startswith("no work exchanged")
+    assert 0.0 < abs(e["stator_work_J"]) <= e["rounding_bound_J"]
