@@ -463,8 +463,8 @@ def _cmd_atlas(args):
             raise InputError("`--quick` sets the grid; leave out `--x-points`/`--y-points`")
         n = (8 if flag == "--x" else 6) if args.quick else (20 if points is None else points)
         scale = scale or ("log" if name == "frequency" else "linear")
-        axes.append((name, sweep_values(start, stop, n, scale,
-                                        names=(f"{flag} START", f"{flag} STOP", f"{flag}-points"))))
+        names = (f"{flag} START", f"{flag} STOP", f"{flag}-points")
+        axes.append((name, sweep_values(start, stop, n, scale, names=names)))
     params = scene_parameters(args, entry)
     frequency = params.pop("frequency", None)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
