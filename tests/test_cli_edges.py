@@ -271,3 +271,35 @@ def test_the_two_rod_drive_without_friction_exchanges_no_work(capsys):
     e = json.loads(capsys.readouterr().out)["energy"]
     assert e["closing_error"] is None and e["note"].startswith("no work exchanged")
     assert 0.0 < abs(e["stator_work_J"]) <= e["rounding_bound_J"]
+
+
+def test_an_interrupted_characteristic_keeps_its_finished_loads_under_partial_names(
+        tmp_path, capsys, monkeypatch):
+    import moreau.analysis.characteristic as ch
+    real, calls = ch.steady_of, []
+
+    def third_interrupted(*a, **k):
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(ch, "steady_of", third_interrupted)
+    assert main(["characteristic", "--frequency", "2000", "--points", "3", "--out",
+                 str(tmp_path), "--no-plot"]) == 130
+    table = tmp_path / "characteristic_friction-drive_2000Hz_event-driven.partial.csv"
+    assert capsys.readouterr().err.strip() == (
+        f"moreau: interrupted: characteristic: 2 loads finished, kept in {table}")
+    with open(table) as fh:
+        rows = list(csv.DictReader(fh))
+    # no load (the rotor runs forwards at 2000 Hz), then the stall search's first probe,
+    # past the stall (no orbit there: the search halves back), kept with its status
+    assert len(rows) == 2 and float(rows[0]["load_N"]) == 0.0 and rows[0]["status"] == "ok"
+    sc = FrictionDrive(frequency=2000.0)
+    v0 = sc.displacement_to_si(find_steady_state(sc).displacement_per_period) / (
+        sc.period * sc.time_unit_s)
+    assert float(rows[0]["average_velocity_m_per_s"]) == pytest.approx(v0, rel=1e-12)
+    assert float(rows[1]["load_N"]) > 0.0 and rows[1]["status"].startswith("ConvergenceError")
+    assert json.loads(table.with_suffix(".json").read_text())["partial"] is True
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [table.name, table.with_suffix(".json").name])

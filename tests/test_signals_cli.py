@@ -59,6 +59,7 @@ def test_sigint_stops_a_long_steady_state(tmp_path):
     assert rc == 130 and line == "moreau: interrupted" and took < STOP_WITHIN
 
 
+@pytest.mark.slow  # the same in process, interrupted by a stub: test_cli_edges.py
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
 def test_sigterm_stops_a_characteristic_and_keeps_its_finished_loads_as_partial(tmp_path):
     # 5000 grid loads, a steady state each: minutes
