@@ -178,7 +178,8 @@ def _cmd_sweep(args):
     if args.log and args.scale == "linear":
         raise InputError("`--log` contradicts `--scale linear`")
     points = args.points if args.points is not None else args.num
-    values = sweep_values(args.start, args.stop, 50 if points is None else points, scale)
+    values = sweep_values(args.start, args.stop, 50 if points is None else points, scale,
+                          names=("START", "STOP", "--points"))
     params = scene_parameters(args, entry)
     if args.parameter in params and args.parameter != "frequency":
         raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
@@ -258,7 +259,8 @@ def _cmd_bifurcation(args):
     """``moreau bifurcation``: section samples of the long-run motion against one parameter."""
     entry = get_entry(args.scene)
     scale = args.scale or ("log" if args.parameter == "frequency" else "linear")
-    values = sweep_values(args.start, args.stop, args.points, scale)
+    values = sweep_values(args.start, args.stop, args.points, scale,
+                          names=("START", "STOP", "--points"))
     params = scene_parameters(args, entry)
     if args.parameter in params:
         raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")

@@ -78,8 +78,8 @@ def sweep_values(start, stop, points, scale="linear", names=("START", "STOP", "p
         raise InputError(f"`{names[0]}` and `{names[1]}` must differ when `{names[2]}` > 1, "
                          f"got {start:g} twice")
     if points > MAX_POINTS:
-        raise InputError(f"`{names[2]}` = {points:.3g} is more than the limit {MAX_POINTS:.0e} "
-                         "of one sweep")
+        raise InputError(f"`points` = {points:.3g} is more than the limit {MAX_POINTS:.0e} of one "
+                         "sweep")
     if scale not in ("linear", "log"):
         raise InputError(f"`scale` must be 'linear' or 'log', got {scale!r}")
     if scale == "log":
