@@ -222,6 +222,10 @@ def _cmd_characteristic(args):
           f"{s['load_at_max_power_N']:.9e} N")
     print(f"  load convention        {s['load_convention']}")
     print(f"  beyond stall           {s['reversal']}")
+    for key, label in (("stall_located_by", "stall located by"),
+                       ("max_power_located_by", "max power located by")):
+        if "not refined" in s.get(key, ""):
+            print(f"  {label:<23}{s[key]}")
     if s.get("note"):
         print(f"  note                   {s['note']}")
 
