@@ -563,14 +563,19 @@ def _cmd_compare(args):
     report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep,
                          schemes=schemes, **params)
     report["settings"] = settings
+    if report["interrupted"]:
+        # the finished rows, never under the names of a finished comparison; no figure
+        report["partial"] = True
+        paths = cmp.write_outputs(report, out, tag=tag + ".partial", plot=False)
+        n = len(report["rows"])
+        raise KeyboardInterrupt(f"compare: {n} row{'' if n == 1 else 's'} finished, kept in "
+                                f"{paths['csv']}")
     paths = cmp.write_outputs(report, out, tag=tag, plot=not args.no_plot)
     if args.json:
         print(json.dumps(report))
     else:
         print(cmp.format_table(report))
         print("wrote " + ", ".join(p for p in paths.values() if p))
-    if report["interrupted"]:
-        raise KeyboardInterrupt
 
 
 def parse_settings(items, option):

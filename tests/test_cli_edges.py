@@ -303,3 +303,28 @@ def test_an_interrupted_characteristic_keeps_its_finished_loads_under_partial_na
     assert json.loads(table.with_suffix(".json").read_text())["partial"] is True
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [table.name, table.with_suffix(".json").name])
+
+
+def test_an_interrupted_comparison_keeps_its_rows_under_partial_names(tmp_path, capsys,
+                                                                      monkeypatch):
+    # it wrote the finished rows (and a figure) under the names of a finished comparison
+    import moreau.analysis.compare as cmp
+    real, calls = cmp.run_row, []
+
+    def second_interrupted(*a, **k):
+        calls.append(1)
+        if len(calls) == 2:
+            raise KeyboardInterrupt
+        return real(*a, **k)
+
+    monkeypatch.setattr(cmp, "run_row", second_interrupted)
+    assert main(["compare", "--scene", "bouncing-ball", "--quick", "--quiet", "--json", "--out",
+                 str(tmp_path)]) == 130
+    table = tmp_path / "compare_bouncing-ball.partial.csv"
+    assert capsys.readouterr().err.strip() == (
+        f"moreau: interrupted: compare: 1 row finished, kept in {table}")
+    side = json.loads(table.with_suffix(".json").read_text())
+    assert side["partial"] is True and side["interrupted"] is True and len(side["rows"]) == 1
+    assert _code_version_ok(side["provenance"])
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [table.name, table.with_suffix(".json").name])
