@@ -24,7 +24,9 @@ from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
 from .errors import InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
-from .integrators.base import INTEGRATORS, check_options, get_integrator, scheme_options
+from .provenance import provenance
+from .integrators.base import (INTEGRATORS, check_options, get_integrator,
+                               propagate_interrupts, scheme_options)
 from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
 from .studies.paper.reproduce import reproduce
@@ -123,7 +125,8 @@ def _cmd_steady(args):
     _scheme_args(args)
     entry = get_entry(args.scene)
     params = scene_parameters(args, entry)
-    if "frequency" in entry.parameter_names() and "frequency" not in params:
+    if ("frequency" in entry.parameter_names() and "frequency" not in params
+            and entry.defaults().get("frequency") is None):
         raise InputError("`--frequency` is required (drive frequency in Hz)")
     scene = entry.factory(**params)
     check_periodic(scene)
@@ -175,7 +178,8 @@ def _cmd_sweep(args):
     if args.log and args.scale == "linear":
         raise InputError("`--log` contradicts `--scale linear`")
     points = args.points if args.points is not None else args.num
-    values = sweep_values(args.start, args.stop, 50 if points is None else points, scale)
+    values = sweep_values(args.start, args.stop, 50 if points is None else points, scale,
+                          names=("START", "STOP", "--points"))
     params = scene_parameters(args, entry)
     if args.parameter in params and args.parameter != "frequency":
         raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
@@ -218,6 +222,12 @@ def _cmd_characteristic(args):
           f"{s['load_at_max_power_N']:.9e} N")
     print(f"  load convention        {s['load_convention']}")
     print(f"  beyond stall           {s['reversal']}")
+    for key, label in (("stall_located_by", "stall located by"),
+                       ("max_power_located_by", "max power located by")):
+        if "not refined" in s.get(key, ""):
+            print(f"  {label:<23}{s[key]}")
+    if s.get("note"):
+        print(f"  note                   {s['note']}")
 
 
 def _efficiency_vs_frequency(args, entry, params, frequency, scheme):
@@ -229,23 +239,32 @@ def _efficiency_vs_frequency(args, entry, params, frequency, scheme):
                                 scheme=scheme, points=points, out=args.out,
                                 plot=not args.no_plot, log=(lambda s: None) if args.json else print)
     if args.json:
-        print(json.dumps(d, default=str))
-        return
-    print(f"{entry.name} ({scheme.name}): efficiency at the load of maximum output power")
-    print(f"  {'f [Hz]':>10} {'load [N]':>14} {'P_out [W]':>14} {'P_in [W]':>14} {'efficiency':>11}")
-    for r in d["rows"]:
-        if r["status"] != "ok":
-            print(f"  {r['frequency_Hz']:>10g}  {r['status']}")
-            continue
-        print(f"  {r['frequency_Hz']:>10g} {r['load_at_max_power_N']:>14.6e} "
-              f"{r['max_power_W']:>14.6e} {r['input_power_W']:>14.6e} {r['efficiency']:>11.6f}")
+        # JSON has no NaN: a value a failed row lacks is null
+        rows = [{k: None if isinstance(v, float) and v != v else v for k, v in r.items()}
+                for r in d["rows"]]
+        print(json.dumps(dict(d, rows=rows), default=str))
+    else:
+        print(f"{entry.name} ({scheme.name}): efficiency at the load of maximum output power")
+        print(f"  {'f [Hz]':>10} {'load [N]':>14} {'P_out [W]':>14} {'P_in [W]':>14} "
+              f"{'efficiency':>11}")
+        for r in d["rows"]:
+            if r["status"] != "ok":
+                print(f"  {r['frequency_Hz']:>10g}  {r['status']}")
+                continue
+            print(f"  {r['frequency_Hz']:>10g} {r['load_at_max_power_N']:>14.6e} "
+                  f"{r['max_power_W']:>14.6e} {r['input_power_W']:>14.6e} "
+                  f"{r['efficiency']:>11.6f}")
+    if not any(r["status"] == "ok" for r in d["rows"]):
+        raise MoreauError(f"no frequency has a characteristic: all {len(d['rows'])} failed "
+                          f"(first: {d['rows'][0]['status']})")
 
 
 def _cmd_bifurcation(args):
     """``moreau bifurcation``: section samples of the long-run motion against one parameter."""
     entry = get_entry(args.scene)
     scale = args.scale or ("log" if args.parameter == "frequency" else "linear")
-    values = sweep_values(args.start, args.stop, args.points, scale)
+    values = sweep_values(args.start, args.stop, args.points, scale,
+                          names=("START", "STOP", "--points"))
     params = scene_parameters(args, entry)
     if args.parameter in params:
         raise InputError(f"`{args.parameter}` is swept; do not fix it with `--set` or its option")
@@ -271,7 +290,7 @@ def _cmd_bifurcation(args):
                                                         "lyapunov_per_period",
                                                         "lyapunov_is_bound", "flight", "start",
                                                         "status")} for p in d["points"]],
-                          "marks": d["marks"]}))
+                          "marks": d["marks"], "provenance": provenance()}))
         return
     for p in d["points"]:
         print(f"  {p['value']:.6g}: {p['motion'] or p['status']}, Lyapunov "
@@ -318,16 +337,25 @@ def _cmd_run(args):
             raise InputError(f"scheme {args.scheme!r} steps in time: give `--steps`")
         steps = int(round(1000 * periods))
     check_options(args.scheme, options, scene)
-    res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
-                            steps=steps, samples=args.samples,
-                            progress=not args.quiet, **options)
+    # the one run is the whole job: an interrupt ends it with what it had (status -4)
+    with propagate_interrupts(False):
+        res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
+                                steps=steps, samples=args.samples,
+                                progress=not args.quiet, **options)
     shown = dict(options)
     if stepping and steps is not None:
         shown["steps"] = steps
     tag = history_tag(entry.name, params, args.scheme, shown)
-    settings = claim_outputs(os.path.join(args.out, tag), {
-        "scene": entry.name, "parameters": params, "scheme": args.scheme, "options": shown,
-        "periods": periods, "duration": duration, "samples": args.samples}, args.force)
+    interrupted = res.status == -4
+    run_settings = {"scene": entry.name, "parameters": params, "scheme": args.scheme,
+                    "options": shown, "periods": periods, "duration": duration,
+                    "samples": args.samples}
+    if interrupted:
+        # never under the names of a finished run: the history is marked partial
+        tag += ".partial"
+        settings = run_settings
+    else:
+        settings = claim_outputs(os.path.join(args.out, tag), run_settings, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
     names = getattr(scene, "coordinate_names", None)
@@ -336,7 +364,11 @@ def _cmd_run(args):
         "coordinates": None if names is None else {f"q_{i}": n for i, n in enumerate(names)},
         "scheme": args.scheme, "options": shown,
         "periods": periods, "duration": duration, "status": res.status, "message": res.message,
-        "command": "moreau run", "settings": settings})
+        "partial": interrupted, "command": "moreau run", "settings": settings})
+    if interrupted:
+        end = cols[0][2][-1] if len(cols[0][2]) else 0.0
+        raise KeyboardInterrupt(f"run: stopped at {cols[0][0]} = {end:.6g} {cols[0][1]}; the "
+                                f"partial history ({len(cols[0][2])} samples) is in {path}")
     print(f"wrote {path} and {side} ({len(cols[0][2])} samples); status {res.status}: "
           f"{res.message}")
     if not args.no_plot:
@@ -437,7 +469,8 @@ def _cmd_atlas(args):
             raise InputError("`--quick` sets the grid; leave out `--x-points`/`--y-points`")
         n = (8 if flag == "--x" else 6) if args.quick else (20 if points is None else points)
         scale = scale or ("log" if name == "frequency" else "linear")
-        axes.append((name, sweep_values(start, stop, n, scale)))
+        names = (f"{flag} START", f"{flag} STOP", f"{flag}-points")
+        axes.append((name, sweep_values(start, stop, n, scale, names=names)))
     params = scene_parameters(args, entry)
     frequency = params.pop("frequency", None)
     scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
@@ -530,14 +563,19 @@ def _cmd_compare(args):
     report = cmp.compare(args.scene, quick=args.quick, progress=progress, on_row=keep,
                          schemes=schemes, **params)
     report["settings"] = settings
+    if report["interrupted"]:
+        # the finished rows, never under the names of a finished comparison; no figure
+        report["partial"] = True
+        paths = cmp.write_outputs(report, out, tag=tag + ".partial", plot=False)
+        n = len(report["rows"])
+        raise KeyboardInterrupt(f"compare: {n} row{'' if n == 1 else 's'} finished, kept in "
+                                f"{paths['csv']}")
     paths = cmp.write_outputs(report, out, tag=tag, plot=not args.no_plot)
     if args.json:
         print(json.dumps(report))
     else:
         print(cmp.format_table(report))
         print("wrote " + ", ".join(p for p in paths.values() if p))
-    if report["interrupted"]:
-        raise KeyboardInterrupt
 
 
 def parse_settings(items, option):
@@ -581,7 +619,8 @@ def build_parser():
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("steady", help="periodic steady state of a driven scene (a statistical "
                                         "one, mean with interval, where no orbit exists)")
-    p.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
+    p.add_argument("--frequency", type=float, default=None,
+                   help="drive frequency [Hz] (default: the scene's)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     _add_params(p, scheme_defaults=False)
     p.add_argument("--max-period", type=int, default=1,
@@ -633,7 +672,8 @@ def build_parser():
                    help="time to simulate [s] (or the scene's time unit if it has no SI units)")
     r.add_argument("--steps", type=int, default=None,
                    help="time-stepping schemes: steps over the whole run")
-    r.add_argument("--samples", type=int, default=2000, help="samples kept (default 2000)")
+    r.add_argument("--samples", type=int, default=2000,
+                   help="samples written, evenly spaced in time (default 2000)")
     r.add_argument("--out", default="out", help="output folder (default ./out)")
     r.add_argument("--quiet", action="store_true", help="no progress bar")
     r.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -748,17 +788,22 @@ def _check_common(args):
 
 def _stop_on_sigterm():
     """Make SIGTERM (``kill PID``, ``timeout``, a batch system's time limit) stop a command as
-    Ctrl-C does: workers ended, the finished points kept, one line. Returns what to restore
-    and the record of the signal."""
+    Ctrl-C does: workers ended, the finished points kept, one line. Returns the handlers to
+    restore and the record of the signal."""
     seen = {"signal": None}
     if threading.current_thread() is not threading.main_thread():
-        return None, seen  # handlers can be set in the main thread only
+        return {}, seen  # handlers can be set in the main thread only
 
     def stop(signum, frame):
         seen["signal"] = signum
         raise KeyboardInterrupt
 
-    return signal.signal(signal.SIGTERM, stop), seen
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, stop)}
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        # Ctrl-C as before, but recorded: an error it causes where an interrupt cannot pass
+        # (inside numba's compiler) is still the interruption (an ignored SIGINT stays so)
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, stop)
+    return previous, seen
 
 
 def main(argv=None):
@@ -767,8 +812,17 @@ def main(argv=None):
     configure_cli(args.verbose)
     previous, seen = _stop_on_sigterm()
     try:
-        _check_common(args)
-        args.func(args)
+        try:
+            _check_common(args)
+            # a command is one job: an interrupt inside any of its runs stops it, not only
+            # the run
+            with propagate_interrupts():
+                args.func(args)
+        except Exception as exc:
+            if seen["signal"] is not None:
+                # numba's compiler, interrupted, fails with its own error: it is the signal's
+                raise KeyboardInterrupt from exc
+            raise
     except InputError as exc:
         print(f"moreau: error: {exc}", file=sys.stderr)
         return 2
@@ -777,17 +831,20 @@ def main(argv=None):
         return 1
     except KeyboardInterrupt as exc:
         # 128 + the signal, as a shell reports a command stopped by it
-        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM) if seen["signal"]
-                       else ("interrupted", 130))
+        how, status = (("terminated (SIGTERM)", 128 + signal.SIGTERM)
+                       if seen["signal"] == signal.SIGTERM else ("interrupted", 130))
         if isinstance(exc, Interrupted):
             resume = "; run the same command again to resume" if exc.cache_dir is not None else ""
             print(f"\nmoreau: {how}: {exc}{resume}", file=sys.stderr)
+        elif str(exc):
+            # what the command kept (a partial history, the finished points)
+            print(f"\nmoreau: {how}: {exc}", file=sys.stderr)
         else:
             print(f"\nmoreau: {how}", file=sys.stderr)
         return status
     finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     return 0
 
 

@@ -13,17 +13,21 @@ Examples
 ['code_version', 'command', 'cpu', 'cpu_count']
 >>> p["moreau_version"] == __import__("moreau").__version__
 True
+>>> p["code_version"].startswith(p["moreau_version"] + "+")
+True
 """
 
 import datetime
+import hashlib
 import importlib.metadata
 import os
+import pathlib
 import platform
 import sys
 
 from . import __version__
 
-__all__ = ["provenance", "machine"]
+__all__ = ["provenance", "machine", "code_version"]
 
 
 def _version(dist):
@@ -76,14 +80,50 @@ def machine():
             "architecture": platform.machine(), "system": platform.system()}
 
 
+#: modules that only present results (files, figures, text); editing them keeps the cache
+_PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
+                 "studies/paper/figures.py", "studies/paper/report.py",
+                 "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
+                 "analysis/history.py", "studies/paper/tables.py"}
+
+
+def code_version():
+    """Package version plus a hash of the source files that compute results.
+
+    Used as part of the cache key (:mod:`moreau.analysis.engine`): any edit
+    of the computing code gives new keys. Modules that only write files,
+    figures or text are left out. It hashes the installed files, so it
+    identifies the code also outside a git checkout (about 10 ms).
+
+    Examples
+    --------
+    >>> v = code_version()
+    >>> v.startswith("0.") and len(v.split("+")[1]) == 16
+    True
+    """
+    root = pathlib.Path(__file__).resolve().parent
+    h = hashlib.sha256()
+    for path in sorted(root.rglob("*.py")):
+        if path.relative_to(root).as_posix() in _PRESENTATION:
+            continue
+        h.update(str(path.relative_to(root)).encode())
+        h.update(path.read_bytes())
+    return f"{__version__}+{h.hexdigest()[:16]}"
+
+
+#: :func:`provenance`'s argument of that name shadows the function
+_code_version = code_version
+
+
 def provenance(code_version=None):
     """A JSON-ready dict identifying this run.
 
     Parameters
     ----------
     code_version : str, optional
-        The hash of the computing sources
-        (:func:`moreau.analysis.engine.code_version`), where the caller has it.
+        The package version and a hash of the computing sources
+        (:func:`code_version`); computed here where not given, so that no
+        output leaves it out.
 
     Returns
     -------
@@ -93,6 +133,8 @@ def provenance(code_version=None):
         ``cpu``, ``cpu_count``, ``threads``, ``time_utc`` (ISO 8601) and
         ``command`` (the command line).
     """
+    if code_version is None:
+        code_version = _code_version()
     return {
         "moreau_version": __version__,
         "code_version": code_version,

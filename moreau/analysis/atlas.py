@@ -132,6 +132,11 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
         raise InputError(f"`--x` and `--y` must be two different parameters, got {xname!r} twice")
     xv = np.asarray(xv, dtype=float).reshape(-1)
     yv = np.asarray(yv, dtype=float).reshape(-1)
+    for axis, name, v in (("x", xname, xv), ("y", yname, yv)):
+        if np.unique(v).size != v.size:
+            # a repeated value computes one point twice and collapses the grid of the NetCDF
+            raise InputError(f"`{axis}`: the values of {name!r} must be distinct, got "
+                             f"{v.tolist()}")
     if netcdf:
         if out is None:
             raise InputError("`netcdf` writes a file next to the CSV: give `out`")

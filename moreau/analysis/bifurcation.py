@@ -60,6 +60,7 @@ import numpy as np
 
 from .._validate import positive_int
 from ..errors import InputError, MoreauError
+from ..integrators.result import SimulationResult
 from ..integrators.base import check_options, get_integrator, simulate
 from ..integrators.base import scheme_options as options_of
 from ..outputs import claim_outputs
@@ -127,6 +128,26 @@ def _section_columns(scene, res, cyclic, disp):
         out.append(("displacement_per_period", "m" if to_si else "1",
                     float(to_si(disp) if to_si else disp)))
     return out
+
+
+def section_column_names(scene, cyclic):
+    """The names of the section columns of ``scene`` (the ``--quantity`` choices), before a run.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> section_column_names(make_scene("stick-slip-motor"), 0)[-2:]
+    ['gap_0', 'displacement_per_period']
+    """
+    q0, v0 = scene.initial_state()
+    q0, v0 = np.asarray(q0, float), np.asarray(v0, float)
+    nc = np.asarray(scene.contact_jacobians(q0, 0.0)[0]).shape[0]
+    zeros = np.zeros((1, nc))
+    # one sample at the start: si_columns names its columns from the shapes alone
+    res = SimulationResult(t=np.zeros(1), q=q0[None, :], v=v0[None, :],
+                           regime=zeros.astype(int), force_N=zeros, force_T=zeros,
+                           slip_velocity=zeros, gap=zeros)
+    return [name for name, _, _ in _section_columns(scene, res, cyclic, 0.0)]
 
 
 def _one_period(scene, scheme, q, v, opts):
@@ -334,6 +355,13 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
             options={k: v for k, v in opts.items() if k not in ("h", "save_every", "sample_dt")})
     cyc = tuple(getattr(probe, "cyclic_coordinates", ()))
     cyclic = cyc[0] if len(cyc) == 1 else None
+    if quantities is not None:
+        # the figure is drawn after all the work: a wrong name is refused before it
+        known = section_column_names(probe, cyclic)
+        unknown = [q for q in quantities if q not in known]
+        if unknown:
+            raise InputError(f"`quantities` (`--quantity`) must name section columns, one of "
+                             f"{known}; got {unknown}")
     stem = settings = None
     if out is not None:
         out = check_output_dir(out)
@@ -402,6 +430,9 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
     result = {"points": points, "marks": marks, "columns": unit_of,
               "parameter_column": columns[parameter], "scene": entry.name, "scheme": scheme,
               "interrupted": interrupted}
+    if interrupted and stem is not None:
+        # never under the names of a finished diagram; no figure (work after the signal)
+        stem, plot = stem.with_name(stem.name + ".partial"), False
     if stem is not None and points:
         _write(result, stem, entry, parameter, values, fixed_frequency, fixed, scheme, opts,
                transient, samples, settings, log)
@@ -454,8 +485,8 @@ def bifurcation_marks(points, parameter):
     --------
     >>> pts = [{"value": 1.0, "period": 1, "flight": False, "status": "ok"},
     ...        {"value": 2.0, "period": 2, "flight": True, "status": "ok"}]
-    >>> [(m["kind"], m["at"]) for m in bifurcation_marks(pts, "a")]
-    [('period doubling', 1.5), ('grazing', 1.5)]
+    >>> [(m["kind"], m["from"], m["to"], m["at"]) for m in bifurcation_marks(pts, "a")]
+    [('period doubling', 'period-1', 'period-2', 1.5), ('grazing', 'contact', 'flight', 1.5)]
     """
     marks = []
     for a, b in zip(points, points[1:]):
@@ -467,7 +498,10 @@ def bifurcation_marks(points, parameter):
         if ka != kb:
             kind = ("period doubling" if ka and kb == 2 * ka else
                     "period halving" if kb and ka == 2 * kb else "period change")
-            marks.append({"kind": kind, "from": ka, "to": kb, **where})
+            # the motions by name: a period of 0 is "no period", not a period
+            marks.append({"kind": kind,
+                          "from": a.get("motion") or classify_motion(ka, math.nan),
+                          "to": b.get("motion") or classify_motion(kb, math.nan), **where})
         if a["flight"] != b["flight"]:
             marks.append({"kind": "grazing", "from": "flight" if a["flight"] else "contact",
                           "to": "flight" if b["flight"] else "contact", **where})
@@ -667,6 +701,7 @@ def _write(result, stem, entry, parameter, values, frequency, fixed, scheme, opt
             "sampled_periods": samples, "section": "tau = 0 (mod 2 pi), after the transient",
             "continuation": "each point starts from the previous point's last section state",
             "marks": result["marks"], "interrupted": result["interrupted"],
+            "partial": result["interrupted"],
             "lyapunov": {"delta0_relative": LYAPUNOV_DELTA0, "floor": LYAPUNOV_FLOOR,
                          "unit": "per drive period"},
             "motions": {str(p["value"]): p["motion"] for p in result["points"]},

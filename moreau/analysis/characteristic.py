@@ -84,6 +84,11 @@ _MAX_GROWTH = 4.0
 _MAX_PROBES = 60
 #: Newton and bracketing iterations of a Moreau–Jean steady state that failed with its default
 _MJ_MAX_ITER = 300
+#: a no-load mean velocity within this share of the stator's speed (the scene's
+#: ``velocity_scale``) is no motion: 100 times the reference's shooting tolerance (1e-10
+#: of that speed), far below any motor's (the two-rod drive's symmetric no-load
+#: velocity is 5.8e-20 m/s, 2.5e-17 of it)
+NO_MOTION_RTOL = 1e-8
 
 
 def characteristic_tag(scene, frequency, scheme):
@@ -133,6 +138,10 @@ class _Curve:
                     sc.period * sc.time_unit_s)
                 self.points[load] = (v, "ok", sc, ss)
             except MoreauError as exc:
+                if isinstance(exc, InputError) and not self.points:
+                    # the first point fails on the settings (a scheme that does not take
+                    # the scene), not on its load: an input error, refused before more work
+                    raise
                 self.points[load] = (None, f"{type(exc).__name__}: {' '.join(str(exc).split())}",
                                      sc, None)
         return self.points[load]
@@ -160,13 +169,14 @@ class _Curve:
     def velocity(self, load):
         v, status, _, _ = self.at(load)
         if v is None:
-            raise MoreauError(f"no steady state at load {load!r} N inside the stall bracket "
+            raise MoreauError(f"no steady state at load {load:.6g} N inside the stall bracket "
                               f"({status})")
         return v
 
 
 def _stall(curve, v0, unit):
-    """Signed stall force: bracket the sign change of ``v(F)`` along the opposing load, then Brent."""
+    """Signed stall force and how it was located: bracket the sign change of ``v(F)`` along
+    the opposing load, then Brent (a linear interpolation where a load inside fails)."""
     s = math.copysign(1.0, v0)
     fa, va = 0.0, v0
     f = s * _FIRST_PROBE * unit
@@ -183,9 +193,26 @@ def _stall(curve, v0, unit):
             continue
         if v * s <= 0.0:
             if v == 0.0:
-                return f
-            root = brentq(curve.velocity, fa, f, xtol=1e-12 * abs(f), rtol=1e-10, maxiter=100)
-            return float(root)
+                return f, "a grid probe with zero velocity"
+            seen = [(fa, va), (f, v)]
+
+            def velocity(x):
+                out = curve.velocity(x)
+                seen.append((x, out))
+                return out
+
+            try:
+                root = brentq(velocity, fa, f, xtol=1e-12 * abs(f), rtol=1e-10, maxiter=100)
+                return float(root), "Brent's method"
+            except MoreauError as exc:
+                # a load inside the bracket without a steady state: interpolate across the
+                # tightest sign change the loads with one give
+                lo = max((p for p in seen if p[1] * s > 0.0), key=lambda p: abs(p[0]))
+                hi = min((p for p in seen if p[1] * s <= 0.0), key=lambda p: abs(p[0]))
+                root = lo[0] - lo[1] * (hi[0] - lo[0]) / (hi[1] - lo[1])
+                return float(root), (f"linear interpolation between the loads {lo[0]:.9g} and "
+                                     f"{hi[0]:.9g} N (not refined: "
+                                     f"{' '.join(str(exc).split())})")
         # the secant's zero, overshot by a tenth, at most _MAX_GROWTH times further out
         slope = (v - va) / (f - fa)
         target = abs(f) * _MAX_GROWTH
@@ -258,27 +285,53 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
     if out is not None:
         out = check_output_dir(out)
 
-    v0, status, _, _ = curve.at(0.0)
-    if v0 is None:
-        raise MoreauError(f"no steady state at no load: {status}")
-    if v0 == 0.0:
-        raise MoreauError("the rotor does not move at no load: no characteristic to trace")
-    unit = float(sc0.force_to_si(1.0))
-    stall = _stall(curve, v0, unit)
-    n_stall = len(curve.points)
+    rows = []
+    try:
+        try:
+            v0, status, _, _ = curve.at(0.0)
+        except InputError as exc:
+            raise InputError(f"scheme {scheme.name!r} on scene {entry.name!r}: {exc}") from None
+        if v0 is None:
+            raise MoreauError(f"no steady state at no load: {status}")
+        # the shooting's velocity scale (1 in the scene's units where it names none)
+        vs = float(np.max(np.abs(getattr(sc0, "velocity_scale", 1.0))))
+        still = NO_MOTION_RTOL * float(sc0.displacement_to_si(vs)) / float(sc0.time_unit_s)
+        if abs(v0) <= still:
+            raise MoreauError(f"the rotor does not move at no load: its mean velocity {v0:.3g} "
+                              f"m/s is below {NO_MOTION_RTOL:g} of the velocity scale "
+                              f"({still / NO_MOTION_RTOL:.3g} m/s), rounding; no characteristic "
+                              "to trace")
+        unit = float(sc0.force_to_si(1.0))
+        stall, stall_by = _stall(curve, v0, unit)
+        n_stall = len(curve.points)
 
-    loads = np.linspace(0.0, beyond * stall, points)
-    rows = [_row(curve, f, v0, scheme) for f in loads]
-    power = np.array([r["output_power_W"] if r["status"] == "ok" else -math.inf for r in rows])
-    i = int(np.argmax(power))
-    lo, hi = loads[max(i - 1, 0)], loads[min(i + 1, points - 1)]
-    lo, hi = sorted((lo, hi))
-    # the power curve is smooth near its maximum: Brent's bounded minimisation of -F v
-    res = minimize_scalar(lambda f: -f * curve.velocity(f), bounds=(lo, hi), method="bounded",
-                          options={"xatol": 1e-10 * abs(stall)})
-    f_best, p_best = (float(res.x), float(-res.fun)) if -res.fun >= power[i] else (
-        float(loads[i]), float(power[i]))
-    best = _row(curve, f_best, v0, scheme)
+        loads = np.linspace(0.0, beyond * stall, points)
+        for f in loads:
+            rows.append(_row(curve, f, v0, scheme))
+        power = np.array([r["output_power_W"] if r["status"] == "ok" else -math.inf
+                          for r in rows])
+        i = int(np.argmax(power))
+        lo, hi = loads[max(i - 1, 0)], loads[min(i + 1, points - 1)]
+        lo, hi = sorted((lo, hi))
+        refined = "Brent's method between the grid's neighbours of its best load"
+        try:
+            # the power curve is smooth near its maximum: Brent's bounded minimisation of -F v
+            res = minimize_scalar(lambda f: -f * curve.velocity(f), bounds=(lo, hi),
+                                  method="bounded", options={"xatol": 1e-10 * abs(stall)})
+            f_best, p_best = (float(res.x), float(-res.fun)) if -res.fun >= power[i] else (
+                float(loads[i]), float(power[i]))
+        except MoreauError as exc:
+            # a load without a steady state inside the bracket: the grid's best stands
+            refined = (f"not refined (a load inside the bracket has no steady state: "
+                       f"{' '.join(str(exc).split())}): the grid's best load")
+            f_best, p_best = float(loads[i]), float(power[i])
+        best = _row(curve, f_best, v0, scheme)
+    except KeyboardInterrupt:
+        if out is not None and curve.points:
+            path = _write_partial(curve, out, entry, frequency, scheme)
+            raise KeyboardInterrupt(f"characteristic: {len(curve.points)} loads finished, kept "
+                                    f"in {path}") from None
+        raise
     reversed_rows = [r for r in rows if r["motion"] == "reversed"]
     direction = "forward" if v0 > 0 else "backward"
     summary = {
@@ -303,12 +356,19 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
                      if reversed_rows else
                      "no grid load beyond the stall force has a steady state (the rotor runs away)"),
         "points": points,
+        "failed_points": sum(r["status"] != "ok" for r in rows),
+        "stall_located_by": stall_by,
+        "max_power_located_by": refined,
         "steady_states_for_stall": n_stall,
         "parameters": {k: v for k, v in sc0.params.__dict__.items() if k != "load"}
         if hasattr(sc0, "params") else dict(fixed),
         "scheme_settings": {"theta": scheme.theta, "steps_per_period": scheme.steps_per_period,
                             "rtol": scheme.rtol, "options": scheme.options},
+        "provenance": provenance(),
     }
+    if summary["failed_points"]:
+        summary["note"] = (f"{summary['failed_points']} of the {points} grid loads have no "
+                           "steady state (their `status` in the table); the others are kept")
     if out is not None:
         stem = out / characteristic_tag(entry.name, frequency or 0.0, scheme)
         csv_path = stem.with_name(stem.name + ".csv")
@@ -316,7 +376,7 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
             w = csv.DictWriter(fh, fieldnames=list(COLUMNS))
             w.writeheader()
             w.writerows(rows)
-        side = dict(summary, provenance=provenance(), csv=csv_path.name)
+        side = dict(summary, csv=csv_path.name)
         json_path = stem.with_name(stem.name + ".json")
         json_path.write_text(json.dumps(side, indent=1, default=str))
         log(f"wrote {csv_path} and {json_path.name}")
@@ -395,6 +455,9 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
     if not has_energy_audit(sc0, scheme.name):
         raise InputError(f"scene {entry.name!r} has no energy audit under scheme "
                          f"{scheme.name!r}: the input power, hence the efficiency, is unknown")
+    points = positive_int("points", points)
+    if not 3 <= points <= MAX_POINTS:
+        raise InputError(f"`--points` must be from 3 to {MAX_POINTS}, got {points}")
     if out is not None:
         out = check_output_dir(out)
     rows = []
@@ -404,6 +467,26 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
         try:
             s = motor_characteristic(entry.name, frequency=f, fixed=fixed, scheme=scheme,
                                      points=points, out=None, plot=False)["summary"]
+        except InputError:
+            # the settings, not the frequency (a scheme that does not take the scene)
+            raise
+        except KeyboardInterrupt:
+            if out is None or not rows:
+                raise
+            stem = out / (f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_"
+                          f"{_scheme_tag(scheme)}.partial")
+            csv_path = stem.with_name(stem.name + ".csv")
+            with open(csv_path, "w", newline="") as fh:
+                w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
+                w.writeheader()
+                w.writerows(rows)
+            stem.with_name(stem.name + ".json").write_text(json.dumps(
+                {"scene": entry.name, "scheme": scheme.name, "frequencies_Hz": freqs,
+                 "partial": True, "frequencies_finished": len(rows), "csv": csv_path.name,
+                 "provenance": provenance()}, indent=1, default=str))
+            raise KeyboardInterrupt(f"efficiency against frequency: {len(rows)} of "
+                                    f"{len(freqs)} frequencies finished, kept in "
+                                    f"{csv_path}") from None
         except MoreauError as exc:
             row["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
             rows.append(row)
@@ -432,6 +515,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
         "best_efficiency": best["efficiency"] if best else None,
         "frequency_of_best_efficiency_Hz": best["frequency_Hz"] if best else None,
         "failed_frequencies": [r["frequency_Hz"] for r in rows if r["status"] != "ok"],
+        "provenance": provenance(),
         "parameters": {k: v for k, v in sc0.params.__dict__.items() if k != "load"}
         if hasattr(sc0, "params") else dict(fixed),
         "scheme_settings": {"theta": scheme.theta, "steps_per_period": scheme.steps_per_period,
@@ -444,7 +528,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
             w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
             w.writeheader()
             w.writerows(rows)
-        side = dict(summary, provenance=provenance(), csv=csv_path.name)
+        side = dict(summary, csv=csv_path.name)
         stem.with_name(stem.name + ".json").write_text(json.dumps(side, indent=1, default=str))
         log(f"wrote {csv_path} and {stem.name}.json")
         if plot:
@@ -454,6 +538,29 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
             else:
                 log("matplotlib is not installed: no figure (pip install matplotlib)")
     return {"summary": summary, "rows": rows}
+
+
+def _write_partial(curve, out, entry, frequency, scheme):
+    """The loads an interrupted characteristic finished, as ``STEM.partial.csv`` (velocity
+    and status only: the audit is work) with a sidecar saying ``partial: true``."""
+    stem = out / (characteristic_tag(entry.name, frequency or 0.0, scheme) + ".partial")
+    csv_path = stem.with_name(stem.name + ".csv")
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(COLUMNS))
+        w.writeheader()
+        for load in sorted(curve.points):
+            v, status, _, ss = curve.points[load]
+            row = dict.fromkeys(COLUMNS, math.nan)
+            row.update(load_N=load, motion="", mode=ss.mode if ss is not None else "",
+                       status=status)
+            if v is not None:
+                row.update(average_velocity_m_per_s=v, output_power_W=load * v)
+            w.writerow(row)
+    stem.with_name(stem.name + ".json").write_text(json.dumps(
+        {"scene": entry.name, "frequency_Hz": frequency, "scheme": scheme.name,
+         "partial": True, "loads_finished": len(curve.points), "csv": csv_path.name,
+         "provenance": provenance()}, indent=1, default=str))
+    return csv_path
 
 
 def _row(curve, load, v0, scheme):

@@ -41,6 +41,8 @@ from joblib.externals.loky.process_executor import BrokenProcessPool
 
 from .. import __version__
 from ..errors import ConvergenceError, InputError, Interrupted, PainleveError, WorkerError
+# the cache key's code version lives with the provenance; named here too (engine.code_version)
+from ..provenance import code_version
 from ..scenes import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
@@ -55,35 +57,6 @@ __all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "e
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
 _PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
-
-
-#: modules that only present results (files, figures, text); editing them keeps the cache
-_PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
-                 "studies/paper/figures.py", "studies/paper/report.py",
-                 "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
-                 "analysis/history.py", "studies/paper/tables.py"}
-
-
-def code_version():
-    """Package version plus a hash of the source files that compute results.
-
-    Used as part of the cache key: any edit of the computing code gives new
-    keys. Modules that only write files, figures or text are left out.
-
-    Examples
-    --------
-    >>> v = code_version()
-    >>> v.startswith("0.") and len(v.split("+")[1]) == 16
-    True
-    """
-    root = pathlib.Path(__file__).resolve().parents[1]
-    h = hashlib.sha256()
-    for path in sorted(root.rglob("*.py")):
-        if path.relative_to(root).as_posix() in _PRESENTATION:
-            continue
-        h.update(str(path.relative_to(root)).encode())
-        h.update(path.read_bytes())
-    return f"{__version__}+{h.hexdigest()[:16]}"
 
 
 def mj_check_columns(check):
@@ -305,6 +278,9 @@ def _energy_columns(sc, ss, scheme, status):
         return cols
     for (_, si), col in zip(ENERGY_TERMS, ENERGY_COLUMNS):
         cols[col] = audit[si]
+    if audit["closing_error"] is None:
+        cols["energy_status"] = audit["note"]
+        return cols
     cols["energy_closing_error"] = audit["closing_error"]
     cols["energy_status"] = "ok"
     return cols

@@ -64,7 +64,11 @@ def run_history(scene, *, periods=None, duration=None, scheme="event-driven", st
         Steps of a time-stepping scheme over the whole run (sets ``h``);
         alternatively give ``h`` in ``options``, in the scene's time unit.
     samples : int
-        Samples kept (about; the event-driven schemes add their events).
+        Samples kept: exactly this many, evenly spaced from the start to the
+        end of the run (fewer where the run stops early), at least 2. An
+        event-driven scheme samples its exact motion there, a time-stepping
+        scheme interpolates between its step ends
+        (:func:`~moreau.integrators.simulate`'s ``t_eval``).
     **options
         The scheme's own options; one it does not take is refused before any
         work, naming it and the scheme.
@@ -92,6 +96,9 @@ def run_history(scene, *, periods=None, duration=None, scheme="event-driven", st
         unit = scene.time_unit_s
         span = positive("duration", duration) / (unit if unit else 1.0)
     samples = positive_int("samples", samples)
+    if samples < 2:
+        raise InputError(f"`samples` must be >= 2 (the start and the end of the run), got "
+                         f"{samples}")
     if samples > MAX_SAMPLES:
         raise InputError(f"`samples` = {samples:.3g} is more than the limit {MAX_SAMPLES:.0e} "
                          "of one time history")
@@ -120,7 +127,9 @@ def run_history(scene, *, periods=None, duration=None, scheme="event-driven", st
         elif "samples_per_period" in accepted and periods is not None:
             options.setdefault("samples_per_period", max(1, int(round(samples / periods))))
     q0, v0 = scene.initial_state()
-    res = simulate(scene, (0.0, span), q0, v0, scheme, progress=progress, **options)
+    t_eval = np.linspace(0.0, span, samples)
+    res = simulate(scene, (0.0, span), q0, v0, scheme, progress=progress, t_eval=t_eval,
+                   **options)
     return res, scene.si_columns(res)
 
 

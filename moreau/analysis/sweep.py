@@ -55,17 +55,28 @@ VALUE_COLUMNS = ("mode", "displacement_per_period_m", "average_velocity_m_per_s"
                  "max_multiplier", "stable", "status", "compute_time_s")
 
 
-def sweep_values(start, stop, points, scale="linear"):
+def sweep_values(start, stop, points, scale="linear", names=("START", "STOP", "points")):
     """``points`` values from ``start`` to ``stop``, linear or log-spaced, checked.
+
+    ``names`` are the option names an error message gives; ``START`` and
+    ``STOP`` must differ when there are several points (equal ones would
+    compute one point several times).
 
     Examples
     --------
     >>> sweep_values(10, 1000, 3, "log").tolist()
     [10.0, 100.0, 1000.0]
+    >>> sweep_values(0.1, 0.1, 2)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `START` and `STOP` must differ when `points` > 1, got 0.1 twice
     """
-    start = finite_scalar("START", start)
-    stop = finite_scalar("STOP", stop)
-    points = positive_int("points", points)
+    start = finite_scalar(names[0], start)
+    stop = finite_scalar(names[1], stop)
+    points = positive_int(names[2], points)
+    if points > 1 and start == stop:
+        raise InputError(f"`{names[0]}` and `{names[1]}` must differ when `{names[2]}` > 1, "
+                         f"got {start:g} twice")
     if points > MAX_POINTS:
         raise InputError(f"`points` = {points:.3g} is more than the limit {MAX_POINTS:.0e} of one "
                          "sweep")
@@ -73,7 +84,7 @@ def sweep_values(start, stop, points, scale="linear"):
         raise InputError(f"`scale` must be 'linear' or 'log', got {scale!r}")
     if scale == "log":
         if start <= 0 or stop <= 0:
-            raise InputError("`START` and `STOP` must be > 0 for a log-spaced sweep")
+            raise InputError(f"`{names[0]}` and `{names[1]}` must be > 0 for a log-spaced sweep")
         return np.geomspace(start, stop, points)
     return np.linspace(start, stop, points)
 

@@ -373,8 +373,11 @@ _PROPAGATE_INTERRUPTS = contextvars.ContextVar("moreau_propagate_interrupts", de
 
 
 @contextlib.contextmanager
-def propagate_interrupts():
+def propagate_interrupts(enabled=True):
     """Within this block, Ctrl-C stops :func:`simulate`'s caller too.
+
+    ``enabled=False`` restores a lone run's behaviour inside a block that
+    propagates (``moreau run`` keeps its partial history).
 
     A lone :func:`simulate` turns ``KeyboardInterrupt`` into its result's
     status ``-4`` and returns what it had: the run was the whole job. A batch
@@ -390,7 +393,7 @@ def propagate_interrupts():
     >>> _PROPAGATE_INTERRUPTS.get()
     False
     """
-    token = _PROPAGATE_INTERRUPTS.set(True)
+    token = _PROPAGATE_INTERRUPTS.set(bool(enabled))
     try:
         yield
     finally:

@@ -381,7 +381,9 @@ def walker_energy_audit(scene, steady, options):
         elif a.regime == Regime.NEGATIVE:
             neg += I[2]
         prev = b
-    dE = float(energy.energy(*_qv(end), end.tau) - energy.energy(*_qv(start), start.tau))
+    e0, e1 = energy.energy(*_qv(start), start.tau), energy.energy(*_qv(end), end.tau)
+    # the energy's size over the period (at the pieces' starts) scales the rounding bound
+    levels = [e0, e1] + [energy.energy(*_qv(a), a.tau) for a, _, _ in pieces]
     return balance({"stator_work": stator, "load_work": load, "friction_positive_slip": pos,
                     "friction_negative_slip": neg, "impact_loss": impact,
-                    "stored_energy_change": dE})
+                    "stored_energy_change": float(e1 - e0)}, levels)

@@ -112,7 +112,7 @@ def test_steady_json_carries_energy(capsys):
     assert main(["steady", "--frequency", "185", "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     e = rep["energy"]
-    assert set(e) == {si for _, si in ENERGY_TERMS} | {"closing_error"}
+    assert set(e) == {si for _, si in ENERGY_TERMS} | {"closing_error", "rounding_bound_J"}
     assert abs(e["closing_error"]) < 1e-9
     sc = FrictionDrive(frequency=185.0)
     # joules: m l^2 w^2 times the dimensionless work
@@ -126,7 +126,7 @@ def test_steady_json_carries_energy(capsys):
 def test_steady_json_of_the_two_rod_drive_carries_the_generic_audit(capsys):
     assert main(["steady", "--scene", "bidirectional-drive", "--frequency", "185", "--json"]) == 0
     e = json.loads(capsys.readouterr().out)["energy"]
-    assert set(e) == {si for _, si in ENERGY_TERMS} | {"closing_error"}
+    assert set(e) == {si for _, si in ENERGY_TERMS} | {"closing_error", "rounding_bound_J"}
     assert abs(e["closing_error"]) < 1e-9
     # both rods alike and in phase: the rotor stays, the stator work goes to friction,
     # equally to both slip directions (the mirror symmetry)

@@ -49,7 +49,6 @@ def test_steady_parameters_are_used(capsys):
     (["--frequency", "100", "--phi0", "1.7"], "`phi0` must be in the open interval"),
     (["--frequency", "100", "--m2", "nan"], "`m2` must be finite"),
     (["--frequency", "100", "--k", "-5"], "`k` must be > 0"),
-    ([], "`--frequency` is required"),
 ])
 def test_steady_bad_input(capsys, args, match):
     rc = main(["steady", *args, "--json"])

@@ -72,6 +72,7 @@ from ...analysis.mj_steady_state import moreau_jean_steady_state
 from ...analysis.statistical import statistical_steady_state
 from ...analysis.steady_state import find_steady_state
 from ...errors import ConvergenceError, InputError, MoreauError
+from ...provenance import provenance
 from ...integrators import INTEGRATORS, simulate
 from ...integrators.base import scheme_options
 from ...scenes import registry
@@ -725,6 +726,7 @@ def run_catalogue(cases=None, full=False, progress=True, on_row=None, schemes=No
         store.close()
     report["cells"] = {"total": store.total, "cached": store.cached,
                        "computed": store.computed, "cache_dir": store.cache_dir}
+    report["provenance"] = provenance()
     return report
 
 

@@ -180,7 +180,8 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
     """
     if parameter not in SWEEPABLE:
         raise InputError(f"`PARAM` must be one of {list(SWEEPABLE)}, got {parameter!r}")
-    values = scene_sweep.sweep_values(start, stop, points, scale)
+    values = scene_sweep.sweep_values(start, stop, points, scale,
+                                      names=("START", "STOP", "--points"))
     if len(values) > 1 and values[0] == values[-1]:
         raise InputError("`START` and `STOP` must differ when `--points` > 1")
     return values
