@@ -337,25 +337,24 @@ def _cmd_run(args):
             raise InputError(f"scheme {args.scheme!r} steps in time: give `--steps`")
         steps = int(round(1000 * periods))
     check_options(args.scheme, options, scene)
+    shown = dict(options)
+    if stepping and steps is not None:
+        shown["steps"] = steps
+    tag = history_tag(entry.name, params, args.scheme, shown)
+    run_settings = {"scene": entry.name, "parameters": params, "scheme": args.scheme,
+                    "options": shown, "periods": periods, "duration": duration,
+                    "samples": args.samples}
+    # the files a finished run would replace are checked before the run, not after it
+    settings = claim_outputs(os.path.join(args.out, tag), run_settings, args.force)
     # the one run is the whole job: an interrupt ends it with what it had (status -4)
     with propagate_interrupts(False):
         res, cols = run_history(scene, periods=periods, duration=duration, scheme=args.scheme,
                                 steps=steps, samples=args.samples,
                                 progress=not args.quiet, **options)
-    shown = dict(options)
-    if stepping and steps is not None:
-        shown["steps"] = steps
-    tag = history_tag(entry.name, params, args.scheme, shown)
     interrupted = res.status == -4
-    run_settings = {"scene": entry.name, "parameters": params, "scheme": args.scheme,
-                    "options": shown, "periods": periods, "duration": duration,
-                    "samples": args.samples}
     if interrupted:
         # never under the names of a finished run: the history is marked partial
         tag += ".partial"
-        settings = run_settings
-    else:
-        settings = claim_outputs(os.path.join(args.out, tag), run_settings, args.force)
     path = os.path.join(args.out, tag + ".csv")
     os.makedirs(args.out, exist_ok=True)
     names = getattr(scene, "coordinate_names", None)

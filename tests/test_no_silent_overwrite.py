@@ -3,9 +3,14 @@
 import csv
 import json
 
+from moreau import cli
 from moreau.cli import main
 
 SWEEP = ["sweep", "frequency", "20", "40", "--points", "2", "--jobs", "1", "--quiet", "--no-plot"]
+
+
+def _no_run(*args, **kwargs):
+    raise RuntimeError("the run started before its outputs were checked")
 
 
 def _refusal(name, differ):
@@ -58,12 +63,15 @@ def test_the_paper_atlas_names_its_scheme_and_refuses_other_settings(tmp_path, c
     assert {"numpy_version", "numba_version", "cpu", "threads", "time_utc", "command"} <= set(prov)
 
 
-def test_a_run_of_another_length_is_refused_then_forced(tmp_path, capsys):
+def test_a_run_of_another_length_is_refused_then_forced(tmp_path, capsys, monkeypatch):
     argv = ["run", "--scene", "bouncing-ball", "--duration", "0.1", "--quiet", "--no-plot",
             "--out", str(tmp_path)]
     assert main(argv) == 0
     capsys.readouterr()
-    assert main(argv[:3] + ["--duration", "0.2"] + argv[5:]) == 2
+    with monkeypatch.context() as m:
+        # the refusal comes before the run: a run here would be work thrown away
+        m.setattr(cli, "run_history", _no_run)
+        assert main(argv[:3] + ["--duration", "0.2"] + argv[5:]) == 2
     assert capsys.readouterr().err == _refusal("history_bouncing-ball_event-driven", "duration")
     assert main(argv[:3] + ["--duration", "0.2"] + argv[5:] + ["--force"]) == 0
 
