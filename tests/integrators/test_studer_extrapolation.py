@@ -242,3 +242,15 @@ def test_sample_dt_samples_the_dense_output_on_its_grid(fast):
     # the steps do not depend on the sampling
     own = simulate(sc, span, q0, v0, NAME, tol=1e-8, fast=fast)
     np.testing.assert_array_equal(own.q[-1], r.q[-1])
+
+
+def test_studer_has_a_statistical_steady_state():
+    # `moreau steady --frequency 185 --scheme studer-extrapolation` failed with "did not
+    # sample the run at the ends of the drive periods"
+    from moreau.analysis.statistical import statistical_steady_state
+    sc = make_scene("friction-drive", frequency=185.0)
+    st = statistical_steady_state(sc, NAME)
+    ref = find_steady_state(sc, statistical=False).displacement_per_period
+    lo, hi = st.confidence_interval
+    # measured: 400 periods, [-6.639090e-3, -6.638984e-3] around the walker's -6.639079e-3
+    assert lo <= ref <= hi and hi - lo < 1e-4 * abs(ref)
