@@ -61,6 +61,19 @@ Accumulation of impacts (Zeno) policy
     accumulation the policy did not end. A long run of well-separated
     impacts (an elastic ball bouncing for ever) is not one.
 
+Rest
+    A phase that starts at rest (velocities within ``vel_tol`` of zero, the
+    mode's accelerations zero to rounding) under a forcing that does not
+    change with time is an equilibrium: its state, forces and event
+    functions are constant, no event can end it, and it is taken in one
+    step to the window's end (or to the scene's next forcing breakpoint),
+    the samples on the way being that state. The forcing counts as constant
+    when ``forces``, ``gaps``, ``contact_jacobians`` and ``contact_drift`` at
+    the state give the same numbers at 16 times spread evenly over the rest
+    of the phase and at ``t + 10^k`` (``k >= -6``) as at its start; a forcing that changes
+    and returns between them must declare its ``forcing_breakpoints``. After
+    the Zeno closure of a bouncing ball the cost no longer grows with the window.
+
 Known limits: a gap that dips below zero and comes back inside one
 integrator step is not seen (``max_step`` bounds the step); scenes with
 discontinuous forcing (a sawtooth drive) are integrated across the jumps by
@@ -725,6 +738,41 @@ class GenericEventDriven(Integrator):
                 meta.append(("painleve", i))
         return rhs, events, meta, evaluate
 
+    def _rest_phase(self):
+        """Take a phase at rest under a constant forcing in one step; True if it was one."""
+        t, q, v, mode = self.t, self.q, self.v, self.mode
+        if np.max(np.abs(v), initial=0.0) > self._vtol():
+            return False
+        try:
+            a, _, _, _, _, kin = self.ms.solve(t, q, v, mode)
+        except PainleveError:
+            return False
+        self.counters["rhs"] += 1
+        free = np.linalg.solve(kin[0], kin[1])
+        scale = max(float(np.max(np.abs(free), initial=0.0)),
+                    float(np.max(np.abs(a - free), initial=0.0)))
+        if np.max(np.abs(a), initial=0.0) > 1e-12 * scale:
+            return False
+        breaks = self.scene.forcing_breakpoints(t, self.t_bound)
+        t_end = float(breaks[0]) if len(breaks) else self.t_bound
+        if not _constant_forcing(self.scene, q, v, t, t_end):
+            return False
+        n = self.scene.ndof
+        y = np.concatenate([q, v])
+        self.counters["segments"] += 1
+        self.counters["rest_phases"] = self.counters.get("rest_phases", 0) + 1
+        if self.phases is not None:
+            self.phases.append((t, t_end, lambda s, y=y: y.copy(), mode.copy()))
+        if self._want_pieces:
+            self._add_piece(np.array([t, t_end]), lambda s, y=y: y.copy(),
+                            lambda s, mode=mode.copy(): self._sample_row(s, q, v, mode))
+        while self._next_sample < t_end:
+            self._record_state(self._next_sample, y[:n].copy(), y[n:].copy())
+            self._next_sample += self.sample_dt
+        self.t = t_end
+        self._record_state(self.t, self.q, self.v)
+        return True
+
     def _step_impl(self):
         if self.t == self._last_event_t:
             self._stalled += 1
@@ -733,6 +781,8 @@ class GenericEventDriven(Integrator):
                                   f"(contact modes {self.ms.letters(self.mode)})")
         else:
             self._last_event_t, self._stalled = self.t, 0
+        if self._rest_phase():
+            return
         rhs, events, meta, evaluate = self._phase_functions()
         y0 = np.concatenate([self.q, self.v])
         self.counters["segments"] += 1
@@ -785,6 +835,33 @@ class GenericEventDriven(Integrator):
                 forced[kd[1]] = kd[2]
         self._resolve(kind=label, forced=forced, contact=contact)
         self._record_state(self.t, self.q, self.v)
+
+
+def _constant_forcing(scene, q, v, t0, t1):
+    """Whether the scene's functions at ``(q, v)`` give the same numbers over ``[t0, t1]``.
+
+    Probed at 16 evenly spread times and at ``t0 + 10^k`` (``k >= -6``) inside
+    the interval, against ``t0``.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> _constant_forcing(BouncingBall(), np.array([0.05]), np.zeros(1), 0.0, 1e9)
+    True
+    """
+    def values(s):
+        out = [scene.forces(q, v, s), scene.gaps(q, s), *scene.contact_jacobians(q, s),
+               *scene.contact_drift(q, v, s)]
+        return [np.asarray(x, dtype=float) for x in out]
+
+    ref = values(t0)
+    span = t1 - t0
+    probes = list(t0 + span * np.linspace(0.0, 1.0, 17)[1:])
+    probes += [t0 + 10.0 ** k for k in range(-6, 20) if 10.0 ** k < span]
+    for s in probes:
+        if not all(np.array_equal(a, b) for a, b in zip(ref, values(s))):
+            return False
+    return True
 
 
 @register_integrator("event-driven")
