@@ -123,8 +123,6 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     trow = np.zeros(ncm, dtype=np.int64)
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
     lw = (Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
-    zreg = np.zeros(ncm, dtype=np.int64)
-    zf = np.zeros(ncm)
 
     t = th[0]
     h = th[1]
@@ -501,8 +499,15 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     gaps_fn(par, q, t, Gm)  # noqa: F821
                 else:
                     contacts_fn(par, q, t, Gm, True, False)  # noqa: F821
+            # the first step's regime and forces, as every time-stepping scheme records its
+            # start (no step has ended there)
+            for c in range(nc):
+                pN[c] = sq_pN[ir, c]
+                pT[c] = sq_pT[ir, c]
+                sl[c] = sq_slip[ir, c]
+                reg[c] = sq_reg[ir, c]
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t, q, v, zreg, zf, zf, 1.0, zf, Gm, n, nc)
+                          t, q, v, reg, pN, pT, H, sl, Gm, n, nc)
             rec_kind[nrec] = -1
             for k in range(n):
                 rec_a0[nrec, k] = 0.0

@@ -93,7 +93,8 @@ from ..regimes import Regime
 from .base import Integrator, get_integrator, register_integrator
 from .result import Event
 
-__all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference"]
+__all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference",
+           "contact_law_regimes"]
 
 _F, _P, _N, _S = int(Regime.FLIGHT), int(Regime.POSITIVE), int(Regime.NEGATIVE), int(Regime.STICK)
 _SIGN = {_P: 1.0, _N: -1.0}
@@ -214,6 +215,94 @@ class ContactModeSolver:
             kin = self.kinematics(t, q, v)
         _, _, WN, wN, _, _, _, _ = kin
         return WN @ v + wN
+
+
+def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
+    """The regimes of a sample ``(t, q, v)`` by the contact law at that state.
+
+    Every scheme records a regime code with each sample, each in its own way:
+    a time-stepping scheme the impulse of the step that ends there, a
+    compliant one the force of its spring at the state, a run's first sample
+    none (flight, before any step). This names the sample as the continuous
+    system would, the same way for every scheme:
+
+    * a contact recorded open whose gap and normal velocity are zero (within
+      ``rtol`` of the state's scales) is taken as closed, sticking where its
+      slip velocity is zero and sliding its way otherwise; it stays closed if
+      the contact problem of that mode gives it a positive normal force;
+    * a closed frictional contact in stick sticks only if the stick holds:
+      the tangential force that keeps its slip acceleration zero, with the
+      closed contacts held, lies in the cone ``|lamT| <= mu lamN``; else it
+      slips the way the force leaves the cone (``lamT > mu lamN``: negative
+      slip). A step whose impulse stayed inside the cone across a slip
+      reversal records a stick the continuous system does not have.
+
+    Parameters
+    ----------
+    scene : Scene
+    t, q, v : the sample's time and state
+    regime : array_like of int
+        The regime codes the scheme recorded (:class:`moreau.regimes.Regime`).
+    solver : ContactModeSolver, optional
+        Reused across the samples of a run.
+    rtol : float
+        Relative tolerance of a zero gap, normal and slip velocity.
+
+    Returns
+    -------
+    ndarray of int
+
+    Examples
+    --------
+    A ball resting on the floor, recorded in flight (a first sample), is closed:
+
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> ball = BouncingBall(radius=0.1)
+    >>> contact_law_regimes(ball, 0.0, np.array([0.1]), np.zeros(1), [0]).tolist()
+    [1]
+    """
+    ms = solver if solver is not None else ContactModeSolver(scene)
+    mode = np.array(regime, dtype=int).reshape(ms.nc)
+    if ms.nc == 0 or not np.any((mode == _F) | (mode == _S)):
+        return mode
+    q = np.asarray(q, dtype=float)
+    v = np.asarray(v, dtype=float)
+    kin = ms.kinematics(t, q, v)
+    WN, wN, WT, wT = kin[2], kin[3], kin[4], kin[5]
+    g = np.asarray(scene.gaps(q, t), dtype=float)
+    vN = WN @ v + wN
+    vT = ms.slip_velocities(q, v, t, kin)
+    av = np.abs(v)
+    vscale = max(float(np.max(np.abs(WN) @ av + np.abs(wN), initial=0.0)),
+                 float(np.max(np.abs(WT) @ av + np.abs(wT), initial=0.0)), 1e-300)
+    vtol = rtol * vscale
+    gtol = rtol * (1.0 + float(np.max(np.abs(q))))
+    touched = np.flatnonzero((mode == _F) & (np.abs(g) <= gtol) & (np.abs(vN) <= vtol))
+    for i in touched:
+        if ms.trow[i] < 0 or vT[i] > vtol:
+            mode[i] = _P
+        elif vT[i] < -vtol:
+            mode[i] = _N
+        else:
+            mode[i] = _S
+    if not np.any(mode == _S) and not touched.size:
+        return mode
+    try:
+        _, lamN, lamT, _, _, _ = ms.solve(t, q, v, mode)
+    except PainleveError:
+        return np.array(regime, dtype=int).reshape(ms.nc)
+    for i in touched:
+        if not lamN[i] > 0.0:
+            mode[i] = _F
+    fscale = max(float(np.max(np.abs(lamN))), 1e-300)
+    for i in np.flatnonzero(mode == _S):
+        if ms.trow[i] < 0:
+            mode[i] = _P
+        elif lamT[i] > ms.mu[i] * lamN[i] + rtol * fscale:
+            mode[i] = _N
+        elif lamT[i] < -ms.mu[i] * lamN[i] - rtol * fscale:
+            mode[i] = _P
+    return mode
 
 
 def project_positions(scene, t, q, contacts, max_iter=4):

@@ -571,8 +571,10 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             c["max_penetration"] = max(c["max_penetration"], float(np.max(-gap, initial=0.0)))
         if self._pending_initial:
             g0 = np.asarray(sc.gaps(q, t), float) if nc else gap
-            self._add_rows(_rows(t, q, v, np.zeros(nc, dtype=int), np.zeros(nc), np.zeros(nc),
-                                 np.zeros(nc), g0, -1, np.zeros(n), np.zeros(n)))
+            # the first step's regime and forces, as every time-stepping scheme records its
+            # start (no step has ended there)
+            self._add_rows(_rows(t, q, v, regime, pN / H, pT / H, slip, g0, -1, np.zeros(n),
+                                 np.zeros(n)))
             self._pending_initial = False
         self.t, self.q, self.v = t1, q1, v1
         self._closed = closed.copy()
