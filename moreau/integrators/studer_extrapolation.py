@@ -76,6 +76,20 @@ acceleration: with ``a_old`` the last accepted step's mean acceleration and
 ``|a_new - a_old| H``, which enters the error estimate (with ``p = 0``).
 Without that the friction drive's error stalled at 1e-3 for any tolerance.
 
+Dense output
+------------
+Between the ends of its macro steps the scheme's motion is the dense output
+of :func:`dense_state`: in a smooth step the quintic Hermite interpolant of
+the end positions, velocities and accelerations, the accelerations being the
+mean accelerations of the first and the last base step of each sequence,
+extrapolated with the state (as accurate as the step ends for ``K <= 4``:
+the oscillator at tol 1e-10 is off by 1.8e-9 between its steps and at
+them); in a step with a switch the cubic Hermite interpolant; a step with an
+impact is not interpolated across it, but split where the motions before and
+after the impulse meet. ``t_eval`` samples, events and ``sample_dt`` take it
+(the bouncing ball sampled inside its steps: 2.1e-2 off at any tol as chords,
+2.4e-11 at tol 1e-10 now).
+
 On a scene with a compiled model the macro steps run in
 :mod:`moreau.integrators._studer_kernels` (the same step, equal to the
 Python one to 1e-12 from the same state and step size).
