@@ -23,10 +23,14 @@ at a few states and compares them with independent computations:
   differences of ``forces``; a scene that leaves the default (central
   differences, :meth:`~moreau.scenes.base.Scene.force_jacobians`) while its
   forces depend on the state gets a note saying so;
+* the tangential rows, where the scene states the tangential positions
+  whose rates they are (an optional method ``slip_positions(q, t)``, one
+  entry per frictional contact: a belt's ``x - vb t``), against their
+  differences: ``WT v + wT`` along the motion and ``wT`` in time at fixed
+  positions;
 * the compiled model, where the scene gives one, against the Python one,
   each output by name (a wrong sign of a rheonomic term ``wT`` in one of
-  them is named; the tangential rows have no position whose differences
-  would check ``wT`` otherwise).
+  them is named; without ``slip_positions`` nothing else checks ``wT``).
 
 A problem met at several states is listed once, with the states.
 
@@ -331,6 +335,19 @@ def check_scene(scene: Scene, states: Sequence[tuple[ArrayLike, ArrayLike]] | No
                 fdt = (scene.gaps(q, ts + eps) - scene.gaps(q, ts - eps)) / (2 * eps)
                 key = "rheonomic terms (wN against d/dt of the gaps)"
                 worst[key] = max(worst[key], _rel(wN, fdt))
+            slide = getattr(scene, "slip_positions", None)
+            if slide is not None and WT is not None and wT is not None and nf:
+                # the tangential rows against a tangential position the scene states
+                sp = _shape(add, "slip_positions(q, t)", slide(q, ts), (nf,))
+                if sp is not None:
+                    fd = (np.asarray(slide(q + eps * v, ts + eps), dtype=float)
+                          - np.asarray(slide(q - eps * v, ts - eps), dtype=float)) / (2 * eps)
+                    key = "slip rates (WT, wT)"
+                    worst[key] = max(worst.get(key, 0.0), _rel(WT @ v + wT, fd))
+                    fdt = (np.asarray(slide(q, ts + eps), dtype=float)
+                           - np.asarray(slide(q, ts - eps), dtype=float)) / (2 * eps)
+                    key = "rheonomic terms (wT against d/dt of the slip positions)"
+                    worst[key] = max(worst.get(key, 0.0), _rel(wT, fdt))
 
             def rates(s):
                 WN_, wN_, WT_, wT_ = scene.contact_jacobians(q + s * v, ts + s)

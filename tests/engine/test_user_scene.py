@@ -50,6 +50,21 @@ def test_check_scene_names_a_wrong_sign_of_the_belts_rheonomic_term():
             WN, wN, WT, wT = super().contact_jacobians(q, t)
             return WN, wN, WT, -wT
 
+    # with the belt's position stated, the Python model alone is checked
+    class Stated(BeltBlock):
+        def slip_positions(self, q, t):
+            return np.array([q[0] - self.vb * t])
+
+    class StatedFlipped(Stated):
+        def contact_jacobians(self, q, t):
+            WN, wN, WT, wT = super().contact_jacobians(q, t)
+            return WN, wN, WT, -wT
+
+    assert moreau.check_scene(Stated()).ok
+    report = moreau.check_scene(StatedFlipped())
+    assert {p.split(":")[0] for p in report.problems} == {
+        "slip rates (WT, wT)", "rheonomic terms (wT against d/dt of the slip positions)"}
+    # without it, the compiled model is the second statement
     report = moreau.check_scene(Flipped())
     (problem,) = report.problems
     assert problem == ("the compiled model's wT (the tangential rows' rheonomic term) differs "
