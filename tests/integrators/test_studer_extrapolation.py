@@ -272,3 +272,15 @@ def test_studer_has_a_statistical_steady_state():
     lo, hi = st.confidence_interval
     # measured: 400 periods, [-6.639090e-3, -6.638984e-3] around the walker's -6.639079e-3
     assert lo <= ref <= hi and hi - lo < 1e-4 * abs(ref)
+
+
+def test_compare_measures_the_ball_s_trajectory_on_the_dense_output():
+    # `compare` read 0.0213 at tol 1e-4 and at 1e-10 (chords between the steps)
+    from moreau.analysis.compare import make_case
+    case = make_case("bouncing-ball")
+    errs = []
+    for tol in (1e-4, 1e-10):
+        out = case.scheme(NAME, {"tol": tol, "fast": False})
+        errs.append(case.measure_scheme(NAME, {"tol": tol}, out))
+    # measured 8.4e-5 and 5.6e-11
+    assert errs[0] < 2e-4 and errs[1] < 1e-9
