@@ -32,7 +32,7 @@ from ..errors import ConvergenceError, InputError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import check_options, scheme_options as options_of
 from ..integrators.event_driven_generic import (ContactModeSolver, contact_law_regimes,
-                                                project_positions)
+                                                contact_velocity_scale, project_positions)
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
@@ -155,8 +155,12 @@ def period_mode(scene, res, ts, span):
     """
     nc = scene.ncontacts
     ms = ContactModeSolver(scene)
-    law = np.array([contact_law_regimes(scene, tk, qk, vk, rk, ms) for tk, qk, vk, rk
-                    in zip(res.t[:-1], res.q[:-1], res.v[:-1], res.regime[:-1])],
+    # the run's velocity scale: a sample may fall where everything is at rest (the two-rod
+    # drive's swap at tau = pi)
+    vscale = contact_velocity_scale(scene, res.t, res.q, res.v, ms)
+    law = np.array([contact_law_regimes(scene, tk, qk, vk, rk, ms, vscale=vscale)
+                    for tk, qk, vk, rk in zip(res.t[:-1], res.q[:-1], res.v[:-1],
+                                              res.regime[:-1])],
                    dtype=int).reshape(-1, nc)
     modes = []
     for c in range(nc):

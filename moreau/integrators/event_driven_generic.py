@@ -94,7 +94,7 @@ from .base import Integrator, get_integrator, register_integrator
 from .result import Event
 
 __all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference",
-           "contact_law_regimes"]
+           "contact_law_regimes", "contact_velocity_scale"]
 
 _F, _P, _N, _S = int(Regime.FLIGHT), int(Regime.POSITIVE), int(Regime.NEGATIVE), int(Regime.STICK)
 _SIGN = {_P: 1.0, _N: -1.0}
@@ -217,7 +217,7 @@ class ContactModeSolver:
         return WN @ v + wN
 
 
-def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
+def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9, vscale=None):
     """The regimes of a sample ``(t, q, v)`` by the contact law at that state.
 
     Every scheme records a regime code with each sample, each in its own way:
@@ -247,6 +247,10 @@ def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
         Reused across the samples of a run.
     rtol : float
         Relative tolerance of a zero gap, normal and slip velocity.
+    vscale : float, optional
+        Scale of the contact velocities (:func:`contact_velocity_scale`): that of
+        the run, where a sample may fall where everything is at rest. Default:
+        that of the sample's own state.
 
     Returns
     -------
@@ -272,9 +276,9 @@ def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
     g = np.asarray(scene.gaps(q, t), dtype=float)
     vN = WN @ v + wN
     vT = ms.slip_velocities(q, v, t, kin)
-    av = np.abs(v)
-    vscale = max(float(np.max(np.abs(WN) @ av + np.abs(wN), initial=0.0)),
-                 float(np.max(np.abs(WT) @ av + np.abs(wT), initial=0.0)), 1e-300)
+    if vscale is None:
+        vscale = _velocity_terms(kin, v)
+    vscale = max(float(vscale), 1e-300)
     vtol = rtol * vscale
     gtol = rtol * (1.0 + float(np.max(np.abs(q))))
     touched = np.flatnonzero((mode == _F) & (np.abs(g) <= gtol) & (np.abs(vN) <= vtol))
@@ -290,7 +294,9 @@ def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
     try:
         _, lamN, lamT, _, _, _ = ms.solve(t, q, v, mode)
     except PainleveError:
-        return np.array(regime, dtype=int).reshape(ms.nc)
+        # redundant closed contacts (two rods sticking on one rotor): the forces of the
+        # mode are not determined; the acceleration-level LCP decides, as at an event
+        return _decided_regimes(scene, ms, t, q, v, regime, vscale, rtol)
     for i in touched:
         if not lamN[i] > 0.0:
             mode[i] = _F
@@ -303,6 +309,53 @@ def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9):
         elif lamT[i] < -ms.mu[i] * lamN[i] - rtol * fscale:
             mode[i] = _P
     return mode
+
+
+def _velocity_terms(kin, v):
+    # the largest term of the contact velocities |W| |v| + |w| (not the velocities: zero
+    # in stick), as the event-driven tolerances measure them
+    WN, wN, WT, wT = kin[2], kin[3], kin[4], kin[5]
+    av = np.abs(v)
+    return max(float(np.max(np.abs(WN) @ av + np.abs(wN), initial=0.0)),
+               float(np.max(np.abs(WT) @ av + np.abs(wT), initial=0.0)))
+
+
+def contact_velocity_scale(scene, ts, qs, vs, solver=None, samples=64):
+    """The scale of the contact velocities over a run's samples (at most ``samples`` of them).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> contact_velocity_scale(BouncingBall(), [0.0, 1.0], [[1.0], [0.5]], [[0.0], [-1.0]])
+    1.0
+    """
+    ms = solver if solver is not None else ContactModeSolver(scene)
+    idx = np.unique(np.linspace(0, len(ts) - 1, min(samples, len(ts))).round().astype(int))
+    out = 0.0
+    for k in idx:
+        q, v = np.asarray(qs[k], dtype=float), np.asarray(vs[k], dtype=float)
+        out = max(out, _velocity_terms(ms.kinematics(float(ts[k]), q, v), v))
+    return out
+
+
+def _decided_regimes(scene, ms, t, q, v, regime, vscale, rtol):
+    """The event-driven mode decision at a sample (:meth:`GenericEventDriven._decide`).
+
+    A contact the scheme recorded closed counts as touching; a sample the
+    decision cannot name (no solution, a Painlevé case) keeps its regimes.
+    """
+    integ = object.__new__(GenericEventDriven)
+    integ.scene, integ.ms, integ.lcp_method = scene, ms, "lemke"
+    integ.vel_tol, integ._vscale = rtol, vscale
+    g = np.asarray(scene.gaps(q, t), dtype=float)
+    closed = np.asarray(regime).reshape(ms.nc) != _F
+    integ.gap_tol = max(float(np.max(np.abs(g[closed]), initial=0.0)),
+                        rtol * (1.0 + float(np.max(np.abs(q)))))
+    integ.counters = {"lcp_solves": 0}
+    try:
+        return integ._decide(t, q, v, {})
+    except (PainleveError, LCPError):
+        return np.array(regime, dtype=int).reshape(ms.nc)
 
 
 def project_positions(scene, t, q, contacts, max_iter=4):
