@@ -243,10 +243,10 @@ def test_a_quick_comparison_fits_the_order_of_every_step_count_scheme():
 
 
 def test_an_adaptive_scheme_s_trajectory_error_is_measured_at_its_own_samples():
-    # Studer's extrapolation has no sample_dt: its samples are its adaptive steps (81 over
-    # the period at tol 1e-9, up to 0.29 apart), and interpolating them onto the grid gave a
-    # trajectory error of 6.6e-3 (tol 1e-9) and 6.1e-4 (tol 1e-11) for a run whose headline
-    # is within 6e-7 and 8e-9: the error is now taken at its own samples
+    # Studer's samples were its adaptive steps (81 over the period at tol 1e-9, up to 0.29
+    # apart), and interpolating them onto the grid gave a trajectory error of 6.6e-3 (tol
+    # 1e-9) and 6.1e-4 (tol 1e-11) for a run whose headline is within 6e-7 and 8e-9; it now
+    # samples its dense output on the grid (`sample_dt`)
     case = make_case("friction-drive", frequency=185.0)
     coarse = case.measure_scheme("studer-extrapolation", {"tol": 1e-9}, None)
     fine = case.measure_scheme("studer-extrapolation", {"tol": 1e-11}, None)

@@ -31,7 +31,8 @@ from .._validate import positive, positive_int
 from ..errors import ConvergenceError, InputError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import check_options, scheme_options as options_of
-from ..integrators.event_driven_generic import project_positions
+from ..integrators.event_driven_generic import (ContactModeSolver, contact_law_regimes,
+                                                contact_velocity_scale, project_positions)
 from ..integrators.result import SteadyState
 from ..modes import mode_name
 from ..regimes import REGIME_LETTERS, Regime
@@ -39,7 +40,7 @@ from .floquet import period_map_jacobian, sorted_multipliers
 from .steady_solvers import register_steady_solver
 
 __all__ = ["shoot_periodic", "free_bases", "period_map_options", "bracket_scalar",
-           "guess_options"]
+           "guess_options", "period_mode"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -132,6 +133,46 @@ def period_map_options(scheme, options):
         raise InputError(f"`steps_per_period` applies to time-stepping schemes; scheme "
                          f"{scheme!r} chooses its own steps")
     return opts
+
+
+def period_mode(scene, res, ts, span):
+    """Mode name and regimes of a run recorded over one period, the same way for every scheme.
+
+    Each sample but the last (the period's end, the start again) is named by
+    the contact law at its state
+    (:func:`~moreau.integrators.event_driven_generic.contact_law_regimes`):
+    a run's first sample on a closed contact is not flight, and a
+    time-stepping step whose impulse stayed in the cone across a slip
+    reversal is not a stick.
+
+    Returns
+    -------
+    mode : str
+        Each contact's canonical mode, joined by ``"|"``.
+    regimes : list of [float, str]
+        Where the regimes (one letter per contact) change, as phases in ``[0, span)``
+        from ``ts``.
+    """
+    nc = scene.ncontacts
+    ms = ContactModeSolver(scene)
+    # the run's velocity scale: a sample may fall where everything is at rest (the two-rod
+    # drive's swap at tau = pi)
+    vscale = contact_velocity_scale(scene, res.t, res.q, res.v, ms)
+    law = np.array([contact_law_regimes(scene, tk, qk, vk, rk, ms, vscale=vscale)
+                    for tk, qk, vk, rk in zip(res.t[:-1], res.q[:-1], res.v[:-1],
+                                              res.regime[:-1])],
+                   dtype=int).reshape(-1, nc)
+    modes = []
+    for c in range(nc):
+        letters = [REGIME_LETTERS[Regime(int(x))] for x in law[:, c]]
+        modes.append(mode_name(letters) if letters else "")
+    regimes, prev = [], None
+    for tk, row in zip(res.t[:-1], law):
+        key = "".join(REGIME_LETTERS[Regime(int(x))] for x in row)
+        if key != prev:
+            regimes.append([float((tk - ts) % span), key])
+            prev = key
+    return "|".join(modes), regimes
 
 
 def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=None, cyclic=None,
@@ -359,24 +400,14 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         Jr = period_map_jacobian(lambda zz: residual(*state(zz, (qs, vs)))[0],
                                  np.zeros(z.size), fd * vscale)
         multipliers = sorted_multipliers(np.linalg.eigvals(Jr + np.eye(z.size)))
-    nc = scene.ncontacts
-    modes, regimes = [], []
-    for c in range(nc):
-        letters = [REGIME_LETTERS[Regime(int(x))] for x in res.regime[:-1, c]]
-        modes.append(mode_name(letters) if letters else "")
-    prev = None
-    for tk, row in zip(res.t[:-1], res.regime[:-1]):
-        key = "".join(REGIME_LETTERS[Regime(int(x))] for x in row)
-        if key != prev:
-            regimes.append([float((tk - ts) % span), key])
-            prev = key
+    mode, regimes = period_mode(scene, res, ts, span)
     closed = res.regime != int(Regime.FLIGHT)
     fmin = float(np.min(np.where(closed, res.force_N, np.inf))) if closed.any() else 0.0
     return SteadyState(
         scheme=scheme,
         displacement_per_period=disp,
         state0=np.concatenate([qs, vs]),
-        mode="|".join(modes),
+        mode=mode,
         regimes=regimes,
         min_normal_force=fmin,
         periodic_residual=float(np.max(np.abs(r)) / vscale),

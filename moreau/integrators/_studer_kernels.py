@@ -22,19 +22,25 @@ from ._mj_kernels import (OK, S_PEN, SINGULAR, _classify, _invert_gj, _invert_sm
                           record_sample)
 from ._tdg_kernels import _solve_small, _stage_problem
 
-__all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY"]
+__all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY", "DENSE_IMPACT",
+           "DENSE_SWITCH", "DENSE_SMOOTH"]
 
 #: status: a non-finite state or error estimate after a macro step
 NOT_FINITE = -5
 #: status: the run's bound on macro steps is reached
 TOO_MANY = -8
+#: dense output of a macro step (:mod:`moreau.integrators.studer_extrapolation`): a contact
+#: closed in it (an impulse), a switch of the regimes without one, a smooth step
+DENSE_IMPACT = 0
+DENSE_SWITCH = 1
+DENSE_SMOOTH = 2
 #: the loop's counters, in the order of its ``cnt`` argument
 STUDER_COUNTERS = ("macro_steps", "base_steps", "rejected_steps", "smooth_steps", "forced_steps")
 
 
 def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, closed, last_reg,
                 acc, record_initial, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT,
-                rec_slip, rec_gap, stats, cnt):
+                rec_slip, rec_gap, rec_kind, rec_a0, rec_a1, stats, cnt):
     """Run up to ``nmax`` accepted macro steps of a compiled model in one call.
 
     ``th = [t, h, has_acc]`` (time, next macro step, whether ``acc`` holds the
@@ -42,7 +48,12 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     force), ``last_reg`` (regimes the last step ended in) and ``acc`` are the
     state, updated in place. ``budget`` bounds the macro steps tried. One
     sample is recorded per accepted step (and the start with
-    ``record_initial``). Returns ``(status, accepted, samples)``. On
+    ``record_initial``), with the data of the step's dense output in
+    ``rec_kind, rec_a0, rec_a1`` (:data:`DENSE_SMOOTH`: the accelerations at
+    the step's ends extrapolated as the state is; :data:`DENSE_SWITCH`: those
+    of the two-step sequence; :data:`DENSE_IMPACT`: the last smooth
+    acceleration in both; -1 on the start's sample). Returns
+    ``(status, accepted, samples)``. On
     ``LCP_HANDBACK`` or ``PAINLEVE`` (:mod:`moreau.integrators._mj_kernels`) the
     state is the start of the macro step that failed; the caller takes that
     step in Python.
@@ -52,6 +63,8 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     const_mass = CONST_MASS  # noqa: F821
     force_lemke = lcp_ctl[0] != 0
     n2 = 2 * n
+    # a row of the table: q, v and the accelerations at the start and the end (dense output)
+    n4 = 4 * n
     ncm = max(nc, 1)
     mrows = 2 * ncm
     M = np.zeros((n, n))
@@ -70,9 +83,11 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     q1 = np.empty(n)
     v1 = np.empty(n)
     y = np.empty(n2)
-    Y = np.zeros((K, n2))
-    R = np.zeros((K, n2))
-    Rn = np.zeros((K, n2))
+    Y = np.zeros((K, n4))
+    R = np.zeros((K, n4))
+    Rn = np.zeros((K, n4))
+    a0 = np.zeros(n)
+    a1 = np.zeros(n)
     sq_smooth = np.zeros(K, dtype=np.bool_)
     sq_missed = np.zeros(K, dtype=np.bool_)
     sq_closing = np.zeros(K, dtype=np.bool_)
@@ -108,8 +123,6 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     trow = np.zeros(ncm, dtype=np.int64)
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
     lw = (Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
-    zreg = np.zeros(ncm, dtype=np.int64)
-    zf = np.zeros(ncm)
 
     t = th[0]
     h = th[1]
@@ -117,6 +130,7 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
     have_Mi = False
     nrec = 0
     nacc = 0
+    kind = DENSE_SWITCH
     status = OK
     while nacc < nmax and status == OK:
         # -- one macro step: tried until its error estimate allows ---------------------
@@ -227,6 +241,14 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                             v1[k] = a
                         for r in range(nfa):
                             sl[fa[r]] = U[na + r]
+                    # the mean accelerations of the first and the last base step: at
+                    # the ends of the macro step to O(hb), and extrapolated with the state
+                    if ib == 0:
+                        for k in range(n):
+                            Y[j - 1, n2 + k] = (v1[k] - vs[k]) / hb
+                    if ib == j - 1:
+                        for k in range(n):
+                            Y[j - 1, n2 + n + k] = (v1[k] - vs[k]) / hb
                     for k in range(n):
                         qs[k] = qm[k] + 0.5 * hb * v1[k]
                         vs[k] = v1[k]
@@ -298,22 +320,26 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
             smooth = smooth and jdone == K
             if smooth:
                 # Aitken-Neville on n_j = j, for an error expansion in every power of h
-                for d in range(n2):
+                for d in range(n4):
                     R[0, d] = Y[0, d]
                 for j in range(2, K + 1):
-                    for d in range(n2):
+                    for d in range(n4):
                         Rn[0, d] = Y[j - 1, d]
                     for kk in range(2, j + 1):
                         ratio = j / (j - kk + 1) - 1.0
-                        for d in range(n2):
+                        for d in range(n4):
                             Rn[kk - 1, d] = Rn[kk - 2, d] + (Rn[kk - 2, d] - R[kk - 2, d]) / ratio
                     for kk in range(j):
-                        for d in range(n2):
+                        for d in range(n4):
                             R[kk, d] = Rn[kk, d]
                 err = 0.0
                 for d in range(n2):
                     y[d] = R[K - 1, d]
                     err = max(err, abs(y[d] - R[K - 2, d]) / (tol * (1.0 + abs(y[d]))))
+                for k in range(n):
+                    a0[k] = R[K - 1, n2 + k]
+                    a1[k] = R[K - 1, n2 + n + k]
+                kind = DENSE_SMOOTH
                 order = K
                 ir = K - 1
             else:
@@ -323,6 +349,18 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     err = max(err, abs(y[d] - Y[0, d]) / (tol * (1.0 + abs(y[d]))))
                 order = 1
                 ir = 1
+                if sq_closing[1]:
+                    # an impulse somewhere in the step: the dense output joins the smooth
+                    # motions before and after it (the last step's acceleration in both)
+                    kind = DENSE_IMPACT
+                    for k in range(n):
+                        a0[k] = acc[k] if has_acc else 0.0
+                        a1[k] = a0[k]
+                else:
+                    kind = DENSE_SWITCH
+                    for k in range(n):
+                        a0[k] = Y[1, n2 + k]
+                        a1[k] = Y[1, n2 + n + k]
                 if has_acc and not (sq_closing[0] or sq_closing[1]):
                     changed = False
                     for c in range(nc):
@@ -461,8 +499,19 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     gaps_fn(par, q, t, Gm)  # noqa: F821
                 else:
                     contacts_fn(par, q, t, Gm, True, False)  # noqa: F821
+            # the first step's regime and forces, as every time-stepping scheme records its
+            # start (no step has ended there)
+            for c in range(nc):
+                pN[c] = sq_pN[ir, c]
+                pT[c] = sq_pT[ir, c]
+                sl[c] = sq_slip[ir, c]
+                reg[c] = sq_reg[ir, c]
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t, q, v, zreg, zf, zf, 1.0, zf, Gm, n, nc)
+                          t, q, v, reg, pN, pT, H, sl, Gm, n, nc)
+            rec_kind[nrec] = -1
+            for k in range(n):
+                rec_a0[nrec, k] = 0.0
+                rec_a1[nrec, k] = 0.0
             nrec += 1
             record_initial = False
         for c in range(nc):
@@ -472,6 +521,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
             reg[c] = sq_reg[ir, c]
         record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
                       t1, q1, v1, reg, pN, pT, H, sl, G1, n, nc)
+        rec_kind[nrec] = kind
+        for k in range(n):
+            rec_a0[nrec, k] = a0[k]
+            rec_a1[nrec, k] = a1[k]
         nrec += 1
         has_acc = not sq_closing[ir]
         for k in range(n):

@@ -192,8 +192,6 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
     trow = np.zeros(ncm, dtype=np.int64)
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
     lw = (Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
-    zreg = np.zeros(ncm, dtype=np.int64)
-    zf = np.zeros(ncm)
 
     have_Mi = False
     nrec = 0
@@ -444,8 +442,10 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
                     stats[S_PEN] = -Gi[i, 0]
                 reg[i] = _classify(pN[i], pT[i], mu[i])
         if record_initial:
+            # the first step's regime and forces, as every time-stepping scheme records its
+            # start (no step has ended there)
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, zreg, zf, zf, hk, zf, G0, n, nc)
+                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
             nrec += 1
             record_initial = False
         for i in range(nc):

@@ -60,6 +60,7 @@ from .._validate import nonnegative, positive
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
+from .event_driven_generic import contact_law_regimes
 
 __all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution",
            "clamped_restitution"]
@@ -180,7 +181,11 @@ class _Compliant(Integrator):
         self._ode = self._solver(self._rhs, self.t0, y0, self.t_bound, rtol=self.rtol,
                                  atol=atol_y, max_step=self.max_step, **extra)
         self._next_sample = self.t0
-        self._record_state(self.t0, y0)
+        # the start on a closed contact (gap and normal velocity zero) carries no spring
+        # force yet: its regime is the contact law's (event_driven_generic), not flight
+        row = list(self._sample_row(self.t0, y0))
+        row[3] = contact_law_regimes(scene, self.t0, row[1], row[2], row[3])
+        self._record(*row)
         self._next_sample = self.t0 + (self.sample_dt or 0.0)
 
     def _velocity_atol_floor(self, m_min, q0):

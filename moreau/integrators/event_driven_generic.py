@@ -61,6 +61,19 @@ Accumulation of impacts (Zeno) policy
     accumulation the policy did not end. A long run of well-separated
     impacts (an elastic ball bouncing for ever) is not one.
 
+Rest
+    A phase that starts at rest (velocities within ``vel_tol`` of zero, the
+    mode's accelerations zero to rounding) under a forcing that does not
+    change with time is an equilibrium: its state, forces and event
+    functions are constant, no event can end it, and it is taken in one
+    step to the window's end (or to the scene's next forcing breakpoint),
+    the samples on the way being that state. The forcing counts as constant
+    when ``forces``, ``gaps``, ``contact_jacobians`` and ``contact_drift`` at
+    the state give the same numbers at 16 times spread evenly over the rest
+    of the phase and at ``t + 10^k`` (``k >= -6``) as at its start; a forcing that changes
+    and returns between them must declare its ``forcing_breakpoints``. After
+    the Zeno closure of a bouncing ball the cost no longer grows with the window.
+
 Known limits: a gap that dips below zero and comes back inside one
 integrator step is not seen (``max_step`` bounds the step); scenes with
 discontinuous forcing (a sawtooth drive) are integrated across the jumps by
@@ -80,7 +93,8 @@ from ..regimes import Regime
 from .base import Integrator, get_integrator, register_integrator
 from .result import Event
 
-__all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference"]
+__all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference",
+           "contact_law_regimes", "contact_velocity_scale"]
 
 _F, _P, _N, _S = int(Regime.FLIGHT), int(Regime.POSITIVE), int(Regime.NEGATIVE), int(Regime.STICK)
 _SIGN = {_P: 1.0, _N: -1.0}
@@ -201,6 +215,147 @@ class ContactModeSolver:
             kin = self.kinematics(t, q, v)
         _, _, WN, wN, _, _, _, _ = kin
         return WN @ v + wN
+
+
+def contact_law_regimes(scene, t, q, v, regime, solver=None, rtol=1e-9, vscale=None):
+    """The regimes of a sample ``(t, q, v)`` by the contact law at that state.
+
+    Every scheme records a regime code with each sample, each in its own way:
+    a time-stepping scheme the impulse of the step that ends there, a
+    compliant one the force of its spring at the state, a run's first sample
+    none (flight, before any step). This names the sample as the continuous
+    system would, the same way for every scheme:
+
+    * a contact recorded open whose gap and normal velocity are zero (within
+      ``rtol`` of the state's scales) is taken as closed, sticking where its
+      slip velocity is zero and sliding its way otherwise; it stays closed if
+      the contact problem of that mode gives it a positive normal force;
+    * a closed frictional contact in stick sticks only if the stick holds:
+      the tangential force that keeps its slip acceleration zero, with the
+      closed contacts held, lies in the cone ``|lamT| <= mu lamN``; else it
+      slips the way the force leaves the cone (``lamT > mu lamN``: negative
+      slip). A step whose impulse stayed inside the cone across a slip
+      reversal records a stick the continuous system does not have.
+
+    Parameters
+    ----------
+    scene : Scene
+    t, q, v : the sample's time and state
+    regime : array_like of int
+        The regime codes the scheme recorded (:class:`moreau.regimes.Regime`).
+    solver : ContactModeSolver, optional
+        Reused across the samples of a run.
+    rtol : float
+        Relative tolerance of a zero gap, normal and slip velocity.
+    vscale : float, optional
+        Scale of the contact velocities (:func:`contact_velocity_scale`): that of
+        the run, where a sample may fall where everything is at rest. Default:
+        that of the sample's own state.
+
+    Returns
+    -------
+    ndarray of int
+
+    Examples
+    --------
+    A ball resting on the floor, recorded in flight (a first sample), is closed:
+
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> ball = BouncingBall(radius=0.1)
+    >>> contact_law_regimes(ball, 0.0, np.array([0.1]), np.zeros(1), [0]).tolist()
+    [1]
+    """
+    ms = solver if solver is not None else ContactModeSolver(scene)
+    mode = np.array(regime, dtype=int).reshape(ms.nc)
+    if ms.nc == 0 or not np.any((mode == _F) | (mode == _S)):
+        return mode
+    q = np.asarray(q, dtype=float)
+    v = np.asarray(v, dtype=float)
+    kin = ms.kinematics(t, q, v)
+    WN, wN, WT, wT = kin[2], kin[3], kin[4], kin[5]
+    g = np.asarray(scene.gaps(q, t), dtype=float)
+    vN = WN @ v + wN
+    vT = ms.slip_velocities(q, v, t, kin)
+    if vscale is None:
+        vscale = _velocity_terms(kin, v)
+    vscale = max(float(vscale), 1e-300)
+    vtol = rtol * vscale
+    gtol = rtol * (1.0 + float(np.max(np.abs(q))))
+    touched = np.flatnonzero((mode == _F) & (np.abs(g) <= gtol) & (np.abs(vN) <= vtol))
+    for i in touched:
+        if ms.trow[i] < 0 or vT[i] > vtol:
+            mode[i] = _P
+        elif vT[i] < -vtol:
+            mode[i] = _N
+        else:
+            mode[i] = _S
+    if not np.any(mode == _S) and not touched.size:
+        return mode
+    try:
+        _, lamN, lamT, _, _, _ = ms.solve(t, q, v, mode)
+    except PainleveError:
+        # redundant closed contacts (two rods sticking on one rotor): the forces of the
+        # mode are not determined; the acceleration-level LCP decides, as at an event
+        return _decided_regimes(scene, ms, t, q, v, regime, vscale, rtol)
+    for i in touched:
+        if not lamN[i] > 0.0:
+            mode[i] = _F
+    fscale = max(float(np.max(np.abs(lamN))), 1e-300)
+    for i in np.flatnonzero(mode == _S):
+        if ms.trow[i] < 0:
+            mode[i] = _P
+        elif lamT[i] > ms.mu[i] * lamN[i] + rtol * fscale:
+            mode[i] = _N
+        elif lamT[i] < -ms.mu[i] * lamN[i] - rtol * fscale:
+            mode[i] = _P
+    return mode
+
+
+def _velocity_terms(kin, v):
+    # the largest term of the contact velocities |W| |v| + |w| (not the velocities: zero
+    # in stick), as the event-driven tolerances measure them
+    WN, wN, WT, wT = kin[2], kin[3], kin[4], kin[5]
+    av = np.abs(v)
+    return max(float(np.max(np.abs(WN) @ av + np.abs(wN), initial=0.0)),
+               float(np.max(np.abs(WT) @ av + np.abs(wT), initial=0.0)))
+
+
+def contact_velocity_scale(scene, ts, qs, vs, solver=None, samples=64):
+    """The scale of the contact velocities over a run's samples (at most ``samples`` of them).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> contact_velocity_scale(BouncingBall(), [0.0, 1.0], [[1.0], [0.5]], [[0.0], [-1.0]])
+    1.0
+    """
+    ms = solver if solver is not None else ContactModeSolver(scene)
+    idx = np.unique(np.linspace(0, len(ts) - 1, min(samples, len(ts))).round().astype(int))
+    out = 0.0
+    for k in idx:
+        q, v = np.asarray(qs[k], dtype=float), np.asarray(vs[k], dtype=float)
+        out = max(out, _velocity_terms(ms.kinematics(float(ts[k]), q, v), v))
+    return out
+
+
+def _decided_regimes(scene, ms, t, q, v, regime, vscale, rtol):
+    """The event-driven mode decision at a sample (:meth:`GenericEventDriven._decide`).
+
+    A contact the scheme recorded closed counts as touching; a sample the
+    decision cannot name (no solution, a Painlevé case) keeps its regimes.
+    """
+    integ = object.__new__(GenericEventDriven)
+    integ.scene, integ.ms, integ.lcp_method = scene, ms, "lemke"
+    integ.vel_tol, integ._vscale = rtol, vscale
+    g = np.asarray(scene.gaps(q, t), dtype=float)
+    closed = np.asarray(regime).reshape(ms.nc) != _F
+    integ.gap_tol = max(float(np.max(np.abs(g[closed]), initial=0.0)),
+                        rtol * (1.0 + float(np.max(np.abs(q)))))
+    integ.counters = {"lcp_solves": 0}
+    try:
+        return integ._decide(t, q, v, {})
+    except (PainleveError, LCPError):
+        return np.array(regime, dtype=int).reshape(ms.nc)
 
 
 def project_positions(scene, t, q, contacts, max_iter=4):
@@ -725,6 +880,41 @@ class GenericEventDriven(Integrator):
                 meta.append(("painleve", i))
         return rhs, events, meta, evaluate
 
+    def _rest_phase(self):
+        """Take a phase at rest under a constant forcing in one step; True if it was one."""
+        t, q, v, mode = self.t, self.q, self.v, self.mode
+        if np.max(np.abs(v), initial=0.0) > self._vtol():
+            return False
+        try:
+            a, _, _, _, _, kin = self.ms.solve(t, q, v, mode)
+        except PainleveError:
+            return False
+        self.counters["rhs"] += 1
+        free = np.linalg.solve(kin[0], kin[1])
+        scale = max(float(np.max(np.abs(free), initial=0.0)),
+                    float(np.max(np.abs(a - free), initial=0.0)))
+        if np.max(np.abs(a), initial=0.0) > 1e-12 * scale:
+            return False
+        breaks = self.scene.forcing_breakpoints(t, self.t_bound)
+        t_end = float(breaks[0]) if len(breaks) else self.t_bound
+        if not _constant_forcing(self.scene, q, v, t, t_end):
+            return False
+        n = self.scene.ndof
+        y = np.concatenate([q, v])
+        self.counters["segments"] += 1
+        self.counters["rest_phases"] = self.counters.get("rest_phases", 0) + 1
+        if self.phases is not None:
+            self.phases.append((t, t_end, lambda s, y=y: y.copy(), mode.copy()))
+        if self._want_pieces:
+            self._add_piece(np.array([t, t_end]), lambda s, y=y: y.copy(),
+                            lambda s, mode=mode.copy(): self._sample_row(s, q, v, mode))
+        while self._next_sample < t_end:
+            self._record_state(self._next_sample, y[:n].copy(), y[n:].copy())
+            self._next_sample += self.sample_dt
+        self.t = t_end
+        self._record_state(self.t, self.q, self.v)
+        return True
+
     def _step_impl(self):
         if self.t == self._last_event_t:
             self._stalled += 1
@@ -733,6 +923,8 @@ class GenericEventDriven(Integrator):
                                   f"(contact modes {self.ms.letters(self.mode)})")
         else:
             self._last_event_t, self._stalled = self.t, 0
+        if self._rest_phase():
+            return
         rhs, events, meta, evaluate = self._phase_functions()
         y0 = np.concatenate([self.q, self.v])
         self.counters["segments"] += 1
@@ -785,6 +977,33 @@ class GenericEventDriven(Integrator):
                 forced[kd[1]] = kd[2]
         self._resolve(kind=label, forced=forced, contact=contact)
         self._record_state(self.t, self.q, self.v)
+
+
+def _constant_forcing(scene, q, v, t0, t1):
+    """Whether the scene's functions at ``(q, v)`` give the same numbers over ``[t0, t1]``.
+
+    Probed at 16 evenly spread times and at ``t0 + 10^k`` (``k >= -6``) inside
+    the interval, against ``t0``.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> _constant_forcing(BouncingBall(), np.array([0.05]), np.zeros(1), 0.0, 1e9)
+    True
+    """
+    def values(s):
+        out = [scene.forces(q, v, s), scene.gaps(q, s), *scene.contact_jacobians(q, s),
+               *scene.contact_drift(q, v, s)]
+        return [np.asarray(x, dtype=float) for x in out]
+
+    ref = values(t0)
+    span = t1 - t0
+    probes = list(t0 + span * np.linspace(0.0, 1.0, 17)[1:])
+    probes += [t0 + 10.0 ** k for k in range(-6, 20) if 10.0 ** k < span]
+    for s in probes:
+        if not all(np.array_equal(a, b) for a, b in zip(ref, values(s))):
+            return False
+    return True
 
 
 @register_integrator("event-driven")

@@ -321,8 +321,9 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         fN, fT = pN / h, pT / h
         if self._pending_initial:
             g0r = np.asarray(sc.gaps(self.q, t0), dtype=float) if nc else gap
-            self._record(t0, self.q, self.v, np.zeros(nc, dtype=int), np.zeros(nc), np.zeros(nc),
-                         np.zeros(nc), g0r)
+            # the first step's regime and forces, as every time-stepping scheme records its
+            # start (no step has ended there)
+            self._record(t0, self.q, self.v, regime, fN, fT, slip, g0r)
             self._pending_initial = False
         self.t, self.q, self.v = t1, q1, v1
         if self._k % self.save_every == 0 or t1 >= self.t_bound:

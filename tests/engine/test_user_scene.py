@@ -27,6 +27,69 @@ def test_check_scene_names_a_wrong_jacobian():
     assert any("gap rates (WN, wN)" in p for p in report.problems)
 
 
+def test_check_scene_names_a_gap_that_jumps():
+    # issue 34: a jump of 0.1 at x = 0.05 read "every check passed" (4 states checked,
+    # nothing between them); the block rides the belt through x = 0.05 at t = 0.4
+    class Jump(BeltBlock):
+        def gaps(self, q, t):
+            return np.array([q[1] + (0.1 if q[0] > 0.05 else 0.0)])
+
+    report = moreau.check_scene(Jump())
+    assert not report.ok
+    (problem,) = report.problems
+    assert problem.startswith("`gaps(q, t)` of contact 0 is not continuous: it changes by 0.1")
+    assert "along the motion" in report.where[problem]
+    assert moreau.check_scene(BeltBlock()).ok
+
+
+def test_check_scene_names_a_wrong_sign_of_the_belts_rheonomic_term():
+    from belt_scene import CompiledBeltBlock
+
+    class Flipped(CompiledBeltBlock):
+        def contact_jacobians(self, q, t):
+            WN, wN, WT, wT = super().contact_jacobians(q, t)
+            return WN, wN, WT, -wT
+
+    # with the belt's position stated, the Python model alone is checked
+    class Stated(BeltBlock):
+        def slip_positions(self, q, t):
+            return np.array([q[0] - self.vb * t])
+
+    class StatedFlipped(Stated):
+        def contact_jacobians(self, q, t):
+            WN, wN, WT, wT = super().contact_jacobians(q, t)
+            return WN, wN, WT, -wT
+
+    assert moreau.check_scene(Stated()).ok
+    report = moreau.check_scene(StatedFlipped())
+    assert {p.split(":")[0] for p in report.problems} == {
+        "slip rates (WT, wT)", "rheonomic terms (wT against d/dt of the slip positions)"}
+    # without it, the compiled model is the second statement
+    report = moreau.check_scene(Flipped())
+    (problem,) = report.problems
+    assert problem == ("the compiled model's wT (the tangential rows' rheonomic term) differs "
+                       "from the Python model's")
+    # one line for the 12 states where it appears (4 identical lines before)
+    summary = report.summary()
+    assert summary.count("problem:") == 1 and "at every one of the 12 states" in summary
+    assert moreau.check_scene(CompiledBeltBlock()).ok
+
+
+def test_check_scene_names_a_wrong_rheonomic_normal_term():
+    # wN against the gaps' change in time at fixed positions: a belt whose surface rises
+    class Rising(BeltBlock):
+        def gaps(self, q, t):
+            return np.array([q[1] - 0.1 * t])
+
+        def contact_jacobians(self, q, t):
+            WN, wN, WT, wT = super().contact_jacobians(q, t)
+            return WN, wN + 0.1, WT, wT      # the sign of dg/dt = -0.1 wrong
+
+    report = moreau.check_scene(Rising(), motion=False)
+    assert any(p.startswith("rheonomic terms (wN against d/dt of the gaps)")
+               for p in report.problems)
+
+
 def test_check_scene_names_a_wrong_shape_and_a_mass_that_is_not_positive_definite():
     class Bad(BeltBlock):
         def mass(self, q):

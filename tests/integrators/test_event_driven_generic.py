@@ -51,6 +51,48 @@ def test_ball_accumulation_ends_at_rest_near_the_zeno_time():
     assert res.force_N[-1, 0] == pytest.approx(1.0, rel=1e-12)
 
 
+def test_a_rest_after_the_accumulation_costs_nothing_more_for_a_longer_window():
+    # the defect: after the Zeno closure each max_step of the rest was integrated (T = 1e3:
+    # 6.3 s, T = 1e4: 56 s; `moreau run --scene bouncing-ball --duration 1e9` never ended)
+    ball = BouncingBall(restitution=0.5, radius=0.1)
+    runs = [simulate(ball, (0.0, T), [0.6], [0.0], GEN, t_eval=[0.5, 10.0, T]) for T in (20, 1e9)]
+    for res in runs:
+        assert res.status == 0 and res.stats["rest_phases"] == 1
+        # the rest state, exact (sampled inside the rest phase and at its end)
+        assert res.q[-1, 0] == 0.1 and res.v[-1, 0] == 0.0 and res.q[1, 0] == 0.1
+        assert res.force_N[-1, 0] == pytest.approx(1.0, rel=1e-12)
+        assert res.q[0, 0] == pytest.approx(0.6 - 0.125, abs=1e-12)
+    # the same right-hand sides and segments (measured 1151 and 21) for 20 and 1e9
+    assert runs[0].stats["rhs"] == runs[1].stats["rhs"] < 2000
+    assert runs[0].stats["segments"] == runs[1].stats["segments"]
+
+
+class _LoadedBlock(SlidingBlock):
+    """A block at rest on a floor, pushed by a force ``(t - 2)^2`` from ``t = 2`` on."""
+
+    def __init__(self):
+        super().__init__(mu=0.5, incline=0.0)
+
+    def forces(self, q, v, t):
+        f = np.array(super().forces(q, v, t), dtype=float)
+        f[0] += max(t - 2.0, 0.0) ** 2
+        return f
+
+
+def test_a_rest_under_a_changing_forcing_is_integrated():
+    # at rest at t = 0 with the push still zero: not an equilibrium, the forcing changes
+    sc = _LoadedBlock()
+    q0, v0 = np.zeros(sc.ndof), np.zeros(sc.ndof)
+    res = simulate(sc, (0.0, 4.0), q0, v0, GEN)
+    assert res.status == 0 and "rest_phases" not in res.stats
+    # slips when (t - 2)^2 reaches mu N = 0.5; x(4) = int_ts^4 (4 - s) ((s - 2)^2 - 0.5) ds
+    ts = 2.0 + math.sqrt(0.5)
+    u = 4.0 - ts
+    # with s = 4 - w: (s - 2)^2 = (2 - w)^2, x = int_0^u w ((2 - w)^2 - 0.5) dw
+    x = 2.0 * u ** 2 - 4.0 * u ** 3 / 3.0 + u ** 4 / 4.0 - 0.25 * u ** 2
+    assert res.q[-1, 0] == pytest.approx(x, abs=1e-9)
+
+
 def test_perfectly_elastic_ball_keeps_its_energy():
     ball = BouncingBall(restitution=1.0, radius=0.1)
     res = simulate(ball, (0.0, 10.5), [0.6], [0.0], GEN)

@@ -173,3 +173,114 @@ def test_a_stick_phase_does_not_step_over_the_slip_phase_of_a_sawtooth_drive(fas
         errors.append(abs((r.q[-1, 0] - r.q[0, 0]) / ref - 1.0))
     # measured 6.7e-7 and 6.4e-14
     assert errors[0] < 1e-4 and errors[1] < 1e-9
+
+
+# -- the dense output between the steps (issue 34, item 4) ----------------------------------
+
+def test_samples_between_the_steps_follow_the_tolerance():
+    # the defect: t_eval samples were the chords between step ends, 0.512458 at t = 0.364
+    # where the ball is at 0.533752 (2.1e-2 at any tol) while the step ends were exact
+    ball = make_scene("bouncing-ball", restitution=0.5)
+    q0, v0 = ball.initial_state()
+    grid = np.linspace(0.0, 2.6, 261)
+    qx, vx = ball.exact_solution(grid, q0, v0)
+
+    def run(tol):
+        r = simulate(ball, (0.0, 2.6), q0, v0, NAME, tol=tol, t_eval=grid, fast=False)
+        assert r.success and np.array_equal(r.t, grid) and r.stats["steps"] < 50
+        assert np.max(np.abs(r.gap[:, 0] - (r.q[:, 0] - ball.r))) <= 1e-15
+        return max(np.max(np.abs(r.q[:, 0] - qx[:, 0])), np.max(np.abs(r.v[:, 0] - vx[:, 0])))
+    # measured 5.2e-5, 4.7e-7, 2.9e-9, 2.4e-11 over 22 to 42 steps (before: 2.1e-2 each)
+    _assert_follows_the_tolerance(_errors(run), 1.0)
+
+
+def test_the_dense_output_has_the_order_of_the_steps():
+    # smooth steps: the quintic Hermite interpolant with the extrapolated end accelerations
+    # is as accurate between the steps as the steps' ends are (K = 4 columns)
+    grid = np.linspace(0.0, 4.0, 801)
+    for tol in (1e-6, 1e-10):
+        own = simulate(Oscillator(), (0.0, 4.0), [1.0], [0.0], NAME, tol=tol)
+        r = simulate(Oscillator(), (0.0, 4.0), [1.0], [0.0], NAME, tol=tol, t_eval=grid)
+        ends = max(np.max(np.abs(own.q[:, 0] - np.cos(own.t))),
+                   np.max(np.abs(own.v[:, 0] + np.sin(own.t))))
+        inner = max(np.max(np.abs(r.q[:, 0] - np.cos(grid))),
+                    np.max(np.abs(r.v[:, 0] + np.sin(grid))))
+        # measured 2.61e-6 and 1.80e-9, equal to the ends' errors (steps up to 0.25 long)
+        assert inner <= 1.5 * ends, (tol, inner, ends)
+
+
+@pytest.mark.slow
+def test_the_dense_output_on_a_contact_with_slip_reversals():
+    # the friction drive's orbit: a closed contact, two slip reversals (switch steps)
+    sc, span, q0, v0, _, _ = _friction_drive_orbit()
+    grid = np.linspace(*span, 401)
+    ref = simulate(sc, span, q0, v0, "event-driven", rtol=1e-13, t_eval=grid)
+    for tol in (1e-6, 1e-10):
+        r = simulate(sc, span, q0, v0, NAME, tol=tol, t_eval=grid)
+        own = simulate(sc, span, q0, v0, NAME, tol=tol)
+        at = simulate(sc, span, q0, v0, "event-driven", rtol=1e-13, t_eval=own.t)
+        ends = max(np.max(np.abs(own.q - at.q)), np.max(np.abs(own.v - at.v)))
+        inner = max(np.max(np.abs(r.q - ref.q)), np.max(np.abs(r.v - ref.v)))
+        # measured 4.5e-7 against 2.8e-7 at the ends (tol 1e-6), 4.3e-10 against 4.3e-10
+        assert inner <= 3.0 * ends, (tol, inner, ends)
+
+
+def test_the_dense_output_does_not_interpolate_across_an_impact():
+    ball = make_scene("bouncing-ball", restitution=0.5)
+    q0, v0 = ball.initial_state()
+    t1 = float(ball.impacts(q0, v0, 1).t[0])
+    own = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=1e-10, fast=False)
+    k = np.searchsorted(own.t, t1)
+    assert own.t[k - 1] < t1 < own.t[k]           # the impact is inside a macro step
+    grid = np.sort(np.concatenate([t1 + np.linspace(-1e-4, 1e-4, 401), own.t[k - 1:k + 1]]))
+    r = simulate(ball, (0.0, 2.0), q0, v0, NAME, tol=1e-10, fast=False, t_eval=grid)
+    qx, vx = ball.exact_solution(grid, q0, v0)
+    away = np.abs(grid - t1) > 1e-8
+    # measured 1.5e-12 and 3.8e-10: falling before the impact, rising after it (the chord
+    # would give a velocity between -1.4 and 0.7 inside the step)
+    assert np.max(np.abs(r.q[:, 0] - qx[:, 0])) < 1e-9
+    assert np.max(np.abs(r.v[away, 0] - vx[away, 0])) < 1e-8
+
+
+def test_sample_dt_samples_the_dense_output_on_its_grid():
+    # a statistical steady state reads the run at the ends of the drive periods
+    # (moreau.analysis.section_runs): Studer failed there with "did not sample the run"
+    sc = make_scene("friction-drive", frequency=185.0)
+    q0, v0 = sc.initial_state()
+    span = (0.0, 2 * np.pi)
+    dt = np.pi / 4
+    grid = dt * np.arange(9)
+    r = simulate(sc, span, q0, v0, NAME, tol=1e-8, sample_dt=dt)
+    e = simulate(sc, span, q0, v0, NAME, tol=1e-8, t_eval=grid)
+    assert r.success and np.array_equal(r.t[:-1], grid[:-1]) and r.t[-1] == span[1]
+    np.testing.assert_allclose(r.q[:-1], e.q[:-1], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(r.v[:-1], e.v[:-1], rtol=0, atol=1e-15)
+    # the steps do not depend on the sampling
+    own = simulate(sc, span, q0, v0, NAME, tol=1e-8)
+    np.testing.assert_array_equal(own.q[-1], r.q[-1])
+    # the grid times fall inside the steps (58 over the period)
+    assert not np.isin(grid[1:-1], own.t).any()
+
+
+def test_studer_has_a_statistical_steady_state():
+    # `moreau steady --frequency 185 --scheme studer-extrapolation` failed with "did not
+    # sample the run at the ends of the drive periods"
+    from moreau.analysis.statistical import statistical_steady_state
+    sc = make_scene("friction-drive", frequency=185.0)
+    st = statistical_steady_state(sc, NAME)
+    ref = find_steady_state(sc, statistical=False).displacement_per_period
+    lo, hi = st.confidence_interval
+    # measured: 400 periods, [-6.639090e-3, -6.638984e-3] around the walker's -6.639079e-3
+    assert lo <= ref <= hi and hi - lo < 1e-4 * abs(ref)
+
+
+def test_compare_measures_the_ball_s_trajectory_on_the_dense_output():
+    # `compare` read 0.0213 at tol 1e-4 and at 1e-10 (chords between the steps)
+    from moreau.analysis.compare import make_case
+    case = make_case("bouncing-ball")
+    errs = []
+    for tol in (1e-4, 1e-10):
+        out = case.scheme(NAME, {"tol": tol, "fast": False})
+        errs.append(case.measure_scheme(NAME, {"tol": tol}, out))
+    # measured 8.4e-5 and 5.6e-11
+    assert errs[0] < 2e-4 and errs[1] < 1e-9
