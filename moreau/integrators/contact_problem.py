@@ -16,23 +16,129 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 
 import numpy as np
 
-from ..errors import LCPError, PainleveError
+from ..errors import InputError, LCPError, PainleveError
 from ..lcp import lcp_residual, solve_lcp
 from ..lcp.friction import build_friction_lcp, friction_impulses
 from . import _mj_kernels as _kernels
 
 __all__ = ["solve_contact_problem", "new_contact_counters", "one_contact_impulse",
-           "one_contact_residual"]
+           "one_contact_residual", "PAINLEVE_POLICIES", "check_painleve", "tangential_impact",
+           "sliding_regimes"]
+
+#: accepted values of the schemes' ``painleve`` option: take the tangential impact
+#: (the impulsive stick the complete contact problem gives) or stop the run there
+PAINLEVE_POLICIES = ("impulse", "stop")
+
+
+def check_painleve(painleve):
+    """Validate a scheme's ``painleve`` option (:data:`PAINLEVE_POLICIES`).
+
+    Examples
+    --------
+    >>> check_painleve("stop")
+    'stop'
+    >>> check_painleve("jam")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `painleve` must be one of ['impulse', 'stop'], got 'jam'
+    """
+    if not isinstance(painleve, str) or painleve not in PAINLEVE_POLICIES:
+        raise InputError(f"`painleve` must be one of {list(PAINLEVE_POLICIES)}, got {painleve!r}")
+    return painleve
 
 
 def new_contact_counters():
     """The statistics :func:`solve_contact_problem` updates, all zero."""
     return {"lcp_solves": 0, "direct_solves": 0, "pivots": 0, "fallbacks": 0,
-            "max_residual": 0.0}
+            "max_residual": 0.0, "tangential_impacts": 0, "tangential_impact_times": []}
+
+
+def tangential_impact(W, U_free, mu, e, vN_pre, slip_before):
+    """Whether a one-contact step is a tangential impact (dynamic jamming).
+
+    The contact slid the way ``slip_before`` (``+1`` positive slip, ``-1``
+    negative, ``0`` not sliding) at the end of the step before, it presses
+    (``b = u_N + e min(vN_pre, 0) < 0``) and its sliding piece that way has a
+    normal velocity that does not grow with the normal impulse,
+    ``W_NN - mu s W_NT <= 0``: sliding on has no solution, and the step's
+    unique answer (:func:`one_contact_impulse`) is the stick, whose impulse
+    does not vanish with the step (Génot and Brogliato 1999's tangential
+    impact, Stewart 1998's impulsive resolution of Painlevé's paradox).
+
+    Parameters
+    ----------
+    W : array_like, shape (2, 2)
+    U_free : array_like, shape (2,)
+    mu, e, vN_pre, slip_before : float
+
+    Examples
+    --------
+    A rod's tip sliding the paradoxical way (``W_NN = 1.6``, ``W_NT = 1.2``, ``mu = 10``):
+
+    >>> W = [[1.6, 1.2], [1.2, 1.4]]
+    >>> tangential_impact(W, [-1e-3, 0.5], 10.0, 0.0, 0.0, 1.0)
+    True
+    >>> tangential_impact(W, [-1e-3, 0.5], 10.0, 0.0, 0.0, 0.0)   # it was not sliding
+    False
+    """
+    W = np.asarray(W, dtype=float)
+    U = np.asarray(U_free, dtype=float).reshape(-1)
+    return bool(_kernels._jam(float(W[0, 0]), float(W[0, 1]), float(mu), float(U[0]), float(e),
+                              float(vN_pre), float(slip_before)))
+
+
+def sliding_regimes(scene, q, v, t):
+    """Regime codes of the contacts of ``scene`` that slide at ``(q, v, t)``, as the step before ``t`` would leave them.
+
+    A frictional contact that is closed (gap <= 0) and not separating
+    (normal velocity <= 0) with a nonzero slip velocity is coded
+    ``POSITIVE`` or ``NEGATIVE`` by the slip's sign; every other contact
+    ``FLIGHT``. A scheme starts its tangential-impact detection
+    (:func:`tangential_impact`) from these, so that a run started sliding
+    into a Painlevé configuration records its first step's jam.
+
+    Examples
+    --------
+    >>> import math
+    >>> from moreau.scenes.painleve_rod import PainleveRod
+    >>> rod = PainleveRod()
+    >>> q0, v0 = rod.sliding_state(phi=math.atan(2.0), tip_speed=-1.0)
+    >>> sliding_regimes(rod, q0, v0, 0.0).tolist()
+    [2]
+    """
+    nc = scene.ncontacts
+    out = np.zeros(nc, dtype=np.int64)
+    if nc == 0:
+        return out
+    fr = np.asarray(scene.frictional_index, dtype=int)
+    if fr.size == 0:
+        return out
+    g = np.asarray(scene.gaps(q, t), dtype=float)
+    vN, vT = (np.asarray(a, dtype=float) for a in scene.contact_velocities(q, v, t))
+    for k, i in enumerate(fr):
+        if g[i] <= 0.0 and vN[i] <= 0.0 and vT[k] != 0.0:
+            out[i] = 1 if vT[k] > 0.0 else 2
+    return out
+
+
+def _jam_check(W, U_free, mu, e, vN_pre, slip_before, painleve, c, t):
+    if slip_before is None or mu.size != 1 or not mu[0] > 0.0:
+        return
+    if not tangential_impact(W[:2, :2], U_free[:2], mu[0], e[0], vN_pre[0], slip_before[0]):
+        return
+    if painleve == "stop":
+        where = f" at t = {t!r}" if t is not None else ""
+        raise PainleveError(
+            f"tangential impact{where} (painleve='stop'): discrete Painlevé condition "
+            f"W_NN - mu |W_NT| > 0 violated (W_NN = {W[0, 0]:.6g}, W_NT = {W[0, 1]:.6g}, "
+            f"mu = {mu[0]:.6g}) with the contact sliding the paradoxical way: no sliding "
+            f"solution exists, the step's solution is an impulsive stick")
+    c["tangential_impacts"] = c.get("tangential_impacts", 0) + 1
+    c.setdefault("tangential_impact_times", []).append(None if t is None else float(t))
 
 
 def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counters=None,
-                          lemke_max_iter=None, t=None):
+                          lemke_max_iter=None, t=None, slip_before=None, painleve="impulse"):
     """Impulses of the active contacts of one step.
 
     Parameters
@@ -54,7 +160,16 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     lemke_max_iter : int, optional
         Pivot limit of Lemke's method.
     t : float, optional
-        Time of the step, for the error message.
+        Time of the step, for the error message and the record of a tangential impact.
+    slip_before : array_like, shape (na,), optional
+        Slip direction of each active contact at the end of the step before
+        (``+1``, ``-1``, ``0``); with it a one-contact step is checked for a
+        tangential impact (:func:`tangential_impact`), which is counted in
+        ``counters["tangential_impacts"]`` with its time in
+        ``counters["tangential_impact_times"]``.
+    painleve : {"impulse", "stop"}
+        At a tangential impact, take it (the default) or raise
+        :class:`~moreau.errors.PainleveError`.
 
     Returns
     -------
@@ -69,7 +184,8 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     LCPError
         The contact problem has no certified solution.
     PainleveError
-        One contact violates the discrete Painlevé condition.
+        A tangential impact with ``painleve="stop"``, or one contact whose
+        Delassus matrix is singular violates the discrete Painlevé condition.
 
     Examples
     --------
@@ -85,6 +201,7 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     e = np.asarray(e, dtype=float)
     vN_pre = np.asarray(vN_pre, dtype=float)
     na = mu.size
+    _jam_check(W, U_free, mu, e, vN_pre, slip_before, painleve, c, t)
     c["lcp_solves"] += 1
     if na == 1 and lcp_method == "auto":
         c["direct_solves"] += 1
@@ -143,12 +260,10 @@ def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
     ------
     PainleveError
         The contact must act (``u_N < -e min(vN_pre, 0)``), the discrete
-        Painlevé condition ``W_NN - mu |W_NT| > 0`` fails, and either the
-        free slip ``u_T`` runs along the branch whose normal velocity does not
-        grow with ``pN`` (the paradox: only an impulsive jam could solve it) or
-        the problem has no solution or several. Where the condition fails but
-        the contact slides the harmless way and the solution is unique, it is
-        returned.
+        Painlevé condition ``W_NN - mu |W_NT| > 0`` fails and ``W`` is
+        singular, so that the problem has no solution or several. With ``W``
+        positive definite there is always exactly one answer, the
+        tangential impact included (Notes).
     FloatingPointError
         The contact must act and ``W_NN`` is not positive and finite, or the
         data are not finite: a diverged state or a mass matrix that is no
@@ -162,9 +277,32 @@ def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):
     slip (slope ``W_NN -/+ mu W_NT``, positive under the Painlevé condition),
     so exactly one case applies and the result is unique. Cases are tested in
     the order stick, positive slip, negative slip; where two hold (on a case
-    boundary) they give the same impulse. When the condition fails, all three
-    cases are tried. With ``u_N >= -e min(vN_pre, 0)`` the answer is "no
-    impulse" even if a paradoxical slip branch offers a second solution.
+    boundary) they give the same impulse. With ``u_N >= -e min(vN_pre, 0)``
+    the answer is "no impulse" even if a paradoxical slip branch offers a
+    second solution.
+
+    When the condition fails, the problem still has exactly one solution for
+    ``b = u_N + e min(vN_pre, 0) < 0`` and ``W`` positive definite. Take
+    ``pN`` as the parameter: ``pT(pN)`` is the clamp of ``-(u_T + W_TN pN) /
+    W_TT`` to ``[-mu pN, mu pN]``, so ``pN -> v_N(pN)`` is continuous and
+    piecewise linear, from ``v_N(0) = b < 0``, in at most three pieces: a
+    slip against the free slip ``u_T`` (slope ``W_NN - mu sign(u_T) W_NT``,
+    the only one that may fall), stick (slope ``det W / W_TT > 0``) and,
+    only where ``|W_NT| > mu W_TT``, a slip beyond it (slope ``W_NN - mu
+    |W_NT| > 0``, since then ``W_NN > W_NT^2 / W_TT > mu |W_NT|``). The last
+    piece is unbounded with a positive slope, so ``v_N`` has exactly one
+    root. Where the first piece falls (the free slip runs the paradoxical
+    way) the root lies on the stick piece: the tangential impact, whose
+    impulse ``-W^-1 (b, u_T)`` does not vanish with the step
+    (:func:`tangential_impact`). The friction LCP of one contact is the
+    same problem: its matrix is copositive (``z^T M z = p^T W p + mu beta
+    pN``) and ``z >= 0, M z >= 0, z^T M z = 0`` forces ``p = 0``, so
+    ``z^T q = 0``: the condition under which Lemke's method (covering vector
+    ``d > 0``) cannot end on a secondary ray of a copositive LCP (Cottle,
+    Pang and Stone 1992, Sec. 4.4; Anitescu and Potra 1997): a ray
+    ``(z*, z0*) + lambda (z_h, 0)`` has ``z_h >= 0, M z_h >= 0, z_h^T M z_h
+    = 0`` and ``z_h^T q = -z_h^T M z* - z0* d^T z_h < 0``, the first term
+    being ``>= 0`` by copositivity.
 
     Examples
     --------
@@ -212,18 +350,13 @@ def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
     if not Wnn > 0.0:
         # (non-finite data never get here: one_contact_impulse refuses them first)
         raise FloatingPointError(_broken_delassus(Wnn))
-    if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
-        # one slip branch has a non-increasing normal velocity and the step would
-        # slide along it: the only way out is an impulsive jam whose size does not
-        # vanish with h, so the continuous problem is paradoxical
-        raise PainleveError(
-            f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
-            f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) with the contact sliding "
-            f"the paradoxical way: no sliding solution exists")
+    # a positive definite W always gives one answer (see _mj_kernels._one_contact_cases):
+    # only a singular one (normal and tangential rows dependent) gets here
     raise PainleveError(
         f"discrete Painlevé condition W_NN - mu |W_NT| > 0 violated "
-        f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) and the contact problem has "
-        f"no unique solution")
+        f"(W_NN = {Wnn:.6g}, W_NT = {Wnt:.6g}, mu = {mu:.6g}) on a singular Delassus matrix "
+        f"(W_NN W_TT - W_NT W_TN = {Wnn * Wtt - Wnt * Wtn:.6g}): the contact problem has no "
+        f"unique solution")
 
 
 def one_contact_residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre, pN, pT):
