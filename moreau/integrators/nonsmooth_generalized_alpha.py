@@ -410,6 +410,13 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
     Returns ``(acc, lamN)``, ``lamN`` the normal forces of every contact (zero
     on the others).
 
+    A sliding contact in a Painlevé configuration with no consistent force
+    (its normal-force coefficient ``WN M^-1 (WN - mu s WT)^T <= 0`` while the
+    free motion presses it) has no smooth start: the state needs an impulse,
+    the tangential impact. Such contacts get no smooth force here, and the
+    first step's impulsive stage takes the jam (the velocity-level problem,
+    which always has a solution).
+
     Examples
     --------
     A block sliding on level ground: the contact carries its weight and brakes it by mu = 0.3:
@@ -450,7 +457,18 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
     U_free = H @ np.linalg.solve(M, f) + np.concatenate([wNb[ib],
                                                          [wTb[trow[i]] for i in stick]])
     mu_eff = np.where(sliding, 0.0, mu[ib])
-    lam, ln, _ = solve_contact_problem(H @ MiGT, U_free, mu_eff, np.zeros(ib.size),
+    A = H @ MiGT
+    paradox = np.array([s and A[k, k] <= 0.0 for k, s in enumerate(sliding)], dtype=bool)
+    if paradox.any():
+        # the acceleration-level problem of a sliding contact whose normal-force
+        # coefficient is not positive has no solution or several: leave it to the
+        # impulsive stage (see the docstring), and solve for the others
+        keep = ~paradox
+        rows = np.concatenate([keep, np.ones(stick.size, dtype=bool)])
+        ib, A, U_free, G, mu_eff = ib[keep], A[np.ix_(rows, rows)], U_free[rows], G[rows], mu_eff[keep]
+        if ib.size == 0:
+            return np.linalg.solve(M, f), lamN
+    lam, ln, _ = solve_contact_problem(A, U_free, mu_eff, np.zeros(ib.size),
                                        np.zeros(ib.size), lcp_method=lcp_method,
                                        counters=counters, t=t)
     lamN[ib] = ln
