@@ -23,7 +23,7 @@ from . import _mj_kernels as _kernels
 
 __all__ = ["solve_contact_problem", "new_contact_counters", "one_contact_impulse",
            "one_contact_residual", "PAINLEVE_POLICIES", "check_painleve", "tangential_impact",
-           "sliding_regimes"]
+           "sliding_regimes", "painleve_option", "slip_signs"]
 
 #: accepted values of the schemes' ``painleve`` option: take the tangential impact
 #: (the impulsive stick the complete contact problem gives) or stop the run there
@@ -45,6 +45,27 @@ def check_painleve(painleve):
     if not isinstance(painleve, str) or painleve not in PAINLEVE_POLICIES:
         raise InputError(f"`painleve` must be one of {list(PAINLEVE_POLICIES)}, got {painleve!r}")
     return painleve
+
+
+def painleve_option(painleve, fast):
+    """``(painleve, fast)`` of a scheme whose compiled loop takes tangential impacts without checking.
+
+    ``"stop"`` is checked on the generic step: ``fast="auto"`` becomes False,
+    ``fast=True`` is refused.
+    """
+    painleve = check_painleve(painleve)
+    if painleve == "stop":
+        if fast is True:
+            raise InputError("`painleve='stop'` is checked on the generic step: it needs "
+                             "`fast` 'auto' or False")
+        fast = False
+    return painleve, fast
+
+
+def slip_signs(regimes):
+    """``+1`` / ``-1`` / ``0`` of regime codes: positive slip, negative slip, neither."""
+    reg = np.asarray(regimes)
+    return np.where(reg == 1, 1.0, np.where(reg == 2, -1.0, 0.0))
 
 
 def new_contact_counters():

@@ -108,7 +108,8 @@ from ._blocks import CompiledRecording
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE
 from ._nsga_kernels import CONVERGENCE, nsga_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
                           check_work, classify_impulse, compiled_model_of, next_time)
 
@@ -196,7 +197,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                         (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
-                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS):
+                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h = check_step("nonsmooth-generalized-alpha", h)
         self.rho_inf = in_closed_interval("rho_inf", rho_inf, 0.0, 1.0)
@@ -224,6 +226,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         self._acc = acc0
         self._a = acc0.copy()
         self._coef = np.array([self.am, self.af, self.gamma, self.beta])
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
 
     def _fast_block(self):
@@ -269,10 +273,15 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                 # the contact velocities at v*(x + dx) are affine in the smooth forces
                 W = kv * (H @ JiHT)
                 U_free = H @ (vs + kv * dx) + np.concatenate([wN[ib], wT[tr]])
+                # Newton iterates: the check only stops (painleve="stop")
+                stop = self.painleve == "stop"
                 lam, ln, lt = solve_contact_problem(W, U_free, self.mu_c[ib], np.zeros(ib.size),
                                                     np.zeros(ib.size),
                                                     lcp_method=self.lcp_method,
-                                                    counters=self.counters, t=self.t)
+                                                    counters=self.counters, t=self.t,
+                                                    painleve=self.painleve,
+                                                    slip_before=(slip_signs(self._prev_reg[ib])
+                                                                 if stop else None))
                 dx = dx + JiHT @ lam
                 lamN[ib], lamT[ib] = ln, lt
                 slip[fb] = (U_free + W @ lam)[ib.size:]
@@ -343,7 +352,9 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                 U_free = H @ vs + np.concatenate([wN[ia], wT[tr]])
                 p, pn, pt = solve_contact_problem(W, U_free, self.mu_c[ia], self.e_c[ia], vN0,
                                                   lcp_method=self.lcp_method,
-                                                  counters=self.counters, t=t0)
+                                                  counters=self.counters, t=t0,
+                                                  slip_before=slip_signs(self._prev_reg[ia]),
+                                                  painleve=self.painleve)
                 pN[ia], pT[ia] = pn, pt
                 v1 = vs + MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]
@@ -361,6 +372,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         PN, PT = h * lamN + pN, h * lamT + pT
         regime = np.array([int(classify_impulse(PN[i], PT[i], self.mu_c[i]))
                            for i in range(nc)])
+        self._prev_reg = regime
         self._closed = (pN > 0.0) | (lamN > 0.0)
         self._k += 1
         fN, fT = PN / h, PT / h

@@ -74,7 +74,8 @@ from .._validate import positive_int
 from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._sp_kernels import sp_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
                           check_work, classify_impulse, compiled_model_of, next_time)
 
@@ -136,7 +137,8 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
                         (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, lcp_method="auto",
-                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS):
+                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h = check_step("schatzman-paoli", h)
         self.lcp_method, self.lemke_max_iter = check_lcp_options(lcp_method, lemke_max_iter)
@@ -153,6 +155,8 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         self._pending_initial = True
         # the Verlet velocity that carries the two-step recursion (see the module docstring)
         self._v_verlet = self.v.copy()
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
 
     def _step_impl(self):
@@ -199,7 +203,8 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
                 p, pn, pt = solve_contact_problem(
                     W, U_free, self.mu_c[ia], np.zeros(ia.size), np.zeros(ia.size),
                     lcp_method=self.lcp_method, counters=self.counters,
-                    lemke_max_iter=self.lemke_max_iter, t=t0)
+                    lemke_max_iter=self.lemke_max_iter, t=t0,
+                    slip_before=slip_signs(self._prev_reg[ia]), painleve=self.painleve)
                 pN[ia], pT[ia] = pn, pt
                 dv_contact = MinvHT @ p
                 v_half = u_plus + dv_contact
@@ -218,6 +223,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
+        self._prev_reg = regime
         self._closed = pN > 0.0
         self._k += 1
         fN, fT = pN / h, pT / h

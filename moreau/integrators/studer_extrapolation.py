@@ -97,7 +97,8 @@ from ._loops import runner_for
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._studer_kernels import NOT_FINITE, STUDER_COUNTERS, TOO_MANY, studer_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .event_driven_generic import project_positions
 from .moreau_jean import (check_lcp_options, check_scene_contacts, classify_impulse,
                           compiled_model_of)
@@ -171,7 +172,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     _block_steps = FAST_BLOCK
 
     def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
-                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS):
+                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS, painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.tol = in_open_interval("tol", tol, 0.0, 1.0)
         if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
@@ -204,6 +205,8 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             vN = np.asarray(WN, float) @ self.v + np.asarray(wN, float)
             self._closed = ((g <= CLOSED_GAP * (1.0 + float(np.max(np.abs(self.q)))))
                             & (vN >= -CLOSED_SPEED * (1.0 + float(np.max(np.abs(self.v))))))
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
 
     # -- the base step ---------------------------------------------------------------------
@@ -260,9 +263,13 @@ class StuderExtrapolation(CompiledRecording, Integrator):
                     # no contact needs to push: zero normal impulse bounds the friction
                     U = U_free
                 else:
+                    # the base steps of a macro step start from its regimes; the check
+                    # only stops (painleve="stop"): the sequences repeat the base steps
+                    stop = self.painleve == "stop"
                     p, pn, pt = solve_contact_problem(
                         W, U_free, self.mu_c[ia], e, vN_pre, lcp_method=self.lcp_method,
-                        counters=self.counters, t=t)
+                        counters=self.counters, t=t, painleve=self.painleve,
+                        slip_before=slip_signs(self._prev_reg[ia]) if stop else None)
                     pN[ia], pT[ia] = pn, pt
                     v1 = v_free + MinvHT @ p
                     U = U_free + W @ p
@@ -482,4 +489,5 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         self._last_reg = regime.copy()
         # the acceleration of the step, unless a contact closed in it (an impulse)
         self._acc = None if rec[8] else (v1 - v) / H
+        self._prev_reg = np.asarray(regime, dtype=int)
         self._record(t1, q1, v1, regime, pN / H, pT / H, slip, gap)

@@ -167,8 +167,14 @@ def _steady(scene, key, steps, fast, painleve="impulse"):
     if name == "moreau-jean":
         # the compiled discrete period map (projection, the friction drive's default)
         return moreau_jean_steady_state(scene, steps, theta=opts["theta"], painleve=painleve)
+    opts = _run_options(key, fast)
+    if painleve != "impulse":
+        # a study of the Painlevé configuration: checked on the generic step
+        opts.update(painleve=painleve)
+        if "fast" in opts:
+            opts["fast"] = False
     return find_steady_state(scene, scheme=name, steps_per_period=steps, rtol=1e-10,
-                             scheme_options=_run_options(key, fast))
+                             scheme_options=opts)
 
 
 def _run_options(key, fast):
