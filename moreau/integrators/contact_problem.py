@@ -17,13 +17,14 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 import numpy as np
 
 from ..errors import InputError, LCPError, PainleveError
-from ..lcp import lcp_residual, solve_lcp
+from ..lcp import lcp_residual, lcp_violation, solve_lcp
+from ..lcp.lemke import DEFAULT_TOL
 from ..lcp.friction import build_friction_lcp, friction_impulses
 from . import _mj_kernels as _kernels
 
 __all__ = ["solve_contact_problem", "new_contact_counters", "one_contact_impulse",
            "one_contact_residual", "PAINLEVE_POLICIES", "check_painleve", "tangential_impact",
-           "sliding_regimes", "painleve_option", "slip_signs"]
+           "sliding_regimes", "painleve_option", "slip_signs", "friction_pieces"]
 
 #: accepted values of the schemes' ``painleve`` option: take the tangential impact
 #: (the impulsive stick the complete contact problem gives) or stop the run there
@@ -244,12 +245,151 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
         c["pivots"] += int(r.pivots)
     if r.fallback_used:
         c["fallbacks"] += 1
-    if not r.success:
+    z = r.z if r.success else None
+    if z is None and na <= MAX_PIECES_CONTACTS:
+        # a frictional contact problem has a solution (one_contact_impulse's Notes: the
+        # matrix is copositive, and with W = J M^-1 J^T, no rheonomic term and e = 0
+        # Lemke's condition holds), so a float Lemke that ends on a ray has met rounding
+        # on a degenerate problem (redundant contacts, a block flat on two corners):
+        # the complete enumeration of the contacts' pieces finds it, certified the same way
+        z = friction_pieces(W, U_free, mu, e, vN_pre, Ml, ql, layout)
+        if z is not None:
+            c["piece_enumerations"] = c.get("piece_enumerations", 0) + 1
+    if z is None:
         where = f" at t = {t!r}" if t is not None else ""
-        raise LCPError(f"contact problem{where} not solved: {r.message}")
-    pN, pT = friction_impulses(r.z, layout)
-    c["max_residual"] = max(c["max_residual"], float(lcp_residual(Ml, ql, r.z)))
-    return friction_impulses(r.z, layout, stacked=True), np.asarray(pN), np.asarray(pT)
+        tried = (f"; the enumeration of the {4 ** na} pieces of its {na} contacts found none"
+                 if na <= MAX_PIECES_CONTACTS else "")
+        raise LCPError(f"contact problem{where} not solved: {r.message}{tried}")
+    pN, pT = friction_impulses(z, layout)
+    c["max_residual"] = max(c["max_residual"], float(lcp_residual(Ml, ql, z)))
+    return friction_impulses(z, layout, stacked=True), np.asarray(pN), np.asarray(pT)
+
+
+#: most active contacts whose pieces :func:`friction_pieces` enumerates (4^4 = 256 pieces)
+MAX_PIECES_CONTACTS = 4
+
+
+def friction_pieces(W, U_free, mu, e, vN_pre, Ml=None, ql=None, layout=None):
+    """A certified solution of the contact problem by enumerating each contact's piece.
+
+    Each contact is open, sticking, sliding positively or negatively (open or
+    closed without friction). A choice of pieces fixes ``m`` linear
+    equations on the stacked impulse ``p`` (an open contact's impulses zero,
+    a closed one's normal velocity zero, a sticking one's slip zero, a
+    sliding one's ``p_T = -/+ mu p_N``) and inequalities (the other side of
+    each complementarity, the cone). Where the equations are regular the
+    piece is one solve; where they are singular (redundant contacts: a block
+    flat on two sticking corners) a point of the affine solution set that
+    meets the inequalities is found by a linear program (HiGHS) and
+    projected back onto the equations. A candidate is kept only when it
+    passes the check every LCP solution passes
+    (:func:`moreau.lcp.lcp_violation` on the friction LCP of
+    :func:`~moreau.lcp.friction.build_friction_lcp`, at Lemke's tolerance).
+
+    Returns the LCP vector ``z`` (``layout``'s order), or None where no piece
+    gives a certified solution.
+
+    Examples
+    --------
+    Two sticking corners of a block at rest (4 rows on 3 dof, ``W`` singular):
+
+    >>> J = np.array([[0, 1, -0.5], [0, 1, 0.5], [1, 0, 1.0], [1, 0, 1.0]])
+    >>> W = J @ np.diag([1.0, 1.0, 3.0 / 1.25]) @ J.T
+    >>> z = friction_pieces(W, np.array([-0.1, -0.1, 0.0, 0.0]), np.array([1.0, 1.0]),
+    ...                     np.zeros(2), np.zeros(2))
+    >>> Ml, ql, layout = build_friction_lcp(W, [-0.1, -0.1, 0.0, 0.0], [1.0, 1.0], 0.0)
+    >>> bool(lcp_violation(Ml, ql, z) <= DEFAULT_TOL)
+    True
+    """
+    from itertools import product
+
+    W = np.asarray(W, dtype=float)
+    U = np.asarray(U_free, dtype=float)
+    mu = np.asarray(mu, dtype=float)
+    e = np.asarray(e, dtype=float)
+    vN_pre = np.asarray(vN_pre, dtype=float)
+    if Ml is None:
+        Ml, ql, layout = build_friction_lcp(W, U, mu, e, vN_pre)
+    na = mu.size
+    m = W.shape[0]
+    b = U.copy()
+    b[:na] += e * np.minimum(vN_pre, 0.0)
+    trow = np.full(na, -1)
+    trow[mu > 0.0] = na + np.arange(int(np.sum(mu > 0.0)))
+    choices = [("S", "P", "N", "O") if trow[i] >= 0 else ("C", "O") for i in range(na)]
+    scale = max(float(np.max(np.abs(W))), 1.0)
+    for combo in product(*choices):
+        E = np.zeros((m, m))
+        f = np.zeros(m)
+        G, g = [], []           # G p <= g
+        for i, mode in enumerate(combo):
+            n_, t_ = i, trow[i]
+            if mode == "O":
+                E[n_, n_] = 1.0
+                G.append(-W[n_])
+                g.append(b[n_])                      # vN = b + W p >= 0
+                if t_ >= 0:
+                    E[t_, t_] = 1.0
+                continue
+            E[n_] = W[n_]
+            f[n_] = -b[n_]
+            row = np.zeros(m)
+            row[n_] = -1.0
+            G.append(row)
+            g.append(0.0)                            # pN >= 0
+            if t_ < 0:
+                continue
+            if mode == "S":
+                E[t_] = W[t_]
+                f[t_] = -b[t_]
+                for sgn in (1.0, -1.0):              # sgn pT - mu pN <= 0
+                    row = np.zeros(m)
+                    row[t_] = sgn
+                    row[n_] = -mu[i]
+                    G.append(row)
+                    g.append(0.0)
+            else:
+                s = 1.0 if mode == "P" else -1.0     # slip +: pT = -mu pN, vT >= 0
+                E[t_, t_] = 1.0
+                E[t_, n_] = s * mu[i]
+                G.append(-s * W[t_])
+                g.append(s * b[t_])
+        G, g = np.array(G), np.array(g)
+        p = _piece_point(E, f, G, g, scale)
+        if p is None:
+            continue
+        vT = (b + W @ p)[na:]
+        z = np.zeros(layout.size)
+        z[layout.normal] = p[:na]
+        fr = layout.frictional
+        pT = p[na:]
+        z[layout.tplus[fr]] = np.maximum(pT, 0.0)
+        z[layout.tminus[fr]] = np.maximum(-pT, 0.0)
+        z[layout.beta[fr]] = np.abs(vT)
+        if lcp_violation(Ml, ql, z) <= DEFAULT_TOL:
+            return z
+    return None
+
+
+def _piece_point(E, f, G, g, scale):
+    # a point with E p = f and G p <= g (to rounding), or None
+    try:
+        cond = np.linalg.cond(E)
+    except np.linalg.LinAlgError:
+        cond = np.inf
+    if np.isfinite(cond) and cond < 1e10:
+        p = np.linalg.solve(E, f)
+        tol = 1e-9 * (scale * float(np.max(np.abs(p), initial=0.0)) + float(np.max(np.abs(f), initial=0.0)) + 1e-300)
+        return p if np.all(G @ p <= g + tol) else None
+    from scipy.optimize import linprog
+    res = linprog(np.zeros(E.shape[1]), A_ub=G, b_ub=g, A_eq=E, b_eq=f,
+                  bounds=[(None, None)] * E.shape[1], method="highs")
+    if res.status != 0:
+        return None
+    p = res.x
+    # back onto the equations exactly (the inequalities had slack or are checked next)
+    p = p + np.linalg.lstsq(E, f - E @ p, rcond=1e-12)[0]
+    return p
 
 
 def one_contact_impulse(W, u_free, mu, e=0.0, vN_pre=0.0):

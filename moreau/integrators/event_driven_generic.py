@@ -78,6 +78,7 @@ from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
 from ..regimes import Regime
 from .base import Integrator, get_integrator, register_integrator
+from .contact_problem import MAX_PIECES_CONTACTS, friction_pieces
 from .result import Event
 
 __all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference"]
@@ -426,13 +427,20 @@ class GenericEventDriven(Integrator):
             lcp = build_friction_lcp(W, vrel, mu, e, vN_pre)
             res = solve_lcp(lcp.M, lcp.q, self.lcp_method)
             self.counters["lcp_solves"] += 1
-            if not res.success:
+            z = res.z if res.success else None
+            if z is None and len(touching) <= MAX_PIECES_CONTACTS:
+                # the velocity-level problem has a solution (contact_problem.solve_contact_problem)
+                z = friction_pieces(W, vrel, mu, e, vN_pre, *lcp)
+                if z is not None:
+                    self.counters["piece_enumerations"] = self.counters.get(
+                        "piece_enumerations", 0) + 1
+            if z is None:
                 if np.any(mu > 0):
                     raise PainleveError(
                         f"the frictional impact problem at t = {t:.12g} has no solution "
                         f"(Lemke: {res.message}); a Painlevé-type impact configuration")
                 raise LCPError(f"impact LCP at t = {t:.12g} not solved: {res.message}")
-            p = friction_impulses(res.z, lcp.layout, stacked=True)
+            p = friction_impulses(z, lcp.layout, stacked=True)
             vN_post = (vrel + W @ p)[:len(touching)]
             # Zeno policy: a rebound far below the contact's approach speeds is
             # the accumulation point of a bounce sequence; close the contact

@@ -119,3 +119,24 @@ def test_event_driven_names_the_painleve_configuration():
     assert res.status == -1
     assert res.message.startswith("Painlevé configuration at t = 0: contact 0 slides (N)")
     assert "-0.8 <= 0" in res.message and "tangential impact" in res.message
+
+
+@settings(deadline=None, max_examples=60)
+@given(st.lists(st.floats(-1.0, 1.0), min_size=12, max_size=12), st.floats(0.05, 10.0),
+       st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3))
+def test_the_piece_enumeration_solves_every_frictional_problem(entries, mu, v):
+    # two frictional contacts on three dof (W = J M^-1 J^T singular, as a block on two
+    # corners), e = 0, no rheonomic term: a solution exists; the enumeration finds it
+    # and certifies it on the friction LCP (what Lemke's answer must pass)
+    from moreau.integrators.contact_problem import friction_pieces
+    from moreau.lcp import lcp_violation
+    from moreau.lcp.lemke import DEFAULT_TOL
+    J = np.array(entries).reshape(4, 3)
+    J[0, 1] = J[1, 1] = 1.0             # normal rows that can push
+    Minv = np.diag([1.0, 1.0, 3.0])
+    W = J @ Minv @ J.T
+    U = J @ np.array(v)
+    z = friction_pieces(W, U, [mu, mu], [0.0, 0.0], [0.0, 0.0])
+    assert z is not None
+    M, q, _ = build_friction_lcp(W, U, [mu, mu], 0.0)
+    assert lcp_violation(M, q, z) <= DEFAULT_TOL
