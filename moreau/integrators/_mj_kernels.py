@@ -430,7 +430,10 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
 
     Layout: ``[force_lemke, warm_start, max_iter, L, na, ia (max(nc, 1)
     slots), support flags (4 max(nc, 1) slots), regimes (max(nc, 1)
-    slots)]``. The first three are the options (see :func:`mj_run`); then
+    slots), painleve_stop]``. The first three are the options (see
+    :func:`mj_run`), the last one another (hand every one-contact step whose
+    free slip runs into a Painlevé configuration to the generic step, which
+    stops there: ``painleve="stop"``, :func:`set_painleve_stop`); then
     the warm start's memory, the last contact LCP solved in the loop (``L =
     -1``: none), and the regime of each contact in the last step taken
     (:func:`prev_regimes`: a tangential impact is a step that stops a
@@ -440,12 +443,17 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
     tuple, which numba cannot inline.)
     """
     ncm = max(nc, 1)
-    ctl = np.zeros(CTL_IA + 6 * ncm, dtype=np.int64)
+    ctl = np.zeros(CTL_IA + 6 * ncm + 1, dtype=np.int64)
     ctl[CTL_FORCE] = bool(force_lemke)
     ctl[CTL_WARM] = bool(warm_start)
     ctl[CTL_MAXIT] = int(max_iter)
     ctl[CTL_L] = -1
     return ctl
+
+
+def set_painleve_stop(ctl, nc, stop):
+    """Set the ``painleve_stop`` option of ``ctl`` (:func:`new_lcp_control`)."""
+    ctl[CTL_IA + 6 * max(nc, 1)] = bool(stop)
 
 
 def prev_regimes(ctl, nc):
@@ -933,6 +941,7 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     roff = CTL_IA + 5 * ncm
     for i in range(nc):
         reg[i] = lcp_ctl[roff + i]
+    pstop = lcp_ctl[roff + ncm] != 0
     constant_W = const_mass and not has_jac
     have_Wi = False
     have_Mi = False
@@ -1060,7 +1069,9 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                 # a tangential impact is taken by the generic step, which records it (or
                 # stops there with painleve="stop"); it is rare, the test is not
                 if not ok or (reg[i] != 0 and reg[i] != 3
-                              and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))):
+                              and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
+                        or (pstop and uT != 0.0
+                            and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], math.copysign(1.0, uT))):
                     status = PAINLEVE
                     break
                 rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
@@ -1150,9 +1161,13 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                 if lst != 0:
                     status = LCP_HANDBACK
                     break
-                if (na == 1 and nfa == 1 and reg[ia[0]] != 0 and reg[ia[0]] != 3
-                        and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
-                                 _slip_sign(reg[ia[0]]))):
+                if na == 1 and nfa == 1 and (
+                        (reg[ia[0]] != 0 and reg[ia[0]] != 3
+                         and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
+                                  _slip_sign(reg[ia[0]])))
+                        or (pstop and Uf[1] != 0.0
+                            and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]],
+                                     vN0[ia[0]], math.copysign(1.0, Uf[1])))):
                     # one contact by Lemke (lcp_method="lemke"): a tangential impact, as above
                     status = PAINLEVE
                     break

@@ -14,6 +14,8 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 :class:`~moreau.errors.LCPError`; no false solution is returned.
 """
 
+import math
+
 import numpy as np
 
 from ..errors import InputError, LCPError, PainleveError
@@ -144,17 +146,25 @@ def sliding_regimes(scene, q, v, t):
 
 
 def _jam_check(W, U_free, mu, e, vN_pre, slip_before, painleve, c, t):
-    if slip_before is None or mu.size != 1 or not mu[0] > 0.0:
+    if mu.size != 1 or not mu[0] > 0.0:
+        return
+    if painleve == "stop":
+        # the study of Painlevé configurations: stop wherever the free slip, whatever
+        # its size, runs into a sliding piece without solution
+        uT = float(U_free[1])
+        if uT != 0.0 and tangential_impact(W[:2, :2], U_free[:2], mu[0], e[0], vN_pre[0],
+                                           math.copysign(1.0, uT)):
+            where = f" at t = {t!r}" if t is not None else ""
+            raise PainleveError(
+                f"tangential impact{where} (painleve='stop'): discrete Painlevé condition "
+                f"W_NN - mu |W_NT| > 0 violated (W_NN = {W[0, 0]:.6g}, W_NT = {W[0, 1]:.6g}, "
+                f"mu = {mu[0]:.6g}) with the contact sliding the paradoxical way: no sliding "
+                f"solution exists, the step's solution is an impulsive stick")
+        return
+    if slip_before is None:
         return
     if not tangential_impact(W[:2, :2], U_free[:2], mu[0], e[0], vN_pre[0], slip_before[0]):
         return
-    if painleve == "stop":
-        where = f" at t = {t!r}" if t is not None else ""
-        raise PainleveError(
-            f"tangential impact{where} (painleve='stop'): discrete Painlevé condition "
-            f"W_NN - mu |W_NT| > 0 violated (W_NN = {W[0, 0]:.6g}, W_NT = {W[0, 1]:.6g}, "
-            f"mu = {mu[0]:.6g}) with the contact sliding the paradoxical way: no sliding "
-            f"solution exists, the step's solution is an impulsive stick")
     c["tangential_impacts"] = c.get("tangential_impacts", 0) + 1
     c.setdefault("tangential_impact_times", []).append(None if t is None else float(t))
 
@@ -190,8 +200,13 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
         ``counters["tangential_impacts"]`` with its time in
         ``counters["tangential_impact_times"]``.
     painleve : {"impulse", "stop"}
-        At a tangential impact, take it (the default) or raise
-        :class:`~moreau.errors.PainleveError`.
+        ``"impulse"`` (default): take a tangential impact. ``"stop"``: raise
+        :class:`~moreau.errors.PainleveError` on a one-contact step whose
+        contact presses and whose free slip ``u_T``, of any size, runs along a
+        sliding piece without solution (``W_NN - mu sign(u_T) W_NT <= 0``):
+        every tangential impact, and also a stick whose slip of rounding size
+        points the paradoxical way (the schemes' behaviour before the
+        tangential impact was taken).
 
     Returns
     -------

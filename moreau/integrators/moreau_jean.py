@@ -143,7 +143,7 @@ from .base import Integrator, register_integrator
 from ._blocks import CompiledRecording
 from .contact_problem import (check_painleve, one_contact_impulse, one_contact_residual,
                               sliding_regimes, solve_contact_problem)
-from ._mj_kernels import mj_loop, prev_regimes
+from ._mj_kernels import mj_loop, prev_regimes, set_painleve_stop
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
@@ -352,8 +352,12 @@ class MoreauJean(CompiledRecording, Integrator):
         ``"impulse"`` (default) takes the step's unique solution, the
         impulsive stick (dynamic jamming), and counts it in
         ``stats["tangential_impacts"]`` with the step's start time in
-        ``stats["tangential_impact_times"]``; ``"stop"`` ends the run there
-        with status ``-1`` (:class:`~moreau.errors.PainleveError`). Detected
+        ``stats["tangential_impact_times"]``; ``"stop"`` ends the run with
+        status ``-1`` (:class:`~moreau.errors.PainleveError`) at every step
+        whose pressed contact's free slip, of any size, runs into a sliding
+        piece without solution (a tangential impact, or a stick with a slip of
+        rounding size pointing that way: the behaviour before the tangential
+        impact was taken), for a study of Painlevé configurations. Detected
         on steps with one active frictional contact.
 
     Notes
@@ -418,6 +422,8 @@ class MoreauJean(CompiledRecording, Integrator):
                               self.lemke_max_iter,
                               warm_start=self.lcp_warm_start and self.lcp_method == "auto")
         self._regimes_before()[:] = sliding_regimes(scene, self.q, self.v, self.t0)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, nc, self.painleve == "stop")
 
     @property
     def closed(self):
