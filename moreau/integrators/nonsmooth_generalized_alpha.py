@@ -171,6 +171,15 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         finish (Lemke fails, the Painlevé condition, the smooth Newton
         iteration) is taken by the generic step.
     max_steps : int
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact, counted in
+        ``stats["tangential_impacts"]`` on the generic step where the impulsive stage takes
+        it), or stop with status ``-1`` wherever the pressed contact's free slip, of any
+        size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
+        checked on the generic step (``fast`` "auto" or False).
 
     Examples
     --------

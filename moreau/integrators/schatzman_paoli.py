@@ -106,6 +106,14 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         problem Lemke cannot solve is taken by the generic step (QP fallback).
     max_steps : int
         Bound on the number of steps of the run.
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact, counted in
+        ``stats["tangential_impacts"]`` on the generic step), or stop with status ``-1``
+        wherever the pressed contact's free slip, of any size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
+        checked on the generic step (``fast`` "auto" or False).
 
     Notes
     -----

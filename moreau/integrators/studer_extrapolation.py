@@ -140,6 +140,13 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         Lemke cannot solve is taken by the Python step (QP fallback).
     max_steps : int
         Bound on the macro steps (accepted and rejected) of the run.
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact), or stop with status ``-1``
+        wherever the pressed contact's free slip, of any size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
+        checked on the generic step (``fast`` "auto" or False).
 
     Examples
     --------

@@ -140,3 +140,15 @@ def test_the_piece_enumeration_solves_every_frictional_problem(entries, mu, v):
     assert z is not None
     M, q, _ = build_friction_lcp(W, U, [mu, mu], 0.0)
     assert lcp_violation(M, q, z) <= DEFAULT_TOL
+
+
+@pytest.mark.parametrize("scheme", ["compliant-rk45"])
+def test_compliant_schemes_note_the_paradoxical_configuration(scheme):
+    rod = PainleveRod(mu=2.0)
+    q0, v0 = rod.sliding_state(PHI_STAR, -1.0)
+    res = simulate(rod, (0.0, 0.05), q0, v0, scheme)
+    assert res.status == 0 and len(res.stats["painleve_paradox_times"]) == 1
+    assert "slid in a Painlevé configuration" in res.message
+    q0, v0 = rod.sliding_state(PHI_STAR, +1.0)          # the harmless way: no note
+    res = simulate(rod, (0.0, 0.05), q0, v0, scheme)
+    assert res.status == 0 and "painleve_paradox_times" not in res.stats
