@@ -452,8 +452,16 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
 
 
 def set_painleve_stop(ctl, nc, stop):
-    """Set the ``painleve_stop`` option of ``ctl`` (:func:`new_lcp_control`)."""
+    """Set the ``painleve_stop`` option of ``ctl`` (:func:`new_lcp_control`), its last entry."""
     ctl[CTL_IA + 6 * max(nc, 1)] = bool(stop)
+
+
+@njit(cache=True)
+def _stop_at(ctl, Wnn, Wnt, mu, uN, uT, e, vN_pre):
+    # painleve="stop" (the last entry of ctl): the pressed contact's free slip, of any size,
+    # runs into a sliding piece without solution; the generic step stops there
+    return (ctl[ctl.shape[0] - 1] != 0 and uT != 0.0
+            and _jam(Wnn, Wnt, mu, uN, e, vN_pre, math.copysign(1.0, uT)))
 
 
 def prev_regimes(ctl, nc):
@@ -941,7 +949,6 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     roff = CTL_IA + 5 * ncm
     for i in range(nc):
         reg[i] = lcp_ctl[roff + i]
-    pstop = lcp_ctl[roff + ncm] != 0
     constant_W = const_mass and not has_jac
     have_Wi = False
     have_Mi = False
@@ -1070,8 +1077,7 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                 # stops there with painleve="stop"); it is rare, the test is not
                 if not ok or (reg[i] != 0 and reg[i] != 3
                               and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
-                        or (pstop and uT != 0.0
-                            and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], math.copysign(1.0, uT))):
+                        or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
                     status = PAINLEVE
                     break
                 rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
@@ -1165,9 +1171,8 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                         (reg[ia[0]] != 0 and reg[ia[0]] != 3
                          and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
                                   _slip_sign(reg[ia[0]])))
-                        or (pstop and Uf[1] != 0.0
-                            and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]],
-                                     vN0[ia[0]], math.copysign(1.0, Uf[1])))):
+                        or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
+                                    e[ia[0]], vN0[ia[0]])):
                     # one contact by Lemke (lcp_method="lemke"): a tangential impact, as above
                     status = PAINLEVE
                     break

@@ -51,18 +51,9 @@ def check_painleve(painleve):
 
 
 def painleve_option(painleve, fast):
-    """``(painleve, fast)`` of a scheme whose compiled loop takes tangential impacts without checking.
-
-    ``"stop"`` is checked on the generic step: ``fast="auto"`` becomes False,
-    ``fast=True`` is refused.
-    """
-    painleve = check_painleve(painleve)
-    if painleve == "stop":
-        if fast is True:
-            raise InputError("`painleve='stop'` is checked on the generic step: it needs "
-                             "`fast` 'auto' or False")
-        fast = False
-    return painleve, fast
+    """``(painleve, fast)`` of a scheme, checked (the compiled loops hand a step where
+    ``"stop"`` applies to the generic step, which stops there)."""
+    return check_painleve(painleve), fast
 
 
 def slip_signs(regimes):

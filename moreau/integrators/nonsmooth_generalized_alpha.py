@@ -108,6 +108,7 @@ from ._blocks import CompiledRecording
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE
 from ._nsga_kernels import CONVERGENCE, nsga_loop
 from .base import Integrator, register_integrator
+from ._mj_kernels import set_painleve_stop
 from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
                               solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
@@ -178,8 +179,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         ``stats["tangential_impacts"]`` on the generic step where the impulsive stage takes
         it), or stop with status ``-1`` wherever the pressed contact's free slip, of any
         size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
-        checked on the generic step (``fast`` "auto" or False).
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Examples
     --------
@@ -238,6 +238,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         self.painleve, fast = painleve_option(painleve, fast)
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _fast_block(self):
         q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()

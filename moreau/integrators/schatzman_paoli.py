@@ -74,6 +74,7 @@ from .._validate import positive_int
 from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._sp_kernels import sp_loop
 from .base import Integrator, register_integrator
+from ._mj_kernels import set_painleve_stop
 from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
                               solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
@@ -112,8 +113,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         impulsive stick (default; the tangential impact, counted in
         ``stats["tangential_impacts"]`` on the generic step), or stop with status ``-1``
         wherever the pressed contact's free slip, of any size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
-        checked on the generic step (``fast`` "auto" or False).
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Notes
     -----
@@ -166,6 +166,8 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         self.painleve, fast = painleve_option(painleve, fast)
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _step_impl(self):
         if self._fast:

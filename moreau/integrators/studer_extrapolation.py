@@ -97,6 +97,7 @@ from ._loops import runner_for
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._studer_kernels import NOT_FINITE, STUDER_COUNTERS, TOO_MANY, studer_loop
 from .base import Integrator, register_integrator
+from ._mj_kernels import set_painleve_stop
 from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
                               solve_contact_problem)
 from .event_driven_generic import project_positions
@@ -145,8 +146,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         condition fails the way the contact slides): take the step's unique answer, the
         impulsive stick (default; the tangential impact), or stop with status ``-1``
         wherever the pressed contact's free slip, of any size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
-        checked on the generic step (``fast`` "auto" or False).
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Examples
     --------
@@ -215,6 +215,8 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         self.painleve, fast = painleve_option(painleve, fast)
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     # -- the base step ---------------------------------------------------------------------
     def _midpoint(self, t, q, v, h, closed):

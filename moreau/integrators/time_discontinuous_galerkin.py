@@ -83,6 +83,7 @@ from ..errors import InputError
 from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._tdg_kernels import tdg_loop
 from .base import Integrator, register_integrator
+from ._mj_kernels import set_painleve_stop
 from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
                               solve_contact_problem)
 from .event_driven_generic import project_positions
@@ -134,8 +135,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         condition fails the way the contact slides): take the step's unique answer, the
         impulsive stick (default; the tangential impact), or stop with status ``-1``
         wherever the pressed contact's free slip, of any size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`). ``"stop"`` is
-        checked on the generic step (``fast`` "auto" or False).
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Notes
     -----
@@ -193,6 +193,8 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         self.painleve, fast = painleve_option(painleve, fast)
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     # -- the pieces of one step ----------------------------------------------
     def _rows(self, ia, q, t, jac=None):

@@ -91,8 +91,9 @@ def test_painleve_stop_ends_the_run_there_and_bad_values_are_refused():
     with pytest.raises(InputError, match=r"`painleve` must be one of \['impulse', 'stop'\]"):
         simulate(rod, (0.0, 0.01), q0, v0, "moreau-jean", h=1e-3, painleve="jam")
     for scheme in ("schatzman-paoli", "nonsmooth-generalized-alpha"):
-        res = simulate(rod, (0.0, 0.01), q0, v0, scheme, h=1e-3, painleve="stop")
-        assert res.status == -1 and "tangential impact" in res.message, scheme
+        for fast in (True, False):
+            res = simulate(rod, (0.0, 0.01), q0, v0, scheme, h=1e-3, painleve="stop", fast=fast)
+            assert res.status == -1 and "tangential impact" in res.message, (scheme, fast)
 
 
 @pytest.mark.parametrize("scheme", ["schatzman-paoli", "nonsmooth-generalized-alpha"])

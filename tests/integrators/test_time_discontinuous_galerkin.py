@@ -124,10 +124,13 @@ def test_the_painleve_rod_stops_with_the_status_that_names_it_when_asked():
     # first step, which painleve="stop" turns into the named stop
     sc = make_scene("painleve-rod")
     q0, v0 = sc.sliding_state(math.atan(2.0), -1.0)
-    r = simulate(sc, (0.0, 0.1), q0, v0, NAME, h=1e-3, painleve="stop")
-    assert r.status == -1 and "Painlevé" in r.message and "tangential impact" in r.message
-    with pytest.raises(InputError, match="`painleve='stop'` is checked on the generic step"):
-        simulate(sc, (0.0, 0.1), q0, v0, NAME, h=1e-3, painleve="stop", fast=True)
+    for fast in (True, False):
+        r = simulate(sc, (0.0, 0.1), q0, v0, NAME, h=1e-3, painleve="stop", fast=fast)
+        assert r.status == -1 and "Painlevé" in r.message and "tangential impact" in r.message
+    # by default it takes an impulse and runs on (its post-jam slip, 0.333 the well-posed
+    # way, is not the other schemes' stick: an open finding)
+    r = simulate(sc, (0.0, 0.1), q0, v0, NAME, h=1e-3)
+    assert r.status == 0 and r.t[-1] == pytest.approx(0.1)
 
 
 @pytest.mark.parametrize("scene_name", ["friction-drive", "sliding-box"])
