@@ -217,12 +217,22 @@ class RockingBlock(SIUnits, Scene):
         return np.array([rx, ry, th]), np.array([-w * ry, w * rx, w])
 
     # -- valid region -------------------------------------------------------------------
-    def in_valid_region(self, q):
-        """Whether ``q`` is inside the model's valid region ``|theta| < pi/2``."""
-        q = finite_array("q", q, shape=(3,))
-        return abs(float(q[2])) < 0.5 * math.pi
+    #: where the model holds: the top corners, not modelled as contacts, stay above the floor
+    valid_region = "|theta| < pi/2"
+    #: a run to rest: the Zeno time of the default release is 3.09
+    default_window = 4.0
 
-    valid_region = "|theta| < pi/2 (the top corners, not modelled as contacts, stay above the floor)"
+    def inside_valid_region(self, t, q, v):
+        """Whether each state (a row of ``q``) lies in the valid region ``|theta| < pi/2``.
+
+        Examples
+        --------
+        >>> RockingBlock().inside_valid_region(np.zeros(2), np.array([[0, 1, 0.3], [0, 0, 2.0]]),
+        ...                                    np.zeros((2, 3))).tolist()
+        [True, False]
+        """
+        q = np.asarray(q, dtype=float).reshape(-1, 3)
+        return np.abs(q[:, 2]) < 0.5 * math.pi
 
     # -- closed forms ----------------------------------------------------------------------
     @property
