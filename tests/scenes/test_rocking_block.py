@@ -117,3 +117,21 @@ def test_event_driven_settles_at_the_zeno_time(block):
     assert np.max(np.abs(ratios - R)) <= 1e-12
     assert abs(res.q[-1, 2]) <= 1e-14 and np.max(np.abs(res.v[-1])) <= 1e-14
     assert res.regime_letters(0)[-1] == res.regime_letters(1)[-1] == "S"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("lcp_method", ["auto", "lemke"])
+@pytest.mark.parametrize("theta", [1.0, 0.5])
+def test_moreau_jean_converges_to_housners_ratio_at_first_order(block, theta, lcp_method):
+    # the runs the schemes used to stop: theta = 1/2 at its first impacts, h = 1e-5 and
+    # 1e-6 at the settling (t = 3.08)
+    q0, v0 = block.initial_state()
+    errors = []
+    for h in (1e-4, 1e-5, 1e-6):
+        res = simulate(block, (0.0, 4.0), q0, v0, "moreau-jean", h=h, theta=theta,
+                       lcp_method=lcp_method)
+        assert res.status == 0 and abs(res.q[-1, 2]) <= 1e-6
+        k = _impacts(res)[:3]
+        errors.append(np.max(np.abs(res.v[k, 2] / res.v[k - 1, 2] - R)))
+    rates = np.log10(np.array(errors[:-1]) / np.array(errors[1:]))
+    assert np.all((rates > 0.9) & (rates < 1.1))
