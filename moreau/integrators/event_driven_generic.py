@@ -169,7 +169,10 @@ class ContactModeSolver:
         rhs = -(H @ Mih + wbar)
         try:
             lam = np.linalg.solve(A, rhs)
-            singular = not np.all(np.isfinite(lam)) or np.linalg.cond(A) > 1e12
+            # redundant rows need three (two contacts, one sticking) or more than the
+            # dof; the condition number (an SVD) is only paid there
+            singular = not np.all(np.isfinite(lam)) or (
+                A.shape[0] >= 3 and (A.shape[0] > self.ndof or np.linalg.cond(A) > 1e12))
         except np.linalg.LinAlgError:
             singular = True
         if singular:
