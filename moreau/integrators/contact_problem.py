@@ -19,7 +19,7 @@ import math
 import numpy as np
 
 from ..errors import InputError, LCPError, PainleveError
-from ..lcp import lcp_residual, lcp_violation, solve_lcp
+from ..lcp import MAX_ITER, lcp_residual, lcp_violation, solve_lcp
 from ..lcp.lemke import DEFAULT_TOL
 from ..lcp.friction import build_friction_lcp, friction_impulses
 from . import _mj_kernels as _kernels
@@ -252,7 +252,8 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     if r.fallback_used:
         c["fallbacks"] += 1
     z = r.z if r.success else None
-    if z is None and na <= MAX_PIECES_CONTACTS:
+    # (a pivot limit the caller set, `lemke_max_iter`, is kept: its failure is the answer)
+    if z is None and r.status != MAX_ITER and na <= MAX_PIECES_CONTACTS:
         # a frictional contact problem has a solution (one_contact_impulse's Notes: the
         # matrix is copositive, and with W = J M^-1 J^T, no rheonomic term and e = 0
         # Lemke's condition holds), so a float Lemke that ends on a ray has met rounding

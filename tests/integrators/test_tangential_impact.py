@@ -155,16 +155,24 @@ def test_compliant_schemes_note_the_paradoxical_configuration(scheme):
     assert res.status == 0 and "painleve_paradox_times" not in res.stats
 
 
-def test_a_failed_lemke_is_followed_by_the_certified_enumeration():
-    # the block flat on two corners (W singular), Lemke cut at one pivot: the contact
-    # problem is still solved, by the enumeration of the pieces, and certified
-    from moreau.integrators.contact_problem import new_contact_counters, solve_contact_problem
+def test_a_secondary_ray_is_followed_by_the_certified_enumeration(monkeypatch):
+    # the block flat on two corners (W singular), Lemke ending on a secondary ray (as a
+    # float Lemke did on it, issue 33): the contact problem is still solved, by the
+    # enumeration of the pieces, and certified
+    import moreau.integrators.contact_problem as cp
+    from moreau.lcp import SECONDARY_RAY, LCPResult
+
+    def ray(M, q, **kw):
+        r = solve_lcp(M, q, method="lemke", max_iter=1)
+        return LCPResult(r.z, r.w, SECONDARY_RAY, r.pivots, r.residual, "lemke")
+
+    monkeypatch.setattr(cp, "solve_lcp", ray)
     J = np.array([[0.0, 1.0, -0.5], [0.0, 1.0, 0.5], [1.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
     W = J @ np.diag([1.0, 1.0, 2.4]) @ J.T
-    c = new_contact_counters()
-    p, pN, pT = solve_contact_problem(W, np.array([-0.1, -0.1, 0.0, 0.0]), np.array([10.0, 10.0]),
-                                      np.zeros(2), np.zeros(2), lcp_method="lemke",
-                                      lemke_max_iter=1, counters=c)
+    c = cp.new_contact_counters()
+    p, pN, pT = cp.solve_contact_problem(W, np.array([-0.1, -0.1, 0.0, 0.0]),
+                                         np.array([10.0, 10.0]), np.zeros(2), np.zeros(2),
+                                         lcp_method="lemke", counters=c)
     assert c["piece_enumerations"] == 1 and c["max_residual"] <= 1e-12
     U = np.array([-0.1, -0.1, 0.0, 0.0]) + W @ p
     assert np.max(np.abs(U)) <= 1e-14 and pN.sum() == pytest.approx(0.1)
