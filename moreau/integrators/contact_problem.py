@@ -15,8 +15,10 @@ friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`) through
 """
 
 import math
+from itertools import product
 
 import numpy as np
+from scipy.optimize import linprog
 
 from ..errors import InputError, LCPError, PainleveError
 from ..lcp import MAX_ITER, lcp_residual, lcp_violation, solve_lcp
@@ -308,8 +310,6 @@ def friction_pieces(W, U_free, mu, e, vN_pre, Ml=None, ql=None, layout=None):
     >>> bool(lcp_violation(Ml, ql, z) <= DEFAULT_TOL)
     True
     """
-    from itertools import product
-
     W = np.asarray(W, dtype=float)
     U = np.asarray(U_free, dtype=float)
     mu = np.asarray(mu, dtype=float)
@@ -388,7 +388,6 @@ def _piece_point(E, f, G, g, scale):
         p = np.linalg.solve(E, f)
         tol = 1e-9 * (scale * float(np.max(np.abs(p), initial=0.0)) + float(np.max(np.abs(f), initial=0.0)) + 1e-300)
         return p if np.all(G @ p <= g + tol) else None
-    from scipy.optimize import linprog
     res = linprog(np.zeros(E.shape[1]), A_ub=G, b_ub=g, A_eq=E, b_eq=f,
                   bounds=[(None, None)] * E.shape[1], method="highs")
     if res.status != 0:

@@ -15,9 +15,12 @@ from hypothesis import strategies as st
 
 from moreau.errors import InputError
 from moreau.integrators import simulate
-from moreau.integrators.contact_problem import (one_contact_impulse, one_contact_residual,
-                                                tangential_impact)
-from moreau.lcp import build_friction_lcp, friction_impulses, solve_lcp
+import moreau.integrators.contact_problem as cp
+from moreau.integrators.contact_problem import (friction_pieces, one_contact_impulse,
+                                                one_contact_residual, tangential_impact)
+from moreau.lcp import (SECONDARY_RAY, LCPResult, build_friction_lcp, friction_impulses,
+                        lcp_violation, solve_lcp)
+from moreau.lcp.lemke import DEFAULT_TOL
 from moreau.scenes.painleve_rod import PainleveRod
 
 PHI_STAR = math.atan(2.0)
@@ -129,9 +132,6 @@ def test_the_piece_enumeration_solves_every_frictional_problem(entries, mu, v):
     # two frictional contacts on three dof (W = J M^-1 J^T singular, as a block on two
     # corners), e = 0, no rheonomic term: a solution exists; the enumeration finds it
     # and certifies it on the friction LCP (what Lemke's answer must pass)
-    from moreau.integrators.contact_problem import friction_pieces
-    from moreau.lcp import lcp_violation
-    from moreau.lcp.lemke import DEFAULT_TOL
     J = np.array(entries).reshape(4, 3)
     J[0, 1] = J[1, 1] = 1.0             # normal rows that can push
     Minv = np.diag([1.0, 1.0, 3.0])
@@ -159,8 +159,6 @@ def test_a_secondary_ray_is_followed_by_the_certified_enumeration(monkeypatch):
     # the block flat on two corners (W singular), Lemke ending on a secondary ray (as a
     # float Lemke did on it, issue 33): the contact problem is still solved, by the
     # enumeration of the pieces, and certified
-    import moreau.integrators.contact_problem as cp
-    from moreau.lcp import SECONDARY_RAY, LCPResult
 
     def ray(M, q, **kw):
         r = solve_lcp(M, q, method="lemke", max_iter=1)
