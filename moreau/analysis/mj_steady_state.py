@@ -48,6 +48,7 @@ import numpy as np
 from .._validate import finite_array, in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
 from .modes import impacts_after_flight, mode_name, step_letters
+from ..integrators.contact_problem import check_painleve
 from ..integrators.moreau_jean import LCP_METHODS, MoreauJean
 from ..integrators.result import SteadyState
 from .floquet import period_map_jacobian, sorted_multipliers
@@ -165,6 +166,8 @@ class PeriodMap:
     fast : bool or "auto"
     lcp_method : {"auto", "lemke", "qp"}
         Passed to :class:`~moreau.integrators.moreau_jean.MoreauJean`.
+    painleve : {"impulse", "stop"}
+        Passed to :class:`~moreau.integrators.moreau_jean.MoreauJean`.
 
     Raises
     ------
@@ -181,7 +184,8 @@ class PeriodMap:
     """
 
     def __init__(self, scene, steps_per_period, theta=1.0, projection=True, fast="auto",
-                 lcp_method="auto"):
+                 lcp_method="auto", painleve="impulse"):
+        self.painleve = check_painleve(painleve)
         period = getattr(scene, "period", None)
         if period is None:
             raise InputError(f"`scene` ({type(scene).__name__}) has no periodic drive "
@@ -254,7 +258,7 @@ class PeriodMap:
         c0 = np.broadcast_to(np.asarray(closed, dtype=bool), (nc,)).copy()
         integ = MoreauJean(self.scene, 0.0, q, v, self.period, h=self.h, theta=self.theta,
                            projection=self.projection, fast=self.fast, closed0=c0,
-                           lcp_method=self.lcp_method,
+                           lcp_method=self.lcp_method, painleve=self.painleve,
                            save_every=1 if record else self.n)
         while integ.status == "running":
             integ.step()
@@ -292,7 +296,7 @@ MAX_STEPS_PER_PERIOD = 10**7
 
 def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_iter=50,
                              projection=True, x_guess=None, fast="auto", transient_periods=300,
-                             lcp_method="auto"):
+                             lcp_method="auto", painleve="impulse"):
     """Periodic steady state of the Moreau–Jean map of a periodic scene, by shooting.
 
     Parameters
@@ -318,6 +322,9 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
         Initial ``x`` at ``t = 0``; by default the scene's ``initial_state()``.
     fast : {"auto", True, False}
         Use the compiled loop (every scene with a compiled model).
+    painleve : {"impulse", "stop"}
+        Moreau–Jean's option: take a tangential impact, or stop there (a
+        study of Painlevé configurations, the stress catalogue's).
     lcp_method : {"auto", "lemke", "qp"}
         The contact solver of every step (Moreau–Jean's option); ``"qp"``
         takes the generic Python step. The fixed point is that of this
@@ -378,9 +385,10 @@ def moreau_jean_steady_state(scene, steps_per_period, theta=1.0, tol=1e-12, max_
     tol = positive("tol", tol)
     max_iter = positive_int("max_iter", max_iter)
     transient_periods = positive_int("transient_periods", transient_periods)
-    pm = PeriodMap(scene, steps_per_period, theta, projection, fast, lcp_method)
+    pm = PeriodMap(scene, steps_per_period, theta, projection, fast, lcp_method, painleve)
     if lcp_method == "qp":
-        pm.derivative_map = PeriodMap(scene, steps_per_period, theta, projection, fast, "auto")
+        pm.derivative_map = PeriodMap(scene, steps_per_period, theta, projection, fast, "auto",
+                                      painleve)
     vs = float(getattr(scene, "velocity_scale", 1.0))
     nk = len(pm.kept)
     scale = np.concatenate([np.ones(nk), np.full(scene.ndof, vs)])

@@ -103,8 +103,10 @@ def new_stats():
 
 @njit(cache=True)
 def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
-    # returns (pN, pT, ok); ok = False when the discrete Painlevé condition
-    # fails and the problem has no solution or several (see moreau_jean.py)
+    # returns (pN, pT, ok); ok = False only where W is not positive definite and
+    # the problem has no solution or several (see contact_problem.one_contact_impulse:
+    # with W_NN W_TT > W_NT^2 and the contact pressing, the solution is unique and
+    # may be the tangential impact, a stick that the sliding piece cannot give)
     b = uN + e * min(vN_pre, 0.0)
     if b >= 0.0:
         return 0.0, 0.0, True
@@ -130,10 +132,14 @@ def _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu, e, vN_pre):
 @njit(cache=True)
 def _one_contact_cases(Wnn, Wnt, Wtn, Wtt, uT, mu, b, det):
     # _one_contact where Wnn - mu |Wnt| <= 0 (the discrete Painlevé condition fails):
-    # every case that holds, which must agree. A call of its own, so that the common
-    # cases are small where a loop inlines them (SPECIALISED)
-    if (uT > 0.0 and Wnn - mu * Wnt <= 0.0) or (uT < 0.0 and Wnn + mu * Wnt <= 0.0):
-        return 0.0, 0.0, False
+    # every case that holds, which must agree. With b < 0 and det > 0 exactly one
+    # holds: along pN the normal velocity falls only on the first slip piece (the
+    # paradoxical one, from b < 0, so no root there) and rises on the stick piece
+    # after it, whose slope det / Wtt > 0 never ends (a slip piece beyond it would
+    # need |Wnt| > mu Wtt, hence Wnn > Wnt^2 / Wtt > mu |Wnt|). Where the free slip
+    # runs the paradoxical way the answer is therefore the stick: the tangential
+    # impact. A call of its own, so that the common cases are small where a loop
+    # inlines them (SPECIALISED)
     nfound = 0
     fN = 0.0
     fT = 0.0
@@ -170,6 +176,16 @@ def _one_contact_cases(Wnn, Wnt, Wtn, Wtt, uT, mu, b, det):
     if nfound == 0:
         ok = False
     return fN, fT, ok
+
+
+@njit(cache=True)
+def _jam(Wnn, Wnt, mu, uN, e, vN_pre, s):
+    # a tangential impact: the contact slid the way s (+1: positive slip, -1: negative)
+    # in the step before, it presses (b < 0), and its sliding piece that way has a
+    # non-increasing normal velocity (W_NN - mu s W_NT <= 0): sliding on has no
+    # solution, and the step's answer is the impulsive stick
+    b = uN + e * min(vN_pre, 0.0)
+    return s != 0.0 and mu > 0.0 and b < 0.0 and Wnn - mu * s * Wnt <= 0.0
 
 
 @njit(cache=True)
@@ -413,21 +429,55 @@ def new_lcp_control(nc, force_lemke=False, warm_start=True, max_iter=0):
     """Options and warm-start memory of the loop's contact problems, one int64 array.
 
     Layout: ``[force_lemke, warm_start, max_iter, L, na, ia (max(nc, 1)
-    slots), support flags (4 max(nc, 1) slots)]``. The first three are the
-    options (see :func:`mj_run`); the rest is the warm start's memory, the
-    last contact LCP solved in the loop (``L = -1``: none), which the caller
-    keeps from one call of :func:`mj_run` to the next. (One array rather than
-    separate arguments: the loop already takes the thirty arguments beyond
-    which CPython passes a call's arguments as a tuple, which numba cannot
-    inline.)
+    slots), support flags (4 max(nc, 1) slots), regimes (max(nc, 1)
+    slots), painleve_stop]``. The first three are the options (see
+    :func:`mj_run`), the last one another (hand every one-contact step whose
+    free slip runs into a Painlevé configuration to the generic step, which
+    stops there: ``painleve="stop"``, :func:`set_painleve_stop`); then
+    the warm start's memory, the last contact LCP solved in the loop (``L =
+    -1``: none), and the regime of each contact in the last step taken
+    (:func:`prev_regimes`: a tangential impact is a step that stops a
+    slip), which the caller keeps from one call of :func:`mj_run` to the
+    next. (One array rather than separate arguments: the loop already takes
+    the thirty arguments beyond which CPython passes a call's arguments as a
+    tuple, which numba cannot inline.)
     """
     ncm = max(nc, 1)
-    ctl = np.zeros(CTL_IA + 5 * ncm, dtype=np.int64)
+    ctl = np.zeros(CTL_IA + 6 * ncm + 1, dtype=np.int64)
     ctl[CTL_FORCE] = bool(force_lemke)
     ctl[CTL_WARM] = bool(warm_start)
     ctl[CTL_MAXIT] = int(max_iter)
     ctl[CTL_L] = -1
     return ctl
+
+
+def set_painleve_stop(ctl, nc, stop):
+    """Set the ``painleve_stop`` option of ``ctl`` (:func:`new_lcp_control`), its last entry."""
+    ctl[CTL_IA + 6 * max(nc, 1)] = bool(stop)
+
+
+@njit(cache=True)
+def _stop_at(ctl, Wnn, Wnt, mu, uN, uT, e, vN_pre):
+    # painleve="stop" (the last entry of ctl): the pressed contact's free slip, of any size,
+    # runs into a sliding piece without solution; the generic step stops there
+    return (ctl[ctl.shape[0] - 1] != 0 and uT != 0.0
+            and _jam(Wnn, Wnt, mu, uN, e, vN_pre, math.copysign(1.0, uT)))
+
+
+def prev_regimes(ctl, nc):
+    """The view of ``ctl`` (:func:`new_lcp_control`) holding each contact's regime in the last step."""
+    ncm = max(nc, 1)
+    return ctl[CTL_IA + 5 * ncm:CTL_IA + 5 * ncm + nc]
+
+
+@njit(cache=True)
+def _slip_sign(regime):
+    # +1 for positive slip, -1 for negative, 0 otherwise (Regime codes)
+    if regime == 1:
+        return 1.0
+    if regime == 2:
+        return -1.0
+    return 0.0
 
 
 @njit(cache=True)
@@ -895,6 +945,10 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     # start's subsystem
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
 
+    # the regime of each contact in the step before (a tangential impact stops a slip)
+    roff = CTL_IA + 5 * ncm
+    for i in range(nc):
+        reg[i] = lcp_ctl[roff + i]
     constant_W = const_mass and not has_jac
     have_Wi = False
     have_Mi = False
@@ -1019,7 +1073,11 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                     Wtt += G1[i, 3 + n + j] * WiHT[j, 1]
                     uT += G1[i, 3 + n + j] * vf[j]
                 pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
-                if not ok:
+                # a tangential impact is taken by the generic step, which records it (or
+                # stops there with painleve="stop"); it is rare, the test is not
+                if not ok or (reg[i] != 0 and reg[i] != 3
+                              and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
+                        or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
                     status = PAINLEVE
                     break
                 rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
@@ -1108,6 +1166,15 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
                                                 lcp_ctl, Ab, xb, idx, pcol, not regimes)
                 if lst != 0:
                     status = LCP_HANDBACK
+                    break
+                if na == 1 and nfa == 1 and (
+                        (reg[ia[0]] != 0 and reg[ia[0]] != 3
+                         and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
+                                  _slip_sign(reg[ia[0]])))
+                        or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
+                                    e[ia[0]], vN0[ia[0]])):
+                    # one contact by Lemke (lcp_method="lemke"): a tangential impact, as above
+                    status = PAINLEVE
                     break
                 stats[S_PIVOTS] += piv
                 stats[S_LCP] += 1.0
@@ -1251,6 +1318,8 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
             nrec += 1
         if last:
             break
+    for i in range(nc):
+        lcp_ctl[roff + i] = reg[i]
     return status, k, nrec
 
 

@@ -19,7 +19,7 @@ import numpy as np
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual,
+                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
@@ -224,6 +224,8 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                     if nfb == 1:
                         ln, lt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
                                                   Uf[1], mu[i], 0.0, 0.0)
+                        ok = ok and not _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
+                                                 0.0, 0.0)
                         lam[1] = lt
                     else:
                         ln, lt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, 0.0,
@@ -352,7 +354,8 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
                     if nfa == 1:
                         pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
                                                   Uf[1], mu[i], e[i], vN0[i])
-                        if not ok:
+                        if not ok or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
+                                              e[i], vN0[i]):
                             status = PAINLEVE
                             break
                         res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],

@@ -16,7 +16,7 @@ import numpy as np
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual,
+                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
@@ -188,7 +188,7 @@ def sp_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, vv, vf, closed, save_eve
                     Wtt += G1[i, 3 + n + j] * MiHT[j, 1]
                     uT += G1[i, 3 + n + j] * up[j]
                 pn, pt, ok = _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], 0.0, 0.0)
-                if not ok:
+                if not ok or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, 0.0, 0.0):
                     status = PAINLEVE
                     break
                 res = _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], 0.0, 0.0, pn, pt)

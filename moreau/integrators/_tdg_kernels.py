@@ -18,7 +18,7 @@ from numba import njit
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _classify, _invert_gj,
-                          _invert_small, _lcp_size, _lcp_step, _one_contact, _residual,
+                          _invert_small, _lcp_size, _lcp_step, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
 
 __all__ = ["tdg_loop"]
@@ -69,7 +69,7 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
         if nfa == 1:
             pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], U[0], U[1], mu[i],
                                       e[0], vpre[0])
-            if not ok:
+            if not ok or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], U[0], U[1], e[0], vpre[0]):
                 return PAINLEVE
             res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], U[0], U[1], mu[i], e[0],
                             vpre[0], pn, pt)

@@ -326,6 +326,39 @@ class _Compliant(Integrator):
                 self._record_state(ode.t, y)
         self.t = self.t_bound if ode.status == "finished" else ode.t
         self.q, self.v = y[:self._n].copy(), y[self._n:].copy()
+        self._note_paradox(ode.t, self.q, self.v)
+
+    def _note_paradox(self, t, q, v):
+        # a loaded contact sliding where the rigid model's normal-force coefficient
+        # WN M^-1 (WN - mu s WT)^T is not positive: a Painlevé configuration, which the
+        # compliant contact crosses by its stiffness; the result says so
+        if not len(self.fr):
+            return
+        fN, _, slip, _, rows = self._contact_forces(q, v, t)
+        live = [i for i in self.fr if fN[i] > 0.0 and abs(slip[i]) > 10.0 * self.eps]
+        if not live:
+            self._in_paradox = False
+            return
+        WN, WT = rows
+        Minv = np.linalg.inv(np.asarray(self.scene.mass(q), float))
+        row = {int(i): k for k, i in enumerate(self.fr)}
+        bad = [i for i in live if WN[i] @ Minv @ (WN[i] - self.mu[i] * np.sign(slip[i])
+                                                  * WT[row[int(i)]]) <= 0.0]
+        if bad and not getattr(self, "_in_paradox", False):
+            self.counters.setdefault("painleve_paradox_times", []).append(float(t))
+        self._in_paradox = bool(bad)
+
+    def result(self):
+        """The run's :class:`SimulationResult`; its message notes a Painlevé configuration met."""
+        res = super().result()
+        times = self.counters.get("painleve_paradox_times")
+        if times:
+            res.message += (f" A loaded contact slid in a Painlevé configuration (the rigid "
+                            f"contact's normal-force coefficient WN M^-1 (WN - mu s WT)^T <= 0) "
+                            f"from t = {times[0]:.6g} ({len(times)} time(s), "
+                            f"stats['painleve_paradox_times']): the compliant contact resolves "
+                            f"it by its stiffness, where the rigid sliding contact has no solution or two.")
+        return res
 
 
 @register_integrator("compliant-radau")

@@ -91,6 +91,7 @@ from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
 from ..regimes import Regime
 from .base import Integrator, get_integrator, register_integrator
+from .contact_problem import MAX_PIECES_CONTACTS, friction_pieces
 from .result import Event
 
 __all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference",
@@ -179,13 +180,17 @@ class ContactModeSolver:
         X = np.linalg.solve(M, np.column_stack([h, G.T]))
         Mih, MiG = X[:, 0], X[:, 1:]
         A = H @ MiG
+        rhs = -(H @ Mih + wbar)
         try:
-            lam = np.linalg.solve(A, -(H @ Mih + wbar))
+            lam = np.linalg.solve(A, rhs)
+            # redundant rows need three (two contacts, one sticking) or more than the
+            # dof; the condition number (an SVD) is only paid there
+            singular = not np.all(np.isfinite(lam)) or (
+                A.shape[0] >= 3 and (A.shape[0] > self.ndof or np.linalg.cond(A) > 1e12))
         except np.linalg.LinAlgError:
-            raise PainleveError(
-                f"the contact problem of mode {self.letters(mode)} is singular at t = {t:.12g}: "
-                "the normal forces are not determined (Painlevé configuration or "
-                "redundant contacts)") from None
+            singular = True
+        if singular:
+            lam = self._redundant(mode, A, rhs, H, G, t)
         a = Mih + MiG @ lam
         nclosed = len(closed)
         lamN[closed] = lam[:nclosed]
@@ -195,6 +200,22 @@ class ContactModeSolver:
         for k, i in enumerate(stick):
             lamT[i] = lam[nclosed + k]
         return a, lamN, lamT, A, closed, kin
+
+    def _redundant(self, mode, A, rhs, H, G, t):
+        # Redundant contacts without sliding (a block resting flat on two sticking
+        # corners: 4 rows, 3 dof): H = G, A = H M^-1 H^T is positive semidefinite and
+        # the accelerations are the unique projection, whatever split of the forces
+        # solves A lam = rhs; the minimum-norm split is taken. With a sliding contact
+        # (G != H) a singular A is a Painlevé configuration.
+        sliding = np.any(np.isin(mode, (_P, _N)) & (self.mu > 0.0))
+        if not sliding:
+            lam = np.linalg.lstsq(A, rhs, rcond=1e-12)[0]
+            if np.max(np.abs(A @ lam - rhs)) <= 1e-9 * max(float(np.max(np.abs(rhs))), 1e-300) + 1e-14:
+                return lam
+        raise PainleveError(
+            f"the contact problem of mode {self.letters(mode)} is singular at t = {t:.12g}: "
+            "the normal forces are not determined (Painlevé configuration or "
+            "redundant contacts)")
 
     @staticmethod
     def letters(mode):
@@ -530,7 +551,9 @@ class GenericEventDriven(Integrator):
         H = np.vstack([WN[closed]] + ([WT[self.ms.trow[stick]]] if stick else []))
         w = np.concatenate([wN[closed]] + ([wT[self.ms.trow[stick]]] if stick else []))
         MiH = np.linalg.solve(sc.mass(q), H.T)
-        lam = -np.linalg.solve(H @ MiH, H @ v + w)
+        # lstsq: redundant closed contacts (a block flat on two corners) make H M^-1 H^T
+        # singular; the projected velocity is unique all the same
+        lam = -np.linalg.lstsq(H @ MiH, H @ v + w, rcond=1e-12)[0]
         v_post = v + MiH @ lam
         if self.jumps is not None:
             pN, pT = np.zeros(self.ms.nc), np.zeros(self.ms.nc)
@@ -562,13 +585,20 @@ class GenericEventDriven(Integrator):
             lcp = build_friction_lcp(W, vrel, mu, e, vN_pre)
             res = solve_lcp(lcp.M, lcp.q, self.lcp_method)
             self.counters["lcp_solves"] += 1
-            if not res.success:
+            z = res.z if res.success else None
+            if z is None and len(touching) <= MAX_PIECES_CONTACTS:
+                # the velocity-level problem has a solution (contact_problem.solve_contact_problem)
+                z = friction_pieces(W, vrel, mu, e, vN_pre, *lcp)
+                if z is not None:
+                    self.counters["piece_enumerations"] = self.counters.get(
+                        "piece_enumerations", 0) + 1
+            if z is None:
                 if np.any(mu > 0):
                     raise PainleveError(
                         f"the frictional impact problem at t = {t:.12g} has no solution "
                         f"(Lemke: {res.message}); a Painlevé-type impact configuration")
                 raise LCPError(f"impact LCP at t = {t:.12g} not solved: {res.message}")
-            p = friction_impulses(res.z, lcp.layout, stacked=True)
+            p = friction_impulses(z, lcp.layout, stacked=True)
             vN_post = (vrel + W @ p)[:len(touching)]
             # Zeno policy: a rebound far below the contact's approach speeds is
             # the accumulation point of a bounce sequence; close the contact
@@ -587,12 +617,62 @@ class GenericEventDriven(Integrator):
                               f"`max_step`={self.max_step:g} of time before t = {t:.12g} (an "
                               "accumulation the Zeno policy did not end?)")
         v_post = v + MiJ @ p
+        v_post, p = self._close_accumulation(t, touching, fr, J, w, MiJ, W, vrel, v, v_post, p)
         if self.jumps is not None:
             pN, pT = np.zeros(ms.nc), np.zeros(ms.nc)
             pN[touching] = p[:len(touching)]
             pT[fr] = p[len(touching):]
             self.jumps.append((t, q.copy(), v.copy(), v_post.copy(), pN, pT, "impact"))
         return v_post
+
+    def _close_accumulation(self, t, touching, fr, J, w, MiJ, W, vrel, v, v_post, p):
+        """The accumulation point of impacts on several contacts (a rocking block settling).
+
+        After a plastic impact on one contact another touching one may leave
+        at a speed far below the approach speeds seen there (the rocking
+        block's pivot corner, lifted by the other corner's impact at ``2 a
+        |w'|``): the next impact comes back within a time of the same order,
+        and the series accumulates, as a bouncing ball's does. Where a
+        touching contact leaves at or below ``zeno_rtol`` times its largest
+        approach speed, the accumulation point is taken: the velocity is
+        projected, in the metric of ``M``, onto every touching contact closed
+        (normal velocity 0) and the frictional ones whose slip is as small
+        sticking, and the contacts close. The projection removes velocities of
+        the size of that weak lift-off; where it would change a contact
+        velocity by more (the outcome depends on more than the accumulation),
+        the run stops naming the contacts.
+        """
+        n_t = len(touching)
+        U = vrel + W @ p
+        vN = U[:n_t]
+        appr = self._approach[touching]
+        # a lift-off below the velocity tolerance is a closed contact already (_decide)
+        weak = (vN > self._vtol()) & (vN <= self.zeno_rtol * appr)
+        if not weak.any():
+            return v_post, p
+        small = float(np.max(vN[weak]))
+        # contacts that leave at more than the Zeno bound are left free
+        strong = (vN > self._vtol()) & ~weak
+        rows = [k for k in range(n_t) if not strong[k]]
+        rows += [n_t + k for k, i in enumerate(fr)
+                 if not strong[list(touching).index(i)]
+                 and abs(U[n_t + k]) <= max(self._vtol(), self.zeno_rtol * self._approach[i])]
+        Jr = J[rows]
+        lam = -np.linalg.lstsq(W[np.ix_(rows, rows)], U[rows], rcond=1e-12)[0]
+        v_closed = v_post + MiJ[:, rows] @ lam
+        change = np.abs(J @ (v_closed - v_post))
+        if np.max(change) > 10.0 * small + self._vtol():
+            names = [int(touching[k]) for k in np.flatnonzero(weak)]
+            raise MoreauError(
+                f"an accumulation of impacts at t = {t:.12g} whose outcome this scheme cannot "
+                f"decide: contacts {names} leave at {small:.3g}, below `zeno_rtol` times their "
+                f"approach speeds, but closing the touching contacts {list(map(int, touching))} "
+                f"would change a contact velocity by {np.max(change):.3g}")
+        p = p.copy()
+        p[rows] += lam
+        self.counters["zeno_closures"] = self.counters.get("zeno_closures", 0) + int(weak.sum())
+        self.counters.setdefault("accumulation_times", []).append(float(t))
+        return v_closed, p
 
     # -- mode decision ------------------------------------------------------------------
     def _decide(self, t, q, v, forced):
@@ -640,6 +720,16 @@ class GenericEventDriven(Integrator):
         X = np.linalg.solve(M, np.column_stack([h, G.T]))
         A = H @ X[:, 1:]
         b = H @ X[:, 0] + wbar
+        for k, i in enumerate(cand):
+            if i in sign and i not in forced and A[k, k] <= 0.0 and b[k] < 0.0:
+                raise PainleveError(
+                    f"Painlevé configuration at t = {t:.12g}: contact {i} slides "
+                    f"({'P' if sign[i] > 0 else 'N'}) with the normal-force coefficient "
+                    f"WN M^-1 (WN - mu s WT)^T = {A[k, k]:.6g} <= 0 (mu = {ms.mu[i]:.6g}) while "
+                    f"the free motion presses it (normal acceleration {b[k]:.6g} < 0): sliding "
+                    "has no solution. The state needs an impulse, the tangential impact "
+                    "(dynamic jamming), which this event-driven scheme does not take; the "
+                    "time-stepping schemes take it")
         mu_eff = np.array([ms.mu[i] if i in cone else 0.0 for i in cand])
         lcp = build_friction_lcp(A, b, mu_eff, 0.0, np.zeros(nC))
         res = solve_lcp(lcp.M, lcp.q, self.lcp_method)

@@ -141,8 +141,9 @@ from ..errors import InputError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
 from ._blocks import CompiledRecording
-from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
-from ._mj_kernels import mj_loop
+from .contact_problem import (check_painleve, one_contact_impulse, one_contact_residual,
+                              sliding_regimes, solve_contact_problem)
+from ._mj_kernels import mj_loop, prev_regimes, set_painleve_stop
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
@@ -196,7 +197,7 @@ def classify_impulse(pN, pT, mu):
 def _new_counters():
     return {"steps": 0, "lcp_solves": 0, "direct_solves": 0, "pivots": 0, "fallbacks": 0,
             "max_residual": 0.0, "max_penetration": 0.0, "projection_iterations": 0,
-            "warm_starts": 0}
+            "warm_starts": 0, "tangential_impacts": 0, "tangential_impact_times": []}
 
 
 #: default bound on the steps of one run (about two minutes at 1e7 steps/s); `max_steps` raises it
@@ -344,6 +345,20 @@ class MoreauJean(CompiledRecording, Integrator):
         memory; see the module docstring). Default: none. Lets a run continue
         another one exactly (:class:`moreau.analysis.mj_steady_state.PeriodMap`);
         the final flags are :attr:`closed`.
+    painleve : {"impulse", "stop"}
+        What a step does at a tangential impact, a contact sliding into a
+        configuration where the discrete Painlevé condition fails the way it
+        slides (:func:`~moreau.integrators.contact_problem.tangential_impact`):
+        ``"impulse"`` (default) takes the step's unique solution, the
+        impulsive stick (dynamic jamming), and counts it in
+        ``stats["tangential_impacts"]`` with the step's start time in
+        ``stats["tangential_impact_times"]``; ``"stop"`` ends the run with
+        status ``-1`` (:class:`~moreau.errors.PainleveError`) at every step
+        whose pressed contact's free slip, of any size, runs into a sliding
+        piece without solution (a tangential impact, or a stick with a slip of
+        rounding size pointing that way: the behaviour before the tangential
+        impact was taken), for a study of Painlevé configurations. Detected
+        on steps with one active frictional contact.
 
     Notes
     -----
@@ -373,8 +388,10 @@ class MoreauJean(CompiledRecording, Integrator):
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
                  lcp_method="auto", save_every=1, fast="auto", closed0=None,
-                 lemke_max_iter=None, lcp_warm_start=True, max_steps=MAX_STEPS):
+                 lemke_max_iter=None, lcp_warm_start=True, max_steps=MAX_STEPS,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
+        self.painleve = check_painleve(painleve)
         self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
             h, theta, projection, lcp_method, save_every)
         check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
@@ -397,10 +414,16 @@ class MoreauJean(CompiledRecording, Integrator):
             self._closed[:] = c0.reshape(-1)
         self._k = 0
         self.counters = _new_counters()
+        # each contact's regime in the step before (the compiled path keeps it in its
+        # control array, see _regimes_before)
+        self._prev_reg = np.zeros(nc, dtype=np.int64)
         self._pending_initial = True
         self._choose_compiled(fast, compiled_model_of(scene), self.lcp_method,
                               self.lemke_max_iter,
                               warm_start=self.lcp_warm_start and self.lcp_method == "auto")
+        self._regimes_before()[:] = sliding_regimes(scene, self.q, self.v, self.t0)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, nc, self.painleve == "stop")
 
     @property
     def closed(self):
@@ -463,6 +486,7 @@ class MoreauJean(CompiledRecording, Integrator):
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
+        self._regimes_before()[:] = regime
         self._closed = closed
         self._k += 1
         self.t, self.q, self.v = t1, q1, v1
@@ -482,14 +506,26 @@ class MoreauJean(CompiledRecording, Integrator):
         self.q, self.v, self._closed = q, v, closed
         # Lemke failed on this step: the generic step solves it (QP fallback with
         # lcp_method="auto", an LCPError with "lemke"), then the loop resumes.
-        # Painlevé: the generic step meets the same case and raises with the full
-        # diagnosis (the state is the start of that step).
+        # A tangential impact (or a Painlevé case on a singular Delassus matrix): the
+        # generic step takes it and records it, or raises with the full diagnosis (the
+        # state is the start of that step).
         self._after_block(
             status,
             singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
                       "t = {t!r}; reduce `h` or use a smaller `theta`"),
             numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
                        "too large for an explicit part of the forces)"))
+
+    def _regimes_before(self):
+        # the regimes of the last step taken, generic or compiled (a view, written in place)
+        if self._fast:
+            return prev_regimes(self._lcp_ctl, self.scene.ncontacts)
+        return self._prev_reg
+
+    def _slip_before(self, ia):
+        reg = self._regimes_before()[ia]
+        return np.where(reg == int(Regime.POSITIVE), 1.0,
+                        np.where(reg == int(Regime.NEGATIVE), -1.0, 0.0))
 
     def _contact_step(self, q, t1, v_free, Winv, active, vN0, pN, pT):
         sc = self.scene
@@ -506,7 +542,9 @@ class MoreauJean(CompiledRecording, Integrator):
         na = len(ia)
         if na == 1 and self.lcp_method == "auto":
             p, pN[ia], pT[ia] = solve_contact_problem(W, U_free, mu, e, vN0[ia],
-                                                      counters=self.counters, t=self.t)
+                                                      counters=self.counters, t=self.t,
+                                                      slip_before=self._slip_before(ia),
+                                                      painleve=self.painleve)
         else:
             p = self._solve_lcp(W, U_free, mu, e, vN0[ia], ia, pN, pT)
         v1 = v_free + Winv_HT @ p
@@ -519,7 +557,8 @@ class MoreauJean(CompiledRecording, Integrator):
         # the assembled LCP of several contacts (or of one, with a forced solver)
         p, pN[ia], pT[ia] = solve_contact_problem(
             W, U_free, mu, e, vN_pre, lcp_method=self.lcp_method, counters=self.counters,
-            lemke_max_iter=self.lemke_max_iter, t=self.t)
+            lemke_max_iter=self.lemke_max_iter, t=self.t, slip_before=self._slip_before(ia),
+            painleve=self.painleve)
         return p
 
     def _project(self, q, t, closed):

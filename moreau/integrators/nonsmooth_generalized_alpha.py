@@ -108,7 +108,9 @@ from ._blocks import CompiledRecording
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE
 from ._nsga_kernels import CONVERGENCE, nsga_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from ._mj_kernels import set_painleve_stop
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
                           check_work, classify_impulse, compiled_model_of, next_time)
 
@@ -170,6 +172,14 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         finish (Lemke fails, the Painlevé condition, the smooth Newton
         iteration) is taken by the generic step.
     max_steps : int
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact, counted in
+        ``stats["tangential_impacts"]`` on the generic step where the impulsive stage takes
+        it), or stop with status ``-1`` wherever the pressed contact's free slip, of any
+        size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Examples
     --------
@@ -196,7 +206,8 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                         (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
-                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS):
+                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h = check_step("nonsmooth-generalized-alpha", h)
         self.rho_inf = in_closed_interval("rho_inf", rho_inf, 0.0, 1.0)
@@ -224,7 +235,11 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         self._acc = acc0
         self._a = acc0.copy()
         self._coef = np.array([self.am, self.af, self.gamma, self.beta])
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _fast_block(self):
         q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()
@@ -269,10 +284,15 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                 # the contact velocities at v*(x + dx) are affine in the smooth forces
                 W = kv * (H @ JiHT)
                 U_free = H @ (vs + kv * dx) + np.concatenate([wN[ib], wT[tr]])
+                # Newton iterates: the check only stops (painleve="stop")
+                stop = self.painleve == "stop"
                 lam, ln, lt = solve_contact_problem(W, U_free, self.mu_c[ib], np.zeros(ib.size),
                                                     np.zeros(ib.size),
                                                     lcp_method=self.lcp_method,
-                                                    counters=self.counters, t=self.t)
+                                                    counters=self.counters, t=self.t,
+                                                    painleve=self.painleve,
+                                                    slip_before=(slip_signs(self._prev_reg[ib])
+                                                                 if stop else None))
                 dx = dx + JiHT @ lam
                 lamN[ib], lamT[ib] = ln, lt
                 slip[fb] = (U_free + W @ lam)[ib.size:]
@@ -343,7 +363,9 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
                 U_free = H @ vs + np.concatenate([wN[ia], wT[tr]])
                 p, pn, pt = solve_contact_problem(W, U_free, self.mu_c[ia], self.e_c[ia], vN0,
                                                   lcp_method=self.lcp_method,
-                                                  counters=self.counters, t=t0)
+                                                  counters=self.counters, t=t0,
+                                                  slip_before=slip_signs(self._prev_reg[ia]),
+                                                  painleve=self.painleve)
                 pN[ia], pT[ia] = pn, pt
                 v1 = vs + MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]
@@ -361,6 +383,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
         PN, PT = h * lamN + pN, h * lamT + pT
         regime = np.array([int(classify_impulse(PN[i], PT[i], self.mu_c[i]))
                            for i in range(nc)])
+        self._prev_reg = regime
         self._closed = (pN > 0.0) | (lamN > 0.0)
         self._k += 1
         fN, fT = PN / h, PT / h
@@ -410,6 +433,13 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
     Returns ``(acc, lamN)``, ``lamN`` the normal forces of every contact (zero
     on the others).
 
+    A sliding contact in a Painlevé configuration with no consistent force
+    (its normal-force coefficient ``WN M^-1 (WN - mu s WT)^T <= 0`` while the
+    free motion presses it) has no smooth start: the state needs an impulse,
+    the tangential impact. Such contacts get no smooth force here, and the
+    first step's impulsive stage takes the jam (the velocity-level problem,
+    which always has a solution).
+
     Examples
     --------
     A block sliding on level ground: the contact carries its weight and brakes it by mu = 0.3:
@@ -450,7 +480,18 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
     U_free = H @ np.linalg.solve(M, f) + np.concatenate([wNb[ib],
                                                          [wTb[trow[i]] for i in stick]])
     mu_eff = np.where(sliding, 0.0, mu[ib])
-    lam, ln, _ = solve_contact_problem(H @ MiGT, U_free, mu_eff, np.zeros(ib.size),
+    A = H @ MiGT
+    paradox = np.array([s and A[k, k] <= 0.0 for k, s in enumerate(sliding)], dtype=bool)
+    if paradox.any():
+        # the acceleration-level problem of a sliding contact whose normal-force
+        # coefficient is not positive has no solution or several: leave it to the
+        # impulsive stage (see the docstring), and solve for the others
+        keep = ~paradox
+        rows = np.concatenate([keep, np.ones(stick.size, dtype=bool)])
+        ib, A, U_free, G, mu_eff = ib[keep], A[np.ix_(rows, rows)], U_free[rows], G[rows], mu_eff[keep]
+        if ib.size == 0:
+            return np.linalg.solve(M, f), lamN
+    lam, ln, _ = solve_contact_problem(A, U_free, mu_eff, np.zeros(ib.size),
                                        np.zeros(ib.size), lcp_method=lcp_method,
                                        counters=counters, t=t)
     lamN[ib] = ln

@@ -113,7 +113,9 @@ from .._validate import positive_int
 from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._sp_kernels import sp_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from ._mj_kernels import set_painleve_stop
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
                           check_work, classify_impulse, compiled_model_of, next_time)
 
@@ -144,6 +146,13 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         problem Lemke cannot solve is taken by the generic step (QP fallback).
     max_steps : int
         Bound on the number of steps of the run.
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact, counted in
+        ``stats["tangential_impacts"]`` on the generic step), or stop with status ``-1``
+        wherever the pressed contact's free slip, of any size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Notes
     -----
@@ -178,7 +187,8 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
                         (100, 300, 1000), {})
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, lcp_method="auto",
-                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS):
+                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h = check_step("schatzman-paoli", h)
         self.lcp_method, self.lemke_max_iter = check_lcp_options(lcp_method, lemke_max_iter)
@@ -199,7 +209,11 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
         self._v_verlet = self.v.copy()
         self._v_force = self.v.copy()
         self._node = None
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _step_impl(self):
         if self._fast:
@@ -248,7 +262,10 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
                     W, U_free, self.mu_c[ia], np.zeros(ia.size), np.zeros(ia.size),
                     lcp_method=self.lcp_method,
                     counters=self.counters if count else new_contact_counters(),
-                    lemke_max_iter=self.lemke_max_iter, t=t)
+                    lemke_max_iter=self.lemke_max_iter, t=t,
+                    # a node solved again must not record its tangential impact twice
+                    slip_before=slip_signs(self._prev_reg[ia]) if count else None,
+                    painleve=self.painleve)
                 pN[ia], pT[ia] = pn, pt
                 dv_contact = MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]
@@ -284,6 +301,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
+        self._prev_reg = regime
         fN, fT = pN / h, pT / h
         if self._pending_initial:
             self._record(t0, q, self.v, regime, fN, fT, slip, g0)

@@ -115,7 +115,9 @@ from ._dense import Piece
 from ._studer_kernels import (DENSE_IMPACT, DENSE_SMOOTH, DENSE_SWITCH, NOT_FINITE,
                               STUDER_COUNTERS, TOO_MANY, studer_loop)
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from ._mj_kernels import set_painleve_stop
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .event_driven_generic import project_positions
 from .moreau_jean import (check_lcp_options, check_scene_contacts, classify_impulse,
                           compiled_model_of)
@@ -161,6 +163,12 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         Record the state every ``sample_dt`` from ``t0`` (and at the run's
         end), taken from the dense output, instead of at every macro step's
         end. The steps do not depend on it.
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact), or stop with status ``-1``
+        wherever the pressed contact's free slip, of any size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Examples
     --------
@@ -195,7 +203,8 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     exact_motion = True
 
     def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
-                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS, sample_dt=None):
+                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS, sample_dt=None,
+                 painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.sample_dt = None if sample_dt is None else positive("sample_dt", sample_dt)
         # the accepted steps' rows (with their dense output) not yet handed to simulate
@@ -236,7 +245,11 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             vN = np.asarray(WN, float) @ self.v + np.asarray(wN, float)
             self._closed = ((g <= CLOSED_GAP * (1.0 + float(np.max(np.abs(self.q)))))
                             & (vN >= -CLOSED_SPEED * (1.0 + float(np.max(np.abs(self.v))))))
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     # -- the base step ---------------------------------------------------------------------
     def _midpoint(self, t, q, v, h, closed):
@@ -292,9 +305,13 @@ class StuderExtrapolation(CompiledRecording, Integrator):
                     # no contact needs to push: zero normal impulse bounds the friction
                     U = U_free
                 else:
+                    # the base steps of a macro step start from its regimes; the check
+                    # only stops (painleve="stop"): the sequences repeat the base steps
+                    stop = self.painleve == "stop"
                     p, pn, pt = solve_contact_problem(
                         W, U_free, self.mu_c[ia], e, vN_pre, lcp_method=self.lcp_method,
-                        counters=self.counters, t=t)
+                        counters=self.counters, t=t, painleve=self.painleve,
+                        slip_before=slip_signs(self._prev_reg[ia]) if stop else None)
                     pN[ia], pT[ia] = pn, pt
                     v1 = v_free + MinvHT @ p
                     U = U_free + W @ p
@@ -595,6 +612,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         self._last_reg = regime.copy()
         # the acceleration of the step, unless a contact closed in it (an impulse)
         self._acc = None if rec[8] else (v1 - v) / H
+        self._prev_reg = np.asarray(regime, dtype=int)
         self._add_rows(_rows(t1, q1, v1, regime, pN / H, pT / H, slip, gap, kind,
                              y[2 * n:3 * n], y[3 * n:]))
 

@@ -99,7 +99,9 @@ from ..errors import InputError
 from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
 from ._tdg_kernels import tdg_loop
 from .base import Integrator, register_integrator
-from .contact_problem import new_contact_counters, solve_contact_problem
+from ._mj_kernels import set_painleve_stop
+from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
+                              solve_contact_problem)
 from .event_driven_generic import project_positions
 from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
                           check_work, classify_impulse, compiled_model_of, next_time)
@@ -147,6 +149,12 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         problem Lemke cannot solve is taken by the generic step (QP fallback).
     max_steps : int
         Bound on the number of steps of the run.
+    painleve : {"impulse", "stop"}
+        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
+        condition fails the way the contact slides): take the step's unique answer, the
+        impulsive stick (default; the tangential impact), or stop with status ``-1``
+        wherever the pressed contact's free slip, of any size, runs that way
+        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
 
     Notes
     -----
@@ -179,7 +187,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
 
     def __init__(self, scene, t0, q0, v0, t_bound, h=None, degree=2, lcp_method="auto",
                  lemke_max_iter=None, save_every=1, projection=True, fast="auto",
-                 max_steps=MAX_STEPS):
+                 max_steps=MAX_STEPS, painleve="impulse"):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.h = check_step("time-discontinuous-galerkin", h)
         if isinstance(degree, bool) or degree not in LOBATTO_TABLEAUS:
@@ -201,7 +209,11 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
                          "projection_iterations": 0}
         self._pending_initial = True
+        self.painleve, fast = painleve_option(painleve, fast)
+        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
+        if self._fast:
+            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     # -- the pieces of one step ----------------------------------------------
     def _rows(self, ia, q, t, jac=None):
@@ -223,9 +235,13 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
         if np.all(U_free[:na] + e * np.minimum(vN_pre, 0.0) >= 0.0):
             # no contact needs to push: zero normal impulse bounds the friction to zero
             return np.zeros(U_free.size), U_free
+        # a step solves several of these: the check only stops (painleve="stop")
+        stop = self.painleve == "stop"
         p, _, _ = solve_contact_problem(W, U_free, self.mu_c[ia], e, vN_pre,
                                         lcp_method=self.lcp_method, counters=self.counters,
-                                        lemke_max_iter=self.lemke_max_iter, t=t)
+                                        lemke_max_iter=self.lemke_max_iter, t=t,
+                                        slip_before=slip_signs(self._prev_reg[ia]) if stop else None,
+                                        painleve=self.painleve)
         return p, U_free + W @ p
 
     def _step_impl(self):
@@ -316,6 +332,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
+        self._prev_reg = regime
         self._closed = pN > 0.0
         self._k += 1
         fN, fT = pN / h, pT / h

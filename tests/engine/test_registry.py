@@ -17,7 +17,7 @@ NAMES = registry.scene_names()
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
     assert NAMES == ["ball-chain", "bidirectional-drive", "bouncing-ball", "flexible-rod-drive",
-                     "friction-drive", "painleve-rod", "piezo-drive",
+                     "friction-drive", "painleve-rod", "piezo-drive", "rocking-block",
                      "sliding-block", "sliding-box", "stick-slip-motor"]
 
 

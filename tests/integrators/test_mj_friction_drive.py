@@ -61,11 +61,17 @@ def test_compiled_blocks_join_seamlessly(monkeypatch):
 
 @pytest.mark.parametrize("fast", [False, True])
 def test_painleve_violation_in_the_drive(fast):
-    # mu tan(phi) > 1: the paper's Painlevé condition fails as soon as the rod presses
+    # mu tan(phi) > 1: the paper's Painlevé condition fails as soon as the rod presses.
+    # The study of the configuration stops there (painleve="stop", the former default)
     sc = FrictionDrive(FrictionDriveParams(mu=1.5), frequency=185.0)
-    res = mj(sc, 1, 200, fast=fast)
+    res = mj(sc, 1, 200, fast=fast, painleve="stop")
     assert res.status == -1 and "Painlevé" in res.message
     assert np.all(np.isfinite(res.q))
+    # by default the step's contact problem has its answer: the rod, pressed from rest,
+    # sticks (self-locking) all period, with no slip to jam
+    res = mj(sc, 1, 200, fast=fast)
+    assert res.status == 0 and set(res.regime_letters()) == {"S"}
+    assert res.stats["tangential_impacts"] == 0
 
 
 # -- mode naming from per-step regimes ------------------------------------------------

@@ -1,6 +1,7 @@
 """Moreau–Jean on small scenes with exact solutions (generic Python path)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -310,15 +311,19 @@ def test_enumeration_frictionless_and_restitution():
     assert one_contact_impulse([[2.0]], [1.0], 0.0, e=0.5, vN_pre=3.0) == (0.0, 0.0)
 
 
-def test_painleve_violation_stops_the_run_with_status_minus_one():
-    # W_NN - mu W_NT = -1: positive slip would need a jam impulse
+def test_painleve_violation_is_a_tangential_impact_or_a_stop():
+    # W_NN - mu W_NT = -1: positive slip has no solution; the step's answer is the jam,
+    # the stick p = -W^-1 (uN, uT) = (7, -3) (|pT| <= mu pN)
     W = [[1.0, 2.0], [2.0, 5.0]]
-    with pytest.raises(MoreauError, match=r"Painlevé condition W_NN - mu \|W_NT\| > 0 "
-                                          r"violated .* sliding the paradoxical way"):
-        one_contact_impulse(W, [-1.0, 1.0], 1.0)
+    assert one_contact_impulse(W, [-1.0, 1.0], 1.0) == (pytest.approx(7.0), pytest.approx(-3.0))
     res = run(SkewContact(), 1.0, [0.0, 0.0], [0.0, 1.0], h=0.1)
+    assert res.status == 0 and res.stats["tangential_impact_times"] == [0.0]
+    assert res.regime_letters()[1] == "S" and res.v[1][1] * 1.0 + 2.0 * res.v[1][0] == \
+        pytest.approx(0.0, abs=1e-14)        # the slip WT v = 2 v0 + v1 stopped
+    res = run(SkewContact(), 1.0, [0.0, 0.0], [0.0, 1.0], h=0.1, painleve="stop")
     assert res.status == -1 and not res.success
-    assert "Painlevé" in res.message and len(res.t) == 0
+    assert re.search(r"Painlevé condition W_NN - mu \|W_NT\| > 0 violated .* sliding the "
+                     r"paradoxical way", res.message) and len(res.t) == 0
 
 
 def test_harmless_slip_direction_runs_despite_the_painleve_condition():
@@ -510,6 +515,10 @@ def test_a_broken_delassus_entry_is_a_numerical_failure_not_a_painleve_case(W, u
 def test_a_genuine_painleve_case_is_still_named_so():
     from moreau.errors import PainleveError
     from moreau.integrators.contact_problem import one_contact_impulse
-    # W_NN > 0 but W_NN - mu W_NT < 0, sliding the paradoxical way
-    with pytest.raises(PainleveError, match="discrete Painlevé condition"):
-        one_contact_impulse([[1.0, 2.0], [2.0, 5.0]], [-1.0, 1.0], 0.9)
+    # W_NN > 0 but W_NN - mu W_NT < 0, sliding the paradoxical way, on a singular W (the
+    # normal and tangential rows dependent): no stick, no slip, no solution
+    with pytest.raises(PainleveError, match="discrete Painlevé condition .* singular Delassus"):
+        one_contact_impulse([[1.0, 2.0], [2.0, 4.0]], [-1.0, 1.0], 0.9)
+    # with W positive definite the same slip has its answer, the jam: p = -W^-1 (uN, uT)
+    assert one_contact_impulse([[1.0, 2.0], [2.0, 5.0]], [-1.0, 1.0], 0.9) == (
+        pytest.approx(7.0), pytest.approx(-3.0))

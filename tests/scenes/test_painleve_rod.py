@@ -188,10 +188,11 @@ def test_moreau_jean_sliding_rod_converges_at_first_order():
     assert 0.8 <= np.polyfit(np.log(hs), np.log(errors), 1)[0] <= 1.3
 
 
-def test_moreau_jean_stops_with_a_painleve_diagnosis():
+def test_moreau_jean_stops_with_a_painleve_diagnosis_when_asked():
+    # by default the step takes the tangential impact (tests/integrators/test_tangential_impact.py)
     rod = PainleveRod(mu=2.0)
     q0, v0 = rod.sliding_state(PHI_STAR, -1.0)
-    res = simulate(rod, (0.0, 1.0), q0, v0, "moreau-jean", h=1e-3)
+    res = simulate(rod, (0.0, 1.0), q0, v0, "moreau-jean", h=1e-3, painleve="stop")
     assert res.status == -1 and not res.success
     assert re.search(r"Painlev[ée] condition .* violated", res.message)
     assert re.search(r"\bmu`? = 2\b", res.message)

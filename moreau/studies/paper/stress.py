@@ -162,14 +162,20 @@ def _guard(case, scheme, fn):
 
 
 # -- the schemes of the columns ---------------------------------------------------------------
-def _steady(scene, key, steps, fast):
-    """Steady state of column ``key`` at ``steps`` steps per period."""
+def _steady(scene, key, steps, fast, painleve="impulse"):
+    """Steady state of column ``key`` at ``steps`` steps per period (``painleve``: Moreau–Jean's option)."""
     name, opts = _COLUMNS[key]
     if name == "moreau-jean":
         # the compiled discrete period map (projection, the friction drive's default)
-        return moreau_jean_steady_state(scene, steps, theta=opts["theta"])
+        return moreau_jean_steady_state(scene, steps, theta=opts["theta"], painleve=painleve)
+    opts = _run_options(key, fast)
+    if painleve != "impulse":
+        # a study of the Painlevé configuration: checked on the generic step
+        opts.update(painleve=painleve)
+        if "fast" in opts:
+            opts["fast"] = False
     return find_steady_state(scene, scheme=name, steps_per_period=steps, rtol=1e-10,
-                             scheme_options=_run_options(key, fast))
+                             scheme_options=opts)
 
 
 def _run_options(key, fast):
@@ -248,7 +254,12 @@ def _steady_case(case, scene, schemes, fast, steps=STEPS, bound=BOUND, note="", 
 
 
 def _ill_posed_case(case, scene, schemes, fast, cell=_no_cache):
-    """Beyond the Painlevé limit: every scheme must fail and name the cause."""
+    """Beyond the Painlevé limit: every scheme must fail and name the cause.
+
+    Moreau–Jean takes tangential impacts by default (the velocity-level
+    problem is always solvable); this case studies the Painlevé
+    configuration itself, so it runs with ``painleve="stop"``.
+    """
     def expect_failure(fn, scheme):
         def run():
             ss = fn()
@@ -263,7 +274,7 @@ def _ill_posed_case(case, scene, schemes, fast, cell=_no_cache):
         rows.append(cell(case, "event-driven", lambda: _guard(case, "event-driven", ed)))
     for scheme in _stepping(schemes):
         rows.append(cell(case, scheme, lambda scheme=scheme: _guard(case, scheme, expect_failure(
-            lambda: _steady(scene, scheme, STEPS, fast), scheme))))
+            lambda: _steady(scene, scheme, STEPS, fast, painleve="stop"), scheme))))
     return rows
 
 
