@@ -59,7 +59,7 @@ import math
 import numpy as np
 
 from .._validate import positive_int
-from ..errors import InputError, MoreauError
+from ..errors import InputError, MoreauError, RunawayError
 from ..integrators.base import check_options, get_integrator, simulate
 from ..integrators.base import scheme_options as options_of
 from ..outputs import claim_outputs
@@ -72,6 +72,7 @@ from .classify import MAX_PERIOD_K, sequence_period
 from .engine import check_output_dir
 from .period_k import full_state_of
 from .periodic_shooting import free_bases, period_map_options, touching_contacts
+from .runaway import certain_runaway, runaway_in
 from .scheme_settings import make_scheme, steady_of
 from .sweep import MAX_POINTS, plan_points
 
@@ -360,6 +361,9 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                    "start": "continued" if state is not None else "rest", "samples": {}}
             try:
                 sc = registry.make_scene(entry.name, frequency=f, **params)
+                why = certain_runaway(sc)
+                if why:
+                    raise RunawayError(why)
                 start, settle = state, transient
                 if shoot:
                     orbit = _orbit(sc, steady_scheme)
@@ -383,6 +387,11 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                 k = sequence_period(data, period_rtol)
                 rec.update(period=k, lyapunov_per_period=lyap, lyapunov_is_bound=bound,
                            flight=flight, motion=classify_motion(k, lyap))
+                why = _runaway(sc, names, data) if cyclic is not None else None
+                if why:
+                    # the samples stay in the table; the next point starts afresh
+                    rec.update(period=0, motion="runaway", status=f"RunawayError: {why}")
+                    state = None
             except MoreauError as exc:
                 rec["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
                 state = None
@@ -413,6 +422,13 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         raise KeyboardInterrupt(f"bifurcation: {len(points)} of {values.size} points finished"
                                 + (f", kept in {stem}.csv" if stem is not None else ""))
     return result
+
+
+def _runaway(scene, names, data):
+    # the runaway detector on the sampled displacements per period, in scene units
+    d = data[:, names.index("displacement_per_period")]
+    to_si = getattr(scene, "displacement_to_si", None)
+    return runaway_in(d / to_si(1.0) if to_si else d, scene)
 
 
 def _orbit(scene, steady_scheme):
