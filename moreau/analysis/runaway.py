@@ -40,7 +40,7 @@ Examples
 >>> from moreau.scenes.friction_drive import FrictionDrive
 >>> sc = FrictionDrive(frequency=185.0, load=0.005)
 >>> runaway_in(-0.2 * np.arange(1.0, 101.0), sc)[:48]
-'no steady state: past stall (load F_L = 0.005 N); '
+'no steady state: past stall (load F_L = 0.005 N)'
 >>> runaway_in(np.full(100, 0.01), sc) is None
 True
 """
