@@ -92,3 +92,39 @@ def test_table_ball_flip_at_its_closed_form():
     assert m["kind"] == "period doubling"
     assert m["bracket"][0] - 1e-12 <= exact <= m["bracket"][1] + 1e-12
     assert abs(m["at"] - exact) < 1e-5
+
+
+def test_a_walk_stalled_at_a_grazing_touchdown_says_so(monkeypatch):
+    # at 12612.72 Hz, e = 1 (just past the lift-off above) the walk stalled with 1001
+    # touchdowns F -> F at one time and only said "an accumulation of events"
+    from moreau.integrators.result import Event
+    from moreau.regimes import Regime
+    from moreau.scenes import make_scene
+    from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+    from moreau.errors import MoreauError
+    sc = make_scene("friction-drive", frequency=185.0)
+    q0, v0 = sc.rest_state()
+    real = FrictionDriveWalker.segment
+
+    def grazing(self, st, tau_end, on_segment=None):
+        if st.tau > 1.0:
+            out = st.copy()
+            out.regime = Regime.FLIGHT
+            return out, Event(st.tau, "touchdown", Regime.FLIGHT, Regime.FLIGHT)
+        return real(self, st, tau_end, on_segment)
+
+    monkeypatch.setattr(FrictionDriveWalker, "segment", grazing)
+    w = FrictionDriveWalker(sc)
+    st = w.classify(ContactState(0.0, Regime.FLIGHT, q0[0], v0[0], q0[1], v0[1]))
+    with pytest.raises(MoreauError, match="makes no progress: 1001 events in a row .* a grazing "
+                                          "contact: the rod meets the rotor with no normal "
+                                          "velocity and no normal force"):
+        w.advance(st, 2 * np.pi)
+
+
+def test_the_walk_at_the_measured_lift_off_names_the_grazing():
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.errors import MoreauError
+    from moreau.scenes.friction_drive import FrictionDrive
+    with pytest.raises(MoreauError, match="a grazing contact"):
+        find_steady_state(FrictionDrive(frequency=12612.72, restitution=1.0), statistical=False)
