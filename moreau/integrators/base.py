@@ -23,6 +23,7 @@ from ..errors import ContactLostError, InputError, LCPError, MoreauError, Painle
 from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
+from ._divergence import divergence
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
@@ -153,6 +154,8 @@ class Integrator:
         self.q = _state_vector("q0", q0, n)
         self.v = _state_vector("v0", v0, n)
         self.t = self.t0
+        #: where the run started, to tell a diverged state from the failure it caused
+        self._start = (self.q.copy(), self.v.copy(), self.t0)
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -186,8 +189,14 @@ class Integrator:
         else:
             self.counters["steps"] += 1
             if self.t >= self.t_bound:
-                self.status = "finished"
-                self.message = STATUS_MESSAGES[0]
+                why = divergence(self.scene, *self._start, self.q, self.v, self.t,
+                                 getattr(self, "h", None))
+                if why:
+                    # finite but blown up: not a result
+                    self._fail(-5, f"{why}. The run reached the end of its window with it")
+                else:
+                    self.status = "finished"
+                    self.message = STATUS_MESSAGES[0]
         return self.status
 
     def interrupt(self, message=None):
@@ -198,6 +207,14 @@ class Integrator:
         self._fail(-4, message or STATUS_MESSAGES[-4])
 
     def _fail(self, code, message):
+        if code in (-1, -3, -5):
+            # a blown-up state breaks the contact problem or the arithmetic on the way: the
+            # cause to name is the divergence (the flexible rod with Schatzman-Paoli at 100
+            # steps a period read "discrete Painleve condition violated (W_NN = 1.5e103)")
+            why = divergence(self.scene, *self._start, self.q, self.v, self.t,
+                             getattr(self, "h", None))
+            if why:
+                code, message = -5, f"{why}. The step then failed: {message}"
         self.status = "failed"
         self.status_code = code
         self.message = message
