@@ -399,6 +399,8 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                     state = None
             except MoreauError as exc:
                 rec["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+                if isinstance(exc, RunawayError):
+                    rec["motion"] = "runaway"
                 state = None
             points.append(rec)
     except KeyboardInterrupt:

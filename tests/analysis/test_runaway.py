@@ -64,6 +64,10 @@ def test_a_load_beyond_the_sliding_friction_is_named_at_once_and_by_the_run():
     assert grow == pytest.approx(dv, rel=1e-2)
     assert classify_long_run(sc, "moreau-jean", {"steps_per_period": 200})[
         "classification"] == "runaway"
+    # the bifurcation labelled it "non-periodic", status ok
+    (p,) = bifurcation_diagram("stick-slip-motor", "load", [0.3], frequency=1000.0,
+                               transient=5, samples=4, out=None, progress=False)["points"]
+    assert p["motion"] == "runaway" and "exceeds the sliding friction" in p["status"]
 
 
 def test_the_bifurcation_and_the_atlas_class_name_the_runaway():
