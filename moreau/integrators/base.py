@@ -23,7 +23,7 @@ from ..errors import ContactLostError, InputError, LCPError, MoreauError, Painle
 from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
-from ._divergence import divergence
+from ._divergence import GROWTH as DIVERGENCE_GROWTH, divergence
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
@@ -156,6 +156,7 @@ class Integrator:
         self.t = self.t0
         #: where the run started, to tell a diverged state from the failure it caused
         self._start = (self.q.copy(), self.v.copy(), self.t0)
+        self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v), initial=0.0)))
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -188,15 +189,16 @@ class Integrator:
             self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
             self.counters["steps"] += 1
-            if self.t >= self.t_bound:
+            if not float(np.max(np.abs(self.v), initial=0.0)) <= self._v_limit:
+                # blown up, finite or not: stopped here, before its arithmetic overflows
                 why = divergence(self.scene, *self._start, self.q, self.v, self.t,
                                  getattr(self, "h", None))
                 if why:
-                    # finite but blown up: not a result
-                    self._fail(-5, f"{why}. The run reached the end of its window with it")
-                else:
-                    self.status = "finished"
-                    self.message = STATUS_MESSAGES[0]
+                    self.status, self.status_code, self.message = "failed", -5, why
+                    return self.status
+            if self.t >= self.t_bound:
+                self.status = "finished"
+                self.message = STATUS_MESSAGES[0]
         return self.status
 
     def interrupt(self, message=None):
