@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-__all__ = ["divergence", "fastest_oscillation", "GROWTH"]
+__all__ = ["divergence", "fastest_oscillation", "bounded_velocities", "GROWTH"]
 
 #: a state this many times larger than the start (and than 1: the scenes are scaled) diverged
 GROWTH = 1e8
@@ -53,13 +53,27 @@ def fastest_oscillation(scene, q, v, t):
     return float(math.sqrt(np.max(lam))) if lam.size else 0.0
 
 
+def bounded_velocities(scene, n):
+    """Index of the velocities a divergence is judged on: all but the cyclic coordinates'.
+
+    Examples
+    --------
+    >>> from moreau.scenes.friction_drive import FrictionDrive
+    >>> bounded_velocities(FrictionDrive(), 2).tolist()
+    [0]
+    """
+    cyc = set(int(i) for i in getattr(scene, "cyclic_coordinates", ()) or ())
+    return np.array([i for i in range(n) if i not in cyc], dtype=int)
+
+
 def divergence(scene, q_start, v_start, t_start, q, v, t, h=None):
     """Why the state ``(q, v)`` at ``t`` is a diverged run, or None.
 
     Diverged: not finite, or a velocity more than :data:`GROWTH` times the
     larger of 1 and the start's largest velocity (positions are left out: a
-    free body's grows without bound over a long window). The reason gives
-    the growth and,
+    free body's grows without bound over a long window; so are the velocities
+    of cyclic coordinates: a rotor past stall runs away, which is physics,
+    :mod:`moreau.analysis.runaway`). The reason gives the growth and,
     with a step ``h``, ``h omega_max`` at the start against the bound 2 of
     the explicit central-difference (Störmer–Verlet) step.
 
@@ -73,8 +87,9 @@ def divergence(scene, q_start, v_start, t_start, q, v, t, h=None):
     >>> print(divergence(sc, q, v, 0.0, q, v + 1e12, 1.0, h=0.0628))  # doctest: +ELLIPSIS
     the state diverged: its largest velocity is 1e+12 at t = 1 against 1 at the start ...
     """
-    x0 = np.ravel(np.asarray(v_start, float))
-    x = np.ravel(np.asarray(v, float))
+    keep = bounded_velocities(scene, np.size(v))
+    x0 = np.ravel(np.asarray(v_start, float))[keep]
+    x = np.ravel(np.asarray(v, float))[keep]
     start = max(1.0, float(np.max(np.abs(x0))) if x0.size else 1.0)
     finite = bool(np.all(np.isfinite(x)) and np.all(np.isfinite(np.asarray(q, float))))
     big = float(np.max(np.abs(x))) if finite and x.size else (0.0 if finite else math.inf)

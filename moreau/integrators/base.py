@@ -23,7 +23,7 @@ from ..errors import ContactLostError, InputError, LCPError, MoreauError, Painle
 from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
-from ._divergence import GROWTH as DIVERGENCE_GROWTH, divergence
+from ._divergence import GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
@@ -156,7 +156,9 @@ class Integrator:
         self.t = self.t0
         #: where the run started, to tell a diverged state from the failure it caused
         self._start = (self.q.copy(), self.v.copy(), self.t0)
-        self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v), initial=0.0)))
+        self._judged = bounded_velocities(scene, n)
+        self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v[self._judged]),
+                                                                  initial=0.0)))
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -189,7 +191,7 @@ class Integrator:
             self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
             self.counters["steps"] += 1
-            if not float(np.max(np.abs(self.v), initial=0.0)) <= self._v_limit:
+            if not float(np.max(np.abs(self.v[self._judged]), initial=0.0)) <= self._v_limit:
                 # blown up, finite or not: stopped here, before its arithmetic overflows
                 why = divergence(self.scene, *self._start, self.q, self.v, self.t,
                                  getattr(self, "h", None))
