@@ -244,6 +244,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
 
     Raises
     ------
+    RunawayError
+        At a look, the second half of the displacements shows a runaway
+        (:func:`moreau.analysis.runaway.runaway_in`).
     BudgetExhaustedError
         The mean was not stationary within ``precision`` after ``max_periods``.
     ConvergenceError
