@@ -109,7 +109,10 @@ def _state_period(x, rtol):
 def _run_scheme(scene, scheme):
     # the scene's own reference stands for "event-driven" (the friction drive's walker)
     own = getattr(scene, "reference_integrator", None)
-    return own if scheme == "event-driven" and own is not None else scheme
+    if scheme == "event-driven":
+        # the dispatcher states no sampling options of its own: the scheme it runs does
+        return own if own is not None else "event-driven-generic"
+    return scheme
 
 
 def _sampled_options(run, options):

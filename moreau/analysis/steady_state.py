@@ -156,6 +156,10 @@ def _statistical(scene, scheme, failure, budget, options):
     q0, v0 = state if state is not None else scene.initial_state()
     own = getattr(scene, "reference_integrator", None)
     run = own if scheme == "event-driven" and own is not None else scheme
+    if run == "event-driven":
+        # the dispatcher states no options of its own, so the run was not sampled once a
+        # period ("did not sample the run at the ends of the drive periods", stick-slip motor)
+        run = "event-driven-generic"
     opts = _shooting_options(scheme, options)
     if scheme == "moreau-jean":
         opts.setdefault("projection", options.get("projection", True))

@@ -191,17 +191,27 @@ class Integrator:
             self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
             self.counters["steps"] += 1
-            if not float(np.max(np.abs(self.v[self._judged]), initial=0.0)) <= self._v_limit:
-                # blown up, finite or not: stopped here, before its arithmetic overflows
-                why = divergence(self.scene, *self._start, self.q, self.v, self.t,
-                                 getattr(self, "h", None))
-                if why:
-                    self.status, self.status_code, self.message = "failed", -5, why
-                    return self.status
+            if self._stop_if_diverged():
+                return self.status
             if self.t >= self.t_bound:
                 self.status = "finished"
                 self.message = STATUS_MESSAGES[0]
         return self.status
+
+    def _stop_if_diverged(self):
+        """Fail the run as diverged where its velocities blew up; True if it did.
+
+        Checked after every step, and by a compiled loop before it hands a step
+        back to the Python step: stopped there, before its arithmetic overflows.
+        """
+        if float(np.max(np.abs(self.v[self._judged]), initial=0.0)) <= self._v_limit:
+            return False
+        why = divergence(self.scene, *self._start, self.q, self.v, self.t,
+                         getattr(self, "h", None))
+        if not why:
+            return False
+        self.status, self.status_code, self.message = "failed", -5, why
+        return True
 
     def interrupt(self, message=None):
         """Stop the run as interrupted (status ``-4``); what was recorded is kept.
