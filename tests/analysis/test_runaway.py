@@ -82,3 +82,14 @@ def test_the_bifurcation_and_the_atlas_class_name_the_runaway():
     # and a point below stall is not
     assert classify_long_run(FrictionDrive(frequency=185.0, load=-1e-4), budget=40)[
         "classification"] == "period-1"
+
+
+@pytest.mark.slow
+def test_the_generic_event_driven_run_is_sampled_and_its_runaway_named():
+    # without the scene's own statement the statistical run of the event-driven scheme on
+    # the stick-slip motor failed with "did not sample the run at the ends of the drive
+    # periods" (the dispatcher states no sampling option); 16 s unloaded
+    from moreau.analysis.steady_state import _statistical
+    with pytest.raises(RunawayError, match="its mean speed grows by 0.01 m/s every period"):
+        _statistical(StickSlipMotor(frequency=1000.0, load=0.3), "event-driven", None, 40000,
+                     {})

@@ -50,3 +50,30 @@ def test_an_ordinary_state_is_not_diverged():
     assert divergence(ball, q, v, 0.0, q + 1e12, v + 1e7, 1.0) is None
     assert divergence(ball, q, v, 0.0, q * np.inf, v, 1.0).startswith(
         "the state diverged: its largest velocity is inf")
+
+
+@pytest.mark.slow
+def test_the_stiff_rod_under_schatzman_paoli_diverges_by_name_without_overflow_warnings():
+    # compare --stress printed "overflow encountered in matmul" (schatzman_paoli.py, the
+    # Python step a compiled block handed a blown-up state back to) and named the row by
+    # what the state broke on the way (a non-positive Delassus entry, a non-finite state)
+    import warnings
+    from moreau.studies.paper.stress import run_case
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        rows = run_case("flexible-rod-stiff-N50", schemes=("event-driven", "schatzman-paoli"))
+    sp = rows[1]
+    assert sp["outcome"] == "failed" and "the state diverged" in sp["message"]
+    assert "exceeds the stability bound 2 / omega_max" in sp["message"]
+
+
+@pytest.mark.slow
+def test_a_flat_step_in_several_free_directions_is_named_at_once():
+    # piezo drive, Schatzman-Paoli at 300 steps a period: P - I is singular (a direction the
+    # grid-locked map leaves unchanged); 60 blind Newton steps (14 s) ended "did not
+    # converge (residual 0.0162)"; now the flat step is named after one
+    from moreau.analysis.scheme_settings import make_scheme, steady_of
+    from moreau.errors import ResidualFloorError
+    with pytest.raises(ResidualFloorError, match=r"met a flat step of the period map \(P - I "
+                                                 r"singular in a free direction"):
+        steady_of(make_scene("piezo-drive"), make_scheme("schatzman-paoli", None, 300))
