@@ -126,7 +126,16 @@ def test_case(case):
     if case == "coarse-N10":
         # h = T/10: both step sizes still give the right mode, theta = 1/2 within 6 %
         assert mj1["error"] < 1.0 and mj05["error"] < 0.06
-        assert mj1["estimate"] > mj1["bound"] and mj05["estimate"] > mj05["bound"]
+        # theta = 1 converges geometrically from N/2 on and its estimate says "outside the
+        # bound"; theta = 1/2 does not (differences 0.013 then 0.14), so it gives none and
+        # says why instead of 0.28 against an error of 0.056
+        assert mj1["estimate"] > mj1["bound"]
+        assert mj05["estimate"] is None and "not a geometric convergence" in mj05["message"]
+    if case == "mass-ratio-1e6":
+        # issue 34: the grid-locked steady state is the same at N and 2N steps (7e-9), so
+        # 2 |d(N) - d(2N)| read 7.1e-6 against an error of 8.3e-3; no estimate is shown now
+        assert mj1["error"] > 5e-3 and mj1["estimate"] is None
+        assert "no step-halving estimate" in mj1["message"]
     if case == "long-1e7-steps":
         assert "1e+06 steps" in mj1["message"]
         # theta = 1/2: the steady period repeats to rounding; theta = 1 to 1e-7

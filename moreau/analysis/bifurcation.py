@@ -35,8 +35,13 @@ the midpoint of the two values. Where the period-1 orbit can be shot there
 (``refine``, ``--refine``, :func:`refine_mark`), each mark is then located by root finding
 between the two values on the orbit: regula falsi on ``lambda + 1`` of its
 most negative real multiplier (period doubling), on ``lambda - 1`` of its
-largest positive one or bisection on its existence (saddle-node: named apart
-from other period changes), bisection on flight in the orbit (grazing).
+largest positive one (saddle-node: named apart from other period changes),
+bisection on flight in the orbit (grazing). Where the orbit exists on one
+side only, bisection on its existence finds its end, and the mark names
+what ended it: its minimum normal force reaching 0 (grazing, lift-off) or
+its largest multiplier reaching +1 (saddle-node); neither, and the mark
+says so. A runaway point (:mod:`moreau.analysis.runaway`) gets the motion
+``runaway`` and a ``RunawayError`` status.
 
 Outputs: ``OUT/bifurcation_SCENE_P[_FREQ]_SCHEME.csv`` (one row per section
 sample, units in the column names, the point's ``period``,
@@ -59,7 +64,7 @@ import math
 import numpy as np
 
 from .._validate import positive_int
-from ..errors import InputError, MoreauError
+from ..errors import InputError, MoreauError, RunawayError
 from ..integrators.result import SimulationResult
 from ..integrators.base import check_options, get_integrator, simulate
 from ..integrators.base import scheme_options as options_of
@@ -73,6 +78,7 @@ from .classify import MAX_PERIOD_K, sequence_period
 from .engine import check_output_dir
 from .period_k import full_state_of
 from .periodic_shooting import free_bases, period_map_options, touching_contacts
+from .runaway import certain_runaway, runaway_in
 from .scheme_settings import make_scheme, steady_of
 from .sweep import MAX_POINTS, plan_points
 
@@ -388,6 +394,9 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                    "start": "continued" if state is not None else "rest", "samples": {}}
             try:
                 sc = registry.make_scene(entry.name, frequency=f, **params)
+                why = certain_runaway(sc)
+                if why:
+                    raise RunawayError(why)
                 start, settle = state, transient
                 if shoot:
                     orbit = _orbit(sc, steady_scheme)
@@ -411,8 +420,15 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
                 k = sequence_period(data, period_rtol)
                 rec.update(period=k, lyapunov_per_period=lyap, lyapunov_is_bound=bound,
                            flight=flight, motion=classify_motion(k, lyap))
+                why = _runaway(sc, names, data) if cyclic is not None else None
+                if why:
+                    # the samples stay in the table; the next point starts afresh
+                    rec.update(period=0, motion="runaway", status=f"RunawayError: {why}")
+                    state = None
             except MoreauError as exc:
                 rec["status"] = f"{type(exc).__name__}: {' '.join(str(exc).split())}"
+                if isinstance(exc, RunawayError):
+                    rec["motion"] = "runaway"
                 state = None
             points.append(rec)
     except KeyboardInterrupt:
@@ -422,11 +438,22 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
             bar.close()
     marks = bifurcation_marks(points, parameter)
     if refine and steady_scheme is not None and not interrupted:
+        shot = {}
+
         def orbit_at(val):
-            p, f = point({parameter: val})
-            return steady_of(registry.make_scene(entry.name, frequency=f, **p), steady_scheme)
-        marks = [refine_mark(m, orbit_at) if m["kind"] != "period halving" else m
-                 for m in marks]
+            # memoised: a grazing and a period change in one interval bisect the same orbits
+            if val not in shot:
+                p, f = point({parameter: val})
+                try:
+                    shot[val] = steady_of(registry.make_scene(entry.name, frequency=f, **p),
+                                          steady_scheme)
+                except MoreauError as exc:
+                    shot[val] = exc
+            if isinstance(shot[val], MoreauError):
+                raise shot[val]
+            return shot[val]
+        marks = _merge_marks([refine_mark(m, orbit_at) if m["kind"] != "period halving" else m
+                              for m in marks])
     result = {"points": points, "marks": marks, "columns": unit_of,
               "parameter_column": columns[parameter], "scene": entry.name, "scheme": scheme,
               "interrupted": interrupted}
@@ -444,6 +471,27 @@ def bifurcation_diagram(scene, parameter, values, fixed=None, frequency=None,
         raise KeyboardInterrupt(f"bifurcation: {len(points)} of {values.size} points finished"
                                 + (f", kept in {stem}.csv" if stem is not None else ""))
     return result
+
+
+def _runaway(scene, names, data):
+    # the runaway detector on the sampled displacements per period, in scene units
+    d = data[:, names.index("displacement_per_period")]
+    to_si = getattr(scene, "displacement_to_si", None)
+    return runaway_in(d / to_si(1.0) if to_si else d, scene)
+
+
+def _merge_marks(marks):
+    # one mechanism located once: a period change that a refinement found to be the lift-off
+    # of the orbit, and the grazing mark of the same interval, are the same event
+    out = []
+    for m in marks:
+        twin = next((o for o in out if o["kind"] == m["kind"] and "bracket" in o
+                     and o.get("bracket") == m.get("bracket")), None)
+        if twin is None:
+            out.append(m)
+        else:
+            twin.setdefault("also", []).append({k: m[k] for k in ("from", "to") if k in m})
+    return out
 
 
 def _orbit(scene, steady_scheme):
@@ -630,10 +678,14 @@ def refine_mark(mark, orbit_at, xtol=REFINE_XTOL, evals=REFINE_EVALS):
     -----
     * period doubling: ``flip_scalar`` (``lambda + 1``) changes sign between
       the neighbours; regula falsi on it;
-    * saddle-node: ``fold_scalar`` (``lambda - 1``) changes sign, or the
-      orbit exists on one side only; regula falsi, or bisection on its
-      existence;
-    * grazing: bisection on whether the orbit has flight (``F`` in its mode).
+    * saddle-node: ``fold_scalar`` (``lambda - 1``) changes sign; regula falsi;
+    * grazing: bisection on whether the orbit has flight (``F`` in its mode);
+    * the orbit exists on one side only: bisection on its existence (with
+      the neighbour's flight flag), then at its last point the mechanism
+      that ended it is named (``mechanism``): the minimum normal force down
+      to :data:`END_FRACTION` of the neighbour's (grazing, lift-off) or
+      ``|lambda - 1|`` down to that fraction (saddle-node); else the kind
+      stays ``period change``, ``mechanism`` "not identified".
     """
     out = dict(mark)
     a, b = (float(x) for x in mark["between"])
@@ -644,6 +696,15 @@ def refine_mark(mark, orbit_at, xtol=REFINE_XTOL, evals=REFINE_EVALS):
             ss = _try(orbit_at, v)
             return None if ss is None else "F" in ss.mode
         fa, fb = flies(a), flies(b)
+        if (fa is None) != (fb is None) and not (fa or fb):
+            # a contact orbit on one side only: it may end by lifting off
+            end = _orbit_end(orbit_at, a, b, fa is not None, tol, evals)
+            if end["kind"] == "grazing":
+                out.update({k: v for k, v in end.items() if k != "kind"})
+                return out
+            out["refined"] = ("midpoint: the period-1 orbit in contact does not end by lift-off "
+                              f"({end['refined']})")
+            return out
         if fa is None or fb is None or fa == fb:
             out["refined"] = "midpoint: the period-1 orbits at the neighbours do not show the change"
             return out
@@ -668,12 +729,56 @@ def refine_mark(mark, orbit_at, xtol=REFINE_XTOL, evals=REFINE_EVALS):
                     return out
         out["refined"] = "midpoint: no multiplier crosses the unit circle at a real +1 or -1"
         return out
-    # the orbit exists on one side only: it ends at a fold
-    exists = sa is not None
-    lo, hi, n = _bisect(lambda v: _try(orbit_at, v) is not None, a, b, exists, tol, evals)
-    out.update(kind="saddle-node", at=0.5 * (lo + hi), bracket=[lo, hi], evaluations=n + 2,
-               refined="bisection on the existence of the period-1 orbit")
+    # the orbit exists on one side only: it ends by a fold (its multiplier reaches +1) or by
+    # lift-off (its minimum normal force reaches 0); the end says which
+    out.update(_orbit_end(orbit_at, a, b, sa is not None, tol, evals))
     return out
+
+
+#: at the end of a period-1 orbit, its minimum normal force (or ``|lambda - 1|``) below this
+#: fraction of its value at the grid neighbour names the mechanism
+END_FRACTION = 0.05
+
+
+def _orbit_end(orbit_at, a, b, exists_at_a, tol, evals):
+    """Where a period-1 orbit seen at one neighbour only ends, and by which mechanism.
+
+    Bisection on the existence of the orbit with the neighbour's flight flag
+    (in contact, the sign of its minimum normal force), then at its last
+    point the two quantities that can end it are read against their values
+    at the neighbour: the minimum normal force reaching 0 is a grazing
+    (lift-off), the largest real multiplier reaching +1 a saddle-node.
+    """
+    side = orbit_at(a if exists_at_a else b)
+    flight = "F" in side.mode
+
+    def holds(v):
+        ss = _try(orbit_at, v)
+        return ss is not None and ("F" in ss.mode) == flight
+
+    lo, hi, n = _bisect(holds, a, b, exists_at_a, tol, evals)
+    edge = orbit_at(lo if exists_at_a else hi)
+    n0 = float(getattr(side, "min_normal_force", math.nan))
+    n1 = float(getattr(edge, "min_normal_force", math.nan))
+    f0, f1 = fold_scalar(side), fold_scalar(edge)
+    g = n1 / n0 if n0 > 0.0 and math.isfinite(n0) and math.isfinite(n1) else math.nan
+    f = abs(f1) / abs(f0) if math.isfinite(f0) and math.isfinite(f1) and f0 != 0.0 else math.nan
+    lam = f"{1.0 + f1:.6g}" if math.isfinite(f1) else "none real positive"
+    found = (f"the last orbit (at {(lo if exists_at_a else hi):.10g}) has its minimum normal "
+             f"force at {g:.2g} of the neighbour's and its largest real multiplier {lam}")
+    where = dict(at=0.5 * (lo + hi), bracket=[lo, hi], evaluations=n + 2)
+    if not flight and g < END_FRACTION and not f < g:
+        return dict(kind="grazing", **where, mechanism="lift-off: the minimum normal force of "
+                    "the period-1 orbit reaches 0",
+                    refined="bisection on the existence of the period-1 orbit in contact (the "
+                            f"sign of its minimum normal force): {found}")
+    if f < END_FRACTION:
+        return dict(kind="saddle-node", **where, mechanism="fold: the largest multiplier of "
+                    "the period-1 orbit reaches +1",
+                    refined=f"bisection on the existence of the period-1 orbit: {found}")
+    return dict(kind="period change", **where, mechanism="not identified",
+                refined=f"bisection on the existence of the period-1 orbit; it ends with "
+                        f"neither its normal force at 0 nor a multiplier at +1: {found}")
 
 
 def _write(result, stem, entry, parameter, values, frequency, fixed, scheme, opts, transient,
@@ -740,7 +845,8 @@ def bifurcation_figure(result, path, quantities=None):
     axes[-1].set_ylabel("Lyapunov exp.\n[per period]")
     axes[-1].set_xlabel(result["parameter_column"])
     styles = {"period doubling": ("C0", "--"), "period halving": ("C0", ":"),
-              "period change": ("C1", "--"), "grazing": ("C2", "-.")}
+              "period change": ("C1", "--"), "grazing": ("C2", "-."),
+              "saddle-node": ("C4", "--")}
     seen = set()
     for m in result["marks"]:
         color, ls = styles[m["kind"]]

@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from .._validate import finite_array
-from ..errors import InputError, MoreauError
+from ..errors import InputError, MoreauError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import scheme_options
 from ..regimes import REGIME_LETTERS
@@ -290,7 +290,15 @@ class DriveCase(CompareCase):
         opts = dict(options)
         n = opts.pop("steps_per_period", None)
         theta = opts.pop("theta", None)
-        ss = steady_of(self.scene, make_scheme(name, theta, n, None, opts))
+        scheme = make_scheme(name, theta, n, None, opts)
+        try:
+            ss = steady_of(self.scene, scheme)
+        except ResidualFloorError:
+            # a time-stepping map whose fixed point exists only to a residual floor (its
+            # switches locked to the step grid): its long-run mean, as `moreau steady`
+            # gives it (the piezo drive under Schatzman-Paoli, the generalized-alpha and
+            # TDG failed at every setting; their means are within 1.7 to 46 %)
+            ss = steady_of(self.scene, scheme, statistical=True)
         return ss.displacement_per_period, ss
 
     def measure_scheme(self, name, options, out):

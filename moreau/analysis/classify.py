@@ -11,10 +11,10 @@ the scheme's period map plainly from the start state for at most
 * **period-k**: the last section states repeat with period ``k <= 8``
   (:func:`sequence_period`, to ``rtol`` of each column's scale); the
   displacement per period is the mean over the last ``k`` periods;
-* **runaway**: the rotor's mean speed over the last chunk of periods is
-  more than :data:`RUNAWAY_FACTOR` times the scene's velocity scale (no
-  friction force can sustain that; the shooting's runaway check says the
-  same of an orbit);
+* **runaway**: the scene's physics says so before any run, or the
+  displacements per period over the second half of the run grow steadily
+  beyond the drive's speed (:mod:`moreau.analysis.runaway`, the detector
+  every analysis uses);
 * **non-periodic**: no period within the budget; the mean displacement per
   period after the MSER-5 transient, with a batch-means confidence
   interval (:mod:`moreau.analysis.statistical`: the same estimator and the
@@ -47,11 +47,12 @@ from ..integrators import get_integrator
 from ..integrators.base import scheme_options as options_of
 from ..scenes import registry
 from .periodic_shooting import period_map_options
+from .runaway import certain_runaway, runaway_in
 from .section_runs import section_states
 from .statistical import BATCHES, MAX_LAG1, batch_means, mser5_truncation
 
 __all__ = ["classify_long_run", "classification_columns", "sequence_period", "CLASSIFY_COLUMNS",
-           "CLASSIFY_PERIODS", "MAX_PERIOD_K", "RUNAWAY_FACTOR"]
+           "CLASSIFY_PERIODS", "MAX_PERIOD_K"]
 
 TWO_PI = 2.0 * math.pi
 #: the longest period the sampled sequence is tested for
@@ -60,8 +61,6 @@ MAX_PERIOD_K = 8
 CLASSIFY_PERIODS = 100
 #: periods per run between two looks at the samples
 CHUNK = 100
-#: a mean rotor speed above this many velocity scales is a runaway
-RUNAWAY_FACTOR = 2.0
 #: the columns :func:`classification_columns` adds to a row
 CLASSIFY_COLUMNS = ("classification", "classification_detail",
                     "classified_displacement_per_period_m", "classified_half_width_m")
@@ -110,7 +109,10 @@ def _state_period(x, rtol):
 def _run_scheme(scene, scheme):
     # the scene's own reference stands for "event-driven" (the friction drive's walker)
     own = getattr(scene, "reference_integrator", None)
-    return own if scheme == "event-driven" and own is not None else scheme
+    if scheme == "event-driven":
+        # the dispatcher states no sampling options of its own: the scheme it runs does
+        return own if own is not None else "event-driven-generic"
+    return scheme
 
 
 def _sampled_options(run, options):
@@ -185,8 +187,10 @@ def classify_long_run(scene, scheme="event-driven", options=None, start=None, se
     q, v = _start(scene, start)
     ts = float(section_tau)
     keep = [i for i in range(scene.ndof) if i != cyclic]
-    vs = getattr(scene, "velocity_scale", None)
-    vs = float(np.max(np.abs(vs))) if vs is not None else None
+    why = certain_runaway(scene)
+    if why:
+        return {"classification": "runaway", "displacement_per_period": math.nan,
+                "half_width": math.nan, "periods": 0, "detail": why}
     d = np.zeros(0)
     xs = np.zeros((0, len(keep) + scene.ndof))
     while d.size < budget:
@@ -203,12 +207,11 @@ def classify_long_run(scene, scheme="event-driven", options=None, start=None, se
             return {"classification": "runaway", "displacement_per_period": math.nan,
                     "half_width": math.nan, "periods": int(d.size),
                     "detail": f"the state is not finite after {d.size} periods"}
-        speed = abs(float(np.mean(d[-m:]))) / TWO_PI
-        if vs and speed > RUNAWAY_FACTOR * vs:
+        runaway = runaway_in(d[d.size // 2:], scene)
+        if runaway:
             return {"classification": "runaway", "displacement_per_period": float(d[-1]),
                     "half_width": math.nan, "periods": int(d.size),
-                    "detail": f"the rotor's mean speed over the last {m} periods is "
-                              f"{speed / vs:.3g} velocity scales after {d.size} periods"}
+                    "detail": f"{runaway} after {d.size} periods"}
         tail = xs[-min(len(xs), 3 * MAX_PERIOD_K + 1):]
         k = _state_period(tail, rtol) if len(tail) > 2 * MAX_PERIOD_K else 0
         if k:

@@ -511,6 +511,11 @@ def run_other_row(case, name, key, value, fixed, repeat, ref_value, ref_switches
         row.update(time_s=t, error=_relative(value_, ref_value),
                    signed_error=_signed(value_, ref_value),
                    trajectory_error=case.measure_scheme(name, opts, (value_, res)))
+        if getattr(res, "statistical", False):
+            lo, hi = res.confidence_interval
+            row["message"] = (f"statistical steady state (no period-1 orbit: "
+                              f"{res.stats.get('why_not_periodic', '')}): mean in [{lo:.6g}, "
+                              f"{hi:.6g}] ({res.confidence:.0%})")
     except MoreauError as exc:
         row.update(status=-1, message=f"{type(exc).__name__}: {exc}")
     return row

@@ -49,7 +49,8 @@ TWO_PI = 2.0 * math.pi
 #: after Newton stalls on a time-stepping scheme's period map
 FIXED_POINT_PERIODS = 100
 
-#: below this slope of ``P - I`` (one free direction) a time-stepping map is on a flat step
+#: below this slope of ``P - I`` (its smallest singular value in several free directions) a
+#: time-stepping map is on a flat step
 FLAT_SLOPE = 1e-6
 
 
@@ -346,12 +347,19 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
         # a time-stepping scheme's period map is only piecewise smooth (its index set
         # changes on the grid): on a flat step of the map (slope of P - I about 0 in
         # a one-dimensional free space) Newton is blind, and it may stall anyway
-        flat = J is not None and z.size == 1 and abs(J[0, 0]) < FLAT_SLOPE
+        # in several free directions: P - I singular (a direction the grid-locked map
+        # leaves unchanged; the piezo drive under Schatzman-Paoli, 60 blind Newton steps)
+        slope = float(np.linalg.svd(J, compute_uv=False)[-1]) if J is not None else math.inf
+        flat = slope < FLAT_SLOPE
         if it > max_iter or ("h" in takes and flat):
             newton = (f"shooting did not converge in `max_iter`={max_iter} Newton steps "
                       f"(residual {np.max(np.abs(r)) / vscale:.3g} relative)" if not flat else
                       f"Newton shooting met a flat step of the period map (slope of P - I "
-                      f"{J[0, 0]:.2g}) after {it - 1} steps")
+                      f"{J[0, 0]:.2g}) after {it - 1} steps" if z.size == 1 else
+                      f"Newton shooting met a flat step of the period map (P - I singular in "
+                      f"a free direction: smallest singular value {slope:.2g}, the switches "
+                      f"locked to the step grid) after {it - 1} steps, at a residual "
+                      f"{np.max(np.abs(r)) / vscale:.3g} relative")
             if "h" not in takes:
                 raise ConvergenceError(newton)
             if z.size == 1:

@@ -77,11 +77,12 @@ import numpy as np
 from scipy.special import stdtrit
 
 from .._validate import positive, positive_int
-from ..errors import BudgetExhaustedError, ConvergenceError, InputError, MoreauError
+from ..errors import BudgetExhaustedError, ConvergenceError, InputError, MoreauError, RunawayError
 from ..integrators import get_integrator
 from ..integrators.base import check_options, scheme_options as options_of
 from ..integrators.result import SteadyState
 from .periodic_shooting import period_map_options
+from .runaway import runaway_in
 from .section_runs import section_states
 
 __all__ = ["statistical_steady_state", "mser5_truncation", "batch_means", "METHOD",
@@ -243,6 +244,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
 
     Raises
     ------
+    RunawayError
+        At a look, the second half of the displacements shows a runaway
+        (:func:`moreau.analysis.runaway.runaway_in`).
     BudgetExhaustedError
         The mean was not stationary within ``precision`` after ``max_periods``.
     ConvergenceError
@@ -290,6 +294,11 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         if not np.all(np.isfinite(d)):
             raise ConvergenceError("the displacements per period are not finite: the run "
                                    "diverged")
+        # the second half: the first may hold the transient from a far start
+        runaway = runaway_in(d[d.size // 2:], scene)
+        if runaway:
+            raise RunawayError(f"{runaway}; statistical steady state stopped after {d.size} "
+                               f"periods")
         scale_v = float(np.max(np.abs(vs))) if vs is not None else vmax
         floor_d = 0.01 * TWO_PI * scale_v
         cut = mser5_truncation(d)

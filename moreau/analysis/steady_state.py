@@ -25,6 +25,7 @@ from ..scenes.base import Scene
 from . import mj_steady_state  # noqa: F401
 from .period_k import find_period_k, full_state_of
 from .periodic_shooting import guess_options, shoot_periodic
+from .runaway import certain_runaway, runaway_side
 from .statistical import MAX_PERIODS, statistical_steady_state
 from .steady_solvers import get_steady_solver, has_solver
 
@@ -85,6 +86,10 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
     if not isinstance(statistical, (bool, np.bool_)):
         raise InputError(f"`statistical` must be True or False, got {statistical!r}")
     statistical_budget = positive_int("statistical_budget", statistical_budget)
+    why = certain_runaway(scene)
+    if why:
+        # the physics says so: no shooting and no long run can find a steady state
+        raise RunawayError(why)
     if guess is not None:
         _check_guess(scene, guess)
         options["guess"] = guess
@@ -151,6 +156,10 @@ def _statistical(scene, scheme, failure, budget, options):
     q0, v0 = state if state is not None else scene.initial_state()
     own = getattr(scene, "reference_integrator", None)
     run = own if scheme == "event-driven" and own is not None else scheme
+    if run == "event-driven":
+        # the dispatcher states no options of its own, so the run was not sampled once a
+        # period ("did not sample the run at the ends of the drive periods", stick-slip motor)
+        run = "event-driven-generic"
     opts = _shooting_options(scheme, options)
     if scheme == "moreau-jean":
         opts.setdefault("projection", options.get("projection", True))
@@ -274,11 +283,8 @@ def implausible_steady_state(scene, ss):
     vs = getattr(scene, "velocity_scale", None)
     if vs is not None:
         vs = float(np.max(np.abs(vs)))
-    load = getattr(getattr(scene, "params", None), "load", 0.0) or 0.0
     speed = abs(ss.displacement_per_period) / TWO_PI
-    direction = "forwards" if ss.displacement_per_period > 0 else "backwards"
-    side = (f"past stall (load F_L = {load:g} N); the rotor runs away {direction}, "
-            if load else f"the rotor runs away {direction} with no load to drive it, ")
+    side = runaway_side(scene, ss.displacement_per_period)
     if not np.all(np.isfinite(x)):
         return f"no steady state: {side}its periodic state is not finite"
     if vs and np.finfo(float).eps * float(np.max(np.abs(x))) > 1e-6 * vs:

@@ -108,6 +108,9 @@ class CompiledRecording:
         time reached, ``{h}``: the step).
         """
         if status in handback:
+            if self._stop_if_diverged():
+                # a blown-up state handed back: its Python step would overflow on the way
+                return
             self.counters["steps"] += 1
             self._generic_step()
         elif status == SINGULAR:

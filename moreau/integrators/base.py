@@ -23,6 +23,7 @@ from ..errors import ContactLostError, InputError, LCPError, MoreauError, Painle
 from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
+from ._divergence import GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
@@ -153,6 +154,11 @@ class Integrator:
         self.q = _state_vector("q0", q0, n)
         self.v = _state_vector("v0", v0, n)
         self.t = self.t0
+        #: where the run started, to tell a diverged state from the failure it caused
+        self._start = (self.q.copy(), self.v.copy(), self.t0)
+        self._judged = bounded_velocities(scene, n)
+        self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v[self._judged]),
+                                                                  initial=0.0)))
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -185,10 +191,27 @@ class Integrator:
             self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
             self.counters["steps"] += 1
+            if self._stop_if_diverged():
+                return self.status
             if self.t >= self.t_bound:
                 self.status = "finished"
                 self.message = STATUS_MESSAGES[0]
         return self.status
+
+    def _stop_if_diverged(self):
+        """Fail the run as diverged where its velocities blew up; True if it did.
+
+        Checked after every step, and by a compiled loop before it hands a step
+        back to the Python step: stopped there, before its arithmetic overflows.
+        """
+        if float(np.max(np.abs(self.v[self._judged]), initial=0.0)) <= self._v_limit:
+            return False
+        why = divergence(self.scene, *self._start, self.q, self.v, self.t,
+                         getattr(self, "h", None))
+        if not why:
+            return False
+        self.status, self.status_code, self.message = "failed", -5, why
+        return True
 
     def interrupt(self, message=None):
         """Stop the run as interrupted (status ``-4``); what was recorded is kept.
@@ -198,6 +221,14 @@ class Integrator:
         self._fail(-4, message or STATUS_MESSAGES[-4])
 
     def _fail(self, code, message):
+        if code in (-1, -3, -5):
+            # a blown-up state breaks the contact problem or the arithmetic on the way: the
+            # cause to name is the divergence (the flexible rod with Schatzman-Paoli at 100
+            # steps a period read "discrete Painleve condition violated (W_NN = 1.5e103)")
+            why = divergence(self.scene, *self._start, self.q, self.v, self.t,
+                             getattr(self, "h", None))
+            if why:
+                code, message = -5, f"{why}. The step then failed: {message}"
         self.status = "failed"
         self.status_code = code
         self.message = message

@@ -802,8 +802,19 @@ class FrictionDriveWalker:
                 if stalled > MAX_EVENTS_AT_ONE_TIME:
                     raise MoreauError(
                         f"the event-driven walk makes no progress: {stalled} events in a row "
-                        f"at tau = {st.tau!r} (last: {ev.kind}); an accumulation of events")
+                        f"at tau = {st.tau!r} (last: {ev.kind}); "
+                        f"{_stall_cause(ev, 'an accumulation of events')}")
         return st
+
+
+def _stall_cause(ev, otherwise):
+    # a touchdown that leaves the rod in flight, at one time: the flight re-contacts at once
+    # and the closed contact, its normal force not positive, lifts off at once
+    if ev is not None and ev.kind == "touchdown" and ev.before == ev.after == _F:
+        return ("a grazing contact: the rod meets the rotor with no normal velocity and no "
+                "normal force, so each flight re-contacts at once and each contact lifts off "
+                "at once (a tangency the walk does not resolve: the motion is at a lift-off)")
+    return otherwise
 
 
 @register_integrator("friction-drive-walker")
@@ -934,5 +945,5 @@ class EventDriven(Integrator):
             raise MoreauError(
                 f"the event-driven walk makes no progress: {self._stalled} events in a row at "
                 f"tau = {end.tau!r} (last: {ev.kind if ev is not None else 'none'}, regime "
-                f"{Regime(int(end.regime)).name}); an accumulation of impacts it does not "
-                "resolve")
+                f"{Regime(int(end.regime)).name}); "
+                f"{_stall_cause(ev, 'an accumulation of impacts it does not resolve')}")

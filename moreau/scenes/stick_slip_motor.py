@@ -390,6 +390,29 @@ class StickSlipMotor(SIUnits, Scene):
         """Dimensionless sliding friction force ``mu n``."""
         return float(self.mu[0]) * self.n
 
+    def certain_runaway(self):
+        """Why the slider must run away whatever it does, or None.
+
+        Over a period the friction force on the slider is at most ``mu n``
+        in size, so with ``|fL| > mu n`` its velocity changes by at least
+        ``2 pi (|fL| - mu n)`` against the load every period: no steady
+        state, periodic or statistical (:mod:`moreau.analysis.runaway`).
+
+        Examples
+        --------
+        >>> StickSlipMotor(frequency=1000.0, load=0.1).certain_runaway() is None
+        True
+        """
+        mun = self.friction_level
+        if not abs(self.fL) > mun:
+            return None
+        p = self.params
+        way = "backwards" if self.fL > 0 else "forwards"
+        return (f"no steady state: the load |F_L| = {abs(p.load):g} N exceeds the sliding "
+                f"friction mu N = {p.mu * p.normal_force:g} N, so the slider's speed changes "
+                f"by at least {TWO_PI * (abs(self.fL) - mun):.4g} (scene units) every period; "
+                f"it runs away {way}")
+
     def stator(self, tau):
         """Stator displacement, velocity and acceleration ``(s, s', s'')`` at ``tau``."""
         return self.drive(tau)

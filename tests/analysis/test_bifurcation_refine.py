@@ -8,13 +8,40 @@ import pytest
 
 from periodic_scenes import TableBall
 
-from moreau.analysis.bifurcation import flip_scalar, fold_scalar, refine_mark
+from moreau.analysis.bifurcation import _merge_marks, flip_scalar, fold_scalar, refine_mark
 from moreau.analysis.periodic_shooting import shoot_periodic
 from moreau.errors import ConvergenceError
 
 
-def _orbit(multipliers, mode="NP"):
-    return SimpleNamespace(floquet_multipliers=np.asarray(multipliers, complex), mode=mode)
+def _orbit(multipliers, mode="NP", min_normal_force=math.nan):
+    return SimpleNamespace(floquet_multipliers=np.asarray(multipliers, complex), mode=mode,
+                           min_normal_force=min_normal_force)
+
+
+def test_an_orbit_that_ends_by_lifting_off_is_a_grazing_not_a_saddle_node():
+    # issue 34: at 12612.7 Hz (e = 1) the orbit's minimum normal force was 6.6e-8 N and its
+    # multiplier 0.99966 when it ended; bisection on its existence was called a saddle-node,
+    # and the grazing mark of the same interval stayed at the midpoint, 300 Hz off.
+    # Here N_min = 0.7 - p reaches 0 at p = 0.7 with the multiplier at 0.9997 throughout
+    def orbit_at(p):
+        if p > 0.7:
+            raise ConvergenceError("no period-1 orbit")
+        return _orbit([0.9997, 0.2], "NP", min_normal_force=0.7 - p)
+    m = refine_mark({"kind": "period change", "between": [0.5, 0.9], "at": 0.7, "from": 1,
+                     "to": 0}, orbit_at)
+    assert m["kind"] == "grazing" and m["mechanism"].startswith("lift-off")
+    assert m["bracket"][0] <= 0.7 <= m["bracket"][1] and m["at"] == pytest.approx(0.7, abs=1e-6)
+    assert "largest real multiplier 0.9997" in m["refined"]
+    g = refine_mark({"kind": "grazing", "between": [0.5, 0.9], "at": 0.7, "from": "contact",
+                     "to": "flight"}, orbit_at)
+    assert g["kind"] == "grazing" and g["bracket"] == m["bracket"]
+    # the diagram keeps one mark for the one event
+    (one,) = _merge_marks([m, g])
+    assert one["from"] == 1 and one["also"] == [{"from": "contact", "to": "flight"}]
+    # an orbit that ends with neither quantity at its critical value is not named either
+    n = refine_mark({"kind": "period change", "between": [0.5, 0.9], "at": 0.7, "from": 1,
+                     "to": 0}, lambda p: orbit_at(p) if p <= 0.6 else orbit_at(1.0))
+    assert n["kind"] == "period change" and n["mechanism"] == "not identified"
 
 
 def test_saddle_node_told_apart_and_located():
@@ -65,3 +92,39 @@ def test_table_ball_flip_at_its_closed_form():
     assert m["kind"] == "period doubling"
     assert m["bracket"][0] - 1e-12 <= exact <= m["bracket"][1] + 1e-12
     assert abs(m["at"] - exact) < 1e-5
+
+
+def test_a_walk_stalled_at_a_grazing_touchdown_says_so(monkeypatch):
+    # at 12612.72 Hz, e = 1 (just past the lift-off above) the walk stalled with 1001
+    # touchdowns F -> F at one time and only said "an accumulation of events"
+    from moreau.integrators.result import Event
+    from moreau.regimes import Regime
+    from moreau.scenes import make_scene
+    from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+    from moreau.errors import MoreauError
+    sc = make_scene("friction-drive", frequency=185.0)
+    q0, v0 = sc.rest_state()
+    real = FrictionDriveWalker.segment
+
+    def grazing(self, st, tau_end, on_segment=None):
+        if st.tau > 1.0:
+            out = st.copy()
+            out.regime = Regime.FLIGHT
+            return out, Event(st.tau, "touchdown", Regime.FLIGHT, Regime.FLIGHT)
+        return real(self, st, tau_end, on_segment)
+
+    monkeypatch.setattr(FrictionDriveWalker, "segment", grazing)
+    w = FrictionDriveWalker(sc)
+    st = w.classify(ContactState(0.0, Regime.FLIGHT, q0[0], v0[0], q0[1], v0[1]))
+    with pytest.raises(MoreauError, match="makes no progress: 1001 events in a row .* a grazing "
+                                          "contact: the rod meets the rotor with no normal "
+                                          "velocity and no normal force"):
+        w.advance(st, 2 * np.pi)
+
+
+def test_the_walk_at_the_measured_lift_off_names_the_grazing():
+    from moreau.analysis.steady_state import find_steady_state
+    from moreau.errors import MoreauError
+    from moreau.scenes.friction_drive import FrictionDrive
+    with pytest.raises(MoreauError, match="a grazing contact"):
+        find_steady_state(FrictionDrive(frequency=12612.72, restitution=1.0), statistical=False)
