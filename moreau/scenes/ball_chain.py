@@ -191,6 +191,14 @@ class BallChain(SIUnits, Scene):
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
                              self.ndof - 1, True, False)
 
+    def shapes(self, q, t=0.0):
+        """The balls (centres ``q`` [m] on a line) and the contacts between neighbours."""
+        from ._drawing import circle, contact
+        r = self.params.radius
+        x = np.asarray(q, dtype=float)
+        return ([circle((xi, 0.0), r) for xi in x]
+                + [contact(i, (x[i] + r, 0.0), (1.0, 0.0), (0.0, 1.0)) for i in range(len(x) - 1)])
+
     def kinetic_energy(self, v):
         """``sum m_i v_i^2 / 2`` of velocities ``v`` (..., N), in scene units."""
         v = np.asarray(v, dtype=float)

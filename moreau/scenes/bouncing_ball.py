@@ -139,6 +139,13 @@ class BouncingBall(SIUnits, Scene):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
 
+    def shapes(self, q, t=0.0):
+        """The floor, the ball (centre height ``q[0]`` [m]) and its contact point."""
+        from ._drawing import circle, contact, line
+        y, r = float(q[0]), self.params.radius
+        return [line([(-3 * r, 0.0), (3 * r, 0.0)], role="ground"), circle((0.0, y), r),
+                contact(0, (0.0, y - r), (0.0, 1.0))]
+
     # -- exact solution -------------------------------------------------------
     def _initial(self, q0, v0):
         y0 = float(finite_array("q0", q0, shape=(1,))[0])

@@ -421,6 +421,11 @@ class FlexibleRodDrive(DriveUnits, Scene):
         v[0] = -float(self.du1(tau)) / math.cos(phi)
         return q, v
 
+    def shapes(self, q, t=0.0):
+        """The stator's hinge, the rod (the chord to its bent tip) and the rotor (``q[-1]`` [m]) at ``t`` [s]."""
+        from ._drawing import rod_drive_shapes
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=self.ndof - 1)
+
     def initial_state(self):
         """The rest state at ``tau = 0`` (:meth:`rest_state`)."""
         return self.rest_state()

@@ -300,6 +300,11 @@ class FrictionDrive(DriveUnits, Scene):
         """
         return np.array([self.u10]), np.zeros(1), np.ones(1)
 
+    def shapes(self, q, t=0.0):
+        """The stator's hinge, the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m]) at ``t`` [s]."""
+        from ._drawing import rod_drive_shapes
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
+
     def painleve_margin(self, phi):
         """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""
         return 1.0 - float(self.mu[0]) * np.tan(phi)

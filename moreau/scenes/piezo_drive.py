@@ -576,6 +576,11 @@ class PiezoDrive(DriveUnits, Scene):
             q[2] = u1
         return q, v
 
+    def shapes(self, q, t=0.0):
+        """The stator's hinge (moving with the stack), the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m])."""
+        from ._drawing import rod_drive_shapes
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
+
     def initial_state(self):
         """The rest state :meth:`rest_state`."""
         return self.rest_state()

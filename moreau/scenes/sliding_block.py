@@ -149,6 +149,18 @@ class SlidingBlock(SIUnits, Scene):
         par = [math.sin(self.alpha), math.cos(self.alpha)]
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
+    def shapes(self, q, t=0.0):
+        """The plane (inclined by ``alpha``), the block (drawn 0.2 m wide, a point mass) and its contact."""
+        from ._drawing import contact, line, polygon
+        ca, sa = math.cos(self.alpha), math.sin(self.alpha)
+        ex, ey = np.array([ca, -sa]), np.array([sa, ca])   # along and across the plane
+        base = float(q[0]) * ex + float(q[1]) * ey
+        w = 0.1 * self.length
+        corners = [base - w * ex, base + w * ex, base + w * ex + 2 * w * ey,
+                   base - w * ex + 2 * w * ey]
+        return [line([base - 10 * w * ex, base + 10 * w * ex], role="ground"), polygon(corners),
+                contact(0, base, ey, ex)]
+
     # -- exact solution -------------------------------------------------------
     @property
     def sticks(self):

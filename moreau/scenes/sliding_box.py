@@ -168,6 +168,21 @@ class SlidingBox(SIUnits, Scene):
 
     angle_coordinates = (2,)
 
+    def shapes(self, q, t=0.0):
+        """The floor, the box (centre ``q[0:2]`` [m], tilt ``q[2]`` [rad]) and its two corner contacts."""
+        from ._drawing import contact, line, polygon
+        a, b = self.params.half_width, self.params.half_height
+        x, y, th = (float(v) for v in q)
+        c, s = math.cos(th), math.sin(th)
+
+        def world(u, w):
+            return (x + c * u - s * w, y + s * u + c * w)
+
+        out = [line([(x - 4 * a, 0.0), (x + 4 * a, 0.0)], role="ground"),
+               polygon([world(-a, -b), world(a, -b), world(a, b), world(-a, b)])]
+        return out + [contact(i, world(side * a, -b), (0.0, 1.0), (1.0, 0.0))
+                      for i, side in enumerate((-1.0, 1.0))]
+
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
 
