@@ -10,16 +10,11 @@ ffmpeg for an ``.mp4`` (where it is installed).
 
 Examples
 --------
->>> import tempfile, os
->>> from moreau.cli import main
->>> d = tempfile.mkdtemp()
->>> main(["run", "--scene", "bouncing-ball", "--scheme", "moreau-jean", "--duration", "0.5",
-...       "--steps", "200", "--samples", "40", "--out", d, "--no-plot", "--quiet"])  # doctest: +ELLIPSIS
-wrote ...
-0
->>> path, frames = animate_run(d, os.path.join(d, "ball.gif"), max_frames=10)
->>> frames
-10
+From the shell: ``moreau run --scene bouncing-ball --duration 2 --out run1`` then
+``moreau animate run1 --out ball.gif``. The frames are spread evenly in time:
+
+>>> frame_indices([0.0, 0.5, 1.0, 1.5, 2.0], 3).tolist()
+[0, 2, 4]
 """
 
 import csv
@@ -167,40 +162,48 @@ def animate_run(run, out, fps=20, max_frames=100, force=False):
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
     title = f"{meta['scene']} ({meta.get('scheme', '?')})"
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_aspect("equal")
+    ax.set_xlabel("x [m]")
+    ax.set_ylabel("y [m]")
+    drawn = []
 
     def draw(n):
-        ax.clear()
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
-        ax.set_aspect("equal")
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
+        # only the bodies change from frame to frame: the axes are drawn once
+        while drawn:
+            drawn.pop().remove()
         k = idx[n]
         ax.set_title(f"{title}  t = {t[k]:.4g} s", fontsize=9)
         for s in frames[n]:
             colour = "0.6" if s.get("role") in ("ground", "stator") else "C0"
             if s["kind"] == "circle":
-                ax.add_patch(Circle(s["centre"], s["radius"], fc=colour, ec="k", alpha=0.8))
+                drawn.append(ax.add_patch(Circle(s["centre"], s["radius"], fc=colour, ec="k",
+                                                 alpha=0.8)))
             elif s["kind"] == "polygon":
-                ax.add_patch(Polygon(s["points"], closed=True, fc=colour, ec="k", alpha=0.8))
+                drawn.append(ax.add_patch(Polygon(s["points"], closed=True, fc=colour, ec="k",
+                                                  alpha=0.8)))
             elif s["kind"] == "line":
                 xs, ys = zip(*s["points"])
-                ax.plot(xs, ys, "-", color="k" if colour != "C0" else "C0", lw=2)
+                drawn.extend(ax.plot(xs, ys, "-", color="k" if colour != "C0" else "C0", lw=2))
             elif s["kind"] == "contact":
                 (x, y), i = s["point"], s["index"]
-                ax.plot([x], [y], "o", color="C3", ms=4)
+                drawn.extend(ax.plot([x], [y], "o", color="C3", ms=4))
                 f = fN[k, i] * np.array(s["normal"]) + fT[k, i] * np.array(s["tangent"])
                 if arrow and np.hypot(*f) > 0:
-                    ax.annotate("", xy=(x + arrow * f[0], y + arrow * f[1]), xytext=(x, y),
-                                arrowprops=dict(arrowstyle="->", color="C3", lw=1.5))
-        return []
+                    drawn.append(ax.annotate(
+                        "", xy=(x + arrow * f[0], y + arrow * f[1]), xytext=(x, y),
+                        arrowprops=dict(arrowstyle="->", color="C3", lw=1.5)))
+        return drawn
 
-    anim = animation.FuncAnimation(fig, draw, frames=len(frames), interval=1000.0 / fps,
-                                   blit=False)
     writer = (animation.PillowWriter(fps=fps) if ext == ".gif"
               else animation.FFMpegWriter(fps=fps))
     try:
-        anim.save(out, writer=writer)
+        # the writer's own loop: one draw per frame (FuncAnimation.save draws each twice)
+        with writer.saving(fig, out, dpi=80):
+            for n in range(len(frames)):
+                draw(n)
+                writer.grab_frame()
     finally:
         plt.close(fig)
     return out, len(frames)

@@ -1,0 +1,121 @@
+"""`moreau suite`: the table against each problem's reference, a broken scheme flagged, the page."""
+
+import json
+import math
+import os
+import re
+
+import numpy as np
+import pytest
+
+from moreau.cli import main
+from moreau.errors import InputError
+from moreau.integrators.base import INTEGRATORS
+from moreau.integrators.moreau_jean import MoreauJean
+from moreau.suite.problem import PENDING, crossing_time, get_problem, problem_names
+from moreau.suite.report import write_report
+from moreau.suite.run import run_suite
+
+
+class _TooFast(MoreauJean):
+    """A test double: Moreau–Jean started 5 % too fast (a scheme with a wrong answer)."""
+
+    def __init__(self, scene, t0, q0, v0, t_bound, h=None):
+        super().__init__(scene, t0, q0, np.asarray(v0, float) * 1.05 - 0.05, t_bound, h=h)
+
+
+class _Crashes(MoreauJean):
+    """A test double whose step raises an exception that is not a MoreauError (a bug)."""
+
+    def __init__(self, scene, t0, q0, v0, t_bound, h=None):
+        super().__init__(scene, t0, q0, v0, t_bound, h=h)
+
+    def _step_impl(self):
+        raise RuntimeError("the double's step is broken")
+
+
+@pytest.fixture
+def doubles(monkeypatch):
+    monkeypatch.setitem(INTEGRATORS, "too-fast-double", _TooFast)
+    monkeypatch.setitem(INTEGRATORS, "crashing-double", _Crashes)
+
+
+def test_references_are_the_closed_forms():
+    # independent of the problem modules: drop from 0.6 onto r = 0.1 (g = 1): V = 1, t1 = 1,
+    # rebound 0.1 + (e V)^2 / 2, Zeno time t1 + 2 e V / (1 - e); block: v0^2 / (2 mu g), v0 / (mu g)
+    ball = get_problem("bouncing-ball").reference()
+    assert ball["first_impact_time"] == pytest.approx(math.sqrt(2 * 0.5), rel=1e-14)
+    assert ball["rebound_height"] == pytest.approx(0.1 + 0.5 ** 2 / 2, rel=1e-14)
+    assert ball["rest_time"] == pytest.approx(1.0 + 2 * 0.5 / 0.5, rel=1e-14)
+    block = get_problem("sliding-block").reference()
+    assert block["stopping_distance"] == pytest.approx(2.0 ** 2 / (2 * 0.5), rel=1e-14)
+    assert block["stopping_time"] == pytest.approx((1 - 1e-3) * 2.0 / 0.5, rel=1e-14)
+
+
+def test_subset_table_flags_and_page(tmp_path, doubles):
+    schemes = ["moreau-jean", "too-fast-double", "crashing-double", "stick-slip-exact"]
+    cache = tmp_path / "cells"
+    rep = run_suite(problems=["bouncing-ball", "sliding-block"], schemes=schemes, quick=True,
+                    cache_dir=str(cache), progress=False)
+    rows = {(r["problem"], r["scheme"], r["setting"]): r for r in rep["rows"]}
+    # Moreau-Jean at its finest quick step: every quantity within tolerance of the closed form
+    for prob, finest in (("bouncing-ball", "N=4000"), ("sliding-block", "N=1000")):
+        r = rows[(prob, "moreau-jean", finest)]
+        ref = get_problem(prob).reference()
+        scales = get_problem(prob).scales()
+        assert r["outcome"] == "ok", r
+        for q, v in ref.items():
+            assert abs(r["values"][q] - v) / scales[q] <= get_problem(prob).tolerance
+        # first order: ten times the steps, the first impact / the stop ten times closer
+        coarse = rows[(prob, "moreau-jean", "N=400" if prob == "bouncing-ball" else "N=100")]
+        q = "first_impact_time" if prob == "bouncing-ball" else "stopping_distance"
+        assert coarse["errors"][q] == pytest.approx(10 * r["errors"][q], rel=0.05)
+    # the broken doubles are flagged, each with its cause, and the suite went on
+    for prob in ("bouncing-ball", "sliding-block"):
+        fast = [r for k, r in rows.items() if k[:2] == (prob, "too-fast-double")]
+        assert fast and all(r["outcome"] == "inaccurate" for r in fast)
+        assert all("off by" in r["cause"] or "no value" in r["cause"] for r in fast)
+        crash = [r for k, r in rows.items() if k[:2] == (prob, "crashing-double")]
+        assert crash and all(r["outcome"] == "failed" for r in crash)
+        assert all(r["cause"].startswith("unexpected RuntimeError: the double's step")
+                   for r in crash)
+        # a scene's own reference scheme refuses another scene by name
+        (ref_row,) = [r for k, r in rows.items() if k[:2] == (prob, "stick-slip-exact")]
+        assert ref_row["outcome"] == "refused" and "StickSlipMotor" in ref_row["cause"]
+    # every cell was kept; a rerun reads them all back
+    again = run_suite(problems=["bouncing-ball", "sliding-block"], schemes=schemes, quick=True,
+                      cache_dir=str(cache), progress=False)
+    assert again["cells"]["cached"] == again["cells"]["total"] == len(rep["rows"])
+    assert [r["max_error"] for r in again["rows"]] == [r["max_error"] for r in rep["rows"]]
+    # the page links every figure it wrote, and every link resolves
+    paths = write_report(rep, str(tmp_path), settings={"quick": True})
+    page = (tmp_path / "index.md").read_text()
+    links = set(re.findall(r"\]\(([^)]+)\)", page))
+    figures = {p.name for p in tmp_path.glob("*.png")}
+    assert figures == {"overview.png", "wp_bouncing-ball.png", "wp_sliding-block.png"}
+    assert figures <= links
+    assert all((tmp_path / link).exists() for link in links)
+    for p in ("bouncing-ball", "sliding-block"):
+        assert get_problem(p).source in page
+    doc = json.loads((tmp_path / "suite.json").read_text())
+    assert doc["overview"]["bouncing-ball"]["crashing-double"]["outcome"] == "failed"
+    assert "provenance" in doc and paths["csv"].endswith("suite.csv")
+
+
+def test_cli_refuses_before_work(tmp_path, capsys):
+    assert main(["suite", "--problems", "no-such", "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "`problems` must name problems of the suite" in err and "bouncing-ball" in err
+    (tmp_path / "file").write_text("x")
+    assert main(["suite", "--out", str(tmp_path / "file")]) == 2
+    assert "is a file" in capsys.readouterr().err
+
+
+def test_registry_and_pending():
+    names = problem_names()
+    assert {"bouncing-ball", "painleve-rod", "ball-chain", "friction-drive", "sliding-block",
+            "sliding-box", "stick-slip-motor"} <= set(names)
+    assert "rocking-block" in PENDING or "rocking-block" in names
+    with pytest.raises(InputError, match="`problems` must name"):
+        get_problem("nope")
+    assert crossing_time([0.0, 1.0], [1.0, 2.0], 0.0) is None
