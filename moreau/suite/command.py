@@ -3,7 +3,7 @@
 import os
 import time
 
-from ..analysis.engine import check_output_dir
+from ..analysis.engine import check_jobs, check_output_dir
 from ..errors import InputError
 from ..outputs import claim_outputs
 
@@ -31,7 +31,8 @@ def _cmd_suite(args):
                                              "schemes": schemes}, args.force)
     t0 = time.perf_counter()
     report = run_suite(problems=problems, schemes=schemes, quick=args.quick,
-                       cache_dir=os.path.join(out, "cells"), progress=not args.quiet)
+                       cache_dir=os.path.join(out, "cells"), progress=not args.quiet,
+                       n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler)
     report["wall_time_s"] = time.perf_counter() - t0
     paths = write_report(report, out, settings=settings, plot=not args.no_plot)
     cells = report["cells"]
@@ -64,6 +65,11 @@ def add_commands(sub):
                         "OUT/cells and a rerun resumes from them")
     s.add_argument("--force", action="store_true",
                    help="replace the files of an earlier suite run with other settings")
+    s.add_argument("--jobs", type=int, default=1,
+                   help="local worker processes, as for `moreau sweep` (-1: one per core; "
+                        "default 1: the cells' CPU times are cleanest one at a time)")
+    s.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                   help="run the cells on this Dask scheduler (e.g. tcp://host:8786)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")
     s.add_argument("--no-plot", action="store_true", help="skip the figures")
     s.set_defaults(func=_cmd_suite)

@@ -171,25 +171,37 @@ def _warm_up(problem, scheme, options, scene):
         pass
 
 
-def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True):
-    """Run every scheme on every problem; return ``{"rows", "problems", "cells"}``.
+#: per process: the problems' instances, scenes and references, and the (problem, scheme)
+#: pairs already run once (compiled) in this process
+_INSTANCES = {}
+_WARMED = set()
 
-    Parameters
-    ----------
-    problems, schemes : sequence of str, optional
-        Names (all registered ones by default).
-    quick : bool
-        The problems' quick step counts and the schemes' quick settings.
-    cache_dir : str, optional
-        Where each finished cell is kept (and read back on a rerun).
-    progress : bool
-        A tqdm bar on a terminal.
 
-    Raises
-    ------
-    Interrupted
-        On Ctrl-C, after the cells finished so far are kept.
+def _instance(pname):
+    if pname not in _INSTANCES:
+        prob = get_problem(pname)
+        _INSTANCES[pname] = (prob, prob.make_scene(), prob.reference())
+    return _INSTANCES[pname]
+
+
+def cell_task(pname, scheme, label, options):
+    """One cell, computed in this process (a worker's task): its row.
+
+    The first cell of a (problem, scheme) pair in a process runs the scheme
+    once over a twentieth of the window first, untimed, so that numba's
+    compilation (or loading) is not counted in the cell's time.
     """
+    prob, scene, ref = _instance(pname)
+    if (pname, scheme) not in _WARMED:
+        _WARMED.add((pname, scheme))
+        _warm_up(prob, scheme, options, scene)
+    row = run_cell(prob, scheme, label, options, scene, ref)
+    row["cached"] = False
+    return row
+
+
+def plan_cells(problems=None, schemes=None, quick=False):
+    """``[(problem, scheme, label, options)]`` of every cell, checked names first."""
     known = problem_names()
     problems = list(known if problems is None else problems)
     for p in problems:
@@ -201,52 +213,129 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
             raise InputError(f"`schemes` must name registered schemes, from "
                              f"{', '.join(all_schemes)}; got {s!r}")
     plan = []
-    insts = {}
     for pname in problems:
-        prob = get_problem(pname)
-        scene = prob.make_scene()
-        insts[pname] = (prob, scene)
+        prob, scene, _ = _instance(pname)
         for s in schemes:
             try:
                 sets = settings_of(s, prob, scene, quick)
             except MoreauError:
                 sets = [("default", {})]
             plan += [(pname, s, label, opts) for label, opts in sets]
-    rows, done = [], 0
-    refs = {}
-    warmed = set()
+    return problems, schemes, plan
+
+
+def _read_cell(path):
+    try:
+        with open(path) as fh:
+            row = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    row["cached"] = True
+    return row
+
+
+def _keep_cell(path, row):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    tmp = path + f".{os.getpid()}.tmp"
+    with open(tmp, "w") as fh:
+        json.dump(row, fh, default=_json_default)
+    os.replace(tmp, path)
+
+
+def _results(plan, todo, n_jobs, scheduler):
+    """``(index, row)`` of the cells ``todo`` (indices into ``plan``), as they finish."""
+    if scheduler is not None:
+        from distributed import as_completed
+
+        from ..analysis.engine import connect_scheduler
+        client, own = connect_scheduler(scheduler)
+        try:
+            futures = {client.submit(cell_task, *plan[i], pure=False): i for i in todo}
+            for fut in as_completed(list(futures)):
+                i = futures[fut]
+                try:
+                    row = fut.result()
+                except Exception as exc:   # noqa: BLE001  (a lost worker: the cell fails)
+                    pname, s, label, _ = plan[i]
+                    row = {"problem": pname, "scheme": s, "setting": label, "outcome": "failed",
+                           "cause": "the Dask task failed: " + _cause(exc), "status": None,
+                           "values": {}, "errors": {}, "max_error": None, "tolerance": None,
+                           "cpu_s": None, "wall_s": None, "steps": None, "cached": False}
+                yield i, row
+        finally:
+            if own:
+                client.close()
+        return
+    if n_jobs == 1 or len(todo) <= 1:
+        for i in todo:
+            yield i, cell_task(*plan[i])
+        return
+    import joblib
+
+    from ..analysis.engine import _end_workers, end_worker_pool, worker_pool_config
+
+    with worker_pool_config():
+        par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
+    gen = par(joblib.delayed(_indexed_cell)(i, *plan[i]) for i in todo)
+    ok = False
+    try:
+        yield from gen
+        ok = True
+    finally:
+        if not ok:
+            _end_workers(gen)
+        end_worker_pool(kill=not ok)
+
+
+def _indexed_cell(i, *cell):
+    return i, cell_task(*cell)
+
+
+def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
+              n_jobs=1, scheduler=None):
+    """Run every scheme on every problem; return ``{"rows", "problems", "schemes", "cells"}``.
+
+    Parameters
+    ----------
+    problems, schemes : sequence of str, optional
+        Names (all registered ones by default).
+    quick : bool
+        The problems' quick step counts and the schemes' quick settings.
+    cache_dir : str, optional
+        Where each finished cell is kept (and read back on a rerun).
+    progress : bool
+        A tqdm bar on a terminal.
+    n_jobs : int
+        Local worker processes (the pool of ``moreau sweep``; 1: in this process).
+    scheduler : str, optional
+        A Dask scheduler's address: the cells run there instead.
+
+    Raises
+    ------
+    Interrupted
+        On Ctrl-C, after the cells finished so far are kept.
+    """
+    problems, schemes, plan = plan_cells(problems, schemes, quick)
+    rows = [None] * len(plan)
+    todo = []
+    for i, (pname, s, label, _) in enumerate(plan):
+        path = cell_path(cache_dir, pname, s, label) if cache_dir else None
+        row = _read_cell(path) if path and os.path.exists(path) else None
+        if row is None:
+            todo.append(i)
+        else:
+            rows[i] = row
+    done = len(plan) - len(todo)
     bar = None
     if progress:
         from tqdm import tqdm
-        bar = tqdm(total=len(plan), desc="suite", unit="cell", disable=None)
+        bar = tqdm(total=len(plan), initial=done, desc="suite", unit="cell", disable=None)
     try:
         with propagate_interrupts():
-            for pname, s, label, opts in plan:
-                path = cell_path(cache_dir, pname, s, label) if cache_dir else None
-                row = None
-                if path and os.path.exists(path):
-                    try:
-                        with open(path) as fh:
-                            row = json.load(fh)
-                        row["cached"] = True
-                    except (OSError, ValueError):
-                        row = None
-                if row is None:
-                    prob, scene = insts[pname]
-                    if pname not in refs:
-                        refs[pname] = prob.reference()
-                    if (pname, s) not in warmed:
-                        warmed.add((pname, s))
-                        _warm_up(prob, s, opts, scene)
-                    row = run_cell(prob, s, label, opts, scene, refs[pname])
-                    row["cached"] = False
-                    if path:
-                        os.makedirs(os.path.dirname(path), exist_ok=True)
-                        tmp = path + ".tmp"
-                        with open(tmp, "w") as fh:
-                            json.dump(row, fh, default=_json_default)
-                        os.replace(tmp, path)
-                rows.append(row)
+            for i, row in _results(plan, todo, n_jobs, scheduler):
+                rows[i] = row
+                if cache_dir:
+                    _keep_cell(cell_path(cache_dir, *plan[i][:3]), row)
                 done += 1
                 if bar is not None:
                     bar.update(1)
@@ -255,7 +344,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     finally:
         if bar is not None:
             bar.close()
-    return {"rows": rows, "problems": [insts[p][0].describe() for p in problems],
+    return {"rows": rows, "problems": [_instance(p)[0].describe() for p in problems],
             "schemes": schemes, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
                                           "computed": sum(1 for r in rows if not r.get("cached"))}}

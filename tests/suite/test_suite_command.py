@@ -119,3 +119,14 @@ def test_registry_and_pending():
     with pytest.raises(InputError, match="`problems` must name"):
         get_problem("nope")
     assert crossing_time([0.0, 1.0], [1.0, 2.0], 0.0) is None
+
+
+@pytest.mark.slow
+def test_worker_pool_gives_the_same_table(tmp_path):
+    kw = dict(problems=["sliding-block", "painleve-rod"], schemes=["moreau-jean", "event-driven"],
+              quick=True, progress=False)
+    one = run_suite(cache_dir=str(tmp_path / "a"), n_jobs=1, **kw)
+    two = run_suite(cache_dir=str(tmp_path / "b"), n_jobs=2, **kw)
+    assert [(r["problem"], r["scheme"], r["setting"], r["outcome"], r["max_error"])
+            for r in one["rows"]] == [(r["problem"], r["scheme"], r["setting"], r["outcome"],
+                                       r["max_error"]) for r in two["rows"]]
