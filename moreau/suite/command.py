@@ -25,6 +25,10 @@ def _cmd_suite(args):
     from .run import run_suite
 
     out = check_output_dir(args.out)
+    hist = None
+    if args.compare_to is not None:
+        from .history import load_history
+        hist = load_history(args.compare_to)       # a bad history is refused before any work
     problems = _names(args.problems, "--problems")
     schemes = _names(args.schemes, "--schemes")
     settings = claim_outputs(out / "suite", {"quick": bool(args.quick), "problems": problems,
@@ -34,12 +38,35 @@ def _cmd_suite(args):
                        cache_dir=os.path.join(out, "cells"), progress=not args.quiet,
                        n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler)
     report["wall_time_s"] = time.perf_counter() - t0
+    if hist is not None:
+        from ..analysis.regression import calibration_time
+        from .history import compare_to_history, record_run
+        from .run import cell_task
+
+        calibration = calibration_time()
+        report["flags"] = compare_to_history(
+            report["rows"], hist, calibration=calibration,
+            rerun=lambda r: cell_task(r["problem"], r["scheme"], r["setting"],
+                                      _options(r, args.quick)))
+        record_run(args.compare_to, hist, report["rows"], calibration, args.quick)
     paths = write_report(report, out, settings=settings, plot=not args.no_plot)
     cells = report["cells"]
+    if hist is not None:
+        flags = report["flags"]
+        print(f"{len(flags)} flag(s) against {args.compare_to}" + (":" if flags else ""))
+        for f in flags:
+            print(f"  FLAG {f['kind']}: {f['text']}")
     print(format_overview(report["rows"], report["schemes"]))
     print(f"({cells['total']} cells: {cells['computed']} computed, {cells['cached']} from "
           f"{os.path.join(out, 'cells')}; {report['wall_time_s']:.1f} s)")
     print(f"wrote {len(paths)} files; start with {paths['page']}")
+
+
+def _options(row, quick):
+    from .run import _instance, settings_of
+
+    prob, scene, _ = _instance(row["problem"])
+    return dict(settings_of(row["scheme"], prob, scene, quick))[row["setting"]]
 
 
 def _cmd_animate(args):
@@ -65,6 +92,11 @@ def add_commands(sub):
                         "OUT/cells and a rerun resumes from them")
     s.add_argument("--force", action="store_true",
                    help="replace the files of an earlier suite run with other settings")
+    s.add_argument("--compare-to", default=None, metavar="HISTORY",
+                   help="flag the cells that regressed against the history file HISTORY "
+                        "(outcome changed, error grown above the tolerance, time over 1.5x "
+                        "this machine's median, rerun first), then record this run in it "
+                        "(created if missing; benchmarks/baselines.json's format)")
     s.add_argument("--jobs", type=int, default=1,
                    help="local worker processes, as for `moreau sweep` (-1: one per core; "
                         "default 1: the cells' CPU times are cleanest one at a time)")

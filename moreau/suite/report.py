@@ -207,6 +207,12 @@ def _page(report, figures, prov, settings):
              "named), **refused** (the scheme declined the problem by name). The overview "
              "shows each scheme at its finest setting; errors are relative to each "
              "quantity's scale. Data: [suite.csv](suite.csv), [suite.json](suite.json).", ""]
+    if report.get("flags") is not None:
+        flags = report["flags"]
+        lines += ["## Flags against the history", ""]
+        lines += ([f"- **{f['kind']}**: {f['text']}" for f in flags] if flags
+                  else ["None: no cell regressed."])
+        lines.append("")
     if "overview" in figures:
         lines += [f"![overview]({figures['overview']})", ""]
     lines += [format_overview(rows, schemes), ""]

@@ -130,3 +130,28 @@ def test_worker_pool_gives_the_same_table(tmp_path):
     assert [(r["problem"], r["scheme"], r["setting"], r["outcome"], r["max_error"])
             for r in one["rows"]] == [(r["problem"], r["scheme"], r["setting"], r["outcome"],
                                        r["max_error"]) for r in two["rows"]]
+
+
+def test_compare_to_history_flags_first(tmp_path, capsys):
+    hist = tmp_path / "history.json"
+    args = ["suite", "--quick", "--problems", "sliding-block", "--schemes", "moreau-jean",
+            "--no-plot", "--quiet", "--compare-to", str(hist)]
+    assert main(args + ["--out", str(tmp_path / "a")]) == 0
+    assert "0 flag(s)" in capsys.readouterr().out
+    doc = json.loads(hist.read_text())
+    (entry,) = doc["machines"].values()
+    cells = entry["suite_runs"][-1]["cells"]
+    assert cells["sliding-block/moreau-jean/N=1000"]["outcome"] == "ok"
+    # a history in which the coarse cell was ok with a tiny error: now its outcome changed
+    # and its error grew above the tolerance
+    cells["sliding-block/moreau-jean/N=100"].update(outcome="ok", max_error=1e-6)
+    hist.write_text(json.dumps(doc))
+    assert main(args + ["--out", str(tmp_path / "b")]) == 0
+    out = capsys.readouterr().out
+    assert out.index("FLAG outcome: sliding-block/moreau-jean/N=100: outcome ok -> "
+                     "inaccurate") < out.index("| problem |")
+    assert "FLAG error: sliding-block/moreau-jean/N=100: error 1e-06 -> 0.015" in out
+    page = (tmp_path / "b" / "index.md").read_text()
+    assert page.index("## Flags against the history") < page.index("| problem |")
+    assert len(json.loads(hist.read_text())["machines"][next(iter(doc["machines"]))][
+        "suite_runs"]) == 2
