@@ -28,6 +28,9 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
+from ._units import DriveUnits
+
 __all__ = ["circle", "polygon", "line", "contact", "scene_state", "rod_drive_shapes"]
 
 
@@ -58,10 +61,8 @@ def scene_state(scene, q, t):
     """``(q, t)`` in the scene's own units from SI coordinates ``q`` and time ``t`` [s]."""
     q = np.asarray(q, dtype=float).reshape(-1)
     if q.size != scene.ndof:
-        from ..errors import InputError
         raise InputError(f"`q` must have {scene.ndof} coordinates for scene {scene.name!r}, "
                          f"got {q.size}")
-    from ._units import DriveUnits
     if isinstance(scene, DriveUnits):     # a drive: lengths over the rod length, tau = w t
         angles = set(getattr(scene, "angle_coordinates", ()))
         scale = np.array([1.0 if i in angles else scene.params.length for i in range(q.size)])

@@ -50,6 +50,7 @@ from .._validate import (finite_array, finite_scalar, in_closed_interval, nonneg
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
+from ._drawing import circle, contact
 from ._units import SIUnits
 from .base import Scene, params_with
 from .registry import SceneEntry, parameters_of, register_scene
@@ -193,7 +194,6 @@ class BallChain(SIUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """The balls (centres ``q`` [m] on a line) and the contacts between neighbours."""
-        from ._drawing import circle, contact
         r = self.params.radius
         x = np.asarray(q, dtype=float)
         return ([circle((xi, 0.0), r) for xi in x]

@@ -68,6 +68,7 @@ import numpy as np
 
 from .. import _validate as V
 from ..errors import InputError
+from ._drawing import rod_drive_shapes
 from ._units import DriveUnits
 from numba import njit
 
@@ -348,7 +349,6 @@ class BidirectionalDrive(DriveUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """Both rods (``q[0:2]`` [rad], mirror images) and the rotor (``q[2]`` [m]) at ``t`` [s]."""
-        from ._drawing import rod_drive_shapes
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0), (1, -1.0)], rotor=2)
 
     def rest_state(self, tau=0.0):

@@ -44,6 +44,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
+from ._drawing import contact, line
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -191,7 +192,6 @@ class PainleveRod(SIUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """The floor, the rod (centre ``q[0:2]`` [m], angle ``q[2]`` [rad]) and its tip's contact."""
-        from ._drawing import contact, line
         ell = self.length                      # the half-length
         x, y, phi = (float(v) for v in q)
         d = (ell * math.cos(phi), ell * math.sin(phi))

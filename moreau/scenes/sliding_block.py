@@ -27,6 +27,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
+from ._drawing import contact, line, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -151,7 +152,6 @@ class SlidingBlock(SIUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """The plane (inclined by ``alpha``), the block (drawn 0.2 m wide, a point mass) and its contact."""
-        from ._drawing import contact, line, polygon
         ca, sa = math.cos(self.alpha), math.sin(self.alpha)
         ex, ey = np.array([ca, -sa]), np.array([sa, ca])   # along and across the plane
         base = float(q[0]) * ex + float(q[1]) * ey

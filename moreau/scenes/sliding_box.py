@@ -44,6 +44,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
+from ._drawing import contact, line, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -170,7 +171,6 @@ class SlidingBox(SIUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """The floor, the box (centre ``q[0:2]`` [m], tilt ``q[2]`` [rad]) and its two corner contacts."""
-        from ._drawing import contact, line, polygon
         a, b = self.params.half_width, self.params.half_height
         x, y, th = (float(v) for v in q)
         c, s = math.cos(th), math.sin(th)

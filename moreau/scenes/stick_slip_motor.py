@@ -38,6 +38,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ..errors import InputError
+from ._drawing import contact, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -396,7 +397,6 @@ class StickSlipMotor(SIUnits, Scene):
 
     def shapes(self, q, t=0.0):
         """The stator (at its prescribed displacement at ``t`` [s]), the slider (``q[0]`` [m]) and their contact."""
-        from ._drawing import contact, polygon
         X = self.params.amplitude
         s = float(self.drive(float(t) / self.time)[0]) * X
         x, y = float(q[0]), float(q[1])

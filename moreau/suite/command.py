@@ -4,8 +4,13 @@ import os
 import time
 
 from ..analysis.engine import check_jobs, check_output_dir
+from ..analysis.regression import calibration_time
 from ..errors import InputError
 from ..outputs import claim_outputs
+from .animate import animate_run
+from .history import compare_to_history, load_history, record_run
+from .report import format_overview, write_report
+from .run import cell_task, instance, run_suite, settings_of
 
 __all__ = ["add_commands"]
 
@@ -21,13 +26,10 @@ def _names(text, option):
 
 def _cmd_suite(args):
     """``moreau suite``: every registered scheme on every problem of the suite."""
-    from .report import format_overview, write_report
-    from .run import run_suite
 
     out = check_output_dir(args.out)
     hist = None
     if args.compare_to is not None:
-        from .history import load_history
         hist = load_history(args.compare_to)       # a bad history is refused before any work
     problems = _names(args.problems, "--problems")
     schemes = _names(args.schemes, "--schemes")
@@ -39,9 +41,6 @@ def _cmd_suite(args):
                        n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler)
     report["wall_time_s"] = time.perf_counter() - t0
     if hist is not None:
-        from ..analysis.regression import calibration_time
-        from .history import compare_to_history, record_run
-        from .run import cell_task
 
         calibration = calibration_time()
         report["flags"] = compare_to_history(
@@ -63,14 +62,12 @@ def _cmd_suite(args):
 
 
 def _options(row, quick):
-    from .run import _instance, settings_of
 
-    prob, scene, _ = _instance(row["problem"])
+    prob, scene, _ = instance(row["problem"])
     return dict(settings_of(row["scheme"], prob, scene, quick))[row["setting"]]
 
 
 def _cmd_animate(args):
-    from .animate import animate_run
 
     path, frames = animate_run(args.run, args.out, fps=args.fps, max_frames=args.frames,
                                force=args.force)

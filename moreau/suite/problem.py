@@ -39,6 +39,7 @@ import pkgutil
 import numpy as np
 
 from ..errors import InputError
+from ..scenes.registry import make_scene
 
 __all__ = ["Problem", "register_problem", "get_problem", "problem_names", "problems",
            "discover", "PENDING", "crossing_time"]
@@ -71,7 +72,6 @@ class Problem:
         return {}
 
     def make_scene(self):
-        from ..scenes.registry import make_scene
         return make_scene(self.scene, **self.scene_parameters())
 
     def start(self, scene):

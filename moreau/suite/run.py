@@ -29,8 +29,13 @@ import math
 import os
 import re
 import time
+import warnings
 
+import joblib
 import numpy as np
+from tqdm import tqdm
+
+from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_config
 
 from ..errors import InputError, Interrupted, MoreauError
 from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
@@ -177,7 +182,7 @@ _INSTANCES = {}
 _WARMED = set()
 
 
-def _instance(pname):
+def instance(pname):
     if pname not in _INSTANCES:
         prob = get_problem(pname)
         _INSTANCES[pname] = (prob, prob.make_scene(), prob.reference())
@@ -191,7 +196,7 @@ def cell_task(pname, scheme, label, options):
     once over a twentieth of the window first, untimed, so that numba's
     compilation (or loading) is not counted in the cell's time.
     """
-    prob, scene, ref = _instance(pname)
+    prob, scene, ref = instance(pname)
     if (pname, scheme) not in _WARMED:
         _WARMED.add((pname, scheme))
         _warm_up(prob, scheme, options, scene)
@@ -214,7 +219,7 @@ def plan_cells(problems=None, schemes=None, quick=False):
                              f"{', '.join(all_schemes)}; got {s!r}")
     plan = []
     for pname in problems:
-        prob, scene, _ = _instance(pname)
+        prob, scene, _ = instance(pname)
         for s in schemes:
             try:
                 sets = settings_of(s, prob, scene, quick)
@@ -245,9 +250,7 @@ def _keep_cell(path, row):
 def _results(plan, todo, n_jobs, scheduler):
     """``(index, row)`` of the cells ``todo`` (indices into ``plan``), as they finish."""
     if scheduler is not None:
-        from distributed import as_completed
-
-        from ..analysis.engine import connect_scheduler
+        from distributed import as_completed  # optional dependency, checked by the CLI
         client, own = connect_scheduler(scheduler)
         try:
             futures = {client.submit(cell_task, *plan[i], pure=False): i for i in todo}
@@ -270,10 +273,6 @@ def _results(plan, todo, n_jobs, scheduler):
         for i in todo:
             yield i, cell_task(*plan[i])
         return
-    import joblib
-
-    from ..analysis.engine import _end_workers, end_worker_pool, worker_pool_config
-
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
     gen = par(joblib.delayed(_indexed_cell)(i, *plan[i]) for i in todo)
@@ -283,7 +282,10 @@ def _results(plan, todo, n_jobs, scheduler):
         ok = True
     finally:
         if not ok:
-            _end_workers(gen)
+            # closing joblib's generator stops handing out cells (Ctrl-C, an error)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                gen.close()
         end_worker_pool(kill=not ok)
 
 
@@ -328,7 +330,6 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     done = len(plan) - len(todo)
     bar = None
     if progress:
-        from tqdm import tqdm
         bar = tqdm(total=len(plan), initial=done, desc="suite", unit="cell", disable=None)
     try:
         with propagate_interrupts():
@@ -344,7 +345,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     finally:
         if bar is not None:
             bar.close()
-    return {"rows": rows, "problems": [_instance(p)[0].describe() for p in problems],
+    return {"rows": rows, "problems": [instance(p)[0].describe() for p in problems],
             "schemes": schemes, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
                                           "computed": sum(1 for r in rows if not r.get("cached"))}}

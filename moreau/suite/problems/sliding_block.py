@@ -9,7 +9,7 @@ from ..problem import Problem, crossing_time, register_problem
 STOP_FRACTION = 1e-3
 
 
-class _Stops(Problem):
+class StoppingProblem(Problem):
     """Shared by the block and the box: launched at ``speed``, decelerated by ``mu g`` until it sticks."""
 
     reference_kind = "closed form"
@@ -57,7 +57,7 @@ class _Stops(Problem):
 
 
 @register_problem
-class SlidingBlockProblem(_Stops):
+class SlidingBlockProblem(StoppingProblem):
     """The block launched at 2 (scene units) with ``mu = 0.5``: ``d = v0^2 / (2 mu g)``, ``t = v0 / (mu g)``."""
 
     name = "sliding-block"

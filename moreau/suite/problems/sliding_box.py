@@ -2,11 +2,11 @@
 
 from ...scenes.sliding_box import SlidingBoxCase
 from ..problem import register_problem
-from .sliding_block import _Stops
+from .sliding_block import StoppingProblem
 
 
 @register_problem
-class SlidingBoxProblem(_Stops):
+class SlidingBoxProblem(StoppingProblem):
     """The box launched at 1 (scene units) with ``mu = 0.4``: both corners stop together."""
 
     name = "sliding-box"
