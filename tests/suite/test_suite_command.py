@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from moreau.cli import main
-from moreau.errors import InputError
+from moreau.errors import InputError, Interrupted
 from moreau.integrators.base import INTEGRATORS
 from moreau.integrators.moreau_jean import MoreauJean
 from moreau.suite.problem import PENDING, crossing_time, get_problem, problem_names
@@ -155,3 +155,31 @@ def test_compare_to_history_flags_first(tmp_path, capsys):
     assert page.index("## Flags against the history") < page.index("| problem |")
     assert len(json.loads(hist.read_text())["machines"][next(iter(doc["machines"]))][
         "suite_runs"]) == 2
+
+
+class _Interrupts(MoreauJean):
+    """A test double: its second run is interrupted (Ctrl-C) at its first step."""
+
+    runs = 0
+
+    def __init__(self, scene, t0, q0, v0, t_bound, h=None):
+        super().__init__(scene, t0, q0, v0, t_bound, h=h)
+        type(self).runs += 1
+        self.stop = type(self).runs == 3       # the warm-up run, the first cell, the second
+
+    def _step_impl(self):
+        if self.stop:
+            raise KeyboardInterrupt
+        super()._step_impl()
+
+
+def test_an_interrupted_suite_keeps_its_cells_and_resumes(tmp_path, monkeypatch):
+    monkeypatch.setitem(INTEGRATORS, "interrupting-double", _Interrupts)
+    kw = dict(problems=["sliding-block"], schemes=["interrupting-double"], quick=True,
+              cache_dir=str(tmp_path), progress=False)
+    with pytest.raises(Interrupted, match="suite: 1 of 2 cells finished"):
+        run_suite(**kw)
+    assert [p.name for p in tmp_path.rglob("*.json")] == ["N=100.json"]
+    rep = run_suite(**kw)
+    assert rep["cells"] == {"total": 2, "cached": 1, "computed": 1}
+    assert [r["outcome"] for r in rep["rows"]] == ["inaccurate", "ok"]
