@@ -34,11 +34,13 @@ def _cmd_suite(args):
     problems = _names(args.problems, "--problems")
     schemes = _names(args.schemes, "--schemes")
     settings = claim_outputs(out / "suite", {"quick": bool(args.quick), "problems": problems,
-                                             "schemes": schemes}, args.force)
+                                             "schemes": schemes,
+                                             "peers": not args.no_peers}, args.force)
     t0 = time.perf_counter()
     report = run_suite(problems=problems, schemes=schemes, quick=args.quick,
                        cache_dir=os.path.join(out, "cells"), progress=not args.quiet,
-                       n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler)
+                       n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler,
+                       peers=not args.no_peers)
     report["wall_time_s"] = time.perf_counter() - t0
     if hist is not None:
 
@@ -94,6 +96,9 @@ def add_commands(sub):
                         "(outcome changed, error grown above the tolerance, time over 1.5x "
                         "this machine's median, rerun first), then record this run in it "
                         "(created if missing; benchmarks/baselines.json's format)")
+    s.add_argument("--no-peers", action="store_true",
+                   help="leave out Siconos's OSIs (columns by default where Siconos is "
+                        "installed, /usr/bin/python3)")
     s.add_argument("--jobs", type=int, default=1,
                    help="local worker processes, as for `moreau sweep` (-1: one per core; "
                         "default 1: the cells' CPU times are cleanest one at a time)")

@@ -40,6 +40,7 @@ from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_co
 from ..errors import InputError, Interrupted, MoreauError
 from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
 from ..scenes.registry import discover as discover_scenes
+from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
 from .problem import get_problem, problem_names
 
 __all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS"]
@@ -84,6 +85,8 @@ def settings_of(name, problem, scene, quick=False):
     >>> [label for label, _ in settings_of("moreau-jean", p, p.make_scene(), quick=True)]
     ['N=400', 'N=4000']
     """
+    if is_peer(name):
+        return [(PEER_SETTING, {})]
     cls, takes = _options_of(name, scene)
     extra = {}
     if "sample_dt" in takes:
@@ -197,6 +200,10 @@ def cell_task(pname, scheme, label, options):
     compilation (or loading) is not counted in the cell's time.
     """
     prob, scene, ref = instance(pname)
+    if is_peer(scheme):
+        row = run_peer_cell(prob, scheme, scene, ref)
+        row["cached"] = False
+        return row
     if (pname, scheme) not in _WARMED:
         _WARMED.add((pname, scheme))
         _warm_up(prob, scheme, options, scene)
@@ -205,16 +212,22 @@ def cell_task(pname, scheme, label, options):
     return row
 
 
-def plan_cells(problems=None, schemes=None, quick=False):
-    """``[(problem, scheme, label, options)]`` of every cell, checked names first."""
+def plan_cells(problems=None, schemes=None, quick=False, peers=True):
+    """``[(problem, scheme, label, options)]`` of every cell, checked names first.
+
+    Without ``schemes``: every registered scheme, and the Siconos peers where
+    they are installed (``peers``).
+    """
     known = problem_names()
     problems = list(known if problems is None else problems)
     for p in problems:
         get_problem(p)
-    all_schemes = scheme_names()
+    # asking the system interpreter for Siconos takes seconds: only where a peer may run
+    wants_peers = peers and (schemes is None or any(is_peer(s) for s in schemes))
+    all_schemes = scheme_names() + (peer_names() if wants_peers else [])
     schemes = list(all_schemes if schemes is None else schemes)
     for s in schemes:
-        if s not in INTEGRATORS:
+        if s not in all_schemes:
             raise InputError(f"`schemes` must name registered schemes, from "
                              f"{', '.join(all_schemes)}; got {s!r}")
     plan = []
@@ -294,7 +307,7 @@ def _indexed_cell(i, *cell):
 
 
 def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
-              n_jobs=1, scheduler=None):
+              n_jobs=1, scheduler=None, peers=True):
     """Run every scheme on every problem; return ``{"rows", "problems", "schemes", "cells"}``.
 
     Parameters
@@ -307,6 +320,9 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
         Where each finished cell is kept (and read back on a rerun).
     progress : bool
         A tqdm bar on a terminal.
+    peers : bool
+        Without ``schemes``, add Siconos's OSIs as columns where Siconos is
+        installed (:mod:`moreau.suite.peers`).
     n_jobs : int
         Local worker processes (the pool of ``moreau sweep``; 1: in this process).
     scheduler : str, optional
@@ -317,7 +333,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     Interrupted
         On Ctrl-C, after the cells finished so far are kept.
     """
-    problems, schemes, plan = plan_cells(problems, schemes, quick)
+    problems, schemes, plan = plan_cells(problems, schemes, quick, peers)
     rows = [None] * len(plan)
     todo = []
     for i, (pname, s, label, _) in enumerate(plan):

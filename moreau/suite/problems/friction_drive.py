@@ -1,5 +1,6 @@
 """The paper's friction drive at 185 Hz: displacement per period against the event-driven reference."""
 
+import json
 import math
 
 from ...scenes.friction_drive import FrictionDriveCase
@@ -51,6 +52,19 @@ class FrictionDriveProblem(Problem):
 
     def scales(self):
         return {"displacement_per_period": abs(self.reference()["displacement_per_period"])}
+
+    def siconos_case(self, scene):
+        """The peer script's friction drive from the same periodic state, one period."""
+        q0, v0 = self.start(scene)
+        par = {"label": self.name, "J": scene.J, "P": scene.P, "u10": scene.u10, "fL": scene.fL,
+               "sin_phi0": scene.sin_phi0, "mu": float(scene.mu[0]),
+               "e": float(scene.restitution[0]), "q0": [float(x) for x in q0],
+               "v0": [float(x) for x in v0]}
+        return "friction-drive", ["--fd-params", json.dumps(par), "--periods", "1"]
+
+    def siconos_values(self, out):
+        u2 = out["u2_periods"]
+        return {"displacement_per_period": float(u2[-1] - u2[0])}
 
     def measure(self, scene, res):
         return {"displacement_per_period": float(res.q[-1, 1] - res.q[0, 1])}
