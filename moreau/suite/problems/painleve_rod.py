@@ -1,7 +1,5 @@
 """The Painlevé rod sliding on its tip, on the well-posed side of the Painlevé condition."""
 
-import numpy as np
-
 from ...scenes.painleve_rod import PainleveRodCase
 from ..problem import Problem, register_problem
 
@@ -44,16 +42,20 @@ class PainleveRodProblem(Problem):
     def start(self, scene):
         return self._the_case().start()
 
+    _ref = None
+
     def reference(self):
-        sol = self._the_case()._ode(self._the_case().tight_rtol)
-        return {"x_centre_end": float(sol.y[0, -1]), "phi_end": float(sol.y[2, -1])}
+        if self._ref is None:
+            sol = self._the_case()._ode(self._the_case().tight_rtol)
+            self._ref = {"x_centre_end": float(sol.y[0, -1]), "phi_end": float(sol.y[2, -1])}
+        return dict(self._ref)
 
     def scales(self):
         # relative to the motion over the window
         q0, _ = self._the_case().start()
         ref = self.reference()
-        return {"x_centre_end": abs(ref["x_centre_end"] - q0[0]),
-                "phi_end": abs(ref["phi_end"] - q0[2])}
+        return {"x_centre_end": float(abs(ref["x_centre_end"] - q0[0])),
+                "phi_end": float(abs(ref["phi_end"] - q0[2]))}
 
     def measure(self, scene, res):
         return {"x_centre_end": float(res.q[-1, 0]), "phi_end": float(res.q[-1, 2])}
