@@ -151,7 +151,7 @@ class SlidingBlock(SIUnits, Scene):
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
     def shapes(self, q, t=0.0):
-        """The plane (inclined by ``alpha``), the block (drawn 0.2 m wide, a point mass) and its contact."""
+        """The plane (inclined by ``alpha``), the block (a point mass, drawn 0.2 length units wide) and its contact."""
         ca, sa = math.cos(self.alpha), math.sin(self.alpha)
         ex, ey = np.array([ca, -sa]), np.array([sa, ca])   # along and across the plane
         base = float(q[0]) * ex + float(q[1]) * ey

@@ -27,7 +27,7 @@ import numpy as np
 from ..errors import InputError
 from ..scenes.registry import make_scene
 
-__all__ = ["load_run", "animate_run", "frame_indices"]
+__all__ = ["load_run", "animate_run", "write_animation", "frame_indices"]
 
 
 def _find(run):
@@ -125,11 +125,14 @@ def animate_run(run, out, fps=20, max_frames=100, force=False):
     exists (unless ``force``), a suffix other than .gif/.mp4, an .mp4 where
     ffmpeg is missing, and a scene that cannot draw itself.
     """
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    _check_out(out, fps, max_frames, force)
+    scene, meta, cols = load_run(run)
+    return write_animation(scene, cols, out, f"{meta['scene']} ({meta.get('scheme', '?')})",
+                           fps=fps, max_frames=max_frames)
+
+
+def _check_out(out, fps, max_frames, force):
     from matplotlib import animation
-    from matplotlib.patches import Circle, Polygon
 
     ext = os.path.splitext(str(out))[1].lower()
     if ext not in (".gif", ".mp4"):
@@ -146,7 +149,22 @@ def animate_run(run, out, fps=20, max_frames=100, force=False):
     if ext == ".mp4" and not animation.FFMpegWriter.isAvailable():
         raise InputError("`--out` .mp4 needs ffmpeg, which is not installed here; write a .gif "
                          "(Pillow) instead")
-    scene, meta, cols = load_run(run)
+
+
+def write_animation(scene, cols, out, title, fps=20, max_frames=100):
+    """Draw ``scene`` along the SI columns ``cols`` (``t``, ``q_i``, ``force_N_i``, ``force_T_i``).
+
+    ``cols`` maps the names of ``Scene.si_columns`` (without units) to
+    arrays, as :func:`load_run` reads them. Writes ``out`` (.gif: Pillow,
+    .mp4: ffmpeg) and returns ``(path, frames)``.
+    """
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib import animation
+    from matplotlib.patches import Circle, Polygon
+
+    ext = os.path.splitext(str(out))[1].lower()
     t = cols["t"]
     idx = frame_indices(t, max_frames)
     q = np.column_stack([cols[f"q_{i}"] for i in range(scene.ndof)])
@@ -161,7 +179,6 @@ def animate_run(run, out, fps=20, max_frames=100, force=False):
     arrow = 0.25 * span / fmax if fmax > 0 else 0.0
 
     fig, ax = plt.subplots(figsize=(6, 4.5))
-    title = f"{meta['scene']} ({meta.get('scheme', '?')})"
     ax.set_xlim(lo[0], hi[0])
     ax.set_ylim(lo[1], hi[1])
     ax.set_aspect("equal")

@@ -23,9 +23,12 @@ import json
 import math
 import os
 
+from ..errors import MoreauError
+from ..integrators.base import simulate
 from ..provenance import provenance
-from .problem import PENDING
-from .run import OUTCOMES
+from .animate import write_animation
+from .problem import PENDING, get_problem
+from .run import OUTCOMES, settings_of
 
 __all__ = ["overview", "write_report", "format_overview", "OUTCOME_COLOURS"]
 
@@ -159,8 +162,34 @@ def plot_overview(rows, problems, schemes, path):
     plt.close(fig)
 
 
-def write_report(report, out, settings=None, plot=True):
-    """Write the table, figures and ``index.md`` of a suite run to ``out``; return the paths."""
+def animate_problem(name, path, frames=30):
+    """A short animation of problem ``name``: its event-driven run over the window, drawn.
+
+    Returns ``(path, None)``, or ``(None, cause)`` where the run stops or
+    the scene cannot draw itself.
+    """
+    prob = get_problem(name)
+    scene = prob.make_scene()
+    q0, v0 = prob.start(scene)
+    try:
+        label, opts = settings_of("event-driven", prob, scene, quick=True)[-1]
+        res = simulate(scene, (0.0, prob.window), q0, v0, "event-driven", **opts)
+        if not res.success:
+            return None, f"the event-driven run stopped: {res.message}"
+        cols = {n: c for n, _, c in scene.si_columns(res)}
+        write_animation(scene, cols, path, f"{prob.title} (event-driven, {label})",
+                        fps=10, max_frames=frames)
+    except MoreauError as exc:
+        return None, f"{type(exc).__name__}: {exc}"
+    return path, None
+
+
+def write_report(report, out, settings=None, plot=True, animation_frames=30):
+    """Write the table, figures and ``index.md`` of a suite run to ``out``; return the paths.
+
+    With ``plot``, each problem also gets a short animation (``anim_<name>.gif``,
+    at most ``animation_frames`` frames; 0: none) of its event-driven run.
+    """
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
     paths = {}
     paths["csv"] = os.path.join(out, "suite.csv")
@@ -173,7 +202,7 @@ def write_report(report, out, settings=None, plot=True):
     paths["json"] = os.path.join(out, "suite.json")
     with open(paths["json"], "w") as fh:
         json.dump(doc, fh, indent=1, default=lambda x: None if x != x else str(x))
-    figures = {}
+    figures, animations = {}, {}
     for p in probs:
         prow = [r for r in rows if r["problem"] == p["name"]]
         pcsv = os.path.join(out, f"problem_{p['name']}.csv")
@@ -183,17 +212,23 @@ def write_report(report, out, settings=None, plot=True):
             fig = f"wp_{p['name']}.png"
             plot_work_precision(p, prow, os.path.join(out, fig))
             figures[p["name"]] = fig
+        if plot and animation_frames:
+            gif = f"anim_{p['name']}.gif"
+            done, cause = animate_problem(p["name"], os.path.join(out, gif), animation_frames)
+            animations[p["name"]] = gif if done else cause
     if plot:
         plot_overview(rows, [p["name"] for p in probs], schemes, os.path.join(out, "overview.png"))
         figures["overview"] = "overview.png"
     paths.update({f"png_{k}": os.path.join(out, v) for k, v in figures.items()})
+    paths.update({f"gif_{k}": os.path.join(out, v) for k, v in animations.items()
+                  if v.endswith(".gif")})
     paths["page"] = os.path.join(out, "index.md")
     with open(paths["page"], "w") as fh:
-        fh.write(_page(report, figures, doc["provenance"], settings))
+        fh.write(_page(report, figures, doc["provenance"], settings, animations))
     return paths
 
 
-def _page(report, figures, prov, settings):
+def _page(report, figures, prov, settings, animations=None):
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
     quick = bool((settings or {}).get("quick"))
     lines = ["# moreau benchmark suite", "",
@@ -227,6 +262,10 @@ def _page(report, figures, prov, settings):
         lines.append("")
         if p["name"] in figures:
             lines += [f"![work-precision of {p['name']}]({figures[p['name']]})", ""]
+        anim = (animations or {}).get(p["name"])
+        if anim is not None:
+            lines += ([f"![animation of {p['name']}]({anim})", ""] if anim.endswith(".gif")
+                      else [f"No animation: {anim}.", ""])
         lines += [f"Table: [problem_{p['name']}.csv](problem_{p['name']}.csv)", "",
                   "| scheme | setting | outcome | largest error | CPU [s] | steps | cause |",
                   "|---|---|---|---|---|---|---|"]

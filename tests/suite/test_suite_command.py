@@ -89,11 +89,12 @@ def test_subset_table_flags_and_page(tmp_path, doubles):
     assert again["cells"]["cached"] == again["cells"]["total"] == len(rep["rows"])
     assert [r["max_error"] for r in again["rows"]] == [r["max_error"] for r in rep["rows"]]
     # the page links every figure it wrote, and every link resolves
-    paths = write_report(rep, str(tmp_path), settings={"quick": True})
+    paths = write_report(rep, str(tmp_path), settings={"quick": True}, animation_frames=2)
     page = (tmp_path / "index.md").read_text()
     links = set(re.findall(r"\]\(([^)]+)\)", page))
-    figures = {p.name for p in tmp_path.glob("*.png")}
-    assert figures == {"overview.png", "wp_bouncing-ball.png", "wp_sliding-block.png"}
+    figures = {p.name for p in tmp_path.glob("*.png")} | {p.name for p in tmp_path.glob("*.gif")}
+    assert figures == {"overview.png", "wp_bouncing-ball.png", "wp_sliding-block.png",
+                       "anim_bouncing-ball.gif", "anim_sliding-block.gif"}
     assert figures <= links
     assert all((tmp_path / link).exists() for link in links)
     for p in ("bouncing-ball", "sliding-block"):
