@@ -31,6 +31,7 @@ from .scenes.registry import (default_scene, describe, discover, entries, get_en
                               resolve_hook, scene_names)
 from .studies.paper.reproduce import reproduce
 from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs
+from .suite.command import add_commands as add_suite_commands
 
 __all__ = ["main"]
 
@@ -765,6 +766,7 @@ def build_parser():
                    help="replace the files of an earlier comparison with other settings "
                         "(refused otherwise)")
     c.set_defaults(func=_cmd_compare)
+    add_suite_commands(sub)     # moreau suite, moreau animate
     return parser
 
 

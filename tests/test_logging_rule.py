@@ -32,6 +32,8 @@ COMMAND_OUTPUT = {
     ("cli.py", "_cmd_reproduce"): "moreau reproduce: the files written and the timings",
     ("cli.py", "_cmd_compare"): "moreau compare: the table or its JSON",
     ("cli.py", "_cmd_scenes"): "moreau scenes: the list or its JSON",
+    ("suite/command.py", "_cmd_suite"): "moreau suite: the flags, the overview, the files written",
+    ("suite/command.py", "_cmd_animate"): "moreau animate: the file written",
     ("cli.py", "main"): "the command's one-line error or interrupt note on stderr, its exit "
                         "status's reason",
     ("_log.py", "note"): "the logging fallback itself: an INFO note on a terminal's stderr "

@@ -24,7 +24,8 @@ def _subparsers():
 def test_every_command_that_takes_force_is_documented_with_it():
     takes = {name for name, p in _subparsers().items()
              if any("--force" in a.option_strings for a in p._actions)}
-    assert takes == {"sweep", "atlas", "run", "reproduce", "bifurcation", "compare"}
+    assert takes == {"sweep", "atlas", "run", "reproduce", "bifurcation", "compare", "suite",
+                     "animate"}
     paragraphs = [p for p in re.split(r"\n\s*\n", README.read_text()) if "`--force`" in p]
     documented = {name for name in takes for p in paragraphs
                   if re.search(rf"`moreau\s+{name}`", p)}
@@ -178,6 +179,21 @@ COMMANDS = {
     'moreau compare --stress [--quick]':
         (["moreau compare --stress --quick --schemes event-driven,mj-1,mj-1/2"],
          ["out/stress.csv", "out/stress.json"]),
+    # the suite's two smallest problems and two schemes (the quick suite takes minutes)
+    'moreau suite --quick --out suite-results':
+        (["moreau suite --quick --problems sliding-block,painleve-rod "
+          "--schemes moreau-jean,event-driven --out suite-results"],
+         ["suite-results/index.md", "suite-results/suite.csv", "suite-results/overview.png",
+          "suite-results/wp_sliding-block.png"]),
+    'moreau suite --quick --compare-to history.json --out suite-results':
+        (["moreau suite --quick --problems sliding-block,painleve-rod "
+          "--schemes moreau-jean,event-driven --compare-to history.json --out suite-results"],
+         ["history.json"]),
+    'moreau run --scene sliding-box --duration 0.5 --out run1':
+        (["moreau run --scene sliding-box --duration 0.5 --out run1 --samples 50"],
+         ["run1/history_sliding-box_event-driven.csv"]),
+    'moreau animate run1 --out box.gif': (["moreau animate run1 --out box.gif --frames 5"],
+                                          ["box.gif"]),
     'moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45':
         (["moreau compare --scene bouncing-ball --schemes compliant-radau,compliant-rk45 "
           "--quick"], ["out/compare_bouncing-ball.csv", "out/compare_bouncing-ball.json"]),

@@ -50,6 +50,7 @@ from .._validate import (finite_array, finite_scalar, in_closed_interval, nonneg
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
+from ._drawing import circle, contact
 from ._units import SIUnits
 from .base import Scene, params_with
 from .registry import SceneEntry, parameters_of, register_scene
@@ -190,6 +191,13 @@ class BallChain(SIUnits, Scene):
         """Compiled form of this model (:mod:`moreau.compiled`); ``par = (mass ratio,)``."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
                              self.ndof - 1, True, False)
+
+    def shapes(self, q, t=0.0):
+        """The balls (centres ``q`` [m] on a line) and the contacts between neighbours."""
+        r = self.params.radius
+        x = np.asarray(q, dtype=float)
+        return ([circle((xi, 0.0), r) for xi in x]
+                + [contact(i, (x[i] + r, 0.0), (1.0, 0.0), (0.0, 1.0)) for i in range(len(x) - 1)])
 
     def kinetic_energy(self, v):
         """``sum m_i v_i^2 / 2`` of velocities ``v`` (..., N), in scene units."""

@@ -25,7 +25,7 @@ from dataclasses import fields, replace
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MoreauError
 from ._units import columns_of
 
 __all__ = ["Scene", "params_with"]
@@ -165,6 +165,17 @@ class Scene:
                      "force_T": result.force_T, "slip_velocity": result.slip_velocity,
                      "gap": result.gap, "regime": result.regime}
         return columns_of(histories, dict.fromkeys(histories, ""))
+
+    # -- drawing -------------------------------------------------------------
+    def shapes(self, q, t=0.0):
+        """Primitive shapes of the scene at SI coordinates ``q`` and time ``t`` [s].
+
+        Each scene that can be drawn (``moreau animate``) overrides this; the
+        shapes and their units are those of :mod:`moreau.scenes._drawing`.
+        This default refuses, naming the scene.
+        """
+        raise MoreauError(f"scene {self.name!r} ({type(self).__name__}) cannot be drawn: it "
+                          "defines no shapes(q, t)")
 
     # -- conveniences shared by all scenes --------------------------------
     def contact_velocities(self, q, v, t):

@@ -68,6 +68,7 @@ import numpy as np
 
 from .. import _validate as V
 from ..errors import InputError
+from ._drawing import rod_drive_shapes
 from ._units import DriveUnits
 from numba import njit
 
@@ -345,6 +346,10 @@ class BidirectionalDrive(DriveUnits, Scene):
         The layout the energy audit (:mod:`moreau.analysis.energy`) reads.
         """
         return self.u10.copy(), self.delta.copy(), self._side.copy()
+
+    def shapes(self, q, t=0.0):
+        """Both rods (``q[0:2]`` [rad], mirror images) and the rotor (``q[2]`` [m]) at ``t`` [s]."""
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0), (1, -1.0)], rotor=2)
 
     def rest_state(self, tau=0.0):
         """State at ``tau`` with both rods on their contact manifolds and the rotor at rest.

@@ -27,6 +27,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
+from ._drawing import circle, contact, line
 from ._units import SIUnits, SIValues
 from .base import Scene, params_with
 from ..analysis.cases import GRID, CompareCase
@@ -138,6 +139,12 @@ class BouncingBall(SIUnits, Scene):
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
+
+    def shapes(self, q, t=0.0):
+        """The floor, the ball (centre height ``q[0]`` [m]) and its contact point."""
+        y, r = float(q[0]), self.params.radius
+        return [line([(-3 * r, 0.0), (3 * r, 0.0)], role="ground"), circle((0.0, y), r),
+                contact(0, (0.0, y - r), (0.0, 1.0))]
 
     # -- exact solution -------------------------------------------------------
     def _initial(self, q0, v0):

@@ -98,6 +98,7 @@ from ..compiled import CompiledModel
 from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
+from ._drawing import rod_drive_shapes
 from ._units import DriveUnits
 from .base import Scene, params_with
 from .friction_drive import FrictionDrive, FrictionDriveParams
@@ -420,6 +421,10 @@ class FlexibleRodDrive(DriveUnits, Scene):
         q[0] = phi
         v[0] = -float(self.du1(tau)) / math.cos(phi)
         return q, v
+
+    def shapes(self, q, t=0.0):
+        """The stator's hinge, the rod (the chord to its bent tip) and the rotor (``q[-1]`` [m]) at ``t`` [s]."""
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=self.ndof - 1)
 
     def initial_state(self):
         """The rest state at ``tau = 0`` (:meth:`rest_state`)."""

@@ -81,6 +81,7 @@ import numpy as np
 from .. import _validate as V
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
+from ._drawing import rod_drive_shapes
 from ._units import DriveUnits
 from numba import njit
 
@@ -299,6 +300,10 @@ class FrictionDrive(DriveUnits, Scene):
         :class:`~moreau.scenes.bidirectional_drive.BidirectionalDrive` gives two rods.
         """
         return np.array([self.u10]), np.zeros(1), np.ones(1)
+
+    def shapes(self, q, t=0.0):
+        """The stator's hinge, the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m]) at ``t`` [s]."""
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
 
     def painleve_margin(self, phi):
         """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""

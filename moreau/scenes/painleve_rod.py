@@ -44,6 +44,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
+from ._drawing import contact, line
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -188,6 +189,15 @@ class PainleveRod(SIUnits, Scene):
 
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
+
+    def shapes(self, q, t=0.0):
+        """The floor, the rod (centre ``q[0:2]`` [m], angle ``q[2]`` [rad]) and its tip's contact."""
+        ell = self.length                      # the half-length
+        x, y, phi = (float(v) for v in q)
+        d = (ell * math.cos(phi), ell * math.sin(phi))
+        tip = (x - d[0], y - d[1])
+        return [line([(x - 3 * ell, 0.0), (x + 3 * ell, 0.0)], role="ground"),
+                line([tip, (x + d[0], y + d[1])]), contact(0, tip, (0.0, 1.0), (1.0, 0.0))]
 
     # -- states and the paradox ---------------------------------------------
     def sliding_state(self, phi, tip_speed, dphi=0.0):

@@ -104,6 +104,7 @@ from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
+from ._drawing import rod_drive_shapes
 from ._units import DriveUnits
 from .base import Scene, params_with
 from .registry import Parameter, SceneEntry, parameters_of, register_scene
@@ -575,6 +576,10 @@ class PiezoDrive(DriveUnits, Scene):
         if self.ndof == 3:
             q[2] = u1
         return q, v
+
+    def shapes(self, q, t=0.0):
+        """The stator's hinge (moving with the stack), the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m])."""
+        return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
 
     def initial_state(self):
         """The rest state :meth:`rest_state`."""

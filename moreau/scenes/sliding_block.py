@@ -27,6 +27,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
+from ._drawing import contact, line, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -148,6 +149,17 @@ class SlidingBlock(SIUnits, Scene):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = [math.sin(self.alpha), math.cos(self.alpha)]
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
+
+    def shapes(self, q, t=0.0):
+        """The plane (inclined by ``alpha``), the block (a point mass, drawn 0.2 length units wide) and its contact."""
+        ca, sa = math.cos(self.alpha), math.sin(self.alpha)
+        ex, ey = np.array([ca, -sa]), np.array([sa, ca])   # along and across the plane
+        base = float(q[0]) * ex + float(q[1]) * ey
+        w = 0.1 * self.length
+        corners = [base - w * ex, base + w * ex, base + w * ex + 2 * w * ey,
+                   base - w * ex + 2 * w * ey]
+        return [line([base - 10 * w * ex, base + 10 * w * ex], role="ground"), polygon(corners),
+                contact(0, base, ey, ex)]
 
     # -- exact solution -------------------------------------------------------
     @property

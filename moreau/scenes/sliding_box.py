@@ -44,6 +44,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
+from ._drawing import contact, line, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -167,6 +168,20 @@ class SlidingBox(SIUnits, Scene):
                              3, 2, True, False)
 
     angle_coordinates = (2,)
+
+    def shapes(self, q, t=0.0):
+        """The floor, the box (centre ``q[0:2]`` [m], tilt ``q[2]`` [rad]) and its two corner contacts."""
+        a, b = self.params.half_width, self.params.half_height
+        x, y, th = (float(v) for v in q)
+        c, s = math.cos(th), math.sin(th)
+
+        def world(u, w):
+            return (x + c * u - s * w, y + s * u + c * w)
+
+        out = [line([(x - 4 * a, 0.0), (x + 4 * a, 0.0)], role="ground"),
+               polygon([world(-a, -b), world(a, -b), world(a, b), world(-a, b)])]
+        return out + [contact(i, world(side * a, -b), (0.0, 1.0), (1.0, 0.0))
+                      for i, side in enumerate((-1.0, 1.0))]
 
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])

@@ -38,6 +38,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ..errors import InputError
+from ._drawing import contact, polygon
 from .base import Scene
 from ._units import SIUnits
 from .base import params_with
@@ -416,6 +417,17 @@ class StickSlipMotor(SIUnits, Scene):
     def stator(self, tau):
         """Stator displacement, velocity and acceleration ``(s, s', s'')`` at ``tau``."""
         return self.drive(tau)
+
+    def shapes(self, q, t=0.0):
+        """The stator (at its prescribed displacement at ``t`` [s]), the slider (``q[0]`` [m]) and their contact."""
+        X = self.params.amplitude
+        s = float(self.drive(float(t) / self.time)[0]) * X
+        x, y = float(q[0]), float(q[1])
+        return [polygon([(s - 3 * X, -0.6 * X), (s + 3 * X, -0.6 * X), (s + 3 * X, 0.0),
+                         (s - 3 * X, 0.0)], role="stator"),
+                polygon([(x - 0.5 * X, y), (x + 0.5 * X, y), (x + 0.5 * X, y + X),
+                         (x - 0.5 * X, y + X)]),
+                contact(0, (x, y), (0.0, 1.0), (1.0, 0.0))]
 
     # -- Scene interface ----------------------------------------------------
     def mass(self, q):

@@ -1,0 +1,373 @@
+"""Running the suite: every registered scheme on every problem, cell by cell, kept as it goes.
+
+A *cell* is one problem, one scheme and one setting of the scheme (a step
+count, a tolerance, a contact stiffness). Each cell ends in one outcome:
+
+``ok``
+    every headline quantity within the problem's tolerance;
+``inaccurate``
+    the run finished, but an error is above the tolerance (or a quantity
+    could not be read from it, e.g. a ball that never comes to rest);
+``failed``
+    the run stopped with a status below zero or raised a
+    :class:`~moreau.errors.MoreauError`; ``cause`` names it (a Painlevé
+    stop, an LCP failure, a step that broke down). An exception that is not a
+    :class:`~moreau.errors.MoreauError` is a failure too, its cause starting
+    with ``unexpected``: the suite goes on and the table shows it;
+``refused``
+    the scheme refused the problem by name before running (an
+    :class:`~moreau.errors.InputError`, e.g. a scene's own reference scheme
+    given another scene; a stop outside the scene's valid region).
+
+A finished cell is written to ``OUT/cells/`` at once; a rerun of the same
+command reads the cells it finds there instead of computing them again, so
+an interrupted suite resumes.
+"""
+
+import json
+import math
+import os
+import re
+import time
+import warnings
+
+import joblib
+import numpy as np
+from tqdm import tqdm
+
+from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_config
+
+from ..errors import InputError, Interrupted, MoreauError
+from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
+from ..scenes.registry import discover as discover_scenes
+from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
+from .problem import get_problem, problem_names
+
+__all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS"]
+
+#: the outcomes, best first
+OUTCOMES = ("ok", "inaccurate", "failed", "refused")
+#: a run's status that means "outside the scene's valid region": refused, not failed
+REFUSED_STATUS = (-6,)
+#: samples over the window asked of the schemes that choose their own steps
+SAMPLES = 2000
+#: tolerances of the schemes with an ``rtol`` (event-driven): quick, full
+RTOLS = ((1e-6, 1e-10), (1e-4, 1e-7, 1e-10))
+
+
+def scheme_names():
+    """Every registered scheme, sorted (the scenes' own references included)."""
+    discover_scenes()
+    return sorted(INTEGRATORS)
+
+
+def _options_of(name, scene):
+    cls = get_integrator(name)
+    if scene is not None and hasattr(cls, "resolve"):
+        cls = cls.resolve(scene)
+    return cls, scheme_options(cls) or ()
+
+
+def settings_of(name, problem, scene, quick=False):
+    """``[(label, options)]`` of scheme ``name`` on ``problem``, coarsest first.
+
+    A time-stepping scheme (it takes ``h``) runs at the problem's step counts
+    over its window; a scheme that states its own comparison settings
+    (``Integrator.compare_settings``: a tolerance, a contact stiffness) at
+    those; an event-driven scheme at :data:`RTOLS`; any other once with its
+    defaults. Those that choose their own steps are asked for
+    :data:`SAMPLES` samples over the window.
+
+    Examples
+    --------
+    >>> from moreau.suite.problem import get_problem
+    >>> p = get_problem("bouncing-ball")
+    >>> [label for label, _ in settings_of("moreau-jean", p, p.make_scene(), quick=True)]
+    ['N=400', 'N=4000']
+    """
+    if is_peer(name):
+        return [(PEER_SETTING, {})]
+    cls, takes = _options_of(name, scene)
+    extra = {}
+    if "sample_dt" in takes:
+        extra["sample_dt"] = problem.window / SAMPLES
+    elif "samples_per_period" in takes and getattr(scene, "period", None):
+        extra["samples_per_period"] = SAMPLES
+    if "h" in takes:
+        return [(f"N={n}", dict(extra, h=problem.window / n))
+                for n in (problem.quick_steps if quick else problem.steps)]
+    cs = getattr(cls, "compare_settings", None)
+    if cs is not None and cs[0] in takes:
+        key, values, quick_values, fixed = cs
+        return [(f"{key}={v:g}", dict(extra, **dict(fixed), **{key: v}))
+                for v in (quick_values if quick else values)]
+    if "rtol" in takes:
+        return [(f"rtol={r:g}", dict(extra, rtol=r)) for r in RTOLS[0 if quick else 1]]
+    return [("default", extra)]
+
+
+def _cause(exc):
+    return f"{type(exc).__name__}: {exc}"
+
+
+def run_cell(problem, scheme, label, options, scene=None, reference=None):
+    """Run one cell and return its row (see the module docstring for the outcomes).
+
+    The row holds ``problem``, ``scheme``, ``setting`` (the label),
+    ``outcome``, ``cause``, ``status``, ``values`` and ``errors`` (per
+    headline quantity), ``max_error``, ``tolerance``, ``cpu_s`` (the process
+    time of the run and its measurement) and ``steps``.
+    """
+    row = {"problem": problem.name, "scheme": scheme, "setting": label, "outcome": None,
+           "cause": "", "status": None, "values": {}, "errors": {}, "max_error": None,
+           "tolerance": problem.tolerance, "cpu_s": None, "wall_s": None, "steps": None}
+    try:
+        scene = problem.make_scene() if scene is None else scene
+        reference = problem.reference() if reference is None else reference
+        q0, v0 = problem.start(scene)
+        c0, w0 = time.process_time(), time.perf_counter()
+        res = simulate(scene, (0.0, problem.window), q0, v0, scheme, **options)
+        values = problem.measure(scene, res) if res.success else {}
+        row["cpu_s"] = time.process_time() - c0
+        row["wall_s"] = time.perf_counter() - w0
+        row["status"] = int(res.status)
+        row["steps"] = int((res.stats or {}).get("steps", len(res.t)))
+        if not res.success:
+            row["outcome"] = "refused" if res.status in REFUSED_STATUS else "failed"
+            row["cause"] = f"status {res.status}: {res.message}"
+            return row
+        errors = problem.errors(values, reference)
+        row["values"] = {k: (None if v is None else float(v)) for k, v in values.items()}
+        row["errors"] = errors
+        missing = [k for k, e in errors.items() if e is None]
+        row["max_error"] = math.inf if missing else max(errors.values(), default=0.0)
+        if missing:
+            row["outcome"] = "inaccurate"
+            row["cause"] = "no value for " + ", ".join(missing)
+        elif row["max_error"] <= problem.tolerance:
+            row["outcome"] = "ok"
+        else:
+            worst = max(errors, key=errors.get)
+            row["outcome"] = "inaccurate"
+            row["cause"] = f"{worst} off by {errors[worst]:.3g} > {problem.tolerance:g}"
+    except InputError as exc:
+        row.update(outcome="refused", cause=_cause(exc))
+    except MoreauError as exc:
+        row.update(outcome="failed", cause=_cause(exc))
+    except (ArithmeticError, ValueError, TypeError, AttributeError, IndexError, KeyError,
+            RuntimeError, NotImplementedError, np.linalg.LinAlgError) as exc:
+        # a bug in a scheme or a scene: the table says so, the suite goes on
+        row.update(outcome="failed", cause="unexpected " + _cause(exc))
+    return row
+
+
+def _safe(text):
+    return re.sub(r"[^A-Za-z0-9_.=+-]", "_", text)
+
+
+def cell_path(cache_dir, problem, scheme, label):
+    return os.path.join(cache_dir, _safe(problem), _safe(scheme), _safe(label) + ".json")
+
+
+def _warm_up(problem, scheme, options, scene):
+    # numba compiles a scheme's loop for a scene on its first run: do it outside the timings
+    q0, v0 = problem.start(scene)
+    try:
+        with np.errstate(all="ignore"):
+            simulate(scene, (0.0, 0.05 * problem.window), q0, v0, scheme, **options)
+    except Exception:   # noqa: BLE001  (the timed run reports whatever this one met)
+        pass
+
+
+#: per process: the problems' instances, scenes and references, and the (problem, scheme)
+#: pairs already run once (compiled) in this process
+_INSTANCES = {}
+_WARMED = set()
+
+
+def instance(pname):
+    if pname not in _INSTANCES:
+        prob = get_problem(pname)
+        _INSTANCES[pname] = (prob, prob.make_scene(), prob.reference())
+    return _INSTANCES[pname]
+
+
+def cell_task(pname, scheme, label, options):
+    """One cell, computed in this process (a worker's task): its row.
+
+    The first cell of a (problem, scheme) pair in a process runs the scheme
+    once over a twentieth of the window first, untimed, so that numba's
+    compilation (or loading) is not counted in the cell's time.
+    """
+    prob, scene, ref = instance(pname)
+    if is_peer(scheme):
+        row = run_peer_cell(prob, scheme, scene, ref)
+        row["cached"] = False
+        return row
+    if (pname, scheme) not in _WARMED:
+        _WARMED.add((pname, scheme))
+        _warm_up(prob, scheme, options, scene)
+    row = run_cell(prob, scheme, label, options, scene, ref)
+    row["cached"] = False
+    return row
+
+
+def plan_cells(problems=None, schemes=None, quick=False, peers=True):
+    """``[(problem, scheme, label, options)]`` of every cell, checked names first.
+
+    Without ``schemes``: every registered scheme, and the Siconos peers where
+    they are installed (``peers``).
+    """
+    known = problem_names()
+    problems = list(known if problems is None else problems)
+    for p in problems:
+        get_problem(p)
+    # asking the system interpreter for Siconos takes seconds: only where a peer may run
+    wants_peers = peers and (schemes is None or any(is_peer(s) for s in schemes))
+    all_schemes = scheme_names() + (peer_names() if wants_peers else [])
+    schemes = list(all_schemes if schemes is None else schemes)
+    for s in schemes:
+        if s not in all_schemes:
+            raise InputError(f"`schemes` must name registered schemes, from "
+                             f"{', '.join(all_schemes)}; got {s!r}")
+    plan = []
+    for pname in problems:
+        prob, scene, _ = instance(pname)
+        for s in schemes:
+            try:
+                sets = settings_of(s, prob, scene, quick)
+            except MoreauError:
+                sets = [("default", {})]
+            plan += [(pname, s, label, opts) for label, opts in sets]
+    return problems, schemes, plan
+
+
+def _read_cell(path):
+    try:
+        with open(path) as fh:
+            row = json.load(fh)
+    except (OSError, ValueError):
+        return None
+    row["cached"] = True
+    return row
+
+
+def _keep_cell(path, row):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    tmp = path + f".{os.getpid()}.tmp"
+    with open(tmp, "w") as fh:
+        json.dump(row, fh, default=_json_default)
+    os.replace(tmp, path)
+
+
+def _results(plan, todo, n_jobs, scheduler):
+    """``(index, row)`` of the cells ``todo`` (indices into ``plan``), as they finish."""
+    if scheduler is not None:
+        from distributed import as_completed  # optional dependency, checked by the CLI
+        client, own = connect_scheduler(scheduler)
+        try:
+            futures = {client.submit(cell_task, *plan[i], pure=False): i for i in todo}
+            for fut in as_completed(list(futures)):
+                i = futures[fut]
+                try:
+                    row = fut.result()
+                except Exception as exc:   # noqa: BLE001  (a lost worker: the cell fails)
+                    pname, s, label, _ = plan[i]
+                    row = {"problem": pname, "scheme": s, "setting": label, "outcome": "failed",
+                           "cause": "the Dask task failed: " + _cause(exc), "status": None,
+                           "values": {}, "errors": {}, "max_error": None, "tolerance": None,
+                           "cpu_s": None, "wall_s": None, "steps": None, "cached": False}
+                yield i, row
+        finally:
+            if own:
+                client.close()
+        return
+    if n_jobs == 1 or len(todo) <= 1:
+        for i in todo:
+            yield i, cell_task(*plan[i])
+        return
+    with worker_pool_config():
+        par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
+    gen = par(joblib.delayed(_indexed_cell)(i, *plan[i]) for i in todo)
+    ok = False
+    try:
+        yield from gen
+        ok = True
+    finally:
+        if not ok:
+            # closing joblib's generator stops handing out cells (Ctrl-C, an error)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                gen.close()
+        end_worker_pool(kill=not ok)
+
+
+def _indexed_cell(i, *cell):
+    return i, cell_task(*cell)
+
+
+def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
+              n_jobs=1, scheduler=None, peers=True):
+    """Run every scheme on every problem; return ``{"rows", "problems", "schemes", "cells"}``.
+
+    Parameters
+    ----------
+    problems, schemes : sequence of str, optional
+        Names (all registered ones by default).
+    quick : bool
+        The problems' quick step counts and the schemes' quick settings.
+    cache_dir : str, optional
+        Where each finished cell is kept (and read back on a rerun).
+    progress : bool
+        A tqdm bar on a terminal.
+    peers : bool
+        Without ``schemes``, add Siconos's OSIs as columns where Siconos is
+        installed (:mod:`moreau.suite.peers`).
+    n_jobs : int
+        Local worker processes (the pool of ``moreau sweep``; 1: in this process).
+    scheduler : str, optional
+        A Dask scheduler's address: the cells run there instead.
+
+    Raises
+    ------
+    Interrupted
+        On Ctrl-C, after the cells finished so far are kept.
+    """
+    problems, schemes, plan = plan_cells(problems, schemes, quick, peers)
+    rows = [None] * len(plan)
+    todo = []
+    for i, (pname, s, label, _) in enumerate(plan):
+        path = cell_path(cache_dir, pname, s, label) if cache_dir else None
+        row = _read_cell(path) if path and os.path.exists(path) else None
+        if row is None:
+            todo.append(i)
+        else:
+            rows[i] = row
+    done = len(plan) - len(todo)
+    bar = None
+    if progress:
+        bar = tqdm(total=len(plan), initial=done, desc="suite", unit="cell", disable=None)
+    try:
+        with propagate_interrupts():
+            for i, row in _results(plan, todo, n_jobs, scheduler):
+                rows[i] = row
+                if cache_dir:
+                    _keep_cell(cell_path(cache_dir, *plan[i][:3]), row)
+                done += 1
+                if bar is not None:
+                    bar.update(1)
+    except KeyboardInterrupt:
+        raise Interrupted(done, len(plan), cache_dir, "suite", unit="cells") from None
+    finally:
+        if bar is not None:
+            bar.close()
+    return {"rows": rows, "problems": [instance(p)[0].describe() for p in problems],
+            "schemes": schemes, "cells": {"total": len(plan),
+                                          "cached": sum(1 for r in rows if r.get("cached")),
+                                          "computed": sum(1 for r in rows if not r.get("cached"))}}
+
+
+def _json_default(x):
+    if isinstance(x, (np.floating, np.integer)):
+        return x.item()
+    return str(x)
