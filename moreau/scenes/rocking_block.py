@@ -195,6 +195,10 @@ class RockingBlock(SIUnits, Scene):
     def _qscale(self):
         return np.array([self.length, self.length, 1.0])
 
+    def shapes(self, q, t=0.0):
+        """The floor, the block (centre ``q[0:2]`` [m], tilt ``q[2]`` [rad]) and its two corner contacts."""
+        return self._box.shapes(q, t)
+
     def initial_state(self):
         """At rest on the left corner at ``x = 0``, tilted by ``params.tilt``."""
         return self.state_on_corner(self.params.tilt)
