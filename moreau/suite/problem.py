@@ -46,12 +46,7 @@ __all__ = ["Problem", "register_problem", "get_problem", "problem_names", "probl
 
 #: problems whose scene has not landed yet: ``{name: what will state it}``. The suite's page
 #: lists them; the module that registers the problem replaces the entry.
-PENDING = {
-    # MARKED PLACE: the rocking block is written on branch tangential-impact (its scene,
-    # ``rocking-block``, and the problem module moreau/suite/problems/rocking_block.py with
-    # Housner's ratio of the angular velocities over an impact as its closed form)
-    "rocking-block": "scene `rocking-block` with Housner's ratio (branch tangential-impact)",
-}
+PENDING = {}
 
 
 class Problem:
