@@ -16,6 +16,9 @@ __all__ = ["add_commands"]
 
 
 def _names(text, option):
+    if isinstance(text, list):
+        # names given space-separated, comma-separated or both
+        text = ",".join(text)
     if text is None or text.strip() in ("", "all"):
         return None
     names = [x.strip() for x in text.split(",") if x.strip()]
@@ -82,9 +85,9 @@ def add_commands(sub):
                                      "problem with a reference (table, figures, index.md)")
     s.add_argument("--quick", action="store_true",
                    help="two settings per scheme instead of three (a few minutes)")
-    s.add_argument("--schemes", default=None, metavar="NAME,...",
+    s.add_argument("--schemes", default=None, nargs="+", metavar="NAME,...",
                    help="registered schemes to run (default: all)")
-    s.add_argument("--problems", default=None, metavar="NAME,...",
+    s.add_argument("--problems", default=None, nargs="+", metavar="NAME,...",
                    help="problems to run (default: all)")
     s.add_argument("--out", default="suite-results",
                    help="output folder (default ./suite-results); finished cells are kept in "
