@@ -4,11 +4,13 @@ import math
 
 import numpy as np
 import pytest
+from PIL import Image
 from scipy.integrate import solve_ivp
 
 from moreau.cli import main
 from moreau.lcp import build_friction_lcp, friction_impulses, lcp_violation, solve_lcp
 from moreau.suite.problem import PENDING, get_problem, problem_names
+from moreau.suite.report import animate_problem
 from moreau.suite.run import run_suite
 
 
@@ -132,3 +134,11 @@ def test_cli_takes_names_separated_by_spaces(tmp_path, capsys):
     assert main(["suite", "--problems", "painleve-jam", "painleve-jam", "--out",
                  str(tmp_path / "o")]) == 2
     assert "`--problems` names one twice" in capsys.readouterr().err
+
+
+def test_the_jams_page_animation_is_moreau_jeans_run(tmp_path):
+    # the event-driven run stops at t = 0 on the jam: the page draws Moreau-Jean's run instead
+    path, cause = animate_problem("painleve-jam", str(tmp_path / "jam.gif"), frames=3)
+    assert cause is None
+    with Image.open(path) as im:
+        assert im.n_frames == 3

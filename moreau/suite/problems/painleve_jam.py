@@ -87,7 +87,7 @@ class PainleveJamProblem(Problem):
     """
 
     name = "painleve-jam"
-    title = "Painlevé rod: tangential impact (jam) from a paradoxical slide"
+    title = "Painlevé rod: jam from a paradoxical slide"
     scene = "painleve-rod"
     reference_kind = "closed form (the jam) and the stick pendulum by DOP853 (rtol 1e-13)"
     source = ("F. Génot, B. Brogliato, New results on Painlevé paradoxes, Eur. J. Mech. A/Solids "
