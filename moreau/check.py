@@ -55,6 +55,7 @@ from numpy.typing import ArrayLike
 
 from .errors import InputError, MoreauError
 from .compiled import evaluate_compiled
+from .integrators import simulate
 from .scenes.base import Scene
 
 __all__ = ["check_scene", "SceneReport"]
@@ -196,7 +197,6 @@ PATH_PIECES = 64
 
 def _short_motion(scene, q0, v0, t0):
     """A short Moreau-Jean motion from ``(q0, v0)`` at ``t0``: a result, or the reason it failed."""
-    from .integrators import simulate
     period = getattr(scene, "period", None)
     span = min(1.0, 0.25 * period) if period else 1.0
     try:
