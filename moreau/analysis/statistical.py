@@ -362,7 +362,7 @@ def _starts(scene, q0, v0, kind, count, spread, cyclic):
 
 
 def _halves_statistic(y, batches=BATCHES):
-    """``|mean of the second half - mean of the first| / its standard error`` (batch means)."""
+    """``(|mean of the second half - mean of the first|, its standard error)`` (batch means)."""
     size = y.size // batches
     bm = y[y.size - size * batches:].reshape(batches, size).mean(axis=1)
     a, b = bm[:batches // 2], bm[batches // 2:]
