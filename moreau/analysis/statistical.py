@@ -109,8 +109,8 @@ from .periodic_shooting import period_map_options
 from .section_runs import section_states
 
 __all__ = ["statistical_steady_state", "mser5_truncation", "batch_means",
-           "correlation_time", "state_to_si", "METHOD", "MAX_PERIODS",
-           "PRECISION", "BATCHES", "CHUNK", "RESOLUTION", "MAX_LAG1", "MIN_TAUS", "START_KINDS"]
+           "correlation_time", "state_to_si", "check_statistical_options", "METHOD",
+           "MAX_PERIODS", "PRECISION", "BATCHES", "CHUNK", "RESOLUTION", "MAX_LAG1", "MIN_TAUS", "START_KINDS"]
 
 log = logging.getLogger(__name__)
 
@@ -470,6 +470,31 @@ def _in_si(scene, x):
     return (f"{float(conv(x)):.5g} m" if conv is not None else f"{x:.5g}")
 
 
+def check_statistical_options(precision=PRECISION, confidence=0.95, max_periods=MAX_PERIODS,
+                              starts=1, spread=1.0):
+    """The options of :func:`statistical_steady_state`, checked (InputError naming the first bad one).
+
+    Examples
+    --------
+    >>> check_statistical_options(starts=0)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `starts` must be an integer >= 1, got 0
+    """
+    precision = positive("precision", precision)
+    if not 0.0 < finite_scalar("confidence", confidence) < 1.0:
+        raise InputError(f"`confidence` must be in (0, 1), got {confidence!r}")
+    max_periods = positive_int("max_periods", max_periods)
+    if max_periods < MIN_PERIODS:
+        raise InputError(f"`max_periods` must be at least {MIN_PERIODS}, got {max_periods}")
+    starts = positive_int("starts", starts)
+    spread = finite_scalar("spread", spread)
+    if spread == 0.0:
+        raise InputError("`spread` must be nonzero (the largest fraction of the velocity scale "
+                         "given to the rotor), got 0.0")
+    return precision, float(confidence), max_periods, starts, spread
+
+
 def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, section_tau=0.0,
                              precision=PRECISION, confidence=0.95, max_periods=MAX_PERIODS,
                              cyclic=None, scheme_options=None, starts=1, spread=1.0,
@@ -557,18 +582,8 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
         raise InputError(f"`cyclic` must name a coordinate of the scene (0..{scene.ndof - 1}) "
                          f"that does not enter its dynamics, got {cyclic!r}")
     cyclic = int(cyclic)
-    precision = positive("precision", precision)
-    if not 0.0 < float(confidence) < 1.0:
-        raise InputError(f"`confidence` must be in (0, 1), got {confidence!r}")
-    confidence = float(confidence)
-    max_periods = positive_int("max_periods", max_periods)
-    if max_periods < MIN_PERIODS:
-        raise InputError(f"`max_periods` must be at least {MIN_PERIODS}, got {max_periods}")
-    starts = positive_int("starts", starts)
-    spread = finite_scalar("spread", spread)
-    if spread == 0.0:
-        raise InputError("`spread` must be nonzero (the largest fraction of the velocity scale "
-                         "given to the rotor), got 0.0")
+    precision, confidence, max_periods, starts, spread = check_statistical_options(
+        precision, confidence, max_periods, starts, spread)
     if starts > 1 and getattr(scene, "velocity_scale", None) is None:
         raise InputError(f"`starts` > 1 needs a scene with a `velocity_scale` (the rotor's "
                          f"speeds are spread over fractions of it), got {starts}")

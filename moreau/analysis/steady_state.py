@@ -25,7 +25,8 @@ from ..scenes.base import Scene
 from . import mj_steady_state  # noqa: F401
 from .period_k import find_period_k, full_state_of
 from .periodic_shooting import guess_options, shoot_periodic
-from .statistical import MAX_PERIODS, statistical_steady_state
+from .statistical import (MAX_PERIODS, MIN_PERIODS, check_statistical_options,
+                          statistical_steady_state)
 from .steady_solvers import get_steady_solver, has_solver
 
 __all__ = ["SteadyState", "find_steady_state"]
@@ -93,6 +94,8 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
     if unknown:
         raise InputError(f"`statistical_options` takes {', '.join(STATISTICAL_OPTIONS)}; got "
                          f"`{unknown[0]}`")
+    check_statistical_options(max_periods=max(statistical_budget, MIN_PERIODS),
+                              **{k: v for k, v in statistical_options.items() if k != "progress"})
     if guess is not None:
         _check_guess(scene, guess)
         options["guess"] = guess

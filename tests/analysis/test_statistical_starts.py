@@ -171,6 +171,16 @@ def test_the_api_refuses_bad_starts_before_any_work(kw, match, monkeypatch):
         statistical_steady_state(FrictionDrive(frequency=185.0), **kw)
 
 
+def test_find_steady_state_refuses_bad_starts_before_its_shooting(monkeypatch):
+    monkeypatch.setattr(steady_state_module, "_find_steady_state",
+                        lambda *a, **k: pytest.fail("work started"))
+    sc = FrictionDrive(frequency=185.0)
+    with pytest.raises(InputError, match=r"`starts` must be an integer >= 1, got -1"):
+        steady_state_module.find_steady_state(sc, statistical_options={"starts": -1})
+    with pytest.raises(InputError, match=r"`statistical_options` takes precision, "):
+        steady_state_module.find_steady_state(sc, statistical_options={"budget": 5})
+
+
 def test_a_budget_that_runs_out_names_the_option(monkeypatch, capsys):
     sc = _chaotic()
     monkeypatch.setattr(steady_state_module, "_find_steady_state", _no_orbit(sc.rest_state()))
