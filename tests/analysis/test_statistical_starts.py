@@ -237,11 +237,22 @@ def test_the_interval_of_a_slowly_varying_series_covers_its_mean(monkeypatch):
     assert claimed >= 36 and hits >= 34
 
 
-def _finer_run_inside(scene, precision, **kw):
+def _finer_run_inside(scene, precision, fine_budget=None, **kw):
+    # the mean of a run asked for a ten times finer precision lies in the coarse interval;
+    # where the finer run's budget ends first, the mean over all it ran (its estimate)
     coarse = statistical_steady_state(scene, precision=precision, **kw)
-    fine = statistical_steady_state(scene, precision=precision / 10, **kw)
+    assert coarse.stats["status"] == "converged"
     lo, hi = coarse.confidence_interval
-    assert coarse.stats["status"] == fine.stats["status"] == "converged"
+    try:
+        fine = statistical_steady_state(scene, precision=precision / 10,
+                                        **{**kw, "max_periods": fine_budget or
+                                           kw.get("max_periods", statistical.MAX_PERIODS)})
+    except BudgetExhaustedError as exc:
+        if fine_budget is None:
+            raise
+        assert lo <= exc.mean <= hi
+        return coarse, exc
+    assert fine.stats["status"] == "converged"
     assert lo <= fine.displacement_per_period <= hi
     return coarse, fine
 
@@ -261,9 +272,11 @@ def test_a_chaotic_interval_covers_the_mean_of_a_ten_times_finer_run():
 
 
 @pytest.mark.slow
-def test_a_chaotic_interval_at_five_percent_covers_the_mean_at_half_a_percent():
-    # measured: 7.8032e-6 +- 3.2e-7 m over 3200 periods; the 0.5 % run ...
-    _finer_run_inside(_chaotic(), 5e-2, max_periods=1000000)
+def test_a_chaotic_interval_at_five_percent_covers_the_mean_of_a_million_periods():
+    # measured: 7.781e-6 +- 3.2e-7 m over 3200 periods; asked for 0.5 %, the run ends its
+    # 10^6 periods at +- 7.4e-8 (the motion also varies slowly, as the lighter rotor's
+    # switching regimes do: its correlation time grows to about 30 periods)
+    _finer_run_inside(_chaotic(), 5e-2, fine_budget=1000000)
 
 
 @pytest.mark.slow
