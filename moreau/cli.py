@@ -123,9 +123,10 @@ def scene_parameters(args, entry):
 
 #: `moreau steady`'s default budget of a statistical steady state, drive periods of each start:
 #: the reference at 15 kHz, e = 1 (no orbit; chaotic, its displacement per period correlated
-#: over thousands of periods) is called converged after 409 600 to 1 638 400 periods, about 25
-#: to 100 CPU s; the API's default (MAX_PERIODS) stays small for the callers that only try it
-STEADY_MAX_PERIODS = 2000000
+#: over 10^4 periods and more) was called converged from rest after 1 638 400 periods (122 CPU
+#: s) and from rest with the rotor at half the tip's speed after 3 000 000; the API's default
+#: (MAX_PERIODS) stays small for the callers that only try it (the stress catalogue's fallback)
+STEADY_MAX_PERIODS = 4000000
 
 
 def _statistical_args(args):
