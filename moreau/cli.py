@@ -6,6 +6,7 @@ paper's dimensionless variables.
 
 import argparse
 import json
+import math
 import os
 import signal
 import sys
@@ -18,11 +19,12 @@ from .analysis.atlas import classify_budget, run_scene_atlas
 from .analysis.bifurcation import bifurcation_diagram
 from .analysis.characteristic import efficiency_vs_frequency, motor_characteristic
 from .analysis.classify import CLASSIFY_PERIODS
+from .analysis.statistical import MIN_PERIODS, PRECISION
 from .analysis.sweep import require_xarray, run_scene_sweep, sweep_values
 from .analysis.history import history_tag, plot_history, run_history, write_history
 from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
-from .errors import InputError, Interrupted, MoreauError
+from .errors import BudgetExhaustedError, InputError, Interrupted, MoreauError
 from .outputs import claim_outputs
 from .provenance import provenance
 from .integrators.base import (INTEGRATORS, check_options, get_integrator,
@@ -122,7 +124,29 @@ def scene_parameters(args, entry):
     return params
 
 
+#: `moreau steady`'s default budget of a statistical steady state, drive periods of each start:
+#: the reference at 15 kHz, e = 1 (no orbit; chaotic, its displacement per period correlated
+#: over 10^4 periods and more) was called converged from rest after 1 638 400 periods (122 CPU
+#: s) and from rest with the rotor at half the tip's speed after 3 000 000; the API's default
+#: (MAX_PERIODS) stays small for the callers that only try it (the stress catalogue's fallback)
+STEADY_MAX_PERIODS = 4000000
+
+
+def _statistical_args(args):
+    """The statistical steady state's options of ``moreau steady``, checked before any work."""
+    if args.max_periods < MIN_PERIODS:
+        raise InputError(f"`--max-periods` must be an integer >= {MIN_PERIODS}, got "
+                         f"{args.max_periods}")
+    if not (args.precision > 0.0 and math.isfinite(args.precision)):
+        raise InputError(f"`--precision` must be a number > 0, got {args.precision!r}")
+    if args.starts < 1:
+        raise InputError(f"`--starts` must be an integer >= 1, got {args.starts}")
+    return {"max_periods": args.max_periods, "precision": args.precision,
+            "starts": args.starts, "progress": not args.quiet}
+
+
 def _cmd_steady(args):
+    stat = _statistical_args(args)
     _scheme_args(args)
     entry = get_entry(args.scene)
     params = scene_parameters(args, entry)
@@ -131,9 +155,16 @@ def _cmd_steady(args):
         raise InputError("`--frequency` is required (drive frequency in Hz)")
     scene = entry.factory(**params)
     check_periodic(scene)
-    rep = steady_state_report(scene, scheme=args.scheme, steps_per_period=args.steps_per_period,
-                              theta=args.theta, rtol=args.rtol, options=args.scheme_options,
-                              max_period=args.max_period)
+    try:
+        rep = steady_state_report(scene, scheme=args.scheme,
+                                  steps_per_period=args.steps_per_period, theta=args.theta,
+                                  rtol=args.rtol, options=args.scheme_options,
+                                  max_period=args.max_period, statistical_options=stat)
+    except BudgetExhaustedError as exc:
+        # the API names its argument; the command names its option
+        raise BudgetExhaustedError(
+            str(exc).replace("`max_periods`", "`--max-periods`") + "; raise `--max-periods` "
+            "or loosen `--precision`", exc.periods, exc.mean, exc.half_width) from None
     if args.json:
         print(json.dumps(rep))
         return
@@ -147,6 +178,21 @@ def _cmd_steady(args):
               f"transient of {rep['transient_periods']}")
         label = f"{100 * rep['confidence_level']:g} % interval"
         print(f"  {label:<26}[{lo:.9e}, {hi:.9e}] m")
+        start = rep["start"]
+        values = start.get("q_si", start["q"]) + start.get("v_si", start["v"])
+        units = start.get("q_units", []) + start.get("v_units", []) or [""] * len(values)
+        state = ", ".join(f"{x:.6g} {u}".rstrip() for x, u in zip(values, units))
+        print(f"  averaging started         {start['description']}: q, v = {state}")
+        if len(rep["starts"]) > 1:
+            print(f"  attractors ({len(rep['starts'])} starts)")
+            for a in rep["attractors"]:
+                alo, ahi = a["confidence_interval_m"]
+                print(f"    {a['mean_m']:.6e} m in [{alo:.6e}, {ahi:.6e}] from {a['starts']} "
+                      f"start{'s' if a['starts'] > 1 else ''}")
+            for k, row in enumerate(rep["starts"]):
+                what = (f"{row['mean_m']:.6e} m (attractor {row['attractor'] + 1})"
+                        if row["status"] == "converged" else row["status"])
+                print(f"    start {k + 1}: {row['start']['description']}: {what}")
         print(f"  why not periodic          {rep['why_not_periodic']}")
     elif not rep["periodic"]:
         print(f"  note                      {rep.get('message', '')}")
@@ -626,6 +672,17 @@ def build_parser():
     p.add_argument("--max-period", type=int, default=1,
                    help="where the period-1 orbit fails or is unstable, look for a stable "
                         "period-k orbit, k <= MAX_PERIOD (at most 8; default 1)")
+    p.add_argument("--max-periods", type=int, default=STEADY_MAX_PERIODS,
+                   help="where there is no orbit, the statistical steady state's budget of "
+                        f"drive periods, of each start (default {STEADY_MAX_PERIODS})")
+    p.add_argument("--precision", type=float, default=PRECISION,
+                   help="its wanted interval half-width relative to the mean (default "
+                        f"{PRECISION:g})")
+    p.add_argument("--starts", type=int, default=1,
+                   help="its number of starts: the first, then rest with the rotor at "
+                        "fractions up to 1 of the tip's speed amplitude; the means are "
+                        "grouped into attractors (default 1)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
     add_scene_options(p)
     p.set_defaults(func=_cmd_steady)
     s = sub.add_parser("sweep", help="steady states over one parameter range (tidy CSV + figure), "

@@ -202,7 +202,8 @@ def _adaptive_rtol(scheme):
     return max(min(ADAPTIVE_SHOOTING_RTOL, 100.0 * tol), 10.0 * tol)
 
 
-def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_iter=None):
+def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_iter=None,
+              statistical_options=None):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
 
     Sweeps, atlases and comparisons want a periodic orbit or a failure, so
@@ -210,7 +211,9 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
     only the fallback with ``statistical=True`` (``moreau steady``).
     ``guess`` is a neighbouring point's period-1 orbit to start the
     shooting from (continuation, :mod:`moreau.analysis.continuation`);
-    ``max_iter`` bounds its iterations (the solver's default otherwise).
+    ``max_iter`` bounds its iterations (the solver's default otherwise);
+    ``statistical_options`` (``max_periods``, ``precision``, ``starts``, ...)
+    go to the statistical steady state.
 
     Examples
     --------
@@ -218,6 +221,12 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
     >>> steady_of(make_scene("friction-drive", frequency=20.0), ED_REFERENCE).mode
     'NS'
     """
+    extra = dict(statistical_options or {})
+    stat = {}
+    if "max_periods" in extra:
+        stat["statistical_budget"] = extra.pop("max_periods")
+    if extra:
+        stat["statistical_options"] = extra
     if scheme.name == "moreau-jean":
         # the compiled discrete period map names its tolerance `tol`
         kw = {} if scheme.rtol is None else {"tol": scheme.rtol}
@@ -225,7 +234,8 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
             kw["max_iter"] = max_iter
         return find_steady_state(scene, scheme="moreau-jean", theta=scheme.theta,
                                  steps_per_period=scheme.steps_per_period, max_period=max_period,
-                                 statistical=statistical, guess=guess, **kw, **scheme.options)
+                                 statistical=statistical, guess=guess, **stat, **kw,
+                                 **scheme.options)
     # an adaptive scheme's period map carries its own error tolerance: the shooting
     # aims above it unless told otherwise (a fixed-step map is deterministic)
     kw = {"rtol": scheme.rtol if scheme.rtol is not None else
@@ -239,4 +249,4 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
     if scheme.options:
         kw["scheme_options"] = scheme.options
     return find_steady_state(scene, scheme=scheme.name, max_period=max_period,
-                             statistical=statistical, guess=guess, **kw)
+                             statistical=statistical, guess=guess, **stat, **kw)

@@ -26,7 +26,8 @@ from . import mj_steady_state  # noqa: F401
 from .period_k import find_period_k, full_state_of
 from .periodic_shooting import guess_options, shoot_periodic
 from .runaway import certain_runaway, runaway_side
-from .statistical import MAX_PERIODS, statistical_steady_state
+from .statistical import (MAX_PERIODS, MIN_PERIODS, check_statistical_options,
+                          statistical_steady_state)
 from .steady_solvers import get_steady_solver, has_solver
 
 __all__ = ["SteadyState", "find_steady_state"]
@@ -38,7 +39,8 @@ TWO_PI = 2.0 * math.pi
 def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 1e-10,
                       v_guess: float | None = None, max_iter: int = 60, max_period: int = 1,
                       statistical: bool = True, statistical_budget: int = MAX_PERIODS,
-                      guess: ArrayLike | None = None, **options: Any) -> SteadyState:
+                      guess: ArrayLike | None = None,
+                      statistical_options: dict | None = None, **options: Any) -> SteadyState:
     """Periodic steady state of a periodically driven scene, found by shooting, and checked.
 
     The one entry point for every scheme and every caller: what the shooting
@@ -64,9 +66,11 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
     (:func:`moreau.analysis.statistical.statistical_steady_state`): the
     long-run mean displacement per period with its confidence interval,
     from the best state the shooting reached (a time-stepping map's
-    residual floor) or the scene's initial state, within
-    ``statistical_budget`` drive periods (else
-    :class:`~moreau.errors.BudgetExhaustedError`).
+    residual floor; its ``start`` says ``"period-1-search"``) or the
+    scene's initial state, within ``statistical_budget`` drive periods
+    (else :class:`~moreau.errors.BudgetExhaustedError`).
+    ``statistical_options`` are passed on to it: ``precision``,
+    ``confidence``, ``starts``, ``spread``, ``progress``.
 
     Examples
     --------
@@ -86,6 +90,13 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
     if not isinstance(statistical, (bool, np.bool_)):
         raise InputError(f"`statistical` must be True or False, got {statistical!r}")
     statistical_budget = positive_int("statistical_budget", statistical_budget)
+    statistical_options = dict(statistical_options or {})
+    unknown = sorted(set(statistical_options) - set(STATISTICAL_OPTIONS))
+    if unknown:
+        raise InputError(f"`statistical_options` takes {', '.join(STATISTICAL_OPTIONS)}; got "
+                         f"`{unknown[0]}`")
+    check_statistical_options(max_periods=max(statistical_budget, MIN_PERIODS),
+                              **{k: v for k, v in statistical_options.items() if k != "progress"})
     why = certain_runaway(scene)
     if why:
         # the physics says so: no shooting and no long run can find a steady state
@@ -127,7 +138,8 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
         elif failure is not None and not statistical:
             raise failure
     if ss is None:
-        ss = _statistical(scene, scheme, failure, statistical_budget, options)
+        ss = _statistical(scene, scheme, failure, statistical_budget, options,
+                          statistical_options)
     why = implausible_steady_state(scene, ss)
     if why:
         raise RunawayError(why)
@@ -146,14 +158,19 @@ def _check_guess(scene, guess):
         raise InputError("`guess` must have a finite state")
 
 
-def _statistical(scene, scheme, failure, budget, options):
+#: the options of the statistical steady state that ``find_steady_state`` passes on
+STATISTICAL_OPTIONS = ("precision", "confidence", "starts", "spread", "progress")
+
+
+def _statistical(scene, scheme, failure, budget, options, extra=None):
     """The statistical steady state where the shooting found no orbit (``failure`` says why)."""
     state = getattr(failure, "state", None)
+    kind = "period-1-search" if state is not None else None
     if state is None and options.get("x_guess") is not None:
-        state = full_state_of(scene, options["x_guess"])
+        state, kind = full_state_of(scene, options["x_guess"]), "given"
     if state is None and options.get("q0") is not None and options.get("v0") is not None:
-        state = (options["q0"], options["v0"])
-    q0, v0 = state if state is not None else scene.initial_state()
+        state, kind = (options["q0"], options["v0"]), "given"
+    q0, v0 = state if state is not None else (None, None)
     own = getattr(scene, "reference_integrator", None)
     run = own if scheme == "event-driven" and own is not None else scheme
     if run == "event-driven":
@@ -163,9 +180,9 @@ def _statistical(scene, scheme, failure, budget, options):
     opts = _shooting_options(scheme, options)
     if scheme == "moreau-jean":
         opts.setdefault("projection", options.get("projection", True))
-    ss = statistical_steady_state(scene, run, q0=q0, v0=v0,
+    ss = statistical_steady_state(scene, run, q0=q0, v0=v0, start_kind=kind,
                                   section_tau=float(options.get("section_tau", 0.0)),
-                                  max_periods=budget, **opts)
+                                  max_periods=budget, **(extra or {}), **opts)
     ss.scheme = scheme
     ss.stats["why_not_periodic"] = str(failure)
     return ss

@@ -48,20 +48,45 @@ def statistical_report(scene, ss):
     one (:mod:`moreau.analysis.statistical`) adds ``confidence_interval_m``
     (``[low, high]`` of the mean displacement per period, m),
     ``confidence_level``, ``periods_used`` (periods averaged),
-    ``transient_periods`` (detected and dropped), ``statistical_status``,
-    ``statistical_method`` and ``why_not_periodic``.
+    ``transient_periods`` (detected and dropped), ``periods_simulated``,
+    ``statistical_status``, ``statistical_method``, ``statistical_precision``,
+    ``statistical_options`` (the scheme's options of the run),
+    ``why_not_periodic``, ``start`` (where the averaging started: ``how``,
+    ``description``, the state ``q_si``, ``v_si`` with ``q_units``,
+    ``v_units``, and ``q``, ``v`` in the scene's units, to start the API
+    from), ``starts`` (each start's ``start``, ``status``, ``mean_m``,
+    ``confidence_interval_m``, ``attractor``, ``cpu_time_s``) and
+    ``attractors`` (the starts grouped by overlapping intervals:
+    ``mean_m``, ``confidence_interval_m``, ``starts``, ``members``).
     """
     if not getattr(ss, "statistical", False):
         return {"steady_state": "periodic"}
+    si = scene.displacement_to_si
     lo, hi = ss.confidence_interval
     st = ss.stats or {}
+    starts = []
+    for rec in st.get("starts", []):
+        row = {k: v for k, v in rec.items()
+               if k not in ("mean", "confidence_interval", "half_width")}
+        if "mean" in rec:
+            row["mean_m"] = float(si(rec["mean"]))
+            row["confidence_interval_m"] = [float(si(x)) for x in rec["confidence_interval"]]
+        starts.append(row)
     return {"steady_state": "statistical",
-            "confidence_interval_m": [float(scene.displacement_to_si(lo)),
-                                      float(scene.displacement_to_si(hi))],
+            "confidence_interval_m": [float(si(lo)), float(si(hi))],
             "confidence_level": ss.confidence, "periods_used": int(ss.periods_used),
             "transient_periods": st.get("transient_periods"),
+            "periods_simulated": st.get("periods_simulated"),
             "statistical_status": st.get("status"), "statistical_method": st.get("method"),
-            "why_not_periodic": st.get("why_not_periodic")}
+            "statistical_precision": st.get("precision"),
+            "statistical_options": st.get("options"),
+            "why_not_periodic": st.get("why_not_periodic"),
+            "start": ss.start, "starts": starts,
+            "attractors": [{"mean_m": float(si(a["mean"])),
+                            "confidence_interval_m": [float(si(x))
+                                                      for x in a["confidence_interval"]],
+                            "starts": a["starts"], "members": list(a["members"])}
+                           for a in (ss.attractors or [])]}
 
 
 def _energy_of(scene, ss, settings):
@@ -77,7 +102,8 @@ def _energy_of(scene, ss, settings):
 
 
 def steady_state_report(scene, scheme="event-driven", steps_per_period=None, theta=None,
-                        rtol=None, parameters=None, options=None, max_period=1):
+                        rtol=None, parameters=None, options=None, max_period=1,
+                        statistical_options=None):
     """Steady state of ``scene`` as a JSON-ready dict in SI units.
 
     Parameters
@@ -98,6 +124,10 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     max_period : int
         Look for orbits of up to this many drive periods where period 1
         fails or is unstable (:func:`moreau.analysis.steady_state.find_steady_state`).
+    statistical_options : dict, optional
+        For the statistical steady state where no orbit is found:
+        ``max_periods``, ``precision``, ``starts``, ``spread``, ``progress``
+        (:func:`moreau.analysis.statistical.statistical_steady_state`).
 
     Returns
     -------
@@ -125,7 +155,8 @@ def steady_state_report(scene, scheme="event-driven", steps_per_period=None, the
     check_periodic(scene)
     settings = make_scheme(scheme, theta, steps_per_period, rtol, options)
     t0 = time.perf_counter()
-    ss = steady_of(scene, settings, max_period=max_period, statistical=True)
+    ss = steady_of(scene, settings, max_period=max_period, statistical=True,
+                   statistical_options=statistical_options)
     wall = time.perf_counter() - t0
     disp = float(scene.displacement_to_si(ss.displacement_per_period))
     if parameters is None:

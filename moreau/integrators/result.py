@@ -224,6 +224,16 @@ class SteadyState:
     periods_used : int
         Drive periods whose displacements make the mean (after the
         transient, statistical steady states only).
+    start : dict or None
+        Where a statistical steady state's averaging run started: ``how``
+        (``"rest"``, ``"given"``, ``"period-1-search"``, ...),
+        ``description``, the state ``q``, ``v`` (the scene's units) and, where
+        the scene converts to SI, ``q_si``, ``v_si`` with their units
+        (:func:`moreau.analysis.statistical.statistical_steady_state`).
+    attractors : list of dict or None
+        A statistical steady state's starts grouped by overlapping
+        intervals: each ``mean``, ``confidence_interval``, ``half_width``,
+        ``starts`` (how many) and ``members`` (their indices).
     """
 
     scheme: str
@@ -244,6 +254,8 @@ class SteadyState:
     confidence_interval: tuple = None
     confidence: float = None
     periods_used: int = 0
+    start: dict = None
+    attractors: list = None
 
     @property
     def max_multiplier(self):
