@@ -29,7 +29,6 @@ Variables are numbered as in the kernel: ``w_j -> j``, ``z_j -> n + j``,
 """
 
 from fractions import Fraction
-import math
 
 import numpy as np
 
@@ -170,6 +169,8 @@ def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivo
         Pivot limit (counting ``pivots`` already made).
     pivots : int
         Pivots made before the hand-over (counted in the result).
+    trace : list, optional
+        Receives ``(entering, leaving)`` of every pivot after the first.
 
     Returns
     -------
@@ -273,21 +274,3 @@ def _point(T, D, rows, n):
         if n <= v < 2 * n:
             z[v - n] = Fraction(T[i][2 * n + 1], D)
     return z
-
-
-def fractions_to_float(v):
-    """Correctly rounded floats of a list of Fractions."""
-    return np.array([float(x) for x in v])
-
-
-def gcd_scaled(v):
-    """A rational vector times a positive number making it integers with gcd 1 (as floats when exact)."""
-    den = 1
-    for x in v:
-        den = den * x.denominator // math.gcd(den, x.denominator)
-    ints = [int(x * den) for x in v]
-    g = 0
-    for x in ints:
-        g = math.gcd(g, x)
-    g = g or 1
-    return [x // g for x in ints]

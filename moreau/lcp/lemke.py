@@ -23,10 +23,27 @@ friction LCPs.
 
 The ratio test is lexicographic: among rows tied at the minimum ratio it
 picks the lexicographic minimum of ``(b_i, (B^-1)_i) / a_i``, reading the rows
-of ``B^-1`` from the tableau columns of the original ``w`` variables. With
-this rule the basis stays lexicographically feasible and degenerate problems
-cannot cycle. If ``z0`` is among the tied rows it leaves at once, which ends
-the path on a solution.
+of ``B^-1`` from the tableau columns of the original ``w`` variables. If
+``z0`` is among the tied rows it leaves at once, which ends the path on a
+solution. In exact arithmetic this rule keeps the basis lexicographically
+positive and no basis can repeat (Cottle, Pang and Stone 1992, Sec. 4.9).
+
+In floating point a tie can be decided by rounding noise (an exact zero
+computed as -5e-15 against another as -1e-16), and a wrong decision can
+cycle. So an order is taken from floating point only where it stands above a
+rounding bound of the entries, ``ROUND`` (``2^16 eps``, a growth allowance
+over many pivots) times the size of each row; an entering-column entry
+within that bound of zero is no candidate, and if it could have changed the
+step (no other candidate, or a ratio that could undercut the minimum) the
+step is not taken in floating point either. Where floating point cannot
+decide, and where a basis repeats (the visited bases are hashed past ``2 n +
+16`` pivots), :func:`solve` finishes the path in exact integer arithmetic
+(:mod:`moreau.lcp._exact`) from the basis reached, or afresh if that basis is
+not lexicographically positive for the caller's data: the path is then the
+exact lexicographic one and cannot cycle. The compiled entries
+(:func:`lemke_kernel`, :func:`lemke_core`), which have no exact path, count
+an undecidable entry as a tie and stop on a repeated basis with
+:data:`BREAKDOWN`, never running on to the pivot limit.
 
 Tolerances are relative, so they follow the scale of the data. A pivot
 entry counts as positive when it exceeds ``PIVOT_TOL`` times the largest
@@ -35,9 +52,10 @@ badly scaled problems, e.g. a triangular P-matrix whose solution spans
 eleven orders of magnitude, it is genuine) but compared with the rounding
 level of that entry, ``NOISE_TOL * sum_j |B^-1_ij| |A_ej|`` with ``A_e`` the
 entering column of ``[I, -M, -d]``, and kept when it stands above it.
-Ratios tie within ``TIE_TOL`` relative difference, and a right-hand side
-that cancels to rounding level is set to exactly zero so that degenerate
-rows are recognised as such.
+Ratios tie within ``TIE_TOL`` relative difference (the tied rows are then
+ordered by the lexicographic test, right-hand sides first), and a
+right-hand side that cancels to rounding level is set to exactly zero so
+that degenerate rows are recognised as such.
 
 :func:`solve` (and :func:`lemke_kernel`) pivot on balanced data: ``D M D``
 and ``D q`` with ``D`` a diagonal of powers of two that brings the rows of
@@ -61,9 +79,11 @@ partial pivoting) and checked again; if that fails too the status is
 
 A secondary ray is turned into a proof of infeasibility only when a Farkas
 vector built from it checks out in exact rational arithmetic on the caller's
-data (:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
-:data:`INFEASIBLE`, with the Farkas vector in ``certificate``. Otherwise it
-stays :data:`SECONDARY_RAY`, which proves nothing.
+data (:func:`moreau.lcp.certify.infeasibility_from_ray`), or a unit vector
+``e_i`` is one (``q_i < 0`` and row ``i`` of ``M`` non-positive,
+:func:`unit_farkas`): the status is then :data:`INFEASIBLE`, with the Farkas
+vector in ``certificate``. Otherwise it stays :data:`SECONDARY_RAY`, which
+proves nothing (``"auto"`` goes further: :mod:`moreau.lcp.decide`).
 
 Calling from compiled code
 --------------------------
@@ -110,6 +130,7 @@ __all__ = [
     "MAX_ITER",
     "BREAKDOWN",
     "INVALID_INPUT",
+    "unit_farkas",
     "PIVOT_TOL",
     "NOISE_TOL",
     "TIE_TOL",
@@ -131,6 +152,8 @@ ROUND = 2.0**16 * np.finfo(float).eps
 # internal statuses: the compiled pivoting hands over to the exact path
 _HANDOFF_TIE = 100
 _HANDOFF_CYCLE = 101
+# slots of the hash set of visited bases (a power of two)
+_SEEN_SIZE = 1 << 14
 #: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
 #: result to count as solved
 DEFAULT_TOL = 1e-9
@@ -217,8 +240,9 @@ def _row_scales(T, b, pos, n, i, qsum):
 
 
 @njit(cache=True)
-def _lex_compare(T, b, pos, n, i, k, ai, ak, qsum, exact_ok):
-    # Compare rows i and k of [b | B^-1] / a lexicographically: -1 or 1 when
+def _lex_compare(T, b, pos, n, i, k, ai, ak, qsum, exact_ok, rhs_only):
+    # Compare rows i and k of [b | B^-1] / a lexicographically (with rhs_only,
+    # their ratios b / a alone): -1 or 1 when
     # the order stands above the rounding of the entries, 0 when every entry
     # ties, 2 when floating point cannot tell (only with exact_ok; else an
     # undecidable entry counts as a tie, the rounding noise of an exact zero
@@ -255,6 +279,8 @@ def _lex_compare(T, b, pos, n, i, k, ai, ak, qsum, exact_ok):
             return -1 if diff < 0.0 else 1
         if diff != 0.0 and exact_ok:
             return 2
+        if rhs_only:
+            return 0
     return 0
 
 
@@ -578,27 +604,34 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     pivots = 1
     status = MAX_ITER
     entering = leaving + n  # complement of w_r is z_r
-    # the basis identified by the XOR of its variables' keys; Brent's cycle
-    # detection on (basis, entering): an exact lexicographic path never
-    # repeats one, so a repeat is rounding having decided a tie wrongly
+    # (basis, entering) identified by the XOR of its variables' keys: an exact
+    # lexicographic path never repeats one, so a repeat is rounding having
+    # decided a tie wrongly. Past 2 n + 16 pivots (a path that long is rare
+    # outside exponential examples) the states go into a hash set; when it
+    # is three-quarters full it is cleared, and a loop is caught on its next round
     hb = 0
     for i in range(n):
         hb ^= _key(basis[i])
-    saved = hb ^ _key(entering + 3 * n)
-    power = 1
-    lam = 0
+    seen = np.zeros(1, dtype=np.int64)
+    nseen = 0
+    watch = 2 * n + 16
 
     while pivots < max_iter:
-        if pivots > 1:
+        if pivots >= watch:
+            if seen.shape[0] == 1 or 4 * nseen >= 3 * seen.shape[0]:
+                seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
+                nseen = 0
             state = hb ^ _key(entering + 3 * n)
-            lam += 1
-            if state == saved:
+            if state == 0:
+                state = 1
+            h = state & (_SEEN_SIZE - 1)
+            while seen[h] != 0 and seen[h] != state:
+                h = (h + 1) & (_SEEN_SIZE - 1)
+            if seen[h] == state:
                 status = _HANDOFF_CYCLE if exact_ok else BREAKDOWN
                 break
-            if lam == power:
-                saved = state
-                power *= 2
-                lam = 0
+            seen[h] = state
+            nseen += 1
         s = -pos[entering] - 1
         # -- ratio test over rows with a clearly positive pivot-column entry;
         # the column is gathered once into contiguous storage
@@ -613,8 +646,20 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
             break
         thr = PIVOT_TOL * cmax
         theta = np.inf
+        nunc = 0
+        unc = T[n]  # scratch row until the pivot: the rounding bound of each uncertain entry
         for i in range(n):
             a = col[i]
+            unc[i] = 0.0
+            if exact_ok and a != 0.0 and abs(a) <= thr:
+                # an entry within the rounding bound of its row may be an exact
+                # zero or of either sign: no candidate here; whether it could
+                # change the outcome is judged once theta is known
+                si, _ = _row_scales(T, b, pos, n, i, qsum)
+                if abs(a) <= ROUND * si:
+                    unc[i] = ROUND * si
+                    nunc += 1
+                    continue
             if a > 0.0 and a <= thr:
                 # small: keep it only if it stands above its rounding level;
                 # otherwise it is rounding of a zero, and becomes one (in the
@@ -627,6 +672,19 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
                 t = b[i] / a
                 if t < theta:
                     theta = t
+        if nunc > 0:
+            # an uncertain entry a_i in (0, u_i] would have the ratio b_i / a_i >=
+            # b_i / u_i: it can change the step only where that is not above theta
+            # (or where there is no other candidate: the ray would rest on it)
+            for i in range(n):
+                u = unc[i]
+                if u > 0.0:
+                    _, sbi = _row_scales(T, b, pos, n, i, qsum)
+                    if theta == np.inf or b[i] <= theta * u + ROUND * sbi:
+                        status = _HANDOFF_TIE
+                        break
+            if status == _HANDOFF_TIE:
+                break
         if theta == np.inf:
             # secondary ray: entering variable +1, basic ones move by -a_i
             for j in range(n):
@@ -643,14 +701,30 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
         nties = 0
         for i in range(n):
             a = col[i]
-            if a > 0.0 and b[i] / a <= lim:
+            if a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
                 nties += 1
                 if r < 0:
                     r = i
         if nties > 1:
             zrow = pos[z0]
             a_z = col[zrow]
-            if a_z > 0.0 and b[zrow] / a_z <= lim:
+            z0_tied = a_z > 0.0 and unc[zrow] == 0.0 and b[zrow] / a_z <= lim
+            if z0_tied and exact_ok:
+                # z0 leaves on a tie that holds, not on one of TIE_TOL: its ratio
+                # must not stand above another tied row's beyond rounding
+                for i in range(n):
+                    a = col[i]
+                    if i != zrow and a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
+                        c = _lex_compare(T, b, pos, n, zrow, i, a_z, a, qsum, exact_ok, True)
+                        if c == 2:
+                            status = _HANDOFF_TIE
+                            break
+                        if c > 0:
+                            z0_tied = False
+                            break
+                if status == _HANDOFF_TIE:
+                    break
+            if z0_tied:
                 # z0 can leave now: take the solution
                 r = zrow
             else:
@@ -659,8 +733,9 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
                 undecided = False
                 for i in range(r + 1, n):
                     a = col[i]
-                    if a > 0.0 and b[i] / a <= lim:
-                        c = _lex_compare(T, b, pos, n, i, best, a, col[best], qsum, exact_ok)
+                    if a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
+                        c = _lex_compare(T, b, pos, n, i, best, a, col[best], qsum, exact_ok,
+                                         False)
                         if c == 2:
                             undecided = True
                             break
@@ -1006,6 +1081,57 @@ def unit_farkas(M, q):
 
 
 @njit(cache=True)
+def _screen_ray(M, q, ray):
+    # the candidates moreau.lcp.certify._candidates builds from a ray (the
+    # clipped ray, with entries below 1e-12, 1e-9, 1e-6 of the largest removed,
+    # and rounded to 40, 26, 20, 12 bits), each judged by farkas_float, and the
+    # unit vectors (unit_farkas): 1 one is proven, 0 one needs the exact
+    # check, -1 every one fails rigorously. Then whether M might be PSD (where
+    # the exact null-space projection is tried): not when its symmetric part
+    # has a negative diagonal entry, or a zero one with a nonzero row
+    n = q.shape[0]
+    maybe_psd = True
+    for i in range(n):
+        if M[i, i] < 0.0:
+            maybe_psd = False
+        elif M[i, i] == 0.0:
+            for j in range(n):
+                if M[i, j] + M[j, i] != 0.0:
+                    maybe_psd = False
+                    break
+    if unit_farkas(M, q) >= 0:
+        return 1, maybe_psd
+    top = 0.0
+    for i in range(n):
+        if not abs(ray[i]) < np.inf:
+            return 0, maybe_psd
+        top = max(top, ray[i])
+    if not top > 0.0:
+        return -1, maybe_psd
+    y = np.empty(n)
+    c = np.empty(n)
+    for i in range(n):
+        y[i] = max(ray[i] / top, 0.0)
+    best = -1
+    for k in range(8):
+        for i in range(n):
+            if k == 0:
+                c[i] = y[i]
+            elif k < 4:
+                cut = 1e-12 if k == 1 else (1e-9 if k == 2 else 1e-6)
+                c[i] = 0.0 if y[i] < cut else y[i]
+            else:
+                bits = 40 if k == 4 else (26 if k == 5 else (20 if k == 6 else 12))
+                c[i] = math.ldexp(np.round(math.ldexp(y[i], bits)), -bits)
+        v = farkas_float(M, q, c)
+        if v > best:
+            best = v
+            if best == 1:
+                break
+    return best, maybe_psd
+
+
+@njit(cache=True)
 def _ray_proves(M, q, ray):
     # the ray's dz (negative rounding noise clipped) is a Farkas vector, decided
     # rigorously in floating point (farkas_float); an undecided case stays a
@@ -1172,6 +1298,12 @@ class _LemkeResult(LCPResult):
             # name, an eigenvalue computation) only when someone reads them
             _, M, q = self.__dict__["_ray"]
             why = _ray_or_unit_proof(M, q, self.ray)[1]
+            d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
+            self.__dict__["_detail"] = d
+            return d
+        if self.status == SECONDARY_RAY and "_ray" in self.__dict__:
+            _, M, q = self.__dict__["_ray"]
+            why = infeasibility_from_ray(M, q, self.ray)[1]
             d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
             self.__dict__["_detail"] = d
             return d
@@ -1417,6 +1549,13 @@ def _ray_or_unit_proof(M, q, ray):
 
 
 def _prove_secondary_ray(res, M, q, ray, pivots):
+    verdict, maybe_psd = _screen_ray(M, q, ray)
+    if verdict < 0 and not maybe_psd:
+        # every candidate fails rigorously, and M is not PSD (where the exact
+        # null-space projection could still find one): no proof, and the words
+        # only when someone reads them
+        res.status = SECONDARY_RAY
+        return
     y, why = _ray_or_unit_proof(M, q, ray)
     res.status = INFEASIBLE if y is not None else SECONDARY_RAY
     if y is not None:
