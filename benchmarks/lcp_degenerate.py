@@ -46,6 +46,8 @@ def run_family(strategy, n_examples):
         ended = {SOLVED: "solved", SECONDARY_RAY: "ray", INFEASIBLE: "ray"}.get(res.status, "other")
         if ended != status:
             stats["ended otherwise"] += 1
+            if ended == "solved":
+                stats["solved where exact rays"] += 1
         diffs[res.pivots - pivots] += 1
         if "exact arithmetic" in res.detail:
             stats["handed over"] += 1
@@ -72,6 +74,7 @@ def main():
               f"{stats['exact ray']}  exact pivots {min(piv)}-{max(piv)} (mean {sum(piv) / len(piv):.1f})"
               f"  float-exact pivots {{{d}}}  MAX_ITER where exact ends "
               f"{stats['MAX_ITER where exact ends']}  ended otherwise {stats['ended otherwise']}"
+              f" (solved where exact rays {stats['solved where exact rays']})"
               f"  handed over {stats['handed over']} (afresh {stats['started afresh']})"
               f"  [{time.perf_counter() - t0:.1f} s]")
     print(f"all: {total['cases']} cases, MAX_ITER where exact ends {total['MAX_ITER where exact ends']}, "

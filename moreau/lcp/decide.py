@@ -88,7 +88,11 @@ def lp_farkas(M, q):
     n = len(q)
     if n == 0 or np.min(q) >= 0.0:
         return None
-    res = _linprog(q, A_ub=M.T, b_ub=np.zeros(n), bounds=[(0.0, 1.0)] * n)
+    # HiGHS's tolerances are absolute: solve on data of unit size (a positive
+    # scaling of M or q changes no Farkas vector), check on the caller's
+    sm = float(np.max(np.abs(M))) or 1.0
+    res = _linprog(q / float(np.max(np.abs(q))), A_ub=M.T / sm, b_ub=np.zeros(n),
+                   bounds=[(0.0, 1.0)] * n)
     if res.status != 0 or not res.fun < 0.0:
         return None
     y = np.maximum(np.asarray(res.x, dtype=float), 0.0)
@@ -140,7 +144,11 @@ def _piece_certificate(M, q, J, Jc):
     A = np.hstack([M[np.ix_(J, J)].T, M[np.ix_(Jc, J)].T]) if nJ else np.zeros((0, len(Jc)))
     c = np.concatenate([q[J], q[Jc]])
     bounds = [(-1.0, 1.0)] * nJ + [(0.0, 1.0)] * len(Jc)
-    res = _linprog(c, A_ub=A if nJ else None, b_ub=np.zeros(nJ) if nJ else None, bounds=bounds)
+    # unit-size data for HiGHS's absolute tolerances (the certificate is checked exactly)
+    sa = float(np.max(np.abs(A))) if A.size else 1.0
+    sc = float(np.max(np.abs(c))) if c.size else 1.0
+    res = _linprog(c / (sc or 1.0), A_ub=A / (sa or 1.0) if nJ else None,
+                   b_ub=np.zeros(nJ) if nJ else None, bounds=bounds)
     if res.status != 0 or not res.fun < 0.0:
         return False
     x = np.asarray(res.x, dtype=float)
@@ -246,7 +254,11 @@ def enumerate_pieces(M, q, tol=1e-9):
             if all(v >= 0 for v in zJ) and all(
                     qi[i] + sum(Mi[i][j] * zJ[a] for a, j in enumerate(Jl)) >= 0 for i in Jc):
                 z = np.zeros(n)
-                z[J] = [float(v) for v in zJ]
+                try:
+                    z[J] = [float(v) for v in zJ]
+                except OverflowError:
+                    counts["undecided"] += 1  # a solution outside the range of doubles
+                    continue
                 if lcp_violation(M, q, z) <= tol:
                     counts["J"] = Jl
                     return "solved", z, counts

@@ -710,20 +710,18 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
             a_z = col[zrow]
             z0_tied = a_z > 0.0 and unc[zrow] == 0.0 and b[zrow] / a_z <= lim
             if z0_tied and exact_ok:
-                # z0 leaves on a tie that holds, not on one of TIE_TOL: its ratio
-                # must not stand above another tied row's beyond rounding
+                # z0 does not leave where its ratio stands above another tied
+                # row's beyond rounding (a tie of TIE_TOL only). Within rounding
+                # it leaves: the point then solves the LCP up to rounding and is
+                # certified on the data like any other (an exact path would cost
+                # a friction LCP of n = 100 seconds, for a rounding-level step)
                 for i in range(n):
                     a = col[i]
                     if i != zrow and a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
                         c = _lex_compare(T, b, pos, n, zrow, i, a_z, a, qsum, exact_ok, True)
-                        if c == 2:
-                            status = _HANDOFF_TIE
-                            break
-                        if c > 0:
+                        if c == 1:
                             z0_tied = False
                             break
-                if status == _HANDOFF_TIE:
-                    break
             if z0_tied:
                 # z0 can leave now: take the solution
                 r = zrow
@@ -1543,7 +1541,10 @@ def _ray_or_unit_proof(M, q, ray):
         return None, why
     y = np.zeros(len(q))
     y[i] = 1.0
-    return y, (f"Lemke ended on a secondary ray; `certificate` holds the unit vector e_{i}: "
+    cls = certify.copositive_plus_class(M)
+    src = (f"M is copositive-plus ({cls}), so Lemke's theorem says the ray means infeasibility"
+           if cls is not None else "M is of no certified class")
+    return y, (f"Lemke ended on a secondary ray ({src}); `certificate` holds the unit vector e_{i}: "
                f"q_{i} = {q[i]:.3g} < 0 and row {i} of M is <= 0, so w_{i} = (M z)_{i} + q_{i} < 0 "
                f"for every z >= 0 (exact: no arithmetic involved).")
 
@@ -1575,7 +1576,15 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
                                                      entering=entering, max_iter=max_iter,
                                                      pivots=pivots)
     total = piv if resumed else pivots + piv
-    z = np.array([float(v) for v in zx]) if n else np.zeros(0)
+    try:
+        z = np.array([float(v) for v in zx]) if n else np.zeros(0)
+    except OverflowError:
+        # the exact point lies outside the range of doubles
+        res = _LemkeResult(np.zeros(n), q.copy(), BREAKDOWN, total,
+                           float(lcp_violation(M, q, np.zeros(n))), "lemke")
+        res.detail = ("Pivoting was finished in exact arithmetic, but its end point lies outside "
+                      "the range of floating-point numbers.")
+        return res
     w = M @ z + q
     residual = float(lcp_violation(M, q, z))
     why = ("a lexicographic tie that floating point could not separate" if handoff == _HANDOFF_TIE
@@ -1596,7 +1605,9 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
         res.detail = f"{note} {_DETAIL[MAX_ITER]} (after {total} pivots)"
         return res
     res = _LemkeResult(z, w, SECONDARY_RAY, total, residual, "lemke")
-    ray = np.array([float(v) for v in rayx])
+    top = max(abs(v) for v in rayx)
+    # a direction: scaled to a largest entry of 1 before rounding, it stays finite
+    ray = np.array([float(v / top) for v in rayx])
     out[2 * n:] = ray
     res.__dict__["_ray"] = (out, M, q)
     _prove_secondary_ray(res, M, q, ray, total)

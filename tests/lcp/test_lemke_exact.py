@@ -8,20 +8,30 @@ Asserted on each:
 * the float Lemke never stops at its pivot limit where the exact one ends;
 * it ends the same way (solution, or a ray: ``SECONDARY_RAY`` or a proven
   ``INFEASIBLE``), at the same point when the exact terminal basis is
-  nondegenerate (then the point determines the basis);
+  nondegenerate (then the point determines the basis); the one exception
+  allowed: ``z0`` leaving on a tie within rounding of its ratio where the
+  exact path pivots on, which gives a solution up to rounding (certified
+  here) where the exact path may end on a ray;
 * its pivot count is within ``PIVOT_SLACK`` of the exact count.
 
 The families (Hypothesis draws the sizes, the knobs and a seed; numpy fills
-the arrays; data times a non-dyadic factor 0.1 or 1/3 as well as integers, so
-that exact zeros of the elimination come out as rounding noise):
+the arrays): integers, times 1, 1/2 or 3/8, stored exactly, so that a tie of
+the problem as meant is a tie of the floats too, while the eliminations
+(pivots of 3, 5, 7, ...) make rounding noise of their exact zeros. With
+non-dyadic data (0.1, 1/3) the stored floats differ from the problem meant
+by 1e-17, and the exact path of the floats is decided by that difference,
+which no floating-point pivoting can see: there the float path may end
+elsewhere after a tie that rounding shows as exact (about 1 case in 500 in
+``benchmarks/lcp_degenerate.py``), though never at the pivot limit (the
+n = 40 case below is such data):
 
 * ``q_zeros``: integer ``M``, ``q`` with 50-90 % zeros;
 * ``repeated``: ``M`` built from 2-4 distinct integer rows and columns;
 * ``ties``: ``q_i = -1`` on a set ``G`` of 6-11 rows and ``M_ir < M_rr`` for
   ``r = max G``: after ``z0`` enters at row ``r``, ``z_r`` enters with the
   other rows of ``G`` all at ratio 0, a 5-10-row tie (asserted);
-* ``bimatrix``: ``M = [[0, A], [B^T, 0]]``, ``q = -1``, positive integer
-  payoffs with repeated rows;
+* ``bimatrix``: ``M = [[0, A], [B^T, 0]]``, ``q = -1``, integer payoffs of
+  both signs with repeated rows;
 * ``zmatrix``: ``M = s I - B``, ``B >= 0`` integer (the Z-matrices of
   Chandrasekaran's method), ``q`` with zeros;
 * Murty's exponential examples (``2^n`` pivots).
@@ -36,6 +46,7 @@ from moreau.lcp import INFEASIBLE, MAX_ITER, SECONDARY_RAY, solve_lcp
 from moreau.lcp.instances import murty
 from moreau.lcp.lemke import lemke_core, lemke_workspace
 
+from .conftest import assert_certified
 from .exact_reference import reference_lemke
 
 #: the float pivot count may differ from the exact one by this much: only
@@ -52,7 +63,7 @@ def _settings():
 @st.composite
 def _rng_factor(draw):
     rng = np.random.default_rng(draw(st.integers(0, 2**63 - 1)))
-    return rng, draw(st.sampled_from([1.0, 0.1, 1.0 / 3.0]))
+    return rng, draw(st.sampled_from([1.0, 0.5, 0.375]))
 
 
 def _q(rng, n, zeros, factor):
@@ -102,8 +113,10 @@ def bimatrix(draw):
     rng, f = draw(_rng_factor())
     m = draw(st.integers(1, 5))
     k = draw(st.integers(1, 5))
-    A = rng.integers(1, 7, (m, k)).astype(float)
-    B = rng.integers(1, 7, (m, k)).astype(float)
+    # payoffs of both signs: with costs > 0 Lemke (covering ones) ends on a ray
+    # at its second pivot on every game, which would test nothing here
+    A = rng.integers(-3, 7, (m, k)).astype(float)
+    B = rng.integers(-3, 7, (m, k)).astype(float)
     A = A[rng.integers(0, m, m)]
     B = B[:, rng.integers(0, k, k)]
     M = np.zeros((m + k, m + k))
@@ -144,6 +157,11 @@ def check_against_exact(M, q):
         if _nondegenerate_point(M, q, z):
             ze = np.array([float(v) for v in z])
             np.testing.assert_allclose(res.z, ze, rtol=1e-9, atol=1e-12 * max(1.0, np.max(ze)))
+    elif res.success:
+        # z0 left on a tie within rounding of its ratio where the exact path
+        # pivots on (and ends on a ray): a solution up to rounding, certified
+        assert_certified(M, q, res.z, 1e-9)
+        return status, pivots, res, max_ties, z
     else:
         assert res.status in (SECONDARY_RAY, INFEASIBLE), res.message
     assert abs(res.pivots - pivots) <= PIVOT_SLACK, (res.pivots, pivots, res.message)
