@@ -29,6 +29,7 @@ both ending in checks made exactly on the caller's data:
 """
 
 from fractions import Fraction
+import math
 
 import numpy as np
 
@@ -53,7 +54,7 @@ def _rational_images(y, max_den=10**6):
     fr = [Fraction(float(v)).limit_denominator(max_den) for v in y]
     den = 1
     for f in fr:
-        den = den * f.denominator // np.gcd(den, f.denominator)
+        den = den * f.denominator // math.gcd(den, f.denominator)
     ints = [int(f * den) for f in fr]
     if max(abs(v) for v in ints) < 2**53:
         yield np.array(ints, dtype=float)
