@@ -40,7 +40,10 @@ decide, and where a basis repeats (the visited bases are hashed past ``2 n +
 16`` pivots), :func:`solve` finishes the path in exact integer arithmetic
 (:mod:`moreau.lcp._exact`) from the basis reached, or afresh if that basis is
 not lexicographically positive for the caller's data: the path is then the
-exact lexicographic one and cannot cycle. The compiled entries
+exact lexicographic one and cannot cycle. One exception, for cost: where
+``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
+is a solution up to rounding, certified on the data as always), where the
+exact path might pivot on. The compiled entries
 (:func:`lemke_kernel`, :func:`lemke_core`), which have no exact path, count
 an undecidable entry as a tie and stop on a repeated basis with
 :data:`BREAKDOWN`, never running on to the pivot limit.
