@@ -19,10 +19,20 @@ run. Correctness: a solve counts as correct when the solver
 reports success and ``z`` has a scaled residual (``moreau.lcp.lcp_residual``)
 ``<= 1e-8``; on infeasible instances, when it reports failure.
 
+With ``--siconos``, instead: ``solve_lcp(M, q)`` against Siconos's
+lexicographic Lemke (``sn.lcp_lexicolemke``, run by
+``benchmarks/siconos_lcp_peer.py`` under ``/usr/bin/python3``, timed inside
+that process per call: building ``sn.LCP(M, q)`` and solving, as a user with
+new data does) on a test set of this project's own families (P-matrix, PSD,
+non-monotone, degenerate, bimatrix; n = 2 to 40), interleaved with our
+timings in the same run. It prints each problem's times and ratio, the
+geometric mean of the ratios over the problems both solve and the largest.
+
 Usage::
 
     python benchmarks/bench_lcp.py            # full run, a few minutes
     python benchmarks/bench_lcp.py --quick    # smaller sizes, fewer repeats
+    python benchmarks/bench_lcp.py --siconos  # against Siconos's Lemke
 
 Nothing is written to disk. Peers that are not installed are skipped with
 a message (``pip install quantecon lemkelcp``).
@@ -39,7 +49,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."
 
 from numba import njit  # noqa: E402
 
-from moreau.lcp import lcp_residual, lemke_kernel, solve_lcp  # noqa: E402
+from moreau.lcp import lcp_residual, lcp_violation, lemke_kernel, solve_lcp  # noqa: E402
 from moreau.lcp.instances import (  # noqa: E402
     classic_instances,
     random_friction,
@@ -178,6 +188,115 @@ def bench_instances(quick):
     return out
 
 
+PEER = os.path.join(os.path.dirname(os.path.abspath(__file__)), "siconos_lcp_peer.py")
+
+
+def peer_instances():
+    """The test set of ``--siconos``: this project's families, n = 2 to 40 (seeded)."""
+    from moreau.lcp.instances import random_psd
+
+    rng = np.random.default_rng(33)
+    out = []
+    for n in (2, 5, 10, 20, 40):
+        out.append((f"P-matrix n={n}", random_p_matrix(n, rng), rng.standard_normal(n)))
+    for n in (4, 12, 30):
+        M, q, _, _ = random_psd(n, max(1, n // 2), rng)
+        out.append((f"PSD rank n/2 n={n}", M, q))
+    for n in (3, 8, 20):
+        # non-monotone: integer, indefinite symmetric part, positive diagonal
+        M = rng.integers(-3, 4, (n, n)).astype(float)
+        M[np.diag_indices(n)] = rng.integers(1, 4, n)
+        out.append((f"non-monotone n={n}", M, -rng.integers(0, 3, n).astype(float) - 0.5))
+    for n in (6, 15, 40):
+        # degenerate: few distinct rows and columns (tenths), q mostly zeros
+        k = 3
+        base = rng.integers(-1, 4, (k, k)).astype(float) * 0.1
+        M = base[rng.integers(0, k, n)][:, rng.integers(0, k, n)] + rng.integers(0, 3, (n, n)) * 0.1
+        M[np.diag_indices(n)] = np.abs(M[np.diag_indices(n)]) + 0.1
+        q = rng.integers(-2, 3, n).astype(float)
+        q[rng.random(n) < 0.6] = 0.0
+        q[0] = -1.0
+        out.append((f"degenerate n={n}", M, q))
+    for m in (2, 5):
+        # bimatrix games, positive payoffs: Lemke with covering ones ends on a ray
+        A = rng.integers(1, 7, (m, m)).astype(float)
+        B = rng.integers(1, 7, (m, m)).astype(float)
+        M = np.zeros((2 * m, 2 * m))
+        M[:m, m:] = A
+        M[m:, :m] = B.T
+        out.append((f"bimatrix {m}x{m}", M, -np.ones(2 * m)))
+    for n in (4, 10):
+        M = np.triu(rng.integers(1, 3, (n, n)).astype(float))  # P-matrix, integer, degenerate q
+        q = -rng.integers(0, 2, n).astype(float)
+        q[-1] = -1.0
+        out.append((f"triangular integer n={n}", M, q))
+    return out
+
+
+def run_peer(problems, rounds, budget):
+    """Siconos's per-call times, or None with the reason printed."""
+    import json
+    import subprocess
+
+    job = {"problems": [{"M": M.tolist(), "q": q.tolist()} for _, M, q in problems],
+           "rounds": rounds, "budget": budget, "max_iter": 100000}
+    try:
+        proc = subprocess.run(["/usr/bin/python3", PEER], input=json.dumps(job), text=True,
+                              capture_output=True, timeout=1800)
+        data = json.loads(proc.stdout)
+    except (OSError, ValueError, subprocess.SubprocessError) as exc:
+        print(f"Siconos peer not run: {exc}")
+        return None
+    if not data.get("available"):
+        print(f"Siconos peer not available: {data.get('reason')}")
+        return None
+    return data
+
+
+def siconos_comparison(quick):
+    """Per-call time of solve_lcp against Siconos's lexicographic Lemke, in alternating batches."""
+    problems = peer_instances()
+    alternations = 2 if quick else 3
+    rounds = 3 if quick else 5
+    ours = [[] for _ in problems]
+    peer = [[] for _ in problems]
+    peer_solve = [[] for _ in problems]
+    info = None
+    for _ in range(alternations):
+        data = run_peer(problems, rounds, 0.02)
+        if data is None:
+            return
+        info = data["results"]
+        for k, r in enumerate(info):
+            peer[k] += r["times"]
+            peer_solve[k] += r["solve_s"]
+        for k, (_, M, q) in enumerate(problems):
+            ours[k] += time_per_call([lambda M=M, q=q: solve_lcp(M, q)], rounds)[0]
+    print(f"solve_lcp(M, q) against Siconos {data['version']} sn.lcp_lexicolemke (build sn.LCP + "
+          f"solve), CPU microseconds per call, median of {alternations * rounds} batches; "
+          f"ratio = moreau / Siconos")
+    head = (f"{'problem':28s} {'n':>3s} {'moreau':>9s} {'status':>7s} {'siconos':>9s} {'info':>4s}"
+            f" {'ratio':>6s} {'sic. solve only':>15s}")
+    print(head)
+    print("-" * len(head))
+    both = []
+    for k, (name, M, q) in enumerate(problems):
+        res = solve_lcp(M, q)
+        zp = np.array(info[k]["z"])
+        ok_peer = info[k]["info"] == 0 and lcp_violation(M, q, zp) <= 1e-9
+        t_ours = float(np.median(ours[k]))
+        t_peer = float(np.median(peer[k]))
+        ratio = t_ours / t_peer
+        if res.success and ok_peer:
+            both.append(ratio)
+        print(f"{name:28s} {len(q):3d} {fmt_us(t_ours):>9s} {res.status:7d} {fmt_us(t_peer):>9s}"
+              f" {info[k]['info']:4d}{'' if ok_peer or info[k]['info'] else '!'} {ratio:6.2f}"
+              f" {fmt_us(float(np.median(peer_solve[k]))):>15s}")
+    if both:
+        print(f"\nover the {len(both)} problems both solve: geometric mean ratio "
+              f"{float(np.exp(np.mean(np.log(both)))):.2f}, largest {max(both):.2f}")
+
+
 def fmt_us(t):
     if t is None:
         return "-"
@@ -188,7 +307,12 @@ def fmt_us(t):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes and fewer repeats")
+    ap.add_argument("--siconos", action="store_true",
+                    help="per-call time against Siconos's lexicographic Lemke (/usr/bin/python3)")
     args = ap.parse_args(argv)
+    if args.siconos:
+        siconos_comparison(args.quick)
+        return
     rounds = 7 if args.quick else 21
     n_robust = 60 if args.quick else 300
 

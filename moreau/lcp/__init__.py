@@ -14,9 +14,15 @@ check_input, friction, ...)``; :data:`METHODS` maps names to them.
     Tresca fixed point for the friction LCP.
 ``"auto"``
     Lemke first. When Lemke proves the LCP infeasible (a secondary ray with
-    ``M`` copositive-plus, or a ray that is itself a Farkas vector) that is
-    the answer: status :data:`INFEASIBLE`, no QP. On any other failure the
-    QP method, with the path recorded in ``result.path``.
+    ``M`` copositive-plus, a ray that is itself a Farkas vector, or a unit
+    vector that is one) that is the answer: status :data:`INFEASIBLE`, no
+    QP. After a secondary ray that proves nothing, the dual of the LP
+    ``{z >= 0, M z + q >= 0}`` (HiGHS) is tried for a Farkas vector, and for
+    ``n <= enumerate_max_n`` (12) the ``2^n`` complementary pieces are
+    visited (:mod:`moreau.lcp.decide`): a solution found is returned
+    certified, every piece shown empty in exact arithmetic gives
+    :data:`NO_SOLUTION`. On any other failure the QP method, with the path
+    recorded in ``result.path``.
 
 Success means the same for every method: ``z`` passed
 :func:`lcp_violation` ``<= tol`` (``z >= -tol_z``, ``w = M z + q >=
@@ -41,12 +47,15 @@ Examples
 
 import inspect
 
-from . import lemke, qp
+import numpy as np
+
+from . import decide, lemke, qp
 from ._result import (
     BREAKDOWN,
     INFEASIBLE,
     INVALID_INPUT,
     MAX_ITER,
+    NO_SOLUTION,
     NOT_APPLICABLE,
     SECONDARY_RAY,
     SOLVED,
@@ -81,6 +90,7 @@ __all__ = [
     "SOLVER_FAILED",
     "NOT_APPLICABLE",
     "INFEASIBLE",
+    "NO_SOLUTION",
     "lemke_kernel",
     "lemke_core",
     "lemke_workspace",
@@ -92,22 +102,73 @@ __all__ = [
 ]
 
 
-def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None):
+def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
+          enumerate_max_n=decide.ENUMERATE_MAX_N):
     # Lemke's answer is exact when it exists; the QP path is slower and
     # less accurate, so it only runs when pivoting did not deliver. A proof
     # of infeasibility is an answer too: no QP can overturn it.
+    if check_input:
+        if (isinstance(enumerate_max_n, bool) or not isinstance(enumerate_max_n, (int, np.integer))
+                or not 0 <= enumerate_max_n <= 20):
+            raise InputError(f"`enumerate_max_n` must be an integer in [0, 20] (2^n pieces are "
+                             f"visited), got {enumerate_max_n!r}")
     first = lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
     if first.status == SOLVED or first.status == INFEASIBLE:
         return first
+    if first.status == SECONDARY_RAY:
+        decided = _decide_after_ray(first, np.asarray(M, dtype=float), np.asarray(q, dtype=float),
+                                    tol, enumerate_max_n)
+        if decided is not None:
+            return decided
     second = qp.solve(M, q, tol=tol, check_input=check_input, friction=friction)
-    second.path = ("lemke", "qp")
+    second.path = first.path + ("qp",)
     second.detail = f"{second.detail} Lemke first: {first.message}"
     if second.status not in (SOLVED, INFEASIBLE) and first.residual < second.residual:
         # neither solved: keep the point closer to a solution, say so
-        first.path = ("lemke", "qp")
+        first.path = first.path + ("qp",)
         first.detail = f"{first.detail} The QP fallback failed too: {second.message}"
         return first
     return second
+
+
+def _decide_after_ray(first, M, q, tol, max_n):
+    # Lemke's secondary ray proved nothing: a Farkas vector from the LP dual,
+    # then (small n) the complementary pieces. Returns a result, or None with
+    # what was tried written into first.detail and first.path
+    n = len(q)
+    y = decide.lp_farkas(M, q)
+    if y is not None:
+        res = LCPResult(first.z, first.w, INFEASIBLE, first.pivots, first.residual, "lp",
+                        path=("lemke", "lp"))
+        res.certificate = y
+        res.detail = (f"Lemke ended on a secondary ray that proves nothing; the dual of the LP "
+                      f"{{z >= 0, M z + q >= 0}} (HiGHS) gave a Farkas vector y, with y >= 0, "
+                      f"M^T y <= 0 and q.y = {float(q @ y):.3g} < 0 checked exactly on the given "
+                      f"data, in `certificate`.")
+        return res
+    if n > max_n:
+        first.path = ("lemke", "lp")
+        return None
+    out, z, counts = decide.enumerate_pieces(M, q, 1e-9 if tol is None else tol)
+    how = (f"the 2^{n} = {counts['pieces']} complementary pieces were visited "
+           f"(after Lemke ended on a secondary ray and the LP dual gave no Farkas vector)")
+    if out == "solved":
+        res = LCPResult(z, M @ z + q, SOLVED, first.pivots, lcp_violation(M, q, z), "enumerate",
+                        path=("lemke", "lp", "enumerate"))
+        res.detail = f"Solved by enumeration: {how}; z lies in the piece J = {counts['J']}."
+        return res
+    if out == "none":
+        res = LCPResult(first.z, first.w, NO_SOLUTION, first.pivots, first.residual, "enumerate",
+                        path=("lemke", "lp", "enumerate"))
+        res.detail = (f"{how[0].upper()}{how[1:]}, and each was shown empty in exact rational arithmetic on the given "
+                      f"data: {counts['regular']} by the unique solution of M_JJ z_J = -q_J "
+                      f"violating a sign, {counts['singular']} (M_JJ singular) by a Farkas "
+                      f"certificate checked exactly. So LCP(M, q) has no solution.")
+        return res
+    first.path = ("lemke", "lp", "enumerate")
+    first.detail = (f"{first.detail} Then {how}: no solution found, but {counts['undecided']} "
+                    f"of them could not be decided exactly, so nothing is proven.")
+    return None
 
 
 #: method name -> solve function, all with the signature of :func:`solve_lcp`

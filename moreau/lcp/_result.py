@@ -21,6 +21,7 @@ __all__ = [
     "SOLVER_FAILED",
     "NOT_APPLICABLE",
     "INFEASIBLE",
+    "NO_SOLUTION",
     "lcp_residual",
     "lcp_violation",
 ]
@@ -45,6 +46,10 @@ NOT_APPLICABLE = 6
 #: the LCP has no solution and the result carries the proof: a Farkas vector
 #: ``y >= 0`` with ``M^T y <= 0`` and ``q.y < 0`` in ``certificate``
 INFEASIBLE = 7
+#: the LCP has no solution, shown by visiting every complementary piece in
+#: exact arithmetic (``"auto"``'s enumeration); it may have feasible points,
+#: so there is no Farkas vector (``certificate`` is None)
+NO_SOLUTION = 8
 
 STATUS_MESSAGES = {
     SOLVED: "Solution found.",
@@ -55,6 +60,7 @@ STATUS_MESSAGES = {
     SOLVER_FAILED: "The QP backend returned no usable solution.",
     NOT_APPLICABLE: "The method has no formulation for this problem.",
     INFEASIBLE: "Infeasible: no z >= 0 has M z + q >= 0, so the LCP has no solution.",
+    NO_SOLUTION: "No solution: every complementary piece was shown empty in exact arithmetic.",
 }
 
 

@@ -23,10 +23,30 @@ friction LCPs.
 
 The ratio test is lexicographic: among rows tied at the minimum ratio it
 picks the lexicographic minimum of ``(b_i, (B^-1)_i) / a_i``, reading the rows
-of ``B^-1`` from the tableau columns of the original ``w`` variables. With
-this rule the basis stays lexicographically feasible and degenerate problems
-cannot cycle. If ``z0`` is among the tied rows it leaves at once, which ends
-the path on a solution.
+of ``B^-1`` from the tableau columns of the original ``w`` variables. If
+``z0`` is among the tied rows it leaves at once, which ends the path on a
+solution. In exact arithmetic this rule keeps the basis lexicographically
+positive and no basis can repeat (Cottle, Pang and Stone 1992, Sec. 4.9).
+
+In floating point a tie can be decided by rounding noise (an exact zero
+computed as -5e-15 against another as -1e-16), and a wrong decision can
+cycle. So an order is taken from floating point only where it stands above a
+rounding bound of the entries, ``ROUND`` (``2^16 eps``, a growth allowance
+over many pivots) times the size of each row; an entering-column entry
+within that bound of zero is no candidate, and if it could have changed the
+step (no other candidate, or a ratio that could undercut the minimum) the
+step is not taken in floating point either. Where floating point cannot
+decide, and where a basis repeats (the visited bases are hashed past ``2 n +
+16`` pivots), :func:`solve` finishes the path in exact integer arithmetic
+(:mod:`moreau.lcp._exact`) from the basis reached, or afresh if that basis is
+not lexicographically positive for the caller's data: the path is then the
+exact lexicographic one and cannot cycle. One exception, for cost: where
+``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
+is a solution up to rounding, certified on the data as always), where the
+exact path might pivot on. The compiled entries
+(:func:`lemke_kernel`, :func:`lemke_core`), which have no exact path, count
+an undecidable entry as a tie and stop on a repeated basis with
+:data:`BREAKDOWN`, never running on to the pivot limit.
 
 Tolerances are relative, so they follow the scale of the data. A pivot
 entry counts as positive when it exceeds ``PIVOT_TOL`` times the largest
@@ -35,9 +55,10 @@ badly scaled problems, e.g. a triangular P-matrix whose solution spans
 eleven orders of magnitude, it is genuine) but compared with the rounding
 level of that entry, ``NOISE_TOL * sum_j |B^-1_ij| |A_ej|`` with ``A_e`` the
 entering column of ``[I, -M, -d]``, and kept when it stands above it.
-Ratios tie within ``TIE_TOL`` relative difference, and a right-hand side
-that cancels to rounding level is set to exactly zero so that degenerate
-rows are recognised as such.
+Ratios tie within ``TIE_TOL`` relative difference (the tied rows are then
+ordered by the lexicographic test, right-hand sides first), and a
+right-hand side that cancels to rounding level is set to exactly zero so
+that degenerate rows are recognised as such.
 
 :func:`solve` (and :func:`lemke_kernel`) pivot on balanced data: ``D M D``
 and ``D q`` with ``D`` a diagonal of powers of two that brings the rows of
@@ -61,9 +82,11 @@ partial pivoting) and checked again; if that fails too the status is
 
 A secondary ray is turned into a proof of infeasibility only when a Farkas
 vector built from it checks out in exact rational arithmetic on the caller's
-data (:func:`moreau.lcp.certify.infeasibility_from_ray`): the status is then
-:data:`INFEASIBLE`, with the Farkas vector in ``certificate``. Otherwise it
-stays :data:`SECONDARY_RAY`, which proves nothing.
+data (:func:`moreau.lcp.certify.infeasibility_from_ray`), or a unit vector
+``e_i`` is one (``q_i < 0`` and row ``i`` of ``M`` non-positive,
+:func:`unit_farkas`): the status is then :data:`INFEASIBLE`, with the Farkas
+vector in ``certificate``. Otherwise it stays :data:`SECONDARY_RAY`, which
+proves nothing (``"auto"`` goes further: :mod:`moreau.lcp.decide`).
 
 Calling from compiled code
 --------------------------
@@ -83,9 +106,10 @@ from numba import njit
 from .. import _jit_cache
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
-from . import _certified, certify
+from . import _certified, _exact, certify
 from ._certified import farkas_float
 from ._certified import residual as _residual
+from ._result import lcp_violation
 from .certify import FARKAS_TOL, infeasibility_from_ray
 from ._result import (
     BREAKDOWN,
@@ -109,6 +133,7 @@ __all__ = [
     "MAX_ITER",
     "BREAKDOWN",
     "INVALID_INPUT",
+    "unit_farkas",
     "PIVOT_TOL",
     "NOISE_TOL",
     "TIE_TOL",
@@ -121,8 +146,17 @@ PIVOT_TOL = 1e-9
 #: a smaller positive entry is a candidate when it exceeds this times its
 #: rounding scale ``sum_j |B^-1_ij| |A_ej|``
 NOISE_TOL = 1e3 * np.finfo(float).eps
-#: two ratios (or two lexicographic entries) tie within this relative difference
+#: two ratios tie within this relative difference
 TIE_TOL = 1e-9
+#: the rounding allowance of a tableau entry, relative to the size of its row
+#: (2^16 eps: a growth allowance over many pivots). Two lexicographic entries
+#: closer than that are not separated in floating point
+ROUND = 2.0**16 * np.finfo(float).eps
+# internal statuses: the compiled pivoting hands over to the exact path
+_HANDOFF_TIE = 100
+_HANDOFF_CYCLE = 101
+# slots of the hash set of visited bases (a power of two)
+_SEEN_SIZE = 1 << 14
 #: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
 #: result to count as solved
 DEFAULT_TOL = 1e-9
@@ -190,28 +224,79 @@ def _padded(n):
 
 
 @njit(cache=True)
-def _lex_compare(T, pos, n, i, k, ai, ak):
-    # Compare rows i and k of [b | B^-1] / a lexicographically. The RHS
-    # ratios are already known to tie, so start at B^-1. Column j of B^-1 is
-    # the current tableau column of the original basic variable w_j: a unit
-    # vector if w_j is basic, else its non-basic slot.
+def _row_scales(T, b, pos, n, i, qsum):
+    # (S, Sb): the size of the entries that make up row i of the tableau (its
+    # own entries and its row of B^-1), and that of its right-hand side
+    # b_i = (B^-1 q)_i, a sum of terms up to max|B^-1_i| sum|q|
+    s = 0.0
+    for k in range(n + 1):
+        s = max(s, abs(T[i, k]))
+    binv = 0.0
     for j in range(n):
         p = pos[j]
         if p >= 0:
-            vi = 1.0 if p == i else 0.0
-            vk = 1.0 if p == k else 0.0
+            if p == i:
+                binv = max(binv, 1.0)
         else:
-            s = -p - 1
-            vi = T[i, s]
-            vk = T[k, s]
-        # compare vi/ai with vk/ak through cross products (ai, ak > 0):
-        # no division in a loop that can run n times per tied row
+            binv = max(binv, abs(T[i, -p - 1]))
+    return max(s, binv), max(abs(b[i]), binv * qsum)
+
+
+@njit(cache=True)
+def _lex_compare(T, b, pos, n, i, k, ai, ak, qsum, exact_ok, rhs_only):
+    # Compare rows i and k of [b | B^-1] / a lexicographically (with rhs_only,
+    # their ratios b / a alone): -1 or 1 when
+    # the order stands above the rounding of the entries, 0 when every entry
+    # ties, 2 when floating point cannot tell (only with exact_ok; else an
+    # undecidable entry counts as a tie, the rounding noise of an exact zero
+    # being the usual case). Column j of B^-1 is the current tableau column
+    # of the original basic variable w_j: a unit vector if w_j is basic, else
+    # its non-basic slot. Cross products (ai, ak > 0) avoid a division per entry.
+    si, sbi = _row_scales(T, b, pos, n, i, qsum)
+    sk, sbk = _row_scales(T, b, pos, n, k, qsum)
+    for j in range(-1, n):
+        if j < 0:
+            # the right-hand sides: their ratios tie to TIE_TOL, not necessarily exactly
+            vi = b[i]
+            vk = b[k]
+            ei = sbi
+            ek = sbk
+        else:
+            p = pos[j]
+            if p >= 0:
+                vi = 1.0 if p == i else 0.0
+                vk = 1.0 if p == k else 0.0
+            else:
+                s = -p - 1
+                vi = T[i, s]
+                vk = T[k, s]
+            ei = si
+            ek = sk
         xi = vi * ak
         xk = vk * ai
         diff = xi - xk
-        if abs(diff) > TIE_TOL * max(abs(xi), abs(xk)):
+        # the error of vi ak - vk ai when every entry of a row is off by ROUND
+        # times its row's scale
+        bound = ROUND * (ei * ak + abs(vi) * sk + ek * ai + abs(vk) * si)
+        if abs(diff) > bound:
             return -1 if diff < 0.0 else 1
+        if diff != 0.0 and exact_ok:
+            return 2
+        if rhs_only:
+            return 0
     return 0
+
+
+@njit(cache=True, inline="always")
+def _key(v):
+    # a 64-bit mix of a variable's number (splitmix64's finaliser, wrapping
+    # int64 arithmetic): XORed over the basis it identifies a basis
+    x = (v + 1) * -7046029254386353131
+    x ^= (x >> 30) & 0x3FFFFFFFF
+    x *= -4658895280553007687
+    x ^= (x >> 27) & 0x1FFFFFFFFF
+    x *= -7723592293110705685
+    return x ^ ((x >> 31) & 0x1FFFFFFFF)
 
 
 @njit(cache=True)
@@ -432,12 +517,17 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
-    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, np.bool_(False))
 
 
 @njit(cache=True)
-def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
-    # lemke_core (the public entry documents it)
+def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
+    # lemke_core (the public entry documents it). With exact_ok, a tie that
+    # floating point cannot decide, or a repeated basis, returns _HANDOFF_TIE
+    # or _HANDOFF_CYCLE with the basis in ray_out[:n] and the entering
+    # variable in ray_out[n], for the exact path (_exact.exact_lemke) to go
+    # on from; without it (compiled callers) an undecidable entry counts as a
+    # tie and a repeated basis is BREAKDOWN, never a run to max_iter.
     n = q.shape[0]
     for k in range(n + 1):
         ray_out[k] = 0.0
@@ -454,6 +544,7 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
             if a > mmax:
                 mmax = a
     qmax = 0.0
+    qsum = 0.0
     qmin = np.inf
     for i in range(n):
         if not abs(q[i]) < np.inf or not (d[i] > 0.0 and d[i] < np.inf):
@@ -462,6 +553,7 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
                 w_out[k] = 0.0
             return INVALID_INPUT, 0, np.inf
         qmax = max(qmax, abs(q[i]))
+        qsum += abs(q[i])
         qmin = min(qmin, q[i])
     if n == 0 or qmin >= 0.0:
         for k in range(n):
@@ -515,8 +607,34 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     pivots = 1
     status = MAX_ITER
     entering = leaving + n  # complement of w_r is z_r
+    # (basis, entering) identified by the XOR of its variables' keys: an exact
+    # lexicographic path never repeats one, so a repeat is rounding having
+    # decided a tie wrongly. Past 2 n + 16 pivots (a path that long is rare
+    # outside exponential examples) the states go into a hash set; when it
+    # is three-quarters full it is cleared, and a loop is caught on its next round
+    hb = 0
+    for i in range(n):
+        hb ^= _key(basis[i])
+    seen = np.zeros(1, dtype=np.int64)
+    nseen = 0
+    watch = 2 * n + 16
 
     while pivots < max_iter:
+        if pivots >= watch:
+            if seen.shape[0] == 1 or 4 * nseen >= 3 * seen.shape[0]:
+                seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
+                nseen = 0
+            state = hb ^ _key(entering + 3 * n)
+            if state == 0:
+                state = 1
+            h = state & (_SEEN_SIZE - 1)
+            while seen[h] != 0 and seen[h] != state:
+                h = (h + 1) & (_SEEN_SIZE - 1)
+            if seen[h] == state:
+                status = _HANDOFF_CYCLE if exact_ok else BREAKDOWN
+                break
+            seen[h] = state
+            nseen += 1
         s = -pos[entering] - 1
         # -- ratio test over rows with a clearly positive pivot-column entry;
         # the column is gathered once into contiguous storage
@@ -531,8 +649,20 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
             break
         thr = PIVOT_TOL * cmax
         theta = np.inf
+        nunc = 0
+        unc = T[n]  # scratch row until the pivot: the rounding bound of each uncertain entry
         for i in range(n):
             a = col[i]
+            unc[i] = 0.0
+            if exact_ok and a != 0.0 and abs(a) <= thr:
+                # an entry within the rounding bound of its row may be an exact
+                # zero or of either sign: no candidate here; whether it could
+                # change the outcome is judged once theta is known
+                si, _ = _row_scales(T, b, pos, n, i, qsum)
+                if abs(a) <= ROUND * si:
+                    unc[i] = ROUND * si
+                    nunc += 1
+                    continue
             if a > 0.0 and a <= thr:
                 # small: keep it only if it stands above its rounding level;
                 # otherwise it is rounding of a zero, and becomes one (in the
@@ -545,6 +675,19 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
                 t = b[i] / a
                 if t < theta:
                     theta = t
+        if nunc > 0:
+            # an uncertain entry a_i in (0, u_i] would have the ratio b_i / a_i >=
+            # b_i / u_i: it can change the step only where that is not above theta
+            # (or where there is no other candidate: the ray would rest on it)
+            for i in range(n):
+                u = unc[i]
+                if u > 0.0:
+                    _, sbi = _row_scales(T, b, pos, n, i, qsum)
+                    if theta == np.inf or b[i] <= theta * u + ROUND * sbi:
+                        status = _HANDOFF_TIE
+                        break
+            if status == _HANDOFF_TIE:
+                break
         if theta == np.inf:
             # secondary ray: entering variable +1, basic ones move by -a_i
             for j in range(n):
@@ -561,28 +704,50 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
         nties = 0
         for i in range(n):
             a = col[i]
-            if a > 0.0 and b[i] / a <= lim:
+            if a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
                 nties += 1
                 if r < 0:
                     r = i
         if nties > 1:
             zrow = pos[z0]
             a_z = col[zrow]
-            if a_z > 0.0 and b[zrow] / a_z <= lim:
+            z0_tied = a_z > 0.0 and unc[zrow] == 0.0 and b[zrow] / a_z <= lim
+            if z0_tied and exact_ok:
+                # z0 does not leave where its ratio stands above another tied
+                # row's beyond rounding (a tie of TIE_TOL only). Within rounding
+                # it leaves: the point then solves the LCP up to rounding and is
+                # certified on the data like any other (an exact path would cost
+                # a friction LCP of n = 100 seconds, for a rounding-level step)
+                for i in range(n):
+                    a = col[i]
+                    if i != zrow and a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
+                        c = _lex_compare(T, b, pos, n, zrow, i, a_z, a, qsum, exact_ok, True)
+                        if c == 1:
+                            z0_tied = False
+                            break
+            if z0_tied:
                 # z0 can leave now: take the solution
                 r = zrow
             else:
                 best = r
                 unresolved = False
+                undecided = False
                 for i in range(r + 1, n):
                     a = col[i]
-                    if a > 0.0 and b[i] / a <= lim:
-                        c = _lex_compare(T, pos, n, i, best, a, col[best])
+                    if a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
+                        c = _lex_compare(T, b, pos, n, i, best, a, col[best], qsum, exact_ok,
+                                         False)
+                        if c == 2:
+                            undecided = True
+                            break
                         if c < 0:
                             best = i
                             unresolved = False
                         elif c == 0:
                             unresolved = True
+                if undecided:
+                    status = _HANDOFF_TIE
+                    break
                 if unresolved:
                     status = BREAKDOWN
                     break
@@ -593,11 +758,19 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
         basis[r] = entering
         pos[entering] = r
         pos[leaving] = -(s + 1)
+        hb ^= _key(leaving) ^ _key(entering)
         if leaving == z0:
             status = SOLVED
             break
         entering = leaving + n if leaving < n else leaving - n
 
+    if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+        for i in range(n):
+            ray_out[i] = basis[i]
+            z_out[i] = 0.0
+            w_out[i] = q[i]
+        ray_out[n] = entering
+        return status, pivots, np.inf
     _extract_z(b, pos, n, z_out)
     for j in range(n):
         if not abs(z_out[j]) < np.inf:
@@ -663,7 +836,8 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     ray = np.empty(n + 1)
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol, False)
+    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol, np.bool_(False),
+                         np.bool_(False))
 
 
 
@@ -836,7 +1010,7 @@ def _unit_exponents(M, q, rexp, cexp):
 
 @njit(cache=True)
 def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork, max_iter, tol,
-                scale_d, mmax, qmax):
+                scale_d, mmax, qmax, exact_ok):
     # lemke_core on (2^ka R M C, 2^kb R q), R = diag(2^rexp), C = diag(2^cexp),
     # mapped back (z = 2^(ka-kb) C z') and judged on the caller's data with
     # the rounding of M z + q counted (_residual): the scaled problem is the
@@ -853,8 +1027,9 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
         for j in range(n):
             Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
     status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
-                                     tol)
-    if status == INVALID_INPUT:
+                                     tol, exact_ok)
+    if status == INVALID_INPUT or status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+        # a hand-over carries the basis in ray_out: nothing to map back
         return status, pivots, residual
     finite = True
     for j in range(n):
@@ -880,6 +1055,84 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
 
 
 @njit(cache=True)
+def unit_farkas(M, q):
+    """The first ``i`` for which ``e_i`` is a Farkas vector of ``LCP(M, q)``, or -1 (compiled).
+
+    ``e_i`` is one when ``q_i < 0`` and every ``M_ij <= 0``: then ``w_i = (M
+    z)_i + q_i < 0`` for every ``z >= 0``. The test reads the data as they
+    are, with no arithmetic, so it is exact.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> int(unit_farkas(np.array([[1.0, 0.0], [-1.0, 0.0]]), np.array([-1.0, -1.0])))
+    1
+    """
+    n = q.shape[0]
+    for i in range(n):
+        if q[i] < 0.0:
+            ok = True
+            for j in range(n):
+                if not M[i, j] <= 0.0:
+                    ok = False
+                    break
+            if ok:
+                return i
+    return -1
+
+
+@njit(cache=True)
+def _screen_ray(M, q, ray):
+    # the candidates moreau.lcp.certify._candidates builds from a ray (the
+    # clipped ray, with entries below 1e-12, 1e-9, 1e-6 of the largest removed,
+    # and rounded to 40, 26, 20, 12 bits), each judged by farkas_float, and the
+    # unit vectors (unit_farkas): 1 one is proven, 0 one needs the exact
+    # check, -1 every one fails rigorously. Then whether M might be PSD (where
+    # the exact null-space projection is tried): not when its symmetric part
+    # has a negative diagonal entry, or a zero one with a nonzero row
+    n = q.shape[0]
+    maybe_psd = True
+    for i in range(n):
+        if M[i, i] < 0.0:
+            maybe_psd = False
+        elif M[i, i] == 0.0:
+            for j in range(n):
+                if M[i, j] + M[j, i] != 0.0:
+                    maybe_psd = False
+                    break
+    if unit_farkas(M, q) >= 0:
+        return 1, maybe_psd
+    top = 0.0
+    for i in range(n):
+        if not abs(ray[i]) < np.inf:
+            return 0, maybe_psd
+        top = max(top, ray[i])
+    if not top > 0.0:
+        return -1, maybe_psd
+    y = np.empty(n)
+    c = np.empty(n)
+    for i in range(n):
+        y[i] = max(ray[i] / top, 0.0)
+    best = -1
+    for k in range(8):
+        for i in range(n):
+            if k == 0:
+                c[i] = y[i]
+            elif k < 4:
+                cut = 1e-12 if k == 1 else (1e-9 if k == 2 else 1e-6)
+                c[i] = 0.0 if y[i] < cut else y[i]
+            else:
+                bits = 40 if k == 4 else (26 if k == 5 else (20 if k == 6 else 12))
+                c[i] = math.ldexp(np.round(math.ldexp(y[i], bits)), -bits)
+        v = farkas_float(M, q, c)
+        if v > best:
+            best = v
+            if best == 1:
+                break
+    return best, maybe_psd
+
+
+@njit(cache=True)
 def _ray_proves(M, q, ray):
     # the ray's dz (negative rounding noise clipped) is a Farkas vector, decided
     # rigorously in floating point (farkas_float); an undecided case stays a
@@ -894,7 +1147,8 @@ def _ray_proves(M, q, ray):
 
 
 @njit(cache=True)
-def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, scale_d):
+def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, scale_d,
+                  exact_ok):
     # Lemke on the symmetrically balanced data (balance): a uniformly scaled
     # problem pivots exactly as the unscaled one, and the matrix class is
     # kept. Where its answer fails on the caller's data, again with rows
@@ -904,7 +1158,7 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
     sexp = np.zeros(n, dtype=np.int64)
     ok, ka, kb = balance(M, q, sexp)
     if not ok:
-        return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol)
+        return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok)
     plain = -_PLAIN_RANGE <= ka <= _PLAIN_RANGE and -_PLAIN_RANGE <= kb <= _PLAIN_RANGE
     for i in range(n):
         plain = plain and sexp[i] == 0
@@ -913,8 +1167,8 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         # pivoting on them as given is what the normalised copy would do (the
         # property tests scale by 2^k and compare), minus the copy
         status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork,
-                                         max_iter, tol)
-        if status == SECONDARY_RAY and _ray_proves(M, q, ray_out):
+                                         max_iter, tol, exact_ok)
+        if status == SECONDARY_RAY and (_ray_proves(M, q, ray_out) or unit_farkas(M, q) >= 0):
             status = INFEASIBLE
         if status != BREAKDOWN:
             return status, pivots, residual
@@ -929,7 +1183,9 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
     else:
         status, pivots, residual = _run_scaled(M, q, d, sexp, sexp, ka, kb, z_out, w_out,
                                                ray_out, work, iwork, max_iter, tol, scale_d,
-                                               mmax, qmax)
+                                               mmax, qmax, exact_ok)
+        if status == SECONDARY_RAY and unit_farkas(M, q) >= 0:
+            status = INFEASIBLE
         if status != BREAKDOWN:
             return status, pivots, residual
     rexp = np.zeros(n, dtype=np.int64)
@@ -949,9 +1205,11 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         r1 = ray_out.copy()
         status2, pivots2, residual2 = _run_scaled(M, q, d, rexp, cexp, ka2, kb2, z_out, w_out,
                                                   ray_out, work, iwork, max_iter, tol, scale_d,
-                                                  mmax, qmax)
+                                                  mmax, qmax, exact_ok)
         pivots += pivots2
-        if status2 == SOLVED:
+        if status2 == SECONDARY_RAY and unit_farkas(M, q) >= 0:
+            status2 = INFEASIBLE
+        if status2 == SOLVED or status2 == _HANDOFF_TIE or status2 == _HANDOFF_CYCLE:
             return status2, pivots, residual2
         if residual2 < residual:
             status, residual = status2, residual2
@@ -1013,7 +1271,7 @@ def _solve_packed(M, q, d, out, max_iter, tol, scale_d=True):
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
     return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol,
-                         scale_d)
+                         scale_d, np.bool_(True))
 
 
 @njit(cache=True)
@@ -1040,6 +1298,12 @@ class _LemkeResult(LCPResult):
             # proven in compiled code; the words (and the matrix class they
             # name, an eigenvalue computation) only when someone reads them
             _, M, q = self.__dict__["_ray"]
+            why = _ray_or_unit_proof(M, q, self.ray)[1]
+            d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
+            self.__dict__["_detail"] = d
+            return d
+        if self.status == SECONDARY_RAY and "_ray" in self.__dict__:
+            _, M, q = self.__dict__["_ray"]
             why = infeasibility_from_ray(M, q, self.ray)[1]
             d = f"{why} `ray` holds the direction (dz, dz0) (after {self.pivots} pivots)."
             self.__dict__["_detail"] = d
@@ -1065,10 +1329,17 @@ class _LemkeResult(LCPResult):
             return None
         y = self.__dict__.get("_cert")
         if y is None:
-            # scaled by a power of two (largest entry in [1, 2)): exact, so the
-            # vector proven in compiled code is the one handed out
-            y = np.maximum(self.ray[:len(self.z)], 0.0)
-            y = self.__dict__["_cert"] = np.ldexp(y, 1 - np.frexp(np.max(y))[1])
+            _, M, q = self.__dict__["_ray"]
+            if _ray_proves(M, q, self.ray):
+                # scaled by a power of two (largest entry in [1, 2)): exact, so the
+                # vector proven in compiled code is the one handed out
+                y = np.maximum(self.ray[:len(self.z)], 0.0)
+                y = np.ldexp(y, 1 - np.frexp(np.max(y))[1])
+            else:
+                # the compiled code proved it by a unit vector (unit_farkas)
+                y = np.zeros(len(self.z))
+                y[unit_farkas(M, q)] = 1.0
+            self.__dict__["_cert"] = y
         return y
 
     @certificate.setter
@@ -1242,6 +1513,11 @@ def _solve(M, q, max_iter, tol, check_input, covering):
         return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
+    if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+        return _exact_finish(M, q, covering, out, status, pivots,
+                             _MAX_ITER_TABLE[n] if max_iter is None and n < 512 else
+                             (max_iter or default_max_iter(n)),
+                             DEFAULT_TOL if tol is None else tol)
     res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
     if status == INFEASIBLE:
         # proven in compiled code: the ray's dz is a Farkas vector with every
@@ -1253,11 +1529,92 @@ def _solve(M, q, max_iter, tol, check_input, covering):
         # a ray proves infeasibility only through a Farkas vector that holds
         # exactly on the caller's data (the compiled pre-filter is not a proof)
         res.__dict__["_ray"] = (out, M, q)
-        y, why = infeasibility_from_ray(M, q, out[2 * n:])
-        res.status = INFEASIBLE if y is not None else SECONDARY_RAY
-        if y is not None:
-            res.certificate = y
-        res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
+        _prove_secondary_ray(res, M, q, out[2 * n:], pivots)
+    return res
+
+
+def _ray_or_unit_proof(M, q, ray):
+    # (y, why): a Farkas vector from the ray (infeasibility_from_ray), else a
+    # unit vector e_i (q_i < 0, row i of M <= 0: exact without arithmetic)
+    y, why = infeasibility_from_ray(M, q, ray)
+    if y is not None:
+        return y, why
+    i = int(unit_farkas(M, q))
+    if i < 0:
+        return None, why
+    y = np.zeros(len(q))
+    y[i] = 1.0
+    cls = certify.copositive_plus_class(M)
+    src = (f"M is copositive-plus ({cls}), so Lemke's theorem says the ray means infeasibility"
+           if cls is not None else "M is of no certified class")
+    return y, (f"Lemke ended on a secondary ray ({src}); `certificate` holds the unit vector e_{i}: "
+               f"q_{i} = {q[i]:.3g} < 0 and row {i} of M is <= 0, so w_{i} = (M z)_{i} + q_{i} < 0 "
+               f"for every z >= 0 (exact: no arithmetic involved).")
+
+
+def _prove_secondary_ray(res, M, q, ray, pivots):
+    verdict, maybe_psd = _screen_ray(M, q, ray)
+    if verdict < 0 and not maybe_psd:
+        # every candidate fails rigorously, and M is not PSD (where the exact
+        # null-space projection could still find one): no proof, and the words
+        # only when someone reads them
+        res.status = SECONDARY_RAY
+        return
+    y, why = _ray_or_unit_proof(M, q, ray)
+    res.status = INFEASIBLE if y is not None else SECONDARY_RAY
+    if y is not None:
+        res.certificate = y
+    res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
+
+
+def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
+    # the compiled pivoting met a tie rounding could not decide, or a repeated
+    # basis: the path goes on in exact arithmetic (moreau.lcp._exact) from the
+    # basis it had reached, or afresh when that basis is not lexicographically
+    # positive for the caller's data, and its end is judged on the caller's data
+    n = len(q)
+    basis = [int(v) for v in out[2 * n:3 * n]]
+    entering = int(out[3 * n])
+    st, zx, rayx, piv, resumed = _exact.exact_lemke(M, q, covering, basis=basis,
+                                                     entering=entering, max_iter=max_iter,
+                                                     pivots=pivots)
+    total = piv if resumed else pivots + piv
+    try:
+        z = np.array([float(v) for v in zx]) if n else np.zeros(0)
+    except OverflowError:
+        # the exact point lies outside the range of doubles
+        res = _LemkeResult(np.zeros(n), q.copy(), BREAKDOWN, total,
+                           float(lcp_violation(M, q, np.zeros(n))), "lemke")
+        res.detail = ("Pivoting was finished in exact arithmetic, but its end point lies outside "
+                      "the range of floating-point numbers.")
+        return res
+    w = M @ z + q
+    residual = float(lcp_violation(M, q, z))
+    why = ("a lexicographic tie that floating point could not separate" if handoff == _HANDOFF_TIE
+           else "a repeated basis (rounding had decided a tie wrongly)")
+    where = (f"from the basis reached after {pivots} floating-point pivots" if resumed
+             else f"afresh (the basis after {pivots} floating-point pivots was not "
+                  f"lexicographically positive)")
+    note = f"Pivoting met {why} and was finished in exact arithmetic {where}."
+    if st == _exact.SOLVED:
+        status = SOLVED if residual <= tol else BREAKDOWN
+        res = _LemkeResult(z, w, status, total, residual, "lemke")
+        res.detail = note if status == SOLVED else (
+            f"{note} The exact solution, rounded to floats, fails the check on the data "
+            f"(violation {residual:.3g} > tol = {tol:.3g}).")
+        return res
+    if st == _exact.MAX_ITER:
+        res = _LemkeResult(z, w, MAX_ITER, total, residual, "lemke")
+        res.detail = f"{note} {_DETAIL[MAX_ITER]} (after {total} pivots)"
+        return res
+    res = _LemkeResult(z, w, SECONDARY_RAY, total, residual, "lemke")
+    top = max(abs(v) for v in rayx)
+    # a direction: scaled to a largest entry of 1 before rounding, it stays finite
+    ray = np.array([float(v / top) for v in rayx])
+    out[2 * n:] = ray
+    res.__dict__["_ray"] = (out, M, q)
+    _prove_secondary_ray(res, M, q, ray, total)
+    res.detail = f"{note} {res.detail}"
     return res
 
 
