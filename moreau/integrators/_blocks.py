@@ -126,6 +126,27 @@ class CompiledRecording:
                              *(np.asarray(a, float).reshape(1, nc)
                                for a in (force_N, force_T, slip, gap))))
 
+    def _unchecked_states(self):
+        if not self._fast:
+            return super()._unchecked_states()
+        new = self._blocks[self._region_seen:]
+        if not new:
+            return None
+        return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+
+    def _keep_checked(self, count):
+        if not self._fast:
+            return super()._keep_checked(count)
+        if count is not None:
+            kept = self._blocks[:self._region_seen]
+            for b in self._blocks[self._region_seen:]:
+                if count <= 0:
+                    break
+                kept.append(tuple(x[:count] for x in b))
+                count -= len(b[0])
+            self._blocks = kept
+        self._region_seen = len(self._blocks)
+
     def _rows_since(self):
         if not self._fast:
             return super()._rows_since()

@@ -153,6 +153,12 @@ class Integrator:
         self.q = _state_vector("q0", q0, n)
         self.v = _state_vector("v0", v0, n)
         self.t = self.t0
+        # a run must start where the model holds (a scene states its valid region)
+        outside = self.scene.check_valid(self.q, self.v, self.t0) if hasattr(
+            self.scene, "check_valid") else None
+        if outside is not None:
+            raise InputError(f"`q0`, `v0` lie outside the scene's valid region: "
+                             f"{outside.replace('the state left ', '')}")
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -165,6 +171,10 @@ class Integrator:
         self._seen = 0
         #: the last sample handed to simulate's output (time stepping)
         self.last_handed = None
+        # recorded samples checked against the scene's valid region so far, and the
+        # time of the state where the run left it (None while inside)
+        self._region_seen = 0
+        self.region_left_at = None
 
     # -- public API ---------------------------------------------------------
     def step(self):
@@ -188,7 +198,55 @@ class Integrator:
             if self.t >= self.t_bound:
                 self.status = "finished"
                 self.message = STATUS_MESSAGES[0]
+        self._check_region()
         return self.status
+
+    def _check_region(self):
+        """Stop at the first recorded sample, or end-of-step state, outside the scene's valid region.
+
+        The samples after it are dropped and the run ends there with status
+        ``-6``: what a scheme computes beyond is not the scene's model. It
+        overrides a failure of the same step, which came after.
+        """
+        sc = self.scene
+        if getattr(sc, "valid_region", None) is None:
+            return
+        new = self._unchecked_states()
+        if new is not None:
+            t, q, v = new
+            inside = np.asarray(sc.inside_valid_region(t, q, v), dtype=bool)
+            if not inside.all():
+                k = int(np.argmin(inside))
+                self._keep_checked(k + 1)
+                self._left_region(t[k], q[k], v[k])
+                return
+            self._keep_checked(None)
+        if not sc.inside_valid_region(np.array([float(self.t)]), self.q.reshape(1, -1),
+                                      self.v.reshape(1, -1))[0]:
+            self._left_region(self.t, self.q, self.v)
+
+    def _left_region(self, t, q, v):
+        self.t, self.q, self.v = float(t), np.array(q, dtype=float), np.array(v, dtype=float)
+        self.region_left_at = self.t
+        self.events = [e for e in self.events if e.t <= self.t]
+        self._fail(-6, self.scene.check_valid(self.q, self.v, self.t)
+                   + "; the model does not apply beyond it, the run stops there")
+
+    def _unchecked_states(self):
+        """``(t, q, v)`` of the samples recorded since the last check, or None."""
+        new = self._samples[self._region_seen:]
+        if not new:
+            return None
+        n = self.scene.ndof
+        return (np.array([s[0] for s in new], dtype=float),
+                np.array([s[1] for s in new], dtype=float).reshape(len(new), n),
+                np.array([s[2] for s in new], dtype=float).reshape(len(new), n))
+
+    def _keep_checked(self, count):
+        """Keep ``count`` of the samples since the last check, drop the rest; mark them checked."""
+        if count is not None:
+            del self._samples[self._region_seen + count:]
+        self._region_seen = len(self._samples)
 
     def interrupt(self, message=None):
         """Stop the run as interrupted (status ``-4``); what was recorded is kept.
@@ -365,7 +423,23 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     result = integ.result()
     if tracker is not None:
         tracker.finish(result)
+        cut = integ.region_left_at
+        if cut is not None and (tracker.stop is None or tracker.stop[0] > cut):
+            # the exact motion handed over may run past the state that left the region
+            _cut_at(result, cut)
+            result.status, result.message = integ.status_code, integ.message
     return result
+
+
+def _cut_at(result, t):
+    """Drop the samples and events of ``result`` after time ``t`` (in place)."""
+    keep = result.t <= t
+    for name in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
+        setattr(result, name, getattr(result, name)[keep])
+    result.events = [e for e in result.events if e.t <= t]
+    for i, te in enumerate(result.t_events):
+        k = np.asarray(te) <= t
+        result.t_events[i], result.y_events[i] = te[k], result.y_events[i][k]
 
 
 #: inside :func:`propagate_interrupts`: :func:`simulate` lets Ctrl-C through

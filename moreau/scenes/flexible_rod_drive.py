@@ -274,6 +274,8 @@ class FlexibleRodDrive(DriveUnits, Scene):
     """
 
     name = "flexible-rod-drive"
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     #: the rod angle is in rad; the modal amplitudes and the rotor are lengths
     angle_coordinates = (0,)
@@ -420,6 +422,10 @@ class FlexibleRodDrive(DriveUnits, Scene):
         q[0] = phi
         v[0] = -float(self.du1(tau)) / math.cos(phi)
         return q, v
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
 
     def initial_state(self):
         """The rest state at ``tau = 0`` (:meth:`rest_state`)."""

@@ -361,6 +361,8 @@ class PiezoDrive(DriveUnits, Scene):
     """
 
     name = "piezo-drive"
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = TWO_PI
     cyclic_coordinates = (1,)
     angle_coordinates = (0,)
@@ -575,6 +577,10 @@ class PiezoDrive(DriveUnits, Scene):
         if self.ndof == 3:
             q[2] = u1
         return q, v
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
 
     def initial_state(self):
         """The rest state :meth:`rest_state`."""
