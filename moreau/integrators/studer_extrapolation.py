@@ -99,8 +99,8 @@ from ._studer_kernels import NOT_FINITE, STUDER_COUNTERS, TOO_MANY, studer_loop
 from .base import Integrator, register_integrator
 from .contact_problem import new_contact_counters, solve_contact_problem
 from .event_driven_generic import project_positions
-from .moreau_jean import (check_lcp_options, check_scene_contacts, classify_impulse,
-                          compiled_model_of)
+from .moreau_jean import (check_lcp_options, check_scene_contacts, check_step_fits,
+                          classify_impulse, compiled_model_of)
 
 __all__ = ["StuderExtrapolation"]
 
@@ -179,8 +179,10 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
         self.columns = int(columns)
         span = self.t_bound - self.t0
-        self.h = span / 100.0 if h0 is None else positive("h0", h0)
-        self.h_min = 1e-12 * span if h_min is None else positive("h_min", h_min)
+        self.h = span / 100.0 if h0 is None else check_step_fits(
+            "h0", positive("h0", h0), self.t0, self.t_bound)
+        self.h_min = 1e-12 * span if h_min is None else check_step_fits(
+            "h_min", positive("h_min", h_min), self.t0, self.t_bound)
         self.lcp_method, _ = check_lcp_options(lcp_method)
         self.max_steps = positive_int("max_steps", max_steps)
         self.mu_c, self.e_c = check_scene_contacts(scene)
