@@ -181,6 +181,8 @@ class Integrator:
         """Advance by one step (or to the next event); return the status string."""
         if self.status != "running":
             raise MoreauError(f"cannot step an integrator whose status is {self.status!r}")
+        region = getattr(self.scene, "valid_region", None) is not None
+        snapshot = self._snapshot() if region else None
         try:
             self._step_impl()
         except PainleveError as exc:
@@ -198,10 +200,25 @@ class Integrator:
             if self.t >= self.t_bound:
                 self.status = "finished"
                 self.message = STATUS_MESSAGES[0]
-        self._check_region()
+        if region:
+            self._check_region(snapshot)
         return self.status
 
-    def _check_region(self):
+    def _snapshot(self):
+        """What :meth:`_replay` needs to take the last call of ``_step_impl`` again (None: no replay)."""
+        return None
+
+    def _replay(self, snapshot, t, rows):
+        """Take the last ``_step_impl`` again from ``snapshot``, stopping at the sample at ``t``.
+
+        For a scheme that advances many steps a call (a compiled block): its
+        counters and its state then end where the run left the valid region.
+        ``rows`` are the times recorded by that call up to ``t``. Returns
+        True when done; the default does nothing and returns False.
+        """
+        return False
+
+    def _check_region(self, snapshot=None):
         """Stop at the first recorded sample, or end-of-step state, outside the scene's valid region.
 
         The samples after it are dropped and the run ends there with status
@@ -217,9 +234,18 @@ class Integrator:
             inside = np.asarray(sc.inside_valid_region(t, q, v), dtype=bool)
             if not inside.all():
                 k = int(np.argmin(inside))
-                self._keep_checked(k + 1)
-                self._left_region(t[k], q[k], v[k])
-                return
+                if snapshot is not None and self._replay(snapshot, t[k], t[:k + 1]):
+                    # the call taken again up to that sample, which now ends its rows
+                    new = self._unchecked_states()
+                    if new is None:
+                        return
+                    t, q, v = new
+                    inside = np.asarray(sc.inside_valid_region(t, q, v), dtype=bool)
+                    k = int(np.argmin(inside))
+                if not inside[k]:
+                    self._keep_checked(k + 1)
+                    self._left_region(t[k], q[k], v[k])
+                    return
             self._keep_checked(None)
         if not sc.inside_valid_region(np.array([float(self.t)]), self.q.reshape(1, -1),
                                       self.v.reshape(1, -1))[0]:

@@ -331,12 +331,17 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             # this one's, and the switch it may bring is located already
             self._acc = None
 
+    def _loop_steps_to(self, start, t, rows):
+        # one recorded sample per accepted macro step, after the run's first one
+        return int(np.count_nonzero(np.asarray(rows) > start["t"]))
+
     def _fast_block(self, bound):
         n, nc = self.scene.ndof, self.scene.ncontacts
         q, v, closed, reg = self.q.copy(), self.v.copy(), self._closed.copy(), self._last_reg.copy()
         acc = np.zeros(n) if self._acc is None else self._acc.copy()
         th = np.array([self.t, self.h, 0.0 if self._acc is None else 1.0])
-        ns = self._block_steps + 2
+        nmax = getattr(self, "_block_limit", self._block_steps)
+        ns = nmax + 2
         buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
                np.empty((ns, nc)), np.empty((ns, nc)))
@@ -346,7 +351,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         m = self._model
         status, nacc, nrec = runner_for(m, studer_loop, self.scene)(
             m.par, self.mu_c, self.e_c, bound, self.tol, self.columns, self.h_min,
-            self.max_steps - self._macro, self._block_steps, th, q, v, closed, reg, acc,
+            self.max_steps - self._macro, nmax, th, q, v, closed, reg, acc,
             self._pending_initial, self._lcp_ctl, *buf, st, cnt)
         if nrec:
             self._blocks.append(tuple(b[:nrec].copy() for b in buf))
