@@ -90,7 +90,7 @@ import math
 
 import numpy as np
 
-from .._validate import in_open_interval, positive, positive_int
+from .._validate import positive, positive_int, relative_tolerance
 from ..errors import InputError
 from ._blocks import FAST_BLOCK, CompiledRecording
 from ._loops import runner_for
@@ -122,8 +122,8 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     t0, q0, v0, t_bound
         See :class:`~moreau.integrators.base.Integrator`.
     tol : float
-        Local error tolerance, in ``(0, 1)``; positions and velocities are
-        measured relative to ``1 + |y|``.
+        Local error tolerance, in ``[100 eps, 1e-2]`` (what float64 can
+        certify); positions and velocities are measured relative to ``1 + |y|``.
     columns : int
         Extrapolation columns ``K`` in ``[2, 8]``: the order in smooth phases.
     h0 : float, optional
@@ -173,7 +173,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
                  lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
-        self.tol = in_open_interval("tol", tol, 0.0, 1.0)
+        self.tol = relative_tolerance("tol", tol)
         if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
                 or not 2 <= columns <= 8:
             raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
