@@ -111,12 +111,16 @@ TOL_MIN = 100.0 * float(np.finfo(float).eps)
 TOL_MAX = 1e-2
 
 
-def relative_tolerance(name, value):
+def relative_tolerance(name, value, floor=True):
     """Return ``value`` as a float, or raise unless ``100 eps <= value <= 1e-2``.
 
     A tighter tolerance cannot be met in float64: an error estimate made of
     roundings never falls below it, and an adaptive scheme halves its step
     until its step budget runs out. A looser one is no accuracy at all.
+    ``floor=False`` accepts any positive tolerance up to ``1e-2``: for a
+    solver that bounds its own (scipy's ``solve_ivp`` raises a smaller
+    ``rtol`` to ``100 eps`` and says so) and which the package's analyses
+    ask for a hundredth of their own tolerance.
 
     Examples
     --------
@@ -128,6 +132,11 @@ def relative_tolerance(name, value):
     moreau.errors.InputError: `tol` must be in [100 eps, 1e-2] = [2.22e-14, 0.01]: float64 rounding (eps = 2.2e-16) bounds what an error estimate can certify, and a looser one keeps no two digits; got 1e-16
     """
     x = finite_scalar(name, value)
+    if not floor:
+        if not 0.0 < x <= TOL_MAX:
+            raise InputError(f"`{name}` must be in (0, 1e-2]: a looser tolerance keeps no two "
+                             f"digits; got {x!r}")
+        return x
     if not TOL_MIN <= x <= TOL_MAX:
         raise InputError(f"`{name}` must be in [100 eps, 1e-2] = [{TOL_MIN:.3g}, {TOL_MAX:g}]: "
                          f"float64 rounding (eps = 2.2e-16) bounds what an error estimate can "

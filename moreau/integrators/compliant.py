@@ -147,7 +147,7 @@ class _Compliant(Integrator):
         self.power = CONTACT_MODELS[contact_model]
         vs = float(np.max(np.abs(getattr(scene, "velocity_scale", 1.0))))
         self.eps = positive("friction_velocity", friction_velocity) * (vs if vs > 0 else 1.0)
-        self.rtol = relative_tolerance("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.atol = positive("atol", atol)
         nc = scene.ncontacts
         self.mu = np.asarray(scene.mu, float).reshape(-1) if nc else np.zeros(0)
@@ -345,7 +345,7 @@ class CompliantRadau(_Compliant):
     Options: ``stiffness`` (> 0), ``damping`` (>= 0; default from the
     restitution for Kelvin–Voigt), ``contact_model`` (``"kelvin-voigt"`` or
     ``"hunt-crossley"``), ``friction_velocity`` (> 0, in units of the scene's
-    ``velocity_scale``), ``rtol`` (in ``[100 eps, 1e-2]``), ``atol``,
+    ``velocity_scale``), ``rtol`` (in ``(0, 1e-2]``), ``atol``,
     ``max_step`` (default a tenth of a contact's duration), ``sample_dt``
     (default: every step), ``max_steps`` (default ``1e6``: a run whose
     ``(t_bound - t0) / max_step`` exceeds it is refused before any work).

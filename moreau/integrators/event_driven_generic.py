@@ -287,7 +287,7 @@ class GenericEventDriven(Integrator):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.phases = [] if record_pieces else None
         self.jumps = [] if record_pieces else None
-        self.rtol = relative_tolerance("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.atol = positive("atol", atol)
         if ode_method not in ("DOP853", "Radau"):
             raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")

@@ -214,7 +214,7 @@ class FrictionDriveWalker:
 
     def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000, flight_method="taylor"):
         self.scene = scene
-        self.rtol = relative_tolerance("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.grid = positive_int("grid", grid)
         self.max_impacts = positive_int("max_impacts", max_impacts)
         self.mu = float(scene.mu[0])
