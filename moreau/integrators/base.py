@@ -219,11 +219,15 @@ class Integrator:
         return False
 
     def _check_region(self, snapshot=None):
-        """Stop at the first recorded sample, or end-of-step state, outside the scene's valid region.
+        """Stop at the first recorded sample outside the scene's valid region.
 
         The samples after it are dropped and the run ends there with status
         ``-6``: what a scheme computes beyond is not the scene's model. It
-        overrides a failure of the same step, which came after.
+        overrides a failure of the same step, which came after. The recorded
+        samples are what every scheme has, the generic and the compiled path
+        alike (a compiled block is taken again up to that sample,
+        :meth:`_replay`), so both stop on the same sample: with
+        ``save_every = 1`` (the default) on the first step end outside.
         """
         sc = self.scene
         if getattr(sc, "valid_region", None) is None:
@@ -247,9 +251,6 @@ class Integrator:
                     self._left_region(t[k], q[k], v[k])
                     return
             self._keep_checked(None)
-        if not sc.inside_valid_region(np.array([float(self.t)]), self.q.reshape(1, -1),
-                                      self.v.reshape(1, -1))[0]:
-            self._left_region(self.t, self.q, self.v)
 
     def _left_region(self, t, q, v):
         self.t, self.q, self.v = float(t), np.array(q, dtype=float), np.array(v, dtype=float)

@@ -145,9 +145,10 @@ class Scene:
     def inside_valid_region(self, t, q, v):
         """Whether each state lies in the region where the model holds.
 
-        Every scheme checks its recorded samples and the state at the end of
-        each of its steps; the first state outside ends the run with status
-        ``-6``, naming :attr:`valid_region`, the time and the state. The
+        Every scheme checks its recorded samples (each step end at the
+        default ``save_every = 1``); the first one outside ends the run there
+        with status ``-6``, naming :attr:`valid_region`, the time and the
+        state. The
         contact law itself (``gap >= 0`` to the scheme's accuracy) is not
         part of the region: what lies outside it is a state the equations
         no longer describe (a rod turned past the floor, a ball through it).
