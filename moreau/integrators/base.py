@@ -398,6 +398,10 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     SimulationResult
         Status ``-4`` if interrupted by ``KeyboardInterrupt``; the samples
         recorded until then are kept. Status 1 if a terminal event stopped it.
+        Status ``-6`` if a recorded state left the scene's valid region
+        (:meth:`~moreau.scenes.base.Scene.inside_valid_region`): the run ends
+        on that sample, and the message names the region, the time and the
+        state.
 
     Examples
     --------
