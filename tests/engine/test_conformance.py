@@ -66,7 +66,7 @@ def test_moreau_jean_agrees_with_the_reference_within_the_stated_tolerance(name)
 #   scheme stops with status -6 naming the region 0 < phi < pi.
 #
 # Measured over the default windows (2 shared cores): each non-compliant pair takes 0.01 to
-# 1.5 s, but the event-driven schemes on the flexible rod 6 s a period (60 s a window), and
+# 3.3 s, but the event-driven schemes on the flexible rod 23-27 s (all 90: 80 s), and
 # the compliant schemes 15-40 s on each non-periodic scene (Radau on the sliding block and
 # box more than 120 s) and 15-85 s over half a period of a drive (2.4e5 steps of 0.5-1 ms a
 # window: 5-30 min each). The default run takes a twentieth of each window, without the
