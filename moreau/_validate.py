@@ -102,3 +102,43 @@ def finite_array(name, value, shape=None, ndim=None):
     if not np.all(np.isfinite(a)):
         raise InputError(f"`{name}` must contain only finite values (no NaN or inf)")
     return a
+
+
+#: the tightest relative tolerance float64 arithmetic can certify: a hundred units of
+#: rounding (eps = 2.2e-16), the floor scipy's solve_ivp sets for its own rtol
+TOL_MIN = 100.0 * float(np.finfo(float).eps)
+#: the loosest that still promises two correct digits
+TOL_MAX = 1e-2
+
+
+def relative_tolerance(name, value, floor=True):
+    """Return ``value`` as a float, or raise unless ``100 eps <= value <= 1e-2``.
+
+    A tighter tolerance cannot be met in float64: an error estimate made of
+    roundings never falls below it, and an adaptive scheme halves its step
+    until its step budget runs out. A looser one is no accuracy at all.
+    ``floor=False`` accepts any positive tolerance up to ``1e-2``: for a
+    solver that bounds its own (scipy's ``solve_ivp`` raises a smaller
+    ``rtol`` to ``100 eps`` and says so) and which the package's analyses
+    ask for a hundredth of their own tolerance.
+
+    Examples
+    --------
+    >>> relative_tolerance("rtol", 1e-8)
+    1e-08
+    >>> relative_tolerance("tol", 1e-16)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `tol` must be in [100 eps, 1e-2] = [2.22e-14, 0.01]: float64 rounding (eps = 2.2e-16) bounds what an error estimate can certify, and a looser one keeps no two digits; got 1e-16
+    """
+    x = finite_scalar(name, value)
+    if not floor:
+        if not 0.0 < x <= TOL_MAX:
+            raise InputError(f"`{name}` must be in (0, 1e-2]: a looser tolerance keeps no two "
+                             f"digits; got {x!r}")
+        return x
+    if not TOL_MIN <= x <= TOL_MAX:
+        raise InputError(f"`{name}` must be in [100 eps, 1e-2] = [{TOL_MIN:.3g}, {TOL_MAX:g}]: "
+                         f"float64 rounding (eps = 2.2e-16) bounds what an error estimate can "
+                         f"certify, and a looser one keeps no two digits; got {x!r}")
+    return x

@@ -45,8 +45,10 @@ EXPECTED = {
     # on others (another FMA contraction of the compiled loop: seen on an AMD EPYC) it does
     # not, and the statistical steady state is within the bound. Both are honest outcomes;
     # which one is a matter of rounding in a chaotic undamped motion (see UNDAMPED below).
-    # 50 steps: theta = 1 damps too much (5 % error)
-    "flexible-rod-stiff": ("stable", "stable", "stable"),
+    # 50 steps: theta = 1 damps too much (5 % error). With theta = 1/2 a period of the
+    # shooting's map turns the rod to phi = -1542 rad (measured): the run stops there,
+    # naming the rod's valid region, where it used to go on through it
+    "flexible-rod-stiff": ("stable", "stable", {"failed", "stable"}),
     "flexible-rod-stiff-undamped": ("stable", "stable", {"failed", "stable"}),
     "flexible-rod-stiff-N50": ("stable", "inaccurate", "stable"),
 }
@@ -117,11 +119,14 @@ def test_case(case):
             assert all(r["message"].startswith("BudgetExhaustedError: statistical steady "
                                                "state: budget exhausted (`max_periods`=400)")
                        for r in rows)
+    if case == "flexible-rod-stiff" and mj05["outcome"] == "failed":
+        assert "valid region 0 < phi < pi/2" in mj05["message"]
     if case == "flexible-rod-stiff-undamped":
-        # UNDAMPED: either the discrete Painlevé failure, named, or no period-1 orbit (the
-        # modes never settle) and a statistical mean within the bound
+        # UNDAMPED: either the discrete Painlevé failure or the rod turned out of its
+        # valid region, named, or no period-1 orbit (the modes never settle) and a
+        # statistical mean within the bound
         if mj05["outcome"] == "failed":
-            assert "Painlev" in mj05["message"]
+            assert "Painlev" in mj05["message"] or "valid region" in mj05["message"]
         else:
             assert "no period-1 orbit" in mj05["message"] and mj05["error"] < 2e-3
     if case == "coarse-N10":

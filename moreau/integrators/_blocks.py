@@ -10,9 +10,11 @@ books (:meth:`~CompiledRecording._run_block`), and assembles the blocks into
 a :class:`SimulationResult`.
 """
 
+import copy
+
 import numpy as np
 
-from ..errors import InputError
+from ..errors import InputError, MoreauError
 from ._loops import runner_for
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
                           new_lcp_control, new_stats)
@@ -81,7 +83,8 @@ class CompiledRecording:
         st[:] = 0.0
         m = self._model
         status, k, nrec = runner_for(m, template, self.scene)(
-            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k, FAST_BLOCK,
+            m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k,
+            getattr(self, "_block_limit", FAST_BLOCK),
             *before, self.save_every, self._pending_initial, *after, *buf, st)
         ndone = k - self._k
         if nrec:
@@ -128,6 +131,66 @@ class CompiledRecording:
                              np.asarray(regime, np.int64).reshape(1, nc),
                              *(np.asarray(a, float).reshape(1, nc)
                                for a in (force_N, force_T, slip, gap))))
+
+    #: what a snapshot leaves out: the scene and the compiled model are shared, the
+    #: recorded blocks are cut back by count
+    _NOT_SNAPSHOT = ("scene", "_model", "_blocks", "_samples", "_pieces")
+
+    def _snapshot(self):
+        if not self._fast:
+            return None
+        state = {k: copy.deepcopy(v) for k, v in vars(self).items() if k not in self._NOT_SNAPSHOT}
+        return state, len(self._blocks)
+
+    def _loop_steps_to(self, start, t, rows):
+        """Steps of the compiled loop from the state ``start`` (a snapshot) to the sample at ``t``.
+
+        A fixed-step loop: from the grid ``t0 + k h``; the run's last step ends
+        on ``t_bound`` (the loop stops there by itself).
+        """
+        if t >= self.t_bound:
+            return FAST_BLOCK
+        return int(round((t - self.t0) / self.h)) - start["_k"]
+
+    def _replay(self, snapshot, t, rows):
+        if snapshot is None:
+            return False
+        state, nblocks = snapshot
+        limit = self._loop_steps_to(state, t, rows)
+        if not 0 < limit <= FAST_BLOCK:
+            return False
+        del self._blocks[nblocks:]
+        vars(self).update(copy.deepcopy(state))
+        self._block_limit = limit
+        try:
+            self._step_impl()
+        except MoreauError:
+            pass        # it stopped before where the first call failed; the cut decides
+        finally:
+            del self._block_limit
+        self.counters["steps"] += 1      # as Integrator.step counts a call
+        return True
+
+    def _unchecked_states(self):
+        if not self._fast:
+            return super()._unchecked_states()
+        new = self._blocks[self._region_seen:]
+        if not new:
+            return None
+        return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+
+    def _keep_checked(self, count):
+        if not self._fast:
+            return super()._keep_checked(count)
+        if count is not None:
+            kept = self._blocks[:self._region_seen]
+            for b in self._blocks[self._region_seen:]:
+                if count <= 0:
+                    break
+                kept.append(tuple(x[:count] for x in b))
+                count -= len(b[0])
+            self._blocks = kept
+        self._region_seen = len(self._blocks)
 
     def _rows_since(self):
         if not self._fast:

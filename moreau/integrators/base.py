@@ -159,6 +159,12 @@ class Integrator:
         self._judged = bounded_velocities(scene, n)
         self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v[self._judged]),
                                                                   initial=0.0)))
+        # a run must start where the model holds (a scene states its valid region)
+        outside = self.scene.check_valid(self.q, self.v, self.t0) if hasattr(
+            self.scene, "check_valid") else None
+        if outside is not None:
+            raise InputError(f"`q0`, `v0` lie outside the scene's valid region: "
+                             f"{outside.replace('the state left ', '')}")
         self.status = "running"
         self.status_code = 0
         self.message = ""
@@ -171,12 +177,18 @@ class Integrator:
         self._seen = 0
         #: the last sample handed to simulate's output (time stepping)
         self.last_handed = None
+        # recorded samples checked against the scene's valid region so far, and the
+        # time of the state where the run left it (None while inside)
+        self._region_seen = 0
+        self.region_left_at = None
 
     # -- public API ---------------------------------------------------------
     def step(self):
         """Advance by one step (or to the next event); return the status string."""
         if self.status != "running":
             raise MoreauError(f"cannot step an integrator whose status is {self.status!r}")
+        region = getattr(self.scene, "valid_region", None) is not None
+        snapshot = self._snapshot() if region else None
         try:
             self._step_impl()
         except PainleveError as exc:
@@ -196,6 +208,8 @@ class Integrator:
             if self.t >= self.t_bound:
                 self.status = "finished"
                 self.message = STATUS_MESSAGES[0]
+        if region:
+            self._check_region(snapshot)
         return self.status
 
     def _stop_if_diverged(self):
@@ -212,6 +226,77 @@ class Integrator:
             return False
         self.status, self.status_code, self.message = "failed", -5, why
         return True
+
+    def _snapshot(self):
+        """What :meth:`_replay` needs to take the last call of ``_step_impl`` again (None: no replay)."""
+        return None
+
+    def _replay(self, snapshot, t, rows):
+        """Take the last ``_step_impl`` again from ``snapshot``, stopping at the sample at ``t``.
+
+        For a scheme that advances many steps a call (a compiled block): its
+        counters and its state then end where the run left the valid region.
+        ``rows`` are the times recorded by that call up to ``t``. Returns
+        True when done; the default does nothing and returns False.
+        """
+        return False
+
+    def _check_region(self, snapshot=None):
+        """Stop at the first recorded sample outside the scene's valid region.
+
+        The samples after it are dropped and the run ends there with status
+        ``-6``: what a scheme computes beyond is not the scene's model. It
+        overrides a failure of the same step, which came after. The recorded
+        samples are what every scheme has, the generic and the compiled path
+        alike (a compiled block is taken again up to that sample,
+        :meth:`_replay`), so both stop on the same sample: with
+        ``save_every = 1`` (the default) on the first step end outside.
+        """
+        sc = self.scene
+        if getattr(sc, "valid_region", None) is None:
+            return
+        new = self._unchecked_states()
+        if new is not None:
+            t, q, v = new
+            inside = np.asarray(sc.inside_valid_region(t, q, v), dtype=bool)
+            if not inside.all():
+                k = int(np.argmin(inside))
+                if snapshot is not None and self._replay(snapshot, t[k], t[:k + 1]):
+                    # the call taken again up to that sample, which now ends its rows
+                    new = self._unchecked_states()
+                    if new is None:
+                        return
+                    t, q, v = new
+                    inside = np.asarray(sc.inside_valid_region(t, q, v), dtype=bool)
+                    k = int(np.argmin(inside))
+                if not inside[k]:
+                    self._keep_checked(k + 1)
+                    self._left_region(t[k], q[k], v[k])
+                    return
+            self._keep_checked(None)
+
+    def _left_region(self, t, q, v):
+        self.t, self.q, self.v = float(t), np.array(q, dtype=float), np.array(v, dtype=float)
+        self.region_left_at = self.t
+        self.events = [e for e in self.events if e.t <= self.t]
+        self._fail(-6, self.scene.check_valid(self.q, self.v, self.t)
+                   + "; the model does not apply beyond it, the run stops there")
+
+    def _unchecked_states(self):
+        """``(t, q, v)`` of the samples recorded since the last check, or None."""
+        new = self._samples[self._region_seen:]
+        if not new:
+            return None
+        n = self.scene.ndof
+        return (np.array([s[0] for s in new], dtype=float),
+                np.array([s[1] for s in new], dtype=float).reshape(len(new), n),
+                np.array([s[2] for s in new], dtype=float).reshape(len(new), n))
+
+    def _keep_checked(self, count):
+        """Keep ``count`` of the samples since the last check, drop the rest; mark them checked."""
+        if count is not None:
+            del self._samples[self._region_seen + count:]
+        self._region_seen = len(self._samples)
 
     def interrupt(self, message=None):
         """Stop the run as interrupted (status ``-4``); what was recorded is kept.
@@ -344,6 +429,10 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     SimulationResult
         Status ``-4`` if interrupted by ``KeyboardInterrupt``; the samples
         recorded until then are kept. Status 1 if a terminal event stopped it.
+        Status ``-6`` if a recorded state left the scene's valid region
+        (:meth:`~moreau.scenes.base.Scene.inside_valid_region`): the run ends
+        on that sample, and the message names the region, the time and the
+        state.
 
     Examples
     --------
@@ -396,7 +485,23 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     result = integ.result()
     if tracker is not None:
         tracker.finish(result)
+        cut = integ.region_left_at
+        if cut is not None and (tracker.stop is None or tracker.stop[0] > cut):
+            # the exact motion handed over may run past the state that left the region
+            _cut_at(result, cut)
+            result.status, result.message = integ.status_code, integ.message
     return result
+
+
+def _cut_at(result, t):
+    """Drop the samples and events of ``result`` after time ``t`` (in place)."""
+    keep = result.t <= t
+    for name in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
+        setattr(result, name, getattr(result, name)[keep])
+    result.events = [e for e in result.events if e.t <= t]
+    for i, te in enumerate(result.t_events):
+        k = np.asarray(te) <= t
+        result.t_events[i], result.y_events[i] = te[k], result.y_events[i][k]
 
 
 #: inside :func:`propagate_interrupts`: :func:`simulate` lets Ctrl-C through

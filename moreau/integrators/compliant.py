@@ -56,7 +56,7 @@ import numpy as np
 from scipy.integrate import RK45, Radau
 from scipy.optimize import brentq
 
-from .._validate import nonnegative, positive
+from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from .base import Integrator, register_integrator
@@ -64,6 +64,9 @@ from .event_driven_generic import contact_law_regimes
 
 __all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution",
            "clamped_restitution"]
+
+#: default bound on the steps of one run: the steps are taken in Python, 0.3-1 ms each
+MAX_STEPS = 10**6
 
 #: normal force laws: name -> exponent of the penetration
 CONTACT_MODELS = {"kelvin-voigt": 1.0, "hunt-crossley": 1.5}
@@ -135,7 +138,7 @@ class _Compliant(Integrator):
 
     def __init__(self, scene, t0, q0, v0, t_bound, stiffness=1e6, damping=None,
                  contact_model="kelvin-voigt", friction_velocity=1e-4, rtol=1e-8, atol=1e-10,
-                 max_step=None, sample_dt=None):
+                 max_step=None, sample_dt=None, max_steps=MAX_STEPS):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.stiffness = positive("stiffness", stiffness)
         if contact_model not in CONTACT_MODELS:
@@ -145,7 +148,7 @@ class _Compliant(Integrator):
         self.power = CONTACT_MODELS[contact_model]
         vs = float(np.max(np.abs(getattr(scene, "velocity_scale", 1.0))))
         self.eps = positive("friction_velocity", friction_velocity) * (vs if vs > 0 else 1.0)
-        self.rtol = positive("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.atol = positive("atol", atol)
         nc = scene.ncontacts
         self.mu = np.asarray(scene.mu, float).reshape(-1) if nc else np.zeros(0)
@@ -163,10 +166,22 @@ class _Compliant(Integrator):
         else:
             self.damping = np.full(nc, nonnegative("damping", damping))
         # a contact lasts about pi sqrt(m / k): steps must not jump over one
+        given = max_step is not None
         if max_step is None:
             m_min = float(np.min(meff)) if nc else 1.0
             max_step = 0.1 * math.pi * math.sqrt(m_min / self.stiffness)
         self.max_step = positive("max_step", max_step)
+        self.max_steps = positive_int("max_steps", max_steps)
+        steps = math.ceil((self.t_bound - self.t0) / self.max_step)
+        if steps > self.max_steps:
+            why = ("`max_step`" if given else
+                   f"the default `max_step` = 0.1 pi sqrt(m / k) (a tenth of the contact's "
+                   f"duration pi sqrt(m / k), effective mass m = {m_min:.3g}, `stiffness` k = "
+                   f"{self.stiffness:g})")
+            raise InputError(f"{why} = {self.max_step:.3g} takes at least {steps:.3g} steps over "
+                             f"[{self.t0:g}, {self.t_bound:g}], more than `max_steps` = "
+                             f"{self.max_steps:.3g} (about 1 ms a step): take a softer contact, "
+                             f"a shorter run, or raise `max_steps`")
         self.sample_dt = None if sample_dt is None else positive("sample_dt", sample_dt)
         self.counters.update(rhs_evaluations=0, jacobian_evaluations=0)
         n = scene.ndof
@@ -368,9 +383,10 @@ class CompliantRadau(_Compliant):
     Options: ``stiffness`` (> 0), ``damping`` (>= 0; default from the
     restitution for Kelvin–Voigt), ``contact_model`` (``"kelvin-voigt"`` or
     ``"hunt-crossley"``), ``friction_velocity`` (> 0, in units of the scene's
-    ``velocity_scale``), ``rtol``, ``atol``,
+    ``velocity_scale``), ``rtol`` (in ``(0, 1e-2]``), ``atol``,
     ``max_step`` (default a tenth of a contact's duration), ``sample_dt``
-    (default: every step).
+    (default: every step), ``max_steps`` (default ``1e6``: a run whose
+    ``(t_bound - t0) / max_step`` exceeds it is refused before any work).
 
     The velocities' absolute tolerance is ``max(atol, floor)``, the floor
     being the least one Radau's Newton iteration can certify against the

@@ -86,7 +86,7 @@ from itertools import combinations, product
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import nonnegative, positive, positive_int
+from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
 from ..regimes import Regime
@@ -463,7 +463,7 @@ class GenericEventDriven(Integrator):
         super().__init__(scene, t0, q0, v0, t_bound)
         self.phases = [] if record_pieces else None
         self.jumps = [] if record_pieces else None
-        self.rtol = positive("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.atol = positive("atol", atol)
         if ode_method not in ("DOP853", "Radau"):
             raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")

@@ -216,7 +216,12 @@ def check_work(scene, t0, t1, h, save_every, max_steps=MAX_STEPS):
     Traceback (most recent call last):
     ...
     moreau.errors.InputError: `h` = 1e-09 over [0, 6.3] takes 6.3e+09 steps, more than `max_steps` = 1e+09: take a larger `h` or raise `max_steps`
+    >>> check_work(BouncingBall(), 0.0, 4.0, 1000.0, 1)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `h` = 1000 is longer than the run [0, 4]: a step may not exceed the window it integrates; take `h` <= 4
     """
+    check_step_fits("h", h, t0, t1)
     steps = math.ceil((t1 - t0) / h - 1e-9)
     if steps > max_steps:
         raise InputError(f"`h` = {h:g} over [{t0:g}, {t1:g}] takes {steps:.2g} steps, more than "
@@ -227,6 +232,18 @@ def check_work(scene, t0, t1, h, save_every, max_steps=MAX_STEPS):
         raise InputError(f"recording every {save_every} of {steps:.2g} steps would take "
                          f"{size / 1024**3:.3g} GiB, more than {MAX_RECORD_BYTES / 1024**3:g} GiB: "
                          f"raise `save_every` to at least {math.ceil(save_every * size / MAX_RECORD_BYTES)}")
+
+
+def check_step_fits(name, h, t0, t1):
+    """Refuse a step longer than the window ``[t0, t1]``.
+
+    Such a step is cut to the window and taken as one step of another size
+    than asked for, which no order statement covers.
+    """
+    if h > (t1 - t0) * (1.0 + 1e-12):
+        raise InputError(f"`{name}` = {h:g} is longer than the run [{t0:g}, {t1:g}]: a step may "
+                         f"not exceed the window it integrates; take `{name}` <= {t1 - t0:g}")
+    return h
 
 
 def check_step(scheme, h):

@@ -22,6 +22,7 @@ STATUS_MESSAGES = {
     -3: "A contact problem (LCP) could not be solved.",
     -4: "The run was interrupted; the result holds what was finished.",
     -5: "A numerical failure occurred.",
+    -6: "The state left the scene's valid region; the model does not apply beyond it.",
 }
 
 

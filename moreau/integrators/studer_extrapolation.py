@@ -104,7 +104,7 @@ import math
 
 import numpy as np
 
-from .._validate import in_open_interval, positive, positive_int
+from .._validate import positive, positive_int, relative_tolerance
 from ..errors import InputError
 from ..regimes import Regime
 from .result import STATUS_MESSAGES, SimulationResult
@@ -119,8 +119,8 @@ from ._mj_kernels import set_painleve_stop
 from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
                               solve_contact_problem)
 from .event_driven_generic import project_positions
-from .moreau_jean import (check_lcp_options, check_scene_contacts, classify_impulse,
-                          compiled_model_of)
+from .moreau_jean import (check_lcp_options, check_scene_contacts, check_step_fits,
+                          classify_impulse, compiled_model_of)
 
 __all__ = ["StuderExtrapolation", "dense_state", "dense_piece"]
 
@@ -142,8 +142,8 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     t0, q0, v0, t_bound
         See :class:`~moreau.integrators.base.Integrator`.
     tol : float
-        Local error tolerance, in ``(0, 1)``; positions and velocities are
-        measured relative to ``1 + |y|``.
+        Local error tolerance, in ``[100 eps, 1e-2]`` (what float64 can
+        certify); positions and velocities are measured relative to ``1 + |y|``.
     columns : int
         Extrapolation columns ``K`` in ``[2, 8]``: the order in smooth phases.
     h0 : float, optional
@@ -214,14 +214,16 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         self._last_row = None
         self._handed_row = None
         self._next_sample = 1
-        self.tol = in_open_interval("tol", tol, 0.0, 1.0)
+        self.tol = relative_tolerance("tol", tol)
         if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
                 or not 2 <= columns <= 8:
             raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
         self.columns = int(columns)
         span = self.t_bound - self.t0
-        self.h = span / 100.0 if h0 is None else positive("h0", h0)
-        self.h_min = 1e-12 * span if h_min is None else positive("h_min", h_min)
+        self.h = span / 100.0 if h0 is None else check_step_fits(
+            "h0", positive("h0", h0), self.t0, self.t_bound)
+        self.h_min = 1e-12 * span if h_min is None else check_step_fits(
+            "h_min", positive("h_min", h_min), self.t0, self.t_bound)
         self.lcp_method, _ = check_lcp_options(lcp_method)
         self.max_steps = positive_int("max_steps", max_steps)
         self.mu_c, self.e_c = check_scene_contacts(scene)
@@ -385,12 +387,17 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             # this one's, and the switch it may bring is located already
             self._acc = None
 
+    def _loop_steps_to(self, start, t, rows):
+        # one recorded sample per accepted macro step, after the run's first one
+        return int(np.count_nonzero(np.asarray(rows) > start["t"]))
+
     def _fast_block(self, bound):
         n, nc = self.scene.ndof, self.scene.ncontacts
         q, v, closed, reg = self.q.copy(), self.v.copy(), self._closed.copy(), self._last_reg.copy()
         acc = np.zeros(n) if self._acc is None else self._acc.copy()
         th = np.array([self.t, self.h, 0.0 if self._acc is None else 1.0])
-        ns = self._block_steps + 2
+        nmax = getattr(self, "_block_limit", self._block_steps)
+        ns = nmax + 2
         buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
                np.empty((ns, nc)), np.empty((ns, nc)), np.empty(ns, dtype=np.int64),
@@ -401,7 +408,7 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         m = self._model
         status, nacc, nrec = runner_for(m, studer_loop, self.scene)(
             m.par, self.mu_c, self.e_c, bound, self.tol, self.columns, self.h_min,
-            self.max_steps - self._macro, self._block_steps, th, q, v, closed, reg, acc,
+            self.max_steps - self._macro, nmax, th, q, v, closed, reg, acc,
             self._pending_initial, self._lcp_ctl, *buf, st, cnt)
         if nrec:
             self._add_rows(tuple(b[:nrec].copy() for b in buf))

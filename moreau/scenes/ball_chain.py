@@ -132,6 +132,13 @@ class BallChain(SIUnits, Scene):
     """
 
     name = "ball-chain"
+    #: only neighbours touch: a ball that passed its neighbour is not in the model
+    valid_region = "q_0 < q_1 < ... < q_N-1 (every ball keeps its place in the chain)"
+
+    @property
+    def default_window(self):
+        """The striker's impact and two time units after it."""
+        return self.impact_time + 2.0
 
     def __init__(self, params=None, **overrides):
         p = params_with(BallChainParams, params, overrides)
@@ -178,6 +185,9 @@ class BallChain(SIUnits, Scene):
 
     def contact_drift(self, q, v, t):
         return np.zeros(self.ndof - 1), np.zeros(0)
+
+    def inside_valid_region(self, t, q, v):
+        return np.all(np.diff(np.asarray(q), axis=1) > 0.0, axis=1)
 
     def initial_state(self):
         """The chain at rest, touching, ball 1 at 0; the striker ``gap0`` away at speed 1."""

@@ -134,6 +134,67 @@ class Scene:
         """
         return np.zeros(0)
 
+    # -- the model's valid region -------------------------------------------
+    #: the states the model is meant for, in words, or None where it holds everywhere
+    #: (e.g. ``"0 < phi < pi"``); every scheme stops where a state leaves them
+    valid_region = None
+    #: a run of the scene's natural length in its own time, for a run that names none
+    #: (the conformance suite); None: ten drive periods, or 1 without a drive
+    default_window = None
+
+    def inside_valid_region(self, t, q, v):
+        """Whether each state lies in the region where the model holds.
+
+        Every scheme checks its recorded samples (each step end at the
+        default ``save_every = 1``); the first one outside ends the run there
+        with status ``-6``, naming :attr:`valid_region`, the time and the
+        state. The
+        contact law itself (``gap >= 0`` to the scheme's accuracy) is not
+        part of the region: what lies outside it is a state the equations
+        no longer describe (a rod turned past the floor, a ball through it).
+
+        Parameters
+        ----------
+        t : ndarray, shape (k,)
+        q, v : ndarray, shape (k, ndof)
+            ``k`` states, one a row.
+
+        Returns
+        -------
+        ndarray of bool, shape (k,)
+            The default: all True.
+        """
+        return np.ones(np.shape(t), dtype=bool)
+
+    def check_valid(self, q, v, t):
+        """None inside the valid region; else a sentence naming the region left, the time and the state.
+
+        Examples
+        --------
+        >>> from moreau.scenes import PainleveRod
+        >>> rod = PainleveRod()
+        >>> rod.check_valid([0.5, 0.1, 0.2], [0.0, 0.0, 0.0], 1.5) is None
+        True
+        >>> print(rod.check_valid([0.5, 0.1, -0.2], [0.0, 0.0, 0.0], 1.5))  # doctest: +ELLIPSIS
+        the state left the model's valid region 0 < phi < pi ... at t = 1.5 (0.338643 s): q = [0.5, 0.1, -0.2], v = [0, 0, 0]
+        """
+        q = np.asarray(q, dtype=float).reshape(1, -1)
+        v = np.asarray(v, dtype=float).reshape(1, -1)
+        if self.valid_region is None or self.inside_valid_region(np.array([float(t)]), q, v)[0]:
+            return None
+        unit = self.time_unit_s
+        si = f" ({float(t) * unit:.6g} s)" if unit else ""
+        fmt = ", ".join
+        return (f"the state left the model's valid region {self.valid_region} at t = {float(t):.6g}"
+                f"{si}: q = [{fmt(f'{x:.6g}' for x in q[0])}], "
+                f"v = [{fmt(f'{x:.6g}' for x in v[0])}]")
+
+    def default_span(self):
+        """The length of a run that names none, in the scene's time: :attr:`default_window`."""
+        if self.default_window is not None:
+            return float(self.default_window)
+        return 10.0 * self.period if self.period is not None else 1.0
+
     # -- defaults and compiled form ---------------------------------------
     def initial_state(self):
         """A sensible default ``(q0, v0)``: the rest state or the scene's documented start."""

@@ -259,6 +259,8 @@ class BidirectionalDrive(DriveUnits, Scene):
 
     ndof = 3
     name = "bidirectional-drive"
+    #: each rod's geometry (tip towards the rotor, contact above its hinge) holds only there
+    valid_region = "0 < phi_a, phi_b < pi/2 (each rod leans towards the rotor from below upright)"
     period = 2.0 * math.pi
     cyclic_coordinates = (2,)
 
@@ -360,6 +362,10 @@ class BidirectionalDrive(DriveUnits, Scene):
         phi = np.arcsin(self.sin_phi0 - self.u1(tau))
         dphi = -self.du1(tau) / np.cos(phi)
         return np.array([phi[0], phi[1], 0.0]), np.array([dphi[0], dphi[1], 0.0])
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, :2]
+        return np.all((phi > 0.0) & (phi < 0.5 * math.pi), axis=1)
 
     def initial_state(self):
         """The rest state at ``tau = 0`` (:meth:`rest_state`)."""

@@ -104,6 +104,10 @@ class BouncingBall(SIUnits, Scene):
 
     ndof = 1
     name = "bouncing-ball"
+    #: the floor is a half-plane: a centre below it is a ball that went through
+    valid_region = "y > 0 (the ball's centre above the floor)"
+    #: from the default start: the first impacts and, for e = 0.5, the ball at rest (t_inf = 4.24)
+    default_window = 4.0
 
     def __init__(self, params=None, **overrides):
         p = params_with(BouncingBallParams, params, overrides)
@@ -131,6 +135,9 @@ class BouncingBall(SIUnits, Scene):
 
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(0)
+
+    def inside_valid_region(self, t, q, v):
+        return np.asarray(q)[:, 0] > 0.0
 
     def initial_state(self):
         """The ball at rest with its lowest point one length unit above the floor."""

@@ -275,6 +275,8 @@ class FlexibleRodDrive(DriveUnits, Scene):
     """
 
     name = "flexible-rod-drive"
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     #: the rod angle is in rad; the modal amplitudes and the rotor are lengths
     angle_coordinates = (0,)
@@ -425,6 +427,10 @@ class FlexibleRodDrive(DriveUnits, Scene):
     def shapes(self, q, t=0.0):
         """The stator's hinge, the rod (the chord to its bent tip) and the rotor (``q[-1]`` [m]) at ``t`` [s]."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=self.ndof - 1)
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
 
     def initial_state(self):
         """The rest state at ``tau = 0`` (:meth:`rest_state`)."""

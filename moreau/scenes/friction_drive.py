@@ -192,6 +192,8 @@ class FrictionDrive(DriveUnits, Scene):
 
     ndof = 2
     name = "friction-drive"
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     cyclic_coordinates = (1,)
     #: the scene's own high-precision event-driven scheme, which
@@ -348,6 +350,10 @@ class FrictionDrive(DriveUnits, Scene):
     def rest_state(self):
         """State at ``tau = 0`` with the rod in contact and everything at rest."""
         return np.array([self.phi0, 0.0]), np.array([0.0, 0.0])
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
 
     def initial_state(self):
         """The rest state :meth:`rest_state` (rod on the rotor at ``phi0``, all at rest)."""

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from .._validate import positive, positive_int
+from .._validate import positive_int, relative_tolerance
 from ..errors import InputError, MoreauError, PainleveError
 from ..regimes import Regime
 from ..integrators.base import Integrator, register_integrator
@@ -214,7 +214,7 @@ class FrictionDriveWalker:
 
     def __init__(self, scene, rtol=1e-12, grid=512, max_impacts=10000, flight_method="taylor"):
         self.scene = scene
-        self.rtol = positive("rtol", rtol)
+        self.rtol = relative_tolerance("rtol", rtol, floor=False)
         self.grid = positive_int("grid", grid)
         self.max_impacts = positive_int("max_impacts", max_impacts)
         self.mu = float(scene.mu[0])

@@ -142,6 +142,11 @@ class PainleveRod(SIUnits, Scene):
 
     ndof = 3
     name = "painleve-rod"
+    #: the lower tip is the only contact: past phi = 0 or pi the other end would be
+    #: the lower one, and it passes through the floor unseen
+    valid_region = "0 < phi < pi (the contact tip is the rod's lowest point)"
+    #: from the default start the rod slides, falls flat (phi -> 0) within it
+    default_window = 2.0
 
     def __init__(self, params=None, **overrides):
         p = params_with(PainleveRodParams, params, overrides)
@@ -175,6 +180,10 @@ class PainleveRod(SIUnits, Scene):
         w2 = v[2] * v[2]
         wT = np.array([c * w2]) if self.mu[0] > 0.0 else np.zeros(0)
         return np.array([s * w2]), wT
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 2]
+        return (phi > 0.0) & (phi < math.pi)
 
     def initial_state(self):
         """Tip on the floor at 45 degrees, sliding at unit speed the well-posed way (away from the rod)."""

@@ -362,6 +362,8 @@ class PiezoDrive(DriveUnits, Scene):
     """
 
     name = "piezo-drive"
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = TWO_PI
     cyclic_coordinates = (1,)
     angle_coordinates = (0,)
@@ -580,6 +582,10 @@ class PiezoDrive(DriveUnits, Scene):
     def shapes(self, q, t=0.0):
         """The stator's hinge (moving with the stack), the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m])."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
 
     def initial_state(self):
         """The rest state :meth:`rest_state`."""

@@ -110,6 +110,8 @@ class SlidingBlock(SIUnits, Scene):
 
     ndof = 2
     name = "sliding-block"
+    #: the default launch stops at t* = 1 / mu = 3.33
+    default_window = 5.0
 
     def __init__(self, params=None, **overrides):
         p = params_with(SlidingBlockParams, params, overrides)

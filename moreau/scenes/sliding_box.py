@@ -113,6 +113,10 @@ class SlidingBox(SIUnits, Scene):
 
     ndof = 3
     name = "sliding-box"
+    #: the two bottom corners are the only contacts: they must stay the lowest points
+    valid_region = "|theta| < pi/2 (the contact corners are the box's lowest points)"
+    #: the default launch stops at t* = 1 / mu = 2.5
+    default_window = 4.0
 
     def __init__(self, params=None, **overrides):
         p = params_with(SlidingBoxParams, params, overrides)
@@ -157,6 +161,9 @@ class SlidingBox(SIUnits, Scene):
         wNbar = w2 * (self.b * c - self._side * self.a * s)
         wTbar = -w2 * (self._side * self.a * c + self.b * s)
         return wNbar, (wTbar if self.params.mu > 0.0 else np.zeros(0))
+
+    def inside_valid_region(self, t, q, v):
+        return np.abs(np.asarray(q)[:, 2]) < 0.5 * math.pi
 
     def initial_state(self):
         """Flat on the floor at ``x = 0``, launched along ``+x`` at unit speed."""

@@ -4,6 +4,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
@@ -179,16 +180,31 @@ def test_painleve_configuration_is_reported():
     assert res.status == -1 and "Painlevé" in res.message
 
 
-def test_well_posed_rod_slides_and_sticks():
+def test_well_posed_rod_slides_until_it_lies_flat_and_the_run_stops_there():
     rod = PainleveRod(mu=2.0)
     q0, v0 = rod.sliding_state(phi=math.atan(2.0), tip_speed=1.0)
     res = simulate(rod, (0.0, 3.0), q0, v0, "event-driven")
-    assert res.status == 0
-    assert [(Regime(e.before), Regime(e.after)) for e in res.events][0] == \
-           (Regime.POSITIVE, Regime.STICK)
+    # the tip slides all the way down: phi reaches 0 at t = 1.46001 on the sliding ODE
+    # (DOP853 at 1e-12, an event on phi); the run stops at its first sample past it,
+    # where it used to go on to a stick at t = 1.893 with the rod through the floor
+    sol = solve_ivp(lambda t, y: np.concatenate([y[3:], rod.sliding_accelerations(y[:3], y[3:])[0]]),
+                    (0.0, 3.0), np.concatenate([q0, v0]), method="DOP853", rtol=1e-12,
+                    atol=1e-12, events=_phi_zero)
+    t_flat = float(sol.t_events[0][0])
+    assert res.status == -6 and "0 < phi < pi" in res.message and "t = 1.46" in res.message
+    assert res.t[-2] < t_flat <= res.t[-1] < t_flat + 3.0 / 256
+    assert res.q[-1, 2] < 0.0 < res.q[-2, 2]
+    assert set(res.regime_letters()) == {"P"} and not res.events
     # the sliding phase agrees with the scene's exact sliding accelerations
     a, lamN, _ = rod.sliding_accelerations(q0, v0)
     assert res.force_N[0, 0] == pytest.approx(lamN, rel=1e-12)
+
+
+def _phi_zero(t, y):
+    return y[2]
+
+
+_phi_zero.terminal = True
 
 
 def test_event_driven_name_selects_the_walker_for_the_friction_drive_only():

@@ -133,6 +133,16 @@ def test_the_painleve_rod_stops_with_the_status_that_names_it_when_asked():
     assert r.status == 0 and r.t[-1] == pytest.approx(0.1)
 
 
+def test_the_painleve_rod_default_run_stops_where_its_model_ends():
+    sc = make_scene("painleve-rod")
+    q0, v0 = sc.initial_state()
+    r = simulate(sc, (0.0, 2.0), q0, v0, NAME, h=1e-3, fast=False)
+    # the rod falls flat: phi crosses 0 at t = 1.2955 (the event-driven reference stops at
+    # its sample 1.30028), the first step end past it is 1.296, where the model ends
+    assert r.status == -6 and "0 < phi < pi" in r.message
+    assert r.t[-1] == pytest.approx(1.296, abs=1e-9) and r.q[-1, 2] < 0.0 < r.q[-2, 2]
+
+
 @pytest.mark.parametrize("scene_name", ["friction-drive", "sliding-box"])
 def test_the_compiled_loop_is_the_generic_step(scene_name):
     # one rheonomic frictional contact with the projection; two contacts through Lemke
