@@ -110,3 +110,28 @@ def divergence(scene, q_start, v_start, t_start, q, v, t, h=None):
     return (msg + f"; the step h = {h:.4g} is within the linear stability bound 2 / omega_max "
             f"= {2.0 / w:.4g} at the start (omega_max = {w:.4g}): a nonlinear or contact-"
             f"driven instability")
+
+
+def explicit_step_note(scene, q_start, v_start, t_start, h):
+    """``"; the step h = ... exceeds the stability bound ..."`` where it does, else ``""``.
+
+    For a run of an explicit scheme that stopped for another reason (it left
+    the scene's valid region) on its way to diverging: the stop names the
+    instability that drove it there.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> sc = make_scene("flexible-rod-drive")
+    >>> q, v = sc.rest_state()
+    >>> explicit_step_note(sc, q, v, 0.0, 1e-6)
+    ''
+    >>> explicit_step_note(sc, q, v, 0.0, 0.0628)[:40]
+    '; the step h = 0.0628 exceeds the stabil'
+    """
+    w = fastest_oscillation(scene, q_start, v_start, t_start)
+    if not math.isfinite(w) or w == 0.0 or h * w < 2.0:
+        return ""
+    return (f"; the step h = {h:.4g} exceeds the stability bound 2 / omega_max = {2.0 / w:.4g} "
+            f"of an explicit step (omega_max = {w:.4g}, the fastest smooth oscillation at the "
+            f"start: h omega_max = {h * w:.3g} > 2), which drove it there")

@@ -23,7 +23,8 @@ from ..errors import ContactLostError, InputError, LCPError, MoreauError, Painle
 from ..scenes import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
-from ._divergence import GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence
+from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence,
+                          explicit_step_note)
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
@@ -279,8 +280,11 @@ class Integrator:
         self.t, self.q, self.v = float(t), np.array(q, dtype=float), np.array(v, dtype=float)
         self.region_left_at = self.t
         self.events = [e for e in self.events if e.t <= self.t]
+        note = ""
+        if getattr(self, "explicit_step", False):
+            note = explicit_step_note(self.scene, *self._start, self.h)
         self._fail(-6, self.scene.check_valid(self.q, self.v, self.t)
-                   + "; the model does not apply beyond it, the run stops there")
+                   + "; the model does not apply beyond it, the run stops there" + note)
 
     def _unchecked_states(self):
         """``(t, q, v)`` of the samples recorded since the last check, or None."""

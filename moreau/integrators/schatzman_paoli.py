@@ -183,6 +183,9 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
     True
     """
 
+    #: an explicit (central-difference) step: a stop names its stability bound where exceeded
+    explicit_step = True
+
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000),
                         (100, 300, 1000), {})
 

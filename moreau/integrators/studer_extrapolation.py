@@ -455,6 +455,28 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         return q, v
 
     # -- the record: step ends, their dense output, the samples --------------------------
+    def _snapshot(self):
+        # no replay of a compiled block: the rows past the first one outside the valid
+        # region are dropped (its step counters may count the rest of that block)
+        return None
+
+    def _unchecked_states(self):
+        new = self._out[self._region_seen:]
+        if not new:
+            return None
+        return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+
+    def _keep_checked(self, count):
+        if count is not None:
+            kept = self._out[:self._region_seen]
+            for b in self._out[self._region_seen:]:
+                if count <= 0:
+                    break
+                kept.append(tuple(x[:count] for x in b))
+                count -= len(b[0])
+            self._out = kept
+        self._region_seen = len(self._out)
+
     def _add_rows(self, rows):
         """Take accepted steps' rows ``(t, q, v, regime, force_N, force_T, slip, gap, kind,
         a0, a1)`` (the start's row first, kind -1): into the result and the dense output."""

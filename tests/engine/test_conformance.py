@@ -191,10 +191,6 @@ def _energy_param(name, scheme):
     marks = []
     if scheme.startswith("compliant"):
         marks.append(pytest.mark.slow)
-    if scheme == "schatzman-paoli":
-        marks.append(pytest.mark.xfail(reason="the velocity Schatzman-Paoli records at an "
-                                       "impact step gains energy (issue 34, its own branch)",
-                                       strict=False))
     return pytest.param(name, scheme, marks=marks)
 
 

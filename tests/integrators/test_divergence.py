@@ -32,8 +32,13 @@ def test_schatzman_paoli_beyond_its_step_bound_reports_the_divergence(fast):
     q0, v0 = sc.rest_state()
     h = 2 * math.pi / 100
     r = simulate(sc, (0.0, 2 * math.pi), q0, v0, "schatzman-paoli", h=h, fast=fast)
-    assert r.status == -5
-    assert r.message.startswith("the state diverged: its largest velocity is ")
+    # the growing state leaves the rod's valid region (0 < phi < pi/2) before its velocity
+    # has grown 1e8-fold: the stop there names the instability that drove it
+    if r.status == -6:
+        assert "0 < phi < pi/2" in r.message and r.message.endswith("which drove it there")
+    else:
+        assert r.status == -5
+        assert r.message.startswith("the state diverged: its largest velocity is ")
     w = fastest_oscillation(sc, q0, v0, 0.0)
     assert h * w > 2.0
     assert f"exceeds the stability bound 2 / omega_max = {2 / w:.4g}" in r.message
