@@ -21,7 +21,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAME
 from ._dense import join_to_last
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP"]
+__all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP", "states_since", "keep_rows"]
 
 # time steps per call of the compiled loop: large enough to hide the call,
 # small enough for a live progress bar and a prompt Ctrl-C
@@ -174,22 +174,12 @@ class CompiledRecording:
     def _unchecked_states(self):
         if not self._fast:
             return super()._unchecked_states()
-        new = self._blocks[self._region_seen:]
-        if not new:
-            return None
-        return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+        return states_since(self._blocks, self._region_seen)
 
     def _keep_checked(self, count):
         if not self._fast:
             return super()._keep_checked(count)
-        if count is not None:
-            kept = self._blocks[:self._region_seen]
-            for b in self._blocks[self._region_seen:]:
-                if count <= 0:
-                    break
-                kept.append(tuple(x[:count] for x in b))
-                count -= len(b[0])
-            self._blocks = kept
+        self._blocks = keep_rows(self._blocks, self._region_seen, count)
         self._region_seen = len(self._blocks)
 
     def _rows_since(self):
@@ -221,3 +211,24 @@ class CompiledRecording:
             slip_velocity=slip, gap=gap, events=[], status=code,
             message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
             stats=dict(self.counters))
+
+
+def states_since(blocks, seen):
+    """``(t, q, v)`` of the row blocks ``blocks[seen:]`` (each ``(t, q, v, ...)``), or None."""
+    new = blocks[seen:]
+    if not new:
+        return None
+    return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+
+
+def keep_rows(blocks, seen, count):
+    """``blocks`` with only ``count`` rows after ``blocks[:seen]`` (all of them for None)."""
+    if count is None:
+        return blocks
+    kept = blocks[:seen]
+    for b in blocks[seen:]:
+        if count <= 0:
+            break
+        kept.append(tuple(x[:count] for x in b))
+        count -= len(b[0])
+    return kept

@@ -108,7 +108,7 @@ from .._validate import positive, positive_int, relative_tolerance
 from ..errors import InputError
 from ..regimes import Regime
 from .result import STATUS_MESSAGES, SimulationResult
-from ._blocks import FAST_BLOCK, CompiledRecording
+from ._blocks import FAST_BLOCK, CompiledRecording, keep_rows, states_since
 from ._loops import runner_for
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._dense import Piece
@@ -461,20 +461,10 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         return None
 
     def _unchecked_states(self):
-        new = self._out[self._region_seen:]
-        if not new:
-            return None
-        return tuple(np.concatenate([b[i] for b in new]) for i in range(3))
+        return states_since(self._out, self._region_seen)
 
     def _keep_checked(self, count):
-        if count is not None:
-            kept = self._out[:self._region_seen]
-            for b in self._out[self._region_seen:]:
-                if count <= 0:
-                    break
-                kept.append(tuple(x[:count] for x in b))
-                count -= len(b[0])
-            self._out = kept
+        self._out = keep_rows(self._out, self._region_seen, count)
         self._region_seen = len(self._out)
 
     def _add_rows(self, rows):
