@@ -32,6 +32,7 @@ from fractions import Fraction
 import math
 
 import numpy as np
+from scipy.optimize import linprog
 
 from ._certified import lcp_violation
 from ._exact import integer_data
@@ -44,7 +45,6 @@ ENUMERATE_MAX_N = 12
 
 
 def _linprog(*args, **kwargs):
-    from scipy.optimize import linprog
     return linprog(*args, method="highs", **kwargs)
 
 
