@@ -56,7 +56,7 @@ from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, eliminate, lemke_core, lemke_workspace
 
-__all__ = ["mj_loop", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
+__all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
 
 # status codes (those of SimulationResult where they overlap)
@@ -99,6 +99,17 @@ WARM_MARGIN = 1e-8
 
 def new_stats():
     return np.zeros(len(STAT_NAMES))
+
+
+@njit(inline="always")
+def grid_step(t0, k, h, t_bound):
+    """``(t_k, t_{k+1}, step, last)`` of the fixed-step grid ``t0 + k h``, the last step cut at
+    ``t_bound``: the compiled loops' twin of :func:`moreau.integrators.moreau_jean.next_time`."""
+    tk = t0 + k * h
+    t1 = t0 + (k + 1) * h
+    if t1 >= t_bound - 1e-9 * h:
+        return tk, t_bound, t_bound - tk, True
+    return tk, t1, h, False
 
 
 @njit(cache=True)
@@ -959,14 +970,7 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     # countdown, because an integer division per step costs as much as a sine
     to_save = save_every - k0 % save_every
     while k - k0 < nmax:
-        tk = t0 + k * h
-        t1 = t0 + (k + 1) * h
-        hk = h
-        last = False
-        if t1 >= t_bound - 1e-9 * h:
-            t1 = t_bound
-            hk = t_bound - tk
-            last = True
+        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
         if tk >= t_bound:
             break
         # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v

@@ -21,6 +21,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
                           _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
+from ._mj_kernels import grid_step
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -131,14 +132,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     status = OK
     to_save = save_every - k0 % save_every
     while k - k0 < nmax:
-        tk = t0 + k * h
-        t1 = t0 + (k + 1) * h
-        hk = h
-        last = False
-        if t1 >= t_bound - 1e-9 * h:
-            t1 = t_bound
-            hk = t_bound - tk
-            last = True
+        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
         if tk >= t_bound:
             break
         # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts

@@ -18,6 +18,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
                           _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
+from ._mj_kernels import grid_step
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["sp_loop"]
@@ -97,14 +98,7 @@ def sp_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, vv, vf, closed, save_eve
             t1 = t_bound
             last = False
         else:
-            tk = t0 + kn * h
-            t1 = t0 + (kn + 1) * h
-            hk = h
-            last = False
-            if t1 >= t_bound - 1e-9 * h:
-                t1 = t_bound
-                hk = t_bound - tk
-                last = True
+            tk, t1, hk, last = grid_step(t0, kn, h, t_bound)
         if not ahead:
             # the call's first node: its mass, forces and gaps
             if tk >= t_bound:

@@ -19,7 +19,7 @@ from numba import njit
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _classify, _invert_gj,
                           _invert_small, _lcp_size, _lcp_step, _one_contact, _residual, _stop_at,
-                          lcp_buffers, record_sample)
+                          grid_step, lcp_buffers, record_sample)
 
 __all__ = ["tdg_loop"]
 
@@ -199,14 +199,7 @@ def tdg_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, closed, save_every, rec
     status = OK
     to_save = save_every - k0 % save_every
     while k - k0 < nmax:
-        tk = t0 + k * h
-        t1 = t0 + (k + 1) * h
-        hk = h
-        last = False
-        if t1 >= t_bound - 1e-9 * h:
-            t1 = t_bound
-            hk = t_bound - tk
-            last = True
+        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
         if tk >= t_bound:
             break
         if not (const_mass and have_Mi):
