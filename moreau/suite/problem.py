@@ -61,12 +61,27 @@ class Problem:
     tolerance = 1e-2
     steps = (200, 1000, 5000)
     quick_steps = (200, 2000)
+    #: a problem built on a scene's comparison case (``moreau.analysis.cases``): its class
+    case_class = None
+    _case = None
+
+    def case_parameters(self):
+        """Keyword parameters of :attr:`case_class` (its defaults where empty)."""
+        return {}
+
+    def _the_case(self):
+        # built once, on first use: a case's reference is computed lazily and kept
+        if self._case is None:
+            self._case = self.case_class(**self.case_parameters())
+        return self._case
 
     def scene_parameters(self):
         """Keyword parameters of the registered scene (its defaults where empty)."""
         return {}
 
     def make_scene(self):
+        if self.case_class is not None:
+            return self._the_case().scene
         return make_scene(self.scene, **self.scene_parameters())
 
     def start(self, scene):

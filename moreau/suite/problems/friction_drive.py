@@ -30,15 +30,10 @@ class FrictionDriveProblem(Problem):
     tolerance = 1e-2
     steps = (200, 2000, 20000)
     quick_steps = (200, 2000)
-    _case = None
+    case_class = FrictionDriveCase
 
-    def _the_case(self):
-        if self._case is None:
-            self._case = FrictionDriveCase(frequency=185.0)
-        return self._case
-
-    def make_scene(self):
-        return self._the_case().scene
+    def case_parameters(self):
+        return {"frequency": 185.0}
 
     def start(self, scene):
         r = self._the_case()._tight()

@@ -25,12 +25,7 @@ class PainleveRodProblem(Problem):
     tolerance = 1e-2
     steps = (100, 1000, 10000)
     quick_steps = (100, 1000)
-    _case = None
-
-    def _the_case(self):
-        if self._case is None:
-            self._case = PainleveRodCase()
-        return self._case
+    case_class = PainleveRodCase
 
     @property
     def window(self):

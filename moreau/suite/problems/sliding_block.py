@@ -16,16 +16,6 @@ class StoppingProblem(Problem):
     tolerance = 1e-2
     steps = (100, 1000, 10000)
     quick_steps = (100, 1000)
-    case_class = None
-    _case = None
-
-    def _the_case(self):
-        if self._case is None:
-            self._case = self.case_class(**self.case_parameters())
-        return self._case
-
-    def make_scene(self):
-        return self._the_case().scene
 
     def scene_parameters(self):
         return {"mu": self.case_parameters()["mu"]}

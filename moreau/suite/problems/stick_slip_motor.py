@@ -25,15 +25,7 @@ class StickSlipMotorProblem(Problem):
     tolerance = 1e-2
     steps = (100, 1000, 10000)
     quick_steps = (100, 1000)
-    _case = None
-
-    def _the_case(self):
-        if self._case is None:
-            self._case = StickSlipCase()
-        return self._case
-
-    def make_scene(self):
-        return self._the_case().scene
+    case_class = StickSlipCase
 
     def start(self, scene):
         return self._the_case().start()
