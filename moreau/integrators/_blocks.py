@@ -21,7 +21,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAME
 from ._dense import join_to_last
 from .result import STATUS_MESSAGES, SimulationResult
 
-__all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP", "states_since", "keep_rows"]
+__all__ = ["CompiledRecording", "FAST_BLOCK", "EXPLICIT_BLOWUP", "states_since", "keep_rows", "result_of_rows"]
 
 # time steps per call of the compiled loop: large enough to hide the call,
 # small enough for a live progress bar and a prompt Ctrl-C
@@ -197,20 +197,26 @@ class CompiledRecording:
         """Assemble the recorded samples into a :class:`SimulationResult`."""
         if not self._fast:
             return super().result()
-        n, nc = self.scene.ndof, self.scene.ncontacts
-        if self._blocks:
-            t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*self._blocks))
-        else:
-            t = np.zeros(0)
-            q = v = np.zeros((0, n))
-            reg = np.zeros((0, nc), dtype=np.int64)
-            fN = fT = slip = gap = np.zeros((0, nc))
-        code = self.status_code
-        return SimulationResult(
-            t=t, q=q, v=v, regime=reg.astype(int), force_N=fN, force_T=fT,
-            slip_velocity=slip, gap=gap, events=[], status=code,
-            message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
-            stats=dict(self.counters))
+        return result_of_rows(self, self._blocks)
+
+
+def result_of_rows(integrator, blocks):
+    """The :class:`SimulationResult` of ``integrator`` from its row blocks
+    ``(t, q, v, regime, force_N, force_T, slip, gap)``."""
+    n, nc = integrator.scene.ndof, integrator.scene.ncontacts
+    if blocks:
+        t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*blocks))
+    else:
+        t = np.zeros(0)
+        q = v = np.zeros((0, n))
+        reg = np.zeros((0, nc), dtype=np.int64)
+        fN = fT = slip = gap = np.zeros((0, nc))
+    code = integrator.status_code
+    return SimulationResult(
+        t=t, q=q, v=v, regime=reg.astype(int), force_N=fN, force_T=fT,
+        slip_velocity=slip, gap=gap, events=[], status=code,
+        message=integrator.message or STATUS_MESSAGES.get(code, ""), scheme=integrator.scheme,
+        stats=dict(integrator.counters))
 
 
 def states_since(blocks, seen):

@@ -107,8 +107,8 @@ import numpy as np
 from .._validate import positive, positive_int, relative_tolerance
 from ..errors import InputError
 from ..regimes import Regime
-from .result import STATUS_MESSAGES, SimulationResult
-from ._blocks import FAST_BLOCK, CompiledRecording, keep_rows, states_since
+from .result import SimulationResult  # noqa: F401  (named in result's docstring)
+from ._blocks import FAST_BLOCK, CompiledRecording, keep_rows, result_of_rows, states_since
 from ._loops import runner_for
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._dense import Piece
@@ -510,25 +510,12 @@ class StuderExtrapolation(CompiledRecording, Integrator):
 
     def result(self):
         """Assemble the recorded rows into a :class:`SimulationResult`."""
-        n, nc = self.scene.ndof, self.scene.ncontacts
         chunks = list(self._out)
         if self.sample_dt is not None and self._last_row is not None and (
                 not chunks or self._last_row[0][0] > chunks[-1][0][-1]):
             # the state the run ended in (the window's end, or where it stopped)
             chunks.append(self._last_row[:8])
-        if chunks:
-            t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*chunks))
-        else:
-            t = np.zeros(0)
-            q = v = np.zeros((0, n))
-            reg = np.zeros((0, nc), dtype=int)
-            fN = fT = slip = gap = np.zeros((0, nc))
-        code = self.status_code
-        return SimulationResult(
-            t=t, q=q, v=v, regime=reg.astype(int), force_N=fN, force_T=fT,
-            slip_velocity=slip, gap=gap, events=[], status=code,
-            message=self.message or STATUS_MESSAGES.get(code, ""), scheme=self.scheme,
-            stats=dict(self.counters))
+        return result_of_rows(self, chunks)
 
     def _too_many(self):
         return f"more than `max_steps` = {self.max_steps} macro steps; raise it or loosen `tol`"
