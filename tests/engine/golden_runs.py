@@ -1,0 +1,88 @@
+"""The stored runs that hold the engine to its results while it is reshaped (issue 35).
+
+Every time-stepping scheme runs every registered scene for ``STEPS`` steps
+of ``h = (period or default span) / 1000`` from the scene's initial state,
+with the scheme's default options (an adaptive scheme over the same span), and Moreau–Jean also with ``theta = 1/2``
+and with ``lcp_method = "lemke"``. For each run the file keeps the SHA-256 of
+the full ``t``, ``q``, ``v``, regime and force arrays (the bit-for-bit check)
+and every tenth sample of ``t``, ``q``, ``v`` (to say how far a changed run
+moved).
+
+Run ``python tests/engine/golden_runs.py`` to write ``tests/data/golden_runs.npz``;
+only do so where a change of results is intended and explained.
+"""
+
+import hashlib
+import json
+import os
+import platform
+import sys
+
+import numpy as np
+
+STEPS = 400
+RUNS = [("moreau-jean", {}), ("moreau-jean", {"theta": 0.5}),
+        ("moreau-jean", {"lcp_method": "lemke"}), ("schatzman-paoli", {}),
+        ("nonsmooth-generalized-alpha", {}), ("studer-extrapolation", {}),
+        ("time-discontinuous-galerkin", {})]
+PATH = os.path.join(os.path.dirname(__file__), "..", "data", "golden_runs.npz")
+
+
+def key(scene, scheme, options):
+    return "|".join([scene, scheme, json.dumps(options, sort_keys=True)])
+
+
+def machine():
+    """What the bits depend on besides the code: CPU, and numpy's and numba's versions."""
+    import numba
+    flags = ""
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith(("model name", "flags")):
+                    flags += line
+                if line.startswith("flags"):
+                    break
+    except OSError:
+        flags = platform.processor()
+    return hashlib.sha256("|".join([flags, np.__version__, numba.__version__,
+                                    platform.machine()]).encode()).hexdigest()
+
+
+def run(scene_name, scheme, options):
+    """``(digest, t, q, v)`` of one run (every tenth sample of t, q, v)."""
+    from moreau.integrators import simulate
+    from moreau.scenes import registry
+    scene = registry.make_scene(scene_name)
+    q0, v0 = scene.initial_state()
+    h = (scene.period or scene.default_span()) / 1000
+    from moreau.integrators.base import get_integrator, scheme_options
+    if "h" in (scheme_options(get_integrator(scheme)) or ()):
+        options = {"h": h, **options}
+    res = simulate(scene, (0.0, STEPS * h), q0, v0, scheme, **options)
+    digest = hashlib.sha256()
+    for name in ("t", "q", "v", "regime", "force_N", "force_T"):
+        digest.update(np.ascontiguousarray(getattr(res, name)).tobytes())
+    digest.update(str(res.status).encode())
+    return digest.hexdigest(), res.t[::10].copy(), res.q[::10].copy(), res.v[::10].copy()
+
+
+def all_keys():
+    from moreau.scenes import registry
+    return [(s, scheme, opts) for s in registry.scene_names() for scheme, opts in RUNS]
+
+
+def write():
+    out = {"machine": np.array(machine())}
+    for scene, scheme, opts in all_keys():
+        k = key(scene, scheme, opts)
+        digest, t, q, v = run(scene, scheme, opts)
+        out[k + "|digest"] = np.array(digest)
+        out[k + "|t"], out[k + "|q"], out[k + "|v"] = t, q, v
+        print(k, digest[:12], flush=True)
+    np.savez_compressed(PATH, **out)
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
+    write()
