@@ -1,4 +1,4 @@
-"""The README against the program: what it says about outputs, and every command it shows."""
+"""The README and the guide's pages against the program: its tables, and every command they show."""
 
 import json
 import os
@@ -13,12 +13,97 @@ import pytest
 import moreau
 from moreau.cli import build_parser
 
-README = pathlib.Path(moreau.__file__).resolve().parent.parent / "README.md"
+ROOT = pathlib.Path(moreau.__file__).resolve().parent.parent
+README = ROOT / "README.md"
+#: the guide: the README (a user's guide), and the pages of docs/ that hold the details
+#: it moved there (tutorial.md only includes the README)
+GUIDE = [README] + sorted(p for p in (ROOT / "docs").glob("*.md")
+                          if p.name not in ("index.md", "tutorial.md"))
+MAX_README_LINES = 350
 
 
 def _subparsers():
     (sub,) = [a for a in build_parser()._actions if a.__class__.__name__ == "_SubParsersAction"]
     return sub.choices
+
+
+def test_the_readme_is_a_short_guide():
+    lines = README.read_text().splitlines()
+    assert len(lines) <= MAX_README_LINES, (
+        f"README.md has {len(lines)} lines, at most {MAX_README_LINES}: details and "
+        "measurements belong in docs/ (docs/benchmarks.md for the dated ones)")
+
+
+def _table(heading):
+    """The first column's backticked names of the table under the README's ``## heading``."""
+    text = README.read_text()
+    section = re.search(rf"^## {re.escape(heading)}\n(.*?)(?=^## |\Z)", text, flags=re.S | re.M)
+    assert section, f"README.md has no section '## {heading}'"
+    rows = [line for line in section.group(1).splitlines() if line.startswith("| `")]
+    assert rows, f"no table under '## {heading}'"
+    return [set(re.findall(r"`([^`]+)`", row.split("|")[1])) for row in rows]
+
+
+def test_the_command_table_lists_exactly_the_cli_commands():
+    # one row a command, in `moreau --help`'s set; a command added or removed shows up here
+    rows = _table("The commands")
+    assert all(len(names) == 1 for names in rows), rows
+    names = [n for (n,) in rows]
+    assert all(n.startswith("moreau ") for n in names), names
+    assert sorted(n.split()[1] for n in names) == sorted(_subparsers())
+
+
+def test_the_tour_shows_every_command():
+    tour = [c for block in readme_blocks(README) for c in block]
+    shown = {m for c in tour for m in re.findall(r"(?:^|&& )moreau (\w+)", c)}
+    assert shown == set(_subparsers())
+
+
+def test_the_scene_table_lists_every_registered_scene():
+    from moreau.scenes import registry
+    rows = _table("Scenes")
+    listed = [n for names in rows for n in names]
+    assert sorted(listed) == sorted(registry.scene_names()), (
+        "README.md's scene table and the registry differ: add or remove a line")
+
+
+def test_the_scheme_table_lists_every_registered_scheme():
+    (steady,) = [p for n, p in _subparsers().items() if n == "steady"]
+    (scheme,) = [a for a in steady._actions if "--scheme" in a.option_strings]
+    listed = [n for names in _table("Schemes") for n in names]
+    assert sorted(listed) == sorted(scheme.choices), (
+        "README.md's scheme table and the CLI's --scheme choices differ: add or remove a line")
+
+
+def test_every_benchmark_the_readme_names_exists():
+    names = [n for names in _table("Benchmarks") for n in names]
+    assert len(names) >= 8
+    for name in names:
+        assert (ROOT / "benchmarks" / name).is_file(), name
+
+
+def test_every_guide_link_resolves():
+    # a page the README or a guide page links to exists, and so does the heading it names
+    for page in GUIDE:
+        for target in re.findall(r"\]\(([^)\s]+\.md)(?:#([^)]+))?\)", page.read_text()):
+            path = (page.parent / target[0]).resolve()
+            assert path.is_file(), (page.name, target)
+            if target[1]:
+                slugs = {_slug(h) for h in re.findall(r"^#+ (.+)$", path.read_text(), flags=re.M)}
+                assert target[1] in slugs, (page.name, target, sorted(slugs))
+
+
+def _slug(heading):
+    # GitHub's (and myst's) anchor of a heading: lower case, punctuation dropped, spaces to -
+    return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
+
+
+def test_no_dated_measurement_is_left_in_the_readme():
+    # the README's numbers with a date are only the headline ones, each pointing to the
+    # page that has its machine and method
+    for paragraph in re.split(r"\n\s*\n", README.read_text()):
+        if re.search(r"20\d\d-\d\d-\d\d", paragraph):
+            assert "docs/benchmarks.md" in paragraph, paragraph
 
 
 def test_every_command_that_takes_force_is_documented_with_it():
@@ -64,12 +149,12 @@ COMMANDS = {
     'moreau sweep k 5e3 2e4 --points 40 --set frequency=185 --set mu=0.2':
         (["moreau sweep k 5e3 2e4 --points 2 --set frequency=185 --set mu=0.2 --jobs 1"],
          ["out/sweep_k_185Hz.csv", "out/sweep_k_185Hz.json"]),
-    'moreau sweep mu --frequency 185 --scheme moreau-jean --theta 0.5 --steps-per-period 2000':
-        (["moreau sweep mu --frequency 185 --scheme moreau-jean --theta 0.5 "
+    'moreau sweep mu --set frequency=185 --scheme moreau-jean --theta 0.5 --steps-per-period 2000':
+        (["moreau sweep mu --set frequency=185 --scheme moreau-jean --theta 0.5 "
           "--steps-per-period 200 --points 2 --jobs 1"],
          ["out/sweep_mu_185Hz_mj_theta0.5_N200.csv", "out/sweep_mu_185Hz_mj_theta0.5_N200.json"]),
-    'moreau characteristic --frequency 185 --json':
-        (["moreau characteristic --frequency 185 --points 5 --json"],
+    'moreau characteristic --set frequency=185 --json':
+        (["moreau characteristic --set frequency=185 --points 5 --json"],
          ["out/characteristic_friction-drive_185Hz_event-driven.csv",
           "out/characteristic_friction-drive_185Hz_event-driven.json",
           "out/characteristic_friction-drive_185Hz_event-driven.png"]),
@@ -88,12 +173,12 @@ COMMANDS = {
         (["moreau atlas --f-points 3 --y-points 2 --jobs 1"],
          ["out/atlas_f-mu.csv", "out/atlas_f-mu.json", "out/atlas_f-mu.png",
           "out/atlas_f-phi0.csv", "out/atlas_f-phi0.svg"]),
-    'moreau atlas --plane f-phi0 --f-points 100 --y-points 50 --mu 0.2 --out out/mu0.2':
-        (["moreau atlas --plane f-phi0 --f-points 3 --y-points 2 --mu 0.2 --out out/mu0.2 "
+    'moreau atlas --plane f-phi0 --f-points 100 --y-points 50 --set mu=0.2 --out out/mu0.2':
+        (["moreau atlas --plane f-phi0 --f-points 3 --y-points 2 --set mu=0.2 --out out/mu0.2 "
           "--jobs 1"],
          ["out/mu0.2/atlas_f-phi0.csv", "out/mu0.2/atlas_f-phi0.json"]),
-    'moreau sweep load 0 0.1 --points 11 --scene stick-slip-motor --frequency 1000':
-        (["moreau sweep load 0 0.1 --points 2 --scene stick-slip-motor --frequency 1000 "
+    'moreau sweep load 0 0.1 --points 11 --scene stick-slip-motor --set frequency=1000':
+        (["moreau sweep load 0 0.1 --points 2 --scene stick-slip-motor --set frequency=1000 "
           "--jobs 1"],
          ["out/sweep_stick-slip-motor_load_1000Hz_event-driven.csv",
           "out/sweep_stick-slip-motor_load_1000Hz_event-driven.json"]),
@@ -103,17 +188,17 @@ COMMANDS = {
     'moreau atlas --scheduler tcp://HEAD:8786 --out /shared/atlas --cache /shared/moreau-cache':
         SKIP_CLUSTER,
     'moreau reproduce --scheduler tcp://HEAD:8786 --out /shared/results': SKIP_CLUSTER,
-    'moreau steady --frequency 185 --json': (["moreau steady --frequency 185 --json"], []),
-    'moreau steady --frequency 2000 --mu 0.5': (["moreau steady --frequency 2000 --mu 0.5"], []),
-    'moreau steady --scene stick-slip-motor --frequency 1000 --set drive=sine':
-        (["moreau steady --scene stick-slip-motor --frequency 1000 --set drive=sine"], []),
-    'moreau run --frequency 185 --periods 10':
-        (["moreau run --frequency 185 --periods 10"],
+    'moreau steady --set frequency=185 --json': (["moreau steady --set frequency=185 --json"], []),
+    'moreau steady --set frequency=2000 --set mu=0.5': (["moreau steady --set frequency=2000 --set mu=0.5"], []),
+    'moreau steady --scene stick-slip-motor --set frequency=1000 --set drive=sine':
+        (["moreau steady --scene stick-slip-motor --set frequency=1000 --set drive=sine"], []),
+    'moreau run --set frequency=185 --periods 10':
+        (["moreau run --set frequency=185 --periods 10"],
          ["out/history_friction-drive_frequency185_event-driven.csv",
           "out/history_friction-drive_frequency185_event-driven.json",
           "out/history_friction-drive_frequency185_event-driven.png"]),
-    'moreau run --frequency 185 --scheme moreau-jean --steps-per-period 2000':
-        (["moreau run --frequency 185 --scheme moreau-jean --steps-per-period 2000"],
+    'moreau run --set frequency=185 --scheme moreau-jean --steps-per-period 2000':
+        (["moreau run --set frequency=185 --scheme moreau-jean --steps-per-period 2000"],
          ["out/history_friction-drive_frequency185_moreau-jean_steps20000.csv",
           "out/history_friction-drive_frequency185_moreau-jean_steps20000.json"]),
     'moreau run --scene sliding-box --duration 0.5 --scheme moreau-jean --steps 5000 --theta 0.5':
@@ -125,26 +210,26 @@ COMMANDS = {
         (["moreau run --scene bouncing-ball --set restitution=0.9 --duration 2 --rtol 1e-12"],
          ["out/history_bouncing-ball_restitution0.9_event-driven_rtol1e-12.csv",
           "out/history_bouncing-ball_restitution0.9_event-driven_rtol1e-12.json"]),
-    'moreau steady --frequency 185 --scheme moreau-jean --steps-per-period 2000 --json':
-        (["moreau steady --frequency 185 --scheme moreau-jean --steps-per-period 2000 --json"],
+    'moreau steady --set frequency=185 --scheme moreau-jean --steps-per-period 2000 --json':
+        (["moreau steady --set frequency=185 --scheme moreau-jean --steps-per-period 2000 --json"],
          []),
-    'moreau steady --scene bidirectional-drive --frequency 185 --x10-b 0':
-        (["moreau steady --scene bidirectional-drive --frequency 185 --x10-b 0"], []),
-    'moreau steady --scene bidirectional-drive --frequency 185 --x10-a 0':
-        (["moreau steady --scene bidirectional-drive --frequency 185 --x10-a 0"], []),
-    'moreau steady --scene bidirectional-drive --frequency 185 --phase 1.0 --scheme moreau-jean':
-        (["moreau steady --scene bidirectional-drive --frequency 185 --phase 1.0 "
+    'moreau steady --scene bidirectional-drive --set frequency=185 --set x10_b=0':
+        (["moreau steady --scene bidirectional-drive --set frequency=185 --set x10_b=0"], []),
+    'moreau steady --scene bidirectional-drive --set frequency=185 --set x10_a=0':
+        (["moreau steady --scene bidirectional-drive --set frequency=185 --set x10_a=0"], []),
+    'moreau steady --scene bidirectional-drive --set frequency=185 --set phase=1.0 --scheme moreau-jean':
+        (["moreau steady --scene bidirectional-drive --set frequency=185 --set phase=1.0 "
           "--scheme moreau-jean"], []),
     'python -m moreau.studies.bidirectional.direction_control out/':
         (["python -m moreau.studies.bidirectional.direction_control out/ --points 2"],
          ["out/direction_control.csv", "out/bidirectional_direction_control.png"]),
-    'moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 25 --frequency 185':
-        (["moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 2 --frequency 185 "
+    'moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 25 --set frequency=185':
+        (["moreau sweep --scene bidirectional-drive phase 0 6.2832 --points 2 --set frequency=185 "
           "--jobs 1"],
          ["out/sweep_bidirectional_phase_185Hz.csv", "out/sweep_bidirectional_phase_185Hz.json"]),
-    'moreau sweep --scene bidirectional-drive balance -1 1 --points 21 --frequency 185 '
+    'moreau sweep --scene bidirectional-drive balance -1 1 --points 21 --set frequency=185 '
     '--scheme moreau-jean':
-        (["moreau sweep --scene bidirectional-drive balance -1 1 --points 2 --frequency 185 "
+        (["moreau sweep --scene bidirectional-drive balance -1 1 --points 2 --set frequency=185 "
           "--scheme moreau-jean --jobs 1"],
          ["out/sweep_bidirectional_balance_185Hz_mj_theta1_N1000.csv",
           "out/sweep_bidirectional_balance_185Hz_mj_theta1_N1000.json"]),
@@ -163,8 +248,8 @@ COMMANDS = {
     'python -m pytest benchmarks/test_regression.py -n 0 --update-baselines':
         "rewrites the stored baselines of the checkout",
     'moreau scenes [--json]': (["moreau scenes", "moreau scenes --json"], []),
-    'moreau compare --scene friction-drive --frequency 185 [--out DIR] [--json] [--quick]':
-        (["moreau compare --scene friction-drive --frequency 185 --out cmp --json --quick"],
+    'moreau compare --scene friction-drive --set frequency=185 [--out DIR] [--json] [--quick]':
+        (["moreau compare --scene friction-drive --set frequency=185 --out cmp --json --quick"],
          ["cmp/compare_friction-drive_185Hz.csv", "cmp/compare_friction-drive_185Hz.json",
           "cmp/compare_friction-drive_185Hz.png"]),
     'moreau compare --scene NAME [--set NAME=VALUE ...]':
@@ -200,9 +285,10 @@ COMMANDS = {
 }
 
 
-def readme_blocks():
-    """The README's bash blocks, each a list of commands without their comments."""
-    blocks = re.findall(r"```bash\n(.*?)```", README.read_text(), flags=re.S)
+def readme_blocks(*pages):
+    """The bash blocks of the guide (or of ``pages``), each a list of commands without comments."""
+    text = "\n".join(p.read_text() for p in (pages or GUIDE))
+    blocks = re.findall(r"```bash\n(.*?)```", text, flags=re.S)
     return [[line.split("  #")[0].strip() for line in b.splitlines()
              if line.strip() and not line.startswith("#")] for b in blocks]
 

@@ -1,9 +1,10 @@
-"""Every Python snippet of the README runs, each in its own fresh copy of an interpreter.
+"""Every Python snippet of the README and of the guide's pages in docs/ runs, each in its own
+fresh copy of an interpreter.
 
 A snippet that names what an earlier paragraph defines (an LCP's ``M`` and
-``q``, a user's ``scene``) gets those names from a preamble here; a snippet
-added to the README without an entry fails
-``test_the_table_covers_every_python_snippet``.
+``q``; the README's compiled model, its user's scene of the snippet before)
+gets those names from a preamble here; a snippet added to the guide without
+an entry fails ``test_the_table_covers_every_python_snippet``.
 """
 
 import json
@@ -19,14 +20,27 @@ import moreau
 
 ROOT = pathlib.Path(moreau.__file__).resolve().parent.parent
 README = ROOT / "README.md"
+#: the README and the guide's pages (tutorial.md only includes the README)
+GUIDE = [README] + sorted(p for p in (ROOT / "docs").glob("*.md")
+                          if p.name not in ("index.md", "tutorial.md"))
+
+#: the README's own tour of the API: the front ends, a user's scene, its compiled model
+README_FIRSTS = {"from moreau import find_steady_state, simulate", "from moreau import compare",
+                 "import numpy as np", "from numba import njit"}
 
 
-def python_snippets():
-    return re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
+def python_snippets(*pages):
+    text = "\n".join(p.read_text() for p in (pages or GUIDE))
+    return re.findall(r"```python\n(.*?)```", text, flags=re.S)
 
 
 #: first line of a snippet -> the preamble that defines what it takes from the prose
 PREAMBLES = {
+    "from moreau import find_steady_state, simulate": "",
+    "from moreau import compare": "",
+    "import numpy as np": "",
+    # the README's compiled model extends the scene of the snippet before it
+    "from numba import njit": None,
     "from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams": "",
     "from moreau.integrators import simulate": "",
     "from moreau.scenes.piezo_drive import PiezoDrive, identify_hysteresis": "",
@@ -34,16 +48,23 @@ PREAMBLES = {
         "import numpy as np\n"
         "M = np.array([[2.0, 1.0], [1.0, 2.0]])\n"
         "q = np.array([-5.0, -6.0])\n"),
-    "import moreau": (
-        "import sys\n"
-        f"sys.path.insert(0, {str(ROOT / 'tests' / 'engine')!r})\n"
-        "from belt_scene import BeltBlock\n"
-        "scene = BeltBlock()\n"
-        "q0, v0 = scene.initial_state()\n"),
 }
 
 #: what each snippet's last names must hold after it ran (a check that could fail)
 CHECKS = {
+    "from moreau import find_steady_state, simulate":
+        "assert ss.mode == 'NP' and res.success and res.stats['lcp_solves'] > 0\n"
+        "assert abs(si['t'][-1] - 10 / 185.0) < 1e-9",
+    "from moreau import compare":
+        "assert {r['scheme'] for r in rep['rows']} >= {'exact', 'moreau-jean'}\n"
+        "assert all(r['status'] == 0 for r in rep['rows']) and rep['orders']",
+    "import numpy as np":
+        "assert report.ok and res.success and ref.success\n"
+        "assert res.stats['lcp_solves'] > 0 and abs(res.q[-1, 1]) < 1e-12",
+    # the compiled loop and the generic Python step of the same scene agree to rounding
+    "from numba import njit":
+        "slow = simulate(BeltBlock(), (0.0, 4.0), q0, v0, 'moreau-jean', h=0.01, fast=False)\n"
+        "assert res.success and np.allclose(res.q, slow.q, rtol=0, atol=1e-12)",
     "from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams":
         "assert ss.mode == 'NP' and res.success and si['t'][-1] > 0 and len(df) == len(res.t)",
     "from moreau.integrators import simulate":
@@ -52,15 +73,31 @@ CHECKS = {
         "assert abs(fit.alpha - 0.3) < 1e-6 and abs(fit.beta - 0.02) < 1e-8 and ss.mode",
     "from moreau.lcp import solve_lcp, build_friction_lcp":
         "assert res.success and abs(res.z @ res.w) < 1e-12",
-    "import moreau":
-        "assert res.success and ref.success and rep['rows']",
 }
+
+
+def _snippet(first):
+    (code,) = [s for s in python_snippets(README) if s.startswith(first + "\n")]
+    return code
+
+
+PREAMBLES["from numba import njit"] = _snippet("import numpy as np")
 
 
 def test_the_table_covers_every_python_snippet():
     firsts = [s.splitlines()[0] for s in python_snippets()]
     assert len(firsts) >= 4
     assert sorted(firsts) == sorted(PREAMBLES) == sorted(CHECKS)
+
+
+def test_the_readme_tours_the_front_ends():
+    # simulate, compare, find_steady_state, check_scene, a user's scene and CompiledModel
+    firsts = {s.splitlines()[0] for s in python_snippets(README)}
+    assert firsts == README_FIRSTS
+    code = "\n".join(python_snippets(README))
+    for name in ("simulate(", "compare(", "find_steady_state(", "check_scene(", "(Scene)",
+                 "CompiledModel("):
+        assert name in code, name
 
 
 # One interpreter imports the package and its libraries once (0.8 s of every fresh start),
