@@ -154,7 +154,7 @@ def main(argv=None):
         _show(rows, "starts", name, "event-driven", r)
     print("2. Moreau-Jean (2000 steps) from rest, and the reference from where it ended")
     q, v = _starts(scene)["rest"]
-    # Moreau-Jean without position projection, as measured for the README (the statistical
+    # Moreau-Jean without position projection, as measured in docs/benchmarks.md (the statistical
     # steady state projects by default, as Moreau-Jean's shooting and `moreau steady` do)
     mj = _stat(scene, "moreau-jean", q, v, fine, budget, steps_per_period=2000, projection=False)
     _show(rows, "starts", "rest", "moreau-jean N=2000", mj)

@@ -1,6 +1,6 @@
 """Regression suite: accuracy and run time of every scheme on every scene (pytest-benchmark).
 
-Run the full suite (about a minute; documented in the README)::
+Run the full suite (about a minute; documented in docs/benchmarks.md)::
 
     python -m pytest benchmarks/test_regression.py -n 0
 

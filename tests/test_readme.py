@@ -173,8 +173,8 @@ COMMANDS = {
         (["moreau atlas --f-points 3 --y-points 2 --jobs 1"],
          ["out/atlas_f-mu.csv", "out/atlas_f-mu.json", "out/atlas_f-mu.png",
           "out/atlas_f-phi0.csv", "out/atlas_f-phi0.svg"]),
-    'moreau atlas --plane f-phi0 --f-points 100 --y-points 50 --set mu=0.2 --out out/mu0.2':
-        (["moreau atlas --plane f-phi0 --f-points 3 --y-points 2 --set mu=0.2 --out out/mu0.2 "
+    'moreau atlas --plane f-phi0 --f-points 100 --y-points 50 --mu 0.2 --out out/mu0.2':
+        (["moreau atlas --plane f-phi0 --f-points 3 --y-points 2 --mu 0.2 --out out/mu0.2 "
           "--jobs 1"],
          ["out/mu0.2/atlas_f-phi0.csv", "out/mu0.2/atlas_f-phi0.json"]),
     'moreau sweep load 0 0.1 --points 11 --scene stick-slip-motor --set frequency=1000':
