@@ -106,6 +106,13 @@ def test_no_dated_measurement_is_left_in_the_readme():
             assert "docs/benchmarks.md" in paragraph, paragraph
 
 
+def test_ci_runs_the_readme_test_command():
+    # .ci/run is the README's test command, with only pip's byte-compiling switched off
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
+    (run,) = [line for line in ci if "pytest" in line and not line.startswith("#")]
+    assert run.replace(" --no-compile", "") in [c for b in readme_blocks(README) for c in b]
+
+
 def test_every_command_that_takes_force_is_documented_with_it():
     takes = {name for name, p in _subparsers().items()
              if any("--force" in a.option_strings for a in p._actions)}
