@@ -102,8 +102,8 @@ def disk_incline(params=None, **overrides):
     --------
     >>> sc = disk_incline(slope=0.3)
     >>> q0, v0 = sc.initial_state()
-    >>> float(sc.gaps(q0, 0.0)[0]), round(float(v0[2]), 12)
-    (0.0, 0.638550856814)
+    >>> float(sc.gaps(q0, 0.0)[0]), round(float(v0[2]), 12)    # rolling: w = speed / r, scene units
+    (0.0, 0.201927510938)
     """
     p = params_with(DiskInclineParams, params, overrides)
     sc = disk_incline_model(p).build("disk-incline", default_window=10.0)

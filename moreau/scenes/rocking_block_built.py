@@ -63,7 +63,7 @@ def rocking_block_built(params=None, **overrides):
     --------
     >>> sc = rocking_block_built(width=0.2, height=0.4)
     >>> q0, _ = sc.initial_state()
-    >>> [round(float(g), 12) for g in sc.gaps(q0, 0.0)]
+    >>> [round(float(g), 12) + 0.0 for g in sc.gaps(q0, 0.0)]
     [0.0, 0.044702727979]
     """
     return rocking_block_model(params, **overrides).build(

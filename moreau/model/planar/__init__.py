@@ -17,16 +17,18 @@ Example: a disk rolling down a rough incline, in ten lines.
 >>> import math
 >>> from moreau.model.planar import Model, Circle, HalfPlane
 >>> from moreau.integrators import simulate
->>> slope = math.radians(20.0)
+>>> slope, r = math.radians(20.0), 0.1
+>>> normal = (-math.sin(slope), math.cos(slope))
 >>> m = Model(gravity=(0.0, -9.81))
->>> floor = m.add_shape(m.ground, HalfPlane((0.0, 0.0), (-math.sin(slope), math.cos(slope))))
->>> disk = m.add_body(mass=1.0, inertia=0.5 * 0.1 ** 2, position=(0.0, 0.1))
->>> m.add_contact(m.add_shape(disk, Circle(0.1)), floor, mu=0.5)
+>>> floor = m.add_shape(m.ground, HalfPlane((0.0, 0.0), normal))
+>>> disk = m.add_body(mass=1.0, inertia=0.5 * r ** 2, position=(r * normal[0], r * normal[1]))
+>>> m.add_contact(m.add_shape(disk, Circle(r)), floor, mu=0.5)
 [0]
 >>> scene = m.build("disk-on-incline")
->>> res = simulate(scene, (0.0, 1.0), *scene.initial_state(), "moreau-jean", h=1e-3)
->>> q = scene.to_si(res)["q"]      # along the slope the disk rolls at 2/3 g sin(slope)
->>> round(float(q[-1, 0] * math.cos(slope)) / (9.81 * math.sin(slope) / 3.0), 3)
+>>> res = simulate(scene, (0.0, 10.0), *scene.initial_state(), "moreau-jean", h=1e-2)
+>>> q = scene.to_si(res)                          # SI: t [s], q [m, rad]
+>>> down = -(q["q"][-1, 0] * math.cos(slope) + q["q"][-1, 1] * math.sin(slope))
+>>> round(float(down / (9.81 * math.sin(slope) / 3.0 * q["t"][-1] ** 2)), 2)   # 2/3 g sin
 1.0
 
 Contact kinematics
