@@ -49,19 +49,20 @@ def test_check_scene_passes_along_a_motion():
 
 
 def _material_rate(scene, i, q, v, t, which, e):
-    # the contact point of body `which` as a material point of that body, moved along
-    # (q + s v, t + s): its velocity along e by central differences
-    fr = K.contact_frame(scene.par, i, q, q, t)
-    s = fr[0] if which == 0 else fr[1]
-    off = np.array([fr[5], fr[6]] if which == 0 else [fr[7], fr[8]])
-    c, sn = math.cos(s[4]), math.sin(s[4])
-    local = np.array([c * off[0] + sn * off[1], -sn * off[0] + c * off[1]])
+    # the contact point of body `which` (0: A, 1: B) as a material point of that body,
+    # moved along (q + s v, t + s): its velocity along e by central differences
+    c = MODEL.contacts[i]
+    body = c["A"] if which == 0 else c["B"]
+    fr = scene.contact_frames(q, t)[i]
+    off = fr[4:6] if which == 0 else fr[6:8]
+    th = scene.poses(q, t)[body, 2]
+    local = np.array([math.cos(th) * off[0] + math.sin(th) * off[1],
+                      -math.sin(th) * off[0] + math.cos(th) * off[1]])
 
     def pos(h):
-        st = K.body_state(scene.par, int(scene.par[int(scene.par[4]) + K.CREC * i + 1 + which]),
-                          q + h * v, q + h * v, t + h)
-        cc, ss = math.cos(st[4]), math.sin(st[4])
-        return np.array([st[2] + cc * local[0] - ss * local[1], st[3] + ss * local[0] + cc * local[1]])
+        x, y, a = scene.poses(q + h * v, t + h)[body]
+        return np.array([x + math.cos(a) * local[0] - math.sin(a) * local[1],
+                         y + math.sin(a) * local[0] + math.cos(a) * local[1]])
 
     h = 1e-6
     return float(e @ (pos(h) - pos(-h)) / (2 * h))
@@ -75,8 +76,7 @@ def test_the_rows_are_the_relative_velocities_of_the_contact_points(seed):
         WN, wN, WT, wT = SCENE.contact_jacobians(q, t)
         fr_index = list(SCENE.frictional_index)
         for i in range(SCENE.ncontacts):
-            fr = K.contact_frame(SCENE.par, i, q, q, t)
-            n = np.array([fr[3], fr[4]])
+            n = SCENE.contact_frames(q, t)[i, 2:4]
             tang = np.array([n[1], -n[0]])
             for e, row in ((n, WN[i] @ v + wN[i]),) + (
                     ((tang, WT[fr_index.index(i)] @ v + wT[fr_index.index(i)]),)

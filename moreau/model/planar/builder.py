@@ -13,6 +13,7 @@ from ...errors import InputError
 from ...scenes._drawing import circle, contact, line, polygon
 from ...scenes._units import SIUnits
 from ...scenes.base import Scene
+from . import _codegen
 from . import _kernels as K
 
 __all__ = ["Model", "Body", "TimeFunction", "Point", "Circle", "Segment", "Polygon",
@@ -251,6 +252,12 @@ class Model:
             raise InputError(f"`{name}` must be a body of this model, got {body!r}")
         return body
 
+    def _free(self, name, body):
+        self._body(name, body)
+        if body.kind != K.FREE:
+            raise InputError(f"`{name}` must be a free body: a given force on {body!r} moves nothing")
+        return body
+
     # -- bodies --------------------------------------------------------------------------
     def add_body(self, mass, inertia, position=(0.0, 0.0), angle=0.0, velocity=(0.0, 0.0),
                  angular_velocity=0.0, name=None):
@@ -397,7 +404,7 @@ class Model:
 
     def add_force(self, body, force, point=(0.0, 0.0)):
         """A given force ``(fx, fy)`` [N] (world frame; numbers or :class:`TimeFunction`) at ``point`` of ``body``."""
-        b = self._body("body", body)
+        b = self._free("body", body)
         if len(force) != 2:
             raise InputError("`force` must be a pair (fx, fy)")
         self.forces.append(dict(kind=K.FORCE, i=b.index, r=_vec2("point", point),
@@ -406,7 +413,7 @@ class Model:
 
     def add_torque(self, body, torque):
         """A given torque [N m] (a number or a :class:`TimeFunction`) on ``body``."""
-        b = self._body("body", body)
+        b = self._free("body", body)
         self.forces.append(dict(kind=K.TORQUE, i=b.index, f=TimeFunction.of("torque", torque)))
 
     def _initial_pose(self, body):
@@ -456,7 +463,8 @@ class Model:
             else:
                 r[1] = -1
             if rec["kind"] == K.FIXED:
-                r[4:7] = [rec["pose"][0] / L, rec["pose"][1] / L, rec["pose"][2]]
+                th = rec["pose"][2]
+                r[4:9] = [rec["pose"][0] / L, rec["pose"][1] / L, th, math.cos(th), math.sin(th)]
             elif rec["kind"] == K.DRIVEN:
                 fx, fy, ft = rec["motion"]
                 r[7:10] = [("T", put(fx.packed(L, T))), ("T", put(fy.packed(L, T))),
@@ -550,6 +558,7 @@ class PlanarScene(SIUnits, Scene):
                 q0 += [b["pose"][0] / L, b["pose"][1] / L, b["pose"][2]]
                 v0 += [b["vel"][0] * T / L, b["vel"][1] * T / L, b["vel"][2] * T]
         self._q0, self._v0 = np.array(q0), np.array(v0)
+        self._fn = _codegen.compiled_functions(self.par)
 
     def _qscale(self):
         s = np.full(self.ndof, self.length)
@@ -565,14 +574,14 @@ class PlanarScene(SIUnits, Scene):
     # -- Scene interface: the compiled functions -----------------------------------------------
     def mass(self, q):
         M = np.zeros((self.ndof, self.ndof))
-        K.mass(self.par, self._qv(q), M)
+        self._fn.mass(self.par, self._qv(q), M)
         return M
 
     def _forces(self, q, v, t, jac):
         n = self.ndof
         D = np.zeros((n, 1 + 2 * n))
         q, v = self._qv(q, v)
-        K.forces(self.par, q, v, float(t), D, jac)
+        self._fn.forces(self.par, q, v, float(t), D, jac)
         return D
 
     def forces(self, q, v, t):
@@ -585,7 +594,7 @@ class PlanarScene(SIUnits, Scene):
 
     def _contacts(self, q, t, need_T):
         G = np.zeros((max(self.ncontacts, 1), 3 + 2 * self.ndof))
-        K.contacts(self.par, self._qv(q), float(t), G, True, need_T)
+        self._fn.contacts(self.par, self._qv(q), float(t), G, True, need_T)
         return G[:self.ncontacts]
 
     def gaps(self, q, t):
@@ -600,14 +609,30 @@ class PlanarScene(SIUnits, Scene):
     def contact_drift(self, q, v, t):
         Dr = np.zeros((max(self.ncontacts, 1), 2))
         q, v = self._qv(q, v)
-        K.drift(self.par, q, v, float(t), Dr)
+        self._fn.drift(self.par, q, v, float(t), Dr)
         Dr = Dr[:self.ncontacts]
         return Dr[:, 0].copy(), Dr[self.frictional_index, 1].copy()
 
     def compiled_model(self):
-        """The compiled model: the shared planar functions with this model's ``par``."""
-        return CompiledModel(K.mass, K.forces, K.contacts, K.drift, self.par, self.ndof,
+        """The compiled model: the functions generated for this model's structure, with its ``par``."""
+        f = self._fn
+        return CompiledModel(f.mass, f.forces, f.contacts, f.drift, self.par, self.ndof,
                              self.ncontacts, True, self._has_jac)
+
+    def poses(self, q, t):
+        """``(x, y, theta)`` of every body (the ground first), scene units, shape (bodies, 3)."""
+        P = np.zeros((len(self.description.bodies), 3))
+        q = self._qv(q)
+        self._fn.poses(self.par, q, q, float(t), P)
+        return P
+
+    def contact_frames(self, q, t):
+        """Per contact: body A's contact point (world), the normal, and the contact point's
+        offsets ``s_A``, ``s_B`` from the centres of mass of A and B; shape (ncontacts, 8)."""
+        F = np.zeros((max(self.ncontacts, 1), 8))
+        q = self._qv(q)
+        self._fn.frames(self.par, q, q, float(t), F)
+        return F[:self.ncontacts]
 
     def initial_state(self):
         """The bodies' initial poses and velocities, in the order added (scene units)."""
@@ -625,10 +650,7 @@ class PlanarScene(SIUnits, Scene):
         tt = float(t) / self.time
         L = self.length
         out = []
-        poses = []
-        for k in range(len(self.description.bodies)):
-            s = K.body_state(self.par, k, q, q, tt)
-            poses.append((s[2] * L, s[3] * L, s[4]))
+        poses = [(x * L, y * L, th) for x, y, th in self.poses(q, tt)]
         for ref in self.description.shapes:
             x, y, th = poses[ref.body.index]
             c, s = math.cos(th), math.sin(th)
@@ -648,9 +670,6 @@ class PlanarScene(SIUnits, Scene):
             elif isinstance(sh, HalfPlane):
                 d = np.array([sh.normal[1], -sh.normal[0]]) * 10.0 * L
                 out.append(line([world(sh.point - d), world(sh.point + d)], "ground"))
-        for i in range(self.ncontacts):
-            fr = K.contact_frame(self.par, i, q, q, tt)
-            sA = fr[0]
-            n = (fr[3], fr[4])
-            out.append(contact(i, ((sA[2] + fr[5]) * L, (sA[3] + fr[6]) * L), n))
+        for i, fr in enumerate(self.contact_frames(q, tt)):
+            out.append(contact(i, (fr[0] * L, fr[1] * L), (fr[2], fr[3])))
         return out
