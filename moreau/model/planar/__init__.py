@@ -8,9 +8,12 @@ stators), shapes (:class:`Point`, :class:`Circle`, :class:`Segment`, convex
 own ``mu`` and ``e``, and forces (gravity, springs and dashpots between body
 points, torsion springs, given forces and torques). :meth:`Model.build`
 returns a scene that every scheme and analysis takes. Its compiled model
-is one set of ``numba`` functions shared by every planar model, with the
-description packed into ``par`` (:mod:`moreau.model.planar._kernels`); its
-Python methods call those same functions, so the model is written once.
+is numba source generated from the model's structure (which bodies are free,
+fixed or driven, each contact's kind, each force), with every number in
+``par`` (:mod:`moreau.model.planar._codegen`): models of one structure share
+one module, kept with numba's disk cache under ``~/.cache/moreau/planar``
+(or ``$MOREAU_PLANAR_CACHE``). Its Python methods call those same functions,
+so the model is written once.
 
 Example: a disk rolling down a rough incline, in ten lines.
 
@@ -30,6 +33,19 @@ Example: a disk rolling down a rough incline, in ten lines.
 >>> down = -(q["q"][-1, 0] * math.cos(slope) + q["q"][-1, 1] * math.sin(slope))
 >>> round(float(down / (9.81 * math.sin(slope) / 3.0 * q["t"][-1] ** 2)), 2)   # 2/3 g sin
 1.0
+
+Contact pairs
+-------------
+The engine works with a fixed number of contacts, so :meth:`Model.add_contact`
+fixes the candidate pairs when the model is built, each one contact row
+with its own gap, normal and tangent: a circle or a point against any
+shape is one row (its centre against the other shape's nearest feature,
+chosen at each evaluation); a polygon or segment against a half-plane is one
+row per vertex (``vertices`` selects some); two polygons give each vertex of
+each against the other. The distance to a polygon is continuous; inside it
+(a deep penetration) it is the least penetration over the faces, with kinks
+where that face changes, and a point passing through a two-sided segment
+sees its distance turn at zero: a model is meant to stay near its surfaces.
 
 Contact kinematics
 ------------------
