@@ -96,8 +96,8 @@ Forces: a spring-dashpot of tension ``f = k (l - l0) + c l'`` along ``e =
 ``F``, the Jacobians follow by the chain rule.
 """
 
-from .builder import (Body, Circle, HalfPlane, Model, PlanarScene, Point, Polygon, Segment,
-                      TimeFunction)
+from .builder import (Body, Circle, HalfPlane, JointRows, Model, PlanarScene, Point, Polygon,
+                      Segment, TimeFunction)
 
 __all__ = ["Model", "Body", "TimeFunction", "Point", "Circle", "Segment", "Polygon",
-           "HalfPlane", "PlanarScene"]
+           "HalfPlane", "PlanarScene", "JointRows"]

@@ -49,6 +49,11 @@ class _Structure:
         self.nb, self.nc, self.nf = _i(par[0]), _i(par[1]), _i(par[2])
         self.ob, self.oc, self.of = _i(par[3]), _i(par[4]), _i(par[5])
         self.n = _i(par[6])
+        self.nj, self.oj = _i(par[9]), _i(par[10])
+
+    def joint(self, r):
+        o = self.oj + K.JREC * r
+        return _i(self.par[o]), _i(self.par[o + 1]), _i(self.par[o + 2]), o
 
     def body(self, k):
         o = self.ob + K.BREC * k
@@ -321,11 +326,103 @@ def _frames(st):
     return lines
 
 
+def _joint_frame(lines, st, r, indent="    "):
+    kind, i, j, o = st.joint(r)
+    if kind == K.JPOINT:
+        lines.append(f"{indent}sAx, sAy = turn(c{i}, s{i}, par[{o + 3}], par[{o + 4}])")
+        lines.append(f"{indent}sBx, sBy = turn(c{j}, s{j}, par[{o + 5}], par[{o + 6}])")
+    elif kind == K.JLINE:
+        lines.append(f"{indent}g, nx, ny, sAx, sAy, sBx, sBy, rAx, rAy, ux, uy = frame_plane("
+                     f"x{i}, y{i}, c{i}, s{i}, par[{o + 3}], par[{o + 4}], 0.0, x{j}, y{j}, "
+                     f"c{j}, s{j}, par[{o + 5}], par[{o + 6}], par[{o + 7}], par[{o + 8}])")
+    return kind, i, j, o
+
+
+def _joint_rows(st):
+    # (kind, i, j, o, row, e): the rows of every joint record in order
+    out, row = [], 0
+    for r in range(st.nj):
+        kind, i, j, o = st.joint(r)
+        es = [("1.0", "0.0"), ("0.0", "1.0")] if kind == K.JPOINT else [("nx", "ny")]
+        if kind == K.JANGLE:
+            es = [None]
+        for e in es:
+            out.append((r, kind, i, j, o, row, e))
+            row += 1
+    return out
+
+
+def _joint_bodies(st):
+    used = set()
+    for r in range(st.nj):
+        used.update(st.joint(r)[1:3])
+    return used
+
+
+def _joints(st):
+    lines = ["@njit(cache=True)", "def joints(par, q, t, G, need_gap):"]
+    _bodies(lines, st, _joint_bodies(st), with_v=False)
+    last = None
+    for r, kind, i, j, o, row, e in _joint_rows(st):
+        if r != last:
+            _joint_frame(lines, st, r)
+            last = r
+        if kind == K.JANGLE:
+            lines.append("    if need_gap:")
+            lines.append(f"        G[{row}, 0] = th{i} - th{j} - par[{o + 9}]")
+            w = []
+            for body, sg in ((i, ""), (j, "-")):
+                kb, d, _ = st.body(body)
+                if kb == K.FREE:
+                    lines.append(f"    G[{row}, {3 + d + 2}] = {sg}1.0")
+                elif kb == K.DRIVEN:
+                    w.append(f"{sg}w{body}")
+            lines.append(f"    G[{row}, 1] = {' + '.join(w) if w else '0.0'}")
+            continue
+        if kind == K.JPOINT:
+            ex, ey = e
+            lines.append("    if need_gap:")
+            lines.append(f"        G[{row}, 0] = {ex} * (x{i} + sAx - x{j} - sBx) + {ey} * "
+                         f"(y{i} + sAy - y{j} - sBy)")
+        else:
+            lines.append("    if need_gap:")
+            lines.append(f"        G[{row}, 0] = g")
+        _rows(lines, st, row, i, j, e, 3, 1, "    ")
+    lines.append("    return")
+    return lines
+
+
+def _joint_drift(st):
+    lines = ["@njit(cache=True)", "def joint_drift(par, q, v, t, Dr):"]
+    _bodies(lines, st, _joint_bodies(st), with_v=True)
+    last = None
+    for r, kind, i, j, o, row, e in _joint_rows(st):
+        if r != last:
+            _joint_frame(lines, st, r)
+            last = r
+        if kind == K.JANGLE:
+            lines.append(f"    Dr[{row}, 0] = al{i} - al{j}")
+            continue
+        ex, ey = e
+        if kind == K.JPOINT:
+            # e fixed in space: e . (-w_i^2 r'_i + w_j^2 r'_j)
+            dn = (f"{ex} * (-w{i} * w{i} * sAx + w{j} * w{j} * sBx) + "
+                  f"{ey} * (-w{i} * w{i} * sAy + w{j} * w{j} * sBy)")
+        else:
+            dn = f"drift_plane(w{i}, w{j}, vx{i} - vx{j}, vy{i} - vy{j}, nx, ny, rAx, rAy, ux, uy)"
+        lines.append(f"    Dr[{row}, 0] = {dn}{_acc_terms(st, i, j, e)}")
+    lines.append("    return")
+    return lines
+
+
 def source_of(par):
     """The generated module's source for the packed description ``par``."""
     st = _Structure(par)
     parts = [_HEAD]
-    for gen in (_mass, _forces, _contacts, _drift, _poses, _frames):
+    gens = (_mass, _forces, _contacts, _drift, _poses, _frames)
+    if st.nj:
+        gens += (_joints, _joint_drift)
+    for gen in gens:
         parts.append("\n\n" + "\n".join(gen(st)) + "\n")
     return "".join(parts)
 

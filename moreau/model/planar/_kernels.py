@@ -13,8 +13,9 @@ this file, so an edit here never runs stale code). The formulas are derived in
 
 Layout of ``par`` (integers stored as floats)
 ---------------------------------------------
-``par[0:9]`` header: number of bodies, contacts, force records; offsets of
-the body, contact and force tables; ``ndof``; gravity ``(gx, gy)``.
+``par[0:11]`` header: number of bodies, contacts, force records; offsets of
+the body, contact and force tables; ``ndof``; gravity ``(gx, gy)``; number
+and offset of the joint records.
 
 Body record (``BREC`` floats): ``kind`` (0 fixed, 1 free, 2 driven), first
 coordinate index (free bodies), mass, inertia, then a fixed body's pose
@@ -36,13 +37,19 @@ Force record (``FREC`` floats): ``SPRING`` (bodies ``i, j``, points
 stiffness, rest angle, damping), ``FORCE`` (body, point, offsets of the time
 functions of the world components), ``TORQUE`` (body, offset of its time
 function).
+
+Joint record (``JREC`` floats): ``kind``, bodies ``i, j``, points ``ri, rj``
+(body frames), the unit normal ``n0`` of a slot (body ``j``'s frame), the
+rest angle: ``JPOINT`` (two rows, ``P_i - P_j = 0``), ``JLINE`` (one row,
+``n . (P_i - Q_j) = 0``), ``JANGLE`` (one row, ``theta_i - theta_j - th0 = 0``).
 """
 
 import math
 
 from numba import njit
 
-HEADER = 9
+HEADER = 11
+JREC = 10
 BREC = 10
 CREC = 14
 FREC = 12
@@ -50,6 +57,7 @@ FREC = 12
 FIXED, FREE, DRIVEN = 0, 1, 2
 PLANE, POINTS, POLY = 0, 1, 2
 SPRING, TORSION, FORCE, TORQUE = 0, 1, 2, 3
+JPOINT, JLINE, JANGLE = 0, 1, 2
 
 
 @njit

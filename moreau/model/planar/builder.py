@@ -17,7 +17,7 @@ from . import _codegen
 from . import _kernels as K
 
 __all__ = ["Model", "Body", "TimeFunction", "Point", "Circle", "Segment", "Polygon",
-           "HalfPlane", "PlanarScene"]
+           "HalfPlane", "PlanarScene", "JointRows"]
 
 
 def _vec2(name, value):
@@ -239,6 +239,7 @@ class Model:
         self.shapes = []          # _ShapeRef
         self.contacts = []        # dicts
         self.forces = []          # dicts
+        self.joints = []          # dicts
         self.ground = self._add(dict(kind=K.FIXED, pose=(0.0, 0.0, 0.0)), "ground")
 
     def _add(self, rec, name):
@@ -416,6 +417,59 @@ class Model:
         b = self._free("body", body)
         self.forces.append(dict(kind=K.TORQUE, i=b.index, f=TimeFunction.of("torque", torque)))
 
+    # -- joints (their rows; the solution waits for the mixed LCP) ------------------------
+    def _joint_bodies(self, body_i, body_j):
+        bi, bj = self._body("body_i", body_i), self._body("body_j", body_j)
+        if bi is bj:
+            raise InputError("`body_i` and `body_j` are one body: a joint joins two bodies")
+        if bi.kind != K.FREE and bj.kind != K.FREE:
+            raise InputError("`body_i` and `body_j` are both fixed or driven: a joint needs a "
+                             "free body")
+        return bi, bj
+
+    def add_revolute(self, body_i, point_i, body_j, point_j):
+        """A pin: ``point_i`` of ``body_i`` stays on ``point_j`` of ``body_j`` (two rows ``P_i - P_j = 0``)."""
+        bi, bj = self._joint_bodies(body_i, body_j)
+        self.joints.append(dict(kind=K.JPOINT, i=bi.index, j=bj.index,
+                                ri=_vec2("point_i", point_i), rj=_vec2("point_j", point_j)))
+
+    def add_prismatic(self, body_i, point_i, body_j, point_j, axis):
+        """A slider: ``point_i`` of ``body_i`` moves along the line of ``body_j`` through ``point_j`` along ``axis`` (body ``j``'s frame), the relative angle fixed at its initial value.
+
+        Two rows: ``n . (P_i - Q_j) = 0`` with ``n`` normal to the axis, and
+        ``theta_i - theta_j - theta_0 = 0``.
+        """
+        bi, bj = self._joint_bodies(body_i, body_j)
+        u = _vec2("axis", axis)
+        ln = float(np.hypot(*u))
+        if ln == 0.0:
+            raise InputError("`axis` of a prismatic joint must not be zero")
+        th0 = self._initial_pose(bi)[2] - self._initial_pose(bj)[2]
+        self.joints.append(dict(kind=K.JLINE, i=bi.index, j=bj.index, ri=_vec2("point_i", point_i),
+                                rj=_vec2("point_j", point_j), n0=np.array([u[1], -u[0]]) / ln))
+        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=th0))
+
+    def add_weld(self, body_i, body_j):
+        """``body_i`` held to ``body_j`` in their initial relative pose (three rows)."""
+        bi, bj = self._joint_bodies(body_i, body_j)
+        xi, yi, thi = self._initial_pose(bi)
+        xj, yj, thj = self._initial_pose(bj)
+        c, s = math.cos(thj), math.sin(thj)
+        rj = np.array([c * (xi - xj) + s * (yi - yj), -s * (xi - xj) + c * (yi - yj)])
+        self.joints.append(dict(kind=K.JPOINT, i=bi.index, j=bj.index, ri=np.zeros(2), rj=rj))
+        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=thi - thj))
+
+    def joint_rows(self):
+        """The bilateral rows of the joints (:class:`JointRows`), in the built scene's units.
+
+        :meth:`build` does not take joints yet: no scheme solves equality rows
+        until the mixed LCP (issue 36, item 2) reaches them.
+        """
+        if not self.joints:
+            raise InputError("the model has no joints: add one with `add_revolute`, "
+                             "`add_prismatic` or `add_weld`")
+        return JointRows(self)
+
     def _initial_pose(self, body):
         rec = self.bodies[body.index]
         if rec["kind"] == K.DRIVEN:
@@ -502,13 +556,26 @@ class Model:
             else:
                 r[1:3] = [rec["i"], ("T", put(rec["f"].packed(F * L, T)))]
             frecs.append(r)
+        jrecs = []
+        for rec in self.joints:
+            r = [0.0] * K.JREC
+            r[0:3] = [rec["kind"], rec["i"], rec["j"]]
+            if rec["kind"] != K.JANGLE:
+                r[3:7] = [rec["ri"][0] / L, rec["ri"][1] / L, rec["rj"][0] / L, rec["rj"][1] / L]
+            if rec["kind"] == K.JLINE:
+                r[7:9] = [rec["n0"][0], rec["n0"][1]]
+            if rec["kind"] == K.JANGLE:
+                r[9] = rec["th0"]
+            jrecs.append(r)
         ob = K.HEADER
         oc = ob + K.BREC * len(brecs)
         of = oc + K.CREC * len(crecs)
-        ot = of + K.FREC * len(frecs)
+        oj = of + K.FREC * len(frecs)
+        ot = oj + K.JREC * len(jrecs)
         g = self.gravity * T * T / L
-        base[:] = [len(brecs), len(crecs), len(frecs), ob, oc, of, dof, g[0], g[1]]
-        par = base + [x for r in brecs + crecs + frecs for x in r]
+        base[:] = [len(brecs), len(crecs), len(frecs), ob, oc, of, dof, g[0], g[1],
+                   len(jrecs), oj]
+        par = base + [x for r in brecs + crecs + frecs + jrecs for x in r]
         par = [ot + x[1] if isinstance(x, tuple) else x for x in par] + tail
         return np.array(par, dtype=float), dof
 
@@ -528,6 +595,10 @@ class Model:
         """
         if not any(b["kind"] == K.FREE for b in self.bodies):
             raise InputError("the model has no free body: add one with `add_body`")
+        if self.joints:
+            raise InputError(f"the model has {len(self.joints)} joint record(s): no scheme solves "
+                             "their equality rows yet (the mixed LCP, issue 36 item 2); their "
+                             "rows are `Model.joint_rows()`")
         if (valid_region is None) != (inside is None):
             raise InputError("`valid_region` and `inside` go together: the words and the test")
         return PlanarScene(self, name, valid_region, inside, default_window)
@@ -673,3 +744,44 @@ class PlanarScene(SIUnits, Scene):
         for i, fr in enumerate(self.contact_frames(q, tt)):
             out.append(contact(i, (fr[0] * L, fr[1] * L), (fr[2], fr[3])))
         return out
+
+
+class JointRows:
+    """The bilateral rows of a model's joints: ``g(q, t) = 0``, their Jacobian and drift terms.
+
+    Rows in the order the joints were added (a revolute joint two, a
+    prismatic joint two, a weld three)::
+
+        dg/dt     = W v + w
+        d2g/dt2   = W a + wbar
+
+    in the scene units of :meth:`Model.build`'s scene (the same ``q`` and
+    ``v``), from the generated functions ``joints`` and ``joint_drift``.
+    """
+
+    def __init__(self, model):
+        self.par, self.ndof = model.pack()
+        self.nrows = sum(2 if j["kind"] == K.JPOINT else 1 for j in model.joints)
+        self._fn = _codegen.compiled_functions(self.par)
+
+    def _G(self, q, t):
+        q = np.ascontiguousarray(q, dtype=float).reshape(self.ndof)
+        G = np.zeros((self.nrows, 3 + 2 * self.ndof))
+        self._fn.joints(self.par, q, float(t), G, True)
+        return G
+
+    def values(self, q, t):
+        """``g(q, t)``, shape (nrows,)."""
+        return self._G(q, t)[:, 0].copy()
+
+    def jacobians(self, q, t):
+        """``(W, w)``: shapes (nrows, ndof) and (nrows,)."""
+        G = self._G(q, t)
+        return G[:, 3:3 + self.ndof].copy(), G[:, 1].copy()
+
+    def drift(self, q, v, t):
+        """``wbar``, shape (nrows,)."""
+        Dr = np.zeros((self.nrows, 2))
+        self._fn.joint_drift(self.par, np.ascontiguousarray(q, dtype=float),
+                             np.ascontiguousarray(v, dtype=float), float(t), Dr)
+        return Dr[:, 0].copy()
