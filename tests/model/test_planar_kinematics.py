@@ -16,20 +16,40 @@ from moreau.check import check_scene
 from moreau.compiled import check_compiled_model
 from moreau.model.planar import _kernels as K
 
-from planar_zoo import random_states, zoo
+from planar_zoo import mini_zoo, random_states, zoo
 
-SCENE, MODEL = zoo()
+# the full zoo (21 contacts, 9 coordinates) compiles in about 50 s with an empty cache: its
+# checks run with the long ones (-m slow); the default run checks the small one (15 s cold)
+MODELS = {"mini": mini_zoo, "full": zoo}
+ZOO = [pytest.param("mini"), pytest.param("full", marks=pytest.mark.slow)]
+_BUILT = {}
 
 
+def built(name):
+    if name not in _BUILT:
+        _BUILT[name] = MODELS[name]()
+    return _BUILT[name]
+
+
+@pytest.mark.slow
 def test_the_zoo_has_every_contact_kind():
+    SCENE, MODEL = built("full")
     kinds = [c["kind"] for c in MODEL.contacts]
     assert SCENE.ncontacts == 4 + 1 + 1 + 1 + 2 + 1 + 2 + 1 + 1 + 6 + 1 == 21
     assert {K.PLANE, K.POINTS, K.POLY} == set(kinds)
     assert SCENE.ndof == 9 and SCENE.frictional_index.size == 20
 
 
+def test_the_mini_zoo_has_every_contact_kind():
+    SCENE, MODEL = built("mini")
+    assert [c["kind"] for c in MODEL.contacts] == [K.PLANE, K.POLY, K.POINTS, K.POLY]
+    assert SCENE.ndof == 6 and len(MODEL.forces) == 4
+
+
+@pytest.mark.parametrize("zoo_name", ZOO)
 @pytest.mark.parametrize("seed", [1, 2])
-def test_check_scene_passes_on_random_states(seed):
+def test_check_scene_passes_on_random_states(seed, zoo_name):
+    SCENE, MODEL = built(zoo_name)
     # each state alone: the straight paths between states this far apart pass through deep
     # penetrations, where the distance to a polygon has kinks (the nearest face changes)
     for state in random_states(SCENE, 6, seed):
@@ -42,16 +62,18 @@ def test_check_scene_passes_on_random_states(seed):
         assert report.errors["compiled model"] == 0.0
 
 
-def test_check_scene_passes_along_a_motion():
+@pytest.mark.parametrize("zoo_name", ZOO)
+def test_check_scene_passes_along_a_motion(zoo_name):
     # the default checks: the initial state, three perturbations and a Moreau-Jean motion
+    SCENE, MODEL = built(zoo_name)
     report = check_scene(SCENE)
     assert report.ok, report.summary()
 
 
-def _material_rate(scene, i, q, v, t, which, e):
+def _material_rate(scene, model, i, q, v, t, which, e):
     # the contact point of body `which` (0: A, 1: B) as a material point of that body,
     # moved along (q + s v, t + s): its velocity along e by central differences
-    c = MODEL.contacts[i]
+    c = model.contacts[i]
     body = c["A"] if which == 0 else c["B"]
     fr = scene.contact_frames(q, t)[i]
     off = fr[4:6] if which == 0 else fr[6:8]
@@ -68,8 +90,10 @@ def _material_rate(scene, i, q, v, t, which, e):
     return float(e @ (pos(h) - pos(-h)) / (2 * h))
 
 
+@pytest.mark.parametrize("zoo_name", ZOO)
 @pytest.mark.parametrize("seed", [3, 4])
-def test_the_rows_are_the_relative_velocities_of_the_contact_points(seed):
+def test_the_rows_are_the_relative_velocities_of_the_contact_points(seed, zoo_name):
+    SCENE, MODEL = built(zoo_name)
     worst = 0.0
     for q, v in random_states(SCENE, 4, seed):
         t = 0.21
@@ -81,7 +105,8 @@ def test_the_rows_are_the_relative_velocities_of_the_contact_points(seed):
             for e, row in ((n, WN[i] @ v + wN[i]),) + (
                     ((tang, WT[fr_index.index(i)] @ v + wT[fr_index.index(i)]),)
                     if i in fr_index else ()):
-                rel = _material_rate(SCENE, i, q, v, t, 0, e) - _material_rate(SCENE, i, q, v, t, 1, e)
+                rel = (_material_rate(SCENE, MODEL, i, q, v, t, 0, e)
+                       - _material_rate(SCENE, MODEL, i, q, v, t, 1, e))
                 worst = max(worst, abs(row - rel) / max(1.0, abs(rel)))
     assert worst <= 1e-7
 
@@ -109,8 +134,9 @@ def test_the_box_corners_are_the_sliding_box_rows():
 
 
 def test_the_scaled_model_is_the_si_model_in_other_units():
-    # the same zoo in metres and seconds and in its own units: one motion
-    si, _ = zoo({"length": 1.0, "mass": 1.0, "time": 1.0})
+    # the same model in metres and seconds and in its own units: one motion
+    SCENE, _ = built("mini")
+    si, _ = mini_zoo({"length": 1.0, "mass": 1.0, "time": 1.0})
     L, T, F = SCENE.length, SCENE.time, SCENE.force
     q0, v0 = SCENE.initial_state()
     qs = SCENE._qscale()

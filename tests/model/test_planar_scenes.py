@@ -22,7 +22,7 @@ def test_the_built_block_runs_the_hand_written_block(fast):
     qb, vb = built.initial_state()
     np.testing.assert_allclose(qb, q0, rtol=0, atol=1e-15)
     assert (built.length, built.time) == (hand.length, hand.time)
-    span = (0.0, 4.0) if fast else (0.0, 1.5)
+    span = (0.0, 4.0) if fast else (0.0, 1.0)
     ra = simulate(hand, span, q0, v0, "moreau-jean", h=2e-3, fast=fast)
     rb = simulate(built, span, q0, v0, "moreau-jean", h=2e-3, fast=fast)
     assert ra.success and rb.success and ra.q.shape == rb.q.shape
