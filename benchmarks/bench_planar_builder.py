@@ -8,7 +8,7 @@ by the compiled Moreau–Jean loop in one process: steps per second through
 through pointers) and in the model's specialised loop, and the generic
 Python path (``fast=False``, where the built scene's Python methods call
 the compiled functions). Each rate is a median over ``--repeats`` runs
-after a warm-up; the block is released at its default tilt and rocks to
+after a warm-up, the two scenes' runs interleaved; the block is released at its default tilt and rocks to
 rest, so the runs mix one- and two-contact steps and flat rest. The
 ratios built / hand-written are printed; the target of issue 36 is >= 0.7.
 
@@ -31,21 +31,27 @@ from moreau.scenes.rocking_block import RockingBlock  # noqa: E402
 from moreau.scenes.rocking_block_built import rocking_block_built  # noqa: E402
 
 
-def rate(scene, h, nsteps, repeats, **opts):
-    q0, v0 = scene.initial_state()
+def rates(scenes, h, nsteps, repeats, **opts):
+    """Steps per second of each scene, its runs interleaved with the others' (a busy machine's
+    load falls on all of them alike); medians over ``repeats`` after a warm-up."""
+    runs = {}
+    for name, scene in scenes.items():
+        q0, v0 = scene.initial_state()
 
-    def run():
-        res = simulate(scene, (0.0, nsteps * h), q0, v0, "moreau-jean", h=h,
-                       save_every=nsteps, **opts)
-        if not res.success or res.stats["steps"] != nsteps:
-            raise RuntimeError(f"benchmark run failed: {res.message}")
-    run()
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
+        def run(scene=scene, q0=q0, v0=v0):
+            res = simulate(scene, (0.0, nsteps * h), q0, v0, "moreau-jean", h=h,
+                           save_every=nsteps, **opts)
+            if not res.success or res.stats["steps"] != nsteps:
+                raise RuntimeError(f"benchmark run failed: {res.message}")
         run()
-        times.append(time.perf_counter() - t0)
-    return nsteps / statistics.median(times)
+        runs[name] = run
+    times = {name: [] for name in scenes}
+    for _ in range(repeats):
+        for name, run in runs.items():
+            t0 = time.perf_counter()
+            run()
+            times[name].append(time.perf_counter() - t0)
+    return {name: nsteps / statistics.median(ts) for name, ts in times.items()}
 
 
 def main(argv=None):
@@ -61,14 +67,14 @@ def main(argv=None):
     saved = os.environ.get(_loops.SPECIALISE_ENV)
     for label, mode in (("shared", "0"), ("specialised", "1")):
         os.environ[_loops.SPECIALISE_ENV] = mode
-        for name, sc in scenes.items():
-            out.setdefault(name, {})[label] = rate(sc, h, args.steps, args.repeats)
+        for name, r in rates(scenes, h, args.steps, args.repeats).items():
+            out.setdefault(name, {})[label] = r
     if saved is None:
         os.environ.pop(_loops.SPECIALISE_ENV, None)
     else:
         os.environ[_loops.SPECIALISE_ENV] = saved
-    for name, sc in scenes.items():
-        out[name]["generic"] = rate(sc, h, 2000, max(1, args.repeats // 2), fast=False)
+    for name, r in rates(scenes, h, 2000, max(1, args.repeats // 2), fast=False).items():
+        out[name]["generic"] = r
     print(f"{'rocking block':14s} {'shared/s':>10s} {'specialised/s':>13s} {'generic/s':>10s}")
     for name in scenes:
         r = out[name]
