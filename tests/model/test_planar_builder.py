@@ -78,3 +78,14 @@ def test_the_contact_list_of_a_polygon_pair():
     # the triangle's bottom vertices sit 0.1 above the box's top face
     gaps = sc.gaps(sc.initial_state()[0], 0.0) * sc.length
     np.testing.assert_allclose(gaps, [0.1, 0.1], rtol=1e-12)
+
+
+def test_a_built_scene_pickles_for_worker_processes():
+    import pickle
+
+    from moreau.scenes.rocking_block_built import rocking_block_built
+    sc = rocking_block_built(width=0.3)
+    again = pickle.loads(pickle.dumps(sc))
+    q0, v0 = sc.initial_state()
+    np.testing.assert_array_equal(again.gaps(q0, 0.0), sc.gaps(q0, 0.0))
+    assert again.compiled_model().contacts is sc.compiled_model().contacts

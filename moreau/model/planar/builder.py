@@ -631,6 +631,17 @@ class PlanarScene(SIUnits, Scene):
         self._q0, self._v0 = np.array(q0), np.array(v0)
         self._fn = _codegen.compiled_functions(self.par)
 
+    def __getstate__(self):
+        # the generated module is found again from par (a worker process imports or
+        # compiles it there)
+        state = dict(self.__dict__)
+        del state["_fn"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._fn = _codegen.compiled_functions(self.par)
+
     def _qscale(self):
         s = np.full(self.ndof, self.length)
         s[2::3] = 1.0
