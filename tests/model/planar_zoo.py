@@ -1,6 +1,5 @@
 """A planar model with every contact kind, body kind and force of the builder (for the tests)."""
 
-import math
 
 import numpy as np
 

@@ -1,6 +1,5 @@
 """The planar builder refuses bad models by name, and shares generated code between models of one structure."""
 
-import math
 
 import numpy as np
 import pytest

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 
 from moreau.check import check_scene
-from moreau.compiled import check_compiled_model
 from moreau.model.planar import _kernels as K
 
 from planar_zoo import mini_zoo, random_states, zoo
