@@ -9,7 +9,9 @@ and every tenth sample of ``t``, ``q``, ``v`` (to say how far a changed run
 moved).
 
 Run ``python tests/engine/golden_runs.py`` to write ``tests/data/golden_runs.npz``;
-only do so where a change of results is intended and explained.
+only do so where a change of results is intended and explained. A new scene's
+runs are added, every stored run kept as it is, by ``python
+tests/engine/golden_runs.py --add-missing``.
 """
 
 import hashlib
@@ -83,6 +85,22 @@ def write():
     np.savez_compressed(PATH, **out)
 
 
+def add_missing():
+    """Store the runs of the keys not in the file yet (new scenes), keeping every stored one."""
+    out = dict(np.load(PATH))
+    if str(out["machine"]) != machine():
+        raise SystemExit("the stored runs were made on another machine: regenerate them all")
+    for scene, scheme, opts in all_keys():
+        k = key(scene, scheme, opts)
+        if k + "|digest" in out:
+            continue
+        digest, t, q, v = run(scene, scheme, opts)
+        out[k + "|digest"] = np.array(digest)
+        out[k + "|t"], out[k + "|q"], out[k + "|v"] = t, q, v
+        print("added", k, digest[:12], flush=True)
+    np.savez_compressed(PATH, **out)
+
+
 if __name__ == "__main__":
     sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", ".."))
-    write()
+    add_missing() if "--add-missing" in sys.argv[1:] else write()

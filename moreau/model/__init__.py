@@ -1,0 +1,1 @@
+"""The model layer: how mechanical systems are described (:mod:`moreau.model.planar`)."""

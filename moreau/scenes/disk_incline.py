@@ -1,0 +1,187 @@
+"""A disk on a rough incline, stated with the planar builder: rolling at ``(2/3) g sin(alpha)``.
+
+A uniform disk (mass ``m``, radius ``r``, centroidal inertia ``I = m r^2 / 2``)
+on a plane inclined at ``alpha``, one frictional contact (Coulomb ``mu``).
+Launched rolling down the slope at ``speed``, it keeps rolling when
+friction can hold the contact point: with ``s`` the speed down the slope
+and ``w`` the rotation, rolling ``s = r w`` and the equations along the
+slope ``m s' = m g sin(alpha) - F``, ``I w' = r F`` give::
+
+    s' = g sin(alpha) / (1 + I / (m r^2)) = (2/3) g sin(alpha),   F = m g sin(alpha) / 3
+
+which needs ``F <= mu m g cos(alpha)``, i.e. ``mu >= tan(alpha) / 3``. Below
+that the disk slips from the start: ``s' = g (sin(alpha) - mu cos(alpha))``
+and ``r w' = 2 mu g cos(alpha)``, and the slip ``s - r w`` grows, so it
+never sticks again. The textbook result (e.g. Goldstein, Poole and Safko,
+Classical Mechanics, 3rd ed., 2002, ch. 1 and 5; Meriam and Kraige,
+Engineering Mechanics: Dynamics, the rolling disk on an incline).
+
+Units: lengths in ``r``, time in ``sqrt(r / g)``, mass in ``m`` (the
+builder's defaults). Coordinates ``(x, y, theta)`` of the centre; the
+incline passes through the origin, its outward normal ``(-sin alpha, cos
+alpha)``; the disk starts touching it at the origin.
+
+The model (:func:`disk_incline_model`)::
+
+    m = Model(gravity=(0.0, -g))
+    floor = m.add_shape(m.ground, HalfPlane((0.0, 0.0), (-sin(alpha), cos(alpha))))
+    disk = m.add_body(mass, mass * r**2 / 2, position=r * normal, velocity=speed * down,
+                      angular_velocity=speed / r)
+    m.add_contact(m.add_shape(disk, Circle(r)), floor, mu=mu)
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import finite_array, in_open_interval, nonnegative, positive
+from ..analysis.cases import GRID, CompareCase
+from ..errors import InputError
+from ..model.planar import Circle, HalfPlane, Model
+from .base import params_with
+from .registry import SceneEntry, parameters_of, register_scene
+
+__all__ = ["DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact"]
+
+
+@dataclass(frozen=True)
+class DiskInclineParams:
+    """SI parameters of the disk on an incline.
+
+    Attributes
+    ----------
+    mass : float
+        [kg], > 0.
+    radius : float
+        [m], > 0.
+    slope : float
+        Inclination ``alpha`` [rad], in (0, pi/2).
+    mu : float
+        Coulomb friction at the contact, >= 0.
+    gravity : float
+        [m/s^2], > 0.
+    speed : float
+        Initial speed down the slope [m/s], rolling, >= 0.
+    """
+
+    mass: float = 1.0
+    radius: float = 0.1
+    slope: float = 0.3
+    mu: float = 0.5
+    gravity: float = 9.81
+    speed: float = 0.2
+
+    def __post_init__(self):
+        for name in ("mass", "radius", "gravity"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        object.__setattr__(self, "speed", nonnegative("speed", self.speed))
+        object.__setattr__(self, "slope",
+                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+
+
+def disk_incline_model(params=None, **overrides):
+    """The builder's model of the disk on the incline (SI parameters of :class:`DiskInclineParams`)."""
+    p = params_with(DiskInclineParams, params, overrides)
+    sa, ca = math.sin(p.slope), math.cos(p.slope)
+    normal, down = np.array([-sa, ca]), np.array([-ca, -sa])
+    m = Model(gravity=(0.0, -p.gravity))
+    floor = m.add_shape(m.ground, HalfPlane((0.0, 0.0), normal))
+    # rolling: the contact point C = X - r n is at rest, V = r w perp(n) = r w down
+    disk = m.add_body(p.mass, 0.5 * p.mass * p.radius ** 2, position=p.radius * normal,
+                      velocity=p.speed * down, angular_velocity=p.speed / p.radius, name="disk")
+    m.add_contact(m.add_shape(disk, Circle(p.radius)), floor, mu=p.mu)
+    return m
+
+
+def disk_incline(params=None, **overrides):
+    """The scene (a :class:`~moreau.model.planar.PlanarScene`) of the disk on the incline.
+
+    Examples
+    --------
+    >>> sc = disk_incline(slope=0.3)
+    >>> q0, v0 = sc.initial_state()
+    >>> float(sc.gaps(q0, 0.0)[0]), round(float(v0[2]), 12)    # rolling: w = speed / r, scene units
+    (0.0, 0.201927510938)
+    """
+    p = params_with(DiskInclineParams, params, overrides)
+    sc = disk_incline_model(p).build("disk-incline", default_window=10.0)
+    sc.params = p
+    return sc
+
+
+def disk_incline_exact(params, t):
+    """``(s, s', w)``: distance and speed down the slope and rotation at times ``t`` [s] (SI).
+
+    Examples
+    --------
+    >>> s, sd, w = disk_incline_exact(DiskInclineParams(speed=0.0), [1.0])
+    >>> round(float(sd[0]) / (9.81 * math.sin(0.3)), 12)     # rolling: 2/3 g sin(alpha)
+    0.666666666667
+    """
+    p = params if isinstance(params, DiskInclineParams) else DiskInclineParams(**params)
+    tt = np.atleast_1d(finite_array("t", t)).astype(float)
+    if np.any(tt < 0.0):
+        raise InputError("`t` must be >= 0")
+    g, a, r = p.gravity, p.slope, p.radius
+    if p.mu >= math.tan(a) / 3.0:
+        acc = 2.0 / 3.0 * g * math.sin(a)
+        alpha = acc / r
+    else:
+        acc = g * (math.sin(a) - p.mu * math.cos(a))
+        alpha = 2.0 * p.mu * g * math.cos(a) / r
+    s = p.speed * tt + 0.5 * acc * tt ** 2
+    return s, p.speed + acc * tt, p.speed / r + alpha * tt
+
+
+class DiskInclineCase(CompareCase):
+    """The disk over the window: distance down the slope against the closed form."""
+
+    headline_name = "distance down the slope"
+    window = 10.0
+
+    def __init__(self, **params):
+        self.scene = disk_incline(**params)
+        self.p = self.scene.params
+        self._params = dict(params)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.scene.initial_state()
+
+    def coordinate(self, q):
+        a = self.p.slope
+        return -(q[:, 0] * math.cos(a) + q[:, 1] * math.sin(a))
+
+    def reference(self, rtol):
+        s, _, _ = disk_incline_exact(self.p, [self.window * self.scene.time])
+        return float(s[0]) / self.scene.length, [(0.0, "S" if self.p.mu >= math.tan(
+            self.p.slope) / 3.0 else "P")]
+
+    def reference_grid(self):
+        s, _, _ = disk_incline_exact(self.p, np.linspace(0.0, self.window, GRID + 1)
+                                     * self.scene.time)
+        return s / self.scene.length
+
+    def headline_of_run(self, res):
+        return float(self.coordinate(res.q[-1:])[0])
+
+    def _run_switches(self, res, h):
+        return []
+
+
+register_scene(SceneEntry(
+    name="disk-incline",
+    factory=disk_incline,
+    parameters=parameters_of(DiskInclineParams, {"mass": "kg", "radius": "m", "slope": "rad",
+                                                 "mu": "", "gravity": "m/s^2", "speed": "m/s"}),
+    description=("disk rolling down a rough incline at (2/3) g sin(alpha), built with the "
+                 "planar builder (closed form)"),
+    case=DiskInclineCase,
+    reference="exact",
+    sweepable=("mu", "slope", "speed"),
+    mj_tolerance=1e-2,
+))
