@@ -58,12 +58,12 @@ import numpy as np
 from numba import njit
 
 from _timing import median_time
-from moreau.compiled import CompiledModel
+from moreau.model.compiled import CompiledModel
 from moreau.integrators import INTEGRATORS, simulate
 from moreau.integrators.base import get_integrator, scheme_options
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 from moreau.scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TWO_PI = 2.0 * np.pi
@@ -120,7 +120,7 @@ def stiffness_schemes():
     return tuple(out)
 
 
-# the wall oscillator's compiled model (moreau.compiled): the user-scene hook
+# the wall oscillator's compiled model (moreau.model.compiled): the user-scene hook
 @njit(cache=True)
 def _osc_mass(par, q, M):
     M[0, 0] = 1.0

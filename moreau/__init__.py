@@ -20,7 +20,7 @@ _LAZY = {
     "compare": "moreau.analysis.compare",
     "find_steady_state": "moreau.analysis.steady_state",
     "check_scene": "moreau.check",
-    "Scene": "moreau.scenes.base",
+    "Scene": "moreau.model.scene",
 }
 
 

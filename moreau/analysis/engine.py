@@ -43,7 +43,7 @@ from .. import __version__
 from ..errors import ConvergenceError, InputError, Interrupted, PainleveError, WorkerError
 # the cache key's code version lives with the provenance; named here too (engine.code_version)
 from ..provenance import code_version
-from ..scenes import registry
+from ..model import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
 from .classify import CLASSIFY_COLUMNS, classification_columns

@@ -148,7 +148,7 @@ def _mode_of(merged):
 class PeriodMap:
     """One drive period of Moreau–Jean steps of a periodic scene, as a map of its state.
 
-    Works through the :class:`~moreau.scenes.base.Scene` interface for any
+    Works through the :class:`~moreau.model.scene.Scene` interface for any
     scene with a periodic drive (``scene.period``): the coordinates listed in
     ``scene.cyclic_coordinates`` (e.g. the rotor position) do not enter the
     dynamics, so the map acts on ``x = (q without them, v)`` and reports the

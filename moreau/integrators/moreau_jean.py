@@ -390,7 +390,7 @@ class MoreauJean(CompiledRecording, Integrator):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.scenes.base import Scene
+    >>> from moreau.model.scene import Scene
     >>> class Block(Scene):
     ...     ndof, mu, restitution = 2, np.array([0.5]), np.array([0.0])
     ...     def mass(self, q): return np.eye(2)
@@ -597,7 +597,7 @@ class MoreauJean(CompiledRecording, Integrator):
 
 
 def compiled_model_of(scene):
-    """The scene's :class:`~moreau.compiled.CompiledModel`, or None.
+    """The scene's :class:`~moreau.model.compiled.CompiledModel`, or None.
 
     None when the scene has no ``compiled_model()``, or when a subclass
     overrides one of the model methods (``mass``, ``forces``,

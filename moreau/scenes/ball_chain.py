@@ -44,16 +44,16 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from .._validate import (finite_array, finite_scalar, in_closed_interval, nonnegative, positive,
                          positive_int)
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ._drawing import circle, contact
-from ._units import SIUnits
-from .base import Scene, params_with
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.units import SIUnits
+from ..model.scene import Scene, params_with
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
            "simultaneous_impact"]
@@ -198,7 +198,7 @@ class BallChain(SIUnits, Scene):
         return q, v
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`); ``par = (mass ratio,)``."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`); ``par = (mass ratio,)``."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
                              self.ndof - 1, True, False)
 
@@ -389,7 +389,7 @@ class BallChainCase(CompareCase):
         return float(res.q[-1, -1])
 
 
-# -- compiled model (moreau.compiled); par = (striker mass / ball mass,) -------------------
+# -- compiled model (moreau.model.compiled); par = (striker mass / ball mass,) -------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

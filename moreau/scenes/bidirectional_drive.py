@@ -69,15 +69,15 @@ import numpy as np
 from .. import _validate as V
 from ..errors import InputError
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
+from ..model.units import DriveUnits
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
-from .base import Scene, params_with
+from ..model.scene import Scene, params_with
 from .friction_drive import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["BidirectionalDriveParams", "BidirectionalDrive"]
 
@@ -170,7 +170,7 @@ class BidirectionalDriveParams:
                    phase=phase, load=params.load, restitution=params.restitution)
 
 
-# -- compiled model (moreau.compiled) ---------------------------------------------------
+# -- compiled model (moreau.model.compiled) ---------------------------------------------------
 # par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b, then the memory of memo_sincos:
 # rod r's angle at MEMO + 6 r, its phase at MEMO + 6 r + 3; rod r (angle q[r], stator
 # phase delta_r) on the rotor q[2], the second rod mirrored (sgn = -1)
@@ -372,7 +372,7 @@ class BidirectionalDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         # the parameters, then per rod the memory of its angle's and its phase's sines
         # and cosines (MEMO)
         par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.u10[0], self.u10[1],
@@ -393,7 +393,7 @@ class BidirectionalDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 3) =
+        (:data:`moreau.model.units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 3) =
         (``phi_a``, ``phi_b`` [rad], rotor displacement [m]), ``v`` (n, 3)
         [rad/s, rad/s, m/s], ``force_N``, ``force_T`` (n, 2) [N] (rods a, b),
         ``slip_velocity`` (n, 2) [m/s], ``gap`` (n, 2) [m], ``regime`` (n, 2)

@@ -24,14 +24,14 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from ._drawing import circle, contact, line
-from ._units import SIUnits, SIValues
-from .base import Scene, params_with
+from ..model.units import SIUnits, SIValues
+from ..model.scene import Scene, params_with
 from ..analysis.cases import GRID, CompareCase
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 
@@ -144,7 +144,7 @@ class BouncingBall(SIUnits, Scene):
         return np.array([self.r + 1.0]), np.zeros(1)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
 
     def shapes(self, q, t=0.0):
@@ -330,7 +330,7 @@ class BouncingBallCase(CompareCase):
 
 
 
-# -- compiled model (moreau.compiled); par: r ---------------------------------------------
+# -- compiled model (moreau.model.compiled); par: r ---------------------------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

@@ -94,15 +94,15 @@ import numpy as np
 from numba import njit
 
 from .. import _validate as V
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
-from .base import Scene, params_with
+from ..model.units import DriveUnits
+from ..model.scene import Scene, params_with
 from .friction_drive import FrictionDrive, FrictionDriveParams
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FlexibleRodDriveParams", "FlexibleRodDrive", "pinned_free_modes", "MAX_MODES"]
 
@@ -466,7 +466,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         return np.sqrt(lam) * self.omega / (2.0 * math.pi)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         n = self.N
         par = np.concatenate([[self.J, self.P, self.u10, self.fL, self.sin_phi0, float(n),
                                self.fp],
@@ -480,7 +480,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`; ``q`` (n, N + 2) = rod
+        (:data:`moreau.model.units.COMMON_KEYS`; ``q`` (n, N + 2) = rod
         angle [rad], modal amplitudes [m], rotor displacement [m]) and the
         named extras: ``phi`` [rad], ``x2`` [m], ``v2`` [m/s],
         ``tip_deflection`` [m] (``l psi . eta``, normal to the rod), each (n,).
@@ -499,7 +499,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.compiled) -----------------------------------------------------
+# -- compiled model (moreau.model.compiled) -----------------------------------------------------
 # par: J, P, u10, fL, sin_phi0, N, fp, then W_i^2, beta_i, psi_i, 2 zeta W_i (N each);
 # q = (phi, eta_1 .. eta_N, u2)
 

@@ -82,16 +82,16 @@ from .. import _validate as V
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
+from ..model.units import DriveUnits
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
-from .base import Scene, params_with
+from ..model.scene import Scene, params_with
 from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ..analysis.steady_state import find_steady_state
 from ..integrators import simulate
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
@@ -360,7 +360,7 @@ class FrictionDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         # the parameters, then the memory of the last angle's and phase's sines and
         # cosines (PHI_MEMO, PHASE_MEMO)
         par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp,
@@ -377,7 +377,7 @@ class FrictionDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 2) =
+        (:data:`moreau.model.units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 2) =
         (rod angle [rad], rotor displacement [m]), ``v`` (n, 2) [rad/s, m/s],
         ``force_N``, ``force_T`` (n, 1) [N], ``slip_velocity`` (n, 1) [m/s],
         ``gap`` (n, 1) [m], ``regime`` (n, 1) codes; and the drive's named
@@ -397,7 +397,7 @@ class FrictionDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0, fp, then the memory of
+# -- compiled model (moreau.model.compiled); par: J, P, u10, fL, sin_phi0, fp, then the memory of
 # memo_sincos: angle phi, sin, cos; phase tau, sin, cos -----------------------------------
 PHI_MEMO = 6
 PHASE_MEMO = 9

@@ -41,18 +41,18 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from ._drawing import contact, line
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
+from ..model.scene import Scene
+from ..model.units import SIUnits
+from ..model.scene import params_with
 from scipy.integrate import solve_ivp
 
 from ..analysis.cases import GRID, CompareCase
 from ..errors import MoreauError
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["PainleveRodParams", "PainleveRod", "painleve_critical_mu", "PAINLEVE_MU_MIN"]
 
@@ -190,7 +190,7 @@ class PainleveRod(SIUnits, Scene):
         return self.sliding_state(phi=math.pi / 4, tip_speed=1.0)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [], 3, 1, True, False)
 
     # -- units ----------------------------------------------------------------
@@ -436,7 +436,7 @@ class PainleveRodCase(CompareCase):
 
 
 
-# -- compiled model (moreau.compiled); no parameters ------------------------------------
+# -- compiled model (moreau.model.compiled); no parameters ------------------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

@@ -99,15 +99,15 @@ from scipy.integrate import quad
 from scipy.optimize import least_squares
 
 from .. import _validate as V
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
-from .base import Scene, params_with
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.units import DriveUnits
+from ..model.scene import Scene, params_with
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["PiezoDriveParams", "PiezoDrive", "HysteresisFit", "identify_hysteresis"]
 
@@ -592,7 +592,7 @@ class PiezoDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         if self.ndof == 3:
             return CompiledModel(_mass_dyn, _forces_dyn, _contacts_dyn, _drift_dyn, self._par, 3,
                                  1, False, True, gaps=_gaps_dyn)
@@ -602,7 +602,7 @@ class PiezoDrive(DriveUnits, Scene):
     def to_si(self, result):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
-        The keys every scene gives (:data:`moreau.scenes._units.COMMON_KEYS`;
+        The keys every scene gives (:data:`moreau.model.units.COMMON_KEYS`;
         ``q`` = (rod angle [rad], rotor [m], stator [m])) and the named
         coordinates ``phi`` [rad], ``x2`` [m], ``v2`` [m/s] and, with a
         dynamic stator, ``x1`` [m], ``v1`` [m/s].

@@ -24,16 +24,16 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from ._drawing import contact, line, polygon
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
+from ..model.scene import Scene
+from ..model.units import SIUnits
+from ..model.scene import params_with
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["SlidingBlockParams", "SlidingBlock"]
 
@@ -148,7 +148,7 @@ class SlidingBlock(SIUnits, Scene):
         return np.zeros(2), np.array([1.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         par = [math.sin(self.alpha), math.cos(self.alpha)]
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
@@ -306,7 +306,7 @@ class SlidingBlockCase(CompareCase):
 
 
 
-# -- compiled model (moreau.compiled); par: sin(alpha), cos(alpha) -------------------------
+# -- compiled model (moreau.model.compiled); par: sin(alpha), cos(alpha) -------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

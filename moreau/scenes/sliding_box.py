@@ -41,16 +41,16 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
+from ..model.compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from ._drawing import contact, line, polygon
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
+from ..model.scene import Scene
+from ..model.units import SIUnits
+from ..model.scene import params_with
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase, flatten
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["SlidingBoxParams", "SlidingBox"]
 
@@ -170,7 +170,7 @@ class SlidingBox(SIUnits, Scene):
         return np.array([0.0, self.b, 0.0]), np.array([1.0, 0.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.a, self.b, self.inertia],
                              3, 2, True, False)
 
@@ -288,7 +288,7 @@ class SlidingBoxCase(CompareCase):
 
 
 
-# -- compiled model (moreau.compiled); par: a, b, inertia -----------------------------
+# -- compiled model (moreau.model.compiled); par: a, b, inertia -----------------------------
 # corners at body coordinates (-a, -b) and (+a, -b)
 
 @njit(cache=True)

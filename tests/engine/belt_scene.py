@@ -10,8 +10,8 @@ slips back: the classic stick-slip oscillator.
 import numpy as np
 from numba import njit
 
-from moreau.compiled import CompiledModel
-from moreau.scenes.base import Scene
+from moreau.model.compiled import CompiledModel
+from moreau.model.scene import Scene
 
 
 class BeltBlock(Scene):
@@ -43,7 +43,7 @@ class BeltBlock(Scene):
         return np.zeros(2), np.array([self.vb, 0.0])
 
 
-# -- the same model through the compiled hook (moreau.compiled) ------------------------
+# -- the same model through the compiled hook (moreau.model.compiled) ------------------------
 # par = (k, vb). Kept in this importable module, so the engine caches its compiled loop on
 # disk; the functions are the Python methods above, written for numba.
 

@@ -6,7 +6,7 @@ import pytest
 
 from moreau.analysis.atlas import run_scene_atlas
 from moreau.cli import main
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 
 

@@ -5,7 +5,7 @@ import json
 import pytest
 
 from moreau.cli import main
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 from moreau.scenes.stick_slip_exact import stick_slip_steady_state
 
 

@@ -12,7 +12,7 @@ from moreau.integrators.result import Event
 from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 TWO_PI = 2 * math.pi
 

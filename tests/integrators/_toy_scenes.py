@@ -6,8 +6,8 @@ import numpy as np
 from numba import njit
 from scipy.optimize import brentq
 
-from moreau.compiled import CompiledModel
-from moreau.scenes.base import Scene
+from moreau.model.compiled import CompiledModel
+from moreau.model.scene import Scene
 
 
 class Oscillator(Scene):

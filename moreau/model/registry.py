@@ -143,11 +143,16 @@ def register_scene(entry):
     return entry
 
 
+#: the package whose public modules are the scenes; imported by name on discovery, so that
+#: this module stays on the ground floor, below the scenes that register themselves here
+SCENE_PACKAGE = "moreau.scenes"
+
+
 def scene_modules():
-    """Names of the public modules of :mod:`moreau.scenes` (private ``_name`` ones and this one left out)."""
-    package = importlib.import_module(__package__)
-    return [f"{__package__}.{info.name}" for info in pkgutil.iter_modules(package.__path__)
-            if not info.name.startswith("_") and info.name not in ("registry", "base")]
+    """Names of the public modules of :mod:`moreau.scenes` (private ``_name`` ones left out)."""
+    package = importlib.import_module(SCENE_PACKAGE)
+    return [f"{SCENE_PACKAGE}.{info.name}" for info in pkgutil.iter_modules(package.__path__)
+            if not info.name.startswith("_")]
 
 
 _discovered = False
