@@ -73,9 +73,9 @@ from ..model.units import DriveUnits
 from numba import njit
 
 from ..model.compiled import CompiledModel
-from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from .friction_drive.rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
 from ..model.scene import Scene, params_with
-from .friction_drive import FrictionDrive, FrictionDriveParams
+from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 

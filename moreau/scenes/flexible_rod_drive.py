@@ -101,7 +101,7 @@ from ..analysis.steady_state import find_steady_state
 from ._drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.scene import Scene, params_with
-from .friction_drive import FrictionDrive, FrictionDriveParams
+from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FlexibleRodDriveParams", "FlexibleRodDrive", "pinned_free_modes", "MAX_MODES"]

@@ -83,7 +83,7 @@ def drive_185():
 @pytest.fixture(scope="module")
 def stick_slip_motor():
     from moreau.model.registry import make_scene
-    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+    from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
     scene = make_scene("stick-slip-motor")
     return scene, stick_slip_steady_state(scene)
 

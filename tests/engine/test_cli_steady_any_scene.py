@@ -6,7 +6,7 @@ import pytest
 
 from moreau.cli import main
 from moreau.model.registry import make_scene
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 def steady(capsys, *args):

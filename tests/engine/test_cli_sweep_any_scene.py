@@ -8,7 +8,7 @@ import pytest
 from moreau.cli import main
 from moreau.analysis.engine import periodic_scene_names
 from moreau.scenes import registry
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):

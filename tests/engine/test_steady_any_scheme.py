@@ -13,7 +13,7 @@ from moreau.analysis.steady_state import find_steady_state
 from moreau.analysis.sweep import sweep_tag
 from moreau.cli import main
 from moreau.model.registry import make_scene
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 @pytest.fixture(scope="module")

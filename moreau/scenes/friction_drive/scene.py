@@ -78,20 +78,20 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .. import _validate as V
-from ..errors import InputError, MoreauError
-from ..regimes import Regime
-from ._drawing import rod_drive_shapes
-from ..model.units import DriveUnits
+from ... import _validate as V
+from ...errors import InputError, MoreauError
+from ...regimes import Regime
+from .._drawing import rod_drive_shapes
+from ...model.units import DriveUnits
 from numba import njit
 
-from ..model.compiled import CompiledModel
-from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
-from ..model.scene import Scene, params_with
-from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
-from ..analysis.steady_state import find_steady_state
-from ..integrators import simulate
-from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
+from ...model.compiled import CompiledModel
+from .rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from ...model.scene import Scene, params_with
+from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
+from ...analysis.steady_state import find_steady_state
+from ...integrators import simulate
+from ...model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
