@@ -439,5 +439,4 @@ register_scene(SceneEntry(
                "load", "restitution"),
     mj_tolerance=5e-3,
     aliases=("bidirectional",),
-    sweep="moreau.studies.bidirectional.bidirectional_sweep:command",
 ))

@@ -664,5 +664,5 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
                "modes", "EI", "damping", "preload"),
     mj_tolerance=5e-3,
-    stress="moreau.scenes.flexible_rod_drive:stress_cases",
+    stress=stress_cases,
 ))

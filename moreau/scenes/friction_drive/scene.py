@@ -522,9 +522,5 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
                "preload"),
     mj_tolerance=5e-3,
-    # the paper's sweep, with its valid-range marks and default ranges
-    sweep="moreau.studies.paper.sweeps:command",
-    # the paper's (f, mu) and (f, phi0) planes, with the valid-range curves
-    atlas="moreau.studies.paper.atlas:command",
     default=True,
 ))

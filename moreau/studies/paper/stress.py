@@ -593,7 +593,7 @@ def _scene_cases():
     for entry in registry.entries():
         if entry.stress is None:
             continue
-        for key, spec in registry.resolve_hook(entry.stress)().items():
+        for key, spec in entry.stress().items():
             if key in CASES or key in out:
                 raise InputError(f"scene {entry.name!r} adds the stress case {key!r}, "
                                  "which exists already")
