@@ -56,8 +56,6 @@ log = logging.getLogger(__name__)
 __all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "cache_memory", "Scheme", "steady_of", "worker_init", "worker_pool_config",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
 
-_PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
-
 
 def mj_check_columns(check):
     """CSV column names of one Moreau–Jean cross-check."""

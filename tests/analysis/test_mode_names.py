@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from moreau.analysis.modes import impacts_after_flight, mode_name, step_letters
+from moreau.modes import impacts_after_flight, mode_name, step_letters
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
 from moreau.analysis.period_k import full_state_of
 from moreau.analysis.periodic_shooting import period_mode

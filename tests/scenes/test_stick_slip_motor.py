@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
-from moreau.analysis.modes import mode_name
+from moreau.modes import mode_name
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes.stick_slip_motor.exact import (_Walker, stick_slip_period_map,
