@@ -1,4 +1,10 @@
-"""moreau: simulation of non-smooth mechanics (unilateral contact, Coulomb friction, impacts)."""
+"""moreau: simulation of non-smooth mechanics (unilateral contact, Coulomb friction, impacts).
+
+The package is built in floors, each importing only from itself and the floors
+below (``docs/architecture.md``; held by ``tests/test_layers.py``): base (this
+module, ``errors``, ...) < ``model`` < ``lcp``, ``contact`` < ``integrators`` <
+``analysis`` < ``scenes`` < ``studies``, ``suite`` < ``cli``.
+"""
 
 import importlib
 
