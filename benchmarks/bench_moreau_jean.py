@@ -64,7 +64,7 @@ SCENES = {
     "stick-slip-motor": ("StickSlipMotor()", TWO_PI / 1000),
     "bidirectional-drive": ("BidirectionalDrive()", TWO_PI / 1000),
     "sliding-box (2 contacts)": ("SlidingBox()", 1e-3),
-    # a user's scene, not registered, through the hook of moreau.model.compiled (issue 17's
+    # a user's scene, not registered, through the hook of moreau.compiled (issue 17's
     # goal: >= 1e6 steps/s with one frictional contact)
     USER_SCENE: ("CompiledBeltBlock()", 1e-3),
 }

@@ -58,7 +58,7 @@ import numpy as np
 from numba import njit
 
 from _timing import median_time
-from moreau.model.compiled import CompiledModel
+from moreau.compiled import CompiledModel
 from moreau.integrators import INTEGRATORS, simulate
 from moreau.integrators.base import get_integrator, scheme_options
 from moreau.model.scene import Scene
@@ -120,7 +120,7 @@ def stiffness_schemes():
     return tuple(out)
 
 
-# the wall oscillator's compiled model (moreau.model.compiled): the user-scene hook
+# the wall oscillator's compiled model (moreau.compiled): the user-scene hook
 @njit(cache=True)
 def _osc_mass(par, q, M):
     M[0, 0] = 1.0

@@ -54,7 +54,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import InputError, MoreauError
-from .model.compiled import evaluate_compiled
+from .compiled import evaluate_compiled
 from .integrators import simulate
 from .model.scene import Scene
 

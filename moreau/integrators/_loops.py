@@ -8,7 +8,7 @@ compiled in two forms from the same source:
 - **shared** (:func:`shared_core`): the template rewritten to take the model
   as its leading arguments, with the model's functions as numba first-class
   functions (:data:`MODEL_SIGNATURES`). One compile per scheme serves every
-  :class:`moreau.model.compiled.CompiledModel`, a user's included, and numba's disk
+  :class:`moreau.compiled.CompiledModel`, a user's included, and numba's disk
   cache keeps it: a new scene costs no compile of the loop.
 - **specialised** (:func:`runner_for` with ``specialise=True``): the template
   compiled in a namespace that holds one model's functions, sizes and flags
@@ -180,7 +180,7 @@ SHARED_PARAMETERS = ("mass_fn", "forces_fn", "contacts_fn", "gaps_fn", "NDOF", "
 _F1 = nbtypes.float64[::1]
 _F2 = nbtypes.float64[:, ::1]
 _B = nbtypes.boolean
-#: the numba signatures of a model's functions (:mod:`moreau.model.compiled`), as the loops call them
+#: the numba signatures of a model's functions (:mod:`moreau.compiled`), as the loops call them
 MODEL_SIGNATURES = {
     "mass": nbtypes.void(_F1, _F1, _F2),
     "forces": nbtypes.void(_F1, _F1, _F1, nbtypes.float64, _F2, _B),
@@ -461,7 +461,7 @@ def specialised_loops():
 
 
 def runner_for(model, template=None, scene=None, specialise=None, stub=False, announce=True):
-    """The compiled loop of ``model`` (a :class:`moreau.model.compiled.CompiledModel`).
+    """The compiled loop of ``model`` (a :class:`moreau.compiled.CompiledModel`).
 
     ``template`` is the loop of a scheme, written against the model's
     globals (default :func:`moreau.integrators._mj_kernels.mj_loop`, the

@@ -4,7 +4,7 @@ This is the fast path of :mod:`moreau.integrators.moreau_jean`: the same
 scheme, the same time grid, index set, contact problem, regime
 classification and projection, run as one ``numba`` call over a block of
 steps that allocates nothing per step. The scene's model comes as the
-functions of its :class:`moreau.model.compiled.CompiledModel`; the loop itself
+functions of its :class:`moreau.compiled.CompiledModel`; the loop itself
 knows no scene, and :mod:`moreau.integrators._loops` compiles it once per
 model, on first use.
 
@@ -838,7 +838,7 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     A template, not called as it stands: :func:`moreau.integrators._loops.runner_for`
     compiles it once per model, in a namespace that adds the model to this
     module's globals: its functions ``mass_fn``, ``forces_fn``,
-    ``contacts_fn`` and ``gaps_fn`` (:class:`moreau.model.compiled.CompiledModel`),
+    ``contacts_fn`` and ``gaps_fn`` (:class:`moreau.compiled.CompiledModel`),
     and the constants ``NDOF``, ``NCONTACTS``, ``CONST_MASS`` (``M``
     independent of ``q``), ``HAS_JAC`` (``dh/dq`` or ``dh/dv`` nonzero) and
     ``HAS_GAPS`` (the model has ``gaps``). Numba
@@ -905,7 +905,7 @@ def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, close
     Wh = np.empty((n, n))
     Wi = np.empty((n, n))
     wk = np.empty((n, n))
-    # model outputs, packed (see moreau.model.compiled): D = [h | K | C]
+    # model outputs, packed (see moreau.compiled): D = [h | K | C]
     D = np.zeros((n, 1 + 2 * n))
     D0 = np.zeros((n, 1 + 2 * n))
     rhs = np.empty(n)

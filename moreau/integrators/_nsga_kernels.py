@@ -2,7 +2,7 @@
 
 The same step as :class:`moreau.integrators.nonsmooth_generalized_alpha.NonsmoothGeneralizedAlpha`
 (see its module docstring), on the functions of a
-:class:`moreau.model.compiled.CompiledModel`: the smooth generalized-α Newton
+:class:`moreau.compiled.CompiledModel`: the smooth generalized-α Newton
 iteration on the model's forces and Jacobians with the closed contacts'
 smooth forces solved inside each iteration, the velocity-level impulse
 problem (both with the contact problem of :mod:`moreau.integrators._mj_kernels`:

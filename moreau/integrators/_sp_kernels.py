@@ -2,7 +2,7 @@
 
 The same step as :class:`moreau.integrators.schatzman_paoli.SchatzmanPaoli`
 (see its module docstring for the derivation), on the functions of a
-:class:`moreau.model.compiled.CompiledModel`, with the contact problem of
+:class:`moreau.compiled.CompiledModel`, with the contact problem of
 :mod:`moreau.integrators._mj_kernels` (the one-contact enumeration, Lemke
 for several contacts; no warm start). Like
 :func:`moreau.integrators._mj_kernels.mj_loop` it is a template:

@@ -3,7 +3,7 @@
 The same macro step as
 :meth:`moreau.integrators.studer_extrapolation.StuderExtrapolation._generic_step`
 (see that module's docstring for the method), on the functions of a
-:class:`moreau.model.compiled.CompiledModel`: the Moreau midpoint base steps, the
+:class:`moreau.compiled.CompiledModel`: the Moreau midpoint base steps, the
 sequences of ``1 .. K`` base steps, the Aitken–Neville table in smooth
 phases, step halving and the switch location elsewhere, the projection of
 the accepted state onto the closed contacts. Every contact problem goes

@@ -2,7 +2,7 @@
 
 The same step as :class:`moreau.integrators.time_discontinuous_galerkin.TimeDiscontinuousGalerkin`
 (see its module docstring for the derivation), on the functions of a
-:class:`moreau.model.compiled.CompiledModel`. Every contact problem of a step (the
+:class:`moreau.compiled.CompiledModel`. Every contact problem of a step (the
 impulse at its left end and one per stage) goes through
 :func:`_stage_problem`: the one-contact enumeration, or the friction LCP and
 Lemke's method for several contacts (no warm start). Like

@@ -597,7 +597,7 @@ class MoreauJean(CompiledRecording, Integrator):
 
 
 def compiled_model_of(scene):
-    """The scene's :class:`~moreau.model.compiled.CompiledModel`, or None.
+    """The scene's :class:`~moreau.compiled.CompiledModel`, or None.
 
     None when the scene has no ``compiled_model()``, or when a subclass
     overrides one of the model methods (``mass``, ``forces``,

@@ -4,21 +4,18 @@
     the scene interface (:class:`Scene`) an integrator runs;
 :mod:`moreau.model.registry`
     the scene registry: scenes register themselves, schemes and analyses
-    look them up by name;
+    look them up by name, studies register their hooks;
 :mod:`moreau.model.units`
-    unit conversions shared by the scenes (the drive scaling, SI scales);
-:mod:`moreau.model.compiled`
-    the compiled form of a scene's model (:class:`CompiledModel`).
+    unit conversions shared by the scenes (the drive scaling, SI scales).
 
-Nothing here imports a scheme, an analysis or a scene: the scenes live above,
-in :mod:`moreau.scenes`, and register themselves here.
+The compiled form of a scene's model, :class:`moreau.compiled.CompiledModel`,
+is on this floor too. Nothing here imports a scheme, an analysis or a scene:
+the scenes live above, in :mod:`moreau.scenes`, and register themselves here.
 """
 
 from . import registry
-from .compiled import CompiledModel, check_compiled_model, evaluate_compiled
 from .registry import Parameter, SceneEntry, get_entry, make_scene, register_scene, scene_names
 from .scene import Scene, params_with
 
 __all__ = ["Scene", "params_with", "registry", "Parameter", "SceneEntry", "get_entry",
-           "make_scene", "register_scene", "scene_names", "CompiledModel", "check_compiled_model",
-           "evaluate_compiled"]
+           "make_scene", "register_scene", "scene_names"]

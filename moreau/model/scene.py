@@ -201,7 +201,7 @@ class Scene:
         raise NotImplementedError(f"{type(self).__name__} defines no initial_state()")
 
     def compiled_model(self):
-        """The model in compiled form (:class:`moreau.model.compiled.CompiledModel`), or None.
+        """The model in compiled form (:class:`moreau.compiled.CompiledModel`), or None.
 
         Scenes that return one run Moreau–Jean in the compiled loop of
         :mod:`moreau.integrators._mj_kernels`; the others take the generic path.

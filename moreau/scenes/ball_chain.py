@@ -44,7 +44,7 @@ import numpy as np
 
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .._validate import (finite_array, finite_scalar, in_closed_interval, nonnegative, positive,
                          positive_int)
 from ..analysis.cases import GRID, CompareCase
@@ -198,7 +198,7 @@ class BallChain(SIUnits, Scene):
         return q, v
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`); ``par = (mass ratio,)``."""
+        """Compiled form of this model (:mod:`moreau.compiled`); ``par = (mass ratio,)``."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
                              self.ndof - 1, True, False)
 
@@ -389,7 +389,7 @@ class BallChainCase(CompareCase):
         return float(res.q[-1, -1])
 
 
-# -- compiled model (moreau.model.compiled); par = (striker mass / ball mass,) -------------------
+# -- compiled model (moreau.compiled); par = (striker mass / ball mass,) -------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

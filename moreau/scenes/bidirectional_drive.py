@@ -72,7 +72,7 @@ from ._drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .friction_drive.rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
 from ..model.scene import Scene, params_with
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
@@ -170,7 +170,7 @@ class BidirectionalDriveParams:
                    phase=phase, load=params.load, restitution=params.restitution)
 
 
-# -- compiled model (moreau.model.compiled) ---------------------------------------------------
+# -- compiled model (moreau.compiled) ---------------------------------------------------
 # par: J, P, sin_phi0, fL, u10a, u10b, delta_a, delta_b, then the memory of memo_sincos:
 # rod r's angle at MEMO + 6 r, its phase at MEMO + 6 r + 3; rod r (angle q[r], stator
 # phase delta_r) on the rotor q[2], the second rod mirrored (sgn = -1)
@@ -372,7 +372,7 @@ class BidirectionalDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         # the parameters, then per rod the memory of its angle's and its phase's sines
         # and cosines (MEMO)
         par = np.array([self.J, self.P, self.sin_phi0, self.fL, self.u10[0], self.u10[1],

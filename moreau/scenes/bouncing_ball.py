@@ -24,7 +24,7 @@ import numpy as np
 
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from ._drawing import circle, contact, line
@@ -144,7 +144,7 @@ class BouncingBall(SIUnits, Scene):
         return np.array([self.r + 1.0]), np.zeros(1)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
 
     def shapes(self, q, t=0.0):
@@ -330,7 +330,7 @@ class BouncingBallCase(CompareCase):
 
 
 
-# -- compiled model (moreau.model.compiled); par: r ---------------------------------------------
+# -- compiled model (moreau.compiled); par: r ---------------------------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

@@ -94,7 +94,7 @@ import numpy as np
 from numba import njit
 
 from .. import _validate as V
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
@@ -466,7 +466,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         return np.sqrt(lam) * self.omega / (2.0 * math.pi)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         n = self.N
         par = np.concatenate([[self.J, self.P, self.u10, self.fL, self.sin_phi0, float(n),
                                self.fp],
@@ -499,7 +499,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.model.compiled) -----------------------------------------------------
+# -- compiled model (moreau.compiled) -----------------------------------------------------
 # par: J, P, u10, fL, sin_phi0, N, fp, then W_i^2, beta_i, psi_i, 2 zeta W_i (N each);
 # q = (phi, eta_1 .. eta_N, u2)
 

@@ -41,7 +41,7 @@ import numpy as np
 
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from ._drawing import contact, line
@@ -190,7 +190,7 @@ class PainleveRod(SIUnits, Scene):
         return self.sliding_state(phi=math.pi / 4, tip_speed=1.0)
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [], 3, 1, True, False)
 
     # -- units ----------------------------------------------------------------
@@ -436,7 +436,7 @@ class PainleveRodCase(CompareCase):
 
 
 
-# -- compiled model (moreau.model.compiled); no parameters ------------------------------------
+# -- compiled model (moreau.compiled); no parameters ------------------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

@@ -99,7 +99,7 @@ from scipy.integrate import quad
 from scipy.optimize import least_squares
 
 from .. import _validate as V
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
@@ -592,7 +592,7 @@ class PiezoDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         if self.ndof == 3:
             return CompiledModel(_mass_dyn, _forces_dyn, _contacts_dyn, _drift_dyn, self._par, 3,
                                  1, False, True, gaps=_gaps_dyn)

@@ -189,7 +189,7 @@ class RockingBlock(SIUnits, Scene):
         return self._box.contact_drift(q, v, t)
 
     def compiled_model(self):
-        """Compiled form of this model: the sliding box's (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model: the sliding box's (:mod:`moreau.compiled`)."""
         return self._box.compiled_model()
 
     def _qscale(self):

@@ -24,7 +24,7 @@ import numpy as np
 
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from ._drawing import contact, line, polygon
@@ -148,7 +148,7 @@ class SlidingBlock(SIUnits, Scene):
         return np.zeros(2), np.array([1.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = [math.sin(self.alpha), math.cos(self.alpha)]
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
@@ -306,7 +306,7 @@ class SlidingBlockCase(CompareCase):
 
 
 
-# -- compiled model (moreau.model.compiled); par: sin(alpha), cos(alpha) -------------------------
+# -- compiled model (moreau.compiled); par: sin(alpha), cos(alpha) -------------------------
 
 @njit(cache=True)
 def _mass(par, q, M):

@@ -41,7 +41,7 @@ import numpy as np
 
 from numba import njit
 
-from ..model.compiled import CompiledModel
+from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from ._drawing import contact, line, polygon
@@ -170,7 +170,7 @@ class SlidingBox(SIUnits, Scene):
         return np.array([0.0, self.b, 0.0]), np.array([1.0, 0.0, 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         return CompiledModel(_mass, _forces, _contacts, _drift, [self.a, self.b, self.inertia],
                              3, 2, True, False)
 
@@ -288,7 +288,7 @@ class SlidingBoxCase(CompareCase):
 
 
 
-# -- compiled model (moreau.model.compiled); par: a, b, inertia -----------------------------
+# -- compiled model (moreau.compiled); par: a, b, inertia -----------------------------
 # corners at body coordinates (-a, -b) and (+a, -b)
 
 @njit(cache=True)

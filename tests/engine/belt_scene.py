@@ -10,7 +10,7 @@ slips back: the classic stick-slip oscillator.
 import numpy as np
 from numba import njit
 
-from moreau.model.compiled import CompiledModel
+from moreau.compiled import CompiledModel
 from moreau.model.scene import Scene
 
 
@@ -43,7 +43,7 @@ class BeltBlock(Scene):
         return np.zeros(2), np.array([self.vb, 0.0])
 
 
-# -- the same model through the compiled hook (moreau.model.compiled) ------------------------
+# -- the same model through the compiled hook (moreau.compiled) ------------------------
 # par = (k, vb). Kept in this importable module, so the engine caches its compiled loop on
 # disk; the functions are the Python methods above, written for numba.
 

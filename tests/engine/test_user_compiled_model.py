@@ -1,4 +1,4 @@
-"""A user's scene gets the compiled Moreau–Jean loop through ``moreau.model.compiled``, no package edit."""
+"""A user's scene gets the compiled Moreau–Jean loop through ``moreau.compiled``, no package edit."""
 
 import glob
 import json
@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from moreau.model.compiled import CompiledModel, check_compiled_model
+from moreau.compiled import CompiledModel, check_compiled_model
 from moreau.errors import InputError
 from moreau.integrators import _loops, _sp_kernels, simulate
 from moreau.integrators.moreau_jean import MoreauJean

@@ -6,7 +6,7 @@ import numpy as np
 from numba import njit
 from scipy.optimize import brentq
 
-from moreau.model.compiled import CompiledModel
+from moreau.compiled import CompiledModel
 from moreau.model.scene import Scene
 
 

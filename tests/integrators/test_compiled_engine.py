@@ -12,7 +12,7 @@ from moreau.integrators.moreau_jean import MoreauJean, compiled_model_of
 from moreau.scenes import (BidirectionalDrive, BidirectionalDriveParams, BouncingBall,
                            FrictionDrive, FrictionDriveParams, PainleveRod, SawtoothDrive,
                            SineDrive, SlidingBlock, SlidingBox, StickSlipMotor)
-from moreau.model.compiled import check_compiled_model
+from moreau.compiled import check_compiled_model
 
 from _agreement import assert_forces_agree
 

@@ -176,7 +176,7 @@ def test_docstring_examples_run():
     import doctest
 
     import moreau.analysis.mj_steady_state as mss
-    import moreau.model.compiled as cm
+    import moreau.compiled as cm
     for mod in (mss, cm):
         assert doctest.testmod(mod, verbose=False).failed == 0
 

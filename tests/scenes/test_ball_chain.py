@@ -24,7 +24,7 @@ import math
 import numpy as np
 import pytest
 
-from moreau.model.compiled import check_compiled_model
+from moreau.compiled import check_compiled_model
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes import registry

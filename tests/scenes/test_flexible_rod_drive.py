@@ -17,7 +17,7 @@ import pytest
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
 from moreau.check import check_scene
 from moreau.cli import main
-from moreau.model.compiled import evaluate_compiled
+from moreau.compiled import evaluate_compiled
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes.flexible_rod_drive import (MAX_MODES, FlexibleRodDrive, mode_shape,

@@ -73,7 +73,7 @@ def rod_forces(D, j, P, sphi0, u10, s, c, ct, need_jac):
 
 @njit(cache=True)
 def rod_rows(G, r, j, rotor, n, sgn, u10, s, c, st, need_T):
-    # contact row r of the rod with angle q[j] (layout of moreau.model.compiled)
+    # contact row r of the rod with angle q[j] (layout of moreau.compiled)
     G[r, 1] = -u10 * st
     G[r, 3 + j] = -c
     if need_T:

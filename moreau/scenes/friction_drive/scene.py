@@ -85,7 +85,7 @@ from .._drawing import rod_drive_shapes
 from ...model.units import DriveUnits
 from numba import njit
 
-from ...model.compiled import CompiledModel
+from ...compiled import CompiledModel
 from .rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
 from ...model.scene import Scene, params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
@@ -360,7 +360,7 @@ class FrictionDrive(DriveUnits, Scene):
         return self.rest_state()
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         # the parameters, then the memory of the last angle's and phase's sines and
         # cosines (PHI_MEMO, PHASE_MEMO)
         par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp,
@@ -397,7 +397,7 @@ class FrictionDrive(DriveUnits, Scene):
         return si
 
 
-# -- compiled model (moreau.model.compiled); par: J, P, u10, fL, sin_phi0, fp, then the memory of
+# -- compiled model (moreau.compiled); par: J, P, u10, fL, sin_phi0, fp, then the memory of
 # memo_sincos: angle phi, sin, cos; phase tau, sin, cos -----------------------------------
 PHI_MEMO = 6
 PHASE_MEMO = 9

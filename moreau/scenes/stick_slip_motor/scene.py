@@ -35,7 +35,7 @@ import numpy as np
 
 from numba import njit
 
-from ...model.compiled import CompiledModel
+from ...compiled import CompiledModel
 from ..._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ...errors import InputError
 from .._drawing import contact, polygon
@@ -464,7 +464,7 @@ class StickSlipMotor(SIUnits, Scene):
         return np.zeros(2), np.array([float(ds), 0.0])
 
     def compiled_model(self):
-        """Compiled form of this model (:mod:`moreau.model.compiled`)."""
+        """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = np.zeros(22)
         par[0], par[1] = self.fL, self.n
         d = self.drive
@@ -526,7 +526,7 @@ class StickSlipCase(CompareCase):
 
 
 
-# -- compiled model (moreau.model.compiled) ---------------------------------------------------
+# -- compiled model (moreau.compiled) ---------------------------------------------------
 # par: [fL, n, drive (0 sine, 1 sawtooth), b, psi, nseg, starts[4], acc[4], vel[4], pos[4]]
 
 @njit(cache=True)

@@ -76,7 +76,7 @@ from typing import Any, Optional
 
 import numpy as np
 
-from ..errors import InputError
+from .errors import InputError
 
 __all__ = ["CompiledModel", "evaluate_compiled", "check_compiled_model", "MODEL_FUNCTIONS"]
 
