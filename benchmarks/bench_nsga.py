@@ -38,7 +38,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 from _timing import median_time  # noqa: E402
 from moreau.integrators import simulate  # noqa: E402
-from moreau.scenes.registry import make_scene  # noqa: E402
+from moreau.model.registry import make_scene  # noqa: E402
 
 GOAL = 1e6
 

@@ -61,9 +61,9 @@ from _timing import median_time
 from moreau.compiled import CompiledModel
 from moreau.integrators import INTEGRATORS, simulate
 from moreau.integrators.base import get_integrator, scheme_options
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 from moreau.scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 TWO_PI = 2.0 * np.pi

@@ -38,7 +38,7 @@ from moreau.analysis.period_k import full_state_of  # noqa: E402
 from moreau.analysis.scheme_settings import make_scheme, steady_of  # noqa: E402
 from moreau.analysis.steady_state import find_steady_state  # noqa: E402
 from moreau.integrators import simulate  # noqa: E402
-from moreau.scenes.registry import make_scene  # noqa: E402
+from moreau.model.registry import make_scene  # noqa: E402
 
 NAME = "studer-extrapolation"
 

@@ -1,4 +1,28 @@
-"""moreau: simulation of non-smooth mechanics (unilateral contact, Coulomb friction, impacts)."""
+"""moreau: simulation of non-smooth mechanics (unilateral contact, Coulomb friction, impacts).
+
+The package is built in floors. A module imports only from its own floor and
+the floors below it, and the imports form no cycle (``tests/test_layers.py``
+holds every import to this list, lowest floor first):
+
+1. ``base``: this module, ``errors``, ``_validate``, ``_log``, ``_jit_cache``,
+   ``outputs``, ``provenance``, ``regimes``, ``modes``;
+2. ``model``: ``model/`` (the scene interface, the scene registry, units) and
+   ``compiled`` (a scene's compiled model);
+3. ``contact``: ``lcp/``, ``contact/`` (the contact problems and their solvers);
+4. ``integrators``: ``integrators/`` (the schemes and their compiled loops);
+5. ``analysis``: ``analysis/``, ``check`` (steady states, comparison cases,
+   sweeps, the scene checker);
+6. ``scenes``: ``scenes/`` (a scene with its own reference or analyses is a
+   package, e.g. ``scenes/friction_drive/``);
+7. ``studies``: ``studies/``, ``suite/`` (studies of particular scenes, which
+   register their own sweep and atlas hooks; the benchmark suite);
+8. ``cli``: ``cli``, ``__main__``.
+
+A scene sits above the analyses because it may bring its own reference
+scheme, steady-state solver and comparison case; the schemes and analyses
+find scenes by name through :mod:`moreau.model.registry`, which imports the
+scene and study packages by name when it first needs them.
+"""
 
 import importlib
 
@@ -20,7 +44,7 @@ _LAZY = {
     "compare": "moreau.analysis.compare",
     "find_steady_state": "moreau.analysis.steady_state",
     "check_scene": "moreau.check",
-    "Scene": "moreau.scenes.base",
+    "Scene": "moreau.model.scene",
 }
 
 

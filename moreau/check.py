@@ -1,6 +1,6 @@
 """Checks of a scene's model: the first thing to run on a scene of one's own.
 
-:func:`check_scene` evaluates the :class:`~moreau.scenes.base.Scene` methods
+:func:`check_scene` evaluates the :class:`~moreau.model.scene.Scene` methods
 at a few states and compares them with independent computations:
 
 * shapes and sizes: ``mass`` (n, n), ``forces`` (n,), ``gaps`` (nc,),
@@ -21,7 +21,7 @@ at a few states and compares them with independent computations:
   tangential rows;
 * ``force_jacobians``, where the scene gives them, against central
   differences of ``forces``; a scene that leaves the default (central
-  differences, :meth:`~moreau.scenes.base.Scene.force_jacobians`) while its
+  differences, :meth:`~moreau.model.scene.Scene.force_jacobians`) while its
   forces depend on the state gets a note saying so;
 * the tangential rows, where the scene states the tangential positions
   whose rates they are (an optional method ``slip_positions(q, t)``, one
@@ -56,7 +56,7 @@ from numpy.typing import ArrayLike
 from .errors import InputError, MoreauError
 from .compiled import evaluate_compiled
 from .integrators import simulate
-from .scenes.base import Scene
+from .model.scene import Scene
 
 __all__ = ["check_scene", "SceneReport"]
 

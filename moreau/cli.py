@@ -29,7 +29,7 @@ from .outputs import claim_outputs
 from .provenance import provenance
 from .integrators.base import (INTEGRATORS, check_options, get_integrator,
                                propagate_interrupts, scheme_options)
-from .scenes.registry import (default_scene, describe, discover, entries, get_entry,
+from .model.registry import (default_scene, describe, discover, entries, get_entry,
                               resolve_hook, scene_names)
 from .studies.paper.reproduce import reproduce
 from .studies.paper.stress import format_stress_table, run_catalogue, write_stress_outputs

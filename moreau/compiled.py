@@ -40,7 +40,7 @@ leave the structural zeros alone):
 ``par`` belongs to the model: its functions may also keep values there from
 one call to the next, as long as each output depends on the arguments alone
 (the friction drive keeps the sines and cosines of its last angle and phase,
-:func:`moreau.scenes._rod.memo_sincos`).
+:func:`moreau.scenes.friction_drive.rod.memo_sincos`).
 
 :func:`check_compiled_model` (and :func:`moreau.check_scene`) hold every
 function to the scene's Python methods.

@@ -81,7 +81,7 @@ def machine():
 
 
 #: modules that only present results (files, figures, text); editing them keeps the cache
-_PRESENTATION = {"cli.py", "cli_bidirectional.py", "provenance.py", "analysis/summary.py",
+_PRESENTATION = {"cli.py", "provenance.py", "analysis/summary.py",
                  "studies/paper/figures.py", "studies/paper/report.py",
                  "studies/paper/reproduce.py", "studies/paper/atlas.py", "studies/paper/sweeps.py",
                  "analysis/history.py", "studies/paper/tables.py"}

@@ -7,7 +7,7 @@ from moreau.analysis.atlas import run_scene_atlas
 from moreau.analysis.sweep import rows_to_xarray
 from moreau.errors import InputError
 from moreau.integrators import simulate
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 pd = pytest.importorskip("pandas")
 xr = pytest.importorskip("xarray")

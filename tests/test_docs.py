@@ -25,7 +25,7 @@ def test_the_reference_builds_without_warnings(tmp_path):
 def test_every_public_module_has_a_page():
     # a module named on no page would be missing from the reference without a warning
     pages = "\n".join(p.read_text() for p in (DOCS / "api").glob("*.rst"))
-    for name in ("moreau.integrators.base", "moreau.integrators.result", "moreau.scenes.registry",
+    for name in ("moreau.integrators.base", "moreau.integrators.result", "moreau.model.registry",
                  "moreau.analysis.steady_state", "moreau.lcp", "moreau.errors"):
         assert f".. automodule:: {name}\n" in pages, name
     schemes = sorted(p.stem for p in (ROOT / "moreau" / "integrators").glob("[!_]*.py")

@@ -19,7 +19,7 @@ import time
 import pytest
 
 import moreau
-from moreau.scenes.registry import get_entry, scene_names
+from moreau.model.registry import get_entry, scene_names
 
 PACKAGE = pathlib.Path(moreau.__file__).resolve().parent
 

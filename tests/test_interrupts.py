@@ -6,7 +6,7 @@ import numpy as np
 
 from moreau.studies.paper import sweeps
 from moreau.integrators import simulate
-from moreau.scenes.friction_drive_walker import EventDriven
+from moreau.scenes.friction_drive.walker import EventDriven
 from moreau.scenes.friction_drive import FrictionDrive
 
 

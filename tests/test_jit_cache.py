@@ -1,6 +1,7 @@
 """The compiled kernel's on-disk cache follows every source compiled into it."""
 
 import os
+import pathlib
 import subprocess
 import sys
 import textwrap
@@ -104,10 +105,15 @@ def test_kernel_stamps_carry_the_digest_of_all_kernel_sources():
     assert lemke.lemke_core._cache._cache_file._source_stamp[0] == "moreau-deps"
 
 
+def _tail(path):
+    """The last two parts of ``path`` ("package/module.py")."""
+    return "/".join(pathlib.PurePath(path).parts[-2:])
+
+
 def test_a_scene_runner_is_tied_to_its_model_and_kernel_sources(monkeypatch):
     from moreau.integrators import _loops
     from moreau.integrators import _mj_kernels as mk
-    from moreau.scenes import friction_drive
+    from moreau.scenes.friction_drive import scene as friction_drive
 
     model = friction_drive.FrictionDrive(frequency=185.0).compiled_model()
     monkeypatch.setattr(_loops, "_RUNNERS", {})
@@ -115,7 +121,7 @@ def test_a_scene_runner_is_tied_to_its_model_and_kernel_sources(monkeypatch):
     run = _loops.runner_for(model, specialise=True)
     deps = _loops.dependency_files(list(model.functions().values()))
     # the model's module and the rod pieces it calls (another file) are both tracked
-    assert {"friction_drive.py", "_rod.py"} <= {os.path.basename(p) for p in deps}
+    assert {"friction_drive/scene.py", "friction_drive/rod.py"} <= {_tail(p) for p in deps}
     digest = _jit_cache.sources_digest(list(mk.KERNEL_SOURCES) + deps)
     stamp = run._cache._cache_file._source_stamp
     assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
@@ -126,7 +132,7 @@ def test_the_shared_loop_is_tied_to_the_kernels_and_each_model_function_to_its_f
 
     from moreau.integrators import _loops
     from moreau.integrators import _mj_kernels as mk
-    from moreau.scenes import friction_drive
+    from moreau.scenes.friction_drive import scene as friction_drive
 
     monkeypatch.setattr(_loops, "_CORES", {})
     core = _loops.shared_core(mk.mj_loop, (numba.int64,))   # built, never compiled here
@@ -142,7 +148,7 @@ def test_the_shared_loop_is_tied_to_the_kernels_and_each_model_function_to_its_f
     assert model.forces is fresh
     _loops._model_prefix(model)
     deps = _loops.dependency_files([fresh])
-    assert src in deps and any(os.path.basename(p) == "_rod.py" for p in deps)
+    assert src in deps and "friction_drive/rod.py" in {_tail(p) for p in deps}
     assert fresh._cache._cache_file._source_stamp[1][1] == _jit_cache.sources_digest(deps)
 
 

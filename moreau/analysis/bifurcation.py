@@ -71,7 +71,7 @@ from ..integrators.base import scheme_options as options_of
 from ..outputs import claim_outputs
 from ..provenance import provenance
 from ..regimes import Regime
-from ..scenes import registry
+from ..model import registry
 from . import engine
 from ..integrators.event_driven_generic import project_positions
 from .classify import MAX_PERIOD_K, sequence_period

@@ -1,7 +1,7 @@
 """Comparison cases: a scene set up for ``moreau compare`` (reference, start, headline).
 
 A registered scene names its case in its registry entry
-(:class:`moreau.scenes.registry.SceneEntry`, field ``case``); the case class
+(:class:`moreau.model.registry.SceneEntry`, field ``case``); the case class
 lives in the scene's own module and derives from the generic classes here:
 
 :class:`CompareCase`

@@ -54,7 +54,7 @@ from scipy.optimize import brentq, minimize_scalar
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError, RunawayError
 from ..provenance import provenance
-from ..scenes import registry
+from ..model import registry
 from .energy import energy_audit, energy_to_si, has_energy_audit
 from .engine import audit_options, check_output_dir, periodic_scene_names
 from .mj_steady_state import moreau_jean_steady_state

@@ -45,7 +45,7 @@ from .._validate import positive_int
 from ..errors import InputError, MoreauError
 from ..integrators import get_integrator
 from ..integrators.base import scheme_options as options_of
-from ..scenes import registry
+from ..model import registry
 from .periodic_shooting import period_map_options
 from .runaway import certain_runaway, runaway_in
 from .section_runs import section_states

@@ -114,8 +114,8 @@ from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
 from ..integrators.base import INTEGRATORS, propagate_interrupts
 from ..provenance import provenance
-from ..scenes.base import Scene
-from ..scenes.registry import get_entry
+from ..model.scene import Scene
+from ..model.registry import get_entry
 from .cases import GRID, SceneCase, switching_error
 
 __all__ = ["pareto", "PARETO_TARGETS", "compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
@@ -262,7 +262,7 @@ def compare(scene: str | Scene, steps: Sequence[int] | None = None,
     ----------
     scene : str or Scene
         The name of a registered scene (``moreau scenes`` lists them), or a
-        :class:`~moreau.scenes.base.Scene` instance (a user's own scene,
+        :class:`~moreau.model.scene.Scene` instance (a user's own scene,
         registered or not), which then needs ``t_span``, ``q0`` and ``v0``:
         its reference is the event-driven scheme at tight tolerance
         (:class:`moreau.analysis.cases.SceneCase`).

@@ -137,7 +137,7 @@ import numpy as np
 
 from ..errors import ConvergenceError, InputError, MoreauError
 from ..regimes import Regime
-from ..scenes import registry
+from ..model import registry
 from .mj_steady_state import PeriodMap
 from .period_k import full_state_of
 from ..integrators.event_driven_generic import GenericEventDriven

@@ -43,7 +43,7 @@ from .. import __version__
 from ..errors import ConvergenceError, InputError, Interrupted, PainleveError, WorkerError
 # the cache key's code version lives with the provenance; named here too (engine.code_version)
 from ..provenance import code_version
-from ..scenes import registry
+from ..model import registry
 from .scheme_settings import ED_REFERENCE, Scheme, make_scheme, steady_of
 from .energy import ENERGY_COLUMNS, ENERGY_TERMS, energy_audit, energy_to_si, has_energy_audit
 from .classify import CLASSIFY_COLUMNS, classification_columns
@@ -55,8 +55,6 @@ log = logging.getLogger(__name__)
 
 __all__ = ["end_worker_pool", "audit_options", "make_scheme", "code_version", "evaluate_point", "evaluate_points", "run_points", "check_output_dir", "cache_memory", "Scheme", "steady_of", "worker_init", "worker_pool_config",
            "ED_REFERENCE", "mj_check_columns", "periodic_scene_names"]
-
-_PARAM_NAMES = ("m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution")
 
 
 def mj_check_columns(check):

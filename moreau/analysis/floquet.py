@@ -13,7 +13,7 @@ circle, the stability margin.
 Two ways to get ``M`` are used in the package:
 
 * the saltation matrices of an event-driven walk (the friction drive's
-  walker, :mod:`moreau.scenes.friction_drive_floquet`): the smooth pieces'
+  walker, :mod:`moreau.scenes.friction_drive.floquet`): the smooth pieces'
   variational equations joined by the jump of the variation at every event;
 * finite differences of the period map itself (:func:`period_map_jacobian`),
   for any scene and scheme: the generic shooting and Moreau–Jean's discrete

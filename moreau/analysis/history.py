@@ -2,7 +2,7 @@
 
 The engine of ``moreau run``. A scene with SI units gives its histories in SI
 (``Scene.si_columns``), the same columns for every scene (the keys of
-``to_si``, :data:`moreau.scenes._units.COMMON_KEYS`, one column per
+``to_si``, :data:`moreau.model.units.COMMON_KEYS`, one column per
 coordinate and per contact), with the unit in each column name (``t [s]``,
 ``q_1 [m]``, ``force_N_0 [N]``); the regime of each contact is written by
 name (``stick``, ``positive``, ``negative``, ``flight``). A JSON sidecar

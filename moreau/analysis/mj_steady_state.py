@@ -34,10 +34,10 @@ system has no stick there, so :func:`merge_step_regimes` drops such a
 one-step stick (the reversal time is put at the middle of that step). Any
 other run, including a one-step stick between slips of the *same* sign or a
 one-step slip, is kept. A closed frictionless contact is named by the sign of
-its slip velocity, never stick (:func:`moreau.analysis.modes.step_letters`),
+its slip velocity, never stick (:func:`moreau.modes.step_letters`),
 and a regime entered from flight is marked as entered through an impact, as
 the event-driven reference marks it. The cyclic sequence is then named by
-:func:`moreau.analysis.modes.mode_name`.
+:func:`moreau.modes.mode_name`.
 """
 
 import math
@@ -47,7 +47,7 @@ import numpy as np
 
 from .._validate import finite_array, in_closed_interval, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError, PainleveError
-from .modes import impacts_after_flight, mode_name, step_letters
+from ..modes import impacts_after_flight, mode_name, step_letters
 from ..integrators.contact_problem import check_painleve
 from ..integrators.moreau_jean import LCP_METHODS, MoreauJean
 from ..integrators.result import SteadyState
@@ -148,7 +148,7 @@ def _mode_of(merged):
 class PeriodMap:
     """One drive period of Moreau–Jean steps of a periodic scene, as a map of its state.
 
-    Works through the :class:`~moreau.scenes.base.Scene` interface for any
+    Works through the :class:`~moreau.model.scene.Scene` interface for any
     scene with a periodic drive (``scene.period``): the coordinates listed in
     ``scene.cyclic_coordinates`` (e.g. the rotor position) do not enter the
     dynamics, so the map acts on ``x = (q without them, v)`` and reports the

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import MoreauError
 from ..integrators import simulate
-from ..scenes import registry
+from ..model import registry
 
 __all__ = ["register_section_run", "section_states", "section_run_names"]
 

@@ -23,7 +23,7 @@ moreau.errors.InputError: `scheme` has no steady-state solver: 'euler'; the sche
 """
 
 from ..errors import InputError
-from ..scenes import registry
+from ..model import registry
 
 __all__ = ["register_steady_solver", "get_steady_solver", "steady_solver_names", "has_solver"]
 

@@ -20,7 +20,7 @@ from ..errors import ConvergenceError, InputError, RunawayError
 # and re-exported here, where callers have always found it
 from ..integrators import INTEGRATORS, get_integrator
 from ..integrators.result import SteadyState
-from ..scenes.base import Scene
+from ..model.scene import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
 from . import mj_steady_state  # noqa: F401
 from .period_k import find_period_k, full_state_of

@@ -6,7 +6,7 @@ conversions (``displacement_to_si``, ``force_to_si``), its drive
 
 Examples
 --------
->>> from moreau.scenes.registry import make_scene
+>>> from moreau.model.registry import make_scene
 >>> rep = steady_state_report(make_scene("friction-drive", frequency=20.0))
 >>> rep["scene"], rep["mode"], rep["displacement_per_period_m"] < 0
 ('friction-drive', 'NS', True)

@@ -37,7 +37,7 @@ from .._validate import finite_scalar, positive, positive_int
 from ..errors import InputError
 from ..outputs import claim_outputs
 from ..provenance import provenance
-from ..scenes import registry
+from ..model import registry
 from . import engine
 from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names

@@ -3,7 +3,7 @@
 Only scene-independent schemes live here, one module per scheme family; each
 registers its schemes when the package discovers it (below). A scene's own exact reference lives
 with its scene and registers itself when the scene modules are discovered
-(:func:`moreau.scenes.registry.discover`, which :func:`simulate` calls before
+(:func:`moreau.model.registry.discover`, which :func:`simulate` calls before
 it looks up a name it does not know); this package imports no scene.
 """
 

@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
-from ..scenes import registry as scene_registry
+from ..model import registry as scene_registry
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
 from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence,
@@ -28,7 +28,7 @@ from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, diver
 from .result import STATUS_MESSAGES, SimulationResult
 
 if TYPE_CHECKING:  # annotations only: the scenes package imports this one at run time
-    from ..scenes.base import Scene
+    from ..model.scene import Scene
 
 __all__ = ["Integrator", "simulate", "propagate_interrupts", "INTEGRATORS", "register_integrator", "get_integrator",
            "check_options"]
@@ -42,7 +42,7 @@ def get_integrator(name):
 
     A scene's own reference scheme registers itself in its scene's module, so
     an unknown name first has the scene modules discovered
-    (:func:`moreau.scenes.registry.discover`); a name still unknown is an
+    (:func:`moreau.model.registry.discover`); a name still unknown is an
     error that lists the known ones.
 
     Examples
@@ -113,7 +113,7 @@ def register_integrator(name):
 
 
 class Integrator:
-    """Base class of integration schemes over a :class:`~moreau.scenes.base.Scene`.
+    """Base class of integration schemes over a :class:`~moreau.model.scene.Scene`.
 
     Parameters
     ----------
@@ -434,7 +434,7 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
         Status ``-4`` if interrupted by ``KeyboardInterrupt``; the samples
         recorded until then are kept. Status 1 if a terminal event stopped it.
         Status ``-6`` if a recorded state left the scene's valid region
-        (:meth:`~moreau.scenes.base.Scene.inside_valid_region`): the run ends
+        (:meth:`~moreau.model.scene.Scene.inside_valid_region`): the run ends
         on that sample, and the message names the region, the time and the
         state.
 

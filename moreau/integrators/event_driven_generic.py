@@ -1,4 +1,4 @@
-"""Event-driven integration of any scene, through the :class:`~moreau.scenes.base.Scene` interface.
+"""Event-driven integration of any scene, through the :class:`~moreau.model.scene.Scene` interface.
 
 The scheme follows the classical event-driven treatment of unilateral
 contact with Coulomb friction (Pfeiffer and Glocker): the motion is cut into
@@ -400,7 +400,7 @@ def project_positions(scene, t, q, contacts, max_iter=4):
 
 @register_integrator("event-driven-generic")
 class GenericEventDriven(Integrator):
-    """Event-driven reference for any :class:`~moreau.scenes.base.Scene`.
+    """Event-driven reference for any :class:`~moreau.model.scene.Scene`.
 
     Each :meth:`step` runs one smooth phase to its first event (or to
     ``t_bound``) and resolves the event. Samples are recorded at every event

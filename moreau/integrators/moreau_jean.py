@@ -390,7 +390,7 @@ class MoreauJean(CompiledRecording, Integrator):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.scenes.base import Scene
+    >>> from moreau.model.scene import Scene
     >>> class Block(Scene):
     ...     ndof, mu, restitution = 2, np.array([0.5]), np.array([0.0])
     ...     def mass(self, q): return np.eye(2)

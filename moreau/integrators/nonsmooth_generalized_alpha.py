@@ -187,7 +187,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.scenes.base import Scene
+    >>> from moreau.model.scene import Scene
     >>> class Spring(Scene):
     ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
     ...     def mass(self, q): return np.eye(1)
@@ -400,7 +400,7 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
 def contact_drift_of(scene, q, v, t):
     """``(wNbar, wTbar)`` of ``scene`` at ``(q, v, t)``: its own, or central differences.
 
-    A scene without :meth:`~moreau.scenes.base.Scene.contact_drift` gets the
+    A scene without :meth:`~moreau.model.scene.Scene.contact_drift` gets the
     derivative of its contact velocities ``W(q + s v, t + s) v + w`` at
     ``s = 0`` by a central difference (``s = 1e-6``: an error of about
     ``1e-11``, far below what the consistent start acceleration needs, which
@@ -444,7 +444,7 @@ def consistent_acceleration(scene, q, v, t, lcp_method="auto", counters=None):
     --------
     A block sliding on level ground: the contact carries its weight and brakes it by mu = 0.3:
 
-    >>> from moreau.scenes.registry import make_scene
+    >>> from moreau.model.registry import make_scene
     >>> acc, lamN = consistent_acceleration(make_scene("sliding-block"), np.zeros(2),
     ...                                     np.array([1.0, 0.0]), 0.0)
     >>> acc.round(12).tolist(), lamN.round(12).tolist()

@@ -170,7 +170,7 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.scenes.base import Scene
+    >>> from moreau.model.scene import Scene
     >>> class Drop(Scene):
     ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([1.0])
     ...     def mass(self, q): return np.eye(1)

@@ -168,7 +168,7 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.scenes.base import Scene
+    >>> from moreau.model.scene import Scene
     >>> class Spring(Scene):
     ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
     ...     def mass(self, q): return np.eye(1)

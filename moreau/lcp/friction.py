@@ -3,7 +3,7 @@
 Given the Delassus matrix ``W`` and free velocity ``v_free`` of one time step,
 the post-step contact velocities are ``v = v_free + W p`` where ``p`` stacks
 the contact impulses. Rows (and columns) of ``W``, ``v_free`` and ``p`` are in
-the order used by :class:`moreau.scenes.base.Scene`::
+the order used by :class:`moreau.model.scene.Scene`::
 
     [N_0, ..., N_{nc-1},  T_{f_0}, ..., T_{f_{nf-1}}]
 

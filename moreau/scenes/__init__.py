@@ -1,17 +1,17 @@
 """Mechanical systems ("scenes") that the integrators run.
 
 Each scene lives in its own module and registers itself there
-(:mod:`moreau.scenes.registry`); nothing here lists them. The scene classes
+(:mod:`moreau.model.registry`); nothing here lists them. The scene classes
 and their public names are reachable as attributes of this package
 (``from moreau.scenes import BouncingBall``): the first such lookup imports
-every scene module (:func:`moreau.scenes.registry.discover`).
+every scene module (:func:`moreau.model.registry.discover`).
 """
 
 import importlib
 
-from . import registry
-from .base import Scene, params_with
-from .registry import get_entry, make_scene, register_scene, scene_names
+from ..model import registry
+from ..model.scene import Scene, params_with
+from ..model.registry import get_entry, make_scene, register_scene, scene_names
 
 __all__ = ["Scene", "params_with", "registry", "get_entry", "make_scene", "register_scene",
            "scene_names"]

@@ -29,7 +29,7 @@ import math
 import numpy as np
 
 from ..errors import InputError
-from ._units import DriveUnits
+from ..model.units import DriveUnits
 
 __all__ = ["circle", "polygon", "line", "contact", "scene_state", "rod_drive_shapes"]
 

@@ -51,9 +51,9 @@ from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ._drawing import circle, contact
-from ._units import SIUnits
-from .base import Scene, params_with
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.units import SIUnits
+from ..model.scene import Scene, params_with
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
            "simultaneous_impact"]

@@ -69,15 +69,15 @@ import numpy as np
 from .. import _validate as V
 from ..errors import InputError
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
+from ..model.units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
-from .base import Scene, params_with
-from .friction_drive import FrictionDrive, FrictionDriveParams
+from .friction_drive.rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from ..model.scene import Scene, params_with
+from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["BidirectionalDriveParams", "BidirectionalDrive"]
 
@@ -393,7 +393,7 @@ class BidirectionalDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 3) =
+        (:data:`moreau.model.units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 3) =
         (``phi_a``, ``phi_b`` [rad], rotor displacement [m]), ``v`` (n, 3)
         [rad/s, rad/s, m/s], ``force_N``, ``force_T`` (n, 2) [N] (rods a, b),
         ``slip_velocity`` (n, 2) [m/s], ``gap`` (n, 2) [m], ``regime`` (n, 2)
@@ -439,5 +439,4 @@ register_scene(SceneEntry(
                "load", "restitution"),
     mj_tolerance=5e-3,
     aliases=("bidirectional",),
-    sweep="moreau.studies.bidirectional.bidirectional_sweep:command",
 ))

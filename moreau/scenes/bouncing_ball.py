@@ -28,10 +28,10 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from ._drawing import circle, contact, line
-from ._units import SIUnits, SIValues
-from .base import Scene, params_with
+from ..model.units import SIUnits, SIValues
+from ..model.scene import Scene, params_with
 from ..analysis.cases import GRID, CompareCase
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 

@@ -99,10 +99,10 @@ from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
-from .base import Scene, params_with
-from .friction_drive import FrictionDrive, FrictionDriveParams
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.units import DriveUnits
+from ..model.scene import Scene, params_with
+from .friction_drive.scene import FrictionDrive, FrictionDriveParams
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FlexibleRodDriveParams", "FlexibleRodDrive", "pinned_free_modes", "MAX_MODES"]
 
@@ -480,7 +480,7 @@ class FlexibleRodDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`; ``q`` (n, N + 2) = rod
+        (:data:`moreau.model.units.COMMON_KEYS`; ``q`` (n, N + 2) = rod
         angle [rad], modal amplitudes [m], rotor displacement [m]) and the
         named extras: ``phi`` [rad], ``x2`` [m], ``v2`` [m/s],
         ``tip_deflection`` [m] (``l psi . eta``, normal to the rod), each (n,).
@@ -664,5 +664,5 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
                "modes", "EI", "damping", "preload"),
     mj_tolerance=5e-3,
-    stress="moreau.scenes.flexible_rod_drive:stress_cases",
+    stress=stress_cases,
 ))

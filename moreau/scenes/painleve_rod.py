@@ -45,14 +45,14 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from ._drawing import contact, line
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
+from ..model.scene import Scene
+from ..model.units import SIUnits
+from ..model.scene import params_with
 from scipy.integrate import solve_ivp
 
 from ..analysis.cases import GRID, CompareCase
 from ..errors import MoreauError
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["PainleveRodParams", "PainleveRod", "painleve_critical_mu", "PAINLEVE_MU_MIN"]
 

@@ -105,9 +105,9 @@ from ..analysis.cases import DriveCase
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
-from .base import Scene, params_with
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.units import DriveUnits
+from ..model.scene import Scene, params_with
+from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["PiezoDriveParams", "PiezoDrive", "HysteresisFit", "identify_hysteresis"]
 
@@ -602,7 +602,7 @@ class PiezoDrive(DriveUnits, Scene):
     def to_si(self, result):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
-        The keys every scene gives (:data:`moreau.scenes._units.COMMON_KEYS`;
+        The keys every scene gives (:data:`moreau.model.units.COMMON_KEYS`;
         ``q`` = (rod angle [rad], rotor [m], stator [m])) and the named
         coordinates ``phi`` [rad], ``x2`` [m], ``v2`` [m/s] and, with a
         dynamic stator, ``x1`` [m], ``v1`` [m/s].

@@ -72,9 +72,9 @@ from scipy.integrate import quad, solve_ivp
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
-from ._units import SIUnits
-from .base import Scene, params_with
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.units import SIUnits
+from ..model.scene import Scene, params_with
+from ..model.registry import SceneEntry, parameters_of, register_scene
 from .sliding_box import SlidingBox
 
 __all__ = ["RockingBlockParams", "RockingBlock", "housner_ratio"]

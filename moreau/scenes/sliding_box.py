@@ -45,12 +45,12 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from ._drawing import contact, line, polygon
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
+from ..model.scene import Scene
+from ..model.units import SIUnits
+from ..model.scene import params_with
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase, flatten
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["SlidingBoxParams", "SlidingBox"]
 

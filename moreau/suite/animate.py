@@ -25,7 +25,7 @@ import os
 import numpy as np
 
 from ..errors import InputError
-from ..scenes.registry import make_scene
+from ..model.registry import make_scene
 
 __all__ = ["load_run", "animate_run", "write_animation", "frame_indices"]
 

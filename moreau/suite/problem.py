@@ -6,7 +6,7 @@ modules, so a new file is picked up by ``moreau suite`` with nothing else to
 edit. A problem states:
 
 ``scene``
-    the registered scene it runs (:mod:`moreau.scenes.registry`), with its
+    the registered scene it runs (:mod:`moreau.model.registry`), with its
     parameters;
 ``start()`` and ``window``
     the start state and the time window, in the scene's own time;
@@ -39,7 +39,7 @@ import pkgutil
 import numpy as np
 
 from ..errors import InputError
-from ..scenes.registry import make_scene
+from ..model.registry import make_scene
 
 __all__ = ["Problem", "register_problem", "get_problem", "problem_names", "problems",
            "discover", "PENDING", "crossing_time"]

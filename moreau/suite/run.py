@@ -39,7 +39,7 @@ from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_co
 
 from ..errors import InputError, Interrupted, MoreauError
 from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
-from ..scenes.registry import discover as discover_scenes
+from ..model.registry import discover as discover_scenes
 from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
 from .problem import get_problem, problem_names
 

@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 
 class DampedOscillator(Scene):

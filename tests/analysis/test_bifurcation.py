@@ -11,7 +11,7 @@ from moreau.analysis.bifurcation import (bifurcation_diagram, bifurcation_marks,
 from moreau.analysis.steady_state import find_steady_state
 from moreau.cli import main
 from moreau.errors import InputError
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from periodic_scenes import DampedOscillator
 

@@ -100,7 +100,7 @@ def test_a_walk_stalled_at_a_grazing_touchdown_says_so(monkeypatch):
     from moreau.integrators.result import Event
     from moreau.regimes import Regime
     from moreau.scenes import make_scene
-    from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+    from moreau.scenes.friction_drive.walker import ContactState, FrictionDriveWalker
     from moreau.errors import MoreauError
     sc = make_scene("friction-drive", frequency=185.0)
     q0, v0 = sc.rest_state()

@@ -18,8 +18,8 @@ from moreau.analysis.steady_state import find_steady_state
 from moreau.cli import main
 from moreau.errors import ConvergenceError, InputError
 from moreau.scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
-from moreau.scenes.registry import make_scene
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.model.registry import make_scene
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 from moreau.studies.paper.atlas import compute_atlas, point_label
 from moreau.studies.paper.tables import read_table
 

@@ -13,7 +13,7 @@ from moreau.analysis.steady_state import find_steady_state
 from moreau.cli import main
 from moreau.errors import InputError
 from moreau.scenes.friction_drive import FrictionDrive
-from moreau.scenes.friction_drive_floquet import walker_monodromy, walker_period_map_slope
+from moreau.scenes.friction_drive.floquet import walker_monodromy, walker_period_map_slope
 
 from periodic_scenes import DampedOscillator, TableBall
 

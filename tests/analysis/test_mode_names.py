@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from moreau.analysis.modes import impacts_after_flight, mode_name, step_letters
+from moreau.modes import impacts_after_flight, mode_name, step_letters
 from moreau.analysis.mj_steady_state import moreau_jean_steady_state
 from moreau.analysis.period_k import full_state_of
 from moreau.analysis.periodic_shooting import period_mode
@@ -82,8 +82,8 @@ def drive_185():
 
 @pytest.fixture(scope="module")
 def stick_slip_motor():
-    from moreau.scenes.registry import make_scene
-    from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+    from moreau.model.registry import make_scene
+    from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
     scene = make_scene("stick-slip-motor")
     return scene, stick_slip_steady_state(scene)
 
@@ -156,7 +156,7 @@ def test_the_two_rod_drive_s_swap_is_not_a_stick():
     # both rods reverse at tau = pi with everything at rest there: TDG's step recorded
     # both in stick (a mode whose forces are not determined, so the LCP decides), and the
     # sample's own velocity scale (8.8e-17) took the contacts for open
-    from moreau.scenes.registry import make_scene
+    from moreau.model.registry import make_scene
     scene = make_scene("bidirectional-drive", frequency=185.0)
     ss = find_steady_state(scene, "time-discontinuous-galerkin", statistical=False,
                            steps_per_period=400)

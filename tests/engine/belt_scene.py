@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 from moreau.compiled import CompiledModel
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 
 class BeltBlock(Scene):

@@ -6,8 +6,8 @@ import pytest
 
 from moreau.analysis.atlas import run_scene_atlas
 from moreau.cli import main
-from moreau.scenes.registry import make_scene
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.model.registry import make_scene
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 def test_every_point_is_the_scenes_steady_state():

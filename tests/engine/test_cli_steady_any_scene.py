@@ -5,8 +5,8 @@ import json
 import pytest
 
 from moreau.cli import main
-from moreau.scenes.registry import make_scene
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.model.registry import make_scene
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 def steady(capsys, *args):

@@ -8,7 +8,7 @@ import pytest
 from moreau.cli import main
 from moreau.analysis.engine import periodic_scene_names
 from moreau.scenes import registry
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
 
 
 def test_generic_sweep_of_the_stick_slip_motor_matches_single_steady_states(tmp_path):
@@ -60,13 +60,19 @@ def test_generic_sweep_refuses_bad_input_before_work(argv, message, tmp_path, ca
     assert not (tmp_path / "o").exists() or not any((tmp_path / "o").glob("*.csv"))
 
 
-def test_study_sweeps_are_named_by_their_entries_and_load():
+def test_study_sweeps_are_registered_by_their_studies():
     names = periodic_scene_names()
     assert {"friction-drive", "bidirectional-drive", "stick-slip-motor"} <= set(names)
-    for name in names:
-        hook = registry.get_entry(name).sweep
-        if hook is not None:
-            assert callable(registry.resolve_hook(hook))
+    own = {name: registry.get_entry(name).sweep for name in names}
+    assert own["friction-drive"].__module__ == "moreau.studies.paper.sweeps"
+    assert own["bidirectional-drive"].__module__ == "moreau.studies.bidirectional.bidirectional_sweep"
+    assert own["stick-slip-motor"] is None
+    assert registry.get_entry("friction-drive").atlas.__module__ == "moreau.studies.paper.atlas"
+    assert registry.get_entry("bidirectional").sweep is own["bidirectional-drive"]
     assert registry.default_scene() == "friction-drive"
-    with pytest.raises(ValueError, match="cannot be loaded"):
+    with pytest.raises(ValueError, match="must be a function"):
         registry.resolve_hook("moreau.nope:command")
+    with pytest.raises(ValueError, match="has a sweep hook already"):
+        registry.register_hook("friction-drive", "sweep", print)
+    with pytest.raises(ValueError, match="`kind` must be one of"):
+        registry.hook("friction-drive", "stress")

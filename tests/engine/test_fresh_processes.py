@@ -91,7 +91,7 @@ def test_a_module_with_an_import_circle_is_caught(tmp_path):
 
 def test_a_scene_reference_is_found_from_the_scene_module_alone():
     # the import that failed with "partially initialized module" before the registry
-    code = ("from moreau.scenes.stick_slip_exact import stick_slip_steady_state\n"
+    code = ("from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state\n"
             "from moreau.scenes.stick_slip_motor import StickSlipMotor\n"
             "print(round(stick_slip_steady_state(StickSlipMotor()).displacement_per_period, 6))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,

@@ -9,7 +9,7 @@ import pytest
 
 from moreau.errors import InputError
 from moreau.scenes import registry
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 NAMES = registry.scene_names()
 

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from moreau.integrators import _blocks, _loops, simulate
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from belt_scene import local_belt_block
 

@@ -1,6 +1,6 @@
 """Every registered scene's ``to_si(result)`` gives the same keys, shapes and units.
 
-The common keys (``moreau.scenes._units.COMMON_KEYS``) with their shapes for
+The common keys (``moreau.model.units.COMMON_KEYS``) with their shapes for
 a short run of each scene at its defaults, values checked against the
 scene's own scales; the drives keep their named coordinates as extras, equal
 to the matching columns of ``q`` and ``v``.

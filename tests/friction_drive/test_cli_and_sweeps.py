@@ -9,7 +9,7 @@ import sys
 import numpy as np
 import pytest
 
-from moreau.analysis.modes import mode_name
+from moreau.modes import mode_name
 from moreau.studies.paper.sweeps import sweep, write_csv
 from moreau.cli import main
 

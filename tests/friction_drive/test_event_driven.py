@@ -9,10 +9,10 @@ from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError, MoreauError, PainleveError
 from moreau.integrators import simulate
 from moreau.integrators.result import Event
-from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+from moreau.scenes.friction_drive.walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 TWO_PI = 2 * math.pi
 

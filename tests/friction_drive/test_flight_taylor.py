@@ -1,7 +1,7 @@
 """The friction drive's flights by compiled Taylor series, against SciPy's DOP853.
 
 The Taylor coefficients come from the recurrences of automatic
-differentiation (``moreau/scenes/_flight_taylor.py``); the independent
+differentiation (``moreau/scenes/friction_drive/_flight_taylor.py``); the independent
 computation is SciPy's DOP853 on the walker's own right-hand side at its
 tightest tolerance.
 """
@@ -17,7 +17,7 @@ from scipy.optimize import brentq
 from moreau.regimes import Regime
 from moreau.scenes import make_scene
 from moreau.scenes.friction_drive import PAPER_DEFAULTS
-from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+from moreau.scenes.friction_drive.walker import ContactState, FrictionDriveWalker
 
 F = Regime.FLIGHT
 TWO_PI = 2.0 * math.pi
@@ -113,7 +113,7 @@ def test_an_unknown_flight_method_is_refused_by_name():
 def test_the_walker_s_section_run_is_the_integrator_s_run_read_at_the_sections():
     # the classification's own run (no recording) against simulate's samples, in flight
     from moreau.integrators import simulate
-    from moreau.scenes.friction_drive_steady import walker_section_states
+    from moreau.scenes.friction_drive.steady import walker_section_states
     sc = make_scene("friction-drive", frequency=15000.0)
     q0, v0 = sc.rest_state()
     qs, vs = walker_section_states(sc, q0, v0, 0.0, 20, {})

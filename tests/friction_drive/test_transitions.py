@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from moreau.scenes.friction_drive_walker import ContactState, FrictionDriveWalker
+from moreau.scenes.friction_drive.walker import ContactState, FrictionDriveWalker
 from moreau.regimes import Regime
 from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams
 

@@ -7,7 +7,7 @@ from numba import njit
 from scipy.optimize import brentq
 
 from moreau.compiled import CompiledModel
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 
 class Oscillator(Scene):

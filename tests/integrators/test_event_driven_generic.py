@@ -9,8 +9,8 @@ from scipy.integrate import solve_ivp
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
 from moreau.integrators import INTEGRATORS, simulate
-from moreau.scenes.stick_slip_exact import stick_slip_steady_state
-from moreau.scenes.friction_drive_walker import EventDriven
+from moreau.scenes.stick_slip_motor.exact import stick_slip_steady_state
+from moreau.scenes.friction_drive.walker import EventDriven
 from moreau.integrators.event_driven_generic import EventDrivenReference, GenericEventDriven
 from moreau.regimes import Regime
 from moreau.scenes import (BouncingBall, FrictionDrive, PainleveRod, SawtoothDrive, SineDrive,

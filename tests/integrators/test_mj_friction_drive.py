@@ -83,7 +83,7 @@ from moreau.errors import ConvergenceError, InputError  # noqa: E402
 def _names(letters):
     h = TWO_PI / len(letters)
     runs = merge_step_regimes(letters, [k * h for k in range(len(letters))], h)
-    from moreau.analysis.modes import mode_name
+    from moreau.modes import mode_name
     return runs, mode_name([s for _, s in runs])
 
 

@@ -18,7 +18,7 @@ from moreau.integrators.moreau_jean import (
 from moreau.lcp import build_friction_lcp, friction_impulses, lcp_residual, solve_lcp
 from moreau.regimes import Regime
 from moreau.scenes import make_scene
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 F, P, N, S = (int(r) for r in (Regime.FLIGHT, Regime.POSITIVE, Regime.NEGATIVE, Regime.STICK))
 

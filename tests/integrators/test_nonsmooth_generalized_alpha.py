@@ -10,7 +10,7 @@ from moreau.integrators import simulate
 from moreau.integrators.nonsmooth_generalized_alpha import (alpha_coefficients,
                                                             consistent_acceleration,
                                                             contact_drift_of, mixed_projection)
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from _toy_scenes import Block, ForcedSlider, Oscillator
 

@@ -7,7 +7,7 @@ from scipy.integrate import solve_ivp
 from moreau.analysis.scheme_settings import ED_REFERENCE, make_scheme, steady_of
 from moreau.errors import InputError
 from moreau.integrators import simulate
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from _toy_scenes import Block, DampedBall, Oscillator
 

@@ -7,7 +7,7 @@ from moreau.analysis.period_k import full_state_of
 from moreau.analysis.steady_state import find_steady_state
 from moreau.errors import InputError
 from moreau.integrators import get_integrator, simulate
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from _toy_scenes import Block, Oscillator
 

@@ -9,7 +9,7 @@ from moreau.analysis.scheme_settings import ED_REFERENCE, make_scheme, steady_of
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.integrators.time_discontinuous_galerkin import LOBATTO_TABLEAUS
-from moreau.scenes.registry import make_scene
+from moreau.model.registry import make_scene
 
 from _toy_scenes import Block, Oscillator
 

@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 import moreau.integrators.moreau_jean  # noqa: F401  (registers "moreau-jean")
-from moreau.analysis.modes import mode_name
+from moreau.modes import mode_name
 from moreau.errors import InputError
 from moreau.integrators import simulate
-from moreau.scenes.stick_slip_exact import (_Walker, stick_slip_period_map,
+from moreau.scenes.stick_slip_motor.exact import (_Walker, stick_slip_period_map,
                                                      stick_slip_steady_state)
 from moreau.regimes import Regime
 from moreau.scenes.stick_slip_motor import (SawtoothDrive, SineDrive, StickSlipMotor,

@@ -27,6 +27,7 @@ from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import check_output_dir, code_version
 from ...analysis.sweep import require_xarray, write_netcdf_beside
 from ...errors import InputError
+from ...model import registry
 from ...outputs import claim_outputs
 from ...provenance import provenance
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
@@ -263,8 +264,8 @@ def params_from_args(args):
 
 
 def command(args):
-    """``moreau sweep --scene bidirectional-drive PARAM START STOP ...`` (its registry entry names
-    this function); every option is checked before any work."""
+    """``moreau sweep --scene bidirectional-drive PARAM START STOP ...`` (registered as the
+    scene's sweep hook); every option is checked before any work."""
 
     param = args.parameter
     if param not in BIDIRECTIONAL_SWEEPABLE:
@@ -314,3 +315,6 @@ def command(args):
                             n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
                             plot=not args.no_plot, force=args.force,
                             continuation=not args.cold, netcdf=getattr(args, "netcdf", False))
+
+
+registry.register_hook("bidirectional-drive", "sweep", command)

@@ -36,6 +36,7 @@ from ...analysis.classify import CLASSIFY_PERIODS
 from ...analysis.sweep import require_xarray, write_netcdf_beside
 from ...analysis.engine import ED_REFERENCE, check_output_dir, code_version, make_scheme
 from ...errors import InputError
+from ...model import registry
 from ...outputs import claim_outputs
 from ...provenance import provenance
 from ...scenes.friction_drive import PAPER_DEFAULTS
@@ -306,7 +307,8 @@ def _counts(arr):
 
 
 def command(args):
-    """``moreau atlas``: the friction drive's atlas from the parsed command-line arguments."""
+    """``moreau atlas``: the friction drive's atlas from the parsed command-line arguments
+    (registered as the scene's atlas hook)."""
     for opt in ("x10_a", "x10_b", "phase"):
         if getattr(args, opt, None) is not None:
             raise InputError(f"`--{opt.replace('_', '-')}` is not a parameter of the friction drive")
@@ -333,3 +335,5 @@ def command(args):
               force=args.force, continuation=not getattr(args, "cold", False),
               classify=classify_budget(args), netcdf=getattr(args, "netcdf", False))
 
+
+registry.register_hook("friction-drive", "atlas", command)

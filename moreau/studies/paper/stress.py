@@ -43,7 +43,7 @@ permanent stick, measurable). The stated bound is ``BOUND = 0.05`` unless a
 case says otherwise.
 
 A registered scene adds its own steady-state cases through its entry's
-``stress`` hook (:mod:`moreau.scenes.registry`); they join :data:`CASES`.
+``stress`` hook (:mod:`moreau.model.registry`); they join :data:`CASES`.
 
 The 10^7-step case runs 10^7 steps in the command (``full=True``) and 10^6
 in the quick catalogue that the tests run.
@@ -77,7 +77,7 @@ from ...errors import ConvergenceError, InputError, MoreauError
 from ...provenance import provenance
 from ...integrators import INTEGRATORS, simulate
 from ...integrators.base import scheme_options
-from ...scenes import registry
+from ...model import registry
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive
 from .valid_range import phi0_valid_range
 
@@ -593,7 +593,7 @@ def _scene_cases():
     for entry in registry.entries():
         if entry.stress is None:
             continue
-        for key, spec in registry.resolve_hook(entry.stress)().items():
+        for key, spec in entry.stress().items():
             if key in CASES or key in out:
                 raise InputError(f"scene {entry.name!r} adds the stress case {key!r}, "
                                  "which exists already")

@@ -20,6 +20,7 @@ from ...analysis import engine, steady_state
 from ...analysis import sweep as scene_sweep
 from ...analysis.engine import check_output_dir, make_scheme
 from ...errors import InputError, MoreauError
+from ...model import registry
 from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive, params_from_kwargs
 from .figures import sweep_figure
@@ -306,7 +307,7 @@ def params_from_args(args):
 
 
 def command(args):
-    """``moreau sweep`` of the paper's friction drive (its registry entry names this function).
+    """``moreau sweep`` of the paper's friction drive (registered as the scene's sweep hook).
 
     ``args`` are the parsed arguments of ``moreau sweep``; every option is
     checked before any work.
@@ -352,3 +353,6 @@ def command(args):
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
               force=args.force, continuation=not args.cold,
               netcdf=getattr(args, "netcdf", False))
+
+
+registry.register_hook("friction-drive", "sweep", command)

@@ -20,7 +20,7 @@ class StickSlipMotorProblem(Problem):
     scene = "stick-slip-motor"
     reference_kind = "closed form"
     source = ("closed-form stick and slip segments of the piecewise-polynomial drive (see "
-              "moreau.scenes.stick_slip_exact)")
+              "moreau.scenes.stick_slip_motor.exact)")
     window = 2.0 * math.pi
     tolerance = 1e-2
     steps = (100, 1000, 10000)

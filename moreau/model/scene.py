@@ -26,7 +26,7 @@ from dataclasses import fields, replace
 import numpy as np
 
 from ..errors import InputError, MoreauError
-from ._units import columns_of
+from .units import columns_of
 
 __all__ = ["Scene", "params_with"]
 
@@ -216,7 +216,7 @@ class Scene:
     def si_columns(self, result):
         """Time histories of ``result`` as ``[(name, unit, column)]``.
 
-        Scenes with SI units give them in SI (``moreau.scenes._units``); this
+        Scenes with SI units give them in SI (``moreau.model.units``); this
         default gives the scene's own units, marked dimensionless (unit ``""``):
         ``t``, ``q_i``, ``v_i``, and per contact ``force_N``, ``force_T``
         (impulses over the step for time-stepping schemes), ``slip_velocity``,

@@ -28,7 +28,7 @@ is the product, over the pieces of the steady period, of
   at times fixed by the drive alone (``f_N`` and the stick margins depend on
   ``tau`` only), so ``S = D_x g``; a re-contact (``h`` the gap) goes through
   the impact law, whose derivative is taken by a complex step through
-  :func:`~moreau.scenes.friction_drive_walker.impact_impulses`.
+  :func:`~moreau.scenes.friction_drive.walker.impact_impulses`.
 
 :func:`walker_period_map_slope` gives the same derivative by central
 differences of the walker's period map, the check of the saltation product.
@@ -50,9 +50,9 @@ import math
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from ..errors import ConvergenceError, InputError, MoreauError
-from ..regimes import Regime
-from .friction_drive_walker import ContactState, FrictionDriveWalker, impact_impulses
+from ...errors import ConvergenceError, InputError, MoreauError
+from ...regimes import Regime
+from .walker import ContactState, FrictionDriveWalker, impact_impulses
 
 __all__ = ["walker_monodromy", "walker_period_map_slope", "GrazingEvent"]
 

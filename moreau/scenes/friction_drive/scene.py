@@ -78,20 +78,20 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from .. import _validate as V
-from ..errors import InputError, MoreauError
-from ..regimes import Regime
-from ._drawing import rod_drive_shapes
-from ._units import DriveUnits
+from ... import _validate as V
+from ...errors import InputError, MoreauError
+from ...regimes import Regime
+from .._drawing import rod_drive_shapes
+from ...model.units import DriveUnits
 from numba import njit
 
-from ..compiled import CompiledModel
-from ._rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
-from .base import Scene, params_with
-from ..analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
-from ..analysis.steady_state import find_steady_state
-from ..integrators import simulate
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ...compiled import CompiledModel
+from .rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from ...model.scene import Scene, params_with
+from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
+from ...analysis.steady_state import find_steady_state
+from ...integrators import simulate
+from ...model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
@@ -377,7 +377,7 @@ class FrictionDrive(DriveUnits, Scene):
         """SI time histories of a :class:`SimulationResult` of this scene.
 
         Returns a dict with the keys every scene gives
-        (:data:`moreau.scenes._units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 2) =
+        (:data:`moreau.model.units.COMMON_KEYS`): ``t`` [s], ``q`` (n, 2) =
         (rod angle [rad], rotor displacement [m]), ``v`` (n, 2) [rad/s, m/s],
         ``force_N``, ``force_T`` (n, 1) [N], ``slip_velocity`` (n, 1) [m/s],
         ``gap`` (n, 1) [m], ``regime`` (n, 1) codes; and the drive's named
@@ -522,9 +522,5 @@ register_scene(SceneEntry(
     sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
                "preload"),
     mj_tolerance=5e-3,
-    # the paper's sweep, with its valid-range marks and default ranges
-    sweep="moreau.studies.paper.sweeps:command",
-    # the paper's (f, mu) and (f, phi0) planes, with the valid-range curves
-    atlas="moreau.studies.paper.atlas:command",
     default=True,
 ))

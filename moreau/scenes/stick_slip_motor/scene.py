@@ -35,16 +35,16 @@ import numpy as np
 
 from numba import njit
 
-from ..compiled import CompiledModel
-from .._validate import finite_scalar, in_closed_interval, in_open_interval, positive
-from ..errors import InputError
-from ._drawing import contact, polygon
-from .base import Scene
-from ._units import SIUnits
-from .base import params_with
-from ..analysis.cases import GRID, CompareCase, regime_switches
-from ..integrators import get_integrator, simulate
-from .registry import Parameter, SceneEntry, parameters_of, register_scene
+from ...compiled import CompiledModel
+from ..._validate import finite_scalar, in_closed_interval, in_open_interval, positive
+from ...errors import InputError
+from .._drawing import contact, polygon
+from ...model.scene import Scene
+from ...model.units import SIUnits
+from ...model.scene import params_with
+from ...analysis.cases import GRID, CompareCase, regime_switches
+from ...integrators import get_integrator, simulate
+from ...model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["StickSlipMotorParams", "StickSlipMotor", "SineDrive", "SawtoothDrive"]
 

@@ -12,17 +12,17 @@ import time
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from .._validate import positive, positive_int
-from ..analysis.energy import RodEnergy, balance, gauss_legendre, register_energy_audit
-from ..analysis.section_runs import register_section_run
-from ..analysis.steady_solvers import register_steady_solver
-from ..errors import ConvergenceError
-from ..integrators.result import SteadyState
-from ..modes import mode_name
-from ..regimes import REGIME_LETTERS, Regime
-from ..analysis.floquet import sorted_multipliers
-from .friction_drive_floquet import GrazingEvent, walker_monodromy, walker_period_map_slope
-from .friction_drive_walker import ContactState, FrictionDriveWalker
+from ..._validate import positive, positive_int
+from ...analysis.energy import RodEnergy, balance, gauss_legendre, register_energy_audit
+from ...analysis.section_runs import register_section_run
+from ...analysis.steady_solvers import register_steady_solver
+from ...errors import ConvergenceError
+from ...integrators.result import SteadyState
+from ...modes import mode_name
+from ...regimes import REGIME_LETTERS, Regime
+from ...analysis.floquet import sorted_multipliers
+from .floquet import GrazingEvent, walker_monodromy, walker_period_map_slope
+from .walker import ContactState, FrictionDriveWalker
 
 __all__ = ["walker_steady_state", "walker_energy_audit"]
 
@@ -175,7 +175,7 @@ def walker_steady_state(scene, rtol=1e-10, v_guess=None, max_iter=60, guess=None
     by default the rotor velocity of ``guess`` (a neighbouring point's
     steady state, continuation) or else the tip's velocity.
     The Floquet multiplier of the map comes from the saltation matrices of
-    the period's events (:mod:`moreau.scenes.friction_drive_floquet`);
+    the period's events (:mod:`moreau.scenes.friction_drive.floquet`);
     ``floquet=False`` skips them (``floquet_multipliers`` stays unset).
     """
     rtol = positive("rtol", rtol)

@@ -14,7 +14,7 @@ each slip regime is expanded once in a Fourier series whose truncation error
 is below round-off; its first and second antiderivatives are then exact, so
 slip segments are integrated in closed form. Flight segments (the rod swings
 freely) are integrated with compiled Taylor series at tight tolerance
-(:mod:`moreau.scenes._flight_taylor`; SciPy's DOP853 on request); re-contact
+(:mod:`moreau.scenes.friction_drive._flight_taylor`; SciPy's DOP853 on request); re-contact
 is an impact with Newton's restitution coefficient and Coulomb friction.
 """
 
@@ -24,11 +24,11 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq, minimize_scalar
 
-from .._validate import positive_int, relative_tolerance
-from ..errors import InputError, MoreauError, PainleveError
-from ..regimes import Regime
-from ..integrators.base import Integrator, register_integrator
-from ..integrators.result import Event
+from ..._validate import positive_int, relative_tolerance
+from ...errors import InputError, MoreauError, PainleveError
+from ...regimes import Regime
+from ...integrators.base import Integrator, register_integrator
+from ...integrators.result import Event
 from ._flight_taylor import CAPACITY as FLIGHT_CAPACITY, ORDER as FLIGHT_ORDER
 from ._flight_taylor import FAILED as _FT_FAILED, FULL as _FT_FULL
 from ._flight_taylor import NEVER_CLEARED as _FT_NEVER_CLEARED, RECONTACT as _FT_RECONTACT
@@ -137,7 +137,7 @@ def impact_impulses(sc, mu, e, tau, phi, dphi, du2, sin=math.sin, cos=math.cos):
     ``sin`` and ``cos`` may be complex functions (``cmath``): the case
     analysis compares real parts only, so a complex-step derivative of the
     post-impact state follows the branch of the real impact
-    (:mod:`moreau.scenes.friction_drive_floquet` takes its saltation
+    (:mod:`moreau.scenes.friction_drive.floquet` takes its saltation
     matrices that way).
 
     Examples
@@ -199,7 +199,7 @@ class FrictionDriveWalker:
         an elastic rod that bounces once a period runs for as long as asked.
     flight_method : {"taylor", "dop853"}
         Flight segments by the compiled Taylor series (the default, see
-        :mod:`moreau.scenes._flight_taylor`) or by SciPy's DOP853 at ``rtol``
+        :mod:`moreau.scenes.friction_drive._flight_taylor`) or by SciPy's DOP853 at ``rtol``
         (slower by about two orders; kept as the cross-check).
 
     Notes
@@ -528,7 +528,7 @@ class FrictionDriveWalker:
 
         Returns ``(state_at_end, recontact, sol)``; ``sol`` is the dense output
         when requested. The compiled Taylor series of
-        :mod:`moreau.scenes._flight_taylor` by default; with
+        :mod:`moreau.scenes.friction_drive._flight_taylor` by default; with
         ``flight_method="dop853"`` SciPy's DOP853 (the cross-check).
         """
         self.counters["flight_segments"] += 1

@@ -30,12 +30,12 @@ import time as _time
 import numpy as np
 from scipy.optimize import brentq
 
-from ..errors import ConvergenceError, InputError
-from ..modes import mode_name
-from ..regimes import Regime
-from ..integrators.base import Integrator, register_integrator
-from ..integrators.result import Event, SteadyState
-from .stick_slip_motor import TWO_PI, StickSlipMotor
+from ...errors import ConvergenceError, InputError
+from ...modes import mode_name
+from ...regimes import Regime
+from ...integrators.base import Integrator, register_integrator
+from ...integrators.result import Event, SteadyState
+from .scene import TWO_PI, StickSlipMotor
 
 __all__ = ["StickSlipReference", "stick_slip_steady_state", "stick_slip_period_map"]
 

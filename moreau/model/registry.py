@@ -1,10 +1,14 @@
 """The scene registry: every scene is one entry, registered by its own module.
 
 A scene module ends with one call to :func:`register_scene`; nothing else in
-the package lists or names the scene. The package discovers the modules of
-:mod:`moreau.scenes` when it is imported (:func:`discover`), so a new file
-with a registered scene is picked up by every command and analysis
-(``moreau scenes``, ``moreau compare --scene NAME``, the conformance tests).
+the package lists or names the scene. The registry discovers the modules of
+:mod:`moreau.scenes` on first use (:func:`discover`), so a new file with a
+registered scene is picked up by every command and analysis (``moreau
+scenes``, ``moreau compare --scene NAME``, the conformance tests).
+
+The registry sits on the ground floor (:mod:`moreau.model`): the schemes and
+analyses below the scenes find them here by name and never import them. It
+imports the scene and study packages by name only, on discovery.
 
 An entry holds:
 
@@ -32,28 +36,32 @@ An entry holds:
     how close Moreau–Jean at the conformance test's step must come to the
     reference (relative to the motion's scale): the scene's stated
     tolerance for the conformance suite.
-``sweep``
-    ``"module:function"`` of the scene's own study sweep, which ``moreau
-    sweep --scene NAME`` runs with its parsed arguments instead of the
-    generic one (:mod:`moreau.analysis.sweep`); None for the generic sweep.
 ``default``
     the scene commands take when none is named (one scene: the paper's).
-``atlas``
-    ``"module:function"`` of the scene's own atlas, which ``moreau atlas
-    --scene NAME`` runs with its parsed arguments when no plane is given
-    (``--x``, ``--y``: the generic atlas, :mod:`moreau.analysis.atlas`); None
-    where the scene has none.
 ``stress``
-    ``"module:function"`` returning the scene's cases for the stress
+    a function returning the scene's cases for the stress
     catalogue (:mod:`moreau.studies.paper.stress`): ``{case_id: {"title",
     "scene", "steps", "bound"}}`` with ``scene`` a callable building the
     scene, and optionally ``reference`` (a callable returning the steady
     state that stands for the event-driven one) with ``note`` saying what it
     is; None where the scene adds none.
 
+A study of one scene registers its own hooks (:func:`register_hook`), and
+the entry finds them by the scene's name (``entry.sweep``, ``entry.atlas``;
+:func:`hook`):
+
+``sweep``
+    the scene's own study sweep, which ``moreau sweep --scene NAME`` runs
+    with its parsed arguments instead of the generic one
+    (:mod:`moreau.analysis.sweep`); None for the generic sweep.
+``atlas``
+    the scene's own atlas, which ``moreau atlas --scene NAME`` runs with its
+    parsed arguments when no plane is given (``--x``, ``--y``: the generic
+    atlas, :mod:`moreau.analysis.atlas`); None where the scene has none.
+
 Examples
 --------
->>> from moreau.scenes import registry
+>>> from moreau.model import registry
 >>> "bouncing-ball" in registry.scene_names()
 True
 >>> ball = registry.make_scene("bouncing-ball", restitution=0.8)
@@ -76,7 +84,7 @@ from ..errors import InputError
 
 __all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
            "make_scene", "discover", "scene_modules", "parameters_of", "describe", "default_scene",
-           "resolve_hook"]
+           "register_hook", "hook", "resolve_hook", "HOOK_KINDS"]
 
 
 class Parameter(NamedTuple):
@@ -103,10 +111,18 @@ class SceneEntry:
     mj_tolerance: float = 1e-2
     #: former names that commands still accept
     aliases: tuple = ()
-    sweep: Optional[str] = None
     default: bool = False
-    atlas: Optional[str] = None
-    stress: Optional[str] = None
+    stress: Optional[Callable] = None
+
+    @property
+    def sweep(self):
+        """The scene's own sweep, registered by its study (:func:`register_hook`), or None."""
+        return hook(self.name, "sweep")
+
+    @property
+    def atlas(self):
+        """The scene's own atlas, registered by its study (:func:`register_hook`), or None."""
+        return hook(self.name, "atlas")
 
     def parameter_names(self):
         return tuple(p.name for p in self.parameters)
@@ -134,6 +150,9 @@ def register_scene(entry):
             entry.factory, "__module__", None):
         raise InputError(f"a scene named {entry.name!r} is registered already "
                          f"(by {old.factory.__module__})")
+    if entry.stress is not None and not callable(entry.stress):
+        raise InputError(f"`stress` of scene {entry.name!r} must be a function, got "
+                         f"{entry.stress!r}")
     names = [p.name for p in entry.parameters]
     if len(set(names)) != len(names):
         raise InputError(f"scene {entry.name!r} lists a parameter twice: {names}")
@@ -143,11 +162,16 @@ def register_scene(entry):
     return entry
 
 
+#: the package whose public modules are the scenes; imported by name on discovery, so that
+#: this module stays on the ground floor, below the scenes that register themselves here
+SCENE_PACKAGE = "moreau.scenes"
+
+
 def scene_modules():
-    """Names of the public modules of :mod:`moreau.scenes` (private ``_name`` ones and this one left out)."""
-    package = importlib.import_module(__package__)
-    return [f"{__package__}.{info.name}" for info in pkgutil.iter_modules(package.__path__)
-            if not info.name.startswith("_") and info.name not in ("registry", "base")]
+    """Names of the public modules of :mod:`moreau.scenes` (private ``_name`` ones left out)."""
+    package = importlib.import_module(SCENE_PACKAGE)
+    return [f"{SCENE_PACKAGE}.{info.name}" for info in pkgutil.iter_modules(package.__path__)
+            if not info.name.startswith("_")]
 
 
 _discovered = False
@@ -196,21 +220,86 @@ def default_scene():
     return names[0]
 
 
-def resolve_hook(path):
-    """The function named by ``"module:function"`` (a registry entry's hook), imported on use.
+#: the kinds of hook a study registers for a scene (see the module docstring)
+HOOK_KINDS = ("sweep", "atlas")
+
+#: the package whose modules are the studies; imported by name when a hook is first asked for
+STUDY_PACKAGE = "moreau.studies"
+
+_HOOKS = {}
+_studies_discovered = False
+
+
+def register_hook(scene, kind, function):
+    """Make ``function`` the ``kind`` hook (one of :data:`HOOK_KINDS`) of ``scene``; return it.
+
+    A study module calls this once for the scene it studies, so that
+    ``moreau sweep --scene NAME`` (or ``moreau atlas``) runs the study's
+    own function. A second registration must come from the same module (a
+    module reloaded).
 
     Examples
     --------
-    >>> resolve_hook("math:sqrt")(4.0)
+    >>> register_hook("bouncing-ball", "plot", print)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `kind` must be one of 'sweep', 'atlas'; got 'plot'
+    """
+    if kind not in HOOK_KINDS:
+        known = ", ".join(repr(k) for k in HOOK_KINDS)
+        raise InputError(f"`kind` must be one of {known}; got {kind!r}")
+    if not callable(function):
+        raise InputError(f"`function` must be callable, got {function!r}")
+    name = get_entry(scene).name
+    old = _HOOKS.get((name, kind))
+    if old is not None and getattr(old, "__module__", None) != getattr(function, "__module__",
+                                                                          None):
+        raise InputError(f"scene {name!r} has a {kind} hook already (from {old.__module__})")
+    _HOOKS[(name, kind)] = function
+    return function
+
+
+def _discover_studies():
+    global _studies_discovered
+    if not _studies_discovered:
+        _studies_discovered = True
+        package = importlib.import_module(STUDY_PACKAGE)
+        for info in pkgutil.walk_packages(package.__path__, f"{STUDY_PACKAGE}."):
+            importlib.import_module(info.name)
+
+
+def hook(scene, kind):
+    """The ``kind`` hook a study registered for ``scene`` (:func:`register_hook`), or None.
+
+    The first call imports every module of :mod:`moreau.studies`, so that each
+    registers its hooks.
+
+    Examples
+    --------
+    >>> hook("friction-drive", "sweep").__module__
+    'moreau.studies.paper.sweeps'
+    >>> hook("bouncing-ball", "atlas") is None
+    True
+    """
+    if kind not in HOOK_KINDS:
+        known = ", ".join(repr(k) for k in HOOK_KINDS)
+        raise InputError(f"`kind` must be one of {known}; got {kind!r}")
+    name = get_entry(scene).name
+    _discover_studies()
+    return _HOOKS.get((name, kind))
+
+
+def resolve_hook(function):
+    """The function a hook stands for: the hook itself, checked to be callable.
+
+    Examples
+    --------
+    >>> resolve_hook(abs)(-2.0)
     2.0
     """
-    module, sep, name = str(path).partition(":")
-    if not sep:
-        raise InputError(f"a hook must read 'module:function', got {path!r}")
-    try:
-        return getattr(importlib.import_module(module), name)
-    except (ImportError, AttributeError) as exc:
-        raise InputError(f"the hook {path!r} cannot be loaded: {exc}") from None
+    if not callable(function):
+        raise InputError(f"a hook must be a function, got {function!r}")
+    return function
 
 
 def make_scene(name, **params):
