@@ -232,7 +232,7 @@ class Scene:
         """Primitive shapes of the scene at SI coordinates ``q`` and time ``t`` [s].
 
         Each scene that can be drawn (``moreau animate``) overrides this; the
-        shapes and their units are those of :mod:`moreau.scenes._drawing`.
+        shapes and their units are those of :mod:`moreau.model.drawing`.
         This default refuses, naming the scene.
         """
         raise MoreauError(f"scene {self.name!r} ({type(self).__name__}) cannot be drawn: it "

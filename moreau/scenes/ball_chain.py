@@ -50,7 +50,7 @@ from .._validate import (finite_array, finite_scalar, in_closed_interval, nonneg
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
-from ._drawing import circle, contact
+from ..model.drawing import circle, contact
 from ..model.units import SIUnits
 from ..model.scene import Scene, params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene

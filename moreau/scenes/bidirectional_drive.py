@@ -68,7 +68,7 @@ import numpy as np
 
 from .. import _validate as V
 from ..errors import InputError
-from ._drawing import rod_drive_shapes
+from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from numba import njit
 

@@ -27,7 +27,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
-from ._drawing import circle, contact, line
+from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
 from ..model.scene import Scene, params_with
 from ..analysis.cases import GRID, CompareCase

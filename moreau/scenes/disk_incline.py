@@ -39,8 +39,8 @@ from .._validate import finite_array, in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
 from ..model.planar import Circle, HalfPlane, Model
-from .base import params_with
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.scene import params_with
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact"]
 

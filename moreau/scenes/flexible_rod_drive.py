@@ -98,7 +98,7 @@ from ..compiled import CompiledModel
 from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
-from ._drawing import rod_drive_shapes
+from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.scene import Scene, params_with
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams

@@ -104,7 +104,7 @@ from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
-from ._drawing import rod_drive_shapes
+from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.scene import Scene, params_with
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene

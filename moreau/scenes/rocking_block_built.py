@@ -29,8 +29,8 @@ import numpy as np
 
 from ..analysis.cases import GRID
 from ..model.planar import HalfPlane, Model, Polygon
-from .base import params_with
-from .registry import SceneEntry, parameters_of, register_scene
+from ..model.scene import params_with
+from ..model.registry import SceneEntry, parameters_of, register_scene
 from .rocking_block import RockingBlock, RockingBlockCase, RockingBlockParams
 
 __all__ = ["rocking_block_model", "rocking_block_built"]

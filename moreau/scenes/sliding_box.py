@@ -44,7 +44,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
-from ._drawing import contact, line, polygon
+from ..model.drawing import contact, line, polygon
 from ..model.scene import Scene
 from ..model.units import SIUnits
 from ..model.scene import params_with

@@ -8,7 +8,7 @@ from moreau.cli import main
 from moreau.errors import InputError, MoreauError
 from moreau.scenes import registry
 from moreau.integrators.result import SimulationResult
-from moreau.scenes._drawing import scene_state
+from moreau.model.drawing import scene_state
 from moreau.model.scene import Scene
 from moreau.suite.animate import animate_run
 

@@ -10,9 +10,9 @@ import numpy as np
 from ..._validate import finite_scalar, in_closed_interval, nonnegative, positive
 from ...compiled import CompiledModel
 from ...errors import InputError
-from ...scenes._drawing import circle, contact, line, polygon
-from ...scenes._units import SIUnits
-from ...scenes.base import Scene
+from ..drawing import circle, contact, line, polygon
+from ..units import SIUnits
+from ..scene import Scene
 from . import _codegen
 from . import _kernels as K
 

@@ -38,7 +38,7 @@ from numba import njit
 from ...compiled import CompiledModel
 from ..._validate import finite_scalar, in_closed_interval, in_open_interval, positive
 from ...errors import InputError
-from .._drawing import contact, polygon
+from ...model.drawing import contact, polygon
 from ...model.scene import Scene
 from ...model.units import SIUnits
 from ...model.scene import params_with
