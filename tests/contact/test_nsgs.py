@@ -100,7 +100,7 @@ def test_apgd_matches_lemke_on_random_problems():
             continue
         done += 1
         assert np.max(np.abs(res.r - r_ref)) <= 1e-6 * (1.0 + np.abs(r_ref).max())
-    assert done >= 25
+    assert done >= 28   # 300 of 300 converged in a seeded trial
 
 
 def test_warm_start_from_the_solution_needs_no_sweep():
