@@ -175,7 +175,7 @@ def project_cone(mu, rn, rt):
     Examples
     --------
     >>> project_cone(0.5, 1.0, 2.0)
-    (0.8, 0.4)
+    (1.6, 0.8)
     >>> project_cone(0.5, -1.0, 0.1)
     (0.0, 0.0)
     """
