@@ -42,15 +42,22 @@ from moreau import _jit_cache
 from moreau._validate import finite_array
 from moreau.errors import InputError
 
+#: numba's cache pickles the module's name with the machine code; a copy of this file imported
+#: under another name (pytest's doctest collection imports a module outside a regular package
+#: by its bare file name) would write entries that the package cannot load, so only the
+#: package's own import caches
+_CACHE = __name__.startswith("moreau.")
+
 __all__ = ["IterativeResult", "check_problem", "project_cone", "local_solve", "natural_map",
            "problem_residual", "delassus", "disk_jacobian", "chain_impact_problem",
            "stacked_disks_problem", "DENSE_CROSSOVER"]
 
-#: below this many contacts a dense ``W`` is as fast as CSR in an NSGS sweep (measured by
-#: ``benchmarks/bench_contact_solvers.py --crossover``: the per-sweep times cross between
-#: 20 and 40 contacts on this machine); :func:`delassus` returns CSR at any size, and a caller
-#: that wants a dense matrix for Lemke below this size calls ``.toarray()``
-DENSE_CROSSOVER = 32
+#: contacts below which the dense path (``W`` dense, the friction LCP, Lemke) is the faster
+#: one: ``benchmarks/bench_contact_solvers.py --crossover`` timed it equal to NSGS (CSR, to
+#: 1e-10) at 16 contacts and 2x slower at 32 on short frictional chains (``W`` positive
+#: definite, Lemke's best case; on hyperstatic stacks Lemke took 0.9 s at 18 contacts).
+#: :func:`delassus` returns CSR at any size; a caller picking Lemke below this size densifies
+DENSE_CROSSOVER = 20
 
 
 class IterativeResult:
@@ -164,7 +171,7 @@ def diagonal_blocks(W):
 
 # -- the cone, the local problem, the residual ---------------------------------------------------
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def project_cone(mu, rn, rt):
     """Euclidean projection of ``(rn, rt)`` onto ``{|r_T| <= mu r_N}``.
 
@@ -188,7 +195,7 @@ def project_cone(mu, rn, rt):
     return t, math.copysign(mu * t, rt)
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def _local_residual_sq(Wnn, Wnt, Wtn, Wtt, bn, bt, mu, rn, rt):
     un = Wnn * rn + Wnt * rt + bn
     ut = Wtn * rn + Wtt * rt + bt
@@ -196,7 +203,7 @@ def _local_residual_sq(Wnn, Wnt, Wtn, Wtt, bn, bt, mu, rn, rt):
     return (rn - pn) ** 2 + (rt - pt) ** 2
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def local_solve(Wnn, Wnt, Wtn, Wtt, bn, bt, mu):
     """Exact solution of one 2D contact: ``u = [[Wnn, Wnt], [Wtn, Wtt]] r + b``, Coulomb.
 
@@ -246,14 +253,14 @@ def local_solve(Wnn, Wnt, Wtn, Wtt, bn, bt, mu):
     return best_n, best_t
 
 
-@njit(cache=True, inline="always")
+@njit(cache=_CACHE, inline="always")
 def _two_sum(a, b):
     s = a + b
     bb = s - a
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=_CACHE, inline="always")
 def _two_prod(a, b):
     # Dekker's splitting (no fused multiply-add in numba's portable code)
     p = a * b
@@ -266,7 +273,7 @@ def _two_prod(a, b):
     return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def velocities_compensated(indptr, indices, data, q, r, u):
     """``u = W r + q`` row by row with compensated sums (Ogita, Rump, Oishi 2005, Dot2)."""
     n = q.shape[0]
@@ -280,7 +287,7 @@ def velocities_compensated(indptr, indices, data, q, r, u):
         u[i] = s + c
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def velocities(indptr, indices, data, q, r, u):
     """``u = W r + q`` (plain float sums, for the solvers' inner checks)."""
     n = q.shape[0]
@@ -291,7 +298,7 @@ def velocities(indptr, indices, data, q, r, u):
         u[i] = s
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def natural_map(r, u, mu):
     """``||F(r)||_2^2`` of the natural map, given ``u = W r + q``; ``inf`` if not finite."""
     nc = mu.shape[0]

@@ -36,10 +36,16 @@ from moreau.contact._sparse import (IterativeResult, check_problem, natural_map,
                                     velocities)
 from moreau.errors import InputError
 
+#: numba's cache pickles the module's name with the machine code; a copy of this file imported
+#: under another name (pytest's doctest collection imports a module outside a regular package
+#: by its bare file name) would write entries that the package cannot load, so only the
+#: package's own import caches
+_CACHE = __name__.startswith("moreau.")
+
 __all__ = ["solve_apgd", "lipschitz_bound"]
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def _power(indptr, indices, data, iters, seed_vec):
     x = seed_vec.copy()
     y = np.empty_like(x)
@@ -71,7 +77,7 @@ def lipschitz_bound(W, iters=30):
     return min(gersh, 1.1 * est) if est > 0.0 else gersh
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def _apgd(indptr, indices, data, q, mu, x, L, max_iter, check_every, tol_abs, hist_it, hist_res,
           best_r):
     nc = mu.shape[0]

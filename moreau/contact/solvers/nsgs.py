@@ -28,10 +28,16 @@ from moreau.contact._sparse import (IterativeResult, check_problem, diagonal_blo
                                     natural_map, project_cone, velocities)
 from moreau.errors import InputError
 
+#: numba's cache pickles the module's name with the machine code; a copy of this file imported
+#: under another name (pytest's doctest collection imports a module outside a regular package
+#: by its bare file name) would write entries that the package cannot load, so only the
+#: package's own import caches
+_CACHE = __name__.startswith("moreau.")
+
 __all__ = ["solve_nsgs"]
 
 
-@njit(cache=True)
+@njit(cache=_CACHE)
 def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_abs, omega,
           hist_it, hist_res, best_r):
     nc = mu.shape[0]
