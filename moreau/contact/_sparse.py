@@ -52,12 +52,13 @@ __all__ = ["IterativeResult", "check_problem", "project_cone", "local_solve", "n
            "problem_residual", "delassus", "disk_jacobian", "chain_impact_problem",
            "stacked_disks_problem", "DENSE_CROSSOVER"]
 
-#: contacts below which the dense path (``W`` dense, the friction LCP, Lemke) is the faster
-#: one: ``benchmarks/bench_contact_solvers.py --crossover`` timed it equal to NSGS (CSR, to
-#: 1e-10) at 16 contacts and 2x slower at 32 on short frictional chains (``W`` positive
-#: definite, Lemke's best case; on hyperstatic stacks Lemke took 0.9 s at 18 contacts).
-#: :func:`delassus` returns CSR at any size; a caller picking Lemke below this size densifies
-DENSE_CROSSOVER = 20
+#: contacts up to which the dense path (``W`` dense, the friction LCP, Lemke) is as fast as
+#: the sparse one: ``benchmarks/bench_contact_solvers.py --crossover`` timed the two equal
+#: between 16 and 32 contacts on short frictional chains (two runs; ``W`` positive definite,
+#: Lemke's best case) and NSGS (CSR, to 1e-10) 3x faster at 64, 10x at 128; on hyperstatic
+#: stacks Lemke took 0.9 s at 18 contacts. :func:`delassus` returns CSR at any size; a
+#: caller picking Lemke up to this size densifies
+DENSE_CROSSOVER = 32
 
 
 class IterativeResult:
