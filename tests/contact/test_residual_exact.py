@@ -4,9 +4,13 @@ Every float is a rational number; ``u = W r + q``, the cone projection
 (``t = (r_N + mu |r_T|) / (1 + mu^2)`` on the edge: no square root) and the
 sum of squares of the natural map are computed exactly with ``Fraction``
 from the very floats the solver returned; only the final square root is
-rounded. The reported ``residual_abs`` must agree to a few units of rounding
-of its own size, which the compensated sums promise even where ``u`` is the
-difference of large terms.
+rounded. With ``u`` from compensated sums (exact to a rounding of ``u``),
+each entry of ``F = r - P_K(r - u_hat)`` is computed in a few operations on
+numbers of the size of ``r_i`` and ``u_i``, so the reported ``residual_abs``
+is the exact one to within ``c eps (||r|| + (1 + mu_max) ||u||)``; the test
+takes ``c = 16``. (A residual of 1e-8 with impulses of size 1 is thus exact
+to seven digits; the first trial of a relative 1e-12 failed at 3.5e-10, the
+rounding of ``r - (r - u)`` where a contact sticks.)
 """
 
 import math
@@ -65,9 +69,14 @@ def _sample():
 def test_reported_residual_is_exact_to_rounding():
     for name, (W, q, mu), res in _sample():
         exact = exact_residual_abs(W, q, mu, res.r)
-        assert exact > 0.0, name
-        assert res.residual_abs == pytest.approx(exact, rel=1e-12), name
-        assert res.residual == pytest.approx(exact / (1.0 + np.linalg.norm(q)), rel=1e-12), name
+        if name == "stack-budget":
+            assert exact > 1e-6, name   # stopped far from a solution: a real number to compare
+        eps = np.finfo(float).eps
+        bound = 16 * eps * (np.linalg.norm(res.r) + (1 + mu.max()) * np.linalg.norm(res.u))
+        assert abs(res.residual_abs - exact) <= bound, name
+        scale = 1.0 + np.linalg.norm(q)
+        assert res.residual == pytest.approx(res.residual_abs / scale, rel=1e-15), name
         if res.converged:
             # "a residual reported as 1e-8 is 1e-8": the exact one meets the tolerance too
-            assert exact / (1.0 + np.linalg.norm(q)) <= res.tol * (1 + 1e-12), name
+            assert exact / scale <= res.tol + bound / scale, name
+            assert bound / scale <= 1e-3 * res.tol, name
