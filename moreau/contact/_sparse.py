@@ -183,6 +183,7 @@ def project_cone(mu, rn, rt):
 
     Examples
     --------
+    >>> from moreau.contact._sparse import project_cone
     >>> project_cone(0.5, 1.0, 2.0)
     (1.6, 0.8)
     >>> project_cone(0.5, -1.0, 0.1)
@@ -218,6 +219,7 @@ def local_solve(Wnn, Wnt, Wtn, Wtt, bn, bt, mu):
     --------
     A unit block pushed into the ground at speed 1 while sliding at 1, ``mu = 0.5``:
 
+    >>> from moreau.contact._sparse import local_solve
     >>> local_solve(1.0, 0.0, 0.0, 1.0, -1.0, 1.0, 0.5)
     (1.0, -0.5)
     """
@@ -341,6 +343,7 @@ def problem_residual(W, q, mu, r):
 
     Examples
     --------
+    >>> from moreau.contact._sparse import problem_residual
     >>> res, res_abs, u = problem_residual([[1.0, 0.0], [0.0, 1.0]], [-1.0, 1.0], [0.5], [1.0, -0.5])
     >>> res, u.tolist()
     (0.0, [0.0, 0.5])

@@ -68,6 +68,7 @@ def lipschitz_bound(W, iters=30):
     Examples
     --------
     >>> import scipy.sparse as sps
+    >>> from moreau.contact.solvers.apgd import lipschitz_bound
     >>> round(lipschitz_bound(sps.csr_array([[2.0, 1.0], [1.0, 2.0]])), 6)
     3.0
     """
@@ -164,6 +165,7 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     Examples
     --------
     >>> import numpy as np
+    >>> from moreau.contact.solvers.apgd import solve_apgd
     >>> W = np.array([[2.0, 0.5, 1.0, 0.5], [0.5, 2.0, 0.5, 1.0],
     ...               [1.0, 0.5, 2.0, 0.5], [0.5, 1.0, 0.5, 2.0]])
     >>> res = solve_apgd(W, [-1.0, 0.2, -1.0, 0.2], [0.3, 0.3], tol=1e-10)

@@ -131,6 +131,7 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     Two contacts of a block on the ground, pushed down and sideways:
 
     >>> import numpy as np
+    >>> from moreau.contact.solvers.nsgs import solve_nsgs
     >>> W = np.array([[2.0, 0.5, 1.0, 0.5], [0.5, 2.0, 0.5, 1.0],
     ...               [1.0, 0.5, 2.0, 0.5], [0.5, 1.0, 0.5, 2.0]])
     >>> res = solve_nsgs(W, [-1.0, 0.2, -1.0, 0.2], [0.3, 0.3], tol=1e-12)
