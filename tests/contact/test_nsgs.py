@@ -164,3 +164,14 @@ def test_bad_input_is_refused_before_work():
         solve_nsgs(W, np.zeros(4), [0.1, 0.1], omega=2.0)
     with pytest.raises(InputError, match="`max_iter`"):
         solve_apgd(W, np.zeros(4), [0.1, 0.1], max_iter=0)
+
+
+@pytest.mark.parametrize("name", ["nsgs", "apgd"])
+def test_contacts_that_no_impulse_moves(name):
+    # W = 0 (two fixed bodies): approaching contacts cannot be helped, and the solver says so
+    W = np.zeros((4, 4))
+    res = SOLVERS[name](W, [-1.0, 0.0, 0.5, 0.0], [0.3, 0.3], tol=1e-10)
+    assert res.status == "not converged" and np.all(np.isfinite(res.r))
+    assert res.residual_abs == pytest.approx(1.0)   # r = 0, u_hat = (-1, 0): F = -P_K((1, 0))
+    res = SOLVERS[name](W, [1.0, 0.0, 0.5, 0.0], [0.3, 0.3], tol=1e-10)
+    assert res.converged and np.all(res.r == 0.0)
