@@ -34,7 +34,7 @@ _ENV = {**os.environ,
 #: matplotlib and tqdm, core dependencies in pyproject.toml that stay lazy: a figure
 #: function selects matplotlib's backend (Agg) when it draws, and pyplot costs ~0.5 s
 OPTIONAL = {"matplotlib", "tqdm", "dask", "distributed", "siconos", "quantecon", "IPython",
-            "nbformat", "nbclient", "hypothesis", "pandas", "xarray"}
+            "nbformat", "nbclient", "hypothesis", "pandas", "xarray", "h5py"}
 
 # -- the import statements of the package's files ------------------------------------------------
 class _File:
