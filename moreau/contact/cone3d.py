@@ -232,6 +232,15 @@ def _natural_sq(r, u, mu):
     return total
 
 
+@njit(cache=True)
+def _project_all(r, mu):
+    out = np.empty_like(r)
+    for i in range(mu.shape[0]):
+        k = 3 * i
+        out[k], out[k + 1], out[k + 2] = _proj(r[k], r[k + 1], r[k + 2], mu[i])
+    return out
+
+
 def project_cone(x, mu):
     """Project ``x = [N, T1, T2]`` (one contact) on the cone ``{|t| <= mu n}``.
 
@@ -736,6 +745,12 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
         u = W @ r + q
         more, res = _pgs(W, q, mu, r, u, int(max_sweeps) - sweeps, tol_sq)
         sweeps += more
+    # Newton's iterate may stand a rounding outside K; its projection is kept
+    # when that costs nothing against the bound
+    r_in = _project_all(r, mu)
+    res_in = _natural_sq(r_in, W @ r_in + q, mu)
+    if res_in <= max(res, tol_sq):
+        r = r_in
     u = W @ r + q
     res = math.sqrt(_natural_sq(r, u, mu))
     status = CONVERGED if res <= tol * scale else NOT_CONVERGED

@@ -1,0 +1,215 @@
+"""The spatial Coulomb problem: exact cone and polyhedral LCP against closed forms.
+
+The one-contact reference is a sphere (mass m, radius R, I = 2/5 m R^2) on a
+plane. Its contact point moves with v + omega x (-R e_z), so the Delassus
+matrix is diag(1/m, 1/m + R^2/I, 1/m + R^2/I) = diag(1, 7/2, 7/2) / m, and
+with free velocity q = (q_N, q_T) the Coulomb law gives by hand:
+lift-off (q_N >= 0): r = 0; otherwise r_N = -m q_N, stick when
+|q_T| <= (7/2) mu (-q_N) with r_T = -(2m/7) q_T, else slip with
+r_T = -mu r_N q_T / |q_T| and u_T = q_T (1 - (7/2) mu (-q_N) / |q_T|).
+"""
+
+import math
+
+import numpy as np
+import pytest
+
+from moreau.contact.cone3d import (
+    CONVERGED,
+    NOT_CONVERGED,
+    build_polyhedral_lcp,
+    cone_residual,
+    facet_directions,
+    local_solve,
+    project_cone,
+    solve_exact,
+    solve_polyhedral,
+)
+from moreau.errors import InputError
+
+M_SPHERE = 2.0
+W_SPHERE = np.diag([1.0, 3.5, 3.5]) / M_SPHERE
+
+
+def sphere_closed_form(q, mu, m=M_SPHERE):
+    qn, qt = q[0], np.asarray(q[1:])
+    if qn >= 0:
+        return np.zeros(3)
+    rn = -m * qn
+    if np.linalg.norm(qt) <= 3.5 * mu * (-qn):
+        return np.array([rn, *(-(2.0 * m / 7.0) * qt)])
+    return np.array([rn, *(-mu * rn * qt / np.linalg.norm(qt))])
+
+
+def random_problem(rng, nc):
+    # W = H M^-1 H^T from a random contact Jacobian with more freedoms than rows
+    ndof = 3 * nc + 3
+    H = rng.standard_normal((3 * nc, ndof))
+    W = H @ np.diag(rng.uniform(0.5, 2.0, ndof)) @ H.T / ndof
+    W = 0.5 * (W + W.T)
+    q = rng.standard_normal(3 * nc)
+    q[0::3] = -np.abs(q[0::3]) * rng.choice([1.0, 1.0, -1.0], nc)
+    return W, q, rng.uniform(0.1, 0.8, nc)
+
+
+@pytest.mark.parametrize("q, case", [
+    ((0.3, 1.0, -2.0), "lift-off"),
+    ((-1.0, 0.4, -0.3), "stick"),          # |q_T| = 0.5 <= 3.5 * 0.5 * 1
+    ((-1.0, 3.0, -4.0), "slip"),            # |q_T| = 5 > 1.75
+    ((-0.2, -0.01, 2.5), "slip"),
+])
+def test_sphere_on_plane_exact_cone_matches_the_closed_form(q, case):
+    q = np.array(q)
+    mu = 0.5
+    ref = sphere_closed_form(q, mu)
+    sol = solve_exact(W_SPHERE, q, mu, tol=1e-13)
+    assert sol.status == CONVERGED
+    np.testing.assert_allclose(sol.r, ref, rtol=0, atol=2e-15)
+    np.testing.assert_allclose(local_solve(W_SPHERE, q, mu), ref, rtol=0, atol=2e-15)
+    assert sol.residual == pytest.approx(cone_residual(W_SPHERE, q, mu, sol.r), abs=0)
+    if case == "slip":
+        # the impulse opposes the sliding velocity exactly, and u_T keeps q_T's direction
+        rt, ut, qt = sol.r[1:], sol.u[1:], q[1:]
+        assert abs(rt[0] * qt[1] - rt[1] * qt[0]) / (np.linalg.norm(rt) * np.linalg.norm(qt)) < 1e-15
+        assert rt @ qt < 0
+        assert np.linalg.norm(rt) == pytest.approx(mu * sol.r[0], rel=1e-15)
+        np.testing.assert_allclose(ut, qt * (1 - 3.5 * mu * (-q[0]) / np.linalg.norm(qt)),
+                                   rtol=0, atol=1e-14)
+        assert sol.u[0] == pytest.approx(0.0, abs=1e-15)
+
+
+def test_polyhedral_cone_is_exact_in_stick_and_lift_off_and_in_slip_along_a_facet_edge():
+    mu = 0.5
+    for d in (4, 8, 16):
+        for q in ((0.3, 1.0, -2.0), (-1.0, 0.4, -0.3)):
+            sol = solve_polyhedral(W_SPHERE, np.array(q), mu, d=d)
+            assert sol.status == CONVERGED
+            np.testing.assert_allclose(sol.r, sphere_closed_form(np.array(q), mu), atol=1e-13)
+        # sliding against a direction D_k of the polygon: its vertex is on the round cone
+        angle = 2 * np.pi * (d // 4 + 1) / d
+        q = np.array([-1.0, -4.0 * math.cos(angle), -4.0 * math.sin(angle)])
+        sol = solve_polyhedral(W_SPHERE, q, mu, d=d)
+        np.testing.assert_allclose(sol.r, sphere_closed_form(q, mu), atol=1e-13)
+        assert sol.residual < 1e-13
+
+
+def _facet_errors(d, mu=0.5, n_angles=360):
+    # worst over sliding directions of the angle between the polyhedral and
+    # the exact tangential impulse, and of the shortfall |r_T| - mu r_N
+    worst_angle = worst_short = 0.0
+    for th in np.arange(n_angles) * 2 * np.pi / n_angles + 0.01:
+        q = np.array([-1.0, 3.0 * math.cos(th), 3.0 * math.sin(th)])
+        ref = sphere_closed_form(q, mu)
+        sol = solve_polyhedral(W_SPHERE, q, mu, d=d)
+        assert sol.status == CONVERGED
+        a, b = sol.r[1:], ref[1:]
+        worst_angle = max(worst_angle, abs(math.atan2(a[0] * b[1] - a[1] * b[0], a @ b)))
+        worst_short = max(worst_short, (np.linalg.norm(b) - np.linalg.norm(a)) / np.linalg.norm(b))
+        assert sol.r[0] == pytest.approx(ref[0], rel=1e-13)        # r_N is exact
+    return worst_angle, worst_short
+
+
+def test_polyhedral_slip_converges_to_the_exact_cone_with_measured_orders():
+    ds = np.array([4, 8, 16, 32])
+    errs = np.array([_facet_errors(int(d)) for d in ds])
+    angle, short = errs[:, 0], errs[:, 1]
+    order_angle = -np.polyfit(np.log(ds), np.log(angle), 1)[0]
+    order_short = -np.polyfit(np.log(ds), np.log(short), 1)[0]
+    # maximal dissipation on a polygon locks the impulse to a vertex over a
+    # fan of sliding directions: the direction error is first order in 1/d
+    # (measured 0.36, 0.17, 0.079, 0.039 rad), bounded by half a facet, pi/d
+    assert np.all(angle <= np.pi / ds)
+    assert 0.95 <= order_angle <= 1.15, order_angle
+    # the magnitude lies on the polygon, at least cos(pi/d) of the radius: second order
+    assert np.all(short <= 1 - np.cos(np.pi / ds) + 1e-14)
+    assert 1.8 <= order_short <= 2.2, order_short
+
+
+def test_random_multi_contact_problems_are_certified_by_both_solvers():
+    rng = np.random.default_rng(20261127)
+    for _ in range(12):
+        W, q, mu = random_problem(rng, int(rng.integers(1, 7)))
+        ex = solve_exact(W, q, mu, tol=1e-11)
+        assert ex.status == CONVERGED, ex.detail
+        assert ex.residual <= 1e-11 * np.linalg.norm(q)
+        assert ex.residual == pytest.approx(cone_residual(W, q, mu, ex.r), rel=1e-12, abs=1e-300)
+        r = ex.r.reshape(-1, 3)
+        assert np.all(np.hypot(r[:, 1], r[:, 2]) <= mu * r[:, 0] * (1 + 1e-12))
+        poly = solve_polyhedral(W, q, mu, d=8)
+        assert poly.status == CONVERGED, poly.detail
+        assert poly.lcp.residual <= 1e-9
+        rp = poly.r.reshape(-1, 3)
+        # the pyramid is inscribed in the cone, and Signorini holds
+        assert np.all(np.hypot(rp[:, 1], rp[:, 2])
+                      <= mu * rp[:, 0] * (1 + 1e-12) + 1e-13 * np.abs(rp).max())
+        assert np.all(poly.u[0::3] >= -1e-12 * np.abs(q).max())
+
+
+def test_a_budget_too_small_says_not_converged_with_its_true_residual():
+    rng = np.random.default_rng(7)
+    W, q, mu = random_problem(rng, 6)
+    sol = solve_exact(W, q, mu, tol=1e-12, max_sweeps=1, max_newton=0)
+    assert sol.status == NOT_CONVERGED and not sol.success
+    assert math.isfinite(sol.residual)
+    assert sol.residual == pytest.approx(cone_residual(W, q, mu, sol.r), rel=1e-12)
+    assert sol.residual > 1e-12 * np.linalg.norm(q)
+    assert sol.iterations == {"sweeps": 1, "newton": 0}
+    # the same problem with the default budget converges
+    assert solve_exact(W, q, mu, tol=1e-12).status == CONVERGED
+
+
+def test_frictionless_contact_has_no_tangential_impulse():
+    sol = solve_exact(W_SPHERE, np.array([-1.0, 3.0, 4.0]), 0.0)
+    np.testing.assert_allclose(sol.r, [M_SPHERE, 0.0, 0.0], atol=1e-15)
+    poly = solve_polyhedral(W_SPHERE, np.array([-1.0, 3.0, 4.0]), 0.0, d=4)
+    np.testing.assert_allclose(poly.r, [M_SPHERE, 0.0, 0.0], atol=1e-13)
+
+
+def test_the_lcp_rows_are_the_derived_ones():
+    rng = np.random.default_rng(3)
+    W, q, mu = random_problem(rng, 2)
+    lcp = build_polyhedral_lcp(W, q, mu, d=5)
+    D = facet_directions(5)
+    z = rng.uniform(0.0, 1.0, lcp.M.shape[0])
+    w = lcp.M @ z + lcp.q
+    r = lcp.impulses(z)
+    u = W @ r + q
+    for i in range(2):
+        b = 7 * i
+        beta, lam = z[b + 1:b + 6], z[b + 6]
+        np.testing.assert_allclose(r[3 * i:3 * i + 3], [z[b], *(D @ beta)], rtol=1e-14)
+        assert w[b] == pytest.approx(u[3 * i], rel=1e-12)
+        np.testing.assert_allclose(w[b + 1:b + 6], lam + D.T @ u[3 * i + 1:3 * i + 3], rtol=1e-12)
+        assert w[b + 6] == pytest.approx(mu[i] * z[b] - beta.sum(), rel=1e-12)
+
+
+def test_cone_projection_against_a_brute_force_minimiser():
+    rng = np.random.default_rng(11)
+    for _ in range(20):
+        x = rng.standard_normal(3)
+        mu = rng.uniform(0.1, 2.0)
+        p = project_cone(x, mu)
+        assert np.hypot(p[1], p[2]) <= mu * p[0] * (1 + 1e-14) + 1e-300
+        # the projection's residual is normal to the cone at p: (x - p).p = 0 and
+        # (x - p) in the polar cone, mu |t| <= -n
+        e = x - p
+        assert abs(e @ p) < 1e-14
+        assert mu * np.hypot(e[1], e[2]) <= -e[0] + 1e-14
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: solve_exact(W_SPHERE, [-1.0, 0.0, 0.0], -0.1), "`mu`"),
+    (lambda: solve_polyhedral(W_SPHERE, [-1.0, 0.0, 0.0], 0.5, d=2), "`d`"),
+    (lambda: solve_polyhedral(W_SPHERE, [-1.0, 0.0, 0.0], 0.5, d=8.0), "`d`"),
+    (lambda: solve_exact(np.eye(4), np.zeros(4), 0.5), "`W`"),
+    (lambda: solve_exact(np.eye(3), np.zeros(6), 0.5), "`q`"),
+    (lambda: solve_exact(np.eye(6), np.zeros(6), [0.5, 0.5, 0.5]), "`mu`"),
+    (lambda: solve_exact(np.array([[1.0, 0.1, 0], [0, 1, 0], [0, 0, 1]]), np.zeros(3), 0.5), "`W`"),
+    (lambda: solve_exact(np.diag([1.0, -1.0, 1.0]), np.zeros(3), 0.5), "`W`"),
+    (lambda: solve_exact(W_SPHERE, [np.nan, 0.0, 0.0], 0.5), "`q`"),
+    (lambda: solve_exact(W_SPHERE, [-1.0, 0.0, 0.0], 0.5, max_sweeps=0), "`max_sweeps`"),
+    (lambda: solve_exact(W_SPHERE, [-1.0, 0.0, 0.0], 0.5, tol=0.0), "`tol`"),
+])
+def test_bad_input_is_refused_by_name(call, name):
+    with pytest.raises(InputError, match=name):
+        call()
