@@ -74,6 +74,7 @@ from numba import njit
 
 from .._validate import finite_array
 from ..errors import InputError
+from ..lcp import STATUS_MESSAGES, solve_lcp
 
 __all__ = [
     "ConeSolution",
@@ -425,8 +426,6 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None):
     >>> sol.status, np.round(sol.r, 12).tolist(), np.round(sol.u, 12).tolist()
     ('converged', [1.0, -0.142857142857, 0.0], [0.0, 0.0, 0.0])
     """
-    from ..lcp import solve_lcp, STATUS_MESSAGES
-
     W, q, mu = check_cone_problem(W, q, mu)
     lcp = build_polyhedral_lcp(W, q, mu, d)
     res = solve_lcp(lcp.M, lcp.q, method, tol=tol)
