@@ -238,11 +238,10 @@ def _free_steps(q0, w0, J, h, n, qs, ws):
     A = np.empty((3, 3))
     F = np.empty(3)
     qn = np.empty(4)
-    Jw0 = J @ w0
-    scale = math.sqrt(Jw0[0] ** 2 + Jw0[1] ** 2 + Jw0[2] ** 2) + 1e-300
     for k in range(n):
         wn = w.copy()
-        for _ in range(50):
+        # Newton converges quadratically; ten steps is far beyond what it needs
+        for _ in range(10):
             m = 0.5 * (w + wn)
             Jm = J @ m
             g = np.array([m[1] * Jm[2] - m[2] * Jm[1], m[2] * Jm[0] - m[0] * Jm[2],
@@ -257,7 +256,7 @@ def _free_steps(q0, w0, J, h, n, qs, ws):
             A += 0.5 * h * (mx @ J - jx)
             dw = np.linalg.solve(A, -F)
             wn += dw
-            if math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) * scale <= 1e-16 * scale * (
+            if math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) <= 1e-15 * (
                     math.sqrt(wn[0] ** 2 + wn[1] ** 2 + wn[2] ** 2) + 1e-300):
                 break
         m = 0.5 * (w + wn)
