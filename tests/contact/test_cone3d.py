@@ -213,3 +213,40 @@ def test_cone_projection_against_a_brute_force_minimiser():
 def test_bad_input_is_refused_by_name(call, name):
     with pytest.raises(InputError, match=name):
         call()
+
+
+def test_local_solve_on_random_coupled_blocks_meets_the_coulomb_law():
+    # W_ii with normal-tangential coupling; slip must oppose the sliding velocity
+    rng = np.random.default_rng(99)
+    n_slip = 0
+    for _ in range(200):
+        H = rng.standard_normal((3, 4))
+        A = H @ H.T / 4 + 0.05 * np.eye(3)
+        b = rng.standard_normal(3) * [1.0, 2.0, 2.0]
+        mu = rng.uniform(0.05, 1.0)
+        r = local_solve(A, b, mu)
+        u = A @ r + b
+        assert cone_residual(A, b, mu, r) <= 1e-13 * np.linalg.norm(b)
+        ut, rt = u[1:], r[1:]
+        if r[0] > 0 and np.linalg.norm(ut) > 1e-9 * np.linalg.norm(b):
+            n_slip += 1
+            assert abs(u[0]) <= 1e-14 * np.linalg.norm(b)
+            assert np.linalg.norm(rt) == pytest.approx(mu * r[0], rel=1e-13)
+            cos = rt @ ut / (np.linalg.norm(rt) * np.linalg.norm(ut))
+            assert cos == pytest.approx(-1.0, abs=1e-13)
+    assert n_slip > 30
+
+
+def test_slipping_contacts_of_multi_contact_problems_oppose_their_sliding_velocity():
+    rng = np.random.default_rng(5)
+    for _ in range(10):
+        W, q, mu = random_problem(rng, 5)
+        sol = solve_exact(W, q, mu, tol=1e-12)
+        assert sol.success
+        r, u = sol.r.reshape(-1, 3), sol.u.reshape(-1, 3)
+        for i in range(5):
+            speed = np.linalg.norm(u[i, 1:])
+            if r[i, 0] > 1e-8 and speed > 1e-6:
+                # |r_T| = mu r_N and r_T = -mu r_N u_T / |u_T|, to the certified residual
+                np.testing.assert_allclose(r[i, 1:], -mu[i] * r[i, 0] * u[i, 1:] / speed,
+                                           atol=1e-9)
