@@ -85,6 +85,13 @@ def main(argv=None):
     for d, a, s, du in rows:
         print(f"{d:>4} {a:16.4e} {s:16.4e} {du:12.4e}")
     ds = np.array([r[0] for r in rows], dtype=float)
+    for th in (0.3, 1.0):
+        q = np.array([-1.0, 3.0 * math.cos(th), 3.0 * math.sin(th)])
+        ref = local_solve(W_SPHERE, q, 0.5)
+        errs = [np.linalg.norm(solve_polyhedral(W_SPHERE, q, 0.5, d=d).r - ref) / np.linalg.norm(ref)
+                for d, *_ in rows]
+        print(f"one direction, theta = {th}: |r - r_exact|/|r_exact| = "
+              + ", ".join(f"{e:.3g}" for e in errs) + " (irregular: the polygon's vertices move)")
     print(f"fitted order in 1/d: direction {order(ds, [r[1] for r in rows]):.2f}, "
           f"magnitude {order(ds, [r[2] for r in rows]):.2f}, "
           f"velocity {order(ds, [r[3] for r in rows]):.2f}")

@@ -87,6 +87,7 @@ __all__ = [
     "solve_polyhedral",
     "local_solve",
     "solve_exact",
+    "solve_cone",
     "CONVERGED",
     "NOT_CONVERGED",
 ]
@@ -758,3 +759,38 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
               f"(tol {tol:g} x ||q||).")
     return ConeSolution(r, u, status, res, res / qn if qn > 0 else res,
                         {"sweeps": int(sweeps), "newton": int(newton)}, "exact", detail)
+
+
+def solve_cone(W, q, mu, cone="exact", **options):
+    """Solve the spatial friction problem with the cone a scheme's ``cone`` option names.
+
+    Parameters
+    ----------
+    W, q, mu :
+        The problem (:func:`check_cone_problem`).
+    cone : "exact" or int
+        ``"exact"``: :func:`solve_exact`; an integer ``d >= 3``:
+        :func:`solve_polyhedral` with ``d`` directions.
+    **options
+        Passed to the solver chosen.
+
+    Returns
+    -------
+    ConeSolution
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5]); q = np.array([-1.0, 0.0, 4.0])
+    >>> [(solve_cone(W, q, 0.5, cone=c).r.round(12) + 0.0).tolist() for c in ("exact", 4)]
+    [[1.0, 0.0, -0.5], [1.0, 0.0, -0.5]]
+    >>> solve_cone(W, q, 0.5, cone="round")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `cone` must be "exact" or an integer number of directions >= 3, got 'round'
+    """
+    if isinstance(cone, str) and cone == "exact":
+        return solve_exact(W, q, mu, **options)
+    if isinstance(cone, bool) or not isinstance(cone, (int, np.integer)) or cone < 3:
+        raise InputError(f'`cone` must be "exact" or an integer number of directions >= 3, '
+                         f'got {cone!r}')
+    return solve_polyhedral(W, q, mu, int(cone), **options)

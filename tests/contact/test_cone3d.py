@@ -250,3 +250,15 @@ def test_slipping_contacts_of_multi_contact_problems_oppose_their_sliding_veloci
                 # |r_T| = mu r_N and r_T = -mu r_N u_T / |u_T|, to the certified residual
                 np.testing.assert_allclose(r[i, 1:], -mu[i] * r[i, 0] * u[i, 1:] / speed,
                                            atol=1e-9)
+
+
+def test_the_cone_option_chooses_the_solver():
+    from moreau.contact.cone3d import solve_cone
+    q = np.array([-1.0, 3.0, 4.0])
+    assert solve_cone(W_SPHERE, q, 0.5).method == "exact"
+    assert solve_cone(W_SPHERE, q, 0.5, cone=16).method == "polyhedral-16"
+    np.testing.assert_allclose(solve_cone(W_SPHERE, q, 0.5, cone="exact", tol=1e-12).r,
+                               sphere_closed_form(q, 0.5), atol=1e-15)
+    for bad in ("Exact", 2, True, 8.0, None):
+        with pytest.raises(InputError, match="`cone`"):
+            solve_cone(W_SPHERE, q, 0.5, cone=bad)
