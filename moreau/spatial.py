@@ -229,6 +229,21 @@ def rotate_body(q, omega, h):
     return out
 
 
+@njit(cache=True, inline="always")
+def _solve3(A, F, out):
+    # A out = F by Cramer's rule: a 3x3 system needs no LAPACK call
+    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
+    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
+    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
+    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
+    out[0] = (F[0] * c00 + A[0, 1] * (F[2] * A[1, 2] - F[1] * A[2, 2])
+              + A[0, 2] * (F[1] * A[2, 1] - F[2] * A[1, 1])) / det
+    out[1] = (A[0, 0] * (F[1] * A[2, 2] - F[2] * A[1, 2]) + F[0] * c01
+              + A[0, 2] * (F[2] * A[1, 0] - F[1] * A[2, 0])) / det
+    out[2] = (A[0, 0] * (F[2] * A[1, 1] - F[1] * A[2, 1])
+              + A[0, 1] * (F[1] * A[2, 0] - F[2] * A[1, 0]) + F[0] * c02) / det
+
+
 @njit(cache=True)
 def _free_steps(q0, w0, J, h, n, qs, ws):
     q = q0.copy()
@@ -237,30 +252,37 @@ def _free_steps(q0, w0, J, h, n, qs, ws):
     ws[0] = w
     A = np.empty((3, 3))
     F = np.empty(3)
+    m = np.empty(3)
+    Jm = np.empty(3)
+    dw = np.empty(3)
+    wn = np.empty(3)
     qn = np.empty(4)
     for k in range(n):
-        wn = w.copy()
+        wn[:] = w
         # Newton converges quadratically; ten steps is far beyond what it needs
         for _ in range(10):
-            m = 0.5 * (w + wn)
-            Jm = J @ m
-            g = np.array([m[1] * Jm[2] - m[2] * Jm[1], m[2] * Jm[0] - m[0] * Jm[2],
-                          m[0] * Jm[1] - m[1] * Jm[0]])
-            F[:] = J @ (wn - w) + h * g
-            # dF/dwn = J + h/2 ([m]x J - [J m]x)
             for i in range(3):
+                m[i] = 0.5 * (w[i] + wn[i])
+            for i in range(3):
+                Jm[i] = J[i, 0] * m[0] + J[i, 1] * m[1] + J[i, 2] * m[2]
+            # F = J (wn - w) + h m x J m;  dF/dwn = J + h/2 ([m]x J - [J m]x)
+            for i in range(3):
+                i1 = (i + 1) % 3
+                i2 = (i + 2) % 3
+                F[i] = (J[i, 0] * (wn[0] - w[0]) + J[i, 1] * (wn[1] - w[1])
+                        + J[i, 2] * (wn[2] - w[2]) + h * (m[i1] * Jm[i2] - m[i2] * Jm[i1]))
                 for j in range(3):
-                    A[i, j] = J[i, j]
-            mx = np.array([[0.0, -m[2], m[1]], [m[2], 0.0, -m[0]], [-m[1], m[0], 0.0]])
-            jx = np.array([[0.0, -Jm[2], Jm[1]], [Jm[2], 0.0, -Jm[0]], [-Jm[1], Jm[0], 0.0]])
-            A += 0.5 * h * (mx @ J - jx)
-            dw = np.linalg.solve(A, -F)
-            wn += dw
+                    A[i, j] = J[i, j] + 0.5 * h * (m[i1] * J[i2, j] - m[i2] * J[i1, j])
+                # minus [J m]x: its (i, i2) entry is (J m)_i1, its (i, i1) entry -(J m)_i2
+                A[i, i2] -= 0.5 * h * Jm[i1]
+                A[i, i1] += 0.5 * h * Jm[i2]
+            _solve3(A, F, dw)
+            for i in range(3):
+                wn[i] -= dw[i]
             if math.sqrt(dw[0] ** 2 + dw[1] ** 2 + dw[2] ** 2) <= 1e-15 * (
                     math.sqrt(wn[0] ** 2 + wn[1] ** 2 + wn[2] ** 2) + 1e-300):
                 break
-        m = 0.5 * (w + wn)
-        _rotate(q, m[0], m[1], m[2], h, qn)
+        _rotate(q, 0.5 * (w[0] + wn[0]), 0.5 * (w[1] + wn[1]), 0.5 * (w[2] + wn[2]), h, qn)
         q[:] = qn
         w[:] = wn
         qs[k + 1] = q
