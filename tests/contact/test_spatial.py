@@ -9,7 +9,6 @@ while its symmetry axis precesses about the fixed world angular momentum L
 at the rate |L| / J1, at the constant angle cos(theta) = J3 omega_3 / |L|.
 """
 
-import math
 
 import numpy as np
 import pytest
