@@ -350,3 +350,13 @@ def test_hard_problems_with_large_mu_converge_through_stall_detection_and_the_re
     sol = solve_exact(W, q, mu)
     assert sol.success and "restarted from the 16-direction polyhedral" in sol.detail, sol.detail
     assert sol.residual <= 1e-10 * np.linalg.norm(q)
+
+
+def test_the_qp_method_says_it_has_no_formulation_for_the_polyhedral_lcp():
+    # M is copositive but not monotone (the row mu r_N - e^T beta has no
+    # symmetric partner): the QP path refuses rather than guessing
+    q = np.array([-1.0, 3.0, 4.0])
+    sol = solve_polyhedral(W_SPHERE, q, 0.5, d=8, method="qp")
+    assert not sol.success and sol.status.startswith("The method has no formulation")
+    assert sol.residual == pytest.approx(cone_residual(W_SPHERE, q, 0.5, sol.r), abs=0)
+    assert math.isfinite(sol.residual) and sol.residual > 0.5
