@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from moreau.errors import InputError
-from moreau.spatial import (
+from moreau.model.spatial import (
     check_inertia,
     free_rigid_body,
     gyroscopic_torque,

@@ -51,8 +51,8 @@ import math
 import numpy as np
 from numba import njit
 
-from ._validate import finite_array, positive, positive_int
-from .errors import InputError
+from .._validate import finite_array, positive, positive_int
+from ..errors import InputError
 
 __all__ = [
     "quat_multiply",
