@@ -1,0 +1,1 @@
+"""The contact problem of one time step: its data, its solvers (issue 35)."""
