@@ -5,7 +5,10 @@ Every scheme ends a step with the same problem on its active rows
 ``e``, pre-step normal velocities, and leading equality rows for joints).
 :func:`solve` reaches every registered solver by name
 (:func:`solver_names`; one module each in :mod:`moreau.contact.solvers`)
-and returns a :class:`ContactSolution`.
+and returns a :class:`ContactSolution`. A solver written in FCLib's
+per-contact layout reaches a problem through :func:`to_fclib` and
+:func:`from_fclib` (:mod:`moreau.contact.fclib`); equality rows are
+eliminated first (:func:`moreau.contact.solvers.mlcp.eliminate_equalities`).
 
 Floor: above :mod:`moreau.lcp`, below :mod:`moreau.integrators`.
 

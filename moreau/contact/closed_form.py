@@ -22,7 +22,7 @@ from ..lcp.friction import build_friction_lcp
 from . import _one_contact as _kernels
 
 __all__ = ["one_contact_impulse", "one_contact_residual", "tangential_impact",
-           "friction_pieces", "MAX_PIECES_CONTACTS"]
+           "friction_pieces", "friction_point", "MAX_PIECES_CONTACTS"]
 
 
 def tangential_impact(W, U_free, mu, e, vN_pre, slip_before):
@@ -149,17 +149,35 @@ def friction_pieces(W, U_free, mu, e, vN_pre, Ml=None, ql=None, layout=None):
         p = _piece_point(E, f, G, g, scale)
         if p is None:
             continue
-        vT = (b + W @ p)[na:]
-        z = np.zeros(layout.size)
-        z[layout.normal] = p[:na]
-        fr = layout.frictional
-        pT = p[na:]
-        z[layout.tplus[fr]] = np.maximum(pT, 0.0)
-        z[layout.tminus[fr]] = np.maximum(-pT, 0.0)
-        z[layout.beta[fr]] = np.abs(vT)
+        z = friction_point(layout, p, (b + W @ p)[na:])
         if lcp_violation(Ml, ql, z) <= DEFAULT_TOL:
             return z
     return None
+
+
+def friction_point(layout, p, vT):
+    """The friction LCP's variables ``z`` of the stacked impulse ``p`` (rows ``[N; T]``).
+
+    ``p_T+ = max(p_T, 0)``, ``p_T- = max(-p_T, 0)`` and ``beta = |v_T|``, with
+    ``vT`` the tangential velocities of the frictional contacts; ``layout``
+    from :func:`~moreau.lcp.friction.build_friction_lcp`.
+
+    Examples
+    --------
+    >>> from moreau.lcp.friction import FrictionLayout
+    >>> friction_point(FrictionLayout([0.5, 0.0], [0.0, 0.0]), np.array([2.0, 1.0, -0.5]),
+    ...                np.array([0.25])).tolist()
+    [2.0, 0.0, 0.5, 0.25, 1.0]
+    """
+    na = layout.n_contacts
+    z = np.zeros(layout.size)
+    z[layout.normal] = p[:na]
+    fr = layout.frictional
+    pT = p[na:]
+    z[layout.tplus[fr]] = np.maximum(pT, 0.0)
+    z[layout.tminus[fr]] = np.maximum(-pT, 0.0)
+    z[layout.beta[fr]] = np.abs(vT)
+    return z
 
 
 def _piece_point(E, f, G, g, scale):

@@ -22,13 +22,18 @@ The laws, on the local velocities ``U = u_free + W p``:
   ``p_T = -mu p_N sign(U_T)`` where ``U_T != 0``.
 """
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
+from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
 from ..errors import InputError
 
 __all__ = ["ContactProblem", "ContactSolution", "SOLVED", "MAX_ITER", "FAILED"]
+
+_NO_ROWS = np.zeros(0)
+_NO_ROWS.setflags(write=False)
 
 #: statuses of a :class:`ContactSolution`
 SOLVED = "solved"
@@ -57,7 +62,8 @@ class ContactProblem:
     Parameters
     ----------
     W : array_like, shape (m, m)
-        Delassus matrix over the stacked rows, ``m = n_eq + nc + nf``.
+        Delassus matrix over the stacked rows, ``m = n_eq + nc + nf``; a
+        dense array (sparse storage is for the sparse solvers to come).
     u_free : array_like, shape (m,)
         Local velocities without impulses.
     mu : array_like, shape (nc,)
@@ -99,8 +105,6 @@ class ContactProblem:
     vN_pre: np.ndarray = None
     n_eq: int = 0
     eq_target: np.ndarray = None
-    #: the frictional contacts' indices (derived)
-    frictional: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self):
         n_eq = self.n_eq
@@ -142,9 +146,8 @@ class ContactProblem:
             if tgt.shape != (n_eq,):
                 raise InputError(f"`eq_target` must have one entry per equality row ({n_eq}), "
                                  f"got shape {tgt.shape}")
-        for name, value in (("W", W), ("u_free", u), ("mu", mu), ("e", e), ("vN_pre", vN),
-                            ("n_eq", int(n_eq)), ("eq_target", tgt), ("frictional", frictional)):
-            object.__setattr__(self, name, value)
+        self.__dict__.update(W=W, u_free=u, mu=mu, e=e, vN_pre=vN, n_eq=int(n_eq), eq_target=tgt,
+                             frictional=frictional)
 
     @classmethod
     def trusted(cls, W, u_free, mu, e, vN_pre, n_eq=0, eq_target=None):
@@ -154,12 +157,17 @@ class ContactProblem:
         ``mu``, ``e`` and ``vN_pre`` are float arrays over the contacts.
         """
         self = object.__new__(cls)
-        for name, value in (("W", W), ("u_free", u_free), ("mu", mu), ("e", e),
-                            ("vN_pre", vN_pre), ("n_eq", n_eq),
-                            ("eq_target", np.zeros(n_eq) if eq_target is None else eq_target),
-                            ("frictional", np.flatnonzero(mu > 0.0))):
-            object.__setattr__(self, name, value)
+        # (the instance dict directly: a frozen dataclass's fields, without its per-field calls)
+        self.__dict__.update(W=W, u_free=u_free, mu=mu, e=e, vN_pre=vN_pre, n_eq=n_eq,
+                             eq_target=_NO_ROWS if eq_target is None and not n_eq
+                             else np.zeros(n_eq) if eq_target is None else eq_target)
         return self
+
+    @cached_property
+    def frictional(self):
+        """Indices of the frictional contacts (``mu > 0``), increasing: contact
+        ``frictional[k]`` owns tangential row ``n_eq + nc + k``."""
+        return np.flatnonzero(self.mu > 0.0)
 
     @property
     def n_contacts(self):
@@ -199,9 +207,8 @@ class ContactProblem:
                 f"n_frictional={self.n_frictional})")
 
 
-@dataclass(frozen=True, eq=False)
-class ContactSolution:
-    """What :func:`moreau.contact.solve` returns.
+class ContactSolution(NamedTuple):
+    """What :func:`moreau.contact.solve` returns (immutable).
 
     Attributes
     ----------
@@ -245,7 +252,7 @@ class ContactSolution:
     iterations: int = 0
     message: str = ""
     path: tuple = ()
-    lcp: object = field(default=None, repr=False)
+    lcp: object = None
 
     @property
     def success(self):

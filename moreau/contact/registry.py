@@ -10,7 +10,10 @@ registered) with :mod:`moreau.contact`.
 import inspect
 from typing import Callable, NamedTuple
 
+import numpy as np
+
 from ..errors import InputError
+from .problem import SOLVED, ContactSolution
 
 __all__ = ["SolverEntry", "register_solver", "solver_names", "get_solver", "solve"]
 
@@ -167,4 +170,8 @@ def solve(problem, method="auto", *, max_iter=None, tol=None, **options):
         if key not in entry.options:
             raise InputError(f"`{key}` is not an option of method {method!r}; its options: "
                              + (", ".join(sorted(entry.options)) or "none beyond max_iter and tol"))
+    if problem.n_rows == 0:
+        none = np.zeros(0)
+        return ContactSolution(none, none, none, none, SOLVED, 0.0, "none", 0,
+                               "Nothing to solve: the problem has no rows.", ())
     return entry.fn(problem, max_iter=max_iter, tol=tol, **options)

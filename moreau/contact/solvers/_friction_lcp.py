@@ -48,3 +48,21 @@ def solve_friction_lcp(problem, lcp_method, max_iter, tol):
     return ContactSolution(friction_impulses(z, layout, stacked=True), _NO_EQ, np.asarray(pN),
                            np.asarray(pT), SOLVED, float(lcp_residual(Ml, ql, z)), method,
                            int(r.pivots) if method == r.method else 0, r.message, path, r)
+
+
+def friction_lcp_solver(lcp_method):
+    """The solver ``fn(problem, *, max_iter=None, tol=None)`` of the friction LCP by ``lcp_method``.
+
+    Examples
+    --------
+    >>> from moreau.contact import ContactProblem
+    >>> sol = friction_lcp_solver("lemke")(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]))
+    >>> np.round(sol.p, 12).tolist(), sol.method, sol.status
+    ([1.0, -0.5], 'lemke', 'solved')
+    """
+    def solve(problem, *, max_iter=None, tol=None):
+        return solve_friction_lcp(problem, lcp_method, max_iter, tol)
+
+    solve.__doc__ = (f"The friction LCP of ``problem`` by :func:`moreau.lcp.solve_lcp`'s "
+                     f"{lcp_method!r} method, then the pieces where it ends on a ray.")
+    return solve

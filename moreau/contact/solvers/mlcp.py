@@ -24,6 +24,7 @@ from ...lcp.friction import build_friction_lcp, friction_impulses
 from ...lcp.lemke import DEFAULT_TOL
 from ...lcp.mlcp import (RANK_RTOL, equality_block, free_part, mlcp_residual, mlcp_violation,
                          schur_complement)
+from ..closed_form import friction_point
 from ..problem import FAILED, SOLVED, ContactProblem, ContactSolution
 from ..registry import register_solver, solve as solve_problem
 
@@ -114,17 +115,8 @@ def build_friction_mlcp(problem):
 def _mlcp_point(problem, layout, p):
     # x = (p_E, z) of the stacked impulse p, beta = |U_T| from the caller's data
     k = problem.n_eq
-    nc = problem.n_contacts
-    U = problem.u_free + problem.W @ p
-    pC = p[k:]
-    z = np.zeros(layout.size)
-    z[layout.normal] = pC[:nc]
-    fr = layout.frictional
-    pT = pC[nc:]
-    z[layout.tplus[fr]] = np.maximum(pT, 0.0)
-    z[layout.tminus[fr]] = np.maximum(-pT, 0.0)
-    z[layout.beta[fr]] = np.abs(U[k + nc:])
-    return np.concatenate([p[:k], z])
+    vT = (problem.u_free + problem.W @ p)[k + problem.n_contacts:]
+    return np.concatenate([p[:k], friction_point(layout, p[k:], vT)])
 
 
 def solve(problem, *, max_iter=None, tol=None, inner="auto", rank_rtol=RANK_RTOL):

@@ -1,24 +1,19 @@
 """``"qp"``: the friction LCP by the QP method of :mod:`moreau.lcp.qp` (a Tresca
-fixed point on OSQP), the fallback of ``"auto"``."""
+fixed point on OSQP; ``max_iter`` its iterations), the fallback of ``"auto"``.
+
+Examples
+--------
+>>> import numpy as np
+>>> from moreau.contact import ContactProblem, solve
+>>> sol = solve(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]), "qp")
+>>> sol.status, sol.method, np.round(sol.p, 6).tolist()
+('solved', 'qp', [1.0, -0.5])
+"""
 
 from ..registry import register_solver
-from ._friction_lcp import solve_friction_lcp
+from ._friction_lcp import friction_lcp_solver
 
 __all__ = ["solve"]
 
-
-def solve(problem, *, max_iter=None, tol=None):
-    """The friction LCP of ``problem`` by the QP method (``max_iter`` fixed-point iterations).
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from moreau.contact import ContactProblem
-    >>> sol = solve(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]))
-    >>> sol.status, sol.method, np.round(sol.p, 6).tolist()
-    ('solved', 'qp', [1.0, -0.5])
-    """
-    return solve_friction_lcp(problem, "qp", max_iter, tol)
-
-
-register_solver("qp", solve, summary="dense friction LCP, QP (Tresca fixed point, OSQP)")
+solve = register_solver("qp", friction_lcp_solver("qp"),
+                        summary="dense friction LCP, QP (Tresca fixed point, OSQP)")
