@@ -7,7 +7,7 @@ Every scheme ends a step with the same problem on its active rows
 (:func:`solver_names`; one module each in :mod:`moreau.contact.solvers`)
 and returns a :class:`ContactSolution`. A solver written in FCLib's
 per-contact layout reaches a problem through :func:`to_fclib` and
-:func:`from_fclib` (:mod:`moreau.contact.fclib`); equality rows are
+:func:`from_fclib` (:mod:`moreau.contact.fclib_layout`); equality rows are
 eliminated first (:func:`moreau.contact.solvers.mlcp.eliminate_equalities`).
 
 Floor: above :mod:`moreau.lcp`, below :mod:`moreau.integrators`.
@@ -27,7 +27,7 @@ A unit point mass on a rod that keeps ``x + y`` constant (equality row
 """
 
 from . import solvers  # noqa: F401  (registers the solvers)
-from .fclib import LocalProblem, from_fclib, to_fclib
+from .fclib_layout import LocalProblem, from_fclib, to_fclib
 from .problem import FAILED, MAX_ITER, SOLVED, ContactProblem, ContactSolution
 from .registry import SolverEntry, get_solver, register_solver, solve, solver_names
 

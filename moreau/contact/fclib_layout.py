@@ -1,4 +1,4 @@
-"""The adapter point to FCLib's layout of a frictional contact problem.
+"""The adapter point to FCLib's layout of a frictional contact problem (the layout, not its files).
 
 FCLib's local problem (``FrictionContactProblem``; Acary, Brémond, Koziol,
 Pérignon 2014, "FCLib: a collection of discrete 3D frictional contact
@@ -17,6 +17,13 @@ written in that layout (``moreau.contact.solvers.nsgs``, ...) reach a
   forces ``r_T = 0``, so the added row changes nothing;
 * equality rows are not in FCLib's local problem: eliminate them first
   (:func:`moreau.contact.solvers.mlcp.eliminate_equalities`).
+
+``W`` comes out dense, like the problem's; a sparse solver converts it
+(``scipy.sparse.csr_array(local.W)``). A solver ``fn(W, q, mu) -> r`` in this
+layout becomes a registered one as
+``register_solver(name, lambda problem, *, max_iter=None, tol=None: ...)``
+that calls ``from_fclib(problem, fn(*to_fclib(problem)[:3]))`` and returns a
+:class:`~moreau.contact.ContactSolution` with its residual and status.
 """
 
 from typing import NamedTuple
