@@ -42,16 +42,17 @@ FAILED = "failed"
 
 
 def _array(name, value, ndim):
+    # a read-only float copy, its rank and finiteness checked (one copy, no np.all wrapper:
+    # the checks are most of a small problem's construction)
     try:
-        a = np.asarray(value, dtype=float)
+        a = np.array(value, dtype=float)
     except (TypeError, ValueError):
         raise InputError(f"`{name}` must be an array of real numbers, got {type(value).__name__}") from None
     if a.ndim != ndim:
         raise InputError(f"`{name}` must be {ndim}-D, got shape {a.shape}")
-    if not np.all(np.isfinite(a)):
+    if not np.isfinite(a).all():
         raise InputError(f"`{name}` must be finite (no NaN or inf)")
-    a = a.copy()
-    a.setflags(write=False)
+    a.flags.writeable = False
     return a
 
 
