@@ -15,6 +15,7 @@ from hypothesis import strategies as st
 
 from moreau.errors import InputError
 from moreau.integrators import simulate
+import moreau.contact.solvers._friction_lcp as friction_lcp
 import moreau.integrators.contact_problem as cp
 from moreau.integrators.contact_problem import (friction_pieces, one_contact_impulse,
                                                 one_contact_residual, tangential_impact)
@@ -164,7 +165,7 @@ def test_a_secondary_ray_is_followed_by_the_certified_enumeration(monkeypatch):
         r = solve_lcp(M, q, method="lemke", max_iter=1)
         return LCPResult(r.z, r.w, SECONDARY_RAY, r.pivots, r.residual, "lemke")
 
-    monkeypatch.setattr(cp, "solve_lcp", ray)
+    monkeypatch.setattr(friction_lcp, "solve_lcp", ray)
     J = np.array([[0.0, 1.0, -0.5], [0.0, 1.0, 0.5], [1.0, 0.0, 1.0], [1.0, 0.0, 1.0]])
     W = J @ np.diag([1.0, 1.0, 2.4]) @ J.T
     c = cp.new_contact_counters()
