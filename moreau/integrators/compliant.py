@@ -50,7 +50,9 @@ Examples
 True
 """
 
+import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 from scipy.integrate import RK45, Radau
@@ -59,7 +61,7 @@ from scipy.optimize import brentq
 from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
-from .base import Integrator, register_integrator
+from .base import Integrator, SchemeOptions, register_integrator
 from .event_driven_generic import contact_law_regimes
 
 __all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution",
@@ -125,6 +127,13 @@ def damping_for_restitution(e, stiffness, mass):
     return 2.0 * zeta * math.sqrt(stiffness * mass)
 
 
+def _contact_model_option(value):
+    if value not in CONTACT_MODELS:
+        raise InputError(f"`contact_model` must be one of {sorted(CONTACT_MODELS)}, got "
+                         f"{value!r}")
+    return value
+
+
 class _Compliant(Integrator):
     """Common part of the compliant schemes (see the module docstring)."""
 
@@ -135,6 +144,30 @@ class _Compliant(Integrator):
     # impact); the integration error is held below it
     compare_settings = ("stiffness", (1e3, 1e4, 1e5), (1e3, 1e4),
                         {"rtol": 1e-9, "atol": 1e-12, "friction_velocity": 1e-3})
+
+    @dataclasses.dataclass(frozen=True)
+    class Options(SchemeOptions):
+        """Options of a compliant scheme (see :class:`CompliantRadau`)."""
+        stiffness: float = 1e6
+        damping: float | None = None
+        contact_model: str = "kelvin-voigt"
+        friction_velocity: float = 1e-4
+        rtol: float = 1e-8
+        atol: float = 1e-10
+        max_step: float | None = None
+        sample_dt: float | None = None
+        max_steps: int = MAX_STEPS
+
+        _rules: ClassVar[dict] = {
+            "stiffness": lambda v: positive("stiffness", v),
+            "damping": lambda v: None if v is None else nonnegative("damping", v),
+            "contact_model": _contact_model_option,
+            "friction_velocity": lambda v: positive("friction_velocity", v),
+            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
+            "atol": lambda v: positive("atol", v),
+            "max_step": lambda v: None if v is None else positive("max_step", v),
+            "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
+            "max_steps": lambda v: positive_int("max_steps", v)}
 
     def __init__(self, scene, t0, q0, v0, t_bound, stiffness=1e6, damping=None,
                  contact_model="kelvin-voigt", friction_velocity=1e-4, rtol=1e-8, atol=1e-10,
