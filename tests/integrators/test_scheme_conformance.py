@@ -12,7 +12,9 @@
 """
 
 import dataclasses
+import inspect
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -102,6 +104,17 @@ def test_options_are_a_frozen_dataclass_naming_the_scheme(name):
         first = opts.names()[0]
         with pytest.raises(dataclasses.FrozenInstanceError):
             setattr(opts, first, getattr(opts, first))
+
+
+@pytest.mark.parametrize("name", SCHEMES)
+def test_options_travel_to_a_worker_and_match_the_constructor(name):
+    cls = get_integrator(name)
+    opts = cls.Options()
+    assert pickle.loads(pickle.dumps(opts)) == opts
+    if not cls.takes_options_object:
+        # a scheme that keeps its keyword constructor: the same names and defaults
+        params = list(inspect.signature(cls.__init__).parameters.values())[6:]
+        assert {p.name: p.default for p in params} == opts.as_dict()
 
 
 @pytest.mark.parametrize("name", SCHEMES)
