@@ -349,6 +349,20 @@ class Integrator:
         self._region_seen = 0
         self.region_left_at = None
 
+    def _take_options(self, options, keywords):
+        """The scheme's options object: ``options`` as given, or made from ``keywords``.
+
+        For a constructor ``(scene, t0, q0, v0, t_bound, options=None, **keywords)``
+        (``takes_options_object``): the object is checked once, where it is made.
+        """
+        if options is None:
+            return self.Options.from_keywords(keywords)
+        if keywords or not isinstance(options, self.Options):
+            raise InputError(f"`options` must be a {type(self).__name__}.Options, without "
+                             f"keywords beside it; got {type(options).__name__} and "
+                             f"{sorted(keywords)}")
+        return options
+
     # -- public API ---------------------------------------------------------
     def step(self):
         """Advance by one step (or to the next event); return the status string."""
@@ -632,7 +646,7 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     if t_eval is not None:
         t_eval = check_t_eval(t_eval, finite_scalar("t_span[0]", t0), finite_scalar("t_span[1]", t1))
     funcs = check_events(events)
-    if cls.takes_options_object:
+    if (cls.resolve(scene) if hasattr(cls, "resolve") else cls).takes_options_object:
         integ = cls(scene, t0, q0, v0, t1, options=given)
     else:
         integ = cls(scene, t0, q0, v0, t1, **options)

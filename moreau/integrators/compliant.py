@@ -169,20 +169,18 @@ class _Compliant(Integrator):
             "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
             "max_steps": lambda v: positive_int("max_steps", v)}
 
-    def __init__(self, scene, t0, q0, v0, t_bound, stiffness=1e6, damping=None,
-                 contact_model="kelvin-voigt", friction_velocity=1e-4, rtol=1e-8, atol=1e-10,
-                 max_step=None, sample_dt=None, max_steps=MAX_STEPS):
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
-        self.stiffness = positive("stiffness", stiffness)
-        if contact_model not in CONTACT_MODELS:
-            raise InputError(f"`contact_model` must be one of {sorted(CONTACT_MODELS)}, got "
-                             f"{contact_model!r}")
+        self.options = o = self._take_options(options, keywords)
+        damping, contact_model, max_step = o.damping, o.contact_model, o.max_step
+        self.stiffness = o.stiffness
         self.contact_model = contact_model
         self.power = CONTACT_MODELS[contact_model]
         vs = float(np.max(np.abs(getattr(scene, "velocity_scale", 1.0))))
-        self.eps = positive("friction_velocity", friction_velocity) * (vs if vs > 0 else 1.0)
-        self.rtol = relative_tolerance("rtol", rtol, floor=False)
-        self.atol = positive("atol", atol)
+        self.eps = o.friction_velocity * (vs if vs > 0 else 1.0)
+        self.rtol, self.atol = o.rtol, o.atol
         nc = scene.ncontacts
         self.mu = np.asarray(scene.mu, float).reshape(-1) if nc else np.zeros(0)
         self.fr = np.asarray(scene.frictional_index, int) if nc else np.zeros(0, int)
@@ -197,14 +195,14 @@ class _Compliant(Integrator):
             else:
                 self.damping = np.zeros(nc)
         else:
-            self.damping = np.full(nc, nonnegative("damping", damping))
+            self.damping = np.full(nc, damping)
         # a contact lasts about pi sqrt(m / k): steps must not jump over one
         given = max_step is not None
         if max_step is None:
             m_min = float(np.min(meff)) if nc else 1.0
             max_step = 0.1 * math.pi * math.sqrt(m_min / self.stiffness)
         self.max_step = positive("max_step", max_step)
-        self.max_steps = positive_int("max_steps", max_steps)
+        self.max_steps = o.max_steps
         steps = math.ceil((self.t_bound - self.t0) / self.max_step)
         if steps > self.max_steps:
             why = ("`max_step`" if given else
@@ -215,7 +213,7 @@ class _Compliant(Integrator):
                              f"[{self.t0:g}, {self.t_bound:g}], more than `max_steps` = "
                              f"{self.max_steps:.3g} (about 1 ms a step): take a softer contact, "
                              f"a shorter run, or raise `max_steps`")
-        self.sample_dt = None if sample_dt is None else positive("sample_dt", sample_dt)
+        self.sample_dt = o.sample_dt
         self.counters.update(rhs_evaluations=0, jacobian_evaluations=0)
         n = scene.ndof
         y0 = np.concatenate([self.q, self.v])

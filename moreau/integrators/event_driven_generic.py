@@ -500,25 +500,20 @@ class GenericEventDriven(Integrator):
             "lcp_method": lambda v: _one_of("lcp_method", v, tuple(sorted(LCP_SOLVERS))),
             "record_pieces": _bool_option}
 
-    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
-                 max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
-                 max_impacts=10000, lcp_method="lemke", record_pieces=False):
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
-        self.phases = [] if record_pieces else None
-        self.jumps = [] if record_pieces else None
-        self.rtol = relative_tolerance("rtol", rtol, floor=False)
-        self.atol = positive("atol", atol)
-        if ode_method not in ("DOP853", "Radau"):
-            raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")
-        self.ode_method = ode_method
-        self.max_step = positive("max_step", max_step)
-        self.sample_dt = (positive("sample_dt", sample_dt) if sample_dt is not None
+        self.options = o = self._take_options(options, keywords)
+        self.phases = [] if o.record_pieces else None
+        self.jumps = [] if o.record_pieces else None
+        self.rtol, self.atol, self.ode_method = o.rtol, o.atol, o.ode_method
+        self.max_step = o.max_step
+        self.sample_dt = (o.sample_dt if o.sample_dt is not None
                           else (self.t_bound - self.t0) / 256.0)
-        self.gap_tol = nonnegative("gap_tol", gap_tol)
-        self.vel_tol = nonnegative("vel_tol", vel_tol)
-        self.zeno_rtol = nonnegative("zeno_rtol", zeno_rtol)
-        self.max_impacts = positive_int("max_impacts", max_impacts)
-        self.lcp_method = lcp_method
+        self.gap_tol, self.vel_tol, self.zeno_rtol = o.gap_tol, o.vel_tol, o.zeno_rtol
+        self.max_impacts = o.max_impacts
+        self.lcp_method = o.lcp_method
         self.ms = ContactModeSolver(scene)
         nc = scene.ncontacts
         self.mode = np.zeros(nc, dtype=int)

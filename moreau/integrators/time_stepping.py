@@ -293,13 +293,7 @@ class TimeStepping(CompiledRecording, Integrator):
 
     def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
-        if options is None:
-            options = self.Options.from_keywords(keywords)
-        elif keywords or not isinstance(options, self.Options):
-            raise InputError(f"`options` must be a {type(self).__name__}.Options, without "
-                             f"keywords beside it; got {type(options).__name__} and "
-                             f"{sorted(keywords)}")
-        self.options = options
+        self.options = options = self._take_options(options, keywords)
         for name, value in options.as_dict().items():
             setattr(self, name, value)
         if self.fixed_step:

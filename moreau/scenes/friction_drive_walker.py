@@ -868,12 +868,15 @@ class EventDriven(Integrator):
             "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
             "samples_per_period": lambda v: positive_int("samples_per_period", v)}
 
-    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, samples_per_period=128):
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
+        self.options = o = self._take_options(options, keywords)
         if scene.ncontacts != 1 or not hasattr(scene, "contact_angle"):
             raise InputError("`scene` must be a FrictionDrive for the event-driven reference")
-        self.walker = FrictionDriveWalker(scene, rtol=rtol)
-        self.samples_per_period = positive_int("samples_per_period", samples_per_period)
+        self.walker = FrictionDriveWalker(scene, rtol=o.rtol)
+        self.samples_per_period = o.samples_per_period
         self._stalled = 0       # events in a row that did not advance time
         st = ContactState(self.t, _F, self.q[0], self.v[0], self.q[1], self.v[1])
         try:
