@@ -226,6 +226,8 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
               statistical_options=None):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
 
+    ``scheme`` may be a scheme's options object, with :func:`make_scheme`'s defaults.
+
     Sweeps, atlases and comparisons want a periodic orbit or a failure, so
     the statistical steady state (:mod:`moreau.analysis.statistical`) is
     only the fallback with ``statistical=True`` (``moreau steady``).
@@ -241,6 +243,8 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
     >>> steady_of(make_scene("friction-drive", frequency=20.0), ED_REFERENCE).mode
     'NS'
     """
+    if isinstance(scheme, SchemeOptions):
+        scheme = make_scheme(scheme)
     extra = dict(statistical_options or {})
     stat = {}
     if "max_periods" in extra:

@@ -2,6 +2,7 @@
 
 import argparse
 import dataclasses
+import functools
 import json
 
 import pytest
@@ -11,9 +12,14 @@ from moreau.integrators.base import INTEGRATORS
 from moreau.scenes import registry
 
 
+@functools.lru_cache(maxsize=1)
+def _subcommands():
+    parser = build_parser()
+    return next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+
+
 def _subcommand(name):
-    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
-    return sub.choices[name]
+    return _subcommands()[name]
 
 
 @pytest.mark.parametrize("command", ["run", "steady", "sweep", "atlas", "bifurcation"])
