@@ -72,6 +72,11 @@ def scene_parameter_flags():
     Each is a flag of the commands that take a scene (``--mu 0.2`` is
     ``--set mu=0.2``), generated from the scenes' registered
     :class:`~moreau.scenes.registry.Parameter` entries.
+
+    Examples
+    --------
+    >>> "friction-drive" in scene_parameter_flags()["phi0"][1]
+    True
     """
     discover()
     out = {}
@@ -88,6 +93,12 @@ def scheme_option_flags():
     also a scene parameter (``damping``) or another flag of the command
     (``--rtol``, the shooting tolerance, ``--theta``): those are given with
     ``--option NAME=VALUE``.
+
+    Examples
+    --------
+    >>> flags = scheme_option_flags()
+    >>> "save_every" in flags, "damping" in flags, "rtol" in flags
+    (True, False, False)
     """
     scene = scene_parameter_flags()
     out = {}

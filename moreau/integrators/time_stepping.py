@@ -258,6 +258,16 @@ class FixedStepOptions(StepOptions):
         status ``-1`` wherever the pressed contact's free slip, of any size,
         runs that way
         (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
+
+    Examples
+    --------
+    >>> from moreau.integrators.schatzman_paoli import SchatzmanPaoli
+    >>> SchatzmanPaoli.Options(h=0.01).save_every
+    1
+    >>> SchatzmanPaoli.Options(h=0.01, painleve="jam")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `painleve` must be one of ['impulse', 'stop'], got 'jam'
     """
     h: float | None = None
     lcp_method: str = "auto"
@@ -285,6 +295,18 @@ class TimeStepping(CompiledRecording, Integrator):
     the step ``h`` is required and the run's step count and recording are
     bounded (:func:`check_work`); ``self._k`` counts the steps taken
     (:func:`next_time`).
+
+    Examples
+    --------
+    >>> from moreau.integrators.moreau_jean import MoreauJean
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> mj = MoreauJean(BouncingBall(), 0.0, [1.0], [0.0], 1.0, options=MoreauJean.Options(h=0.1))
+    >>> mj.h, mj.theta, mj.counters["steps"]
+    (0.1, 1.0, 0)
+    >>> MoreauJean(BouncingBall(), 0.0, [1.0], [0.0], 1.0, theta=0.5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `h` (the time step) is required for the moreau-jean scheme
     """
 
     takes_options_object = True
