@@ -103,12 +103,20 @@ def _options_object(name, options, scene=None):
         if key not in accepted:
             raise InputError(f"`{key}` is not an option of scheme {name!r}; its options: "
                              + ", ".join(accepted))
-    return cls.Options(**options) if cls.Options is not None else None
+    if cls.Options is None or not takes_options_object(cls):
+        # a keyword constructor checks its own options
+        return None
+    return cls.Options(**options)
 
 
 def scheme_options(cls):
-    """Option names of an integrator class, or None where it takes any (``**options``)."""
-    if getattr(cls, "Options", None) is not None:
+    """Option names of an integrator class, or None where it takes any (``**options``).
+
+    A subclass that states its own keyword constructor (a test double of a
+    scheme) takes the options that constructor names.
+    """
+    if getattr(cls, "Options", None) is not None and (takes_options_object(cls) or not [
+            p for p in list(inspect.signature(cls.__init__).parameters.values())[6:]]):
         return cls.Options.names()
     sig = inspect.signature(cls.__init__)
     params = list(sig.parameters.values())[6:]  # self, scene, t0, q0, v0, t_bound
@@ -255,6 +263,16 @@ def scheme_of(method, options=None):
     if isinstance(method, SchemeOptions):
         return method.scheme, {**method.replace(**options).as_dict()}
     return method, options
+
+
+def takes_options_object(cls):
+    """Whether ``cls(scene, t0, q0, v0, t_bound, options=...)`` takes its options object.
+
+    True for a scheme that says so (``takes_options_object``) unless a subclass
+    replaced its constructor by one without ``options``.
+    """
+    return bool(getattr(cls, "takes_options_object", False)) and \
+        "options" in inspect.signature(cls.__init__).parameters
 
 
 def register_integrator(name):
@@ -646,7 +664,7 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     if t_eval is not None:
         t_eval = check_t_eval(t_eval, finite_scalar("t_span[0]", t0), finite_scalar("t_span[1]", t1))
     funcs = check_events(events)
-    if (cls.resolve(scene) if hasattr(cls, "resolve") else cls).takes_options_object:
+    if takes_options_object(cls.resolve(scene) if hasattr(cls, "resolve") else cls):
         integ = cls(scene, t0, q0, v0, t1, options=given)
     else:
         integ = cls(scene, t0, q0, v0, t1, **options)

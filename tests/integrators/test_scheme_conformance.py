@@ -237,3 +237,21 @@ def test_the_ball_keeps_newtons_impact_law(name):
     assert abs(-leave / arrive - e) <= tol / s2, leave / arrive
     # and not the other laws: a plastic (e = 0) or elastic (e = 1) impact is far off
     assert tol / s2 < 0.25
+
+
+def test_a_subclass_with_its_own_keyword_constructor_keeps_it(monkeypatch):
+    # a test double or a user's variant of a scheme: its constructor states its options
+    from moreau.integrators.base import scheme_options
+    from moreau.integrators.moreau_jean import MoreauJean
+
+    class Trapezoidal(MoreauJean):
+        def __init__(self, scene, t0, q0, v0, t_bound, h=None):
+            super().__init__(scene, t0, q0, v0, t_bound, h=h, theta=0.5)
+
+    monkeypatch.setitem(INTEGRATORS, "trapezoidal-double", Trapezoidal)
+    assert scheme_options(Trapezoidal) == ("h",)
+    a = simulate(Spring(), (0.0, 1.0), [1.0], [0.0], "trapezoidal-double", h=0.1)
+    b = simulate(Spring(), (0.0, 1.0), [1.0], [0.0], "moreau-jean", h=0.1, theta=0.5)
+    np.testing.assert_array_equal(a.q, b.q)
+    with pytest.raises(InputError, match="`theta` is not an option of scheme 'trapezoidal-double'"):
+        simulate(Spring(), (0.0, 1.0), [1.0], [0.0], "trapezoidal-double", h=0.1, theta=1.0)
