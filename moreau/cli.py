@@ -5,6 +5,7 @@ paper's dimensionless variables.
 """
 
 import argparse
+import dataclasses
 import json
 import math
 import os
@@ -44,16 +45,121 @@ def scheme_names():
     return sorted(INTEGRATORS)
 
 
+def _flag(name):
+    return "--" + name.replace("_", "-")
+
+
+def _bool_value(text):
+    low = str(text).strip().lower()
+    if low in ("true", "yes", "1", "on"):
+        return True
+    if low in ("false", "no", "0", "off"):
+        return False
+    raise argparse.ArgumentTypeError(f"expected true or false, got {text!r}")
+
+
+def _auto_bool_value(text):
+    return "auto" if str(text).strip().lower() == "auto" else _bool_value(text)
+
+
+def _help(text):
+    return text.replace("%", "%%")
+
+
+def scene_parameter_flags():
+    """``{name: (Parameter, scenes)}`` of every registered scene's parameters, by name.
+
+    Each is a flag of the commands that take a scene (``--mu 0.2`` is
+    ``--set mu=0.2``), generated from the scenes' registered
+    :class:`~moreau.model.registry.Parameter` entries.
+
+    Examples
+    --------
+    >>> "friction-drive" in scene_parameter_flags()["phi0"][1]
+    True
+    """
+    discover()
+    out = {}
+    for e in entries():
+        for prm in e.parameters:
+            out.setdefault(prm.name, (prm, []))[1].append(e.name)
+    return out
+
+
+def scheme_option_flags():
+    """``{name: (field, schemes)}`` of the registered schemes' options that are flags.
+
+    Every field of a scheme's ``Options`` dataclass, except a name that is
+    also a scene parameter (``damping``) or another flag of the command
+    (``--rtol``, the shooting tolerance, ``--theta``): those are given with
+    ``--option NAME=VALUE``.
+
+    Examples
+    --------
+    >>> flags = scheme_option_flags()
+    >>> "save_every" in flags, "damping" in flags, "rtol" in flags
+    (True, False, False)
+    """
+    scene = scene_parameter_flags()
+    out = {}
+    for name in scheme_names():
+        opts = INTEGRATORS[name].Options
+        for f in dataclasses.fields(opts) if opts is not None else ():
+            if f.name in scene or f.name in _OWN_FLAGS or _field_type(f) is None:
+                continue
+            out.setdefault(f.name, (f, []))[1].append(name)
+    return out
+
+
+#: scheme options that have a flag of their own with its own meaning
+_OWN_FLAGS = ("theta", "rtol")
+
+
+def _field_type(field):
+    """The command-line type of an options field (None: not a flag, e.g. an array)."""
+    kind = field.type.__name__ if isinstance(field.type, type) else str(field.type)
+    kind = kind.replace(" ", "")
+    if kind in ("str|bool", "bool|str"):
+        return _auto_bool_value
+    base = kind.replace("|None", "")
+    return {"float": float, "int": int, "bool": _bool_value, "str": str}.get(base)
+
+
+def _scene_flag_type(prm):
+    if prm.unit == "choice" or isinstance(prm.default, str):
+        return str
+    if isinstance(prm.default, bool):
+        return _bool_value
+    if isinstance(prm.default, int):
+        return int
+    return float
+
+
+def add_scene_flags(p):
+    """A flag per registered scene parameter (not one the command has already)."""
+    for name, (prm, scenes) in sorted(scene_parameter_flags().items()):
+        if _flag(name) in p._option_string_actions:
+            continue
+        unit = f" [{prm.unit}]" if prm.unit and prm.unit != "choice" else ""
+        what = prm.doc or name
+        p.add_argument(_flag(name), dest=name, type=_scene_flag_type(prm), default=None,
+                       help=_help(f"{what}{unit}, same as --set {name}=VALUE (scenes: "
+                                  f"{', '.join(scenes)})"))
+
+
+def add_scheme_flags(p):
+    """A flag per registered scheme option (see :func:`scheme_option_flags`)."""
+    for name, (f, schemes) in sorted(scheme_option_flags().items()):
+        if _flag(name) in p._option_string_actions:
+            continue
+        p.add_argument(_flag(name), dest="scheme_opt_" + name, type=_field_type(f),
+                       default=None, metavar=name.upper(),
+                       help=_help(f"scheme option {name}, same as --option {name}=VALUE "
+                                  f"(schemes: {', '.join(schemes)})"))
+
+
 def _add_params(p, scheme_defaults=True):
-    p.add_argument("--mu", type=float, default=None, help="friction coefficient (default 0.1)")
-    p.add_argument("--phi0", type=float, default=None, help="initial rod tilt [rad] (default pi/4)")
-    p.add_argument("--x10", type=float, default=None, help="stator amplitude [m] (default 2e-6)")
-    p.add_argument("--k", dest="k", type=float, default=None, help="spring stiffness [N/m] (default 1e4)")
-    p.add_argument("--m", type=float, default=None, help="rod mass [kg] (default 2e-5)")
-    p.add_argument("--m2", type=float, default=None, help="rotor mass [kg] (default 2e-3)")
-    p.add_argument("--length", type=float, default=None, help="rod length [m] (default 1e-3)")
-    p.add_argument("--load", type=float, default=None, help="rotor load F_L [N] (default 0)")
-    p.add_argument("--restitution", type=float, default=None, help="impact restitution e (default 0)")
+    add_scene_flags(p)
     p.add_argument("--scheme", default="event-driven", choices=scheme_names(),
                    help="any registered scheme (default event-driven)")
     p.add_argument("--option", action="append", metavar="NAME=VALUE",
@@ -65,6 +171,7 @@ def _add_params(p, scheme_defaults=True):
                    help="Moreau-Jean theta in [1/2, 1] (default 1)")
     p.add_argument("--rtol", type=float, default=1e-10 if scheme_defaults else None,
                    help="shooting tolerance (default 1e-10 event-driven, 1e-12 Moreau-Jean)")
+    add_scheme_flags(p)
 
 
 def _scheme_args(args, rtol_acts=True):
@@ -79,25 +186,21 @@ def _scheme_args(args, rtol_acts=True):
     args.scheme_options = scheme.options
 
 
-#: the command-line shorthands of scene parameters (``--mu 0.2`` is ``--set mu=0.2``)
-SHORTHANDS = ("frequency", "mu", "phi0", "x10", "k", "m", "m2", "length", "load", "restitution",
-              "x10_a", "x10_b", "phase")
+def shorthands():
+    """The command-line shorthands of scene parameters (``--mu 0.2`` is ``--set mu=0.2``):
+    ``--frequency`` and a flag per registered scene parameter."""
+    return ("frequency",) + tuple(sorted(set(scene_parameter_flags()) - {"frequency"}))
 
 
 def add_scene_options(p, with_set=True):
-    """The ``--scene`` switch and the two-stator options of ``moreau steady``."""
+    """The ``--scene`` switch (and ``--set``); the scene parameters' flags where not yet there."""
     default = default_scene()
     p.add_argument("--scene", default=default, metavar="NAME",
                    help=f"a registered scene (`moreau scenes`; default {default})")
     if with_set:
         p.add_argument("--set", action="append", metavar="NAME=VALUE",
                        help="any parameter of the scene (repeatable), e.g. --set mu=0.3")
-    p.add_argument("--x10-a", dest="x10_a", type=float, default=None,
-                   help="bidirectional: stator amplitude of rod a [m] (default --x10 or 2e-6)")
-    p.add_argument("--x10-b", dest="x10_b", type=float, default=None,
-                   help="bidirectional: stator amplitude of rod b [m] (default --x10 or 2e-6)")
-    p.add_argument("--phase", type=float, default=None,
-                   help="bidirectional: phase lag of stator b [rad] (default 0)")
+    add_scene_flags(p)
 
 
 def scene_parameters(args, entry):
@@ -106,7 +209,8 @@ def scene_parameters(args, entry):
     A name the scene does not have is refused, listing the ones it has.
     """
     params = parse_settings(args.set or [], "--set")
-    for key in SHORTHANDS:
+    short = shorthands()
+    for key in short:
         val = getattr(args, key, None)
         if val is not None:
             if key in params:
@@ -116,7 +220,7 @@ def scene_parameters(args, entry):
     names = entry.parameter_names()
     for key in params:
         if key not in names:
-            flag = (f"--{key.replace('_', '-')}" if key in SHORTHANDS and not any(
+            flag = (f"--{key.replace('_', '-')}" if key in short and not any(
                 item.partition("=")[0].strip() == key for item in args.set or [])
                     else f"--set {key}")
             raise InputError(f"`{flag}`: `{key}` is not a parameter of scene {entry.name!r}; "
@@ -588,8 +692,8 @@ def _cmd_compare(args):
         raise InputError("`--scene` is required (one of " + ", ".join(scene_names()) +
                          "), or give `--stress`")
     params = parse_settings(list(args.param or []) + list(args.set or []), "--set")
-    for key in ("frequency", "mu", "phi0", "restitution", "load", "drive"):
-        if getattr(args, key) is not None:
+    for key in shorthands():
+        if getattr(args, key, None) is not None:
             if key in params:
                 raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
             params[key] = getattr(args, key)
@@ -799,12 +903,7 @@ def build_parser():
     c.add_argument("--scene", default=None, metavar="NAME",
                    help="a registered scene (`moreau scenes` lists them)")
     c.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
-    c.add_argument("--mu", type=float, default=None, help="friction coefficient")
-    c.add_argument("--phi0", type=float, default=None, help="friction drive: rod tilt [rad]")
-    c.add_argument("--restitution", type=float, default=None, help="impact restitution e")
-    c.add_argument("--load", type=float, default=None, help="load [N]")
-    c.add_argument("--drive", default=None, choices=["sawtooth", "sine"],
-                   help="stick-slip motor: drive shape")
+    add_scene_flags(c)
     c.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="any parameter of the scene or of its comparison case (repeatable)")
     c.add_argument("--param", action="append", metavar="KEY=VALUE", help=argparse.SUPPRESS)
@@ -840,8 +939,16 @@ def _check_common(args):
         except ImportError as exc:
             raise InputError(str(exc)) from None
     if hasattr(args, "option"):
-        # `--option NAME=VALUE` of the scheme, parsed once for every command (and study hook)
+        # `--option NAME=VALUE` of the scheme, parsed once for every command (and study hook),
+        # and the options' own flags
         args.scheme_options = parse_settings(args.option or [], "--option")
+        for key in scheme_option_flags():
+            val = getattr(args, "scheme_opt_" + key, None)
+            if val is not None:
+                if key in args.scheme_options:
+                    raise InputError(f"`{key}` is given twice (`{_flag(key)}` and "
+                                     f"`--option {key}=...`)")
+                args.scheme_options[key] = val
 
 
 def _stop_on_sigterm():

@@ -112,7 +112,7 @@ from tqdm import tqdm
 
 from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
-from ..integrators.base import INTEGRATORS, propagate_interrupts
+from ..integrators.base import INTEGRATORS, SchemeOptions, propagate_interrupts
 from ..provenance import provenance
 from ..model.scene import Scene
 from ..model.registry import get_entry
@@ -254,7 +254,7 @@ def compare(scene: str | Scene, steps: Sequence[int] | None = None,
             repeat: int = 3, quick: bool = False, progress: bool = True,
             on_row: Callable[[dict], None] | None = None, *,
             t_span: tuple[float, float] | None = None, q0: ArrayLike | None = None,
-            v0: ArrayLike | None = None, schemes: Sequence[str] | None = None,
+            v0: ArrayLike | None = None, schemes: Sequence[str | SchemeOptions] | None = None,
             **params: Any) -> dict:
     """Error against run time of every scheme on one scene.
 
@@ -286,10 +286,12 @@ def compare(scene: str | Scene, steps: Sequence[int] | None = None,
         Called with each finished row (the caller can save as it goes).
     t_span, q0, v0 : optional
         The window and start state, for a Scene instance only.
-    schemes : sequence of str, optional
+    schemes : sequence of str or SchemeOptions, optional
         Other registered schemes to run beside the reference and Moreau–Jean
         (those that state how, ``Integrator.compare_settings``, e.g.
-        ``"compliant-radau"``); none by default. On a periodic scene each
+        ``"compliant-radau"``); none by default. A scheme given as its
+        options object (``TimeDiscontinuousGalerkin.Options(degree=1)``) runs
+        its rows with those options. On a periodic scene each
         row is that scheme's own steady state, as for Moreau–Jean.
     **params
         Parameters of a registered scene and of its comparison case
@@ -486,6 +488,14 @@ def other_schemes(case, quick=False, names=None):
                   if getattr(cls, "compare_settings", None) is not None}
     if names is not None and list(names) == ["all"]:
         names = None
+    # a scheme given as its options object: its options join the fixed ones of its rows
+    given = {}
+    if names is not None:
+        names = list(names)
+        for i, n in enumerate(names):
+            if isinstance(n, SchemeOptions):
+                names[i] = n.scheme
+                given[n.scheme] = n.without_step("compare's rows")
     if names is not None:
         for n in names:
             if n not in registered:
@@ -495,7 +505,11 @@ def other_schemes(case, quick=False, names=None):
     out = []
     for name in sorted(registered):
         key, values, quick_values, fixed = registered[name].compare_settings
-        out.append((name, key, quick_values if quick else values, dict(fixed)))
+        extra = given.get(name, {})
+        if key in extra:
+            raise InputError(f"`{key}` is the setting compare varies for scheme {name!r}; "
+                             f"give its options without it")
+        out.append((name, key, quick_values if quick else values, {**dict(fixed), **extra}))
     return out
 
 

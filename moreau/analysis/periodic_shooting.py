@@ -20,7 +20,6 @@ period map: the generic event-driven reference, or Moreau–Jean (where the
 map is that of the discrete scheme).
 """
 
-import inspect
 import math
 import time
 
@@ -443,7 +442,7 @@ def _difference_step(cls, opts):
     name = getattr(cls, "error_tolerance_option", None)
     if not name:
         return 1e-7
-    tol = opts.get(name, inspect.signature(cls.__init__).parameters[name].default)
+    tol = opts.get(name, getattr(cls.Options(), name))
     return max(1e-7, math.sqrt(float(tol)))
 
 

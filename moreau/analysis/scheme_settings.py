@@ -7,12 +7,11 @@ take never reaches a worker process). Sweeps, atlases and ``moreau steady``
 carry one; :func:`steady_of` computes the steady state it describes.
 """
 
-import inspect
 import math
 
 from ..errors import InputError
 from ..integrators import INTEGRATORS, get_integrator
-from ..integrators.base import check_options, scheme_options
+from ..integrators.base import SchemeOptions, check_options, scheme_options
 from .steady_state import find_steady_state
 
 __all__ = ["Scheme", "make_scheme", "steady_of", "ED_REFERENCE", "ADAPTIVE_SHOOTING_RTOL"]
@@ -25,7 +24,10 @@ ADAPTIVE_SHOOTING_RTOL = 1e-8
 class Scheme(tuple):
     """Settings of one steady-state computation: ``(name, theta, steps_per_period, rtol, options)``.
 
-    ``name`` is any registered scheme (:data:`moreau.integrators.INTEGRATORS`).
+    ``name`` is any registered scheme (:data:`moreau.integrators.INTEGRATORS`),
+    or a scheme's options object (``MoreauJean.Options(theta=0.5)``), whose
+    scheme, ``theta`` and other options it takes (not ``h``: the step is
+    ``steps_per_period``).
     ``steps_per_period`` applies to the time-stepping schemes (those with a
     step ``h``) and ``theta`` to those with a ``theta``; both are None
     otherwise. ``rtol`` is the shooting tolerance. ``options`` holds the
@@ -39,6 +41,9 @@ class Scheme(tuple):
     'mj_theta0.5'
     >>> Scheme("compliant-rk45", options={"stiffness": 1e6}).label
     'compliant-rk45_stiffness1e+06'
+    >>> from moreau.integrators.moreau_jean import MoreauJean
+    >>> Scheme(MoreauJean.Options(theta=0.5), steps_per_period=2000).label
+    'mj_theta0.5'
     >>> Scheme("event-driven", theta=0.5)
     Traceback (most recent call last):
     ...
@@ -46,6 +51,7 @@ class Scheme(tuple):
     """
 
     def __new__(cls, name, theta=None, steps_per_period=None, rtol=None, options=None):
+        name, theta, options = _from_object(name, theta, options)
         takes = _takes(name)
         opts = dict(options or {})
         for key, val in (("theta", theta), ("steps_per_period", steps_per_period)):
@@ -129,6 +135,19 @@ class Scheme(tuple):
         return (self[0], self[1], self[2], self[3], dict(self[4]))
 
 
+def _from_object(scheme, theta, options):
+    """``(name, theta, options)`` of a scheme given by name or as its options object."""
+    if not isinstance(scheme, SchemeOptions):
+        return scheme, theta, options
+    given = scheme.without_step("`steps_per_period`")
+    if "theta" in scheme.names():
+        given.pop("theta", None)
+        if theta is not None:
+            raise InputError("`theta` is given by the options object; do not give it beside it")
+        theta = scheme.theta
+    return scheme.scheme, theta, {**given, **dict(options or {})}
+
+
 def _takes(name):
     """The options scheme ``name`` takes (an unknown name lists the registered ones)."""
     return scheme_options(get_integrator(name)) or ()
@@ -157,6 +176,7 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     ...
     moreau.errors.InputError: `--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)
     """
+    scheme, theta, options = _from_object(scheme, theta, options)
     takes = _takes(scheme)
     for flag, key, val in (("--theta", "theta", theta),
                            ("--steps-per-period", "h", steps_per_period)):
@@ -198,13 +218,15 @@ def _adaptive_rtol(scheme):
     opts = dict(scheme.options)
     if not name:
         return ADAPTIVE_SHOOTING_RTOL
-    tol = float(opts.get(name, inspect.signature(cls.__init__).parameters[name].default))
+    tol = float(opts.get(name, getattr(cls.Options(), name)))
     return max(min(ADAPTIVE_SHOOTING_RTOL, 100.0 * tol), 10.0 * tol)
 
 
 def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_iter=None,
               statistical_options=None):
     """:func:`find_steady_state` of ``scene`` with the settings of a :class:`Scheme`.
+
+    ``scheme`` may be a scheme's options object, with :func:`make_scheme`'s defaults.
 
     Sweeps, atlases and comparisons want a periodic orbit or a failure, so
     the statistical steady state (:mod:`moreau.analysis.statistical`) is
@@ -221,6 +243,8 @@ def steady_of(scene, scheme, max_period=1, statistical=False, guess=None, max_it
     >>> steady_of(make_scene("friction-drive", frequency=20.0), ED_REFERENCE).mode
     'NS'
     """
+    if isinstance(scheme, SchemeOptions):
+        scheme = make_scheme(scheme)
     extra = dict(statistical_options or {})
     stat = {}
     if "max_periods" in extra:

@@ -103,7 +103,7 @@ from scipy.special import stdtrit
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import BudgetExhaustedError, ConvergenceError, InputError, MoreauError, RunawayError
 from ..integrators import get_integrator
-from ..integrators.base import check_options, scheme_options as options_of
+from ..integrators.base import SchemeOptions, check_options, scheme_options as options_of
 from ..integrators.result import SteadyState
 from .periodic_shooting import period_map_options
 from .runaway import runaway_in
@@ -511,8 +511,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
     ----------
     scene : Scene
         A ``2 pi``-periodic scene with a cyclic coordinate.
-    scheme : str
-        Any registered scheme.
+    scheme : str or SchemeOptions
+        Any registered scheme, or its options object (its options join
+        ``scheme_options``; the step comes from ``steps_per_period``).
     q0, v0 : array_like, optional
         Start at the section; the scene's ``initial_state()`` by default.
     section_tau : float
@@ -584,6 +585,9 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
     ConvergenceError
         The scheme failed along the way (on every start).
     """
+    if isinstance(scheme, SchemeOptions):
+        scheme_options = {**scheme.without_step("`steps_per_period`"), **(scheme_options or {})}
+        scheme = scheme.scheme
     if cyclic is None:
         cyc = tuple(getattr(scene, "cyclic_coordinates", ()))
         cyclic = cyc[0] if len(cyc) == 1 else None

@@ -19,6 +19,7 @@ from ..errors import ConvergenceError, InputError, RunawayError
 # SteadyState is defined with the other scheme results (below this layer)
 # and re-exported here, where callers have always found it
 from ..integrators import INTEGRATORS, get_integrator
+from ..integrators.base import SchemeOptions
 from ..integrators.result import SteadyState
 from ..model.scene import Scene
 # the package's generic solvers register themselves on import (a scene's own with its scene)
@@ -36,7 +37,7 @@ __all__ = ["SteadyState", "find_steady_state"]
 TWO_PI = 2.0 * math.pi
 
 
-def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 1e-10,
+def find_steady_state(scene: Scene, scheme: str | SchemeOptions = "event-driven", rtol: float = 1e-10,
                       v_guess: float | None = None, max_iter: int = 60, max_period: int = 1,
                       statistical: bool = True, statistical_budget: int = MAX_PERIODS,
                       guess: ArrayLike | None = None,
@@ -84,6 +85,8 @@ def find_steady_state(scene: Scene, scheme: str = "event-driven", rtol: float = 
     """
     if not isinstance(scene, Scene):
         raise InputError(f"`scene` must be a Scene instance, got {type(scene).__name__}")
+    if isinstance(scheme, SchemeOptions):
+        scheme, options = _scheme_object(scheme, options)
     max_period = positive_int("max_period", max_period)
     if max_period > MAX_PERIOD:
         raise InputError(f"`max_period` must be at most {MAX_PERIOD}, got {max_period}")
@@ -162,6 +165,20 @@ def _check_guess(scene, guess):
 STATISTICAL_OPTIONS = ("precision", "confidence", "starts", "spread", "progress")
 
 
+def _scheme_object(scheme, options):
+    """``(name, options)`` of a scheme given as its options object, as a call by name takes them.
+
+    Moreau–Jean's own solver takes its options as keywords (``theta``, ...);
+    the shooting of any other scheme takes them as ``scheme_options``. The
+    step is ``steps_per_period``, not ``h``.
+    """
+    given = scheme.without_step("`steps_per_period`")
+    if scheme.scheme == "moreau-jean":
+        return scheme.scheme, {**given, "theta": scheme.theta, **options}
+    merged = {**given, **(options.get("scheme_options") or {})}
+    return scheme.scheme, {**options, **({"scheme_options": merged} if merged else {})}
+
+
 def _statistical(scene, scheme, failure, budget, options, extra=None):
     """The statistical steady state where the shooting found no orbit (``failure`` says why)."""
     state = getattr(failure, "state", None)
@@ -228,6 +245,8 @@ def _find_steady_state(scene, scheme="event-driven", rtol=1e-10, v_guess=None, m
         ``"event-driven"`` (this function) or ``"moreau-jean"`` (delegates to
         :func:`moreau.analysis.mj_steady_state.moreau_jean_steady_state`,
         which takes ``steps_per_period`` and ``theta`` in ``options``).
+        :func:`find_steady_state` also takes a scheme's options object
+        (``MoreauJean.Options(theta=0.5)``; its step is ``steps_per_period``).
     rtol : float
         Tolerance on the estimated distance of ``u2'`` from the fixed point
         (residual over the secant slope of ``P(x) - x``), relative to the

@@ -35,12 +35,14 @@ import numpy as np
 
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import InputError
+from ..integrators.base import SchemeOptions
 from ..outputs import claim_outputs
 from ..provenance import provenance
 from ..model import registry
 from . import engine
 from .energy import ENERGY_COLUMNS
 from .engine import ED_REFERENCE, check_output_dir, periodic_scene_names
+from .scheme_settings import make_scheme
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
            "MAX_POINTS", "rows_to_xarray", "rows_to_netcdf", "netcdf_attrs", "require_xarray",
@@ -206,7 +208,10 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
         Other parameters of the scene (SI units); the rest keep their defaults.
     frequency : float, optional
         Drive frequency [Hz]; required unless ``parameter`` is ``"frequency"``.
-    scheme : moreau.analysis.engine.Scheme
+    scheme : moreau.analysis.engine.Scheme or SchemeOptions
+        The settings of each point's steady state; a scheme's options object
+        (``MoreauJean.Options(theta=0.5)``) takes the default steps per period
+        and tolerance of :func:`~moreau.analysis.scheme_settings.make_scheme`.
     out : path-like or None
         Output folder, checked writable before any work; None writes nothing.
     cache_dir : path-like, optional
@@ -230,6 +235,8 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     list of dict
         One tidy row per value.
     """
+    if isinstance(scheme, SchemeOptions):
+        scheme = make_scheme(scheme)
     values = np.asarray(values, dtype=float).reshape(-1)
     if netcdf:
         if out is None:

@@ -11,11 +11,12 @@ import importlib
 import pkgutil
 
 from ._loops import specialised_loops
-from .base import INTEGRATORS, Integrator, check_options, get_integrator, register_integrator, simulate
+from .base import (INTEGRATORS, Integrator, SchemeOptions, check_options, get_integrator,
+                   register_integrator, simulate)
 from .result import Event, SimulationResult
 
-__all__ = ["INTEGRATORS", "Integrator", "check_options", "get_integrator", "register_integrator",
-           "simulate", "Event", "SimulationResult", "specialised_loops"]
+__all__ = ["INTEGRATORS", "Integrator", "SchemeOptions", "check_options", "get_integrator",
+           "register_integrator", "simulate", "Event", "SimulationResult", "specialised_loops"]
 
 # every public module here registers its scheme(s) when imported: discover them, so that a
 # new scheme is one new module and no list names it

@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import dataclasses
 import inspect
-from typing import Any, Callable, Sequence, TYPE_CHECKING
+from typing import Any, Callable, ClassVar, Sequence, TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -31,7 +32,7 @@ if TYPE_CHECKING:  # annotations only: the scenes package imports this one at ru
     from ..model.scene import Scene
 
 __all__ = ["Integrator", "simulate", "propagate_interrupts", "INTEGRATORS", "register_integrator", "get_integrator",
-           "check_options"]
+           "check_options", "SchemeOptions", "scheme_of"]
 
 #: registry name -> Integrator subclass, filled by :func:`register_integrator`
 INTEGRATORS = {}
@@ -64,12 +65,13 @@ def get_integrator(name):
 
 
 def check_options(name, options, scene=None):
-    """Refuse an option that scheme ``name`` does not take, before any work.
+    """Refuse an option that scheme ``name`` does not take, or a bad value, before any work.
 
-    The options a scheme takes are the keyword parameters of its
-    constructor (after ``scene, t0, q0, v0, t_bound``): one place states
-    them, and a setting that would not act is an error naming the option
-    and the scheme. A scheme that hands a scene to another one (the
+    The options a scheme takes are the fields of its :class:`SchemeOptions`
+    dataclass (``cls.Options``), or, for a scheme without one, the keyword
+    parameters of its constructor (after ``scene, t0, q0, v0, t_bound``): one
+    place states them, and a setting that would not act is an error naming
+    the option and the scheme. A scheme that hands a scene to another one (the
     ``"event-driven"`` front, which picks the scene's own reference) states
     that by a ``resolve(scene)`` method, and the options are those of the
     scheme it picks.
@@ -81,21 +83,41 @@ def check_options(name, options, scene=None):
     Traceback (most recent call last):
     ...
     moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, ode_method, max_step, sample_dt, gap_tol, vel_tol, zeno_rtol, max_impacts, lcp_method, record_pieces
+    >>> check_options("moreau-jean", {"theta": 2.0})
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `theta` must be in [0.5, 1.0], got 2.0
     """
+    _options_object(name, options, scene)
+
+
+def _options_object(name, options, scene=None):
+    """The checked options object of scheme ``name`` (None for a scheme without one)."""
     cls = get_integrator(name)
     if scene is not None and hasattr(cls, "resolve"):
         cls = cls.resolve(scene)
     accepted = scheme_options(cls)
     if accepted is None:
-        return
+        return None
     for key in options:
         if key not in accepted:
             raise InputError(f"`{key}` is not an option of scheme {name!r}; its options: "
                              + ", ".join(accepted))
+    if cls.Options is None or not takes_options_object(cls):
+        # a keyword constructor checks its own options
+        return None
+    return cls.Options(**options)
 
 
 def scheme_options(cls):
-    """Keyword options of an integrator class, or None where it takes any (``**options``)."""
+    """Option names of an integrator class, or None where it takes any (``**options``).
+
+    A subclass that states its own keyword constructor (a test double of a
+    scheme) takes the options that constructor names.
+    """
+    if getattr(cls, "Options", None) is not None and (takes_options_object(cls) or not [
+            p for p in list(inspect.signature(cls.__init__).parameters.values())[6:]]):
+        return cls.Options.names()
     sig = inspect.signature(cls.__init__)
     params = list(sig.parameters.values())[6:]  # self, scene, t0, q0, v0, t_bound
     if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params):
@@ -103,11 +125,169 @@ def scheme_options(cls):
     return tuple(p.name for p in params)
 
 
+@dataclasses.dataclass(frozen=True)
+class SchemeOptions:
+    """The typed options of one scheme: a frozen dataclass, checked once when made.
+
+    Each registered scheme states its options as ``cls.Options``, a subclass
+    with one field per option (its type and default); the values are checked
+    in ``__post_init__`` (an :class:`~moreau.errors.InputError` names the field
+    and the rule) and normalised (a float, a bool). An instance also names its
+    scheme (:attr:`scheme`), so it is a whole scheme choice: pass it to
+    :func:`simulate` as ``method``, or to an analysis as ``scheme``. What
+    depends on the run (the step count of ``h`` over the interval, the
+    scene's contacts) is checked when the run is made.
+
+    Examples
+    --------
+    >>> from moreau.integrators.moreau_jean import MoreauJean
+    >>> opts = MoreauJean.Options(h=1e-3, theta=0.5)
+    >>> opts.scheme, opts.h, opts.replace(theta=1).theta
+    ('moreau-jean', 0.001, 1.0)
+    >>> MoreauJean.Options(h=-1.0)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `h` must be > 0, got -1.0
+    """
+
+    #: the registered name of the scheme (set by :func:`register_integrator`)
+    scheme: ClassVar[str] = ""
+    #: field name -> its rule: a function of the value that returns it normalised or
+    #: raises an InputError naming the field and the rule
+    _rules: ClassVar[dict] = {}
+
+    def __post_init__(self):
+        self._check()
+
+    def _rule(self, name):
+        return self._rules.get(name)
+
+    def _check(self):
+        """Check and normalise the fields by their rules, in field order."""
+        for f in dataclasses.fields(self):
+            rule = self._rule(f.name)
+            if rule is not None:
+                self._set(f.name, rule(getattr(self, f.name)))
+
+    def _set(self, name, value):
+        # normalising a field of a frozen instance while it is made
+        object.__setattr__(self, name, value)
+
+    def smooth_order(self):
+        """The order of the global error in ``h`` where the motion is smooth, or None.
+
+        None for a scheme that picks its own steps under an error tolerance
+        (or follows the motion exactly), which states no order in a step.
+        """
+        return None
+
+    @classmethod
+    def names(cls):
+        """The option names, in their order."""
+        return tuple(f.name for f in dataclasses.fields(cls))
+
+    @classmethod
+    def from_keywords(cls, options):
+        """The options from a dict of keywords; an unknown one is refused naming the scheme's."""
+        cls._refuse_unknown(options)
+        return cls(**options)
+
+    @classmethod
+    def _refuse_unknown(cls, options):
+        accepted = cls.names()
+        for key in options:
+            if key not in accepted:
+                raise InputError(f"`{key}` is not an option of scheme {cls.scheme!r}; its "
+                                 "options: " + ", ".join(accepted))
+
+    def replace(self, **changes):
+        """A copy with ``changes`` (checked like a new instance)."""
+        self._refuse_unknown(changes)
+        return dataclasses.replace(self, **changes)
+
+    def changed(self):
+        """``{name: value}`` of the fields set away from their defaults.
+
+        What a call by name would pass as keywords; an analysis that sets
+        some options itself (the step from its steps per period) takes these.
+
+        Examples
+        --------
+        >>> from moreau.integrators.moreau_jean import MoreauJean
+        >>> MoreauJean.Options(h=0.01, theta=1, lcp_method="lemke").changed()
+        {'h': 0.01, 'lcp_method': 'lemke'}
+        """
+        out = {}
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if value is f.default:
+                continue
+            if type(value) is type(f.default) and np.ndim(value) == 0 and value == f.default:
+                continue
+            out[f.name] = value
+        return out
+
+    def without_step(self, what="the analysis"):
+        """:meth:`changed` without ``h``; a set ``h`` is refused: ``what`` sets the step."""
+        out = self.changed()
+        if "h" in out:
+            raise InputError(f"`h` is set by {what} (from its steps per period); give the "
+                             f"options of scheme {self.scheme!r} without `h`")
+        return out
+
+    def as_dict(self):
+        """``{name: value}`` of every field (the constructor's keywords)."""
+        return {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+
+    @property
+    def integrator(self):
+        """The :class:`Integrator` subclass these options are for."""
+        return get_integrator(self.scheme)
+
+
+def scheme_of(method, options=None):
+    """``(name, options dict)`` of a scheme given by name or as a :class:`SchemeOptions`.
+
+    ``options`` are keywords given beside it; with an options object they
+    replace its fields. Lets an analysis take either form and pass one on.
+
+    Examples
+    --------
+    >>> from moreau.integrators.moreau_jean import MoreauJean
+    >>> scheme_of(MoreauJean.Options(h=0.01), {"theta": 0.5})[1]["theta"]
+    0.5
+    >>> scheme_of("event-driven", {"rtol": 1e-9})
+    ('event-driven', {'rtol': 1e-09})
+    """
+    options = dict(options or {})
+    if isinstance(method, SchemeOptions):
+        return method.scheme, {**method.replace(**options).as_dict()}
+    return method, options
+
+
+def takes_options_object(cls):
+    """Whether ``cls(scene, t0, q0, v0, t_bound, options=...)`` takes its options object.
+
+    True for a scheme that says so (``takes_options_object``) unless a subclass
+    replaced its constructor by one without ``options``.
+    """
+    return bool(getattr(cls, "takes_options_object", False)) and \
+        "options" in inspect.signature(cls.__init__).parameters
+
+
 def register_integrator(name):
     """Class decorator registering an :class:`Integrator` subclass under ``name``."""
     def deco(cls):
         INTEGRATORS[name] = cls
         cls.scheme = name
+        base = vars(cls).get("Options") or getattr(cls, "Options", None)
+        if base is not None:
+            # every scheme's options name their scheme, also where a class shares its parent's
+            opts = dataclasses.dataclass(frozen=True)(
+                type("Options", (base,), {"scheme": name, "__module__": cls.__module__,
+                                          "__qualname__": f"{cls.__qualname__}.Options",
+                                          "__doc__": base.__doc__}))
+            cls.Options = opts
         return cls
     return deco
 
@@ -144,6 +324,10 @@ class Integrator:
     #: None: ``(setting, values, quick_values, fixed_options)``, one row per value of the
     #: option ``setting`` (e.g. a compliant contact's stiffness)
     compare_settings = None
+    #: the scheme's typed options (a :class:`SchemeOptions` dataclass), or None
+    Options = None
+    #: True where the constructor takes the options as one object (``options=``)
+    takes_options_object = False
 
     def __init__(self, scene, t0, q0, v0, t_bound):
         self.scene = scene
@@ -182,6 +366,20 @@ class Integrator:
         # time of the state where the run left it (None while inside)
         self._region_seen = 0
         self.region_left_at = None
+
+    def _take_options(self, options, keywords):
+        """The scheme's options object: ``options`` as given, or made from ``keywords``.
+
+        For a constructor ``(scene, t0, q0, v0, t_bound, options=None, **keywords)``
+        (``takes_options_object``): the object is checked once, where it is made.
+        """
+        if options is None:
+            return self.Options.from_keywords(keywords)
+        if keywords or not isinstance(options, self.Options):
+            raise InputError(f"`options` must be a {type(self).__name__}.Options, without "
+                             f"keywords beside it; got {type(options).__name__} and "
+                             f"{sorted(keywords)}")
+        return options
 
     # -- public API ---------------------------------------------------------
     def step(self):
@@ -402,8 +600,10 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
         Dimensionless start and end time.
     q0, v0 : array_like
         Initial state.
-    method : str
-        A key of :data:`INTEGRATORS` (e.g. ``"moreau-jean"``).
+    method : str or SchemeOptions
+        A key of :data:`INTEGRATORS` (e.g. ``"moreau-jean"``), or a scheme's
+        options object (``MoreauJean.Options(h=1e-3)``), which names its
+        scheme; keywords in ``options`` then replace its fields.
     progress : bool
         Show a tqdm progress bar over simulated time.
     t_eval : array_like, optional
@@ -426,7 +626,8 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
         ``result.t_events`` and ``result.y_events``; a terminal event ends
         the run with status 1.
     **options
-        Passed to the integrator's constructor.
+        The scheme's options (the fields of its ``Options``), checked before
+        any work.
 
     Returns
     -------
@@ -451,13 +652,22 @@ def simulate(scene: Scene, t_span: tuple[float, float], q0: ArrayLike, v0: Array
     >>> res.status, round(float(res.t_events[0][0]), 12), res.t.tolist()
     (1, 1.0, [0.0, 0.5])
     """
-    cls = get_integrator(method)
-    check_options(method, options, scene)
+    if isinstance(method, SchemeOptions):
+        given = method.replace(**options) if options else method
+        method = given.scheme
+        cls = get_integrator(method)
+        options = given.as_dict()
+    else:
+        cls = get_integrator(method)
+        given = _options_object(method, options, scene)
     t0, t1 = t_span
     if t_eval is not None:
         t_eval = check_t_eval(t_eval, finite_scalar("t_span[0]", t0), finite_scalar("t_span[1]", t1))
     funcs = check_events(events)
-    integ = cls(scene, t0, q0, v0, t1, **options)
+    if takes_options_object(cls.resolve(scene) if hasattr(cls, "resolve") else cls):
+        integ = cls(scene, t0, q0, v0, t1, options=given)
+    else:
+        integ = cls(scene, t0, q0, v0, t1, **options)
     tracker = None
     if t_eval is not None or funcs:
         integ._want_pieces = True

@@ -50,7 +50,9 @@ Examples
 True
 """
 
+import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 from scipy.integrate import RK45, Radau
@@ -59,7 +61,7 @@ from scipy.optimize import brentq
 from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, MoreauError
 from ..regimes import Regime
-from .base import Integrator, register_integrator
+from .base import Integrator, SchemeOptions, register_integrator
 from .event_driven_generic import contact_law_regimes
 
 __all__ = ["CompliantRadau", "CompliantRK45", "CONTACT_MODELS", "damping_for_restitution",
@@ -125,6 +127,13 @@ def damping_for_restitution(e, stiffness, mass):
     return 2.0 * zeta * math.sqrt(stiffness * mass)
 
 
+def _contact_model_option(value):
+    if value not in CONTACT_MODELS:
+        raise InputError(f"`contact_model` must be one of {sorted(CONTACT_MODELS)}, got "
+                         f"{value!r}")
+    return value
+
+
 class _Compliant(Integrator):
     """Common part of the compliant schemes (see the module docstring)."""
 
@@ -136,20 +145,42 @@ class _Compliant(Integrator):
     compare_settings = ("stiffness", (1e3, 1e4, 1e5), (1e3, 1e4),
                         {"rtol": 1e-9, "atol": 1e-12, "friction_velocity": 1e-3})
 
-    def __init__(self, scene, t0, q0, v0, t_bound, stiffness=1e6, damping=None,
-                 contact_model="kelvin-voigt", friction_velocity=1e-4, rtol=1e-8, atol=1e-10,
-                 max_step=None, sample_dt=None, max_steps=MAX_STEPS):
+    @dataclasses.dataclass(frozen=True)
+    class Options(SchemeOptions):
+        """Options of a compliant scheme (see :class:`CompliantRadau`)."""
+        stiffness: float = 1e6
+        damping: float | None = None
+        contact_model: str = "kelvin-voigt"
+        friction_velocity: float = 1e-4
+        rtol: float = 1e-8
+        atol: float = 1e-10
+        max_step: float | None = None
+        sample_dt: float | None = None
+        max_steps: int = MAX_STEPS
+
+        _rules: ClassVar[dict] = {
+            "stiffness": lambda v: positive("stiffness", v),
+            "damping": lambda v: None if v is None else nonnegative("damping", v),
+            "contact_model": _contact_model_option,
+            "friction_velocity": lambda v: positive("friction_velocity", v),
+            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
+            "atol": lambda v: positive("atol", v),
+            "max_step": lambda v: None if v is None else positive("max_step", v),
+            "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
+            "max_steps": lambda v: positive_int("max_steps", v)}
+
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
-        self.stiffness = positive("stiffness", stiffness)
-        if contact_model not in CONTACT_MODELS:
-            raise InputError(f"`contact_model` must be one of {sorted(CONTACT_MODELS)}, got "
-                             f"{contact_model!r}")
+        self.options = o = self._take_options(options, keywords)
+        damping, contact_model, max_step = o.damping, o.contact_model, o.max_step
+        self.stiffness = o.stiffness
         self.contact_model = contact_model
         self.power = CONTACT_MODELS[contact_model]
         vs = float(np.max(np.abs(getattr(scene, "velocity_scale", 1.0))))
-        self.eps = positive("friction_velocity", friction_velocity) * (vs if vs > 0 else 1.0)
-        self.rtol = relative_tolerance("rtol", rtol, floor=False)
-        self.atol = positive("atol", atol)
+        self.eps = o.friction_velocity * (vs if vs > 0 else 1.0)
+        self.rtol, self.atol = o.rtol, o.atol
         nc = scene.ncontacts
         self.mu = np.asarray(scene.mu, float).reshape(-1) if nc else np.zeros(0)
         self.fr = np.asarray(scene.frictional_index, int) if nc else np.zeros(0, int)
@@ -164,14 +195,14 @@ class _Compliant(Integrator):
             else:
                 self.damping = np.zeros(nc)
         else:
-            self.damping = np.full(nc, nonnegative("damping", damping))
+            self.damping = np.full(nc, damping)
         # a contact lasts about pi sqrt(m / k): steps must not jump over one
         given = max_step is not None
         if max_step is None:
             m_min = float(np.min(meff)) if nc else 1.0
             max_step = 0.1 * math.pi * math.sqrt(m_min / self.stiffness)
         self.max_step = positive("max_step", max_step)
-        self.max_steps = positive_int("max_steps", max_steps)
+        self.max_steps = o.max_steps
         steps = math.ceil((self.t_bound - self.t0) / self.max_step)
         if steps > self.max_steps:
             why = ("`max_step`" if given else
@@ -182,7 +213,7 @@ class _Compliant(Integrator):
                              f"[{self.t0:g}, {self.t_bound:g}], more than `max_steps` = "
                              f"{self.max_steps:.3g} (about 1 ms a step): take a softer contact, "
                              f"a shorter run, or raise `max_steps`")
-        self.sample_dt = None if sample_dt is None else positive("sample_dt", sample_dt)
+        self.sample_dt = o.sample_dt
         self.counters.update(rhs_evaluations=0, jacobian_evaluations=0)
         n = scene.ndof
         y0 = np.concatenate([self.q, self.v])

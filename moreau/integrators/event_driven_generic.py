@@ -83,14 +83,17 @@ step-size control, which costs steps and some accuracy.
 import math
 from itertools import combinations, product
 
+import dataclasses
+from typing import ClassVar
+
 import numpy as np
 from scipy.integrate import solve_ivp
 
 from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, LCPError, MoreauError, PainleveError
-from ..lcp import build_friction_lcp, friction_impulses, solve_lcp
+from ..lcp import METHODS as LCP_SOLVERS, build_friction_lcp, friction_impulses, solve_lcp
 from ..regimes import Regime
-from .base import Integrator, get_integrator, register_integrator
+from .base import Integrator, SchemeOptions, get_integrator, register_integrator
 from .contact_problem import MAX_PIECES_CONTACTS, friction_pieces
 from .result import Event
 
@@ -398,6 +401,18 @@ def project_positions(scene, t, q, contacts, max_iter=4):
     return q
 
 
+def _one_of(name, value, allowed):
+    if not isinstance(value, str) or value not in allowed:
+        raise InputError(f"`{name}` must be one of {list(allowed)}, got {value!r}")
+    return value
+
+
+def _bool_option(value):
+    if not isinstance(value, (bool, np.bool_)):
+        raise InputError(f"`record_pieces` must be True or False, got {value!r}")
+    return bool(value)
+
+
 @register_integrator("event-driven-generic")
 class GenericEventDriven(Integrator):
     """Event-driven reference for any :class:`~moreau.model.scene.Scene`.
@@ -457,25 +472,48 @@ class GenericEventDriven(Integrator):
 
     exact_motion = True
 
-    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, atol=1e-15, ode_method="DOP853",
-                 max_step=0.1, sample_dt=None, gap_tol=1e-13, vel_tol=1e-9, zeno_rtol=1e-6,
-                 max_impacts=10000, lcp_method="lemke", record_pieces=False):
+    @dataclasses.dataclass(frozen=True)
+    class Options(SchemeOptions):
+        """Options of :class:`GenericEventDriven` (its parameters after ``t_bound``)."""
+        rtol: float = 1e-12
+        atol: float = 1e-15
+        ode_method: str = "DOP853"
+        max_step: float = 0.1
+        sample_dt: float | None = None
+        gap_tol: float = 1e-13
+        vel_tol: float = 1e-9
+        zeno_rtol: float = 1e-6
+        max_impacts: int = 10000
+        lcp_method: str = "lemke"
+        record_pieces: bool = False
+
+        _rules: ClassVar[dict] = {
+            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
+            "atol": lambda v: positive("atol", v),
+            "ode_method": lambda v: _one_of("ode_method", v, ("DOP853", "Radau")),
+            "max_step": lambda v: positive("max_step", v),
+            "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
+            "gap_tol": lambda v: nonnegative("gap_tol", v),
+            "vel_tol": lambda v: nonnegative("vel_tol", v),
+            "zeno_rtol": lambda v: nonnegative("zeno_rtol", v),
+            "max_impacts": lambda v: positive_int("max_impacts", v),
+            "lcp_method": lambda v: _one_of("lcp_method", v, tuple(sorted(LCP_SOLVERS))),
+            "record_pieces": _bool_option}
+
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
-        self.phases = [] if record_pieces else None
-        self.jumps = [] if record_pieces else None
-        self.rtol = relative_tolerance("rtol", rtol, floor=False)
-        self.atol = positive("atol", atol)
-        if ode_method not in ("DOP853", "Radau"):
-            raise InputError(f"`ode_method` must be 'DOP853' or 'Radau', got {ode_method!r}")
-        self.ode_method = ode_method
-        self.max_step = positive("max_step", max_step)
-        self.sample_dt = (positive("sample_dt", sample_dt) if sample_dt is not None
+        self.options = o = self._take_options(options, keywords)
+        self.phases = [] if o.record_pieces else None
+        self.jumps = [] if o.record_pieces else None
+        self.rtol, self.atol, self.ode_method = o.rtol, o.atol, o.ode_method
+        self.max_step = o.max_step
+        self.sample_dt = (o.sample_dt if o.sample_dt is not None
                           else (self.t_bound - self.t0) / 256.0)
-        self.gap_tol = nonnegative("gap_tol", gap_tol)
-        self.vel_tol = nonnegative("vel_tol", vel_tol)
-        self.zeno_rtol = nonnegative("zeno_rtol", zeno_rtol)
-        self.max_impacts = positive_int("max_impacts", max_impacts)
-        self.lcp_method = lcp_method
+        self.gap_tol, self.vel_tol, self.zeno_rtol = o.gap_tol, o.vel_tol, o.zeno_rtol
+        self.max_impacts = o.max_impacts
+        self.lcp_method = o.lcp_method
         self.ms = ContactModeSolver(scene)
         nc = scene.ncontacts
         self.mode = np.zeros(nc, dtype=int)

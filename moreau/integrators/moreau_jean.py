@@ -132,24 +132,23 @@ of the friction LCP; on the compiled path Lemke's measure,
 after a step, 0 if none); ``projection_iterations``.
 """
 
-import math
+import dataclasses
 
 import numpy as np
 
-from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError
 from ..regimes import Regime
-from .base import Integrator, register_integrator
-from ._blocks import CompiledRecording
-from .contact_problem import (check_painleve, one_contact_impulse, one_contact_residual,
-                              sliding_regimes, solve_contact_problem)
-from ._mj_kernels import mj_loop, prev_regimes, set_painleve_stop
+from .base import register_integrator
+from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
+from ._mj_kernels import mj_loop, prev_regimes
+# the time-stepping checks lived here; their names stay importable from this module
+from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
+                            FixedStepOptions, TimeStepping, check_lcp_options, check_scene_contacts,
+                            check_step, check_step_fits, check_work, compiled_model_of,
+                            next_time)
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
-
-#: accepted values of the ``lcp_method`` option
-LCP_METHODS = ("auto", "lemke", "qp")
 
 # |p_T| within this relative distance of mu p_N counts as slip: the LCP and
 # the enumeration reach the friction-cone boundary only up to rounding
@@ -200,117 +199,8 @@ def _new_counters():
             "warm_starts": 0, "tangential_impacts": 0, "tangential_impact_times": []}
 
 
-#: default bound on the steps of one run (about two minutes at 1e7 steps/s); `max_steps` raises it
-MAX_STEPS = 10**9
-#: bound on the memory the recorded samples of one run may take
-MAX_RECORD_BYTES = 2 * 1024**3
-
-
-def check_work(scene, t0, t1, h, save_every, max_steps=MAX_STEPS):
-    """Refuse, before any work, a run whose step count or recorded samples have no sane bound.
-
-    Examples
-    --------
-    >>> from moreau.scenes.bouncing_ball import BouncingBall
-    >>> check_work(BouncingBall(), 0.0, 6.3, 1e-9, 1)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `h` = 1e-09 over [0, 6.3] takes 6.3e+09 steps, more than `max_steps` = 1e+09: take a larger `h` or raise `max_steps`
-    >>> check_work(BouncingBall(), 0.0, 4.0, 1000.0, 1)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `h` = 1000 is longer than the run [0, 4]: a step may not exceed the window it integrates; take `h` <= 4
-    """
-    check_step_fits("h", h, t0, t1)
-    steps = math.ceil((t1 - t0) / h - 1e-9)
-    if steps > max_steps:
-        raise InputError(f"`h` = {h:g} over [{t0:g}, {t1:g}] takes {steps:.2g} steps, more than "
-                         f"`max_steps` = {max_steps:.2g}: take a larger `h` or raise `max_steps`")
-    n, nc = int(scene.ndof), len(scene.mu)
-    size = (steps // save_every + 2) * 8 * (1 + 2 * n + 5 * nc)
-    if size > MAX_RECORD_BYTES:
-        raise InputError(f"recording every {save_every} of {steps:.2g} steps would take "
-                         f"{size / 1024**3:.3g} GiB, more than {MAX_RECORD_BYTES / 1024**3:g} GiB: "
-                         f"raise `save_every` to at least {math.ceil(save_every * size / MAX_RECORD_BYTES)}")
-
-
-def check_step_fits(name, h, t0, t1):
-    """Refuse a step longer than the window ``[t0, t1]``.
-
-    Such a step is cut to the window and taken as one step of another size
-    than asked for, which no order statement covers.
-    """
-    if h > (t1 - t0) * (1.0 + 1e-12):
-        raise InputError(f"`{name}` = {h:g} is longer than the run [{t0:g}, {t1:g}]: a step may "
-                         f"not exceed the window it integrates; take `{name}` <= {t1 - t0:g}")
-    return h
-
-
-def check_step(scheme, h):
-    """The time step ``h`` of a fixed-step scheme, required and > 0."""
-    if h is None:
-        raise InputError(f"`h` (the time step) is required for the {scheme} scheme")
-    return positive("h", h)
-
-
-def check_lcp_options(lcp_method, lemke_max_iter=None):
-    """Validate the contact-problem options of a scheme; return them normalised.
-
-    Examples
-    --------
-    >>> check_lcp_options("qp", 5)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` runs no Lemke
-    """
-    if lcp_method not in LCP_METHODS:
-        raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS)}, got {lcp_method!r}")
-    if lemke_max_iter is not None:
-        lemke_max_iter = positive_int("lemke_max_iter", lemke_max_iter)
-        if lcp_method == "qp":
-            raise InputError("`lemke_max_iter` limits Lemke's pivots; `lcp_method='qp'` "
-                             "runs no Lemke")
-    return lcp_method, lemke_max_iter
-
-
-def check_options(h, theta, projection, lcp_method, save_every=1):
-    """Validate the Moreau–Jean options; return them normalised."""
-    h = check_step("moreau-jean", h)
-    theta = in_closed_interval("theta", theta, 0.5, 1.0)
-    if not isinstance(projection, (bool, np.bool_)):
-        raise InputError(f"`projection` must be True or False, got {projection!r}")
-    lcp_method, _ = check_lcp_options(lcp_method)
-    save_every = positive_int("save_every", save_every)
-    return h, theta, bool(projection), lcp_method, save_every
-
-
-def check_scene_contacts(scene):
-    """Return ``(mu, e)`` of ``scene`` as float arrays after checking them."""
-    nc = scene.ncontacts
-    mu = np.asarray(scene.mu, dtype=float).reshape(-1)
-    e = np.asarray(scene.restitution, dtype=float).reshape(-1)
-    if e.shape != (nc,):
-        raise InputError(f"`scene.restitution` must have one entry per contact ({nc}), got shape {e.shape}")
-    if not (np.all(np.isfinite(mu)) and np.all(mu >= 0.0)):
-        raise InputError("`scene.mu` must be finite and >= 0 for every contact")
-    if not (np.all(np.isfinite(e)) and np.all((e >= 0.0) & (e <= 1.0))):
-        raise InputError("`scene.restitution` must lie in [0, 1] for every contact")
-    return mu, e
-
-
-def next_time(t0, k, h, t_bound):
-    """``(t_{k+1}, step)`` of the fixed-step grid ``t0 + k h``, the last step cut at ``t_bound``.
-
-    Shared by the generic and the compiled path so that both see the same times.
-    """
-    t1 = t0 + (k + 1) * h
-    if t1 >= t_bound - 1e-9 * h:
-        return t_bound, t_bound - (t0 + k * h)
-    return t1, h
-
-
 @register_integrator("moreau-jean")
-class MoreauJean(CompiledRecording, Integrator):
+class MoreauJean(TimeStepping):
     """Moreau–Jean theta-scheme with velocity-level Newton impacts and exact 2D Coulomb friction.
 
     See the module docstring for the scheme, the index set, the regime
@@ -403,44 +293,40 @@ class MoreauJean(CompiledRecording, Integrator):
     (0.5, 'P')
     """
 
-    def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, projection=False,
-                 lcp_method="auto", save_every=1, fast="auto", closed0=None,
-                 lemke_max_iter=None, lcp_warm_start=True, max_steps=MAX_STEPS,
-                 painleve="impulse"):
-        super().__init__(scene, t0, q0, v0, t_bound)
-        self.painleve = check_painleve(painleve)
-        self.h, self.theta, self.projection, self.lcp_method, self.save_every = check_options(
-            h, theta, projection, lcp_method, save_every)
-        check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
-                   positive_int("max_steps", max_steps))
-        _, self.lemke_max_iter = check_lcp_options(self.lcp_method, lemke_max_iter)
-        if not isinstance(lcp_warm_start, (bool, np.bool_)):
-            raise InputError(f"`lcp_warm_start` must be True or False, got {lcp_warm_start!r}")
-        self.lcp_warm_start = bool(lcp_warm_start)
-        self.mu_c, self.e_c = check_scene_contacts(scene)
-        nc = scene.ncontacts
-        # contact -> its row in WT (frictional contacts only), -1 if frictionless
-        self._trow = np.full(nc, -1, dtype=int)
-        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
-        self._closed = np.zeros(nc, dtype=bool)
-        if closed0 is not None:
-            c0 = np.asarray(closed0)
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Options(FixedStepOptions):
+        """Options of :class:`MoreauJean` (those of every fixed-step scheme,
+        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, and its own)."""
+        theta: float = 1.0
+        projection: bool = False
+        closed0: object = None
+        lemke_max_iter: int | None = None
+        lcp_warm_start: bool = True
+
+        def smooth_order(self):
+            # the trapezoidal rule at theta = 1/2, a first-order theta-method otherwise
+            return 2 if self.theta == 0.5 else 1
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
+        super().__init__(scene, t0, q0, v0, t_bound, options, **keywords)
+        if self._fast:
+            # the compiled path keeps each contact's regime in its control array
+            prev_regimes(self._lcp_ctl, self.scene.ncontacts)[:] = self._prev_reg
+
+    def _new_counters(self):
+        return _new_counters()
+
+    def _warm_start(self):
+        return self.lcp_warm_start and self.lcp_method == "auto"
+
+    def _setup_scheme(self):
+        nc = self.scene.ncontacts
+        if self.closed0 is not None:
+            c0 = np.asarray(self.closed0)
             if c0.dtype != bool or c0.size not in (1, nc):
                 raise InputError(f"`closed0` must be a bool or {nc} bools (one per contact), "
-                                 f"got {closed0!r}")
+                                 f"got {self.closed0!r}")
             self._closed[:] = c0.reshape(-1)
-        self._k = 0
-        self.counters = _new_counters()
-        # each contact's regime in the step before (the compiled path keeps it in its
-        # control array, see _regimes_before)
-        self._prev_reg = np.zeros(nc, dtype=np.int64)
-        self._pending_initial = True
-        self._choose_compiled(fast, compiled_model_of(scene), self.lcp_method,
-                              self.lemke_max_iter,
-                              warm_start=self.lcp_warm_start and self.lcp_method == "auto")
-        self._regimes_before()[:] = sliding_regimes(scene, self.q, self.v, self.t0)
-        if self._fast:
-            set_painleve_stop(self._lcp_ctl, nc, self.painleve == "stop")
 
     @property
     def closed(self):
@@ -594,35 +480,6 @@ class MoreauJean(CompiledRecording, Integrator):
             q = q + MinvWT @ d
             self.counters["projection_iterations"] += 1
         return q
-
-
-def compiled_model_of(scene):
-    """The scene's :class:`~moreau.compiled.CompiledModel`, or None.
-
-    None when the scene has no ``compiled_model()``, or when a subclass
-    overrides one of the model methods (``mass``, ``forces``,
-    ``force_jacobians``, ``gaps``, ``contact_jacobians``) below the class that
-    defined ``compiled_model``: its compiled form would then describe other
-    equations than the Python ones.
-    """
-    get = getattr(scene, "compiled_model", None)
-    if get is None:
-        return None
-    cls = type(scene)
-    owner = next((k for k in cls.__mro__ if "compiled_model" in vars(k)), None)
-    if owner is None:
-        return None
-    above = cls.__mro__[:cls.__mro__.index(owner)]
-    for name in ("mass", "forces", "force_jacobians", "gaps", "contact_jacobians"):
-        if any(name in vars(k) for k in above):
-            return None
-    model = get()
-    if model is None:
-        return None
-    if model.ndof != scene.ndof or model.ncontacts != scene.ncontacts:
-        raise InputError(f"`scene.compiled_model()` describes {model.ndof} dof and "
-                         f"{model.ncontacts} contacts, the scene {scene.ndof} and {scene.ncontacts}")
-    return model
 
 
 def _inverse(W_hat):

@@ -99,20 +99,20 @@ The recorded contact force of a step is its whole percussion over the
 step, ``lambda + Lambda / h``, and its regime is classified from it.
 """
 
+import dataclasses
+from typing import ClassVar
+
 import numpy as np
 
-from .._validate import in_closed_interval, positive_int
-from ..errors import ConvergenceError, InputError, LCPError
+from .._validate import in_closed_interval
+from ..errors import ConvergenceError, LCPError
 from ..lcp import solve_lcp
-from ._blocks import CompiledRecording
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE
 from ._nsga_kernels import CONVERGENCE, nsga_loop
-from .base import Integrator, register_integrator
-from ._mj_kernels import set_painleve_stop
-from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
-                              solve_contact_problem)
-from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
-                          check_work, classify_impulse, compiled_model_of, next_time)
+from .base import register_integrator
+from .contact_problem import new_contact_counters, slip_signs, solve_contact_problem
+from .moreau_jean import classify_impulse
+from .time_stepping import FixedStepOptions, TimeStepping, next_time
 
 __all__ = ["NonsmoothGeneralizedAlpha", "alpha_coefficients", "consistent_acceleration",
            "contact_drift_of", "mixed_projection"]
@@ -148,38 +148,18 @@ def alpha_coefficients(rho_inf):
 
 
 @register_integrator("nonsmooth-generalized-alpha")
-class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
+class NonsmoothGeneralizedAlpha(TimeStepping):
     """Nonsmooth generalized-α time stepping (see the module docstring).
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
-    h : float
-        Time step, > 0; the last step is shortened to end on ``t_bound``.
     rho_inf : float
         Spectral radius at infinity, in ``[0, 1]`` (default 0.9: mild damping
         of the highest modes).
     position_level : bool
         Correct positions onto the admissible set (no penetration, no drift).
-    lcp_method : {"auto", "lemke", "qp"}
-    save_every : int
-    fast : {"auto", True, False}
-        Run the compiled loop (:mod:`moreau.integrators._nsga_kernels`, the same
-        step, equal to rounding) on a scene with a ``compiled_model()``;
-        ``"auto"`` does so unless ``lcp_method="qp"``. A step the loop cannot
-        finish (Lemke fails, the Painlevé condition, the smooth Newton
-        iteration) is taken by the generic step.
-    max_steps : int
-    painleve : {"impulse", "stop"}
-        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
-        condition fails the way the contact slides): take the step's unique answer, the
-        impulsive stick (default; the tangential impact, counted in
-        ``stats["tangential_impacts"]`` on the generic step where the impulsive stage takes
-        it), or stop with status ``-1`` wherever the pressed contact's free slip, of any
-        size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
+    scene, t0, q0, v0, t_bound, options, h, lcp_method, save_every, fast, max_steps, painleve
+        As for every fixed-step scheme: :class:`~moreau.integrators.time_stepping.FixedStepOptions`.
 
     Examples
     --------
@@ -205,41 +185,32 @@ class NonsmoothGeneralizedAlpha(CompiledRecording, Integrator):
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000),
                         (100, 300, 1000), {})
 
-    def __init__(self, scene, t0, q0, v0, t_bound, h=None, rho_inf=0.9, position_level=True,
-                 lcp_method="auto", save_every=1, fast="auto", max_steps=MAX_STEPS,
-                 painleve="impulse"):
-        super().__init__(scene, t0, q0, v0, t_bound)
-        self.h = check_step("nonsmooth-generalized-alpha", h)
-        self.rho_inf = in_closed_interval("rho_inf", rho_inf, 0.0, 1.0)
-        if not isinstance(position_level, (bool, np.bool_)):
-            raise InputError(f"`position_level` must be True or False, got {position_level!r}")
-        self.position_level = bool(position_level)
-        self.lcp_method, _ = check_lcp_options(lcp_method)
-        self.save_every = positive_int("save_every", save_every)
-        check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
-                   positive_int("max_steps", max_steps))
-        self.mu_c, self.e_c = check_scene_contacts(scene)
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Options(FixedStepOptions):
+        """Options of :class:`NonsmoothGeneralizedAlpha` (those of every fixed-step scheme,
+        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, and its own)."""
+        rho_inf: float = 0.9
+        position_level: bool = True
+
+        _rules: ClassVar[dict] = {"rho_inf": lambda v: in_closed_interval("rho_inf", v, 0.0, 1.0)}
+
+        def smooth_order(self):
+            return 2
+
+    def _new_counters(self):
+        return {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
+                "newton_iterations": 0, "position_iterations": 0}
+
+    def _setup_scheme(self):
         self.am, self.af, self.gamma, self.beta = alpha_coefficients(self.rho_inf)
-        nc = scene.ncontacts
-        self._trow = np.full(nc, -1, dtype=int)
-        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
-        self._k = 0
-        self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
-                         "newton_iterations": 0, "position_iterations": 0}
-        self._pending_initial = True
         # a consistent start: the algorithmic acceleration carries the closed contacts'
         # forces, else its O(1) error feeds an O(h) error into the friction forces
-        acc0, lam0 = consistent_acceleration(scene, self.q, self.v, self.t0, self.lcp_method,
-                                             self.counters)
+        acc0, lam0 = consistent_acceleration(self.scene, self.q, self.v, self.t0,
+                                             self.lcp_method, self.counters)
         self._closed = lam0 > 0.0
         self._acc = acc0
         self._a = acc0.copy()
         self._coef = np.array([self.am, self.af, self.gamma, self.beta])
-        self.painleve, fast = painleve_option(painleve, fast)
-        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
-        self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
-        if self._fast:
-            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _fast_block(self):
         q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()

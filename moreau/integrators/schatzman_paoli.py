@@ -107,52 +107,30 @@ Like every explicit scheme, the step must resolve the fastest smooth
 oscillation (``h omega < 2``); a run that blows up stops with a status.
 """
 
+import dataclasses
+
 import numpy as np
 
-from .._validate import positive_int
-from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
+from ._blocks import EXPLICIT_BLOWUP
 from ._sp_kernels import sp_loop
-from .base import Integrator, register_integrator
-from ._mj_kernels import set_painleve_stop
-from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
-                              solve_contact_problem)
-from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
-                          check_work, classify_impulse, compiled_model_of, next_time)
+from .base import register_integrator
+from .contact_problem import new_contact_counters, slip_signs, solve_contact_problem
+from .moreau_jean import classify_impulse
+from .time_stepping import FixedStepOptions, TimeStepping, next_time
 
 __all__ = ["SchatzmanPaoli"]
 
 
 @register_integrator("schatzman-paoli")
-class SchatzmanPaoli(CompiledRecording, Integrator):
+class SchatzmanPaoli(TimeStepping):
     """Schatzman–Paoli time stepping (see the module docstring).
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
-    h : float
-        Time step (dimensionless), > 0; the last step is shortened to end on ``t_bound``.
-    lcp_method : {"auto", "lemke", "qp"}
-        Solver of the contact problem (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
     lemke_max_iter : int, optional
         Pivot limit of Lemke's method.
-    save_every : int
-        Record one sample every ``save_every`` steps (and the last one).
-    fast : {"auto", True, False}
-        Run the compiled loop (:mod:`moreau.integrators._sp_kernels`, the same
-        step, equal to rounding) on a scene with a ``compiled_model()``;
-        ``"auto"`` does so unless ``lcp_method="qp"``. A step whose contact
-        problem Lemke cannot solve is taken by the generic step (QP fallback).
-    max_steps : int
-        Bound on the number of steps of the run.
-    painleve : {"impulse", "stop"}
-        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
-        condition fails the way the contact slides): take the step's unique answer, the
-        impulsive stick (default; the tangential impact, counted in
-        ``stats["tangential_impacts"]`` on the generic step), or stop with status ``-1``
-        wherever the pressed contact's free slip, of any size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
+    scene, t0, q0, v0, t_bound, options, h, lcp_method, save_every, fast, max_steps, painleve
+        As for every fixed-step scheme: :class:`~moreau.integrators.time_stepping.FixedStepOptions`.
 
     Notes
     -----
@@ -189,34 +167,22 @@ class SchatzmanPaoli(CompiledRecording, Integrator):
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000),
                         (100, 300, 1000), {})
 
-    def __init__(self, scene, t0, q0, v0, t_bound, h=None, lcp_method="auto",
-                 lemke_max_iter=None, save_every=1, fast="auto", max_steps=MAX_STEPS,
-                 painleve="impulse"):
-        super().__init__(scene, t0, q0, v0, t_bound)
-        self.h = check_step("schatzman-paoli", h)
-        self.lcp_method, self.lemke_max_iter = check_lcp_options(lcp_method, lemke_max_iter)
-        self.save_every = positive_int("save_every", save_every)
-        check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
-                   positive_int("max_steps", max_steps))
-        self.mu_c, self.e_c = check_scene_contacts(scene)
-        nc = scene.ncontacts
-        self._trow = np.full(nc, -1, dtype=int)
-        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
-        self._closed = np.zeros(nc, dtype=bool)
-        self._k = 0
-        self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0}
-        self._pending_initial = True
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Options(FixedStepOptions):
+        """Options of :class:`SchatzmanPaoli` (those of every fixed-step scheme,
+        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, and its own)."""
+        lemke_max_iter: int | None = None
+
+        def smooth_order(self):
+            return 2        # Stormer-Verlet in smooth phases
+
+    def _setup_scheme(self):
         # the Verlet velocity that carries the two-step recursion, the velocity the forces
         # see at the current node, and that node's solved contact problem where the
         # generic step has it (see the module docstring)
         self._v_verlet = self.v.copy()
         self._v_force = self.v.copy()
         self._node = None
-        self.painleve, fast = painleve_option(painleve, fast)
-        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
-        self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
-        if self._fast:
-            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     def _step_impl(self):
         if self._fast:

@@ -100,27 +100,27 @@ tol 1e-4, 1e-6, 1e-8, 1e-10 (767 base steps at 1e-8); the compiled loop
 takes about 1.4 ms for that period at tol 1e-9 (937 base steps).
 """
 
+import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 
-from .._validate import positive, positive_int, relative_tolerance
+from .._validate import positive, relative_tolerance
 from ..errors import InputError
 from ..regimes import Regime
 from .result import SimulationResult  # noqa: F401  (named in result's docstring)
-from ._blocks import FAST_BLOCK, CompiledRecording, keep_rows, result_of_rows, states_since
+from ._blocks import FAST_BLOCK, keep_rows, result_of_rows, states_since
 from ._loops import runner_for
 from ._mj_kernels import LCP_HANDBACK, PAINLEVE, SINGULAR, STAT_NAMES
 from ._dense import Piece
 from ._studer_kernels import (DENSE_IMPACT, DENSE_SMOOTH, DENSE_SWITCH, NOT_FINITE,
                               STUDER_COUNTERS, TOO_MANY, studer_loop)
-from .base import Integrator, register_integrator
-from ._mj_kernels import set_painleve_stop
-from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
-                              solve_contact_problem)
+from .base import register_integrator
+from .contact_problem import new_contact_counters, slip_signs, solve_contact_problem
 from .event_driven_generic import project_positions
-from .moreau_jean import (check_lcp_options, check_scene_contacts, check_step_fits,
-                          classify_impulse, compiled_model_of)
+from .moreau_jean import classify_impulse
+from .time_stepping import StepOptions, TimeStepping, check_step_fits, optional
 
 __all__ = ["StuderExtrapolation", "dense_state", "dense_piece"]
 
@@ -132,8 +132,15 @@ CLOSED_GAP = 1e-12
 CLOSED_SPEED = 1e-9
 
 
+def _columns_option(columns):
+    if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
+            or not 2 <= columns <= 8:
+        raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
+    return int(columns)
+
+
 @register_integrator("studer-extrapolation")
-class StuderExtrapolation(CompiledRecording, Integrator):
+class StuderExtrapolation(TimeStepping):
     """Moreau midpoint time stepping with step-size control and extrapolation.
 
     Parameters
@@ -202,11 +209,32 @@ class StuderExtrapolation(CompiledRecording, Integrator):
     #: ``t_eval`` samples and events are taken on the dense output (see :func:`dense_piece`)
     exact_motion = True
 
-    def __init__(self, scene, t0, q0, v0, t_bound, tol=1e-6, columns=4, h0=None, h_min=None,
-                 lcp_method="auto", fast="auto", max_steps=MAX_MACRO_STEPS, sample_dt=None,
-                 painleve="impulse"):
-        super().__init__(scene, t0, q0, v0, t_bound)
-        self.sample_dt = None if sample_dt is None else positive("sample_dt", sample_dt)
+    #: the macro steps are the scheme's own (from ``h0``), not a fixed grid
+    fixed_step = False
+
+    @dataclasses.dataclass(frozen=True)
+    class Options(StepOptions):
+        """Options of :class:`StuderExtrapolation` (its parameters after ``t_bound``)."""
+        tol: float = 1e-6
+        columns: int = 4
+        h0: float | None = None
+        h_min: float | None = None
+        lcp_method: str = "auto"
+        fast: str | bool = "auto"
+        max_steps: int = MAX_MACRO_STEPS
+        sample_dt: float | None = None
+        painleve: str = "impulse"
+
+        _rules: ClassVar[dict] = {"tol": lambda v: relative_tolerance("tol", v),
+                                  "columns": _columns_option,
+                                  "h0": optional(lambda v: positive("h0", v)),
+                                  "h_min": optional(lambda v: positive("h_min", v))}
+
+    def _new_counters(self):
+        return {"steps": 0, **new_contact_counters(), "base_steps": 0, "rejected_steps": 0,
+                "smooth_steps": 0, "forced_steps": 0, "max_penetration": 0.0}
+
+    def _setup_scheme(self):
         # the accepted steps' rows (with their dense output) not yet handed to simulate
         self._new_rows = []
         # the rows of the result: every step's end, or the sample_dt grid
@@ -214,31 +242,18 @@ class StuderExtrapolation(CompiledRecording, Integrator):
         self._last_row = None
         self._handed_row = None
         self._next_sample = 1
-        self.tol = relative_tolerance("tol", tol)
-        if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
-                or not 2 <= columns <= 8:
-            raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
-        self.columns = int(columns)
         span = self.t_bound - self.t0
-        self.h = span / 100.0 if h0 is None else check_step_fits(
-            "h0", positive("h0", h0), self.t0, self.t_bound)
-        self.h_min = 1e-12 * span if h_min is None else check_step_fits(
-            "h_min", positive("h_min", h_min), self.t0, self.t_bound)
-        self.lcp_method, _ = check_lcp_options(lcp_method)
-        self.max_steps = positive_int("max_steps", max_steps)
-        self.mu_c, self.e_c = check_scene_contacts(scene)
-        nc = scene.ncontacts
-        self._trow = np.full(nc, -1, dtype=int)
-        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
-        self.counters = {"steps": 0, **new_contact_counters(), "base_steps": 0,
-                         "rejected_steps": 0, "smooth_steps": 0, "forced_steps": 0,
-                         "max_penetration": 0.0}
+        self.h = span / 100.0 if self.h0 is None else check_step_fits(
+            "h0", self.h0, self.t0, self.t_bound)
+        if self.h_min is not None:
+            check_step_fits("h_min", self.h_min, self.t0, self.t_bound)
+        else:
+            self.h_min = 1e-12 * span
+        scene, nc = self.scene, self.scene.ncontacts
         self._macro = 0
-        self._pending_initial = True
         self._acc = None
         # regimes of the last base step of the last accepted step (-1: none yet)
         self._last_reg = np.full(nc, -1, dtype=int)
-        self._closed = np.zeros(nc, dtype=bool)
         if nc:
             # a contact touching at the start without approaching carries a force already
             # (a start on a persistent contact: a steady state's section)
@@ -247,11 +262,6 @@ class StuderExtrapolation(CompiledRecording, Integrator):
             vN = np.asarray(WN, float) @ self.v + np.asarray(wN, float)
             self._closed = ((g <= CLOSED_GAP * (1.0 + float(np.max(np.abs(self.q)))))
                             & (vN >= -CLOSED_SPEED * (1.0 + float(np.max(np.abs(self.v))))))
-        self.painleve, fast = painleve_option(painleve, fast)
-        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
-        self._choose_compiled(fast, compiled_model_of(scene), lcp_method)
-        if self._fast:
-            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
 
     # -- the base step ---------------------------------------------------------------------
     def _midpoint(self, t, q, v, h, closed):

@@ -92,19 +92,19 @@ ball, 1.0e6 and 8.0e5 on the friction drive, two or three contact problems a
 step in contact.
 """
 
+import dataclasses
+from typing import ClassVar
+
 import numpy as np
 
-from .._validate import positive_int
 from ..errors import InputError
-from ._blocks import EXPLICIT_BLOWUP, CompiledRecording
+from ._blocks import EXPLICIT_BLOWUP
 from ._tdg_kernels import tdg_loop
-from .base import Integrator, register_integrator
-from ._mj_kernels import set_painleve_stop
-from .contact_problem import (new_contact_counters, painleve_option, slip_signs, sliding_regimes,
-                              solve_contact_problem)
+from .base import register_integrator
+from .contact_problem import new_contact_counters, slip_signs, solve_contact_problem
 from .event_driven_generic import project_positions
-from .moreau_jean import (MAX_STEPS, check_lcp_options, check_scene_contacts, check_step,
-                          check_work, classify_impulse, compiled_model_of, next_time)
+from .moreau_jean import classify_impulse
+from .time_stepping import FixedStepOptions, TimeStepping, next_time
 
 __all__ = ["TimeDiscontinuousGalerkin", "LOBATTO_TABLEAUS"]
 
@@ -116,45 +116,31 @@ LOBATTO_TABLEAUS = {
 }
 
 
+def _degree_option(degree):
+    if isinstance(degree, bool) or degree not in LOBATTO_TABLEAUS:
+        raise InputError(f"`degree` must be one of {sorted(LOBATTO_TABLEAUS)}, got {degree!r}")
+    return int(degree)
+
+
 @register_integrator("time-discontinuous-galerkin")
-class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
+class TimeDiscontinuousGalerkin(TimeStepping):
     """Half-explicit time-discontinuous Galerkin stepping (see the module docstring).
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
-    h : float
-        Time step (dimensionless), > 0; the last step is shortened to end on ``t_bound``.
     degree : {1, 2}
         Polynomial degree of the velocity on a step: order ``degree + 1`` in
         smooth phases.
-    lcp_method : {"auto", "lemke", "qp"}
-        Solver of each contact problem.
     lemke_max_iter : int, optional
         Pivot limit of Lemke's method.
-    save_every : int
-        Record one sample every ``save_every`` steps (and the last one).
     projection : bool
         Put the gaps of the contacts that carry a force at the end of a step
         back to zero (see the module docstring). With False a contact is
         held where the step caught it: a body at rest stays up to
         ``h V / 2`` above or inside the surface (``V`` its normal speed on
         arrival), an ``O(h)`` error that does not decay.
-    fast : {"auto", True, False}
-        Run the compiled loop (:mod:`moreau.integrators._tdg_kernels`, the same
-        step, equal to rounding) on a scene with a ``compiled_model()``;
-        ``"auto"`` does so unless ``lcp_method="qp"``. A step whose contact
-        problem Lemke cannot solve is taken by the generic step (QP fallback).
-    max_steps : int
-        Bound on the number of steps of the run.
-    painleve : {"impulse", "stop"}
-        At a one-contact step whose sliding piece has no solution (the discrete Painlevé
-        condition fails the way the contact slides): take the step's unique answer, the
-        impulsive stick (default; the tangential impact), or stop with status ``-1``
-        wherever the pressed contact's free slip, of any size, runs that way
-        (:func:`~moreau.integrators.contact_problem.solve_contact_problem`).
+    scene, t0, q0, v0, t_bound, options, h, lcp_method, save_every, fast, max_steps, painleve
+        As for every fixed-step scheme: :class:`~moreau.integrators.time_stepping.FixedStepOptions`.
 
     Notes
     -----
@@ -185,35 +171,22 @@ class TimeDiscontinuousGalerkin(CompiledRecording, Integrator):
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000),
                         (100, 300, 1000), {"degree": 2})
 
-    def __init__(self, scene, t0, q0, v0, t_bound, h=None, degree=2, lcp_method="auto",
-                 lemke_max_iter=None, save_every=1, projection=True, fast="auto",
-                 max_steps=MAX_STEPS, painleve="impulse"):
-        super().__init__(scene, t0, q0, v0, t_bound)
-        self.h = check_step("time-discontinuous-galerkin", h)
-        if isinstance(degree, bool) or degree not in LOBATTO_TABLEAUS:
-            raise InputError(f"`degree` must be one of {sorted(LOBATTO_TABLEAUS)}, got {degree!r}")
-        self.degree = int(degree)
-        self.lcp_method, self.lemke_max_iter = check_lcp_options(lcp_method, lemke_max_iter)
-        self.save_every = positive_int("save_every", save_every)
-        if not isinstance(projection, (bool, np.bool_)):
-            raise InputError(f"`projection` must be True or False, got {projection!r}")
-        self.projection = bool(projection)
-        check_work(scene, self.t0, self.t_bound, self.h, self.save_every,
-                   positive_int("max_steps", max_steps))
-        self.mu_c, self.e_c = check_scene_contacts(scene)
-        nc = scene.ncontacts
-        self._trow = np.full(nc, -1, dtype=int)
-        self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
-        self._closed = np.zeros(nc, dtype=bool)
-        self._k = 0
-        self.counters = {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
-                         "projection_iterations": 0}
-        self._pending_initial = True
-        self.painleve, fast = painleve_option(painleve, fast)
-        self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
-        self._choose_compiled(fast, compiled_model_of(scene), lcp_method, lemke_max_iter)
-        if self._fast:
-            set_painleve_stop(self._lcp_ctl, scene.ncontacts, self.painleve == "stop")
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Options(FixedStepOptions):
+        """Options of :class:`TimeDiscontinuousGalerkin` (those of every fixed-step scheme,
+        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, and its own)."""
+        degree: int = 2
+        lemke_max_iter: int | None = None
+        projection: bool = True
+
+        _rules: ClassVar[dict] = {"degree": _degree_option}
+
+        def smooth_order(self):
+            return self.degree + 1
+
+    def _new_counters(self):
+        return {"steps": 0, **new_contact_counters(), "max_penetration": 0.0,
+                "projection_iterations": 0}
 
     # -- the pieces of one step ----------------------------------------------
     def _rows(self, ia, q, t, jac=None):

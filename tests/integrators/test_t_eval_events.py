@@ -7,6 +7,7 @@ import pytest
 
 from moreau.errors import InputError
 from moreau.integrators import INTEGRATORS, get_integrator, simulate
+from moreau.integrators.base import scheme_options
 from moreau.scenes import registry
 from moreau.scenes.bouncing_ball import BouncingBall
 
@@ -18,7 +19,7 @@ H = 0.01
 
 
 def _options(name):
-    params = get_integrator(name).__init__.__code__.co_varnames
+    params = scheme_options(get_integrator(name)) or ()
     opts = {"h": H} if "h" in params else {}
     if "max_step" in params:
         # a compliant contact's default step is a tenth of a contact's duration: the

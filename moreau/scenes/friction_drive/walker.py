@@ -18,7 +18,9 @@ freely) are integrated with compiled Taylor series at tight tolerance
 is an impact with Newton's restitution coefficient and Coulomb friction.
 """
 
+import dataclasses
 import math
+from typing import ClassVar
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -27,7 +29,7 @@ from scipy.optimize import brentq, minimize_scalar
 from ..._validate import positive_int, relative_tolerance
 from ...errors import InputError, MoreauError, PainleveError
 from ...regimes import Regime
-from ...integrators.base import Integrator, register_integrator
+from ...integrators.base import Integrator, SchemeOptions, register_integrator
 from ...integrators.result import Event
 from ._flight_taylor import CAPACITY as FLIGHT_CAPACITY, ORDER as FLIGHT_ORDER
 from ._flight_taylor import FAILED as _FT_FAILED, FULL as _FT_FULL
@@ -856,12 +858,25 @@ class EventDriven(Integrator):
 
     exact_motion = True
 
-    def __init__(self, scene, t0, q0, v0, t_bound, rtol=1e-12, samples_per_period=128):
+    @dataclasses.dataclass(frozen=True)
+    class Options(SchemeOptions):
+        """Options of the friction drive's walker (its parameters after ``t_bound``)."""
+        rtol: float = 1e-12
+        samples_per_period: int = 128
+
+        _rules: ClassVar[dict] = {
+            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
+            "samples_per_period": lambda v: positive_int("samples_per_period", v)}
+
+    takes_options_object = True
+
+    def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound)
+        self.options = o = self._take_options(options, keywords)
         if scene.ncontacts != 1 or not hasattr(scene, "contact_angle"):
             raise InputError("`scene` must be a FrictionDrive for the event-driven reference")
-        self.walker = FrictionDriveWalker(scene, rtol=rtol)
-        self.samples_per_period = positive_int("samples_per_period", samples_per_period)
+        self.walker = FrictionDriveWalker(scene, rtol=o.rtol)
+        self.samples_per_period = o.samples_per_period
         self._stalled = 0       # events in a row that did not advance time
         st = ContactState(self.t, _F, self.q[0], self.v[0], self.q[1], self.v[1])
         try:

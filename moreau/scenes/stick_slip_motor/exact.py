@@ -24,6 +24,7 @@ reverses or sticks), so ``u -> P(u) - u`` is strictly decreasing and its
 root, the periodic steady state, is bracketed and found by Brent's method.
 """
 
+import dataclasses
 import math
 import time as _time
 
@@ -33,7 +34,7 @@ from scipy.optimize import brentq
 from ...errors import ConvergenceError, InputError
 from ...modes import mode_name
 from ...regimes import Regime
-from ...integrators.base import Integrator, register_integrator
+from ...integrators.base import Integrator, SchemeOptions, register_integrator
 from ...integrators.result import Event, SteadyState
 from .scene import TWO_PI, StickSlipMotor
 
@@ -304,6 +305,10 @@ class StickSlipReference(Integrator):
     exact_motion = True
     #: the scene's exact periodic steady state, for callers that know the scheme by name only
     steady_state = staticmethod(stick_slip_steady_state)
+
+    @dataclasses.dataclass(frozen=True)
+    class Options(SchemeOptions):
+        """The exact scheme takes no options."""
 
     def __init__(self, scene, t0, q0, v0, t_bound):
         _check_scene(scene)
