@@ -23,7 +23,7 @@ from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.integrators.base import INTEGRATORS, SchemeOptions, check_options, get_integrator
 from moreau.scenes import registry
-from moreau.scenes.base import Scene
+from moreau.model.scene import Scene
 
 registry.discover()
 #: every registered scheme with its own options (the "event-driven" front runs one of them)
