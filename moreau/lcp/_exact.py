@@ -285,7 +285,8 @@ def _column_ints(F):
     e = ex.astype(np.int64) - 53
     K = max(0, -int(e[nz].min())) if nz.any() else 0
     sh = np.where(nz, e + K, 0)
-    return [[mi << si for mi, si in zip(mr, sr)] for mr, sr in zip(m.tolist(), sh.tolist())], K
+    # the shifts as one object-array operation: Python integers, no per-entry bytecode
+    return np.left_shift(m.astype(object), sh.astype(object)).tolist(), K
 
 
 def exact_step(M, q, d, basis, entering):
@@ -347,10 +348,9 @@ def exact_step(M, q, d, basis, entering):
         cols.append(-M[:, entering - n])
     cols.append(q)
     ints, K = _column_ints(np.array(cols, dtype=float))
-    A = ints[:k]
-    qi = ints[-1]
-    # fraction-free Gauss-Jordan on [G | I]: G^-1 = Y / D with D > 0
-    T = [[A[c][R[a]] for c in range(k)] + [1 if a == b else 0 for b in range(k)]
+    A = np.array(ints[:k] or np.zeros((0, n), dtype=np.int64), dtype=object).reshape(k, n)
+    # fraction-free Gauss-Jordan on [G | I], G = A[R, Z]: G^-1 = Y / D with D > 0
+    T = [[ints[c][R[a]] for c in range(k)] + [1 if a == b else 0 for b in range(k)]
          for a in range(k)]
     D = 1
     used = [False] * k
@@ -362,42 +362,39 @@ def exact_step(M, q, d, basis, entering):
         D = _pivot(T, D, r, c)
         used[r] = True
         prow[c] = r
-    Y = [T[prow[c]][k:] for c in range(k)]
+    Y = np.array([T[prow[c]][k:] for c in range(k)], dtype=object).reshape(k, k)
+    # numerators of (B^-1)_{i c} for c in R (the tableau column of w_c over 2^K;
+    # the other columns hold D on the row of a basic w_c, 0 elsewhere): -P[j]
+    # on the row of a basic w_j, Y[c'] on the row of z variable Z[c']
+    P = A.T.dot(Y) if k else np.zeros((n, 0), dtype=object)
     zi = {v: c for c, v in enumerate(Z)}
-    tR = {j: t for t, j in enumerate(R)}
+    Rarr = np.array(R, dtype=np.int64)
 
     def numer(a):
-        # numerators of B^-1 a, row by row, over D (Z rows) or D 2^K (w rows): both > 0
-        aR = [a[j] for j in R]
-        y = [sum(Yc[t] * aR[t] for t in range(k) if aR[t]) for Yc in Y]
-        out = []
-        for v in basis:
-            if v < n:
-                out.append(D * a[v] - sum(A[c][v] * y[c] for c in range(k) if y[c]))
-            else:
-                out.append(y[zi[v]])
-        return out
+        # numerators of B^-1 a row by row, over D (Z rows) or D 2^K (w rows): both > 0
+        a = np.array(a, dtype=object)
+        y = Y.dot(a[Rarr]) if k else a[:0]
+        nw = D * a - (y.dot(A) if k else 0)
+        return [nw[v] if v < n else y[zi[v]] for v in basis]
 
-    def binv(i, c):
-        # numerator of (B^-1)_{i c} (the tableau column of w_c, over 2^K): nonzero
-        # only for c in R, or c = j on the row of a basic w_j
+    def binv_row(i):
+        # the nonzero numerators of row i of B^-1, by column, in column order
         v = basis[i]
-        if c not in tR:
-            return D if v == c else 0
-        t = tR[c]
         if v < n:
-            return -sum(A[cc][v] * Y[cc][t] for cc in range(k))
-        return Y[zi[v]][t]
+            ent = {R[t]: -P[v, t] for t in range(k)}
+            ent[v] = D
+        else:
+            ent = {R[t]: Y[zi[v], t] for t in range(k)}
+        return [ent[c] for c in sorted(ent)], sorted(ent)
 
-    bq = numer(qi)
+    bq = numer(ints[-1])
     for i in range(n):
         if bq[i] > 0:
             continue
         if bq[i] < 0:
             return None
-        v = basis[i]
-        lead = sorted(R + ([v] if v < n else []))
-        first = next((x for x in (binv(i, c) for c in lead) if x != 0), 0)
+        vals, _ = binv_row(i)
+        first = next((x for x in vals if x != 0), 0)
         if first <= 0:
             return None
     if e_w:
@@ -428,9 +425,14 @@ def exact_step(M, q, d, basis, entering):
     else:
         r = best[0]
         for i in best[1:]:
-            for c in range(n):
-                xi = binv(i, c) * ae[r]
-                xr = binv(r, c) * ae[i]
+            # (B^-1)_i / a_i against (B^-1)_r / a_r, column by column
+            vi, ci = binv_row(i)
+            vr, cr = binv_row(r)
+            di = dict(zip(ci, vi))
+            dr = dict(zip(cr, vr))
+            for c in sorted(set(ci) | set(cr)):
+                xi = di.get(c, 0) * ae[r]
+                xr = dr.get(c, 0) * ae[i]
                 if xi != xr:
                     if xi < xr:
                         r = i
@@ -445,8 +447,8 @@ def exact_step(M, q, d, basis, entering):
 def basis_point(M, q, J):
     """The point of the complementary basis whose basic ``z`` are ``J``, exactly, rounded to floats.
 
-    Solves ``M_JJ z_J = -q_J`` in exact arithmetic (fraction-free
-    Gauss-Jordan on the data as integers), ``z = 0`` off ``J``; each entry
+    Solves ``M_JJ z_J = -q_J`` in exact arithmetic (Bareiss's fraction-free
+    elimination on the data as integers), ``z = 0`` off ``J``; each entry
     correctly rounded. None when ``M_JJ`` is singular or the point lies
     outside the range of floats.
 
@@ -463,20 +465,31 @@ def basis_point(M, q, J):
         return z
     cols = [M[J, j] for j in J] + [-q[J]]
     ints, _ = _column_ints(np.array(cols, dtype=float))
+    # Bareiss's fraction-free elimination on [M_JJ | -q_J] (every entry stays
+    # an integer minor), then back-substitution for X = det z_J, also in integers
     T = [[ints[c][a] for c in range(k + 1)] for a in range(k)]
-    D = 1
-    used = [False] * k
-    prow = [0] * k
+    prev = 1
     for c in range(k):
-        r = next((a for a in range(k) if not used[a] and T[a][c] != 0), None)
+        r = next((a for a in range(c, k) if T[a][c] != 0), None)
         if r is None:
             return None
-        D = _pivot(T, D, r, c)
-        used[r] = True
-        prow[c] = r
+        if r != c:
+            T[c], T[r] = T[r], T[c]
+        Tc = T[c]
+        p = Tc[c]
+        for a in range(c + 1, k):
+            Ta = T[a]
+            f = Ta[c]
+            T[a] = [0] * (c + 1) + [(Ta[j] * p - f * Tc[j]) // prev for j in range(c + 1, k + 1)]
+        prev = p
+    det = T[k - 1][k - 1]
+    X = [0] * k
+    for c in range(k - 1, -1, -1):
+        Tc = T[c]
+        X[c] = (det * Tc[k] - sum(Tc[j] * X[j] for j in range(c + 1, k))) // Tc[c]
     try:
         for c, j in enumerate(J):
-            z[j] = T[prow[c]][k] / D
+            z[j] = X[c] / det
     except OverflowError:
         return None
     return z

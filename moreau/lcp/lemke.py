@@ -37,10 +37,16 @@ within that bound of zero is no candidate, and if it could have changed the
 step (no other candidate, or a ratio that could undercut the minimum) the
 step is not taken in floating point either. Where floating point cannot
 decide, and where a basis repeats (the visited bases are hashed past ``2 n +
-16`` pivots), :func:`solve` finishes the path in exact integer arithmetic
-(:mod:`moreau.lcp._exact`) from the basis reached, or afresh if that basis is
-not lexicographically positive for the caller's data: the path is then the
-exact lexicographic one and cannot cycle. One exception, for cost: where
+16`` pivots), :func:`solve` decides that one step in exact integer arithmetic
+(:func:`moreau.lcp._exact.exact_step`: ``B^-1`` from the ``k x k`` block of
+the basic non-``w`` variables, ``O(k^3 + n k^2)``) and goes back to floating
+point from the basis reached, on a tableau made afresh from the data with the
+exact right-hand side; a solution reached that way is the exact point of its
+basis, correctly rounded. The whole path is finished in exact arithmetic
+only where a hand-over state repeats, where the basis is not
+lexicographically positive for the caller's data (the path then starts
+afresh) or too close to singular for floating point to follow. The path is
+the exact lexicographic one and cannot cycle. One exception, for cost: where
 ``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
 is a solution up to rounding, certified on the data as always), where the
 exact path might pivot on. The compiled entries
@@ -629,7 +635,9 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
     hb = 0
     for i in range(n):
         hb ^= _key(basis[i])
-    seen = np.zeros(1, dtype=np.int64)
+    # a placeholder of length 1 (a view: no allocation on the short paths);
+    # the set itself is allocated when the watch starts
+    seen = pos[:1]
     nseen = 0
     watch = 2 * n + 15 + pivots
 
@@ -1227,17 +1235,43 @@ def _screen_ray(M, q, ray):
     # unit vectors (unit_farkas): 1 one is proven, 0 one needs the exact
     # check, -1 every one fails rigorously. Then whether M might be PSD (where
     # the exact null-space projection is tried): not when its symmetric part
-    # has a negative diagonal entry, or a zero one with a nonzero row
+    # has a negative diagonal entry, or a zero one with a nonzero row, nor when
+    # M is nonnegative with a positive diagonal (certify.copositive_plus_class
+    # names that class first, and projects only for the PSD one), nor when a
+    # 2 x 2 principal block of S = (M + M^T) / 2 has an eigenvalue below twice
+    # the tolerance of copositive_plus_class (-100 n^2 eps max|S|): then so
+    # has S (interlacing), and that test, far above this one's rounding, says no
     n = q.shape[0]
     maybe_psd = True
+    nonneg = True
+    smax = 0.0
     for i in range(n):
         if M[i, i] < 0.0:
             maybe_psd = False
         elif M[i, i] == 0.0:
+            nonneg = False
             for j in range(n):
                 if M[i, j] + M[j, i] != 0.0:
                     maybe_psd = False
                     break
+        for j in range(n):
+            nonneg = nonneg and M[i, j] >= 0.0
+            smax = max(smax, abs(0.5 * (M[i, j] + M[j, i])))
+    if nonneg:
+        maybe_psd = False
+    if maybe_psd:
+        tau = 2.0 * 100.0 * n * n * np.finfo(np.float64).eps * smax
+        for i in range(n):
+            for j in range(i + 1, n):
+                a = M[i, i]
+                bb = M[j, j]
+                h = 0.5 * (M[i, j] + M[j, i])
+                lam = 0.5 * (a + bb) - math.sqrt(0.25 * (a - bb) ** 2 + h * h)
+                if lam < -tau:
+                    maybe_psd = False
+                    break
+            if not maybe_psd:
+                break
     if unit_farkas(M, q) >= 0:
         return 1, maybe_psd
     top = 0.0
@@ -1462,6 +1496,19 @@ def _resume_packed(M, q, d, out, start, max_iter, tol):
 
 
 @njit(cache=True)
+def _violation(M, q, z):
+    # lcp_violation of a finite z on finite data, without the Python checks
+    n = q.shape[0]
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    return _residual(M, q, z, np.empty(n), mmax, qmax)
+
+
+@njit(cache=True)
 def _handoff_info(info, rexp, cexp, ka, kb, scale_d, plain):
     # the scaling of the data a hand-over happened on: (2^ka R M C, 2^kb R q)
     # with covering 2^rexp d (scale_d) or d, R = diag(2^rexp), C = diag(2^cexp);
@@ -1487,6 +1534,16 @@ class _LemkeResult(LCPResult):
     # the explanation of a failure is composed only when someone reads it,
     # so that a failed solve costs no more than a successful one
     __slots__ = ()
+
+    def __init__(self, z, w, status, pivots, residual):
+        # the base's defaults (path, ray, detail) are the class's: only the
+        # slots are set, a sixth of the cost of a small solve less
+        self.z = z
+        self.w = w
+        self.status = status
+        self.pivots = pivots
+        self.residual = residual
+        self.method = "lemke"
 
     @property
     def detail(self):
@@ -1537,10 +1594,13 @@ class _LemkeResult(LCPResult):
                 # vector proven in compiled code is the one handed out
                 y = np.maximum(self.ray[:len(self.z)], 0.0)
                 y = np.ldexp(y, 1 - np.frexp(np.max(y))[1])
-            else:
+            elif unit_farkas(M, q) >= 0:
                 # the compiled code proved it by a unit vector (unit_farkas)
                 y = np.zeros(len(self.z))
                 y[unit_farkas(M, q)] = 1.0
+            else:
+                # by a cleaned candidate of the ray (_screen_ray)
+                y = _ray_or_unit_proof(M, q, self.ray)[0]
             self.__dict__["_cert"] = y
         return y
 
@@ -1611,7 +1671,8 @@ def _raise_nonfinite(M, q, d):
     if M.ndim != 2 or M.shape[0] != M.shape[1]:
         raise InputError(f"`M` must be square, got shape {M.shape}")
     if q.ndim != 1 or q.shape[0] != M.shape[0]:
-        raise InputError(f"`q` must have length {M.shape[0]} to match `M`, got shape {q.shape}")
+        got = q.shape[0] if q.ndim == 1 else f"shape {q.shape}"
+        raise InputError(f"`q` must have length {M.shape[0]} to match `M`, got {got}")
     if d is not None and np.shape(d) != q.shape:
         raise InputError(f"`covering` must have length {q.shape[0]}, got shape {np.shape(d)}")
     finite_array("M", M)
@@ -1684,9 +1745,8 @@ def _solve(M, q, max_iter, tol, check_input, covering):
         M = _as_matrix(M)
     if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
-    m0, m1 = M.shape
-    if m0 != m1 or m0 != q.shape[0]:
-        M, q = coerce_lcp(M, q)
+    # shapes are checked in compiled code before any read (_solve_packed:
+    # INVALID_INPUT, then _raise_nonfinite names the argument)
     if check_input:
         if max_iter is not None:
             max_iter = positive_int("max_iter", max_iter)
@@ -1712,7 +1772,7 @@ def _solve(M, q, max_iter, tol, check_input, covering):
             M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
         )
     if status == SOLVED:
-        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
@@ -1725,7 +1785,7 @@ def _packed_result(M, q, out, status, pivots, residual, note):
     # the result of a compiled run whose outputs are in `out`; `note` (how
     # the exact path took part) goes before the detail
     n = q.shape[0]
-    res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+    res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)
     if status == INFEASIBLE:
         # proven in compiled code: the ray's dz is a Farkas vector with every
         # sum's rounding bounded (farkas_float); the words, with the matrix
@@ -1769,11 +1829,15 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
                                  basis.tolist(), entering)
         seen.add(key)
         info = out[3 * n + 1:_OUT * n + 4]
-        ex = info[:n].astype(np.int64)
-        ka, kb = int(info[2 * n]), int(info[2 * n + 1])
-        Ms = np.ldexp(M, ex[:, None] + info[n:2 * n].astype(np.int64)[None, :] + ka)
-        qs = np.ldexp(q, ex + kb)
-        ds = np.ldexp(d, ex) if info[2 * n + 2] != 0.0 else d
+        if not info.any():
+            # the plain stage: the data as given
+            Ms, qs, ds = M, q, d
+        else:
+            ex = info[:n].astype(np.int64)
+            ka, kb = int(info[2 * n]), int(info[2 * n + 1])
+            Ms = np.ldexp(M, ex[:, None] + info[n:2 * n].astype(np.int64)[None, :] + ka)
+            qs = np.ldexp(q, ex + kb)
+            ds = np.ldexp(d, ex) if info[2 * n + 2] != 0.0 else d
         step = _exact.exact_step(Ms, qs, ds, basis, entering)
         if step is None:
             return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
@@ -1811,7 +1875,7 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
         if z is not None:
             out[:n] = z
             out[n:2 * n] = M @ out[:n] + q
-            residual = float(lcp_violation(M, q, out[:n]))
+            residual = float(_violation(M, q, out[:n]))
             status = SOLVED if residual <= tol else BREAKDOWN
     why = ("a lexicographic tie that floating point could not separate" if first == _HANDOFF_TIE
            else "a repeated basis (rounding had decided a tie wrongly)")
@@ -1842,6 +1906,12 @@ def _ray_or_unit_proof(M, q, ray):
 
 def _prove_secondary_ray(res, M, q, ray, pivots):
     verdict, maybe_psd = _screen_ray(M, q, ray)
+    if verdict == 1:
+        # a candidate (or a unit vector) is a Farkas vector, decided exactly in
+        # compiled code (farkas_float); the vector and the words are made only
+        # when someone reads them, by the same candidates in the same order
+        res.status = INFEASIBLE
+        return
     if verdict < 0 and not maybe_psd:
         # every candidate fails rigorously, and M is not PSD (where the exact
         # null-space projection could still find one): no proof, and the words
@@ -1870,7 +1940,7 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=Non
     except OverflowError:
         # the exact point lies outside the range of doubles
         res = _LemkeResult(np.zeros(n), q.copy(), BREAKDOWN, total,
-                           float(lcp_violation(M, q, np.zeros(n))), "lemke")
+                           float(lcp_violation(M, q, np.zeros(n))))
         res.detail = ("Pivoting was finished in exact arithmetic, but its end point lies outside "
                       "the range of floating-point numbers.")
         return res
@@ -1884,16 +1954,16 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=Non
     note = f"Pivoting met {why} and was finished in exact arithmetic {where}."
     if st == _exact.SOLVED:
         status = SOLVED if residual <= tol else BREAKDOWN
-        res = _LemkeResult(z, w, status, total, residual, "lemke")
+        res = _LemkeResult(z, w, status, total, residual)
         res.detail = note if status == SOLVED else (
             f"{note} The exact solution, rounded to floats, fails the check on the data "
             f"(violation {residual:.3g} > tol = {tol:.3g}).")
         return res
     if st == _exact.MAX_ITER:
-        res = _LemkeResult(z, w, MAX_ITER, total, residual, "lemke")
+        res = _LemkeResult(z, w, MAX_ITER, total, residual)
         res.detail = f"{note} {_DETAIL[MAX_ITER]} (after {total} pivots)"
         return res
-    res = _LemkeResult(z, w, SECONDARY_RAY, total, residual, "lemke")
+    res = _LemkeResult(z, w, SECONDARY_RAY, total, residual)
     top = max(abs(v) for v in rayx)
     # a direction: scaled to a largest entry of 1 before rounding, it stays finite
     ray = np.array([float(v / top) for v in rayx])
