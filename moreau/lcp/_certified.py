@@ -174,7 +174,7 @@ def farkas_float(M, q, y):
         return -1
     sure = True
     if not qy + qb < 0.0:
-        sg = _dot_sign(M, q, y, -1)
+        sg = _dot_sign(M, q, y, np.int64(-1))
         if sg == 2:
             sure = False
         elif sg >= 0:

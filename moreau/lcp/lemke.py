@@ -615,8 +615,10 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     pos[leaving] = -(n + 1)
     pivots = 1
     entering = leaving + n  # complement of w_r is z_r
-    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, entering,
-                 max_iter, tol, exact_ok, mmax, qmax, qsum, MAX_ITER)
+    # np.int64, not the constants: literal arguments would type (and compile) a
+    # second _path beside _core_resume's
+    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(pivots),
+                 entering, max_iter, tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER))
 
 
 @njit(cache=True)
@@ -936,8 +938,9 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
                 ray_out[j] = 1.0
         ray_out[n] = -col[pos[2 * n]]
         status = SECONDARY_RAY
-    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, int(start[n + 2]), entering,
-                 max_iter, tol, np.bool_(True), mmax, qmax, qsum, status)
+    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(start[n + 2]),
+                 np.int64(entering), max_iter, tol, np.bool_(True), mmax, qmax, qsum,
+                 np.int64(status))
 
 
 @njit(cache=True)
@@ -1344,7 +1347,8 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork,
                                          max_iter, tol, exact_ok)
         if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
-            _handoff_info(info, sexp, sexp, 0, 0, False, True)
+            _handoff_info(info, sexp, sexp, np.int64(0), np.int64(0), np.bool_(False),
+                          np.bool_(True))
             return status, pivots, residual
         if status == SECONDARY_RAY and (_ray_proves(M, q, ray_out) or unit_farkas(M, q) >= 0):
             status = INFEASIBLE
@@ -1363,7 +1367,7 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
                                                ray_out, work, iwork, max_iter, tol, scale_d,
                                                mmax, qmax, exact_ok, ray_out[:0])
         if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
-            _handoff_info(info, sexp, sexp, ka, kb, scale_d, False)
+            _handoff_info(info, sexp, sexp, ka, kb, scale_d, np.bool_(False))
             return status, pivots, residual
         if status == SECONDARY_RAY and unit_farkas(M, q) >= 0:
             status = INFEASIBLE
@@ -1388,7 +1392,7 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
                                                   ray_out, work, iwork, max_iter, tol, scale_d,
                                                   mmax, qmax, exact_ok, ray_out[:0])
         if status2 == _HANDOFF_TIE or status2 == _HANDOFF_CYCLE:
-            _handoff_info(info, rexp, cexp, ka2, kb2, scale_d, False)
+            _handoff_info(info, rexp, cexp, ka2, kb2, scale_d, np.bool_(False))
         pivots += pivots2
         if status2 == SECONDARY_RAY and unit_farkas(M, q) >= 0:
             status2 = INFEASIBLE
