@@ -393,8 +393,13 @@ def exact_step(M, q, d, basis, entering):
             continue
         if bq[i] < 0:
             return None
-        vals, _ = binv_row(i)
-        first = next((x for x in vals if x != 0), 0)
+        # the first nonzero of row i of B^-1 (R is sorted): on a w_j row the
+        # entries -P[j, t] of the columns R[t] < j, then D > 0 at column j
+        v = basis[i]
+        if v < n:
+            first = next((-P[v, t] for t in range(k) if R[t] < v and P[v, t] != 0), D)
+        else:
+            first = next((x for x in Y[zi[v]] if x != 0), 0)
         if first <= 0:
             return None
     if e_w:
