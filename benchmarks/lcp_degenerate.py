@@ -6,13 +6,16 @@ the textbook exact Lemke of ``tests/lcp/exact_reference.py`` on each, and
 prints per family: cases, how each ended, the pivot-count differences (float
 minus exact), how many stopped at the pivot limit where the exact run ends
 (must be 0), how many a different way from the exact run, and how many
-handed over to the exact path (and of those, how many had to start afresh).
+handed over to the exact path: how many steps were decided there (the path
+then went on in floating point), how many runs had the whole path finished in
+exact arithmetic instead, and how many of those had to start afresh.
 Run from a checkout (it imports the test strategies).
 """
 
 import argparse
 import collections
 import pathlib
+import re
 import sys
 import time
 
@@ -51,6 +54,11 @@ def run_family(strategy, n_examples):
         diffs[res.pivots - pivots] += 1
         if "exact arithmetic" in res.detail:
             stats["handed over"] += 1
+            steps = re.search(r"(\d+) steps? of the path", res.detail)
+            if steps:
+                stats["exact steps"] += int(steps.group(1))
+            if "finished in exact arithmetic" in res.detail:
+                stats["whole path exact"] += 1
             if "afresh" in res.detail:
                 stats["started afresh"] += 1
     run()
@@ -75,10 +83,12 @@ def main():
               f"  float-exact pivots {{{d}}}  MAX_ITER where exact ends "
               f"{stats['MAX_ITER where exact ends']}  ended otherwise {stats['ended otherwise']}"
               f" (solved where exact rays {stats['solved where exact rays']})"
-              f"  handed over {stats['handed over']} (afresh {stats['started afresh']})"
+              f"  handed over {stats['handed over']} (exact steps {stats['exact steps']}, whole path "
+              f"exact {stats['whole path exact']}, afresh {stats['started afresh']})"
               f"  [{time.perf_counter() - t0:.1f} s]")
     print(f"all: {total['cases']} cases, MAX_ITER where exact ends {total['MAX_ITER where exact ends']}, "
-          f"ended otherwise {total['ended otherwise']}, handed over {total['handed over']}")
+          f"ended otherwise {total['ended otherwise']}, handed over {total['handed over']} "
+          f"(exact steps {total['exact steps']}, whole path exact {total['whole path exact']})")
 
 
 if __name__ == "__main__":

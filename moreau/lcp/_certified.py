@@ -94,11 +94,64 @@ def residual(M, q, z, w, mmax, qmax):
     return num / qs
 
 
+@njit(cache=True, inline="always")
+def _two_sum(a, b):
+    # a + b = s + e exactly (Knuth's TwoSum)
+    s = a + b
+    bb = s - a
+    return s, (a - (s - bb)) + (b - bb)
+
+
+@njit(cache=True)
+def _grow(e, m, b):
+    # Shewchuk's Grow-Expansion with zero elimination: e[:m], a nonoverlapping
+    # expansion in increasing magnitude, becomes one of its sum plus b, in place
+    # (component k is written after component i >= k is read); returns its length
+    k = 0
+    for i in range(m):
+        b, h = _two_sum(b, e[i])
+        if h != 0.0:
+            e[k] = h
+            k += 1
+    if b != 0.0:
+        e[k] = b
+        k += 1
+    return k
+
+
+@njit(cache=True)
+def _dot_sign(M, q, y, j):
+    # the exact sign (-1, 0, 1) of sum_i c_i y_i with c = q (j < 0) or column j
+    # of M: each product split exactly into two floats (TwoProduct), all summed
+    # exactly into a nonoverlapping expansion (Shewchuk 1997), whose sign is
+    # that of its largest component. 2 where a product lies outside
+    # [2^-960, 2^1000] (underflow would make the split inexact)
+    n = q.shape[0]
+    e = np.empty(2 * n + 1)
+    m = 0
+    for i in range(n):
+        c = q[i] if j < 0 else M[i, j]
+        p = c * y[i]
+        if p == 0.0 and (c == 0.0 or y[i] == 0.0):
+            continue
+        a = abs(p)
+        if not (a < 2.0**1000 and a > 2.0**-960):
+            return 2
+        p, err = _two_prod(c, y[i])
+        m = _grow(e, m, err)
+        m = _grow(e, m, p)
+    if m == 0:
+        return 0
+    return 1 if e[m - 1] > 0.0 else -1
+
+
 @njit(cache=True)
 def farkas_float(M, q, y):
     # y >= 0, M^T y <= 0, q.y < 0 decided in floating point with a rigorous
-    # bound on each sum's rounding: 1 holds, -1 fails, 0 undecided (the exact
-    # rational check of moreau.lcp.certify.farkas_holds then settles it)
+    # bound on each sum's rounding, and where a sum lies within its bound of
+    # zero, by its exact sign (_dot_sign): 1 holds, -1 fails, 0 undecided
+    # (products over- or underflowing; the exact rational check of
+    # moreau.lcp.certify.farkas_holds then settles it)
     n = q.shape[0]
     gam = (n + 2) * _EPS
     pos = False
@@ -119,7 +172,13 @@ def farkas_float(M, q, y):
         return 0
     if qy - qb >= 0.0:
         return -1
-    sure = qy + qb < 0.0
+    sure = True
+    if not qy + qb < 0.0:
+        sg = _dot_sign(M, q, y, np.int64(-1))
+        if sg == 2:
+            sure = False
+        elif sg >= 0:
+            return -1
     for j in range(n):
         g = 0.0
         gb = 0.0
@@ -134,7 +193,11 @@ def farkas_float(M, q, y):
         if g - gb > 0.0:
             return -1
         if not g + gb <= 0.0:
-            sure = False
+            sg = _dot_sign(M, q, y, j)
+            if sg == 2:
+                sure = False
+            elif sg > 0:
+                return -1
     return 1 if sure else 0
 
 

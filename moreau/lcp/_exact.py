@@ -32,7 +32,7 @@ from fractions import Fraction
 
 import numpy as np
 
-__all__ = ["exact_lemke", "integer_data"]
+__all__ = ["exact_lemke", "exact_step", "basis_point", "integer_data"]
 
 SOLVED = 0
 RAY = 1
@@ -273,4 +273,228 @@ def _point(T, D, rows, n):
         v = rows[i]
         if n <= v < 2 * n:
             z[v - n] = Fraction(T[i][2 * n + 1], D)
+    return z
+
+
+def _column_ints(F):
+    # the rows of the float array F as Python integers times one power of two
+    # 2^K, K >= 0 (exact: a float is m 2^e with |m| < 2^53), and K
+    mant, ex = np.frexp(F)
+    m = (mant * 2.0**53).astype(np.int64)
+    nz = m != 0
+    e = ex.astype(np.int64) - 53
+    K = max(0, -int(e[nz].min())) if nz.any() else 0
+    sh = np.where(nz, e + K, 0)
+    # the shifts as one object-array operation: Python integers, no per-entry bytecode
+    return np.left_shift(m.astype(object), sh.astype(object)).tolist(), K
+
+
+def exact_step(M, q, d, basis, entering):
+    """The step of the lexicographic path at ``basis``, decided in exact arithmetic.
+
+    Only what the ratio test reads is computed: with ``Z`` the basic
+    variables other than the ``w``'s and ``R`` the rows whose ``w`` is not
+    basic, ``B^-1`` follows from the ``k x k`` block ``G = A[R, Z]`` (``k =
+    |Z|``) by fraction-free Gauss-Jordan, and each needed entry of ``B^-1 [A
+    | q]`` costs ``O(k)`` integer operations: ``O(k^3 + n k^2)`` in all,
+    against ``O(k n^2)`` for the whole tableau.
+
+    Parameters
+    ----------
+    M, q, d : ndarray
+        The data pivoted on (floats, read exactly) and the covering vector.
+    basis : sequence of int
+        The basic variable of every row (``w_j -> j``, ``z_j -> n + j``,
+        ``z0 -> 2 n``; ``z0`` among them).
+    entering : int
+        The variable to enter.
+
+    Returns
+    -------
+    tuple or None
+        ``("pivot", leaving, b)`` with the variable the lexicographic rule
+        removes (``2 n``, ``z0``, when it is among the tied rows: the path
+        ends on a solution), ``("ray", None, b)`` when the entering column
+        has no positive entry; ``b`` is the right-hand side ``B^-1 q`` of the
+        basis after the step (on a ray, of this one), row by row of
+        ``basis`` (the entering variable in the leaving one's row), each
+        correctly rounded to a float (exact zeros stay zeros). None when
+        the basis is singular or not
+        lexicographically positive for the data (a right-hand side below
+        zero, or a zero one whose row of ``B^-1`` starts negative): no
+        exact step can start from it.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> M = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> kind, leaving, b = exact_step(M, np.array([-1.0, -1.0]), np.ones(2), [0, 4], 3)
+    >>> kind, leaving, b   # z0 = 1 in row 1, z_1 enters: w_0 = -z_1 leaves at 0
+    ('pivot', 0, [0.0, 1.0])
+    """
+    n = len(q)
+    z0 = 2 * n
+    basis = [int(v) for v in basis]
+    entering = int(entering)
+    Z = [v for v in basis if v >= n]
+    wb = {v for v in basis if v < n}
+    R = [j for j in range(n) if j not in wb]
+    k = len(Z)
+    if len(R) != k or len(set(basis)) != n or entering in basis:
+        return None
+    cols = [(-M[:, v - n] if v < z0 else -d) for v in Z]
+    e_w = entering < n
+    if not e_w:
+        cols.append(-M[:, entering - n])
+    cols.append(q)
+    ints, K = _column_ints(np.array(cols, dtype=float))
+    A = np.array(ints[:k] or np.zeros((0, n), dtype=np.int64), dtype=object).reshape(k, n)
+    # fraction-free Gauss-Jordan on [G | I], G = A[R, Z]: G^-1 = Y / D with D > 0
+    T = [[ints[c][R[a]] for c in range(k)] + [1 if a == b else 0 for b in range(k)]
+         for a in range(k)]
+    D = 1
+    used = [False] * k
+    prow = [0] * k
+    for c in range(k):
+        r = next((a for a in range(k) if not used[a] and T[a][c] != 0), None)
+        if r is None:
+            return None
+        D = _pivot(T, D, r, c)
+        used[r] = True
+        prow[c] = r
+    Y = np.array([T[prow[c]][k:] for c in range(k)], dtype=object).reshape(k, k)
+    # numerators of (B^-1)_{i c} for c in R (the tableau column of w_c over 2^K;
+    # the other columns hold D on the row of a basic w_c, 0 elsewhere): -P[j]
+    # on the row of a basic w_j, Y[c'] on the row of z variable Z[c']
+    P = A.T.dot(Y) if k else np.zeros((n, 0), dtype=object)
+    zi = {v: c for c, v in enumerate(Z)}
+    Rarr = np.array(R, dtype=np.int64)
+
+    def numer(a):
+        # numerators of B^-1 a row by row, over D (Z rows) or D 2^K (w rows): both > 0
+        a = np.array(a, dtype=object)
+        y = Y.dot(a[Rarr]) if k else a[:0]
+        nw = D * a - (y.dot(A) if k else 0)
+        return [nw[v] if v < n else y[zi[v]] for v in basis]
+
+    def binv_row(i):
+        # the nonzero numerators of row i of B^-1, by column, in column order
+        v = basis[i]
+        if v < n:
+            ent = {R[t]: -P[v, t] for t in range(k)}
+            ent[v] = D
+        else:
+            ent = {R[t]: Y[zi[v], t] for t in range(k)}
+        return [ent[c] for c in sorted(ent)], sorted(ent)
+
+    bq = numer(ints[-1])
+    for i in range(n):
+        if bq[i] > 0:
+            continue
+        if bq[i] < 0:
+            return None
+        # the first nonzero of row i of B^-1 (R is sorted): on a w_j row the
+        # entries -P[j, t] of the columns R[t] < j, then D > 0 at column j
+        v = basis[i]
+        if v < n:
+            first = next((-P[v, t] for t in range(k) if R[t] < v and P[v, t] != 0), D)
+        else:
+            first = next((x for x in Y[zi[v]] if x != 0), 0)
+        if first <= 0:
+            return None
+    if e_w:
+        # the column of w_c in the integer data: 2^K e_c
+        ae = numer([1 << K if j == entering else 0 for j in range(n)])
+    else:
+        ae = numer(ints[k])
+    best = []
+    for i in range(n):
+        if ae[i] <= 0:
+            continue
+        if not best:
+            best = [i]
+            continue
+        lhs = bq[i] * ae[best[0]]
+        rhs = bq[best[0]] * ae[i]
+        if lhs < rhs:
+            best = [i]
+        elif lhs == rhs:
+            best.append(i)
+    # the true right-hand side is bq_i / D on a Z row and bq_i / (D 2^K) on a w row
+    den = [D if v >= n else D << K for v in basis]
+    if not best:
+        return "ray", None, [x / dd for x, dd in zip(bq, den)]
+    z0_rows = [i for i in best if basis[i] == z0]
+    if z0_rows:
+        r = z0_rows[0]
+    else:
+        r = best[0]
+        for i in best[1:]:
+            # (B^-1)_i / a_i against (B^-1)_r / a_r, column by column
+            vi, ci = binv_row(i)
+            vr, cr = binv_row(r)
+            di = dict(zip(ci, vi))
+            dr = dict(zip(cr, vr))
+            for c in sorted(set(ci) | set(cr)):
+                xi = di.get(c, 0) * ae[r]
+                xr = dr.get(c, 0) * ae[i]
+                if xi != xr:
+                    if xi < xr:
+                        r = i
+                    break
+    # the pivot: b_r / a_r in row r, b_i - a_i b_r / a_r in the others (the
+    # row denominators cancel in a_i / a_r)
+    br, ar = bq[r], ae[r]
+    b = [(bq[i] * ar - ae[i] * br) / (ar * den[i]) if i != r else br / ar for i in range(n)]
+    return "pivot", basis[r], b
+
+
+def basis_point(M, q, J):
+    """The point of the complementary basis whose basic ``z`` are ``J``, exactly, rounded to floats.
+
+    Solves ``M_JJ z_J = -q_J`` in exact arithmetic (Bareiss's fraction-free
+    elimination on the data as integers), ``z = 0`` off ``J``; each entry
+    correctly rounded. None when ``M_JJ`` is singular or the point lies
+    outside the range of floats.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> basis_point(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]), [0, 1])
+    [0.3333333333333333, 0.3333333333333333]
+    """
+    n = len(q)
+    k = len(J)
+    z = [0.0] * n
+    if k == 0:
+        return z
+    cols = [M[J, j] for j in J] + [-q[J]]
+    ints, _ = _column_ints(np.array(cols, dtype=float))
+    # Bareiss's fraction-free elimination on [M_JJ | -q_J] (every entry stays
+    # an integer minor), then back-substitution for X = det z_J, also in integers
+    T = [[ints[c][a] for c in range(k + 1)] for a in range(k)]
+    prev = 1
+    for c in range(k):
+        r = next((a for a in range(c, k) if T[a][c] != 0), None)
+        if r is None:
+            return None
+        if r != c:
+            T[c], T[r] = T[r], T[c]
+        Tc = T[c]
+        p = Tc[c]
+        for a in range(c + 1, k):
+            Ta = T[a]
+            f = Ta[c]
+            T[a] = [0] * (c + 1) + [(Ta[j] * p - f * Tc[j]) // prev for j in range(c + 1, k + 1)]
+        prev = p
+    det = T[k - 1][k - 1]
+    X = [0] * k
+    for c in range(k - 1, -1, -1):
+        Tc = T[c]
+        X[c] = (det * Tc[k] - sum(Tc[j] * X[j] for j in range(c + 1, k))) // Tc[c]
+    try:
+        for c, j in enumerate(J):
+            z[j] = X[c] / det
+    except OverflowError:
+        return None
     return z

@@ -37,10 +37,16 @@ within that bound of zero is no candidate, and if it could have changed the
 step (no other candidate, or a ratio that could undercut the minimum) the
 step is not taken in floating point either. Where floating point cannot
 decide, and where a basis repeats (the visited bases are hashed past ``2 n +
-16`` pivots), :func:`solve` finishes the path in exact integer arithmetic
-(:mod:`moreau.lcp._exact`) from the basis reached, or afresh if that basis is
-not lexicographically positive for the caller's data: the path is then the
-exact lexicographic one and cannot cycle. One exception, for cost: where
+16`` pivots), :func:`solve` decides that one step in exact integer arithmetic
+(:func:`moreau.lcp._exact.exact_step`: ``B^-1`` from the ``k x k`` block of
+the basic non-``w`` variables, ``O(k^3 + n k^2)``) and goes back to floating
+point from the basis reached, on a tableau made afresh from the data with the
+exact right-hand side; a solution reached that way is the exact point of its
+basis, correctly rounded. The whole path is finished in exact arithmetic
+only where a hand-over state repeats, where the basis is not
+lexicographically positive for the caller's data (the path then starts
+afresh) or too close to singular for floating point to follow. The path is
+the exact lexicographic one and cannot cycle. One exception, for cost: where
 ``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
 is a solution up to rounding, certified on the data as always), where the
 exact path might pivot on. The compiled entries
@@ -155,6 +161,9 @@ ROUND = 2.0**16 * np.finfo(float).eps
 # internal statuses: the compiled pivoting hands over to the exact path
 _HANDOFF_TIE = 100
 _HANDOFF_CYCLE = 101
+# the output buffer of _solve_packed: z, w, the ray (n + 1) and the scaling of a
+# hand-over (2 n + 3), _OUT n + 4 floats
+_OUT = 5
 # slots of the hash set of visited bases (a power of two)
 _SEEN_SIZE = 1 << 14
 #: default bound on the violation (:func:`moreau.lcp.lcp_violation`) for a
@@ -605,21 +614,36 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     pos[z0] = r
     pos[leaving] = -(n + 1)
     pivots = 1
-    status = MAX_ITER
     entering = leaving + n  # complement of w_r is z_r
+    # np.int64, not the constants: literal arguments would type (and compile) a
+    # second _path beside _core_resume's
+    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(pivots),
+                 entering, max_iter, tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER))
+
+
+@njit(cache=True)
+def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, entering,
+          max_iter, tol, exact_ok, mmax, qmax, qsum, status):
+    # Lemke's path from the tableau (T, b) of the basis (basis, pos) with
+    # `entering` to enter next, to its end (status MAX_ITER; another status:
+    # the path has ended already, only the terminal point is made); _core
+    # after its first pivot, and _core_resume from a basis the exact path decided
+    z0 = 2 * n
     # (basis, entering) identified by the XOR of its variables' keys: an exact
     # lexicographic path never repeats one, so a repeat is rounding having
-    # decided a tie wrongly. Past 2 n + 16 pivots (a path that long is rare
-    # outside exponential examples) the states go into a hash set; when it
-    # is three-quarters full it is cleared, and a loop is caught on its next round
+    # decided a tie wrongly. Past 2 n + 16 pivots of a run (a path that long
+    # is rare outside exponential examples) the states go into a hash set; when
+    # it is three-quarters full it is cleared, and a loop is caught on its next round
     hb = 0
     for i in range(n):
         hb ^= _key(basis[i])
-    seen = np.zeros(1, dtype=np.int64)
+    # a placeholder of length 1 (a view: no allocation on the short paths);
+    # the set itself is allocated when the watch starts
+    seen = pos[:1]
     nseen = 0
-    watch = 2 * n + 16
+    watch = 2 * n + 15 + pivots
 
-    while pivots < max_iter:
+    while status == MAX_ITER and pivots < max_iter:
         if pivots >= watch:
             if seen.shape[0] == 1 or 4 * nseen >= 3 * seen.shape[0]:
                 seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
@@ -799,6 +823,126 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     return status, pivots, residual
 
 
+# modes of _core_resume: go on along the path, the basis is the solution's
+# (z0 has left), or the entering variable has no positive entry (a ray)
+_RESUME_PATH = 0
+_RESUME_SOLVED = 1
+_RESUME_RAY = 2
+# a basis whose float tableau takes a pivot below this times its column is too
+# close to singular for floating point to follow: the exact path takes the next step
+_REBUILD_TOL = 1e-8
+
+
+@njit(cache=True)
+def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, start):
+    # Lemke's path on (M, q, d) from a basis the exact path (moreau.lcp._exact.exact_step)
+    # has decided: start = (basis of each row (n), entering variable, mode,
+    # pivots made, the basis's right-hand side row by row (n), exactly rounded),
+    # all floats. The tableau of that basis is made afresh from the data, by
+    # pivoting its non-w variables in from the all-w basis (partial pivoting
+    # among the rows whose w must leave), so that the rounding of the path
+    # before the hand-over is gone, and takes the exact right-hand side (its
+    # zeros are the degenerate rows, its order that of the exact path); then,
+    # by mode, the path goes on
+    # (_RESUME_PATH), the basis's point is the answer (_RESUME_SOLVED), or the
+    # entering column gives the secondary ray (_RESUME_RAY). A basis too close
+    # to singular for floating point (a pivot below _REBUILD_TOL times its
+    # column) is handed back at once (_HANDOFF_TIE): the exact path decides
+    # its step too. The data are finite (the hand-over came from _core).
+    n = q.shape[0]
+    mmax = 0.0
+    qmax = 0.0
+    qsum = 0.0
+    for i in range(n):
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+        qmax = max(qmax, abs(q[i]))
+        qsum += abs(q[i])
+    for k in range(n + 1):
+        ray_out[k] = 0.0
+    T = work
+    b = work[n + 1]
+    col = work[n + 2]
+    basis = iwork[:n]
+    pos = iwork[n:]
+    ncol = T.shape[1]
+    for i in range(n):
+        for j in range(n):
+            T[i, j] = -M[i, j]
+        T[i, n] = -d[i]
+        for j in range(n + 1, ncol):
+            T[i, j] = 0.0
+        b[i] = q[i]
+        basis[i] = i
+        pos[i] = i
+        pos[n + i] = -(i + 1)
+    pos[2 * n] = -(n + 1)
+    # the w of row i leaves (its row takes a non-w variable) when w_i is not in the target
+    # basis; ray_out[:n] marks those rows while the tableau is built
+    for i in range(n):
+        ray_out[i] = 1.0
+    for i in range(n):
+        v = int(start[i])
+        if v < n:
+            ray_out[v] = 0.0
+    for t in range(n):
+        v = int(start[t])
+        if v < n:
+            continue
+        s = -pos[v] - 1
+        cmax = 0.0
+        r = -1
+        best = 0.0
+        for i in range(n):
+            a = T[i, s]
+            col[i] = a
+            cmax = max(cmax, abs(a))
+            if ray_out[i] != 0.0 and basis[i] < n and abs(a) > best:
+                best = abs(a)
+                r = i
+        if r < 0 or not best > _REBUILD_TOL * cmax:
+            status = _HANDOFF_TIE
+            if start[n + 1] != _RESUME_PATH:
+                status = BREAKDOWN
+            for i in range(n):
+                ray_out[i] = start[i]
+                z_out[i] = 0.0
+                w_out[i] = q[i]
+            ray_out[n] = start[n]
+            return status, int(start[n + 2]), np.inf
+        _pivot(T, b, col, n, r, s)
+        leaving = basis[r]
+        basis[r] = v
+        pos[v] = r
+        pos[leaving] = -(s + 1)
+        ray_out[r] = 0.0
+    for i in range(n + 1):
+        ray_out[i] = 0.0
+    # the rows were filled in another order than start's: match them by variable
+    for t in range(n):
+        b[pos[int(start[t])]] = start[n + 3 + t]
+    entering = int(start[n])
+    mode = int(start[n + 1])
+    status = MAX_ITER
+    if mode == _RESUME_SOLVED:
+        status = SOLVED
+    elif mode == _RESUME_RAY:
+        s = -pos[entering] - 1
+        for i in range(n):
+            col[i] = T[i, s]
+        for j in range(n):
+            p = pos[n + j]
+            if p >= 0:
+                ray_out[j] = -col[p]
+            elif n + j == entering:
+                ray_out[j] = 1.0
+        ray_out[n] = -col[pos[2 * n]]
+        status = SECONDARY_RAY
+    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(start[n + 2]),
+                 np.int64(entering), max_iter, tol, np.bool_(True), mmax, qmax, qsum,
+                 np.int64(status))
+
+
 @njit(cache=True)
 def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     """Lemke's method with covering vector ``d = 1`` (compiled; callable from ``@njit`` code).
@@ -837,7 +981,7 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
     return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol, np.bool_(False),
-                         np.bool_(False))
+                         np.bool_(False), ray[:0])
 
 
 
@@ -1010,7 +1154,7 @@ def _unit_exponents(M, q, rexp, cexp):
 
 @njit(cache=True)
 def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork, max_iter, tol,
-                scale_d, mmax, qmax, exact_ok):
+                scale_d, mmax, qmax, exact_ok, start):
     # lemke_core on (2^ka R M C, 2^kb R q), R = diag(2^rexp), C = diag(2^cexp),
     # mapped back (z = 2^(ka-kb) C z') and judged on the caller's data with
     # the rounding of M z + q counted (_residual): the scaled problem is the
@@ -1026,8 +1170,13 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
         ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
         for j in range(n):
             Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
-    status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
-                                     tol, exact_ok)
+    if start.shape[0] == 0:
+        status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
+                                         tol, exact_ok)
+    else:
+        # from a basis the exact path decided (start: see _core_resume)
+        status, pivots, residual = _core_resume(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
+                                                max_iter, tol, start)
     if status == INVALID_INPUT or status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         # a hand-over carries the basis in ray_out: nothing to map back
         return status, pivots, residual
@@ -1089,17 +1238,43 @@ def _screen_ray(M, q, ray):
     # unit vectors (unit_farkas): 1 one is proven, 0 one needs the exact
     # check, -1 every one fails rigorously. Then whether M might be PSD (where
     # the exact null-space projection is tried): not when its symmetric part
-    # has a negative diagonal entry, or a zero one with a nonzero row
+    # has a negative diagonal entry, or a zero one with a nonzero row, nor when
+    # M is nonnegative with a positive diagonal (certify.copositive_plus_class
+    # names that class first, and projects only for the PSD one), nor when a
+    # 2 x 2 principal block of S = (M + M^T) / 2 has an eigenvalue below twice
+    # the tolerance of copositive_plus_class (-100 n^2 eps max|S|): then so
+    # has S (interlacing), and that test, far above this one's rounding, says no
     n = q.shape[0]
     maybe_psd = True
+    nonneg = True
+    smax = 0.0
     for i in range(n):
         if M[i, i] < 0.0:
             maybe_psd = False
         elif M[i, i] == 0.0:
+            nonneg = False
             for j in range(n):
                 if M[i, j] + M[j, i] != 0.0:
                     maybe_psd = False
                     break
+        for j in range(n):
+            nonneg = nonneg and M[i, j] >= 0.0
+            smax = max(smax, abs(0.5 * (M[i, j] + M[j, i])))
+    if nonneg:
+        maybe_psd = False
+    if maybe_psd:
+        tau = 2.0 * 100.0 * n * n * np.finfo(np.float64).eps * smax
+        for i in range(n):
+            for j in range(i + 1, n):
+                a = M[i, i]
+                bb = M[j, j]
+                h = 0.5 * (M[i, j] + M[j, i])
+                lam = 0.5 * (a + bb) - math.sqrt(0.25 * (a - bb) ** 2 + h * h)
+                if lam < -tau:
+                    maybe_psd = False
+                    break
+            if not maybe_psd:
+                break
     if unit_farkas(M, q) >= 0:
         return 1, maybe_psd
     top = 0.0
@@ -1148,16 +1323,19 @@ def _ray_proves(M, q, ray):
 
 @njit(cache=True)
 def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, scale_d,
-                  exact_ok):
+                  exact_ok, info):
     # Lemke on the symmetrically balanced data (balance): a uniformly scaled
     # problem pivots exactly as the unscaled one, and the matrix class is
     # kept. Where its answer fails on the caller's data, again with rows
     # scaled to their q (_balance_rows_to_q), then with rows and columns
-    # equilibrated apart (_balance_ruiz).
+    # equilibrated apart (_balance_ruiz). On a hand-over to the exact path
+    # (exact_ok), info (2 n + 3) receives the scaling of the data pivoted on
+    # (_handoff_info), for the exact step and the resume to use the same.
     n = q.shape[0]
     sexp = np.zeros(n, dtype=np.int64)
     ok, ka, kb = balance(M, q, sexp)
     if not ok:
+        # NaN or inf: _core refuses them
         return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok)
     plain = -_PLAIN_RANGE <= ka <= _PLAIN_RANGE and -_PLAIN_RANGE <= kb <= _PLAIN_RANGE
     for i in range(n):
@@ -1168,6 +1346,10 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         # property tests scale by 2^k and compare), minus the copy
         status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork,
                                          max_iter, tol, exact_ok)
+        if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+            _handoff_info(info, sexp, sexp, np.int64(0), np.int64(0), np.bool_(False),
+                          np.bool_(True))
+            return status, pivots, residual
         if status == SECONDARY_RAY and (_ray_proves(M, q, ray_out) or unit_farkas(M, q) >= 0):
             status = INFEASIBLE
         if status != BREAKDOWN:
@@ -1183,7 +1365,10 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
     else:
         status, pivots, residual = _run_scaled(M, q, d, sexp, sexp, ka, kb, z_out, w_out,
                                                ray_out, work, iwork, max_iter, tol, scale_d,
-                                               mmax, qmax, exact_ok)
+                                               mmax, qmax, exact_ok, ray_out[:0])
+        if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+            _handoff_info(info, sexp, sexp, ka, kb, scale_d, np.bool_(False))
+            return status, pivots, residual
         if status == SECONDARY_RAY and unit_farkas(M, q) >= 0:
             status = INFEASIBLE
         if status != BREAKDOWN:
@@ -1205,7 +1390,9 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
         r1 = ray_out.copy()
         status2, pivots2, residual2 = _run_scaled(M, q, d, rexp, cexp, ka2, kb2, z_out, w_out,
                                                   ray_out, work, iwork, max_iter, tol, scale_d,
-                                                  mmax, qmax, exact_ok)
+                                                  mmax, qmax, exact_ok, ray_out[:0])
+        if status2 == _HANDOFF_TIE or status2 == _HANDOFF_CYCLE:
+            _handoff_info(info, rexp, cexp, ka2, kb2, scale_d, np.bool_(False))
         pivots += pivots2
         if status2 == SECONDARY_RAY and unit_farkas(M, q) >= 0:
             status2 = INFEASIBLE
@@ -1265,13 +1452,78 @@ def _solve_packed(M, q, d, out, max_iter, tol, scale_d=True):
     # (z | w | ray) allocated by the caller: returning arrays from compiled
     # code costs more than the whole pivoting on a small LCP.
     n = q.shape[0]
-    if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n or out.shape[0] < 3 * n + 1:
+    if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n or out.shape[0] < _OUT * n + 4:
         # the unchecked path must never read out of bounds
         return INVALID_INPUT, 0, np.inf
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:], work, iwork, max_iter, tol,
-                         scale_d, np.bool_(True))
+    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1], work, iwork,
+                         max_iter, tol, scale_d, np.bool_(True), out[3 * n + 1:])
+
+
+@njit(cache=True)
+def _resume_packed(M, q, d, out, start, max_iter, tol):
+    # _solve_packed from a basis the exact path decided (start: see
+    # _core_resume), on the data scaled as the run that handed over
+    # (out[3 n + 1:], written by _handoff_info); judged on the caller's data
+    n = q.shape[0]
+    info = out[3 * n + 1:]
+    rexp = np.empty(n, dtype=np.int64)
+    cexp = np.empty(n, dtype=np.int64)
+    for i in range(n):
+        rexp[i] = np.int64(info[i])
+        cexp[i] = np.int64(info[n + i])
+    ka = np.int64(info[2 * n])
+    kb = np.int64(info[2 * n + 1])
+    scale_d = info[2 * n + 2] != 0.0
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    work = np.empty((n + 3, _padded(n)))
+    iwork = np.empty(3 * n + 1, dtype=np.int64)
+    z_out = out[:n]
+    w_out = out[n:2 * n]
+    ray_out = out[2 * n:3 * n + 1]
+    status, pivots, residual = _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out,
+                                           work, iwork, max_iter, tol, scale_d, mmax, qmax,
+                                           np.bool_(True), start)
+    if status == SECONDARY_RAY and unit_farkas(M, q) >= 0:
+        status = INFEASIBLE
+    if status != _HANDOFF_TIE and status != _HANDOFF_CYCLE:
+        # the terminal basis, for the exact point of a solution (info is spent)
+        for i in range(n):
+            info[i] = iwork[i]
+    return status, pivots, residual
+
+
+@njit(cache=True)
+def _violation(M, q, z):
+    # lcp_violation of a finite z on finite data, without the Python checks
+    n = q.shape[0]
+    mmax = 0.0
+    qmax = 0.0
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    return _residual(M, q, z, np.empty(n), mmax, qmax)
+
+
+@njit(cache=True)
+def _handoff_info(info, rexp, cexp, ka, kb, scale_d, plain):
+    # the scaling of the data a hand-over happened on: (2^ka R M C, 2^kb R q)
+    # with covering 2^rexp d (scale_d) or d, R = diag(2^rexp), C = diag(2^cexp);
+    # the plain stage pivots on the data as given (all exponents 0)
+    n = rexp.shape[0]
+    for i in range(n):
+        info[i] = 0.0 if plain else float(rexp[i])
+        info[n + i] = 0.0 if plain else float(cexp[i])
+    info[2 * n] = 0.0 if plain else float(ka)
+    info[2 * n + 1] = 0.0 if plain else float(kb)
+    info[2 * n + 2] = 1.0 if scale_d and not plain else 0.0
 
 
 @njit(cache=True)
@@ -1286,6 +1538,16 @@ class _LemkeResult(LCPResult):
     # the explanation of a failure is composed only when someone reads it,
     # so that a failed solve costs no more than a successful one
     __slots__ = ()
+
+    def __init__(self, z, w, status, pivots, residual):
+        # the base's defaults (path, ray, detail) are the class's: only the
+        # slots are set, a sixth of the cost of a small solve less
+        self.z = z
+        self.w = w
+        self.status = status
+        self.pivots = pivots
+        self.residual = residual
+        self.method = "lemke"
 
     @property
     def detail(self):
@@ -1321,7 +1583,8 @@ class _LemkeResult(LCPResult):
         packed = self.__dict__.get("_ray")
         if packed is None:
             return None
-        return packed[0][2 * len(self.z):]
+        n = len(self.z)
+        return packed[0][2 * n:3 * n + 1]
 
     @property
     def certificate(self):
@@ -1335,10 +1598,13 @@ class _LemkeResult(LCPResult):
                 # vector proven in compiled code is the one handed out
                 y = np.maximum(self.ray[:len(self.z)], 0.0)
                 y = np.ldexp(y, 1 - np.frexp(np.max(y))[1])
-            else:
+            elif unit_farkas(M, q) >= 0:
                 # the compiled code proved it by a unit vector (unit_farkas)
                 y = np.zeros(len(self.z))
                 y[unit_farkas(M, q)] = 1.0
+            else:
+                # by a cleaned candidate of the ray (_screen_ray)
+                y = _ray_or_unit_proof(M, q, self.ray)[0]
             self.__dict__["_cert"] = y
         return y
 
@@ -1409,7 +1675,8 @@ def _raise_nonfinite(M, q, d):
     if M.ndim != 2 or M.shape[0] != M.shape[1]:
         raise InputError(f"`M` must be square, got shape {M.shape}")
     if q.ndim != 1 or q.shape[0] != M.shape[0]:
-        raise InputError(f"`q` must have length {M.shape[0]} to match `M`, got shape {q.shape}")
+        got = q.shape[0] if q.ndim == 1 else f"shape {q.shape}"
+        raise InputError(f"`q` must have length {M.shape[0]} to match `M`, got {got}")
     if d is not None and np.shape(d) != q.shape:
         raise InputError(f"`covering` must have length {q.shape[0]}, got shape {np.shape(d)}")
     finite_array("M", M)
@@ -1482,9 +1749,8 @@ def _solve(M, q, max_iter, tol, check_input, covering):
         M = _as_matrix(M)
     if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
-    m0, m1 = M.shape
-    if m0 != m1 or m0 != q.shape[0]:
-        M, q = coerce_lcp(M, q)
+    # shapes are checked in compiled code before any read (_solve_packed:
+    # INVALID_INPUT, then _raise_nonfinite names the argument)
     if check_input:
         if max_iter is not None:
             max_iter = positive_int("max_iter", max_iter)
@@ -1495,7 +1761,7 @@ def _solve(M, q, max_iter, tol, check_input, covering):
             if covering.shape != q.shape:
                 raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
     n = q.shape[0]
-    out = np.empty(3 * n + 1)
+    out = np.empty(_OUT * n + 4)
     if max_iter is None:
         max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
     if covering is None:
@@ -1510,27 +1776,117 @@ def _solve(M, q, max_iter, tol, check_input, covering):
             M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
         )
     if status == SOLVED:
-        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+        return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)
     if status == INVALID_INPUT:
         _raise_nonfinite(M, q, covering)
     if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
-        return _exact_finish(M, q, covering, out, status, pivots,
-                             _MAX_ITER_TABLE[n] if max_iter is None and n < 512 else
-                             (max_iter or default_max_iter(n)),
-                             DEFAULT_TOL if tol is None else tol)
-    res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual, "lemke")
+        return _exact_steps(M, q, covering, out, status, pivots, max_iter,
+                            DEFAULT_TOL if tol is None else tol)
+    return _packed_result(M, q, out, status, pivots, residual, "")
+
+
+def _packed_result(M, q, out, status, pivots, residual, note):
+    # the result of a compiled run whose outputs are in `out`; `note` (how
+    # the exact path took part) goes before the detail
+    n = q.shape[0]
+    res = _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)
     if status == INFEASIBLE:
         # proven in compiled code: the ray's dz is a Farkas vector with every
         # sum's rounding bounded (farkas_float); the words, with the matrix
         # class they name, come only when someone reads them
         res.__dict__["_ray"] = (out, M, q)
-        return res
-    if status == SECONDARY_RAY:
+    elif status == SECONDARY_RAY:
         # a ray proves infeasibility only through a Farkas vector that holds
         # exactly on the caller's data (the compiled pre-filter is not a proof)
         res.__dict__["_ray"] = (out, M, q)
-        _prove_secondary_ray(res, M, q, out[2 * n:], pivots)
+        _prove_secondary_ray(res, M, q, out[2 * n:3 * n + 1], pivots)
+    if note:
+        res.detail = f"{note} {res.detail}".rstrip()
     return res
+
+
+def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
+    # The compiled pivoting met a tie rounding could not decide, or a repeated
+    # basis. That step is decided in exact arithmetic (_exact.exact_step, on
+    # the data as scaled by the run that handed over: powers of two, so the
+    # caller's data exactly), and the path goes back to floating point from
+    # the basis it reached (_resume_packed, on a tableau made afresh from the
+    # data), as often as needed. The whole path is finished in exact arithmetic
+    # (_exact_finish) only where a hand-over state repeats, where the basis is
+    # not lexicographically positive for the data (an earlier decision of
+    # rounding was wrong) or too close to singular to be followed in floating
+    # point, and past 2 n + 16 exact steps.
+    n = q.shape[0]
+    d = np.ones(n) if covering is None else covering
+    first = handoff
+    seen = set()
+    steps = 0
+    start = np.empty(2 * n + 3)
+    status = handoff
+    residual = np.inf
+    while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+        basis = out[2 * n:3 * n].astype(np.int64)
+        entering = int(out[3 * n])
+        key = (frozenset(basis.tolist()), entering)
+        if key in seen or steps > 2 * n + 16:
+            return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
+                                 basis.tolist(), entering)
+        seen.add(key)
+        info = out[3 * n + 1:_OUT * n + 4]
+        if not info.any():
+            # the plain stage: the data as given
+            Ms, qs, ds = M, q, d
+        else:
+            ex = info[:n].astype(np.int64)
+            ka, kb = int(info[2 * n]), int(info[2 * n + 1])
+            Ms = np.ldexp(M, ex[:, None] + info[n:2 * n].astype(np.int64)[None, :] + ka)
+            qs = np.ldexp(q, ex + kb)
+            ds = np.ldexp(d, ex) if info[2 * n + 2] != 0.0 else d
+        step = _exact.exact_step(Ms, qs, ds, basis, entering)
+        if step is None:
+            return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
+                                 basis.tolist(), entering)
+        kind, leaving, b = step
+        steps += 1
+        start[:n] = basis
+        start[n] = entering
+        start[n + 3:] = b
+        if kind == "ray":
+            start[n + 1] = _RESUME_RAY
+        else:
+            pivots += 1
+            start[:n][basis == leaving] = float(entering)
+            if leaving == 2 * n:
+                start[n + 1] = _RESUME_SOLVED
+            else:
+                start[n] = leaving + n if leaving < n else leaving - n
+                start[n + 1] = _RESUME_PATH
+        start[n + 2] = pivots
+        if pivots >= max_iter and kind != "ray" and leaving != 2 * n:
+            status, residual = MAX_ITER, float(lcp_violation(M, q, np.zeros(n)))
+            out[:n] = 0.0
+            out[n:2 * n] = q
+            break
+        status, pivots, residual = _resume_packed(M, q, d, out, start, max_iter, tol)
+    if status == BREAKDOWN:
+        # the float path could not go on from a basis the exact path reached
+        return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol)
+    if status == SOLVED:
+        # the point of the terminal basis in exact arithmetic, correctly rounded
+        # (M_JJ z_J = -q_J, J its z variables): the answer the exact path gives
+        J = [int(v) - n for v in out[3 * n + 1:4 * n + 1] if n <= v < 2 * n]
+        z = _exact.basis_point(M, q, J)
+        if z is not None:
+            out[:n] = z
+            out[n:2 * n] = M @ out[:n] + q
+            residual = float(_violation(M, q, out[:n]))
+            status = SOLVED if residual <= tol else BREAKDOWN
+    why = ("a lexicographic tie that floating point could not separate" if first == _HANDOFF_TIE
+           else "a repeated basis (rounding had decided a tie wrongly)")
+    note = (f"Pivoting met {why}; {steps} step{'s' if steps > 1 else ''} of the path "
+            f"{'were' if steps > 1 else 'was'} decided in exact arithmetic, the rest in "
+            f"floating point.")
+    return _packed_result(M, q, out, status, pivots, residual, note)
 
 
 def _ray_or_unit_proof(M, q, ray):
@@ -1554,6 +1910,12 @@ def _ray_or_unit_proof(M, q, ray):
 
 def _prove_secondary_ray(res, M, q, ray, pivots):
     verdict, maybe_psd = _screen_ray(M, q, ray)
+    if verdict == 1:
+        # a candidate (or a unit vector) is a Farkas vector, decided exactly in
+        # compiled code (farkas_float); the vector and the words are made only
+        # when someone reads them, by the same candidates in the same order
+        res.status = INFEASIBLE
+        return
     if verdict < 0 and not maybe_psd:
         # every candidate fails rigorously, and M is not PSD (where the exact
         # null-space projection could still find one): no proof, and the words
@@ -1567,14 +1929,12 @@ def _prove_secondary_ray(res, M, q, ray, pivots):
     res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
 
 
-def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
-    # the compiled pivoting met a tie rounding could not decide, or a repeated
-    # basis: the path goes on in exact arithmetic (moreau.lcp._exact) from the
-    # basis it had reached, or afresh when that basis is not lexicographically
-    # positive for the caller's data, and its end is judged on the caller's data
+def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=None, entering=None):
+    # the path is finished in exact arithmetic (moreau.lcp._exact) from the
+    # basis the floating-point path handed over (None: afresh), or afresh when
+    # that basis is not lexicographically positive for the caller's data, and
+    # its end is judged on the caller's data
     n = len(q)
-    basis = [int(v) for v in out[2 * n:3 * n]]
-    entering = int(out[3 * n])
     st, zx, rayx, piv, resumed = _exact.exact_lemke(M, q, covering, basis=basis,
                                                      entering=entering, max_iter=max_iter,
                                                      pivots=pivots)
@@ -1584,7 +1944,7 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
     except OverflowError:
         # the exact point lies outside the range of doubles
         res = _LemkeResult(np.zeros(n), q.copy(), BREAKDOWN, total,
-                           float(lcp_violation(M, q, np.zeros(n))), "lemke")
+                           float(lcp_violation(M, q, np.zeros(n))))
         res.detail = ("Pivoting was finished in exact arithmetic, but its end point lies outside "
                       "the range of floating-point numbers.")
         return res
@@ -1598,20 +1958,20 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol):
     note = f"Pivoting met {why} and was finished in exact arithmetic {where}."
     if st == _exact.SOLVED:
         status = SOLVED if residual <= tol else BREAKDOWN
-        res = _LemkeResult(z, w, status, total, residual, "lemke")
+        res = _LemkeResult(z, w, status, total, residual)
         res.detail = note if status == SOLVED else (
             f"{note} The exact solution, rounded to floats, fails the check on the data "
             f"(violation {residual:.3g} > tol = {tol:.3g}).")
         return res
     if st == _exact.MAX_ITER:
-        res = _LemkeResult(z, w, MAX_ITER, total, residual, "lemke")
+        res = _LemkeResult(z, w, MAX_ITER, total, residual)
         res.detail = f"{note} {_DETAIL[MAX_ITER]} (after {total} pivots)"
         return res
-    res = _LemkeResult(z, w, SECONDARY_RAY, total, residual, "lemke")
+    res = _LemkeResult(z, w, SECONDARY_RAY, total, residual)
     top = max(abs(v) for v in rayx)
     # a direction: scaled to a largest entry of 1 before rounding, it stays finite
     ray = np.array([float(v / top) for v in rayx])
-    out[2 * n:] = ray
+    out[2 * n:3 * n + 1] = ray
     res.__dict__["_ray"] = (out, M, q)
     _prove_secondary_ray(res, M, q, ray, total)
     res.detail = f"{note} {res.detail}"

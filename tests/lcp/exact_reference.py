@@ -22,12 +22,16 @@ def _column(M, n, v):
     return [Fraction(-1)] * n
 
 
-def reference_lemke(M, q, max_iter=10**5):
+def reference_lemke(M, q, max_iter=10**5, trace=None):
     """Run exact Lemke; returns ``(status, basis, pivots, z, max_ties)``.
 
     ``status`` is "solved", "ray" or "max_iter"; ``basis`` the frozenset of
     basic variables at the end; ``max_ties`` the largest number of rows tied
-    at the minimum ratio at any step after the first.
+    at the minimum ratio at any step after the first. ``trace`` (a list)
+    receives every step after the first as ``(rows, entering, leaving, b)``:
+    the basic variable of each row before the step, the variables entering
+    and leaving (None on the ray) and the right-hand side after it (on the
+    ray, before), row by row.
     """
     n = len(q)
     qf = [Fraction(float(v)) for v in q]
@@ -45,6 +49,7 @@ def reference_lemke(M, q, max_iter=10**5):
     entering = z0
     max_ties = 0
     while True:
+        before = list(rows)
         # pivot on (r, entering) with column a = B^-1 A_e
         p = a[r]
         Binv[r] = [x / p for x in Binv[r]]
@@ -57,6 +62,8 @@ def reference_lemke(M, q, max_iter=10**5):
         leaving = rows[r]
         rows[r] = entering
         pivots += 1
+        if trace is not None and entering != z0:
+            trace.append((before, entering, leaving, list(b)))
         if leaving == z0:
             z = [Fraction(0)] * n
             for i, v in enumerate(rows):
@@ -70,6 +77,8 @@ def reference_lemke(M, q, max_iter=10**5):
         a = [sum(Binv[i][k] * col[k] for k in range(n) if col[k]) for i in range(n)]
         cand = [i for i in range(n) if a[i] > 0]
         if not cand:
+            if trace is not None:
+                trace.append((list(rows), entering, None, list(b)))
             return "ray", frozenset(rows), pivots, None, max_ties
         theta = min(b[i] / a[i] for i in cand)
         tied = [i for i in cand if b[i] / a[i] == theta]

@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from moreau.lcp import (
     INFEASIBLE,
@@ -173,3 +175,44 @@ def test_a_solvable_lcp_whose_ray_proves_nothing_stays_a_secondary_ray():
     res = solve_lcp(M, q, covering=np.array([5.0, 16.0]))
     assert res.status == SECONDARY_RAY and res.certificate is None
     assert solve_lcp(M, q).status == SOLVED
+
+
+_DECIMALS = [0.0, 0.1, 0.2, 0.3, 0.5, 0.7, 1.0 / 3.0, 2.0, -0.1, -0.2, -0.3, -0.5, -1.0 / 3.0, -1.0]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(2, 6).flatmap(lambda n: st.tuples(
+    st.lists(st.sampled_from(_DECIMALS), min_size=n * n, max_size=n * n),
+    st.lists(st.sampled_from(_DECIMALS), min_size=n, max_size=n),
+    st.lists(st.sampled_from([0.0, 0.1, 0.5, 1.0, 1.0 / 3.0, 3.0]), min_size=n, max_size=n))))
+def test_the_compiled_farkas_check_is_exact(data):
+    # sums of decimals cancel to exact zeros (0.5 + 0.5 - 1) and to values below
+    # any rounding bound (0.1 + 0.2 - 0.3 = 2^-54 ... exactly): the compiled check
+    # (float bound, then the exact sign of an expansion) decides every case, as
+    # the rational check does
+    from moreau.lcp._certified import farkas_float
+    from moreau.lcp.certify import _exact_farkas
+
+    Ml, ql, yl = data
+    n = len(ql)
+    M = np.array(Ml).reshape(n, n)
+    q = np.array(ql)
+    y = np.array(yl)
+    v = farkas_float(M, q, y)
+    if not np.any(y > 0):
+        assert v == -1
+        return
+    assert v in (-1, 1)
+    assert (v == 1) == _exact_farkas(M, q, y)
+
+
+def test_a_column_that_cancels_below_its_rounding_bound_is_decided_exactly():
+    from moreau.lcp._certified import farkas_float
+
+    y = np.ones(3)
+    q = -np.ones(3)
+    # column sums 0.5 + 0.25 - 0.75 = 0 exactly, and 0.1 + 0.2 - 0.3 > 0 exactly
+    M = np.array([[0.5, 0.1, -1.0], [0.25, 0.2, -1.0], [-0.75, -0.3, -1.0]])
+    assert farkas_float(M, q, y) == -1
+    M[:, 1] = [0.1, 0.2, -0.30000000000000004]
+    assert farkas_float(M, q, y) == 1

@@ -44,6 +44,7 @@ from hypothesis import strategies as st
 
 from moreau.lcp import INFEASIBLE, MAX_ITER, SECONDARY_RAY, solve_lcp
 from moreau.lcp.instances import murty
+from moreau.lcp._exact import exact_step
 from moreau.lcp.lemke import lemke_core, lemke_workspace
 
 from .conftest import assert_certified
@@ -197,6 +198,36 @@ def test_bimatrix_games_follow_the_exact_path(prob):
 @given(zmatrix())
 def test_z_matrices_follow_the_exact_path(prob):
     check_against_exact(*prob)
+
+
+@_settings()
+@given(st.one_of(ties(), q_zeros(), bimatrix()))
+def test_exact_step_takes_each_step_of_the_reference_path(prob):
+    # the hand-over's exact step (B^-1 from the k x k block of the non-w basic
+    # variables) against the reference's explicit B^-1, at every step of its
+    # path: the same leaving variable (or the ray), and the right-hand side
+    # after the step correctly rounded
+    M, q = prob
+    n = len(q)
+    trace = []
+    reference_lemke(M, q, trace=trace)
+    for rows, entering, leaving, b in trace:
+        kind, left, bx = exact_step(M, q, np.ones(n), rows, entering)
+        assert (kind, left) == (("ray", None) if leaving is None else ("pivot", leaving))
+        assert bx == [float(v) for v in b]
+
+
+def test_exact_step_refuses_a_basis_that_is_not_lexicographically_positive():
+    # w_0 = -1 + 2 z_0 + t, w_1 = -1 + z_1 + t (t = z0, d = 1). With t basic in
+    # row 1 (the first pivot's choice), w_0 = 0 - 2 z_0 ... has b_0 = 0 and
+    # B^-1 row (1, -1): lexicographically positive. With t in row 0 instead,
+    # w_1 has b_1 = 0 and B^-1 row (-1, 1): negative, no exact step from there
+    M = np.array([[2.0, 0.0], [0.0, 1.0]])
+    q = np.array([-1.0, -1.0])
+    assert exact_step(M, q, np.ones(2), [0, 4], 3) is not None
+    assert exact_step(M, q, np.ones(2), [4, 1], 2) is None
+    # a right-hand side below zero: not a feasible basis at all
+    assert exact_step(M, np.array([-1.0, -2.0]), np.ones(2), [4, 1], 2) is None
 
 
 @pytest.mark.parametrize("n", [2, 3, 5, 7])

@@ -13,7 +13,7 @@ families generate the rest.
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 import moreau.lcp as lcp
@@ -247,6 +247,10 @@ def scaled_family_member(draw):
 @given(scaled_family_member())
 def test_a_uniformly_scaled_problem_has_the_same_outcome(member):
     family, M, q, factor = member
+    if np.frexp(factor)[0] == 0.5:
+        # a power of two scales exactly only where no entry under- or overflows
+        # (a subnormal 4 * 2^-1074 times 1/8 rounds to 0: another problem)
+        assume(np.array_equal(factor * M / factor, M) and np.array_equal(factor * q / factor, q))
     base = check_every_claim(M, q, solve_all(M, q))
     scaled = check_every_claim(factor * M, factor * q, solve_all(factor * M, factor * q))
     assert scaled == base, f"{family} x {factor:g}"
