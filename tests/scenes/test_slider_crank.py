@@ -102,3 +102,38 @@ def test_two_revolutes_at_one_point_and_a_weld_are_refused_naming_the_redundancy
     with pytest.raises(InputError, match=r"redundant: their 7 rows have rank 3 .*revolute joint "
                                          r"0 .*revolute joint 1 .*weld joint 2"):
         m.build()
+
+
+@pytest.mark.slow   # a model structure of its own: a numba compile (5 s on 2 shared cores)
+def test_a_pinned_bar_falls_onto_a_floor_and_rests_there_with_joint_and_contact_rows():
+    # a uniform bar of length 1 pinned at its left end to the ground's origin, released
+    # horizontal; its right end (a point) meets the floor y = -1/2 at angle -pi/6
+    # (frictionless, e = 0): the mixed LCP of a joint (2 rows) and a contact (1 row)
+    from moreau.model.planar import HalfPlane, Point
+    m = Model(gravity=(0.0, -9.81), length=1.0)
+    bar = m.add_body(1.0, 1.0 / 12.0, position=(0.5, 0.0), name="bar")
+    m.add_revolute(m.ground, (0.0, 0.0), bar, (-0.5, 0.0))
+    floor = m.add_shape(m.ground, HalfPlane((0.0, -0.5), (0.0, 1.0)))
+    m.add_contact(m.add_shape(bar, Point((0.5, 0.0))), floor)
+    sc = m.build("pinned-bar")
+    q0, v0 = sc.initial_state()
+    res = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=1e-3)
+    assert res.status == 0, res.message
+    assert res.stats["lcp_solves"] > 0
+    # at rest on the floor: the angle -pi/6, the tip's gap closed to the step's accuracy
+    assert abs(res.q[-1, 2] + math.pi / 6) < 1e-3
+    assert np.max(np.abs(res.v[-1])) < 1e-9
+    assert abs(res.gap[-1, 0]) < 1e-3
+    assert res.constraint_drift < 1e-3
+    # the first impact comes when the exact pendulum, phi'' = -(3 g / 2 L) cos(phi) (1.5
+    # cos(phi) in the scene's units g = L = 1), reaches -pi/6: to the step's accuracy
+    from scipy.integrate import solve_ivp
+
+    def hit(t, y):
+        return y[0] + math.pi / 6
+    hit.terminal = True
+    exact = solve_ivp(lambda t, y: [y[1], -1.5 * math.cos(y[0])], (0.0, 3.0), [0.0, 0.0],
+                      events=hit, rtol=1e-12, atol=1e-12).t_events[0][0]
+    k = int(np.argmax(res.force_N[:, 0] > 0.0))
+    assert np.all(res.force_N[:k, 0] == 0.0)
+    assert abs(res.t[k] - exact) < 5e-3, (res.t[k], exact)
