@@ -55,7 +55,16 @@ def test_moreau_jean_converges_to_the_closed_form_at_its_order(theta, order):
 
 def test_the_scene_passes_check_scene_and_states_its_joints():
     sc = slider_crank()
-    assert check_scene(sc).ok
+    report = check_scene(sc)
+    # measured: 1.3e-10 and 1.1e-10 against central differences
+    assert report.ok and report.errors["joint rates (WE, wE)"] < 1e-8
+    assert report.errors["joint drift (wEbar)"] < 1e-8
+    # a wrong drift term is caught and named
+    bad = slider_crank()
+    drift = bad.joint_drift
+    bad.joint_drift = lambda q, v, t: drift(q, v, t) + 1e-3
+    assert check_scene(bad).problems == [
+        "joint drift (wEbar): differs from central differences by 1.00e-03 (> 1e-06)"]
     q0, v0 = sc.initial_state()
     assert sc.n_joint_rows == 6 and sc.ncontacts == 0
     WE, wE = sc.joint_jacobians(q0, 0.0)
