@@ -178,6 +178,10 @@ class SliderCrankCase(CompareCase):
     def headline_of_run(self, res):
         return float(res.q[-1, 3])
 
+    def _run_switches(self, res, h):
+        # no contact: no regime, no switch
+        return []
+
 
 register_scene(SceneEntry(
     name="slider-crank",
