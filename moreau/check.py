@@ -28,6 +28,9 @@ at a few states and compares them with independent computations:
   entry per frictional contact: a belt's ``x - vb t``), against their
   differences: ``WT v + wT`` along the motion and ``wT`` in time at fixed
   positions;
+* the joint rows, where the scene has joints: ``WE v + wE`` against central
+  differences of ``joint_residuals`` along the motion, ``joint_drift``
+  against differences of ``WE v + wE`` at constant ``v``;
 * the compiled model, where the scene gives one, against the Python one,
   each output by name (a wrong sign of a rheonomic term ``wT`` in one of
   them is named; without ``slip_positions`` nothing else checks ``wT``).
@@ -56,7 +59,7 @@ from numpy.typing import ArrayLike
 from .errors import InputError, MoreauError
 from .compiled import evaluate_compiled
 from .integrators import simulate
-from .model.scene import Scene
+from .model.scene import Scene, joint_row_count
 
 __all__ = ["check_scene", "SceneReport"]
 
@@ -270,6 +273,7 @@ def check_scene(scene: Scene, states: Sequence[tuple[ArrayLike, ArrayLike]] | No
     if np.any(~np.isfinite(e)) or np.any((e < 0) | (e > 1)):
         note(f"`restitution` must be in [0, 1], got {e.tolist()}", None)
     nf = int(np.count_nonzero(mu > 0))
+    nj = joint_row_count(scene)
     if states is None:
         try:
             q0, v0 = scene.initial_state()
@@ -359,6 +363,27 @@ def check_scene(scene: Scene, states: Sequence[tuple[ArrayLike, ArrayLike]] | No
                                                     _rel(wNb, (np_ - nm) / (2 * eps)))
                 worst["tangential drift (wTbar)"] = max(worst["tangential drift (wTbar)"],
                                                         _rel(wTb, (tp - tm) / (2 * eps)))
+        if nj:
+            # the joint rows, like the contacts': rates along the motion, drift at constant v
+            WE, wE = scene.joint_jacobians(q, ts)
+            WE = _shape(add, "joint_jacobians: WE", WE, (nj, n))
+            wE = _shape(add, "joint_jacobians: wE", wE, (nj,))
+            wEb = _shape(add, "joint_drift(q, v, t)", scene.joint_drift(q, v, ts), (nj,))
+            gE = _shape(add, "joint_residuals(q, t)", scene.joint_residuals(q, ts), (nj,))
+            if WE is not None and wE is not None and gE is not None:
+                fd = (np.asarray(scene.joint_residuals(q + eps * v, ts + eps), dtype=float)
+                      - np.asarray(scene.joint_residuals(q - eps * v, ts - eps),
+                                   dtype=float)) / (2 * eps)
+                key = "joint rates (WE, wE)"
+                worst[key] = max(worst.get(key, 0.0), _rel(WE @ v + wE, fd))
+            if wEb is not None and WE is not None and wE is not None:
+                rp = [np.asarray(a, dtype=float)
+                      for a in scene.joint_jacobians(q + eps * v, ts + eps)]
+                rm = [np.asarray(a, dtype=float)
+                      for a in scene.joint_jacobians(q - eps * v, ts - eps)]
+                fd = ((rp[0] @ v + rp[1]) - (rm[0] @ v + rm[1])) / (2 * eps)
+                key = "joint drift (wEbar)"
+                worst[key] = max(worst.get(key, 0.0), _rel(wEb, fd))
         if h is not None:
             K = np.empty((n, n))
             C = np.empty((n, n))

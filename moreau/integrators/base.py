@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
 from ..model import registry as scene_registry
+from ..model.scene import joint_row_count
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
 from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence,
@@ -328,8 +329,16 @@ class Integrator:
     Options = None
     #: True where the constructor takes the options as one object (``options=``)
     takes_options_object = False
+    #: True where the scheme solves a scene's joint (equality) rows; the others refuse a
+    #: scene with joints by name, before any work
+    solves_joints = False
 
     def __init__(self, scene, t0, q0, v0, t_bound):
+        nj = joint_row_count(scene)
+        if nj and not self.solves_joints:
+            raise InputError(f"scheme {self.scheme!r} solves no joints: `scene` "
+                             f"{getattr(scene, 'name', type(scene).__name__)!r} has {nj} joint "
+                             f"(bilateral) rows; use 'moreau-jean'")
         self.scene = scene
         self.t0 = finite_scalar("t0", t0)
         self.t_bound = finite_scalar("t_bound", t_bound)

@@ -62,6 +62,27 @@ step with no active contact solves nothing, a step with a single active
 contact is solved by exact enumeration (:func:`one_contact_impulse`), and
 no restitution term enters where ``e = 0``.
 
+*Joints.* A scene with joint rows (:class:`~moreau.model.scene.Scene`'s
+``joint_jacobians``) adds them to the step's problem as equality rows,
+``WE v_{k+1} + wE = 0`` with free reactions: rows ``[E; N; T]`` of
+:class:`moreau.contact.ContactProblem`, a mixed LCP solved by
+:func:`moreau.contact.solve` (the equality rows eliminated by their Schur
+complement; dependent rows raise
+:class:`~moreau.lcp.mlcp.RankDeficientError`, and are refused before the
+first step where they are dependent at the start). The joint rows are
+evaluated at the predicted end position ``q_k + h v_k`` and ``t_{k+1}``:
+at ``q_k`` the new velocity is tangent to the joints where the step
+starts, an ``O(h)`` error in velocity that makes ``theta = 1/2`` first
+order (measured on the slider-crank: position errors halve with ``h`` at
+either ``theta``); at the predicted position it is ``O(h^2)``, and
+``theta = 1/2`` converges at order 2 (errors divided by 4.0). The
+position-level drift ``|gE|`` is not corrected (no projection or Baumgarte
+term for joints; ``projection=True`` is refused) and is reported as the
+result's ``constraint_drift``: first order at ``theta = 1``, second at
+``theta = 1/2``. Joints take the generic step (the compiled loop solves no
+equality rows; ``fast=True`` is refused), and ``painleve="stop"`` acts on
+steps without joints only.
+
 *Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
 the same step in the compiled loop of :mod:`moreau.integrators._mj_kernels`,
 Lemke included (:func:`moreau.lcp.lemke.lemke_core`); a step on which Lemke
@@ -136,7 +157,10 @@ import dataclasses
 
 import numpy as np
 
-from ..errors import InputError
+from ..contact import ContactProblem, solve as solve_problem
+from ..errors import InputError, LCPError
+from ..lcp.mlcp import RankDeficientError, equality_block
+from ..model.scene import joint_row_count
 from ..regimes import Regime
 from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
@@ -313,6 +337,8 @@ class MoreauJean(TimeStepping):
             # the compiled path keeps each contact's regime in its control array
             prev_regimes(self._lcp_ctl, self.scene.ncontacts)[:] = self._prev_reg
 
+    solves_joints = True
+
     def _new_counters(self):
         return _new_counters()
 
@@ -327,6 +353,36 @@ class MoreauJean(TimeStepping):
                 raise InputError(f"`closed0` must be a bool or {nc} bools (one per contact), "
                                  f"got {self.closed0!r}")
             self._closed[:] = c0.reshape(-1)
+        self._n_eq = joint_row_count(self.scene)
+        self._max_drift = 0.0
+        if self._n_eq:
+            self._check_joints()
+
+    def _check_joints(self):
+        # refused before any work: what the generic step does not do with joints, and
+        # joint rows that are dependent at the start (redundant or inconsistent joints)
+        sc = self.scene
+        if self.projection:
+            raise InputError("`projection` projects onto the contacts only; the scene has "
+                             f"{self._n_eq} joint rows, whose drift is not corrected (no "
+                             "projection or Baumgarte stabilisation of joints yet): use "
+                             "projection=False")
+        WE, _ = sc.joint_jacobians(self.q, self.t0)
+        WE = np.asarray(WE, dtype=float)
+        A = WE @ np.linalg.solve(np.asarray(sc.mass(self.q), dtype=float), WE.T)
+        try:
+            equality_block(A, label="joint rows")
+        except RankDeficientError as exc:
+            raise InputError(f"`scene` {sc.name!r}: its joints are redundant or inconsistent "
+                             f"at the initial state: {exc}") from None
+        g0 = np.asarray(sc.joint_residuals(self.q, self.t0), dtype=float)
+        self._max_drift = float(np.max(np.abs(g0), initial=0.0))
+
+    def result(self):
+        res = super().result()
+        if self._n_eq:
+            res.constraint_drift = self._max_drift
+        return res
 
     @property
     def closed(self):
@@ -366,13 +422,16 @@ class MoreauJean(TimeStepping):
         slip = np.zeros(nc)
         active = np.zeros(nc, dtype=bool)
         v1 = v_free
+        vN0 = np.zeros(nc)
         if nc:
             g0 = np.asarray(sc.gaps(q, t0), dtype=float)
             WN0, wN0, _, _ = sc.contact_jacobians(q, t0)
             vN0 = np.asarray(WN0, dtype=float) @ v + np.asarray(wN0, dtype=float)
             active = (g0 + 0.5 * h * vN0 <= 0.0) | self._closed
-            if active.any():
+            if active.any() and not self._n_eq:
                 v1, slip = self._contact_step(q, t1, v_free, Winv, active, vN0, pN, pT)
+        if self._n_eq:
+            v1, slip = self._joint_step(q, q + h * v, t1, v_free, Winv, active, vN0, pN, pT)
 
         q1 = q + h * (theta * v1 + (1.0 - theta) * v)
         closed = pN > 0.0
@@ -385,6 +444,9 @@ class MoreauJean(TimeStepping):
                            f"probably too large for an explicit part of the forces)")
             return
         gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
+        if self._n_eq:
+            gE = np.asarray(sc.joint_residuals(q1, t1), dtype=float)
+            self._max_drift = max(self._max_drift, float(np.max(np.abs(gE), initial=0.0)))
         if nc:
             self.counters["max_penetration"] = max(self.counters["max_penetration"],
                                                    float(np.max(-gap, initial=0.0)))
@@ -454,6 +516,55 @@ class MoreauJean(TimeStepping):
         U = U_free + W @ p
         slip = np.zeros(sc.ncontacts)
         slip[fa] = U[na:]
+        return v1, slip
+
+    def _joint_step(self, q, q_pred, t1, v_free, Winv, active, vN0, pN, pT):
+        """The step's mixed LCP: the joint rows ``WE v_{k+1} + wE = 0`` with the active contacts.
+
+        Rows ``[E; N; T]`` of :class:`moreau.contact.ContactProblem`, Jacobians
+        at ``q_k`` and rheonomic terms at ``t_{k+1}`` like the contacts', solved
+        by :func:`moreau.contact.solve` (``"auto"``: the equality rows
+        eliminated, the contacts by closed form or Lemke then QP; a forced
+        ``lcp_method`` is the inner solver of ``"mlcp"``).
+        """
+        sc = self.scene
+        WE, wE = (np.asarray(a, dtype=float) for a in sc.joint_jacobians(q_pred, t1))
+        ia = np.flatnonzero(active)
+        rows, rhs = [WE], [wE]
+        fa = ia[:0]
+        if ia.size:
+            WN1, wN1, WT1, wT1 = (np.asarray(a, dtype=float) for a in sc.contact_jacobians(q, t1))
+            fa = ia[self._trow[ia] >= 0]
+            tr = self._trow[fa]
+            rows += [WN1[ia], WT1[tr]]
+            rhs += [wN1[ia], wT1[tr]]
+        H = np.vstack(rows)
+        Winv_HT = Winv @ H.T
+        W = H @ Winv_HT
+        U_free = H @ v_free + np.concatenate(rhs)
+        # (built in the layout from checked data: a state gone non-finite is the step's
+        # failure, found after it, not an input error)
+        problem = ContactProblem.trusted(W, U_free, self.mu_c[ia], self.e_c[ia], vN0[ia],
+                                         n_eq=self._n_eq)
+        if self.lcp_method == "auto":
+            sol = solve_problem(problem, "auto", max_iter=self.lemke_max_iter)
+        else:
+            sol = solve_problem(problem, "mlcp", max_iter=self.lemke_max_iter,
+                                inner=self.lcp_method)
+        if not sol.success:
+            raise LCPError(f"the step's mixed LCP (joints and contacts) at t = {self.t!r} was "
+                           f"not solved ({sol.method}): {sol.message}")
+        if ia.size:
+            self.counters["lcp_solves"] += 1
+            self.counters["max_residual"] = max(self.counters["max_residual"], sol.residual)
+        if "lemke" in sol.path:
+            self.counters["pivots"] += int(sol.iterations)
+        pN[ia], pT[ia] = sol.pN, sol.pT
+        v1 = v_free + Winv_HT @ sol.p
+        slip = np.zeros(sc.ncontacts)
+        if fa.size:
+            U = U_free + W @ sol.p
+            slip[fa] = U[self._n_eq + ia.size:]
         return v1, slip
 
     def _solve_lcp(self, W, U_free, mu, e, vN_pre, ia, pN, pT):

@@ -86,6 +86,10 @@ class SimulationResult:
         (``events=``), the times it occurred (empty without events).
     y_events : list of ndarray
         For each, the states ``(q, v)`` at those times, one row each.
+    constraint_drift : float or None
+        For a scene with joints, the largest ``|gE(q, t)|`` over the run's
+        step ends (the joints' position-level drift, in the scene's units);
+        None for a scene without joints.
     """
 
     t: np.ndarray
@@ -103,6 +107,7 @@ class SimulationResult:
     stats: dict = field(default_factory=dict)
     t_events: list = field(default_factory=list)
     y_events: list = field(default_factory=list)
+    constraint_drift: float | None = None
 
     @property
     def success(self):

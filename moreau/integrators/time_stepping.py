@@ -17,6 +17,7 @@ import numpy as np
 
 from .._validate import in_closed_interval, positive, positive_int
 from ..errors import InputError
+from ..model.scene import joint_row_count
 from ._blocks import CompiledRecording
 from ._mj_kernels import set_painleve_stop
 from .base import Integrator, SchemeOptions
@@ -332,7 +333,16 @@ class TimeStepping(CompiledRecording, Integrator):
         self._pending_initial = True
         self._setup_scheme()
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
-        self._choose_compiled(options.fast, compiled_model_of(scene), self.lcp_method,
+        model = compiled_model_of(scene)
+        if joint_row_count(scene):
+            # the compiled loops solve no equality rows: a scene with joints takes the
+            # generic step
+            if options.fast is True:
+                raise InputError(f"`fast=True`: the compiled loop of {self.scheme!r} solves no "
+                                 f"joints, and the scene has {joint_row_count(scene)} joint "
+                                 "rows; use fast='auto' or False (the generic step)")
+            model = None
+        self._choose_compiled(options.fast, model, self.lcp_method,
                               getattr(options, "lemke_max_iter", None),
                               warm_start=self._warm_start())
         if self._fast:

@@ -19,6 +19,16 @@ of ``frictional_index``. The contact reactions enter the equations of motion as:
 
 so ``lambdaN >= 0`` pushes the gap open, and in positive slip
 (``gammaT > 0``) Coulomb friction gives ``lambdaT = -mu * lambdaN``.
+
+Joints (bilateral constraints), optional: a scene with ``n_joint_rows > 0``
+states ``n_joint_rows`` rows ``gE(q, t) = 0`` with::
+
+    dgE/dt   = WE @ v + wE        (joint_jacobians)
+    d2gE/dt2 = WE @ a + wEbar     (joint_drift)
+
+and their reactions add ``WE.T @ lambdaE`` (free in sign) to the equations of
+motion. The default is none; a scheme that solves no joints refuses such a
+scene by name (:func:`joint_row_count`).
 """
 
 from dataclasses import fields, replace
@@ -28,7 +38,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with"]
+__all__ = ["Scene", "params_with", "joint_row_count"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
@@ -55,6 +65,9 @@ class Scene:
     #: coordinates that do not enter the dynamics (e.g. the rotor position): a
     #: periodic steady state repeats everything else and advances these
     cyclic_coordinates = ()
+
+    #: number of joint (bilateral, equality) rows; 0 for a scene without joints
+    n_joint_rows = 0
 
     @property
     def ncontacts(self):
@@ -113,6 +126,22 @@ class Scene:
     def contact_drift(self, q, v, t):
         """Return ``(wNbar, wTbar)``, the velocity-dependent parts of the contact accelerations."""
         raise NotImplementedError
+
+    # -- joints (optional) ---------------------------------------------------
+    def joint_residuals(self, q, t):
+        """``gE(q, t)``, the joints' position-level rows, shape (n_joint_rows,); 0 on the joints.
+
+        The default: no joints (an empty array).
+        """
+        return np.zeros(0)
+
+    def joint_jacobians(self, q, t):
+        """``(WE, wE)``: ``dgE/dt = WE @ v + wE``, shapes (n_joint_rows, ndof) and (n_joint_rows,)."""
+        return np.zeros((0, self.ndof)), np.zeros(0)
+
+    def joint_drift(self, q, v, t):
+        """``wEbar``: ``d2gE/dt2 = WE @ a + wEbar``, shape (n_joint_rows,)."""
+        return np.zeros(0)
 
     def forcing_breakpoints(self, t0, t1):
         """Times in ``(t0, t1)`` where the prescribed motion or forcing is not smooth.
@@ -249,6 +278,18 @@ class Scene:
         WN, _, WT, _ = self.contact_jacobians(q, t)
         W = np.vstack([WN, WT])
         return W @ np.linalg.solve(self.mass(q), W.T)
+
+
+def joint_row_count(scene):
+    """The number of joint rows of ``scene`` (0 for a scene, or a duck-typed one, without joints).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> joint_row_count(BouncingBall())
+    0
+    """
+    return int(getattr(scene, "n_joint_rows", 0) or 0)
 
 
 def params_with(cls, params, overrides):

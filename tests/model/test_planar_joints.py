@@ -71,10 +71,23 @@ def test_the_weld_and_prismatic_rows_vanish_at_the_initial_state():
     np.testing.assert_allclose(g[[5, 6, 7, 8, 10]], 0.0, atol=1e-15)
 
 
-def test_a_model_with_joints_is_not_built_and_a_bad_joint_is_refused():
+def test_a_model_with_joints_is_built_with_its_rows_and_a_bad_joint_is_refused():
+    # this mechanism's slot on body1 and pin to the ground hold body5 in a singular
+    # configuration at the initial poses: its rows are dependent there, and named
+    with pytest.raises(InputError, match=r"the joints are redundant: their 13 rows have rank 12 "
+                                         r".*prismatic joint 4 \('body5'-'body1'\); revolute "
+                                         r"joint 5 \('body5'-'ground'\)"):
+        _mechanism().build()
+    from moreau.scenes.slider_crank import slider_crank_model
+    m = slider_crank_model()
+    sc = m.build()
+    rows = m.joint_rows()
+    q, v = np.linspace(0.1, 0.9, sc.ndof), np.linspace(-0.5, 0.4, sc.ndof)
+    assert sc.n_joint_rows == rows.nrows
+    np.testing.assert_array_equal(sc.joint_residuals(q, 0.3), rows.values(q, 0.3))
+    np.testing.assert_array_equal(sc.joint_jacobians(q, 0.3)[0], rows.jacobians(q, 0.3)[0])
+    np.testing.assert_array_equal(sc.joint_drift(q, v, 0.3), rows.drift(q, v, 0.3))
     m = _mechanism()
-    with pytest.raises(InputError, match="no scheme solves their equality rows yet"):
-        m.build()
     b = m.bodies[2]["body"]
     with pytest.raises(InputError, match="`body_i` and `body_j` are one body"):
         m.add_revolute(b, (0, 0), b, (0.1, 0))

@@ -431,7 +431,8 @@ class Model:
         """A pin: ``point_i`` of ``body_i`` stays on ``point_j`` of ``body_j`` (two rows ``P_i - P_j = 0``)."""
         bi, bj = self._joint_bodies(body_i, body_j)
         self.joints.append(dict(kind=K.JPOINT, i=bi.index, j=bj.index,
-                                ri=_vec2("point_i", point_i), rj=_vec2("point_j", point_j)))
+                                ri=_vec2("point_i", point_i), rj=_vec2("point_j", point_j),
+                                joint=self._joint_name("revolute", bi, bj)))
 
     def add_prismatic(self, body_i, point_i, body_j, point_j, axis):
         """A slider: ``point_i`` of ``body_i`` moves along the line of ``body_j`` through ``point_j`` along ``axis`` (body ``j``'s frame), the relative angle fixed at its initial value.
@@ -446,8 +447,10 @@ class Model:
             raise InputError("`axis` of a prismatic joint must not be zero")
         th0 = self._initial_pose(bi)[2] - self._initial_pose(bj)[2]
         self.joints.append(dict(kind=K.JLINE, i=bi.index, j=bj.index, ri=_vec2("point_i", point_i),
-                                rj=_vec2("point_j", point_j), n0=np.array([u[1], -u[0]]) / ln))
-        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=th0))
+                                rj=_vec2("point_j", point_j), n0=np.array([u[1], -u[0]]) / ln,
+                                joint=self._joint_name("prismatic", bi, bj)))
+        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=th0,
+                                joint=self.joints[-1]["joint"]))
 
     def add_weld(self, body_i, body_j):
         """``body_i`` held to ``body_j`` in their initial relative pose (three rows)."""
@@ -456,14 +459,47 @@ class Model:
         xj, yj, thj = self._initial_pose(bj)
         c, s = math.cos(thj), math.sin(thj)
         rj = np.array([c * (xi - xj) + s * (yi - yj), -s * (xi - xj) + c * (yi - yj)])
-        self.joints.append(dict(kind=K.JPOINT, i=bi.index, j=bj.index, ri=np.zeros(2), rj=rj))
-        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=thi - thj))
+        name = self._joint_name("weld", bi, bj)
+        self.joints.append(dict(kind=K.JPOINT, i=bi.index, j=bj.index, ri=np.zeros(2), rj=rj,
+                                joint=name))
+        self.joints.append(dict(kind=K.JANGLE, i=bi.index, j=bj.index, th0=thi - thj,
+                                joint=name))
+
+    def _joint_name(self, kind, bi, bj):
+        # the joint's name in messages: its kind, its number among the joints, its bodies
+        number = len({j["joint"] for j in self.joints})
+        return f"{kind} joint {number} ({bi.name!r}-{bj.name!r})"
+
+    def _check_joints(self):
+        """Refuse joints whose rows are dependent at the initial poses, naming them."""
+        rows = JointRows(self)
+        q0 = np.array([x for b in self.bodies if b["kind"] == K.FREE for x in b["pose"]])
+        L = self.units()[0]
+        q0[0::3] /= L
+        q0[1::3] /= L
+        W, _ = rows.jacobians(q0, 0.0)
+        names = [j["joint"] for j in self.joints
+                 for _ in range(2 if j["kind"] == K.JPOINT else 1)]
+        # the left null space of W (combinations of rows that vanish), from the SVD of W^T
+        U, sv, _ = np.linalg.svd(W, full_matrices=True)
+        top = float(sv[0]) if sv.size else 0.0
+        rank = int(np.sum(sv > 1e-10 * max(top, 1e-300)))
+        if rank == W.shape[0]:
+            return
+        dependent = set()
+        for k in range(rank, W.shape[0]):
+            c = U[:, k]
+            dependent.update(np.flatnonzero(np.abs(c) > 1e-8 * np.max(np.abs(c))).tolist())
+        which = sorted({names[r] for r in dependent})
+        raise InputError(f"the joints are redundant: their {W.shape[0]} rows have rank {rank} at "
+                         f"the initial poses, rows {sorted(dependent)} depend on each other "
+                         f"({'; '.join(which)}); remove the joint that repeats a constraint")
 
     def joint_rows(self):
         """The bilateral rows of the joints (:class:`JointRows`), in the built scene's units.
 
-        :meth:`build` does not take joints yet: no scheme solves equality rows
-        until the mixed LCP (issue 36, item 2) reaches them.
+        The built scene states the same rows through the scene interface
+        (``joint_residuals``, ``joint_jacobians``, ``joint_drift``).
         """
         if not self.joints:
             raise InputError("the model has no joints: add one with `add_revolute`, "
@@ -596,9 +632,7 @@ class Model:
         if not any(b["kind"] == K.FREE for b in self.bodies):
             raise InputError("the model has no free body: add one with `add_body`")
         if self.joints:
-            raise InputError(f"the model has {len(self.joints)} joint record(s): no scheme solves "
-                             "their equality rows yet (the mixed LCP, issue 36 item 2); their "
-                             "rows are `Model.joint_rows()`")
+            self._check_joints()
         if (valid_region is None) != (inside is None):
             raise InputError("`valid_region` and `inside` go together: the words and the test")
         return PlanarScene(self, name, valid_region, inside, default_window)
@@ -630,6 +664,8 @@ class PlanarScene(SIUnits, Scene):
                 v0 += [b["vel"][0] * T / L, b["vel"][1] * T / L, b["vel"][2] * T]
         self._q0, self._v0 = np.array(q0), np.array(v0)
         self._fn = _codegen.compiled_functions(self.par)
+        self._joints = JointRows(model) if model.joints else None
+        self.n_joint_rows = 0 if self._joints is None else self._joints.nrows
 
     def __getstate__(self):
         # the generated module is found again from par (a worker process imports or
@@ -695,8 +731,27 @@ class PlanarScene(SIUnits, Scene):
         Dr = Dr[:self.ncontacts]
         return Dr[:, 0].copy(), Dr[self.frictional_index, 1].copy()
 
+    def joint_residuals(self, q, t):
+        if self._joints is None:
+            return np.zeros(0)
+        return self._joints.values(self._qv(q), t)
+
+    def joint_jacobians(self, q, t):
+        if self._joints is None:
+            return np.zeros((0, self.ndof)), np.zeros(0)
+        return self._joints.jacobians(self._qv(q), t)
+
+    def joint_drift(self, q, v, t):
+        if self._joints is None:
+            return np.zeros(0)
+        return self._joints.drift(*self._qv(q, v), t)
+
     def compiled_model(self):
-        """The compiled model: the functions generated for this model's structure, with its ``par``."""
+        """The compiled model: the functions generated for this model's structure, with its ``par``.
+
+        It holds no joint rows: the time-stepping schemes take their generic
+        step on a model with joints.
+        """
         f = self._fn
         return CompiledModel(f.mass, f.forces, f.contacts, f.drift, self.par, self.ndof,
                              self.ncontacts, True, self._has_jac)
@@ -773,6 +828,15 @@ class JointRows:
     def __init__(self, model):
         self.par, self.ndof = model.pack()
         self.nrows = sum(2 if j["kind"] == K.JPOINT else 1 for j in model.joints)
+        self._fn = _codegen.compiled_functions(self.par)
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        del state["_fn"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
         self._fn = _codegen.compiled_functions(self.par)
 
     def _G(self, q, t):
