@@ -52,7 +52,8 @@ from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ..model.drawing import circle, contact
 from ..model.units import SIUnits
-from ..model.scene import Scene, params_with
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
@@ -113,7 +114,7 @@ class BallChainParams:
         object.__setattr__(self, "striker_gap", nonnegative("striker_gap", self.striker_gap))
 
 
-class BallChain(SIUnits, Scene):
+class BallChain(SIUnits, CompiledScene):
     """``N`` balls on a line, the striker approaching the resting chain.
 
     Parameters
@@ -160,32 +161,7 @@ class BallChain(SIUnits, Scene):
         """Time at which the striker reaches the chain (scene units: the gap over the speed 1)."""
         return self.gap0
 
-    # -- Scene interface --------------------------------------------------------
-    def mass(self, q):
-        return np.diag(self.masses)
-
-    def forces(self, q, v, t):
-        return np.zeros(self.ndof)
-
-    def force_jacobians(self, q, v, t):
-        z = np.zeros((self.ndof, self.ndof))
-        return z, z.copy()
-
-    def gaps(self, q, t):
-        q = np.asarray(q, dtype=float)
-        return q[1:] - q[:-1] - 2.0
-
-    def contact_jacobians(self, q, t):
-        n = self.ndof
-        WN = np.zeros((n - 1, n))
-        i = np.arange(n - 1)
-        WN[i, i] = -1.0
-        WN[i, i + 1] = 1.0
-        return WN, np.zeros(n - 1), np.zeros((0, n)), np.zeros(0)
-
-    def contact_drift(self, q, v, t):
-        return np.zeros(self.ndof - 1), np.zeros(0)
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def inside_valid_region(self, t, q, v):
         return np.all(np.diff(np.asarray(q), axis=1) > 0.0, axis=1)
 

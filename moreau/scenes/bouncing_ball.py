@@ -29,7 +29,8 @@ from .._validate import finite_array, in_closed_interval, positive
 from ..errors import InputError
 from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
-from ..model.scene import Scene, params_with
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
 from ..analysis.cases import GRID, CompareCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
@@ -72,7 +73,7 @@ class BouncingBallParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class BouncingBall(SIUnits, Scene):
+class BouncingBall(SIUnits, CompiledScene):
     """A ball of radius ``r`` falling on the floor ``y = 0``, restitution ``e``.
 
     Parameters
@@ -120,22 +121,7 @@ class BouncingBall(SIUnits, Scene):
         self.mu = np.zeros(1)
         self.restitution = np.array([self.e])
 
-    # -- Scene interface ----------------------------------------------------
-    def mass(self, q):
-        return np.eye(1)
-
-    def forces(self, q, v, t):
-        return np.array([-1.0])
-
-    def gaps(self, q, t):
-        return np.array([float(q[0]) - self.r])
-
-    def contact_jacobians(self, q, t):
-        return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
-
-    def contact_drift(self, q, v, t):
-        return np.zeros(1), np.zeros(0)
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def inside_valid_region(self, t, q, v):
         return np.asarray(q)[:, 0] > 0.0
 

@@ -45,7 +45,7 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
 from ..errors import InputError, PainleveError
 from ..model.drawing import contact, line
-from ..model.scene import Scene
+from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
 from ..model.scene import params_with
 from scipy.integrate import solve_ivp
@@ -112,7 +112,7 @@ class PainleveRodParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class PainleveRod(SIUnits, Scene):
+class PainleveRod(SIUnits, CompiledScene):
     """Uniform rod with its lower tip on a rough floor.
 
     Parameters
@@ -158,29 +158,7 @@ class PainleveRod(SIUnits, Scene):
         self.force = p.mass * p.gravity
         self._M = np.diag([1.0, 1.0, 1.0 / 3.0])
 
-    # -- Scene interface ----------------------------------------------------
-    def mass(self, q):
-        return self._M.copy()
-
-    def forces(self, q, v, t):
-        return np.array([0.0, -1.0, 0.0])
-
-    def gaps(self, q, t):
-        return np.array([q[1] - math.sin(q[2])])
-
-    def contact_jacobians(self, q, t):
-        c, s = math.cos(q[2]), math.sin(q[2])
-        WN = np.array([[0.0, 1.0, -c]])
-        if self.mu[0] > 0.0:
-            return WN, np.zeros(1), np.array([[1.0, 0.0, s]]), np.zeros(1)
-        return WN, np.zeros(1), np.zeros((0, 3)), np.zeros(0)
-
-    def contact_drift(self, q, v, t):
-        c, s = math.cos(q[2]), math.sin(q[2])
-        w2 = v[2] * v[2]
-        wT = np.array([c * w2]) if self.mu[0] > 0.0 else np.zeros(0)
-        return np.array([s * w2]), wT
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def inside_valid_region(self, t, q, v):
         phi = np.asarray(q)[:, 2]
         return (phi > 0.0) & (phi < math.pi)

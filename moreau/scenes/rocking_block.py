@@ -73,7 +73,8 @@ from .._validate import finite_array, finite_scalar, in_closed_interval, nonnega
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
 from ..model.units import SIUnits
-from ..model.scene import Scene, params_with
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from .sliding_box import SlidingBox
 
@@ -136,7 +137,7 @@ class RockingBlockParams:
                              f"for the block to fall back onto both corners, got {tilt!r}")
 
 
-class RockingBlock(SIUnits, Scene):
+class RockingBlock(SIUnits, CompiledScene):
     """Rectangular block on a level floor, its two bottom corners frictional contacts.
 
     Parameters
@@ -172,22 +173,7 @@ class RockingBlock(SIUnits, Scene):
         self.mu = self._box.mu
         self.restitution = self._box.restitution
 
-    # -- Scene interface (the box's model) --------------------------------------------
-    def mass(self, q):
-        return self._box.mass(q)
-
-    def forces(self, q, v, t):
-        return self._box.forces(q, v, t)
-
-    def gaps(self, q, t):
-        return self._box.gaps(q, t)
-
-    def contact_jacobians(self, q, t):
-        return self._box.contact_jacobians(q, t)
-
-    def contact_drift(self, q, v, t):
-        return self._box.contact_drift(q, v, t)
-
+    # -- Scene interface (mass, forces, gaps, ...: the box's compiled model, CompiledScene) --
     def compiled_model(self):
         """Compiled form of this model: the sliding box's (:mod:`moreau.compiled`)."""
         return self._box.compiled_model()

@@ -28,7 +28,7 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
 from ..errors import InputError
 from ..model.drawing import contact, line, polygon
-from ..model.scene import Scene
+from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
 from ..model.scene import params_with
 from .._validate import finite_scalar
@@ -82,7 +82,7 @@ class SlidingBlockParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class SlidingBlock(SIUnits, Scene):
+class SlidingBlock(SIUnits, CompiledScene):
     """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
 
     Parameters
@@ -122,27 +122,8 @@ class SlidingBlock(SIUnits, Scene):
         self.length = p.length
         self.time = math.sqrt(p.length / p.gravity)
         self.force = p.mass * p.gravity
-        self._h = np.array([math.sin(self.alpha), -math.cos(self.alpha)])
 
-    # -- Scene interface ----------------------------------------------------
-    def mass(self, q):
-        return np.eye(2)
-
-    def forces(self, q, v, t):
-        return self._h.copy()
-
-    def gaps(self, q, t):
-        return np.array([float(q[1])])
-
-    def contact_jacobians(self, q, t):
-        WN = np.array([[0.0, 1.0]])
-        if self.mu[0] > 0.0:
-            return WN, np.zeros(1), np.array([[1.0, 0.0]]), np.zeros(1)
-        return WN, np.zeros(1), np.zeros((0, 2)), np.zeros(0)
-
-    def contact_drift(self, q, v, t):
-        return np.zeros(1), np.zeros(1 if self.mu[0] > 0.0 else 0)
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def initial_state(self):
         """On the plane at the origin, launched along it at unit speed."""
         return np.zeros(2), np.array([1.0, 0.0])

@@ -45,7 +45,7 @@ from ..compiled import CompiledModel
 from .._validate import finite_array, in_closed_interval, nonnegative, positive
 from ..errors import InputError
 from ..model.drawing import contact, line, polygon
-from ..model.scene import Scene
+from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
 from ..model.scene import params_with
 from .._validate import finite_scalar
@@ -92,7 +92,7 @@ class SlidingBoxParams:
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
 
 
-class SlidingBox(SIUnits, Scene):
+class SlidingBox(SIUnits, CompiledScene):
     """Rigid box on a level floor, two frictional corner contacts.
 
     Parameters
@@ -129,39 +129,8 @@ class SlidingBox(SIUnits, Scene):
         self.length = p.length
         self.time = math.sqrt(p.length / p.gravity)
         self.force = p.mass * p.gravity
-        self._side = np.array([-1.0, 1.0])
 
-    # -- Scene interface ----------------------------------------------------
-    def mass(self, q):
-        return np.diag([1.0, 1.0, self.inertia])
-
-    def forces(self, q, v, t):
-        return np.array([0.0, -1.0, 0.0])
-
-    def gaps(self, q, t):
-        s, c = math.sin(q[2]), math.cos(q[2])
-        return q[1] + self._side * self.a * s - self.b * c
-
-    def contact_jacobians(self, q, t):
-        s, c = math.sin(q[2]), math.cos(q[2])
-        WN = np.zeros((2, 3))
-        WN[:, 1] = 1.0
-        WN[:, 2] = self._side * self.a * c + self.b * s
-        if self.params.mu > 0.0:
-            WT = np.zeros((2, 3))
-            WT[:, 0] = 1.0
-            WT[:, 2] = self.b * c - self._side * self.a * s
-        else:
-            WT = np.zeros((0, 3))
-        return WN, np.zeros(2), WT, np.zeros(WT.shape[0])
-
-    def contact_drift(self, q, v, t):
-        s, c = math.sin(q[2]), math.cos(q[2])
-        w2 = v[2] * v[2]
-        wNbar = w2 * (self.b * c - self._side * self.a * s)
-        wTbar = -w2 * (self._side * self.a * c + self.b * s)
-        return wNbar, (wTbar if self.params.mu > 0.0 else np.zeros(0))
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def inside_valid_region(self, t, q, v):
         return np.abs(np.asarray(q)[:, 2]) < 0.5 * math.pi
 
