@@ -144,3 +144,17 @@ def test_auto_keeps_lemke_up_to_the_crossover():
         sol = solve(ContactProblem(2.0 * np.eye(nc), -np.ones(nc), np.zeros(nc)))
         assert sol.method == method and sol.success
         assert np.allclose(sol.pN, 0.5, rtol=0, atol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["nsgs", "apgd"])
+def test_equality_rows_through_mlcp_with_an_iterative_inner_solver(method):
+    # a rod row E and a frictional contact (N, T): the mlcp eliminates E, the method solves
+    # the rest, and the whole answer is certified on the caller's rows
+    W = np.array([[2.0, 1.0, 0.5], [1.0, 1.0, 0.2], [0.5, 0.2, 1.0]])
+    pb = ContactProblem(W, [-1.0, -2.0, 1.0], [0.4], n_eq=1)
+    ref = solve(pb, "mlcp", inner="lemke")
+    sol = solve(pb, "mlcp", inner=method, tol=1e-12)
+    assert sol.success and sol.method == f"mlcp+{method}"
+    assert np.allclose(sol.p, ref.p, rtol=0, atol=1e-9)
+    # the equality row holds: U_E = 0
+    assert abs(pb.velocities(sol.p)[0]) <= 1e-9
