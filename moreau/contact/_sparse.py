@@ -188,9 +188,12 @@ def project_cone(mu, rn, rt):
     (1.6, 0.8)
     >>> project_cone(0.5, -1.0, 0.1)
     (0.0, 0.0)
+    >>> project_cone(0.0, -1.0, 0.0)
+    (0.0, 0.0)
     """
     a = abs(rt)
-    if a <= mu * rn:
+    # (rn >= 0: with mu = 0 the test a <= mu rn alone holds at rt = 0 for any rn, 0 <= -0.0)
+    if a <= mu * rn and rn >= 0.0:
         return rn, rt
     if mu * a <= -rn:
         return 0.0, 0.0

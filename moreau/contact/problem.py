@@ -228,6 +228,8 @@ class ContactSolution(NamedTuple):
         :func:`~moreau.lcp.friction.build_friction_lcp` (the one-contact closed
         form computes the same number without building it), with equality
         rows :func:`moreau.lcp.mlcp.mlcp_residual` of the friction MLCP.
+        For ``"nsgs"`` and ``"apgd"``, the natural map of FCLib's problem,
+        ``||F(r)|| / (1 + ||q||)``, in the units of their ``tol``.
         A diagnostic; success is decided by the certified violation
         (:func:`moreau.lcp.lcp_violation`) at the solver's tolerance.
     method : str

@@ -126,8 +126,9 @@ def solve(problem, method="auto", *, max_iter=None, tol=None, **options):
     problem : ContactProblem
     method : str
         A registered solver (:func:`solver_names`): ``"auto"`` (one contact
-        in closed form, several by Lemke with the QP fallback, equality rows
-        by ``"mlcp"``), ``"closed-form"``, ``"lemke"``, ``"qp"``, ``"mlcp"``.
+        in closed form, up to 32 by Lemke with the QP fallback, more by
+        NSGS, equality rows by ``"mlcp"``), ``"closed-form"``, ``"lemke"``,
+        ``"qp"``, ``"mlcp"``, ``"nsgs"``, ``"apgd"``.
     max_iter : int, optional
         Pivot or iteration limit.
     tol : float, optional

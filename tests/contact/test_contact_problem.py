@@ -100,7 +100,7 @@ def test_bad_input_is_named(change, message):
 
 def test_solve_refuses_by_name():
     pb = ContactProblem(np.eye(3), [-1.0, -1.0, 0.0], [0.0, 0.4])
-    with pytest.raises(InputError, match="`method` must be one of 'auto', 'closed-form'"):
+    with pytest.raises(InputError, match="`method` must be one of 'apgd', 'auto', 'closed-form'"):
         solve(pb, "simplex")
     with pytest.raises(InputError, match="`method` 'closed-form' solves at most 1 contact"):
         solve(pb, "closed-form")

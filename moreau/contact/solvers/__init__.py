@@ -8,10 +8,12 @@ that a new solver is one new file calling
 ``closed-form`` one contact, exact case analysis (:mod:`.closed_form`)
 ``lemke``       the dense friction LCP by Lemke's method (:mod:`.lemke`)
 ``qp``          the friction LCP by the QP (Tresca fixed point) method (:mod:`.qp`)
-``auto``        closed form for one contact, else Lemke then QP; ``mlcp``
-                where there are equality rows (:mod:`.auto`)
+``auto``        closed form for one contact, Lemke then QP up to 32 contacts,
+                NSGS above; ``mlcp`` where there are equality rows (:mod:`.auto`)
 ``mlcp``        equality rows eliminated (Schur complement), then an inner
                 solver on the contacts (:mod:`.mlcp`)
+``nsgs``        nonsmooth Gauss-Seidel in FCLib's layout, ``W`` in CSR (:mod:`.nsgs`)
+``apgd``        accelerated projected gradient in FCLib's layout (:mod:`.apgd`)
 =============== =============================================================
 """
 

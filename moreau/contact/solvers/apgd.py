@@ -36,13 +36,16 @@ from moreau.contact._sparse import (IterativeResult, check_problem, natural_map,
                                     velocities)
 from moreau.errors import InputError
 
+from ..registry import register_solver
+from . import _iterative
+
 #: numba's cache pickles the module's name with the machine code; a copy of this file imported
 #: under another name (pytest's doctest collection imports a module outside a regular package
 #: by its bare file name) would write entries that the package cannot load, so only the
 #: package's own import caches
 _CACHE = __name__.startswith("moreau.")
 
-__all__ = ["solve_apgd", "lipschitz_bound"]
+__all__ = ["solve_apgd", "lipschitz_bound", "solve"]
 
 
 @njit(cache=_CACHE)
@@ -200,3 +203,40 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     res, res_abs, u = _sparse._residual_checked(W, q, mu, best_r)
     history = np.column_stack([hist_it[:nh], hist_res[:nh] / scale])
     return IterativeResult(best_r, u, res, res_abs, it, tol, "apgd", history)
+
+
+def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
+    """``"apgd"``: a :class:`~moreau.contact.ContactProblem` by :func:`solve_apgd` in FCLib's layout.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        Without equality rows.
+    max_iter : int, optional
+        The budget of gradient steps, 100 000 by default.
+    tol : float, optional
+        Tolerance on the natural-map residual, 1e-8 by default.
+    check_every, L
+        As for :func:`solve_apgd`.
+
+    Returns
+    -------
+    ContactSolution
+        As for ``"nsgs"`` (:func:`moreau.contact.solvers.nsgs.solve`).
+
+    Examples
+    --------
+    >>> from moreau.contact import ContactProblem, solve as solve_contact
+    >>> sol = solve_contact(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]), "apgd", tol=1e-12)
+    >>> sol.status, sol.method, np.round(sol.p, 9).tolist()
+    ('solved', 'apgd', [1.0, -0.5])
+    """
+    budget = 100_000 if max_iter is None else max_iter
+    W, q, mu = _iterative.local_problem(problem)
+    res = solve_apgd(W, q, mu, tol=_iterative.DEFAULT_TOL if tol is None else tol,
+                     max_iter=budget, check_every=check_every, L=L)
+    return _iterative.solution_of(problem, res, budget)
+
+
+register_solver("apgd", solve,
+                summary="accelerated projected gradient with restart, FCLib layout, W in CSR")

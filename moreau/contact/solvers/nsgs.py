@@ -28,13 +28,16 @@ from moreau.contact._sparse import (IterativeResult, check_problem, diagonal_blo
                                     natural_map, project_cone, velocities)
 from moreau.errors import InputError
 
+from ..registry import register_solver
+from . import _iterative
+
 #: numba's cache pickles the module's name with the machine code; a copy of this file imported
 #: under another name (pytest's doctest collection imports a module outside a regular package
 #: by its bare file name) would write entries that the package cannot load, so only the
 #: package's own import caches
 _CACHE = __name__.startswith("moreau.")
 
-__all__ = ["solve_nsgs"]
+__all__ = ["solve_nsgs", "solve"]
 
 
 @njit(cache=_CACHE)
@@ -164,3 +167,42 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     res, res_abs, u = _sparse._residual_checked(W, q, mu, best_r)
     history = np.column_stack([hist_it[:nh], hist_res[:nh] / scale])
     return IterativeResult(best_r, u, res, res_abs, sweeps, tol, "nsgs", history)
+
+
+def solve(problem, *, max_iter=None, tol=None, omega=1.0, check_every=4):
+    """``"nsgs"``: a :class:`~moreau.contact.ContactProblem` by :func:`solve_nsgs` in FCLib's layout.
+
+    Parameters
+    ----------
+    problem : ContactProblem
+        Without equality rows.
+    max_iter : int, optional
+        The budget of sweeps (``max_sweeps``), 10 000 by default.
+    tol : float, optional
+        Tolerance on the natural-map residual (:mod:`._iterative`), 1e-8 by
+        default.
+    omega, check_every
+        As for :func:`solve_nsgs`.
+
+    Returns
+    -------
+    ContactSolution
+        ``residual``: the natural map recomputed on the impulses returned;
+        ``status`` ``"solved"`` only when it is ``<= tol``.
+
+    Examples
+    --------
+    >>> from moreau.contact import ContactProblem, solve as solve_contact
+    >>> sol = solve_contact(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]), "nsgs")
+    >>> sol.status, sol.method, sol.p.tolist()
+    ('solved', 'nsgs', [1.0, -0.5])
+    """
+    budget = 10_000 if max_iter is None else max_iter
+    W, q, mu = _iterative.local_problem(problem)
+    res = solve_nsgs(W, q, mu, tol=_iterative.DEFAULT_TOL if tol is None else tol,
+                     max_sweeps=budget, omega=omega, check_every=check_every)
+    return _iterative.solution_of(problem, res, budget)
+
+
+register_solver("nsgs", solve,
+                summary="nonsmooth Gauss-Seidel over contacts, FCLib layout, W in CSR")

@@ -83,9 +83,13 @@ class RockingBlockProblem(Problem):
 
     _ref = None
 
+    def exact_scene(self):
+        """The :class:`~moreau.scenes.rocking_block.RockingBlock` whose closed forms are the reference."""
+        return self.make_scene()
+
     def reference(self):
         if self._ref is None:
-            blk = self.make_scene()
+            blk = self.exact_scene()
             self._ref = {"first_impact_time": float(blk.phase_time(blk.params.tilt)),
                          "impact_ratio": float(blk.housner_ratio),
                          "settling_time": float(blk.settling_time())}
@@ -93,7 +97,7 @@ class RockingBlockProblem(Problem):
 
     def impact_speed(self):
         """``|theta'|`` at the first impact, by energy: ``(2/3) w^2 = cos(alpha - theta0) - cos(alpha)``."""
-        blk = self.make_scene()
+        blk = self.exact_scene()
         th0, al = blk.params.tilt, blk.alpha
         return math.sqrt(1.5 * 2.0 * math.sin(al - 0.5 * th0) * math.sin(0.5 * th0))
 
@@ -108,7 +112,8 @@ class RockingBlockProblem(Problem):
         out = {"first_impact_time": t1, "impact_ratio": None, "settling_time": None}
         th1 = None if t1 is None else rebound_amplitude(t, th, t1)
         if th1 is not None:
-            al, th0 = scene.alpha, float(scene.params.tilt)
+            blk = self.exact_scene()
+            al, th0 = blk.alpha, float(blk.params.tilt)
             # cos(alpha - x) - cos(alpha) = 2 sin(alpha - x/2) sin(x/2), without cancellation
             out["impact_ratio"] = math.sqrt(
                 math.sin(al - 0.5 * th1) * math.sin(0.5 * th1)
