@@ -57,7 +57,7 @@ from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from .._log import note
-from . import _mj_kernels
+from . import _driver, _mj_kernels
 from ._mj_kernels import no_gaps
 
 __all__ = ["runner_for", "dependency_files"]
@@ -147,6 +147,8 @@ def _build(model, template, stub=False):
         # the variant for runs that cannot reach these kernels (see SHARED_INDIRECT)
         namespace.update({name: getattr(module, spec[1])
                           for name, spec in _indirect(template).items()})
+    # a driver's step rule reads this namespace too (SPECIALISED inlined in it as well)
+    _driver.rebind_steps(namespace)
     # numba names a function's disk-cache files after its qualified name: one
     # per model, from the import paths of its functions and its constants
     tag = repr(sorted(paths.items())) + repr(sorted(consts.items())) + ("stub" if stub else "")
@@ -166,7 +168,9 @@ def _template_sources(template):
     """Every source file a loop of ``template`` compiles in: Lemke's, the template's
     module and the modules of every compiled kernel it calls (another scheme's, too)."""
     sources = list(_mj_kernels.KERNEL_SOURCES)
-    for path in dependency_files([types.SimpleNamespace(py_func=template)]):
+    # a driver's template runs the code of _driver.py in its scheme module's namespace
+    module_file = sys.modules[template.__module__].__file__
+    for path in [module_file] + dependency_files([types.SimpleNamespace(py_func=template)]):
         if path not in sources:
             sources.append(path)
     return sources

@@ -59,7 +59,8 @@ from ._contact_step import (CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, NUMERICAL
                             _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed,
                             new_lcp_control, new_stats, prev_regimes, set_painleve_stop,
                             solve_contacts)
-from . import _contact_step
+from . import _contact_step, _driver
+from ._driver import grid_step, loop_template, record_sample  # noqa: F401
 
 __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
@@ -68,34 +69,6 @@ __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "S
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
 COND_MAX = 1e14
-
-@njit(inline="always")
-def grid_step(t0, k, h, t_bound):
-    """``(t_k, t_{k+1}, step, last)`` of the fixed-step grid ``t0 + k h``, the last step cut at
-    ``t_bound``: the compiled loops' twin of :func:`moreau.integrators.moreau_jean.next_time`."""
-    tk = t0 + k * h
-    t1 = t0 + (k + 1) * h
-    if t1 >= t_bound - 1e-9 * h:
-        return tk, t_bound, t_bound - tk, True
-    return tk, t1, h, False
-
-
-@njit(cache=True)
-def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
-                  reg, pN, pT, h, slip, G, n, nc):
-    """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
-    forces (impulse / step), the slip velocity and the gap (column 0 of ``G``)."""
-    rec_t[nrec] = t
-    for j in range(n):
-        rec_q[nrec, j] = q[j]
-        rec_v[nrec, j] = v[j]
-    for i in range(nc):
-        rec_reg[nrec, i] = reg[i]
-        rec_fN[nrec, i] = pN[i] / h
-        rec_fT[nrec, i] = pT[i] / h
-        rec_slip[nrec, i] = slip[i]
-        rec_gap[nrec, i] = G[i, 0]
-
 
 @njit(cache=True)
 def _invert_small(A, out, n):
@@ -225,466 +198,352 @@ def _invert_gj(A, out, work, n):
 
 
 
-def mj_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, projection, closed, save_every,
-            record_initial, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
-            rec_gap, stats):
-    """Run up to ``nmax`` Moreau–Jean steps of a compiled model in one call.
-
-    A template, not called as it stands: :func:`moreau.integrators._loops.runner_for`
-    compiles it once per model, in a namespace that adds the model to this
-    module's globals: its functions ``mass_fn``, ``forces_fn``,
-    ``contacts_fn`` and ``gaps_fn`` (:class:`moreau.compiled.CompiledModel`),
-    and the constants ``NDOF``, ``NCONTACTS``, ``CONST_MASS`` (``M``
-    independent of ``q``), ``HAS_JAC`` (``dh/dq`` or ``dh/dv`` nonzero) and
-    ``HAS_GAPS`` (the model has ``gaps``). Numba
-    freezes globals, so the compiler drops the branches the model does not
-    take and unrolls the small-matrix loops; passing the functions as
-    arguments instead would make them run-time values, which numba can
-    neither inline nor cache.
-
-    Parameters
-    ----------
-    par : float64[:]
-        The model's parameters.
-    mu, e : float64[:]
-        Friction and restitution of each contact.
-    t0, h, t_bound : float
-        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
-    k0 : int
-        Index of the first step (``t_k0 = t0 + k0 h``).
-    nmax : int
-        Most steps to take in this call.
-    q, v : float64[n]
-        State at ``t_k0``; overwritten with the final state.
-    theta : float
-    projection : bool
-    closed : bool[nc]
-        Contacts that carried a normal impulse in the step before ``k0``; updated.
-    save_every : int
-        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
-    record_initial : bool
-        Also record the state at ``t_k0`` (with the first step's regime and forces).
-    lcp_ctl : int64[:]
-        From :func:`new_lcp_control`: ``force_lemke`` (solve a single active
-        contact by Lemke too, ``lcp_method="lemke"``), ``warm_start`` (try
-        the last contact LCP's support before Lemke, see :func:`_lcp_step`),
-        ``max_iter`` (Lemke's pivot limit; ``<= 0``: the default, 1000, or
-        ``50 L`` above ``L = 20``), then the warm start's memory, read and
-        updated; the caller keeps the array from one call to the next.
-    rec_* : arrays
-        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
-        ones (ns, nc); long enough for this call's samples.
-    stats : float64[:]
-        Accumulated statistics, layout :data:`STAT_NAMES`.
-
-    Returns
-    -------
-    status : int
-        :data:`OK`, :data:`PAINLEVE`, :data:`NUMERICAL`, :data:`SINGULAR`
-        (state: the last good one) or :data:`LCP_HANDBACK` (state: the start
-        of the step Lemke could not solve).
-    k : int
-        Index of the next step (steps taken: ``k - k0``).
-    nrec : int
-        Samples written.
-    """
-    n = NDOF  # noqa: F821  (the model's namespace, see above)
-    nc = NCONTACTS  # noqa: F821
-    const_mass = CONST_MASS  # noqa: F821
-    has_jac = HAS_JAC  # noqa: F821
-    force_lemke = lcp_ctl[CTL_FORCE] != 0
-    warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
-    rvel = np.zeros(2 * max(nc, 1))
-    th = theta
-    M = np.zeros((n, n))
-    Wh = np.empty((n, n))
-    Wi = np.empty((n, n))
-    wk = np.empty((n, n))
-    # model outputs, packed (see moreau.compiled): D = [h | K | C]
-    D = np.zeros((n, 1 + 2 * n))
-    D0 = np.zeros((n, 1 + 2 * n))
-    rhs = np.empty(n)
-    vf = np.empty(n)
-    v1 = np.empty(n)
-    q1 = np.empty(n)
+@njit(cache=True)
+def step_workspace(n, nc, lcp_ctl):
+    """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     ncm = max(nc, 1)
     mrows = 2 * ncm
-    # contact rows (g, wN, wT, WN, WT): at (q_k, t_k), at (q_k, t_k+1), at (q_k+1, t_k+1)
-    G0 = np.zeros((ncm, 3 + 2 * n))
-    G1 = np.zeros((ncm, 3 + 2 * n))
-    Gq = np.zeros((ncm, 3 + 2 * n))
-    vN0 = np.zeros(ncm)
-    active = np.zeros(ncm, dtype=np.bool_)
-    cnew = np.zeros(ncm, dtype=np.bool_)
-    pN = np.zeros(ncm)
-    pT = np.zeros(ncm)
-    slip = np.zeros(ncm)
-    reg = np.zeros(ncm, dtype=np.int64)
-    ia = np.zeros(ncm, dtype=np.int64)
-    fa = np.zeros(ncm, dtype=np.int64)
-    H = np.zeros((mrows, n))
+    lw = lcp_buffers(ncm)
     # the columns where each row of H is nonzero: contact rows touch few
     # coordinates (two balls of a chain), and the Delassus assembly over them
     # alone costs m nnz instead of m n^2 (N = 100 balls: 10x fewer operations
     # per step); the skipped terms are exact zeros, so the sums are the same
     hnz = np.zeros((mrows, n), dtype=np.int64)
-    hcnt = np.zeros(mrows, dtype=np.int64)
-    w = np.zeros(mrows)
-    WiHT = np.zeros((n, mrows))
-    Wd = np.zeros((mrows, mrows))
-    Uf = np.zeros(mrows)
-    p = np.zeros(mrows)
-    # projection buffers
-    Mi = np.empty((n, n))
-    sel = np.zeros(ncm, dtype=np.bool_)
-    X = np.zeros((n, ncm))
-    S = np.zeros((ncm, ncm))
-    rs = np.zeros(ncm)
-    ident = np.arange(ncm)
-    dd = np.zeros(ncm)
-    base = np.zeros(ncm, dtype=np.int64)
-    trow = np.zeros(ncm, dtype=np.int64)
-    # LCP buffers at the largest size (four variables per contact), allocated
-    # once: arrays reassigned inside the loop would be reference-counted on
-    # every step, contact or not; _lcp_step uses their leading L x L block
-    # the LCP buffers; `lay` holds the layout Ml holds (na, ia...), Ab .. pcol the warm
-    # start's subsystem
-    lw = lcp_buffers(ncm)
-    pcol = lw[12]
+    # have_Wi, have_Mi: W_hat^-1 and M^-1 of a constant matrix computed in this call
+    flags = np.zeros(2, dtype=np.int64)
+    return (np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.empty((n, n)),
+            # model outputs, packed (see moreau.compiled): D = [h | K | C]
+            np.zeros((n, 1 + 2 * n)), np.zeros((n, 1 + 2 * n)), np.empty(n), np.empty(n),
+            # contact rows at (q_k, t_k+1)
+            np.zeros((ncm, 3 + 2 * n)), np.zeros(ncm), np.zeros(ncm, dtype=np.bool_),
+            np.zeros(ncm, dtype=np.bool_), np.zeros(ncm, dtype=np.int64),
+            np.zeros(ncm, dtype=np.int64), np.zeros((mrows, n)), hnz,
+            np.zeros(mrows, dtype=np.int64), np.zeros(mrows), np.zeros((n, mrows)),
+            np.zeros((mrows, mrows)), np.zeros(mrows), np.zeros(mrows),
+            # projection buffers
+            np.empty((n, n)), np.zeros(ncm, dtype=np.bool_), np.zeros((n, ncm)),
+            np.zeros((ncm, ncm)), np.zeros(ncm), np.arange(ncm), np.zeros(ncm),
+            np.zeros(ncm, dtype=np.int64), np.zeros(ncm, dtype=np.int64), np.zeros(2 * ncm),
+            flags, lw)
 
-    # the regime of each contact in the step before (a tangential impact stops a slip)
-    roff = CTL_IA + 5 * ncm
-    for i in range(nc):
-        reg[i] = lcp_ctl[roff + i]
+
+@njit(inline="always", error_model="numpy")
+def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
+              HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
+              q, v, out):
+    """One Moreau–Jean step from ``(q, v)`` at ``tk`` to ``(q1, v1)`` at ``t1`` (see :mod:`._driver`).
+
+    ``opts`` is ``(theta, projection)``, ``memo`` ``(closed,)``: the contacts
+    that carried a normal impulse in the step before, updated after a step
+    taken. The free velocity solves ``W_hat dv = h [theta f1 + (1 - theta)
+    f0] + h^2 theta K v``; a contact is active where its gap, extrapolated
+    half a step, closes (or where it was closed); one active contact is
+    solved in closed form, several by :func:`._contact_step.solve_contacts`;
+    then the position update and, with ``projection``, the mass-weighted
+    projection of the closed gaps.
+    """
+    n = NDOF
+    nc = NCONTACTS
+    const_mass = CONST_MASS
+    has_jac = HAS_JAC
+    th, projection = opts
+    q1, v1, pN, pT, slip, reg, G0, Gq = out
+    closed = memo[0]
+    (M, Wh, Wi, wk, D, D0, rhs, vf, G1, vN0, active, cnew, ia, fa, H, hnz, hcnt, w, WiHT, Wd, Uf,
+     p, Mi, sel, X, S, rs, ident, dd, base, trow, rvel, flags, lw) = ws
+    pcol = lw[12]
+    force_lemke = lcp_ctl[CTL_FORCE] != 0
+    warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     constant_W = const_mass and not has_jac
-    have_Wi = False
-    have_Mi = False
-    nrec = 0
-    k = k0
-    status = OK
-    # steps left until the next sample (k % save_every == 0 after the step): a
-    # countdown, because an integer division per step costs as much as a sine
-    to_save = save_every - k0 % save_every
-    while k - k0 < nmax:
-        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
-        if tk >= t_bound:
-            break
-        # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
-        # the gaps at (q_k, t_k) were computed at the end of the step before
-        if not (const_mass and k > k0):
-            mass_fn(par, q, M)
-        # the model is evaluated in the order of its times: t_k (where the step before
-        # ended), then t_k+1, so that a model which keeps its last transcendentals
-        # (the friction drive's sines and cosines of the phase) finds them still current
-        if nc > 0:
-            contacts_fn(par, q, tk, G0, k == k0, False)
-        if th != 1.0:
-            forces_fn(par, q, v, tk, D0, False)
-        forces_fn(par, q, v, t1, D, has_jac)
-        if th != 1.0:
-            for i in range(n):
-                D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
-        a = hk * th
-        a2 = hk * hk * th
-        if has_jac:
-            for i in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += D[i, 1 + j] * v[j]
-                rhs[i] = hk * D[i, 0] + a2 * acc
-            a2 = a2 * th
-            for i in range(n):
-                for j in range(n):
-                    Wh[i, j] = M[i, j] - a * D[i, 1 + n + j] - a2 * D[i, 1 + j]
-        else:
-            for i in range(n):
-                rhs[i] = hk * D[i, 0]
-                for j in range(n):
-                    Wh[i, j] = M[i, j]
-        if not (constant_W and have_Wi):
-            if n <= 3:
-                ok = _invert_small(Wh, Wi, n)
-            else:
-                ok = _invert_gj(Wh, Wi, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
-            have_Wi = True
+    # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
+    # the gaps at (q_k, t_k) were computed at the end of the step before
+    if not (const_mass and k > k0):
+        mass_fn(par, q, M)
+    # the model is evaluated in the order of its times: t_k (where the step before
+    # ended), then t_k+1, so that a model which keeps its last transcendentals
+    # (the friction drive's sines and cosines of the phase) finds them still current
+    if nc > 0:
+        contacts_fn(par, q, tk, G0, k == k0, False)
+    if th != 1.0:
+        forces_fn(par, q, v, tk, D0, False)
+    forces_fn(par, q, v, t1, D, has_jac)
+    if th != 1.0:
+        for i in range(n):
+            D[i, 0] = th * D[i, 0] + (1.0 - th) * D0[i, 0]
+    a = hk * th
+    a2 = hk * hk * th
+    if has_jac:
         for i in range(n):
             acc = 0.0
             for j in range(n):
-                acc += Wi[i, j] * rhs[j]
-            vf[i] = v[i] + acc
-            v1[i] = vf[i]
+                acc += D[i, 1 + j] * v[j]
+            rhs[i] = hk * D[i, 0] + a2 * acc
+        a2 = a2 * th
+        for i in range(n):
+            for j in range(n):
+                Wh[i, j] = M[i, j] - a * D[i, 1 + n + j] - a2 * D[i, 1 + j]
+    else:
+        for i in range(n):
+            rhs[i] = hk * D[i, 0]
+            for j in range(n):
+                Wh[i, j] = M[i, j]
+    if not (constant_W and flags[0] != 0):
+        if n <= 3:
+            ok = _invert_small(Wh, Wi, n)
+        else:
+            ok = _invert_gj(Wh, Wi, wk, n)
+        if not ok:
+            return SINGULAR
+        flags[0] = 1
+    for i in range(n):
+        acc = 0.0
+        for j in range(n):
+            acc += Wi[i, j] * rhs[j]
+        vf[i] = v[i] + acc
+        v1[i] = vf[i]
 
-        # -- contacts
-        # int64, not the literal 0: numba types a call by its first-seen argument types, and
-        # a literal would compile the contact solves a second time for it
-        na = np.int64(0)
-        nfa = 0
+    # -- contacts
+    # int64, not the literal 0: numba types a call by its first-seen argument types, and
+    # a literal would compile the contact solves a second time for it
+    na = np.int64(0)
+    nfa = 0
+    for i in range(nc):
+        pN[i] = 0.0
+        pT[i] = 0.0
+        slip[i] = 0.0
+    if nc > 0:
         for i in range(nc):
-            pN[i] = 0.0
-            pT[i] = 0.0
-            slip[i] = 0.0
-        if nc > 0:
-            for i in range(nc):
-                acc = G0[i, 1]
-                for j in range(n):
-                    acc += G0[i, 3 + j] * v[j]
-                vN0[i] = acc
-                active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
-                if active[i]:
-                    ia[na] = i
-                    na += 1
-                    if mu[i] > 0.0:
-                        fa[nfa] = i
-                        nfa += 1
-        if na > 0:
-            contacts_fn(par, q, t1, G1, False, True)
-        if na == 1 and not force_lemke:
-            # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
-            # matrix, built from the contact's two rows only; loops over n alone, so
-            # that with the sizes known at compile time it is straight-line code
-            i = ia[0]
-            fr = nfa == 1
+            acc = G0[i, 1]
             for j in range(n):
+                acc += G0[i, 3 + j] * v[j]
+            vN0[i] = acc
+            active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
+            if active[i]:
+                ia[na] = i
+                na += 1
+                if mu[i] > 0.0:
+                    fa[nfa] = i
+                    nfa += 1
+    if na > 0:
+        contacts_fn(par, q, t1, G1, False, True)
+    if na == 1 and not force_lemke:
+        # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
+        # matrix, built from the contact's two rows only; loops over n alone, so
+        # that with the sizes known at compile time it is straight-line code
+        i = ia[0]
+        fr = nfa == 1
+        for j in range(n):
+            acc = 0.0
+            acc2 = 0.0
+            for l in range(n):
+                acc += Wi[j, l] * G1[i, 3 + l]
+                acc2 += Wi[j, l] * G1[i, 3 + n + l]
+            WiHT[j, 0] = acc
+            WiHT[j, 1] = acc2
+        Wnn = 0.0
+        uN = G1[i, 1]
+        for j in range(n):
+            Wnn += G1[i, 3 + j] * WiHT[j, 0]
+            uN += G1[i, 3 + j] * vf[j]
+        stats[S_LCP] += 1.0
+        stats[S_DIRECT] += 1.0
+        if fr:
+            Wnt = 0.0
+            Wtn = 0.0
+            Wtt = 0.0
+            uT = G1[i, 2]
+            for j in range(n):
+                Wnt += G1[i, 3 + j] * WiHT[j, 1]
+                Wtn += G1[i, 3 + n + j] * WiHT[j, 0]
+                Wtt += G1[i, 3 + n + j] * WiHT[j, 1]
+                uT += G1[i, 3 + n + j] * vf[j]
+            pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
+            # a tangential impact is taken by the generic step, which records it (or
+            # stops there with painleve="stop"); it is rare, the test is not
+            if not ok or (reg[i] != 0 and reg[i] != 3
+                          and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
+                    or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
+                return PAINLEVE
+            rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
+                                              vN0[i], pn, pt)
+            slip[i] = uT + Wtn * pn + Wtt * pt
+        else:
+            pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i])
+            if not ok:
+                return PAINLEVE
+            rnum, rscale = _residual_parts(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i],
+                                           pn, 0.0)
+        pN[i] = pn
+        pT[i] = pt
+        # stats[S_RES] = max(stats[S_RES], rnum / rscale), dividing only where the
+        # quotient can exceed it: fl(rnum / rscale) > r implies rnum > r rscale exactly,
+        # hence rnum >= fl(r rscale) for the double rnum, so the test skips no update.
+        # On most steps the largest residual stands and the division is skipped
+        # (2 % of a friction-drive step)
+        if rnum >= stats[S_RES] * rscale:
+            res = rnum / rscale
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+        for j in range(n):
+            v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
+    elif na > 0:
+        m = na + nfa
+        for r in range(na):
+            i = ia[r]
+            for j in range(n):
+                H[r, j] = G1[i, 3 + j]
+            w[r] = G1[i, 1]
+        for r in range(nfa):
+            i = fa[r]
+            for j in range(n):
+                H[na + r, j] = G1[i, 3 + n + j]
+            w[na + r] = G1[i, 2]
+        for c in range(m):
+            cnt = 0
+            for j in range(n):
+                if H[c, j] != 0.0:
+                    hnz[c, cnt] = j
+                    cnt += 1
+            hcnt[c] = cnt
+        for c in range(m):
+            for i in range(n):
                 acc = 0.0
-                acc2 = 0.0
-                for l in range(n):
-                    acc += Wi[j, l] * G1[i, 3 + l]
-                    acc2 += Wi[j, l] * G1[i, 3 + n + l]
-                WiHT[j, 0] = acc
-                WiHT[j, 1] = acc2
-            Wnn = 0.0
-            uN = G1[i, 1]
-            for j in range(n):
-                Wnn += G1[i, 3 + j] * WiHT[j, 0]
-                uN += G1[i, 3 + j] * vf[j]
-            stats[S_LCP] += 1.0
-            stats[S_DIRECT] += 1.0
-            if fr:
-                Wnt = 0.0
-                Wtn = 0.0
-                Wtt = 0.0
-                uT = G1[i, 2]
-                for j in range(n):
-                    Wnt += G1[i, 3 + j] * WiHT[j, 1]
-                    Wtn += G1[i, 3 + n + j] * WiHT[j, 0]
-                    Wtt += G1[i, 3 + n + j] * WiHT[j, 1]
-                    uT += G1[i, 3 + n + j] * vf[j]
-                pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
-                # a tangential impact is taken by the generic step, which records it (or
-                # stops there with painleve="stop"); it is rare, the test is not
-                if not ok or (reg[i] != 0 and reg[i] != 3
-                              and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
-                        or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
-                    status = PAINLEVE
-                    break
-                rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
-                                                  vN0[i], pn, pt)
-                slip[i] = uT + Wtn * pn + Wtt * pt
-            else:
-                pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i])
-                if not ok:
-                    status = PAINLEVE
-                    break
-                rnum, rscale = _residual_parts(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i],
-                                               pn, 0.0)
-            pN[i] = pn
-            pT[i] = pt
-            # stats[S_RES] = max(stats[S_RES], rnum / rscale), dividing only where the
-            # quotient can exceed it: fl(rnum / rscale) > r implies rnum > r rscale exactly,
-            # hence rnum >= fl(r rscale) for the double rnum, so the test skips no update.
-            # On most steps the largest residual stands and the division is skipped
-            # (2 % of a friction-drive step)
-            if rnum >= stats[S_RES] * rscale:
-                res = rnum / rscale
-                if res > stats[S_RES]:
-                    stats[S_RES] = res
-            for j in range(n):
-                v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
-        elif na > 0:
-            m = na + nfa
-            for r in range(na):
-                i = ia[r]
-                for j in range(n):
-                    H[r, j] = G1[i, 3 + j]
-                w[r] = G1[i, 1]
-            for r in range(nfa):
-                i = fa[r]
-                for j in range(n):
-                    H[na + r, j] = G1[i, 3 + n + j]
-                w[na + r] = G1[i, 2]
+                for t in range(hcnt[c]):
+                    j = hnz[c, t]
+                    acc += Wi[i, j] * H[c, j]
+                WiHT[i, c] = acc
+        for r in range(m):
+            acc = w[r]
+            for t in range(hcnt[r]):
+                j = hnz[r, t]
+                acc += H[r, j] * vf[j]
+            Uf[r] = acc
             for c in range(m):
-                cnt = 0
-                for j in range(n):
-                    if H[c, j] != 0.0:
-                        hnz[c, cnt] = j
-                        cnt += 1
-                hcnt[c] = cnt
-            for c in range(m):
-                for i in range(n):
-                    acc = 0.0
-                    for t in range(hcnt[c]):
-                        j = hnz[c, t]
-                        acc += Wi[i, j] * H[c, j]
-                    WiHT[i, c] = acc
-            for r in range(m):
-                acc = w[r]
+                acc = 0.0
                 for t in range(hcnt[r]):
                     j = hnz[r, t]
-                    acc += H[r, j] * vf[j]
-                Uf[r] = acc
-                for c in range(m):
-                    acc = 0.0
-                    for t in range(hcnt[r]):
-                        j = hnz[r, t]
-                        acc += H[r, j] * WiHT[j, c]
-                    Wd[r, c] = acc
-            st = solve_contacts(Wd, Uf, na, nfa, ia, mu, e, vN0, reg, warm_on and k > k0, p, pN,
-                                pT, lw, base, trow, rvel, _lcp_step, lcp_ctl, stats)
-            if st != OK:
-                status = st
-                break
-            for i in range(n):
-                acc = vf[i]
-                for c in range(m):
-                    acc += WiHT[i, c] * p[c]
-                v1[i] = acc
-            for r in range(nfa):
-                tr = na + r
-                acc = Uf[tr]
-                for c in range(m):
-                    acc += Wd[tr, c] * p[c]
-                slip[fa[r]] = acc
-
+                    acc += H[r, j] * WiHT[j, c]
+                Wd[r, c] = acc
+        st = solve_contacts(Wd, Uf, na, nfa, ia, mu, e, vN0, reg, warm_on and k > k0, p, pN,
+                            pT, lw, base, trow, rvel, lcp_step, lcp_ctl, stats)
+        if st != OK:
+            return st
         for i in range(n):
-            q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
+            acc = vf[i]
+            for c in range(m):
+                acc += WiHT[i, c] * p[c]
+            v1[i] = acc
+        for r in range(nfa):
+            tr = na + r
+            acc = Uf[tr]
+            for c in range(m):
+                acc += Wd[tr, c] * p[c]
+            slip[fa[r]] = acc
+
+    for i in range(n):
+        q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
+    for i in range(nc):
+        cnew[i] = pN[i] > 0.0
+    gaps_current = False
+    if projection and nc > 0:
+        if not const_mass:
+            mass_fn(par, q1, M)
         for i in range(nc):
-            cnew[i] = pN[i] > 0.0
-        gaps_current = False
-        if projection and nc > 0:
-            if not const_mass:
-                mass_fn(par, q1, M)
+            sel[i] = cnew[i]
+        # M^-1 of a constant mass matrix is kept from the last projection
+        pinv = const_mass and flags[1] != 0
+        for _ in range(PROJECTION_MAXITER):
+            if HAS_GAPS:  # noqa: F821
+                gaps_fn(par, q1, t1, Gq)
+            else:
+                contacts_fn(par, q1, t1, Gq, True, False)
+            gaps_current = True
+            anysel = False
+            gmax = 0.0
             for i in range(nc):
-                sel[i] = cnew[i]
-            # M^-1 of a constant mass matrix is kept from the last projection
-            pinv = const_mass and have_Mi
-            for _ in range(PROJECTION_MAXITER):
-                if HAS_GAPS:  # noqa: F821
-                    gaps_fn(par, q1, t1, Gq)
+                if Gq[i, 0] < 0.0:
+                    sel[i] = True
+                if sel[i]:
+                    anysel = True
+                    gmax = max(gmax, abs(Gq[i, 0]))
+            if (not anysel) or gmax <= PROJECTION_TOL:
+                break
+            if not pinv:
+                if n <= 3:
+                    ok = _invert_small(M, Mi, n)
                 else:
-                    contacts_fn(par, q1, t1, Gq, True, False)
-                gaps_current = True
-                anysel = False
-                gmax = 0.0
-                for i in range(nc):
-                    if Gq[i, 0] < 0.0:
-                        sel[i] = True
-                    if sel[i]:
-                        anysel = True
-                        gmax = max(gmax, abs(Gq[i, 0]))
-                if (not anysel) or gmax <= PROJECTION_TOL:
-                    break
-                if not pinv:
-                    if n <= 3:
-                        ok = _invert_small(M, Mi, n)
-                    else:
-                        ok = _invert_gj(M, Mi, wk, n)
-                    if not ok:
-                        status = NUMERICAL
-                        break
-                    pinv = True
-                    have_Mi = True
-                contacts_fn(par, q1, t1, Gq, False, False)
-                s = 0
-                for i in range(nc):
-                    if sel[i]:
-                        ia[s] = i
-                        s += 1
-                # X = M^-1 WN_sel^T, S = WN_sel X, S d = -g_sel, q += X d
-                if s == 1:
-                    # one contact (the common case): a scalar division, no solver call
-                    i0 = ia[0]
-                    sc = 0.0
+                    ok = _invert_gj(M, Mi, wk, n)
+                if not ok:
+                    return NUMERICAL
+                pinv = True
+                flags[1] = 1
+            contacts_fn(par, q1, t1, Gq, False, False)
+            s = 0
+            for i in range(nc):
+                if sel[i]:
+                    ia[s] = i
+                    s += 1
+            # X = M^-1 WN_sel^T, S = WN_sel X, S d = -g_sel, q += X d
+            if s == 1:
+                # one contact (the common case): a scalar division, no solver call
+                i0 = ia[0]
+                sc = 0.0
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(n):
+                        acc += Mi[i, j] * Gq[i0, 3 + j]
+                    X[i, 0] = acc
+                    sc += Gq[i0, 3 + i] * acc
+                d0 = -Gq[i0, 0] / sc
+                for i in range(n):
+                    q1[i] += X[i, 0] * d0
+            else:
+                for c in range(s):
                     for i in range(n):
                         acc = 0.0
                         for j in range(n):
-                            acc += Mi[i, j] * Gq[i0, 3 + j]
-                        X[i, 0] = acc
-                        sc += Gq[i0, 3 + i] * acc
-                    d0 = -Gq[i0, 0] / sc
-                    for i in range(n):
-                        q1[i] += X[i, 0] * d0
-                else:
+                            acc += Mi[i, j] * Gq[ia[c], 3 + j]
+                        X[i, c] = acc
+                    rs[c] = -Gq[ia[c], 0]
+                for r in range(s):
                     for c in range(s):
-                        for i in range(n):
-                            acc = 0.0
-                            for j in range(n):
-                                acc += Mi[i, j] * Gq[ia[c], 3 + j]
-                            X[i, c] = acc
-                        rs[c] = -Gq[ia[c], 0]
-                    for r in range(s):
-                        for c in range(s):
-                            acc = 0.0
-                            for j in range(n):
-                                acc += Gq[ia[r], 3 + j] * X[j, c]
-                            S[r, c] = acc
-                    # S is regular where the selected gaps are independent; an
-                    # exactly singular one is a numerical failure, as before
-                    if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
-                        status = NUMERICAL
-                        break
-                    for i in range(n):
                         acc = 0.0
-                        for c in range(s):
-                            acc += X[i, c] * dd[c]
-                        q1[i] += acc
-                gaps_current = False
-                stats[S_PROJ] += 1.0
-            if status != OK:
-                break
-        finite = True
-        for i in range(n):
-            if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-                finite = False
-        if not finite:
-            status = NUMERICAL
-            break
-        if nc > 0:
-            if not gaps_current:
-                if HAS_GAPS:  # noqa: F821
-                    gaps_fn(par, q1, t1, Gq)
-                else:
-                    contacts_fn(par, q1, t1, Gq, True, False)
-            for i in range(nc):
-                if -Gq[i, 0] > stats[S_PEN]:
-                    stats[S_PEN] = -Gq[i, 0]
-                reg[i] = _classify(pN[i], pT[i], mu[i])
-        if record_initial:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
-            nrec += 1
-            record_initial = False
+                        for j in range(n):
+                            acc += Gq[ia[r], 3 + j] * X[j, c]
+                        S[r, c] = acc
+                # S is regular where the selected gaps are independent; an
+                # exactly singular one is a numerical failure, as before
+                if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
+                    return NUMERICAL
+                for i in range(n):
+                    acc = 0.0
+                    for c in range(s):
+                        acc += X[i, c] * dd[c]
+                    q1[i] += acc
+            gaps_current = False
+            stats[S_PROJ] += 1.0
+    finite = True
+    for i in range(n):
+        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
+            finite = False
+    if not finite:
+        return NUMERICAL
+    if nc > 0:
+        if not gaps_current:
+            if HAS_GAPS:  # noqa: F821
+                gaps_fn(par, q1, t1, Gq)
+            else:
+                contacts_fn(par, q1, t1, Gq, True, False)
         for i in range(nc):
-            closed[i] = cnew[i]
-            G0[i, 0] = Gq[i, 0]
-        for j in range(n):
-            q[j] = q1[j]
-            v[j] = v1[j]
-        k += 1
-        to_save -= 1
-        if to_save == 0:
-            to_save = save_every
-        if to_save == save_every or last:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
-            nrec += 1
-        if last:
-            break
+            if -Gq[i, 0] > stats[S_PEN]:
+                stats[S_PEN] = -Gq[i, 0]
+            reg[i] = _classify(pN[i], pT[i], mu[i])
     for i in range(nc):
-        lcp_ctl[roff + i] = reg[i]
-    return status, k, nrec
+        closed[i] = cnew[i]
+    return OK
+
+
+mj_loop = loop_template("mj_loop", globals())
 
 
 # error_model="numpy": a division by zero gives inf/nan, which the loop's own
@@ -698,7 +557,7 @@ def no_gaps(par, q, t, G):
 
 #: every source whose compiled code ends up in this module's functions and in
 #: the runners built on mj_loop (Lemke is linked in; globals are frozen in)
-KERNEL_SOURCES = (__file__,) + _contact_step.KERNEL_SOURCES
+KERNEL_SOURCES = (__file__, _driver.__file__) + _contact_step.KERNEL_SOURCES
 
 # numba checks a cached kernel against this file only: tie it to all of them so
 # that editing Lemke cannot leave stale machine code in use
