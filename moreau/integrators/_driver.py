@@ -10,15 +10,16 @@ kept from one call to the next in the contact problem's control array.
 A scheme's kernel module gives two functions under fixed names and builds its
 loop template with :func:`loop_template`:
 
-- ``step_workspace(n, nc, lcp_ctl)``: its buffers, one tuple, allocated once a call;
+- ``step_workspace(n, nc, opts, lcp_ctl)``: its buffers, one tuple, allocated once a call;
 - ``step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS,
   CONST_MASS, HAS_JAC, HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo,
-  lcp_ctl, stats, k, k0, tk, t1, hk, q, v, out)``, inlined (``numba.njit(inline="always")``): one step from ``(q, v)``
-  at ``tk`` to ``(q1, v1)`` at ``t1``, ``out`` being ``(q1, v1, pN, pT, slip,
-  reg, G0, Gq)``. It writes the impulses ``pN``,
-  ``pT``, the slip velocities, the regimes, the contact rows at the start
-  (``G0``, its gap column kept from the step before after the first) and the
-  gaps at the end (``Gq``'s column 0), and returns a status. ``opts`` is a
+  lcp_ctl, stats, k, k0, tk, t1, hk, q, v, out)``, inlined
+  (``numba.njit(inline="always")``): one step from ``(q, v)`` at ``tk`` to
+  ``(q1, v1)`` at ``t1``, ``out`` being ``(q1, v1, pN, pT, slip, reg, G0,
+  Gq)``. It writes the impulses ``pN``, ``pT``, the slip velocities, the
+  regimes, the contact rows at the start (``G0``, whose gap column the driver
+  carries over from the step before) and the gaps at the end (``Gq``'s column
+  0), and returns a status. ``opts`` is a
   tuple of the scheme's options and ``memo`` a tuple of the arrays it
   carries from one call to the next (Moreau–Jean's closed contacts).
 
@@ -132,7 +133,7 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
     n = NDOF  # noqa: F821  (the model's namespace, see above)
     nc = NCONTACTS  # noqa: F821
     ncm = max(nc, 1)
-    ws = step_workspace(n, nc, lcp_ctl)  # noqa: F821  (the scheme's module)
+    ws = step_workspace(n, nc, opts, lcp_ctl)  # noqa: F821  (the scheme's module)
     q1 = np.empty(n)
     v1 = np.empty(n)
     pN = np.zeros(ncm)
@@ -193,11 +194,15 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
 def loop_template(name, namespace):
     """The driver as the loop template ``name`` of the scheme module whose globals are ``namespace``.
 
-    The module must hold the names :func:`drive` reads: :data:`STEP_FUNCTIONS`,
-    ``np``, ``OK``, ``CTL_IA``, ``grid_step``, ``record_sample`` and
-    ``_lcp_step``. The template's qualified name is ``name`` (numba names a
-    function's disk-cache files after it).
+    The module must hold :data:`STEP_FUNCTIONS` and ``_lcp_step`` (a shared
+    loop may take it as an argument, see
+    :data:`moreau.integrators._contact_step.SHARED_INDIRECT`); the driver's
+    own names are added to ``namespace`` where it lacks them. The template's
+    qualified name is ``name`` (numba names a function's disk-cache files
+    after it).
     """
+    for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
+        namespace.setdefault(own, globals()[own])
     fn = types.FunctionType(drive.__code__, namespace, name, drive.__defaults__)
     fn.__qualname__ = name
     fn.__module__ = namespace["__name__"]

@@ -51,14 +51,14 @@ from numba import njit
 
 from .. import _jit_cache
 from ..lcp.lemke import eliminate
-from ._contact_step import (CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, NUMERICAL, OK,  # noqa: F401
-                            PAINLEVE, S_DIRECT, S_FALLBACKS, S_LCP, S_PEN, S_PIVOTS, S_PROJ, S_RES,
-                            S_WARM, SHARED_INDIRECT, SINGULAR, SLIP_RTOL, SPECIALISED, STAT_NAMES,
-                            _classify, _jam, _lcp_size, _lcp_step, _lcp_step_unused, _one_contact,
-                            _one_contact_fr, _regime_solve, _residual, _residual_parts,
-                            _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed,
-                            new_lcp_control, new_stats, prev_regimes, set_painleve_stop,
-                            solve_contacts)
+# the contact step's names, read here by the loop and by the modules that import them from here
+from ._contact_step import (  # noqa: F401
+    CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, LCP_STEP_SIGNATURE, NUMERICAL, OK, PAINLEVE,
+    S_DIRECT, S_FALLBACKS, S_LCP, S_PEN, S_PIVOTS, S_PROJ, S_RES, S_WARM, SHARED_INDIRECT,
+    SINGULAR, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
+    _lcp_step_unused, _one_contact, _one_contact_fr, _regime_solve, _residual, _residual_parts,
+    _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
+    new_stats, prev_regimes, set_painleve_stop, solve_contacts)
 from . import _contact_step, _driver
 from ._driver import grid_step, loop_template, record_sample  # noqa: F401
 
@@ -199,7 +199,7 @@ def _invert_gj(A, out, work, n):
 
 
 @njit(cache=True)
-def step_workspace(n, nc, lcp_ctl):
+def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     ncm = max(nc, 1)
     mrows = 2 * ncm
