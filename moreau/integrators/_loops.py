@@ -69,7 +69,9 @@ log = logging.getLogger(__name__)
 #: the schemes' names of the loop templates, for the compile note
 SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
                       "nsga_loop": "nonsmooth generalized-alpha",
-                      "studer_loop": "Studer extrapolation"}
+                      "studer_loop": "Studer extrapolation",
+                      "tdg_loop": "time-discontinuous Galerkin",
+                      "mjp_loop": "Moreau–Jean projected"}
 #: seconds in a shared loop after which a model's own loop is compiled: with a compile
 #: of C ~ 10 s and the specialised loop taking r ~ 1/2 of the shared one's time, the
 #: compile pays for itself after C / (1 - r) more seconds of work; moving there bounds
