@@ -31,6 +31,9 @@ template both ways). The step rule is compiled again in the loop's namespace
 ``SPECIALISED`` binds.
 """
 
+import ast
+import inspect
+import textwrap
 import types
 
 import numpy as np
@@ -192,22 +195,91 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
 
 
 def loop_template(name, namespace):
-    """The driver as the loop template ``name`` of the scheme module whose globals are ``namespace``.
+    """The driver with the step rule of the scheme module whose globals are ``namespace`` spliced in.
 
-    The module must hold :data:`STEP_FUNCTIONS` and ``_lcp_step`` (a shared
-    loop may take it as an argument, see
+    The module holds :data:`STEP_FUNCTIONS` and ``_lcp_step`` (a shared loop
+    may take it as an argument, see
     :data:`moreau.integrators._contact_step.SHARED_INDIRECT`); the driver's
-    own names are added to ``namespace`` where it lacks them. The template's
-    qualified name is ``name`` (numba names a function's disk-cache files
-    after it).
+    own names are added to ``namespace`` where it lacks them.
+
+    The step rule's source is spliced into the driver's, not called: its
+    statements before the marker ``...`` (unpacking the workspace, the
+    options and the memory) go before the loop, the rest into the loop, each
+    ``return X`` becoming ``status = X`` and a break out of the step. Called
+    (even inlined by numba), the step rule unpacked its workspace on every
+    step, and the reference counts of its thirty arrays made a step of the
+    friction drive about six times slower. The template's qualified name is
+    ``name`` (numba names a function's disk-cache files after it); its source
+    is kept in ``__moreau_source__`` for the shared loop's rewrite.
     """
     for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
         namespace.setdefault(own, globals()[own])
-    fn = types.FunctionType(drive.__code__, namespace, name, drive.__defaults__)
+    tree = ast.parse(textwrap.dedent(inspect.getsource(drive)))
+    fdef = tree.body[0]
+    fdef.name = name
+    step = namespace["step_rule"].py_func
+    sdef = ast.parse(textwrap.dedent(inspect.getsource(step))).body[0]
+    body = sdef.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        body = body[1:]
+    mark = next(i for i, st in enumerate(body) if isinstance(st, ast.Expr)
+                and isinstance(st.value, ast.Constant) and st.value.value is Ellipsis)
+    setup, per_step = body[:mark], body[mark + 1:]
+    if per_step and isinstance(per_step[-1], ast.Return):
+        per_step = per_step[:-1]       # the step's `return OK`
+    per_step = _returns_to_breaks(per_step)
+    loop_at = next(i for i, st in enumerate(fdef.body) if isinstance(st, ast.While))
+    loop = fdef.body[loop_at]
+    at = next(i for i, st in enumerate(loop.body) if isinstance(st, ast.Assign)
+              and isinstance(st.value, ast.Call) and isinstance(st.value.func, ast.Name)
+              and st.value.func.id == "step_rule")
+    call = loop.body[at].value
+    params = [a.arg for a in sdef.args.args]
+    binds = [ast.Assign(targets=[ast.Name(id=p, ctx=ast.Store())], value=arg)
+             for p, arg in zip(params, call.args)
+             if not (isinstance(arg, ast.Name) and arg.id == p)]
+    loop.body[at:at + 1] = per_step
+    fdef.body[loop_at:loop_at] = binds + setup
+    ast.fix_missing_locations(tree)
+    source = ast.unparse(tree)
+    code = compile(source, drive.__code__.co_filename, "exec")
+    scope = {}
+    exec(code, namespace, scope)  # noqa: S102  (the package's own driver and step rule)
+    fn = scope[name]
     fn.__qualname__ = name
     fn.__module__ = namespace["__name__"]
     fn.__doc__ = drive.__doc__
+    fn.__moreau_source__ = source
     return fn
+
+
+def _has_return(stmts):
+    return any(isinstance(n, ast.Return) for st in stmts for n in ast.walk(st))
+
+
+def _returns_to_breaks(stmts):
+    """``return X`` -> ``status = X; break``, and after every loop that held one, a break on."""
+    out = []
+    for st in stmts:
+        if isinstance(st, ast.Return):
+            out.append(ast.Assign(targets=[ast.Name(id="status", ctx=ast.Store())],
+                                  value=st.value))
+            out.append(ast.Break())
+        elif isinstance(st, (ast.For, ast.While)):
+            had = _has_return(st.body)
+            st.body = _returns_to_breaks(st.body)
+            st.orelse = _returns_to_breaks(st.orelse)
+            out.append(st)
+            if had:
+                out.append(ast.parse("if status != OK:\n    break").body[0])
+        elif isinstance(st, ast.If):
+            st.body = _returns_to_breaks(st.body)
+            st.orelse = _returns_to_breaks(st.orelse)
+            out.append(st)
+        else:
+            out.append(st)
+    return out
 
 
 def rebind_steps(namespace):

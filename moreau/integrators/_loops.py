@@ -211,7 +211,9 @@ def _shared_function(template):
     arithmetic; the shared one reads the model's functions and sizes at run
     time, which lets one compiled loop serve every model.
     """
-    source = textwrap.dedent(inspect.getsource(template))
+    # a driver's template keeps its spliced source (moreau.integrators._driver.loop_template)
+    source = getattr(template, "__moreau_source__", None) or textwrap.dedent(
+        inspect.getsource(template))
     tree = ast.parse(source)
     fdef = tree.body[0]
     fdef.decorator_list = []

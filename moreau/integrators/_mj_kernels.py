@@ -255,6 +255,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     constant_W = const_mass and not has_jac
+    ...  # the steps (moreau.integrators._driver.loop_template)
     # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
     # the gaps at (q_k, t_k) were computed at the end of the step before
     if not (const_mass and k > k0):

@@ -55,8 +55,8 @@ def step_workspace(n, nc, opts, lcp_ctl):
     mrows = 2 * ncm
     Gs = np.zeros((ncm, 3 + 2 * n))
     vN0 = np.zeros(ncm)
-    pN = np.zeros(ncm)
-    pT = np.zeros(ncm)
+    pNi = np.zeros(ncm)
+    pTi = np.zeros(ncm)
     ia = np.zeros(ncm, dtype=np.int64)
     fa = np.zeros(ncm, dtype=np.int64)
     H = np.zeros((mrows, n))
@@ -102,7 +102,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
     gs2 = np.zeros(mrows)
     nuu = np.zeros(mrows)
     tmpe = np.zeros(ncm)
-    return (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pN, pT, ia, fa, H, w, MiHT, Wd, Uf, p,
+    return (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p,
             base, trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT,
             lam, dx0, JiHT, Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe)
 
@@ -126,8 +126,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     has_jac = HAS_JAC
     coef, position_level = opts
     a, acc, closed = memo
-    q1, v1, PN, PT, slip, reg, G0, Gq = out
-    (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pN, pT, ia, fa, H, w, MiHT, Wd, Uf, p, base,
+    q1, v1, pN, pT, slip, reg, G0, Gq = out
+    (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p, base,
      trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT, lam, dx0, JiHT,
      Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe) = ws
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
@@ -137,6 +137,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     beta = coef[3]
     cfac = (1.0 - af) / (1.0 - am)
     force_lemke = lcp_ctl[0] != 0
+    ...  # the steps (moreau.integrators._driver.loop_template)
     # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
     kv = hk * gamma * cfac
     nb = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
@@ -271,8 +272,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
     nfa = 0
     for i in range(nc):
-        pN[i] = 0.0
-        pT[i] = 0.0
+        pNi[i] = 0.0
+        pTi[i] = 0.0
     if nc > 0:
         if HAS_GAPS:  # noqa: F821
             gaps_fn(par, qs, t1, Gs)  # noqa: F821
@@ -358,15 +359,15 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
                                     0.0)
                     p[0] = pn
-                pN[i] = pn
-                pT[i] = pt
+                pNi[i] = pn
+                pTi[i] = pt
             else:
                 for rr in range(na):
                     i = ia[rr]
                     if e[i] > 0.0:
                         Uf[rr] += e[i] * min(vN0[i], 0.0)
                 L = _lcp_size(na, ia, mu, base, trow)
-                lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pNi, pTi, L, base, trow,
                                                 Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
                                                 lcp_ctl, Ab, xb, idx, pcol, False)
                 if lst != 0:
@@ -519,9 +520,9 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             if -Gq[i, 0] > stats[S_PEN]:
                 stats[S_PEN] = -Gq[i, 0]
             # the step's whole percussion: smooth force over the step plus the impulse
-            PN[i] = hk * lamN[i] + pN[i]
-            PT[i] = hk * lamT[i] + pT[i]
-            reg[i] = _classify(PN[i], PT[i], mu[i])
+            pN[i] = hk * lamN[i] + pNi[i]
+            pT[i] = hk * lamT[i] + pTi[i]
+            reg[i] = _classify(pN[i], pT[i], mu[i])
     if k == k0 and nc > 0:
         # the gaps at the call's first state, which the driver records there
         if HAS_GAPS:  # noqa: F821
@@ -529,7 +530,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         else:
             contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
     for i in range(nc):
-        closed[i] = pN[i] > 0.0 or lamN[i] > 0.0
+        closed[i] = pNi[i] > 0.0 or lamN[i] > 0.0
     for j in range(n):
         a[j] = a1[j]
         acc[j] = x[j]

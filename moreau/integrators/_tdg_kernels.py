@@ -180,6 +180,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
      Uf, U, p, Ptot, S, gx, MW, base, trow, flags, lw) = ws
     force_lemke = lcp_ctl[0] != 0
     s = cs.shape[0]
+    ...  # the steps (moreau.integrators._driver.loop_template)
     if not (const_mass and flags[0] != 0):
         mass_fn(par, q, M)  # noqa: F821
         ok = _invert_small(M, Mi0, n) if n <= 3 else _invert_gj(M, Mi0, wk, n)

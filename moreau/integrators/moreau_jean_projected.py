@@ -96,6 +96,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     M, Mi, wk, X, S, gv, tau, nuN, nuT, mu0, sel, ia, base, trow, cl0, reg0 = pws
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
     q1, v1, pN, pT, slip, reg, G0, Gq = out
+    ...  # the steps (moreau.integrators._driver.loop_template)
     pen = stats[S_PEN]
     # what Moreau–Jean's step updates, kept for a projection handed back to Python
     closed = memo[0]
