@@ -16,8 +16,10 @@ pre-impact normal velocities and the warm-start memory with the options
   LCP); where Lemke fails the status :data:`LCP_HANDBACK` hands the step to
   Python (the QP fallback).
 
-:func:`solve_contacts` is the entry a scheme's step calls;
 :mod:`moreau.integrators._mj_kernels` documents the warm starts' acceptance.
+A scheme's step rule calls these kernels on buffers it has unpacked before its
+loop: behind one entry taking the buffers as a tuple, the unpacking on every
+step cost the two-contact scenes a third of their speed.
 """
 
 import math
@@ -32,7 +34,7 @@ from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
 from ..lcp.lemke import DEFAULT_TOL, eliminate, lemke_core, lemke_workspace
 
-__all__ = ["solve_contacts", "new_lcp_control", "new_stats", "lcp_buffers", "set_painleve_stop",
+__all__ = ["new_lcp_control", "new_stats", "lcp_buffers", "set_painleve_stop",
            "prev_regimes", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL", "SINGULAR", "LCP_HANDBACK"]
 
 # status codes (those of SimulationResult where they overlap)
@@ -649,71 +651,6 @@ def lcp_needed(ncontacts, lcp_ctl):
 #: :func:`lcp_needed` says it cannot be called, the name of the loop's argument
 #: that decides)
 SHARED_INDIRECT = {"_lcp_step": (LCP_STEP_SIGNATURE, "_lcp_step_unused", lcp_needed, "lcp_ctl")}
-
-
-# inlined (numba IR) into the loops that call it, as _regime_solve is: a call passing
-# its thirty arrays would cost about a microsecond a step
-@njit(inline="always")
-def solve_contacts(Wd, Uf, na, nfa, ia, mu, e, vpre, reg, regimes, p, pN, pT, lw, base, trow,
-                   rvel, lcp_step, lcp_ctl, stats):
-    """The impulses of the active contacts' friction LCP: regime solve, warm start, else Lemke.
-
-    ``Wd`` and ``Uf`` hold the Delassus block and the free local velocities
-    of the stacked rows (``na`` normal rows of the contacts ``ia``, then the
-    tangential rows of the ``nfa`` frictional ones); Newton's restitution
-    ``e`` against the pre-impact normal velocities ``vpre`` (both per
-    contact) is added to ``Uf``'s normal rows here. Where ``regimes`` (the
-    regimes ``reg`` of the step before are known) the step is first solved in
-    them (:func:`_regime_solve`); else, or when that is refused,
-    ``lcp_step`` (:func:`_lcp_step`, passed in so that a shared loop can
-    leave Lemke out, :data:`SHARED_INDIRECT`) assembles the LCP and tries the
-    remembered support before Lemke. ``lw`` are the buffers of
-    :func:`lcp_buffers`, ``base``, ``trow`` and ``rvel`` (``2 max(nc, 1)``)
-    scratch arrays.
-
-    Writes ``p`` (stacked rows), ``pN`` and ``pT`` (by contact) and the
-    statistics. Returns :data:`OK`, :data:`LCP_HANDBACK` (Lemke failed:
-    the caller takes the step in Python) or :data:`PAINLEVE` (a single
-    contact solved by Lemke whose slip runs into a tangential impact).
-    """
-    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
-    # Newton's restitution: the normal rows aim at -e times the approach speed
-    for r in range(na):
-        i = ia[r]
-        if e[i] > 0.0:
-            Uf[r] += e[i] * min(vpre[i], 0.0)
-    L = _lcp_size(na, ia, mu, base, trow)
-    res = np.inf
-    if regimes:
-        res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel, pcol)
-    if 0.0 <= res <= DEFAULT_TOL:
-        stats[S_LCP] += 1.0
-        stats[S_WARM] += 1.0
-    else:
-        # refused: a regime changes in this step (or lies within the margin of changing)
-        # and Lemke decides, from scratch, since the remembered support is that of the
-        # old regimes. Where the regimes are unknown the support may serve
-        lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                       Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                       lcp_ctl, Ab, xb, idx, pcol, not regimes)
-        if lst != 0:
-            return LCP_HANDBACK
-        if na == 1 and nfa == 1 and (
-                (reg[ia[0]] != 0 and reg[ia[0]] != 3
-                 and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vpre[ia[0]],
-                          _slip_sign(reg[ia[0]])))
-                or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
-                            e[ia[0]], vpre[ia[0]])):
-            # one contact by Lemke (lcp_method="lemke"): a tangential impact is taken by
-            # the generic step, as the closed-form solve hands it there
-            return PAINLEVE
-        stats[S_PIVOTS] += piv
-        stats[S_LCP] += 1.0
-        if warm:
-            stats[S_WARM] += 1.0
-    if res > stats[S_RES]:
-        stats[S_RES] = res
-    return OK
 
 
 #: every source whose compiled code ends up in this module's functions (Lemke is linked in)

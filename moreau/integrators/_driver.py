@@ -26,15 +26,14 @@ loop template with :func:`loop_template`:
 The model comes first in the step rule's arguments, as the driver has it:
 frozen globals in a model's own (specialised) loop, run-time arguments in the
 scheme's shared loop (:mod:`moreau.integrators._loops` compiles the one
-template both ways). The step rule is compiled again in the loop's namespace
-(:data:`STEP_FUNCTIONS`), so that a specialised loop inlines what its module's
-``SPECIALISED`` binds.
+template both ways). :func:`loop_template` splices the step rule's source into
+the driver's: its statements before the marker ``...`` run once a call, before
+the loop, the rest once a step, so that the workspace is unpacked once.
 """
 
 import ast
 import inspect
 import textwrap
-import types
 
 import numpy as np
 from numba import njit
@@ -280,21 +279,3 @@ def _returns_to_breaks(stmts):
         else:
             out.append(st)
     return out
-
-
-def rebind_steps(namespace):
-    """Compile ``namespace``'s step functions (:data:`STEP_FUNCTIONS`) again in it, inlined.
-
-    A loop compiled in ``namespace`` then runs step rules whose globals are
-    its own: a model's specialised loop inlines the kernels its module's
-    ``SPECIALISED`` binds there, in the step rule as in the driver.
-    """
-    for name in STEP_FUNCTIONS:
-        f = namespace.get(name)
-        py = getattr(f, "py_func", None)
-        if py is None:
-            continue
-        g = types.FunctionType(py.__code__, namespace, name, py.__defaults__)
-        g.__qualname__ = py.__qualname__
-        g.__module__ = py.__module__
-        namespace[name] = njit(inline="always", error_model="numpy")(g)

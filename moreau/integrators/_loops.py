@@ -57,7 +57,7 @@ from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from .._log import note
-from . import _driver, _mj_kernels
+from . import _mj_kernels
 from ._mj_kernels import no_gaps
 
 __all__ = ["runner_for", "dependency_files"]
@@ -149,8 +149,6 @@ def _build(model, template, stub=False):
         # the variant for runs that cannot reach these kernels (see SHARED_INDIRECT)
         namespace.update({name: getattr(module, spec[1])
                           for name, spec in _indirect(template).items()})
-    # a driver's step rule reads this namespace too (SPECIALISED inlined in it as well)
-    _driver.rebind_steps(namespace)
     # numba names a function's disk-cache files after its qualified name: one
     # per model, from the import paths of its functions and its constants
     tag = repr(sorted(paths.items())) + repr(sorted(consts.items())) + ("stub" if stub else "")

@@ -50,7 +50,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jit_cache
-from ..lcp.lemke import eliminate
+from ..lcp.lemke import DEFAULT_TOL, eliminate
 # the contact step's names, read here by the loop and by the modules that import them from here
 from ._contact_step import (  # noqa: F401
     CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, LCP_STEP_SIGNATURE, NUMERICAL, OK, PAINLEVE,
@@ -58,7 +58,7 @@ from ._contact_step import (  # noqa: F401
     SINGULAR, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
     _lcp_step_unused, _one_contact, _one_contact_fr, _regime_solve, _residual, _residual_parts,
     _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
-    new_stats, prev_regimes, set_painleve_stop, solve_contacts)
+    new_stats, prev_regimes, set_painleve_stop)
 from . import _contact_step, _driver
 from ._driver import grid_step, loop_template, record_sample  # noqa: F401
 
@@ -238,7 +238,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     taken. The free velocity solves ``W_hat dv = h [theta f1 + (1 - theta)
     f0] + h^2 theta K v``; a contact is active where its gap, extrapolated
     half a step, closes (or where it was closed); one active contact is
-    solved in closed form, several by :func:`._contact_step.solve_contacts`;
+    solved in closed form, several by the friction LCP (:mod:`._contact_step`);
     then the position update and, with ``projection``, the mass-weighted
     projection of the closed gaps.
     """
@@ -251,7 +251,9 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     closed = memo[0]
     (M, Wh, Wi, wk, D, D0, rhs, vf, G1, vN0, active, cnew, ia, fa, H, hnz, hcnt, w, WiHT, Wd, Uf,
      p, Mi, sel, X, S, rs, ident, dd, base, trow, rvel, flags, lw) = ws
-    pcol = lw[12]
+    # unpacked before the loop (the driver splices this): a tuple unpacked on every step
+    # costs a two-contact scene a third of its speed
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
     force_lemke = lcp_ctl[CTL_FORCE] != 0
     warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
     constant_W = const_mass and not has_jac
@@ -425,10 +427,45 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     j = hnz[r, t]
                     acc += H[r, j] * WiHT[j, c]
                 Wd[r, c] = acc
-        st = solve_contacts(Wd, Uf, na, nfa, ia, mu, e, vN0, reg, warm_on and k > k0, p, pN,
-                            pT, lw, base, trow, rvel, lcp_step, lcp_ctl, stats)
-        if st != OK:
-            return st
+        # Newton's restitution: the normal rows aim at -e times the approach speed
+        for r in range(na):
+            i = ia[r]
+            if e[i] > 0.0:
+                Uf[r] += e[i] * min(vN0[i], 0.0)
+        L = _lcp_size(na, ia, mu, base, trow)
+        res = np.inf
+        # the regimes of the step before (known from the second step of a call on)
+        regimes = warm_on and k > k0
+        if regimes:
+            res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel,
+                                pcol)
+        if 0.0 <= res <= DEFAULT_TOL:
+            stats[S_LCP] += 1.0
+            stats[S_WARM] += 1.0
+        else:
+            # refused: a regime changes in this step (or lies within the
+            # margin of changing) and Lemke decides, from scratch, since the
+            # remembered support is that of the old regimes. On the first
+            # step of a call the regimes are unknown: the support may serve
+            lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                           Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                           lcp_ctl, Ab, xb, idx, pcol, not regimes)
+            if lst != 0:
+                return LCP_HANDBACK
+            if na == 1 and nfa == 1 and (
+                    (reg[ia[0]] != 0 and reg[ia[0]] != 3
+                     and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
+                              _slip_sign(reg[ia[0]])))
+                    or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
+                                e[ia[0]], vN0[ia[0]])):
+                # one contact by Lemke (lcp_method="lemke"): a tangential impact, as above
+                return PAINLEVE
+            stats[S_PIVOTS] += piv
+            stats[S_LCP] += 1.0
+            if warm:
+                stats[S_WARM] += 1.0
+        if res > stats[S_RES]:
+            stats[S_RES] = res
         for i in range(n):
             acc = vf[i]
             for c in range(m):
