@@ -98,10 +98,18 @@ def test_kernel_stamps_carry_the_digest_of_all_kernel_sources():
     names = {os.path.basename(p) for p in mk.KERNEL_SOURCES}
     assert {"_mj_kernels.py", "lemke.py", "certify.py", "_certified.py"} <= names
     assert mk.CACHE_MODE == "bound"
-    digest = _jit_cache.sources_digest(mk.KERNEL_SOURCES)
-    for disp in (mk._lcp_step, mk._one_contact, mk.no_gaps):
-        stamp = disp._cache._cache_file._source_stamp
-        assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
+    from moreau.integrators import _contact_step as cs
+
+    # the contact step's kernels on their module's sources (Lemke's among them), the
+    # loop's on those and the driver's as well
+    assert set(cs.KERNEL_SOURCES) <= set(mk.KERNEL_SOURCES)
+    assert {"_contact_step.py", "lemke.py", "certify.py", "_certified.py"} <= {
+        os.path.basename(p) for p in cs.KERNEL_SOURCES}
+    for module, disps in ((cs, (cs._lcp_step, cs._one_contact)), (mk, (mk.no_gaps,))):
+        digest = _jit_cache.sources_digest(module.KERNEL_SOURCES)
+        for disp in disps:
+            stamp = disp._cache._cache_file._source_stamp
+            assert stamp[0] == "moreau-deps" and stamp[1][1] == digest
     assert lemke.lemke_core._cache._cache_file._source_stamp[0] == "moreau-deps"
 
 

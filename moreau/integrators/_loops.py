@@ -69,7 +69,9 @@ log = logging.getLogger(__name__)
 #: the schemes' names of the loop templates, for the compile note
 SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
                       "nsga_loop": "nonsmooth generalized-alpha",
-                      "studer_loop": "Studer extrapolation"}
+                      "studer_loop": "Studer extrapolation",
+                      "tdg_loop": "time-discontinuous Galerkin",
+                      "mjp_loop": "Moreau–Jean projected"}
 #: seconds in a shared loop after which a model's own loop is compiled: with a compile
 #: of C ~ 10 s and the specialised loop taking r ~ 1/2 of the shared one's time, the
 #: compile pays for itself after C / (1 - r) more seconds of work; moving there bounds
@@ -166,7 +168,9 @@ def _template_sources(template):
     """Every source file a loop of ``template`` compiles in: Lemke's, the template's
     module and the modules of every compiled kernel it calls (another scheme's, too)."""
     sources = list(_mj_kernels.KERNEL_SOURCES)
-    for path in dependency_files([types.SimpleNamespace(py_func=template)]):
+    # a driver's template runs the code of _driver.py in its scheme module's namespace
+    module_file = sys.modules[template.__module__].__file__
+    for path in [module_file] + dependency_files([types.SimpleNamespace(py_func=template)]):
         if path not in sources:
             sources.append(path)
     return sources
@@ -205,7 +209,9 @@ def _shared_function(template):
     arithmetic; the shared one reads the model's functions and sizes at run
     time, which lets one compiled loop serve every model.
     """
-    source = textwrap.dedent(inspect.getsource(template))
+    # a driver's template keeps its spliced source (moreau.integrators._driver.loop_template)
+    source = getattr(template, "__moreau_source__", None) or textwrap.dedent(
+        inspect.getsource(template))
     tree = ast.parse(source)
     fdef = tree.body[0]
     fdef.decorator_list = []

@@ -16,12 +16,14 @@ Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
 import math
 
 import numpy as np
+from numba import njit
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
                           S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
                           _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
                           lcp_buffers, record_sample)
-from ._mj_kernels import grid_step
+from ._mj_kernels import grid_step  # noqa: F401
+from ._driver import loop_template
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -35,27 +37,9 @@ CONTACT_TOL = 1e-12
 POSITION_MAXITER = 8
 
 
-def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, save_every,
-              record_initial, position_level, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN,
-              rec_fT, rec_slip, rec_gap, stats):
-    """Run up to ``nmax`` nonsmooth generalized-α steps of a compiled model in one call.
-
-    Arguments as :func:`moreau.integrators._mj_kernels.mj_loop`, plus ``a`` and
-    ``acc`` (float64[n], the algorithmic and the smooth acceleration, updated),
-    ``coef = (alpha_m, alpha_f, gamma, beta)`` and ``position_level``.
-    Returns ``(status, k, nrec)``; on :data:`LCP_HANDBACK`, :data:`PAINLEVE`
-    or :data:`CONVERGENCE` the state is the start of the failed step, which
-    the caller takes in Python.
-    """
-    n = NDOF  # noqa: F821  (the model's namespace)
-    nc = NCONTACTS  # noqa: F821
-    has_jac = HAS_JAC  # noqa: F821
-    am = coef[0]
-    af = coef[1]
-    gamma = coef[2]
-    beta = coef[3]
-    cfac = (1.0 - af) / (1.0 - am)
-    force_lemke = lcp_ctl[0] != 0
+@njit(cache=True)
+def step_workspace(n, nc, opts, lcp_ctl):
+    """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     M = np.zeros((n, n))
     Mi = np.empty((n, n))
     J = np.empty((n, n))
@@ -67,18 +51,12 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     a1 = np.empty(n)
     qs = np.empty(n)
     vs = np.empty(n)
-    v1 = np.empty(n)
-    q1 = np.empty(n)
     ncm = max(nc, 1)
     mrows = 2 * ncm
-    G0 = np.zeros((ncm, 3 + 2 * n))
     Gs = np.zeros((ncm, 3 + 2 * n))
-    Gq = np.zeros((ncm, 3 + 2 * n))
     vN0 = np.zeros(ncm)
-    pN = np.zeros(ncm)
-    pT = np.zeros(ncm)
-    slip = np.zeros(ncm)
-    reg = np.zeros(ncm, dtype=np.int64)
+    pNi = np.zeros(ncm)
+    pTi = np.zeros(ncm)
     ia = np.zeros(ncm, dtype=np.int64)
     fa = np.zeros(ncm, dtype=np.int64)
     H = np.zeros((mrows, n))
@@ -89,7 +67,7 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     p = np.zeros(mrows)
     base = np.zeros(ncm, dtype=np.int64)
     trow = np.zeros(ncm, dtype=np.int64)
-    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
+    lw = lcp_buffers(ncm)
     Lmax = 4 * ncm
     # the position correction's frictionless LCP: its own buffers and layout memory
     mu0 = np.zeros(ncm)
@@ -113,8 +91,6 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     Ml3 = np.zeros((Lmax, Lmax))
     lay3 = np.zeros(1 + ncm, dtype=np.int64)
     lay3[0] = -1
-    PN = np.zeros(ncm)
-    PT = np.zeros(ncm)
     # the mixed position correction: equality rows (held contacts) eliminated
     eqr = np.zeros(ncm, dtype=np.int64)
     unr = np.zeros(ncm, dtype=np.int64)
@@ -126,442 +102,439 @@ def nsga_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, a, acc, coef, closed, 
     gs2 = np.zeros(mrows)
     nuu = np.zeros(mrows)
     tmpe = np.zeros(ncm)
+    return (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p,
+            base, trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT,
+            lam, dx0, JiHT, Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe)
 
-    nrec = 0
-    k = k0
-    status = OK
-    to_save = save_every - k0 % save_every
-    while k - k0 < nmax:
-        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
-        if tk >= t_bound:
-            break
-        # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
-        kv = hk * gamma * cfac
-        nb = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-        nfb = 0
-        for i in range(nc):
-            lamN[i] = 0.0
-            lamT[i] = 0.0
-            slip[i] = 0.0
-            if closed[i]:
-                ib[nb] = i
-                nb += 1
-                if mu[i] > 0.0:
-                    fb[nfb] = i
-                    nfb += 1
-        mb = nb + nfb
-        for i in range(n):
-            x[i] = acc[i]
-        converged = False
-        for _ in range(NEWTON_MAXITER):
-            for i in range(n):
-                a1[i] = cfac * x[i] + (af * acc[i] - am * a[i]) / (1.0 - am)
-                qs[i] = q[i] + hk * v[i] + hk * hk * ((0.5 - beta) * a[i] + beta * a1[i])
-                vs[i] = v[i] + hk * ((1.0 - gamma) * a[i] + gamma * a1[i])
-            mass_fn(par, qs, M)  # noqa: F821
-            forces_fn(par, qs, vs, t1, D, True)  # noqa: F821
-            for i in range(n):
-                acc_r = -D[i, 0]
-                for j in range(n):
-                    acc_r += M[i, j] * x[j]
-                    jj = M[i, j]
-                    if has_jac:
-                        jj -= cfac * (hk * hk * beta * D[i, 1 + j] + hk * gamma * D[i, 1 + n + j])
-                    J[i, j] = jj
-                r[i] = acc_r
-            if n <= 3:
-                ok = _invert_small(J, Ji, n)
-            else:
-                ok = _invert_gj(J, Ji, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
-            for i in range(n):
-                dx = 0.0
-                for j in range(n):
-                    dx -= Ji[i, j] * r[j]
-                dx0[i] = dx
-            if nb > 0:
-                # the contact velocities at v*(x + dx) are affine in the smooth forces:
-                # U = U_free + kv H J^-1 H^T lam
-                contacts_fn(par, qs, t1, Gs, False, True)  # noqa: F821
-                for rr in range(nb):
-                    i = ib[rr]
-                    for j in range(n):
-                        H[rr, j] = Gs[i, 3 + j]
-                    w[rr] = Gs[i, 1]
-                for rr in range(nfb):
-                    i = fb[rr]
-                    for j in range(n):
-                        H[nb + rr, j] = Gs[i, 3 + n + j]
-                    w[nb + rr] = Gs[i, 2]
-                for c in range(mb):
-                    for i in range(n):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += Ji[i, j] * H[c, j]
-                        JiHT[i, c] = acc_v
-                for rr in range(mb):
-                    acc_v = w[rr]
-                    for j in range(n):
-                        acc_v += H[rr, j] * (vs[j] + kv * dx0[j])
-                    Uf[rr] = acc_v
-                    for c in range(mb):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += H[rr, j] * JiHT[j, c]
-                        Wd[rr, c] = kv * acc_v
-                if nb == 1 and not force_lemke:
-                    i = ib[0]
-                    stats[S_LCP] += 1.0
-                    stats[S_DIRECT] += 1.0
-                    if nfb == 1:
-                        ln, lt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                                  Uf[1], mu[i], 0.0, 0.0)
-                        ok = ok and not _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
-                                                 0.0, 0.0)
-                        lam[1] = lt
-                    else:
-                        ln, lt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, 0.0,
-                                                  0.0)
-                    if not ok:
-                        status = PAINLEVE
-                        break
-                    lam[0] = ln
-                    lamN[i] = ln
-                    lamT[i] = lt
-                else:
-                    L = _lcp_size(nb, ib, mu, base, trow)
-                    lst, piv, res, warm = _lcp_step(Wd, Uf, nb, ib, mu, lam, lamN, lamT, L, base,
-                                                    trow, Ml3, ql, dl, zl, wl, rayl, work, iwork,
-                                                    lay3, lcp_ctl, Ab, xb, idx, pcol, False)
-                    if lst != 0:
-                        status = LCP_HANDBACK
-                        break
-                    stats[S_PIVOTS] += piv
-                    stats[S_LCP] += 1.0
-                for i in range(n):
-                    acc_v = dx0[i]
-                    for c in range(mb):
-                        acc_v += JiHT[i, c] * lam[c]
-                    dx0[i] = acc_v
-                # the slip at v*: the impulse stage replaces it where it runs
-                for rr in range(nfb):
-                    acc_v = Uf[nb + rr]
-                    for c in range(mb):
-                        acc_v += Wd[nb + rr, c] * lam[c]
-                    slip[fb[rr]] = acc_v
-            dmax = 0.0
-            xmax = 0.0
-            for i in range(n):
-                x[i] += dx0[i]
-                dmax = max(dmax, abs(dx0[i]))
-                xmax = max(xmax, abs(x[i]))
-            if dmax <= NEWTON_RTOL * max(1.0, xmax):
-                converged = True
-                break
-        if status != OK:
-            break
-        if not converged:
-            status = CONVERGENCE
-            break
+
+@njit(inline="always", error_model="numpy")
+def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
+              HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
+              q, v, out):
+    """One nonsmooth generalized-α step from ``(q, v)`` at ``tk`` (see :mod:`._driver`).
+
+    ``opts`` is ``(coef, position_level)`` with ``coef = (alpha_m, alpha_f,
+    gamma, beta)``; ``memo`` is ``(a, acc, closed)``: the algorithmic and the
+    smooth acceleration and the contacts held in the step before, updated
+    after a step taken. The recorded forces are the step's whole percussions
+    (smooth force over the step plus the impulse). Statuses as the driver's,
+    plus :data:`CONVERGENCE` (the smooth Newton iteration did not converge;
+    the caller takes the step in Python).
+    """
+    n = NDOF
+    nc = NCONTACTS
+    has_jac = HAS_JAC
+    coef, position_level = opts
+    a, acc, closed = memo
+    q1, v1, pN, pT, slip, reg, G0, Gq = out
+    (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p, base,
+     trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT, lam, dx0, JiHT,
+     Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe) = ws
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
+    am = coef[0]
+    af = coef[1]
+    gamma = coef[2]
+    beta = coef[3]
+    cfac = (1.0 - af) / (1.0 - am)
+    force_lemke = lcp_ctl[0] != 0
+    ...  # the steps (moreau.integrators._driver.loop_template)
+    # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
+    kv = hk * gamma * cfac
+    nb = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
+    nfb = 0
+    for i in range(nc):
+        lamN[i] = 0.0
+        lamT[i] = 0.0
+        slip[i] = 0.0
+        if closed[i]:
+            ib[nb] = i
+            nb += 1
+            if mu[i] > 0.0:
+                fb[nfb] = i
+                nfb += 1
+    mb = nb + nfb
+    for i in range(n):
+        x[i] = acc[i]
+    converged = False
+    for _ in range(NEWTON_MAXITER):
         for i in range(n):
             a1[i] = cfac * x[i] + (af * acc[i] - am * a[i]) / (1.0 - am)
             qs[i] = q[i] + hk * v[i] + hk * hk * ((0.5 - beta) * a[i] + beta * a1[i])
             vs[i] = v[i] + hk * ((1.0 - gamma) * a[i] + gamma * a1[i])
-            v1[i] = vs[i]
-            q1[i] = qs[i]
-        # -- contacts at the predicted position
-        na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-        nfa = 0
-        for i in range(nc):
-            pN[i] = 0.0
-            pT[i] = 0.0
-        if nc > 0:
-            if HAS_GAPS:  # noqa: F821
-                gaps_fn(par, qs, t1, Gs)  # noqa: F821
-            else:
-                contacts_fn(par, qs, t1, Gs, True, False)  # noqa: F821
-            for i in range(nc):
-                if Gs[i, 0] <= CONTACT_TOL or closed[i]:
-                    ia[na] = i
-                    na += 1
-                    if mu[i] > 0.0:
-                        fa[nfa] = i
-                        nfa += 1
-        if na > 0:
-            # a contact carrying a smooth normal force meets its law at v* already: the
-            # impulse problem is solved only when an active contact carries none
-            need = False
-            for rr in range(na):
-                if not lamN[ia[rr]] > 0.0:
-                    need = True
-            have_mi = False
-            if need:
-                contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
-                for i in range(nc):
-                    acc_v = G0[i, 1]
+        mass_fn(par, qs, M)  # noqa: F821
+        forces_fn(par, qs, vs, t1, D, True)  # noqa: F821
+        for i in range(n):
+            acc_r = -D[i, 0]
+            for j in range(n):
+                acc_r += M[i, j] * x[j]
+                jj = M[i, j]
+                if has_jac:
+                    jj -= cfac * (hk * hk * beta * D[i, 1 + j] + hk * gamma * D[i, 1 + n + j])
+                J[i, j] = jj
+            r[i] = acc_r
+        if n <= 3:
+            ok = _invert_small(J, Ji, n)
+        else:
+            ok = _invert_gj(J, Ji, wk, n)
+        if not ok:
+            return SINGULAR
+        for i in range(n):
+            dx = 0.0
+            for j in range(n):
+                dx -= Ji[i, j] * r[j]
+            dx0[i] = dx
+        if nb > 0:
+            # the contact velocities at v*(x + dx) are affine in the smooth forces:
+            # U = U_free + kv H J^-1 H^T lam
+            contacts_fn(par, qs, t1, Gs, False, True)  # noqa: F821
+            for rr in range(nb):
+                i = ib[rr]
+                for j in range(n):
+                    H[rr, j] = Gs[i, 3 + j]
+                w[rr] = Gs[i, 1]
+            for rr in range(nfb):
+                i = fb[rr]
+                for j in range(n):
+                    H[nb + rr, j] = Gs[i, 3 + n + j]
+                w[nb + rr] = Gs[i, 2]
+            for c in range(mb):
+                for i in range(n):
+                    acc_v = 0.0
                     for j in range(n):
-                        acc_v += G0[i, 3 + j] * v[j]
-                    vN0[i] = acc_v
-                mass_fn(par, qs, M)  # noqa: F821
-                if n <= 3:
-                    ok = _invert_small(M, Mi, n)
+                        acc_v += Ji[i, j] * H[c, j]
+                    JiHT[i, c] = acc_v
+            for rr in range(mb):
+                acc_v = w[rr]
+                for j in range(n):
+                    acc_v += H[rr, j] * (vs[j] + kv * dx0[j])
+                Uf[rr] = acc_v
+                for c in range(mb):
+                    acc_v = 0.0
+                    for j in range(n):
+                        acc_v += H[rr, j] * JiHT[j, c]
+                    Wd[rr, c] = kv * acc_v
+            if nb == 1 and not force_lemke:
+                i = ib[0]
+                stats[S_LCP] += 1.0
+                stats[S_DIRECT] += 1.0
+                if nfb == 1:
+                    ln, lt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                              Uf[1], mu[i], 0.0, 0.0)
+                    ok = ok and not _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
+                                             0.0, 0.0)
+                    lam[1] = lt
                 else:
-                    ok = _invert_gj(M, Mi, wk, n)
-                have_mi = True
+                    ln, lt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, 0.0,
+                                              0.0)
                 if not ok:
-                    status = SINGULAR
-                    break
-                contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
-                m = na + nfa
+                    return PAINLEVE
+                lam[0] = ln
+                lamN[i] = ln
+                lamT[i] = lt
+            else:
+                L = _lcp_size(nb, ib, mu, base, trow)
+                lst, piv, res, warm = lcp_step(Wd, Uf, nb, ib, mu, lam, lamN, lamT, L, base,
+                                                trow, Ml3, ql, dl, zl, wl, rayl, work, iwork,
+                                                lay3, lcp_ctl, Ab, xb, idx, pcol, False)
+                if lst != 0:
+                    return LCP_HANDBACK
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
+            for i in range(n):
+                acc_v = dx0[i]
+                for c in range(mb):
+                    acc_v += JiHT[i, c] * lam[c]
+                dx0[i] = acc_v
+            # the slip at v*: the impulse stage replaces it where it runs
+            for rr in range(nfb):
+                acc_v = Uf[nb + rr]
+                for c in range(mb):
+                    acc_v += Wd[nb + rr, c] * lam[c]
+                slip[fb[rr]] = acc_v
+        dmax = 0.0
+        xmax = 0.0
+        for i in range(n):
+            x[i] += dx0[i]
+            dmax = max(dmax, abs(dx0[i]))
+            xmax = max(xmax, abs(x[i]))
+        if dmax <= NEWTON_RTOL * max(1.0, xmax):
+            converged = True
+            break
+    if not converged:
+        return CONVERGENCE
+    for i in range(n):
+        a1[i] = cfac * x[i] + (af * acc[i] - am * a[i]) / (1.0 - am)
+        qs[i] = q[i] + hk * v[i] + hk * hk * ((0.5 - beta) * a[i] + beta * a1[i])
+        vs[i] = v[i] + hk * ((1.0 - gamma) * a[i] + gamma * a1[i])
+        v1[i] = vs[i]
+        q1[i] = qs[i]
+    # -- contacts at the predicted position
+    na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
+    nfa = 0
+    for i in range(nc):
+        pNi[i] = 0.0
+        pTi[i] = 0.0
+    if nc > 0:
+        if HAS_GAPS:  # noqa: F821
+            gaps_fn(par, qs, t1, Gs)  # noqa: F821
+        else:
+            contacts_fn(par, qs, t1, Gs, True, False)  # noqa: F821
+        for i in range(nc):
+            if Gs[i, 0] <= CONTACT_TOL or closed[i]:
+                ia[na] = i
+                na += 1
+                if mu[i] > 0.0:
+                    fa[nfa] = i
+                    nfa += 1
+    if na > 0:
+        # a contact carrying a smooth normal force meets its law at v* already: the
+        # impulse problem is solved only when an active contact carries none
+        need = False
+        for rr in range(na):
+            if not lamN[ia[rr]] > 0.0:
+                need = True
+        have_mi = False
+        if need:
+            contacts_fn(par, q, tk, G0, False, False)  # noqa: F821
+            for i in range(nc):
+                acc_v = G0[i, 1]
+                for j in range(n):
+                    acc_v += G0[i, 3 + j] * v[j]
+                vN0[i] = acc_v
+            mass_fn(par, qs, M)  # noqa: F821
+            if n <= 3:
+                ok = _invert_small(M, Mi, n)
+            else:
+                ok = _invert_gj(M, Mi, wk, n)
+            have_mi = True
+            if not ok:
+                return SINGULAR
+            contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
+            m = na + nfa
+            for rr in range(na):
+                i = ia[rr]
+                for j in range(n):
+                    H[rr, j] = Gs[i, 3 + j]
+                w[rr] = Gs[i, 1]
+            for rr in range(nfa):
+                i = fa[rr]
+                for j in range(n):
+                    H[na + rr, j] = Gs[i, 3 + n + j]
+                w[na + rr] = Gs[i, 2]
+            for c in range(m):
+                for i in range(n):
+                    acc_v = 0.0
+                    for j in range(n):
+                        acc_v += Mi[i, j] * H[c, j]
+                    MiHT[i, c] = acc_v
+            for rr in range(m):
+                acc_v = w[rr]
+                for j in range(n):
+                    acc_v += H[rr, j] * vs[j]
+                Uf[rr] = acc_v
+                for c in range(m):
+                    acc_v = 0.0
+                    for j in range(n):
+                        acc_v += H[rr, j] * MiHT[j, c]
+                    Wd[rr, c] = acc_v
+            if na == 1 and not force_lemke:
+                i = ia[0]
+                stats[S_LCP] += 1.0
+                stats[S_DIRECT] += 1.0
+                if nfa == 1:
+                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
+                                              Uf[1], mu[i], e[i], vN0[i])
+                    if not ok or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
+                                          e[i], vN0[i]):
+                        return PAINLEVE
+                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
+                                    e[i], vN0[i], pn, pt)
+                    p[0] = pn
+                    p[1] = pt
+                else:
+                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
+                                              vN0[i])
+                    if not ok:
+                        return PAINLEVE
+                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
+                                    0.0)
+                    p[0] = pn
+                pNi[i] = pn
+                pTi[i] = pt
+            else:
                 for rr in range(na):
                     i = ia[rr]
-                    for j in range(n):
-                        H[rr, j] = Gs[i, 3 + j]
-                    w[rr] = Gs[i, 1]
-                for rr in range(nfa):
-                    i = fa[rr]
-                    for j in range(n):
-                        H[na + rr, j] = Gs[i, 3 + n + j]
-                    w[na + rr] = Gs[i, 2]
+                    if e[i] > 0.0:
+                        Uf[rr] += e[i] * min(vN0[i], 0.0)
+                L = _lcp_size(na, ia, mu, base, trow)
+                lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pNi, pTi, L, base, trow,
+                                                Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                                lcp_ctl, Ab, xb, idx, pcol, False)
+                if lst != 0:
+                    return LCP_HANDBACK
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
+                for rr in range(na):
+                    if e[ia[rr]] > 0.0:
+                        Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+            for i in range(n):
+                acc_v = vs[i]
                 for c in range(m):
-                    for i in range(n):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += Mi[i, j] * H[c, j]
-                        MiHT[i, c] = acc_v
-                for rr in range(m):
-                    acc_v = w[rr]
-                    for j in range(n):
-                        acc_v += H[rr, j] * vs[j]
-                    Uf[rr] = acc_v
-                    for c in range(m):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += H[rr, j] * MiHT[j, c]
-                        Wd[rr, c] = acc_v
-                if na == 1 and not force_lemke:
-                    i = ia[0]
-                    stats[S_LCP] += 1.0
-                    stats[S_DIRECT] += 1.0
-                    if nfa == 1:
-                        pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                                  Uf[1], mu[i], e[i], vN0[i])
-                        if not ok or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
-                                              e[i], vN0[i]):
-                            status = PAINLEVE
-                            break
-                        res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
-                                        e[i], vN0[i], pn, pt)
-                        p[0] = pn
-                        p[1] = pt
-                    else:
-                        pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
-                                                  vN0[i])
-                        if not ok:
-                            status = PAINLEVE
-                            break
-                        res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
-                                        0.0)
-                        p[0] = pn
-                    pN[i] = pn
-                    pT[i] = pt
-                else:
-                    for rr in range(na):
-                        i = ia[rr]
-                        if e[i] > 0.0:
-                            Uf[rr] += e[i] * min(vN0[i], 0.0)
-                    L = _lcp_size(na, ia, mu, base, trow)
-                    lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                                    Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                                    lcp_ctl, Ab, xb, idx, pcol, False)
-                    if lst != 0:
-                        status = LCP_HANDBACK
-                        break
-                    stats[S_PIVOTS] += piv
-                    stats[S_LCP] += 1.0
-                    for rr in range(na):
-                        if e[ia[rr]] > 0.0:
-                            Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
-                if res > stats[S_RES]:
-                    stats[S_RES] = res
-                for i in range(n):
-                    acc_v = vs[i]
-                    for c in range(m):
-                        acc_v += MiHT[i, c] * p[c]
-                    v1[i] = acc_v
-                for rr in range(nfa):
-                    tr = na + rr
-                    acc_v = Uf[tr]
-                    for c in range(m):
-                        acc_v += Wd[tr, c] * p[c]
-                    slip[fa[rr]] = acc_v
-            if position_level:
-                # Gauss-Newton with complementarity on the active contacts' gaps
-                for _ in range(POSITION_MAXITER):
-                    if HAS_GAPS:  # noqa: F821
-                        gaps_fn(par, q1, t1, Gq)  # noqa: F821
-                    else:
-                        contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
-                    # done when no gap is negative and every held contact's gap is zero
-                    gmin = 0.0
-                    gheld = 0.0
-                    for rr in range(na):
-                        gmin = min(gmin, Gq[ia[rr], 0])
-                        if lamN[ia[rr]] > 0.0:
-                            gheld = max(gheld, abs(Gq[ia[rr], 0]))
-                    if gmin >= -POSITION_TOL and gheld <= POSITION_TOL:
-                        break
-                    if not have_mi:
-                        mass_fn(par, qs, M)  # noqa: F821
-                        if n <= 3:
-                            ok = _invert_small(M, Mi, n)
-                        else:
-                            ok = _invert_gj(M, Mi, wk, n)
-                        have_mi = True
-                        if not ok:
-                            status = SINGULAR
-                            break
-                    if n > 0:
-                        contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
-                    for c in range(na):
-                        for i in range(n):
-                            acc_v = 0.0
-                            for j in range(n):
-                                acc_v += Mi[i, j] * Gq[ia[c], 3 + j]
-                            X[i, c] = acc_v
-                        gn[c] = Gq[ia[c], 0]
-                    for rr in range(na):
-                        for c in range(na):
-                            acc_v = 0.0
-                            for j in range(n):
-                                acc_v += Gq[ia[rr], 3 + j] * X[j, c]
-                            Wn[rr, c] = acc_v
-                    ne = 0
-                    nun = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-                    for rr in range(na):
-                        if lamN[ia[rr]] > 0.0:
-                            eqr[ne] = rr
-                            ne += 1
-                        else:
-                            unr[nun] = rr
-                            iu[nun] = ia[rr]
-                            nun += 1
-                    if na == 1:
-                        if ne == 1:
-                            nu[0] = -gn[0] / Wn[0, 0]
-                        else:
-                            nu[0] = max(0.0, -gn[0] / Wn[0, 0])
-                    elif ne == 0:
-                        L2 = _lcp_size(na, ia, mu0, base, trow)
-                        lst, piv, res, warm = _lcp_step(Wn, gn, na, ia, mu0, nu, nuN, nuT, L2,
-                                                        base, trow, Ml2, ql, dl, zl, wl, rayl,
-                                                        work, iwork, lay2, lcp_ctl, Ab, xb, idx,
-                                                        pcol, False)
-                        if lst != 0:
-                            status = LCP_HANDBACK
-                            break
-                    else:
-                        # g = 0 on the held rows (nu of either sign): their nu eliminated
-                        for a_ in range(ne):
-                            for b_ in range(ne):
-                                Wee[a_, b_] = Wn[eqr[a_], eqr[b_]]
-                        if ne <= 3:
-                            ok = _invert_small(Wee, Weei, ne)
-                        else:
-                            ok = _invert_gj(Wee, Weei, wke, ne)
-                        if not ok:
-                            status = SINGULAR
-                            break
-                        if nun > 0:
-                            for a_ in range(nun):
-                                ra = unr[a_]
-                                for b_ in range(ne):
-                                    acc_v = 0.0
-                                    for c_ in range(ne):
-                                        acc_v += Wn[ra, eqr[c_]] * Weei[c_, b_]
-                                    tmpe[b_] = acc_v
-                                acc_v = gn[ra]
-                                for b_ in range(ne):
-                                    acc_v -= tmpe[b_] * gn[eqr[b_]]
-                                gs2[a_] = acc_v
-                                for c in range(nun):
-                                    acc_v = Wn[ra, unr[c]]
-                                    for b_ in range(ne):
-                                        acc_v -= tmpe[b_] * Wn[eqr[b_], unr[c]]
-                                    Ws[a_, c] = acc_v
-                            L2 = _lcp_size(nun, iu, mu0, base, trow)
-                            lst, piv, res, warm = _lcp_step(Ws, gs2, nun, iu, mu0, nuu, nuN, nuT,
-                                                            L2, base, trow, Ml2, ql, dl, zl, wl,
-                                                            rayl, work, iwork, lay2, lcp_ctl, Ab,
-                                                            xb, idx, pcol, False)
-                            if lst != 0:
-                                status = LCP_HANDBACK
-                                break
-                            for a_ in range(nun):
-                                nu[unr[a_]] = nuu[a_]
-                        for a_ in range(ne):
-                            acc_v = gn[eqr[a_]]
-                            for c in range(nun):
-                                acc_v += Wn[eqr[a_], unr[c]] * nuu[c]
-                            tmpe[a_] = acc_v
-                        for a_ in range(ne):
-                            acc_v = 0.0
-                            for b_ in range(ne):
-                                acc_v -= Weei[a_, b_] * tmpe[b_]
-                            nu[eqr[a_]] = acc_v
-                    for i in range(n):
-                        acc_v = 0.0
-                        for c in range(na):
-                            acc_v += X[i, c] * nu[c]
-                        q1[i] += acc_v
-                if status != OK:
-                    break
-        finite = True
-        for i in range(n):
-            if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-                finite = False
-        if not finite:
-            status = NUMERICAL
-            break
-        if nc > 0:
-            if HAS_GAPS:  # noqa: F821
-                gaps_fn(par, q1, t1, Gq)  # noqa: F821
-            else:
-                contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
-            for i in range(nc):
-                if -Gq[i, 0] > stats[S_PEN]:
-                    stats[S_PEN] = -Gq[i, 0]
-                # the step's whole percussion: smooth force over the step plus the impulse
-                PN[i] = hk * lamN[i] + pN[i]
-                PT[i] = hk * lamT[i] + pT[i]
-                reg[i] = _classify(PN[i], PT[i], mu[i])
-        if record_initial:
-            if nc > 0:
+                    acc_v += MiHT[i, c] * p[c]
+                v1[i] = acc_v
+            for rr in range(nfa):
+                tr = na + rr
+                acc_v = Uf[tr]
+                for c in range(m):
+                    acc_v += Wd[tr, c] * p[c]
+                slip[fa[rr]] = acc_v
+        if position_level:
+            # Gauss-Newton with complementarity on the active contacts' gaps
+            for _ in range(POSITION_MAXITER):
                 if HAS_GAPS:  # noqa: F821
-                    gaps_fn(par, q, tk, G0)  # noqa: F821
+                    gaps_fn(par, q1, t1, Gq)  # noqa: F821
                 else:
-                    contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, reg, PN, PT, hk, slip, G0, n, nc)
-            nrec += 1
-            record_initial = False
+                    contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                # done when no gap is negative and every held contact's gap is zero
+                gmin = 0.0
+                gheld = 0.0
+                for rr in range(na):
+                    gmin = min(gmin, Gq[ia[rr], 0])
+                    if lamN[ia[rr]] > 0.0:
+                        gheld = max(gheld, abs(Gq[ia[rr], 0]))
+                if gmin >= -POSITION_TOL and gheld <= POSITION_TOL:
+                    break
+                if not have_mi:
+                    mass_fn(par, qs, M)  # noqa: F821
+                    if n <= 3:
+                        ok = _invert_small(M, Mi, n)
+                    else:
+                        ok = _invert_gj(M, Mi, wk, n)
+                    have_mi = True
+                    if not ok:
+                        return SINGULAR
+                if n > 0:
+                    contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                for c in range(na):
+                    for i in range(n):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += Mi[i, j] * Gq[ia[c], 3 + j]
+                        X[i, c] = acc_v
+                    gn[c] = Gq[ia[c], 0]
+                for rr in range(na):
+                    for c in range(na):
+                        acc_v = 0.0
+                        for j in range(n):
+                            acc_v += Gq[ia[rr], 3 + j] * X[j, c]
+                        Wn[rr, c] = acc_v
+                ne = 0
+                nun = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
+                for rr in range(na):
+                    if lamN[ia[rr]] > 0.0:
+                        eqr[ne] = rr
+                        ne += 1
+                    else:
+                        unr[nun] = rr
+                        iu[nun] = ia[rr]
+                        nun += 1
+                if na == 1:
+                    if ne == 1:
+                        nu[0] = -gn[0] / Wn[0, 0]
+                    else:
+                        nu[0] = max(0.0, -gn[0] / Wn[0, 0])
+                elif ne == 0:
+                    L2 = _lcp_size(na, ia, mu0, base, trow)
+                    lst, piv, res, warm = lcp_step(Wn, gn, na, ia, mu0, nu, nuN, nuT, L2,
+                                                    base, trow, Ml2, ql, dl, zl, wl, rayl,
+                                                    work, iwork, lay2, lcp_ctl, Ab, xb, idx,
+                                                    pcol, False)
+                    if lst != 0:
+                        return LCP_HANDBACK
+                else:
+                    # g = 0 on the held rows (nu of either sign): their nu eliminated
+                    for a_ in range(ne):
+                        for b_ in range(ne):
+                            Wee[a_, b_] = Wn[eqr[a_], eqr[b_]]
+                    if ne <= 3:
+                        ok = _invert_small(Wee, Weei, ne)
+                    else:
+                        ok = _invert_gj(Wee, Weei, wke, ne)
+                    if not ok:
+                        return SINGULAR
+                    if nun > 0:
+                        for a_ in range(nun):
+                            ra = unr[a_]
+                            for b_ in range(ne):
+                                acc_v = 0.0
+                                for c_ in range(ne):
+                                    acc_v += Wn[ra, eqr[c_]] * Weei[c_, b_]
+                                tmpe[b_] = acc_v
+                            acc_v = gn[ra]
+                            for b_ in range(ne):
+                                acc_v -= tmpe[b_] * gn[eqr[b_]]
+                            gs2[a_] = acc_v
+                            for c in range(nun):
+                                acc_v = Wn[ra, unr[c]]
+                                for b_ in range(ne):
+                                    acc_v -= tmpe[b_] * Wn[eqr[b_], unr[c]]
+                                Ws[a_, c] = acc_v
+                        L2 = _lcp_size(nun, iu, mu0, base, trow)
+                        lst, piv, res, warm = lcp_step(Ws, gs2, nun, iu, mu0, nuu, nuN, nuT,
+                                                        L2, base, trow, Ml2, ql, dl, zl, wl,
+                                                        rayl, work, iwork, lay2, lcp_ctl, Ab,
+                                                        xb, idx, pcol, False)
+                        if lst != 0:
+                            return LCP_HANDBACK
+                        for a_ in range(nun):
+                            nu[unr[a_]] = nuu[a_]
+                    for a_ in range(ne):
+                        acc_v = gn[eqr[a_]]
+                        for c in range(nun):
+                            acc_v += Wn[eqr[a_], unr[c]] * nuu[c]
+                        tmpe[a_] = acc_v
+                    for a_ in range(ne):
+                        acc_v = 0.0
+                        for b_ in range(ne):
+                            acc_v -= Weei[a_, b_] * tmpe[b_]
+                        nu[eqr[a_]] = acc_v
+                for i in range(n):
+                    acc_v = 0.0
+                    for c in range(na):
+                        acc_v += X[i, c] * nu[c]
+                    q1[i] += acc_v
+    finite = True
+    for i in range(n):
+        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
+            finite = False
+    if not finite:
+        return NUMERICAL
+    if nc > 0:
+        if HAS_GAPS:  # noqa: F821
+            gaps_fn(par, q1, t1, Gq)  # noqa: F821
+        else:
+            contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
         for i in range(nc):
-            closed[i] = pN[i] > 0.0 or lamN[i] > 0.0
-        for j in range(n):
-            q[j] = q1[j]
-            v[j] = v1[j]
-            a[j] = a1[j]
-            acc[j] = x[j]
-        k += 1
-        to_save -= 1
-        if to_save == 0:
-            to_save = save_every
-        if to_save == save_every or last:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t1, q, v, reg, PN, PT, hk, slip, Gq, n, nc)
-            nrec += 1
-        if last:
-            break
-    return status, k, nrec
+            if -Gq[i, 0] > stats[S_PEN]:
+                stats[S_PEN] = -Gq[i, 0]
+            # the step's whole percussion: smooth force over the step plus the impulse
+            pN[i] = hk * lamN[i] + pNi[i]
+            pT[i] = hk * lamT[i] + pTi[i]
+            reg[i] = _classify(pN[i], pT[i], mu[i])
+    if k == k0 and nc > 0:
+        # the gaps at the call's first state, which the driver records there
+        if HAS_GAPS:  # noqa: F821
+            gaps_fn(par, q, tk, G0)  # noqa: F821
+        else:
+            contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
+    for i in range(nc):
+        closed[i] = pNi[i] > 0.0 or lamN[i] > 0.0
+    for j in range(n):
+        a[j] = a1[j]
+        acc[j] = x[j]
+    return OK
+
+
+nsga_loop = loop_template("nsga_loop", globals())

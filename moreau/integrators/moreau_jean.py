@@ -466,8 +466,8 @@ class MoreauJean(TimeStepping):
 
     def _fast_block(self):
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
-        status = self._run_block(mj_loop, (q, v, self.theta, self.projection, closed),
-                                 (self._lcp_ctl,))
+        status = self._run_block(mj_loop, (q, v, (float(self.theta), bool(self.projection)),
+                                           (closed,)), (self._lcp_ctl,))
         self.q, self.v, self._closed = q, v, closed
         # Lemke failed on this step: the generic step solves it (QP fallback with
         # lcp_method="auto", an LCPError with "lemke"), then the loop resumes.

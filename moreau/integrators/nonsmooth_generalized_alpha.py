@@ -215,8 +215,8 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
     def _fast_block(self):
         q, v, a, acc = self.q.copy(), self.v.copy(), self._a.copy(), self._acc.copy()
         closed = self._closed.copy()
-        status = self._run_block(nsga_loop, (q, v, a, acc, self._coef, closed),
-                                 (self.position_level, self._lcp_ctl))
+        status = self._run_block(nsga_loop, (q, v, (self._coef, bool(self.position_level)),
+                                             (a, acc, closed)), (self._lcp_ctl,))
         self.q, self.v, self._a, self._acc, self._closed = q, v, a, acc, closed
         self._after_block(status, handback=(LCP_HANDBACK, PAINLEVE, CONVERGENCE),
                           singular="a singular mass or iteration matrix at t = {t!r}")

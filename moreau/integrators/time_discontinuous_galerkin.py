@@ -225,8 +225,8 @@ class TimeDiscontinuousGalerkin(TimeStepping):
     def _fast_block(self):
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         c_st, a_st, b_st = LOBATTO_TABLEAUS[self.degree]
-        status = self._run_block(tdg_loop, (q, v, closed),
-                                 (c_st, a_st, b_st, self.projection, self._lcp_ctl))
+        status = self._run_block(tdg_loop, (q, v, (c_st, a_st, b_st, bool(self.projection)),
+                                            (closed,)), (self._lcp_ctl,))
         self.q, self.v, self._closed = q, v, closed
         self._after_block(status, numerical=EXPLICIT_BLOWUP)
 

@@ -1,0 +1,281 @@
+"""The compiled driver of the fixed-step schemes: one loop, each scheme's step rule inside it.
+
+:func:`drive` owns what every fixed-step scheme's loop repeated: the time
+grid (:func:`grid_step`), the state and contact buffers, the step limit of a
+call, the save countdown, the recording of the samples (and of the initial
+state), the hand-back statuses (a step rule that returns a status other
+than :data:`OK` stops the call at the start of that step) and the regimes
+kept from one call to the next in the contact problem's control array.
+
+A scheme's kernel module gives two functions under fixed names and builds its
+loop template with :func:`loop_template`:
+
+- ``step_workspace(n, nc, opts, lcp_ctl)``: its buffers, one tuple, allocated once a call;
+- ``step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS,
+  CONST_MASS, HAS_JAC, HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo,
+  lcp_ctl, stats, k, k0, tk, t1, hk, q, v, out)``, inlined
+  (``numba.njit(inline="always")``): one step from ``(q, v)`` at ``tk`` to
+  ``(q1, v1)`` at ``t1``, ``out`` being ``(q1, v1, pN, pT, slip, reg, G0,
+  Gq)``. It writes the impulses ``pN``, ``pT``, the slip velocities, the
+  regimes, the contact rows at the start (``G0``, whose gap column the driver
+  carries over from the step before) and the gaps at the end (``Gq``'s column
+  0), and returns a status. ``opts`` is a
+  tuple of the scheme's options and ``memo`` a tuple of the arrays it
+  carries from one call to the next (Moreau–Jean's closed contacts).
+
+The model comes first in the step rule's arguments, as the driver has it:
+frozen globals in a model's own (specialised) loop, run-time arguments in the
+scheme's shared loop (:mod:`moreau.integrators._loops` compiles the one
+template both ways). :func:`loop_template` splices the step rule's source into
+the driver's: its statements before the marker ``...`` run once a call, before
+the loop, the rest once a step, so that the workspace is unpacked once.
+"""
+
+import ast
+import inspect
+import textwrap
+
+import numpy as np
+from numba import njit
+
+from ._contact_step import CTL_IA, OK
+
+__all__ = ["drive", "grid_step", "record_sample", "loop_template", "STEP_FUNCTIONS"]
+
+#: the names under which a scheme module gives its step (see the module docstring)
+STEP_FUNCTIONS = ("step_workspace", "step_rule")
+
+
+@njit(inline="always")
+def grid_step(t0, k, h, t_bound):
+    """``(t_k, t_{k+1}, step, last)`` of the fixed-step grid ``t0 + k h``, the last step cut at
+    ``t_bound``: the compiled loops' twin of :func:`moreau.integrators.moreau_jean.next_time`."""
+    tk = t0 + k * h
+    t1 = t0 + (k + 1) * h
+    if t1 >= t_bound - 1e-9 * h:
+        return tk, t_bound, t_bound - tk, True
+    return tk, t1, h, False
+
+
+@njit(cache=True)
+def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
+                  reg, pN, pT, h, slip, G, n, nc):
+    """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
+    forces (impulse / step), the slip velocity and the gap (column 0 of ``G``)."""
+    rec_t[nrec] = t
+    for j in range(n):
+        rec_q[nrec, j] = q[j]
+        rec_v[nrec, j] = v[j]
+    for i in range(nc):
+        rec_reg[nrec, i] = reg[i]
+        rec_fN[nrec, i] = pN[i] / h
+        rec_fT[nrec, i] = pT[i] / h
+        rec_slip[nrec, i] = slip[i]
+        rec_gap[nrec, i] = G[i, 0]
+
+
+def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, record_initial,
+          lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, stats):
+    """Run up to ``nmax`` steps of a scheme's step rule on a compiled model in one call.
+
+    A template, not called as it stands (see the module docstring):
+    :func:`moreau.integrators._loops.runner_for` compiles it for a scheme
+    (:func:`loop_template`) with the model's functions ``mass_fn``,
+    ``forces_fn``, ``contacts_fn``, ``gaps_fn`` and sizes ``NDOF``,
+    ``NCONTACTS``, ``CONST_MASS``, ``HAS_JAC``, ``HAS_GAPS`` either frozen in
+    or as leading arguments.
+
+    Parameters
+    ----------
+    par : float64[:]
+        The model's parameters.
+    mu, e : float64[:]
+        Friction and restitution of each contact.
+    t0, h, t_bound : float
+        Grid ``t0 + k h``; the step that reaches ``t_bound`` is cut there.
+    k0 : int
+        Index of the first step (``t_k0 = t0 + k0 h``).
+    nmax : int
+        Most steps to take in this call.
+    q, v : float64[n]
+        State at ``t_k0``; overwritten with the final state.
+    opts : tuple
+        The scheme's options (Moreau–Jean: ``(theta, projection)``).
+    memo : tuple of arrays
+        What the scheme carries from one call to the next (Moreau–Jean:
+        ``(closed,)``, the contacts that carried a normal impulse in the step
+        before); updated.
+    save_every : int
+        Record after every ``save_every``-th step (counted from ``t0``) and after the last.
+    record_initial : bool
+        Also record the state at ``t_k0`` (with the first step's regime and forces).
+    lcp_ctl : int64[:]
+        The contact problem's options, warm-start memory and the regimes of
+        the step before
+        (:func:`moreau.integrators._contact_step.new_lcp_control`), read and
+        updated; the caller keeps the array from one call to the next.
+    rec_* : arrays
+        Sample buffers, ``rec_q``/``rec_v`` of shape (ns, n), the contact
+        ones (ns, nc); long enough for this call's samples.
+    stats : float64[:]
+        Accumulated statistics, layout
+        :data:`moreau.integrators._contact_step.STAT_NAMES`.
+
+    Returns
+    -------
+    status : int
+        ``OK`` or the step rule's status (``PAINLEVE``, ``NUMERICAL``,
+        ``SINGULAR``: the state is the last good one; ``LCP_HANDBACK``: the
+        start of the step the contact problem could not solve).
+    k : int
+        Index of the next step (steps taken: ``k - k0``).
+    nrec : int
+        Samples written.
+    """
+    n = NDOF  # noqa: F821  (the model's namespace, see above)
+    nc = NCONTACTS  # noqa: F821
+    ncm = max(nc, 1)
+    ws = step_workspace(n, nc, opts, lcp_ctl)  # noqa: F821  (the scheme's module)
+    q1 = np.empty(n)
+    v1 = np.empty(n)
+    pN = np.zeros(ncm)
+    pT = np.zeros(ncm)
+    slip = np.zeros(ncm)
+    reg = np.zeros(ncm, dtype=np.int64)
+    # contact rows (g, wN, wT, WN, WT) at (q_k, t_k) and the gaps at (q_k+1, t_k+1)
+    G0 = np.zeros((ncm, 3 + 2 * n))
+    Gq = np.zeros((ncm, 3 + 2 * n))
+    # one argument for all: a call of more than thirty is passed as a tuple by CPython,
+    # which numba cannot inline
+    out = (q1, v1, pN, pT, slip, reg, G0, Gq)
+    # the regime of each contact in the step before (a tangential impact stops a slip)
+    roff = CTL_IA + 5 * ncm
+    for i in range(nc):
+        reg[i] = lcp_ctl[roff + i]
+    nrec = 0
+    k = k0
+    status = OK
+    # steps left until the next sample (k % save_every == 0 after the step): a
+    # countdown, because an integer division per step costs as much as a sine
+    to_save = save_every - k0 % save_every
+    while k - k0 < nmax:
+        tk, t1, hk, last = grid_step(t0, k, h, t_bound)
+        if tk >= t_bound:
+            break
+        status = step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn,  # noqa: F821
+                           NDOF, NCONTACTS, CONST_MASS, HAS_JAC, HAS_GAPS,  # noqa: F821
+                           _lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats,  # noqa: F821
+                           k, k0, tk, t1, hk, q, v, out)
+        if status != OK:
+            break
+        if record_initial:
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
+            nrec += 1
+            record_initial = False
+        for i in range(nc):
+            G0[i, 0] = Gq[i, 0]
+        for j in range(n):
+            q[j] = q1[j]
+            v[j] = v1[j]
+        k += 1
+        to_save -= 1
+        if to_save == 0:
+            to_save = save_every
+        if to_save == save_every or last:
+            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
+                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
+            nrec += 1
+        if last:
+            break
+    for i in range(nc):
+        lcp_ctl[roff + i] = reg[i]
+    return status, k, nrec
+
+
+def loop_template(name, namespace):
+    """The driver with the step rule of the scheme module whose globals are ``namespace`` spliced in.
+
+    The module holds :data:`STEP_FUNCTIONS` and ``_lcp_step`` (a shared loop
+    may take it as an argument, see
+    :data:`moreau.integrators._contact_step.SHARED_INDIRECT`); the driver's
+    own names are added to ``namespace`` where it lacks them.
+
+    The step rule's source is spliced into the driver's, not called: its
+    statements before the marker ``...`` (unpacking the workspace, the
+    options and the memory) go before the loop, the rest into the loop, each
+    ``return X`` becoming ``status = X`` and a break out of the step. Called
+    (even inlined by numba), the step rule unpacked its workspace on every
+    step, and the reference counts of its thirty arrays made a step of the
+    friction drive about six times slower. The template's qualified name is
+    ``name`` (numba names a function's disk-cache files after it); its source
+    is kept in ``__moreau_source__`` for the shared loop's rewrite.
+    """
+    for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
+        namespace.setdefault(own, globals()[own])
+    tree = ast.parse(textwrap.dedent(inspect.getsource(drive)))
+    fdef = tree.body[0]
+    fdef.name = name
+    step = namespace["step_rule"].py_func
+    sdef = ast.parse(textwrap.dedent(inspect.getsource(step))).body[0]
+    body = sdef.body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        body = body[1:]
+    mark = next(i for i, st in enumerate(body) if isinstance(st, ast.Expr)
+                and isinstance(st.value, ast.Constant) and st.value.value is Ellipsis)
+    setup, per_step = body[:mark], body[mark + 1:]
+    if per_step and isinstance(per_step[-1], ast.Return):
+        per_step = per_step[:-1]       # the step's `return OK`
+    per_step = _returns_to_breaks(per_step)
+    loop_at = next(i for i, st in enumerate(fdef.body) if isinstance(st, ast.While))
+    loop = fdef.body[loop_at]
+    at = next(i for i, st in enumerate(loop.body) if isinstance(st, ast.Assign)
+              and isinstance(st.value, ast.Call) and isinstance(st.value.func, ast.Name)
+              and st.value.func.id == "step_rule")
+    call = loop.body[at].value
+    params = [a.arg for a in sdef.args.args]
+    binds = [ast.Assign(targets=[ast.Name(id=p, ctx=ast.Store())], value=arg)
+             for p, arg in zip(params, call.args)
+             if not (isinstance(arg, ast.Name) and arg.id == p)]
+    loop.body[at:at + 1] = per_step
+    fdef.body[loop_at:loop_at] = binds + setup
+    ast.fix_missing_locations(tree)
+    source = ast.unparse(tree)
+    code = compile(source, drive.__code__.co_filename, "exec")
+    scope = {}
+    exec(code, namespace, scope)  # noqa: S102  (the package's own driver and step rule)
+    fn = scope[name]
+    fn.__qualname__ = name
+    fn.__module__ = namespace["__name__"]
+    fn.__doc__ = drive.__doc__
+    fn.__moreau_source__ = source
+    return fn
+
+
+def _has_return(stmts):
+    return any(isinstance(n, ast.Return) for st in stmts for n in ast.walk(st))
+
+
+def _returns_to_breaks(stmts):
+    """``return X`` -> ``status = X; break``, and after every loop that held one, a break on."""
+    out = []
+    for st in stmts:
+        if isinstance(st, ast.Return):
+            out.append(ast.Assign(targets=[ast.Name(id="status", ctx=ast.Store())],
+                                  value=st.value))
+            out.append(ast.Break())
+        elif isinstance(st, (ast.For, ast.While)):
+            had = _has_return(st.body)
+            st.body = _returns_to_breaks(st.body)
+            st.orelse = _returns_to_breaks(st.orelse)
+            out.append(st)
+            if had:
+                out.append(ast.parse("if status != OK:\n    break").body[0])
+        elif isinstance(st, ast.If):
+            st.body = _returns_to_breaks(st.body)
+            st.orelse = _returns_to_breaks(st.orelse)
+            out.append(st)
+        else:
+            out.append(st)
+    return out
