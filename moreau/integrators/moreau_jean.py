@@ -223,6 +223,25 @@ def _new_counters():
             "warm_starts": 0, "tangential_impacts": 0, "tangential_impact_times": []}
 
 
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class ThetaOptions(FixedStepOptions):
+    """The options of the Moreau–Jean family's θ-method step, beyond a fixed-step scheme's.
+
+    Examples
+    --------
+    >>> MoreauJean.Options(h=0.1, theta=0.5).smooth_order()
+    2
+    """
+    theta: float = 1.0
+    closed0: object = None
+    lemke_max_iter: int | None = None
+    lcp_warm_start: bool = True
+
+    def smooth_order(self):
+        # the trapezoidal rule at theta = 1/2, a first-order theta-method otherwise
+        return 2 if self.theta == 0.5 else 1
+
+
 @register_integrator("moreau-jean")
 class MoreauJean(TimeStepping):
     """Moreau–Jean theta-scheme with velocity-level Newton impacts and exact 2D Coulomb friction.
@@ -318,18 +337,11 @@ class MoreauJean(TimeStepping):
     """
 
     @dataclasses.dataclass(frozen=True, kw_only=True)
-    class Options(FixedStepOptions):
+    class Options(ThetaOptions):
         """Options of :class:`MoreauJean` (those of every fixed-step scheme,
-        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, and its own)."""
-        theta: float = 1.0
+        :class:`~moreau.integrators.time_stepping.FixedStepOptions`, the
+        θ-method's, :class:`ThetaOptions`, and ``projection``)."""
         projection: bool = False
-        closed0: object = None
-        lemke_max_iter: int | None = None
-        lcp_warm_start: bool = True
-
-        def smooth_order(self):
-            # the trapezoidal rule at theta = 1/2, a first-order theta-method otherwise
-            return 2 if self.theta == 0.5 else 1
 
     def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound, options, **keywords)

@@ -39,14 +39,15 @@ inside the compiled driver (:mod:`moreau.integrators._driver`); the Python
 class reuses Moreau–Jean's and replaces its projection (:meth:`_project`).
 """
 
+import dataclasses
 import math
 
 import numpy as np
 from numba import njit
 
-from ..errors import InputError, LCPError
+from ..errors import LCPError
 from ..lcp import solve_lcp
-from .base import register_integrator, scheme_options
+from .base import register_integrator
 from ._contact_step import (LCP_HANDBACK, NUMERICAL, OK, S_PEN, S_PROJ,  # noqa: F401
                             SHARED_INDIRECT, _lcp_size, _lcp_step, _lcp_step_unused,
                             lcp_buffers)
@@ -54,7 +55,7 @@ from ._driver import loop_template
 from ._mj_kernels import _invert_gj, _invert_small
 from ._mj_kernels import step_rule as _mj_step
 from ._mj_kernels import step_workspace as _mj_workspace
-from .moreau_jean import MoreauJean
+from .moreau_jean import MoreauJean, ThetaOptions
 
 __all__ = ["MoreauJeanProjected", "mjp_loop"]
 
@@ -203,17 +204,14 @@ class MoreauJeanProjected(MoreauJean):
     ('moreau-jean-projected', True)
     """
 
-    #: Moreau–Jean's options but ``projection``
-    options = tuple(o for o in scheme_options(MoreauJean) if o != "projection")
+    @dataclasses.dataclass(frozen=True, kw_only=True)
+    class Options(ThetaOptions):
+        """Moreau–Jean's options but ``projection``: this scheme always projects."""
+
+    #: read by Moreau–Jean's step: this scheme always projects (its own :meth:`_project`)
+    projection = True
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000),
                         (100, 300, 1000), {})
-
-    def __init__(self, scene, t0, q0, v0, t_bound, h=None, theta=1.0, **options):
-        if "projection" in options:
-            raise InputError("`projection` is not an option of moreau-jean-projected, which "
-                             "always projects; use moreau-jean for projection=True or False")
-        super().__init__(scene, t0, q0, v0, t_bound, h=h, theta=theta, projection=True,
-                         **options)
 
     def _fast_block(self):
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
