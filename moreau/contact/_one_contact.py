@@ -2,9 +2,9 @@
 
 The case analysis (:func:`_one_contact`), the tangential-impact test
 (:func:`_jam`) and the one-contact residual (:func:`_residual`) that
-:mod:`moreau.contact.closed_form` calls. The compiled Moreau–Jean loop
-(:mod:`moreau.integrators._mj_kernels`) runs the same source, so that its
-fast path and the Python schemes agree bit for bit.
+:mod:`moreau.contact.closed_form` calls. The compiled schemes' contact step
+(:mod:`moreau.integrators._contact_step`) calls these same functions, so that
+the compiled path and the Python schemes agree bit for bit.
 """
 
 from numba import njit
