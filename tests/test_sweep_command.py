@@ -54,7 +54,7 @@ def test_scheme_options_change_the_computation(tmp_path):
 
 
 @pytest.mark.parametrize("args, match", [
-    (["--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)"),
+    (["--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean, moreau-jean-projected)"),
     (["--steps-per-period", "100"], "`--steps-per-period` does not act with `--scheme event-driven`: it applies to time-stepping schemes"),
     (["--scheme", "moreau-jean", "--theta", "0.2"], "`theta` must be in [1/2, 1]"),
     (["--rtol", "0"], "`rtol` must be > 0"),

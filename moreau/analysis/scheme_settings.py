@@ -174,7 +174,7 @@ def make_scheme(scheme="event-driven", theta=None, steps_per_period=None, rtol=N
     >>> make_scheme("event-driven", theta=0.5)
     Traceback (most recent call last):
     ...
-    moreau.errors.InputError: `--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)
+    moreau.errors.InputError: `--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean, moreau-jean-projected)
     """
     scheme, theta, options = _from_object(scheme, theta, options)
     takes = _takes(scheme)

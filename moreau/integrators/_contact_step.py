@@ -30,7 +30,6 @@ from numba.core import types as _nbt
 
 from .. import _jit_cache
 from ..contact import _one_contact as _one_contact_module
-from ..contact._one_contact import _jam, _one_contact, _one_contact_cases, _residual, _residual_parts  # noqa: F401
 from ..lcp import _certified
 from ..lcp import certify as _certify
 from ..lcp import lemke as _lemke
@@ -73,6 +72,15 @@ WARM_PIVOT_RTOL = 1e-8
 # lift off) two solutions lie within rounding of each other; Lemke decides
 # there, as the generic step does.
 WARM_MARGIN = 1e-8
+
+
+#: the one-contact closed form, its tangential-impact test and residual: compiled once on
+#: the contact floor, where the Python schemes' contact problem calls the same functions
+_one_contact = _one_contact_module._one_contact
+_one_contact_cases = _one_contact_module._one_contact_cases
+_jam = _one_contact_module._jam
+_residual_parts = _one_contact_module._residual_parts
+_residual = _one_contact_module._residual
 
 
 def new_stats():

@@ -210,6 +210,8 @@ class MoreauJeanProjected(MoreauJean):
 
     #: read by Moreau–Jean's step: this scheme always projects (its own :meth:`_project`)
     projection = True
+    #: its projection is onto the contacts only: a scene with joints is refused by name
+    solves_joints = False
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000),
                         (100, 300, 1000), {})
 

@@ -6,7 +6,7 @@ from moreau.cli import main
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["steady", "--frequency", "185", "--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean)"),
+    (["steady", "--frequency", "185", "--theta", "0.5"], "`--theta` does not act with `--scheme event-driven`: it applies to schemes with a theta (moreau-jean, moreau-jean-projected)"),
     (["steady", "--frequency", "185", "--steps-per-period", "100"], "`--steps-per-period` does not act with `--scheme event-driven`: it applies to time-stepping schemes"),
     (["run", "--frequency", "185", "--scheme", "moreau-jean", "--rtol", "1e-3"],
      "`rtol` is not an option of scheme 'moreau-jean'"),
