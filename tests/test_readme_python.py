@@ -26,7 +26,7 @@ GUIDE = [README] + sorted(p for p in (ROOT / "docs").glob("*.md")
 
 #: the README's own tour of the API: the front ends, a user's scene, its compiled model
 README_FIRSTS = {"from moreau import find_steady_state, simulate", "from moreau import compare",
-                 "import numpy as np", "from numba import njit"}
+                 "import numpy as np", "from numba import njit", "import math"}
 
 
 def python_snippets(*pages):
@@ -43,6 +43,7 @@ PREAMBLES = {
     "from numba import njit": None,
     "from moreau.scenes.friction_drive import FrictionDrive, FrictionDriveParams": "",
     "from moreau.integrators import simulate": "",
+    "import math": "",
     "from moreau.scenes.piezo_drive import PiezoDrive, identify_hysteresis": "",
     "from moreau.lcp import solve_lcp, build_friction_lcp": (
         "import numpy as np\n"
@@ -52,6 +53,9 @@ PREAMBLES = {
 
 #: what each snippet's last names must hold after it ran (a check that could fail)
 CHECKS = {
+    "import math":
+        "assert res.success and abs(down / (9.81 * math.sin(slope) / 3.0 * si['t'][-1] ** 2)"
+        " - 1.0) < 0.01",
     "from moreau import find_steady_state, simulate":
         "assert ss.mode == 'NP' and res.success and res.stats['lcp_solves'] > 0\n"
         "assert abs(si['t'][-1] - 10 / 185.0) < 1e-9",
