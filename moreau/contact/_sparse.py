@@ -322,9 +322,25 @@ def natural_map(r, u, mu):
     return s
 
 
+@njit(cache=_CACHE, inline="always")
+def record_check(indptr, indices, data, q, r, u, mu, it, hist_it, hist_res, nh, best, best_r,
+                 tol_abs):
+    """An iterative solver's check after iteration ``it``: the true residual of ``r``
+    recorded, the best iterate kept; returns ``(nh, best, stop)``, ``stop`` where the
+    residual meets ``tol_abs`` or is no longer finite."""
+    velocities(indptr, indices, data, q, r, u)
+    res = math.sqrt(natural_map(r, u, mu))
+    hist_it[nh] = it
+    hist_res[nh] = res
+    if res < best:
+        best = res
+        best_r[:] = r
+    return nh + 1, best, (not math.isfinite(res)) or res <= tol_abs
+
+
 _jit_cache.bind_cache_to_sources(
     [project_cone, _local_residual_sq, local_solve, _two_sum, _two_prod, velocities_compensated,
-     velocities, natural_map], [__file__])
+     velocities, natural_map, record_check], [__file__])
 
 
 def problem_residual(W, q, mu, r):

@@ -33,7 +33,7 @@ from moreau import _jit_cache
 from moreau._validate import finite_array, finite_scalar, positive_int
 from moreau.contact import _sparse
 from moreau.contact._sparse import (IterativeResult, check_problem, natural_map, project_cone,
-                                    velocities)
+                                    record_check, velocities)
 from moreau.errors import InputError
 
 from ..registry import register_solver
@@ -124,17 +124,9 @@ def _apgd(indptr, indices, data, q, mu, x, L, max_iter, check_every, tol_abs, hi
         x[:] = x_new
         it += 1
         if it % check_every == 0 or it == max_iter:
-            velocities(indptr, indices, data, q, x, u)
-            res = math.sqrt(natural_map(x, u, mu))
-            hist_it[nh] = it
-            hist_res[nh] = res
-            nh += 1
-            if res < best:
-                best = res
-                best_r[:] = x
-            elif not math.isfinite(res):
-                break
-            if res <= tol_abs:
+            nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, it, hist_it,
+                                          hist_res, nh, best, best_r, tol_abs)
+            if stop:
                 break
     return it, nh
 

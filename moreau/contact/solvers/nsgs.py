@@ -25,7 +25,7 @@ from moreau import _jit_cache
 from moreau._validate import finite_array, finite_scalar, positive_int
 from moreau.contact import _sparse
 from moreau.contact._sparse import (IterativeResult, check_problem, diagonal_blocks, local_solve,
-                                    natural_map, project_cone, velocities)
+                                    natural_map, project_cone, record_check, velocities)
 from moreau.errors import InputError
 
 from ..registry import register_solver
@@ -81,17 +81,9 @@ def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_
             r[a + 1] = st
         sweeps += 1
         if sweeps % check_every == 0 or sweeps == max_sweeps:
-            velocities(indptr, indices, data, q, r, u)
-            res = math.sqrt(natural_map(r, u, mu))
-            hist_it[nh] = sweeps
-            hist_res[nh] = res
-            nh += 1
-            if res < best:
-                best = res
-                best_r[:] = r
-            elif not math.isfinite(res):
-                break
-            if res <= tol_abs:
+            nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, sweeps, hist_it,
+                                          hist_res, nh, best, best_r, tol_abs)
+            if stop:
                 break
     return sweeps, nh
 
