@@ -21,6 +21,8 @@ import pytest
 import moreau
 from moreau.model.registry import get_entry, scene_names
 
+from test_layers import find_cycle
+
 PACKAGE = pathlib.Path(moreau.__file__).resolve().parent
 
 
@@ -181,40 +183,15 @@ def _dependencies(f):
     return deps
 
 
-def _find_cycle(graph):
-    state, stack = {}, []
-
-    def visit(v):
-        state[v] = "open"
-        stack.append(v)
-        for w in sorted(graph[v]):
-            if state.get(w) == "open":
-                return stack[stack.index(w):] + [w]
-            if w not in state:
-                cycle = visit(w)
-                if cycle:
-                    return cycle
-        stack.pop()
-        state[v] = "done"
-        return None
-
-    for v in sorted(graph):
-        if v not in state:
-            cycle = visit(v)
-            if cycle:
-                return cycle
-    return None
-
-
 def test_module_graph_has_no_cycle():
     graph = {m: _dependencies(f) for m, f in FILES.items()}
-    cycle = _find_cycle(graph)
+    cycle = find_cycle(graph)
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
 
 
 def test_cycle_finder_finds_a_cycle():
-    assert _find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}) == ["a", "b", "c", "a"]
-    assert _find_cycle({"a": {"b"}, "b": set()}) is None
+    assert find_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": set()}) == ["a", "b", "c", "a"]
+    assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
 # -- the command line on every scene ---------------------------------------------------------------------
