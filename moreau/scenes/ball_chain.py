@@ -45,8 +45,8 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import (finite_array, finite_scalar, in_closed_interval, nonnegative, positive,
-                         positive_int)
+from .._validate import (check_fields, finite_array, finite_scalar, in_closed_interval,
+                         nonnegative, positive, positive_int, restitution)
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
@@ -107,11 +107,9 @@ class BallChainParams:
         if not MIN_BALLS <= int(n) <= MAX_BALLS:
             raise InputError(f"`n_balls` must be in [{MIN_BALLS}, {MAX_BALLS}], got {n!r}")
         object.__setattr__(self, "n_balls", int(n))
-        for name in ("mass", "striker_mass", "radius", "striker_speed"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
-        object.__setattr__(self, "striker_gap", nonnegative("striker_gap", self.striker_gap))
+        check_fields(self, positive, "mass", "striker_mass", "radius", "striker_speed")
+        check_fields(self, restitution, "restitution")
+        check_fields(self, nonnegative, "striker_gap")
 
 
 class BallChain(SIUnits, CompiledScene):

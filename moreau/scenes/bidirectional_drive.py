@@ -120,15 +120,12 @@ class BidirectionalDriveParams:
     restitution: float = 0.0
 
     def __post_init__(self):
-        for name in ("m", "m2", "k", "length"):
-            object.__setattr__(self, name, V.positive(name, getattr(self, name)))
+        V.check_fields(self, V.positive, "m", "m2", "k", "length")
         object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
                                                             "in the open interval (0, pi/2)"))
-        object.__setattr__(self, "mu", V.nonnegative("mu", self.mu))
-        object.__setattr__(self, "load", V.finite_scalar("load", self.load))
-        object.__setattr__(self, "phase", V.finite_scalar("phase", self.phase))
-        object.__setattr__(self, "restitution",
-                           V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        V.check_fields(self, V.nonnegative, "mu")
+        V.check_fields(self, V.finite_scalar, "load", "phase")
+        V.check_fields(self, V.restitution, "restitution")
         for name in ("x10_a", "x10_b"):
             x = V.nonnegative(name, getattr(self, name))
             if not 2.0 * x < self.length * math.sin(self.phi0):

@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import finite_array, in_closed_interval, positive
+from .._validate import check_fields, finite_array, positive, restitution
 from ..errors import InputError
 from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
@@ -67,10 +67,8 @@ class BouncingBallParams:
     length: float = 1.0
 
     def __post_init__(self):
-        for name in ("mass", "radius", "gravity", "length"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, positive, "mass", "radius", "gravity", "length")
+        check_fields(self, restitution, "restitution")
 
 
 class BouncingBall(SIUnits, CompiledScene):

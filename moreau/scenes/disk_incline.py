@@ -35,7 +35,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, in_open_interval, nonnegative, positive
+from .._validate import check_fields, finite_array, in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
 from ..model.planar import Circle, HalfPlane, Model
@@ -73,10 +73,8 @@ class DiskInclineParams:
     speed: float = 0.2
 
     def __post_init__(self):
-        for name in ("mass", "radius", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
-        object.__setattr__(self, "speed", nonnegative("speed", self.speed))
+        check_fields(self, positive, "mass", "radius", "gravity")
+        check_fields(self, nonnegative, "mu", "speed")
         object.__setattr__(self, "slope",
                            in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
 

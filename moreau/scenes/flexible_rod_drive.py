@@ -219,10 +219,10 @@ class FlexibleRodDriveParams:
     def __post_init__(self):
         # the rigid rod's parameters are checked by the rigid rod's own rules
         self.rigid()
-        object.__setattr__(self, "preload", V.nonnegative("preload", self.preload))
+        V.check_fields(self, V.nonnegative, "preload")
         object.__setattr__(self, "modes", _modes("modes", self.modes))
-        object.__setattr__(self, "EI", V.positive("EI", self.EI))
-        object.__setattr__(self, "damping", V.nonnegative("damping", self.damping))
+        V.check_fields(self, V.positive, "EI")
+        V.check_fields(self, V.nonnegative, "damping")
 
     def rigid(self):
         """The rigid rod's :class:`FrictionDriveParams` (these parameters without the beam's)."""

@@ -42,7 +42,8 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
+from .._validate import (check_fields, finite_array, finite_scalar, nonnegative, positive,
+                         restitution)
 from ..errors import InputError, PainleveError
 from ..model.drawing import contact, line
 from ..model.compiled_scene import CompiledScene
@@ -105,11 +106,9 @@ class PainleveRodParams:
     restitution: float = 0.0
 
     def __post_init__(self):
-        for name in ("mass", "length", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, positive, "mass", "length", "gravity")
+        check_fields(self, nonnegative, "mu")
+        check_fields(self, restitution, "restitution")
 
 
 class PainleveRod(SIUnits, CompiledScene):

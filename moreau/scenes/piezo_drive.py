@@ -172,15 +172,13 @@ class PiezoDriveParams:
     u_sat: float = 150.0
 
     def __post_init__(self):
-        for name in ("m", "m2", "k", "length", "m1", "k1", "gain", "voltage", "beta"):
-            object.__setattr__(self, name, V.positive(name, getattr(self, name)))
+        V.check_fields(self, V.positive, "m", "m2", "k", "length", "m1", "k1", "gain", "voltage",
+                       "beta")
         object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
                                                             "in the open interval (0, pi/2)"))
-        for name in ("mu", "c1", "preload"):
-            object.__setattr__(self, name, V.nonnegative(name, getattr(self, name)))
-        object.__setattr__(self, "load", V.finite_scalar("load", self.load))
-        object.__setattr__(self, "restitution",
-                           V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        V.check_fields(self, V.nonnegative, "mu", "c1", "preload")
+        V.check_fields(self, V.finite_scalar, "load")
+        V.check_fields(self, V.restitution, "restitution")
         a = V.finite_scalar("alpha", self.alpha)
         if not 0.0 <= a < 1.0:
             raise InputError(f"`alpha` must be in [0, 1), got {a!r}")

@@ -69,7 +69,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import quad, solve_ivp
 
-from .._validate import finite_array, finite_scalar, in_closed_interval, nonnegative, positive
+from .._validate import (check_fields, finite_array, finite_scalar, nonnegative, positive,
+                         restitution)
 from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
 from ..model.units import SIUnits
@@ -125,11 +126,9 @@ class RockingBlockParams:
     tilt: float = 0.05
 
     def __post_init__(self):
-        for name in ("mass", "width", "height", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, positive, "mass", "width", "height", "gravity")
+        check_fields(self, nonnegative, "mu")
+        check_fields(self, restitution, "restitution")
         alpha = math.atan(self.width / self.height)
         tilt = finite_scalar("tilt", self.tilt)
         if not 0.0 <= tilt < alpha:

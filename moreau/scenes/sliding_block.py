@@ -25,7 +25,8 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import finite_array, in_closed_interval, in_open_interval, nonnegative, positive
+from .._validate import (check_fields, finite_array, in_open_interval, nonnegative, positive,
+                         restitution)
 from ..errors import InputError
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
@@ -72,14 +73,12 @@ class SlidingBlockParams:
     length: float = 1.0
 
     def __post_init__(self):
-        for name in ("mass", "gravity", "length"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        check_fields(self, positive, "mass", "gravity", "length")
+        check_fields(self, nonnegative, "mu")
         object.__setattr__(self, "incline",
                            in_open_interval("incline", self.incline, -math.pi / 2, math.pi / 2,
                                             "in the open interval (-pi/2, pi/2)"))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, restitution, "restitution")
 
 
 class SlidingBlock(SIUnits, CompiledScene):

@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import finite_array, in_closed_interval, nonnegative, positive
+from .._validate import check_fields, finite_array, nonnegative, positive, restitution
 from ..errors import InputError
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
@@ -85,11 +85,9 @@ class SlidingBoxParams:
     length: float = 1.0
 
     def __post_init__(self):
-        for name in ("mass", "half_width", "half_height", "gravity", "length"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, positive, "mass", "half_width", "half_height", "gravity", "length")
+        check_fields(self, nonnegative, "mu")
+        check_fields(self, restitution, "restitution")
 
 
 class SlidingBox(SIUnits, CompiledScene):

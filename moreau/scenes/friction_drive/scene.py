@@ -145,15 +145,13 @@ class FrictionDriveParams:
     preload: float = 0.0
 
     def __post_init__(self):
-        for name in ("m", "m2", "k", "length", "x10"):
-            object.__setattr__(self, name, V.positive(name, getattr(self, name)))
+        V.check_fields(self, V.positive, "m", "m2", "k", "length", "x10")
         object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
                                                             "in the open interval (0, pi/2)"))
-        object.__setattr__(self, "mu", V.nonnegative("mu", self.mu))
-        object.__setattr__(self, "load", V.finite_scalar("load", self.load))
-        object.__setattr__(self, "restitution",
-                           V.in_closed_interval("restitution", self.restitution, 0.0, 1.0))
-        object.__setattr__(self, "preload", V.nonnegative("preload", self.preload))
+        V.check_fields(self, V.nonnegative, "mu")
+        V.check_fields(self, V.finite_scalar, "load")
+        V.check_fields(self, V.restitution, "restitution")
+        V.check_fields(self, V.nonnegative, "preload")
         if not 2.0 * self.x10 < self.length * math.sin(self.phi0):
             raise InputError(
                 f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "

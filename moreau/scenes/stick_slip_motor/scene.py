@@ -36,7 +36,7 @@ import numpy as np
 from numba import njit
 
 from ...compiled import CompiledModel
-from ..._validate import finite_scalar, in_closed_interval, in_open_interval, positive
+from ..._validate import check_fields, finite_scalar, in_open_interval, positive, restitution
 from ...errors import InputError
 from ...model.drawing import contact, polygon
 from ...model.scene import Scene
@@ -326,11 +326,9 @@ class StickSlipMotorParams:
     restitution: float = 0.0
 
     def __post_init__(self):
-        for name in ("mass", "normal_force", "mu", "amplitude"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "load", finite_scalar("load", self.load))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        check_fields(self, positive, "mass", "normal_force", "mu", "amplitude")
+        check_fields(self, finite_scalar, "load")
+        check_fields(self, restitution, "restitution")
 
 
 class StickSlipMotor(SIUnits, Scene):
