@@ -73,7 +73,8 @@ from ..model.units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from .friction_drive.rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from .friction_drive.rod import (MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap,
+                                  rod_rows)
 from ..model.scene import Scene, params_with
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
@@ -227,7 +228,7 @@ def params_from_kwargs(**kwargs):
     return BidirectionalDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
 
 
-class BidirectionalDrive(DriveUnits, Scene):
+class BidirectionalDrive(StatorMotion, DriveUnits, Scene):
     """Two mirror-image rods driving one rotor, in the paper's dimensionless form.
 
     Coordinates ``q = (phi_a, phi_b, u2)``, velocities their derivatives in
@@ -279,19 +280,6 @@ class BidirectionalDrive(DriveUnits, Scene):
         self._side = np.array([1.0, -1.0])
         #: velocity scale of the motion (the larger stator velocity amplitude), for tolerances
         self.velocity_scale = float(np.max(self.u10)) if np.max(self.u10) > 0 else 1.0
-
-    def __repr__(self):
-        return f"BidirectionalDrive(frequency={self.frequency!r}, params={self.params!r})"
-
-    # -- prescribed stator motions, both rods at once ----------------------------
-    def u1(self, tau):
-        return self.u10 * (1.0 - np.cos(tau - self.delta))
-
-    def du1(self, tau):
-        return self.u10 * np.sin(tau - self.delta)
-
-    def ddu1(self, tau):
-        return self.u10 * np.cos(tau - self.delta)
 
     # -- Scene interface ------------------------------------------------------
     def mass(self, q):

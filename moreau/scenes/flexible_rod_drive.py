@@ -101,6 +101,7 @@ from ..analysis.steady_state import find_steady_state
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.scene import Scene, params_with
+from .friction_drive.rod import StatorMotion
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
@@ -238,7 +239,7 @@ class FlexibleRodDriveParams:
         return replace(self, **changes)
 
 
-class FlexibleRodDrive(DriveUnits, Scene):
+class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
     """The friction drive with an Euler–Bernoulli tilt rod of ``N`` bending modes.
 
     Coordinates ``q = (phi, eta_1 .. eta_N, u2)``: the rod's mean-axis angle,
@@ -308,19 +309,6 @@ class FlexibleRodDrive(DriveUnits, Scene):
         self.beta = beta
         self.zeta = p.damping
         self.coordinate_names = ("phi",) + tuple(f"eta{i + 1}" for i in range(n)) + ("x2",)
-
-    def __repr__(self):
-        return f"FlexibleRodDrive(frequency={self.frequency!r}, params={self.params!r})"
-
-    # -- prescribed stator motion -------------------------------------------
-    def u1(self, tau):
-        return self.u10 * (1.0 - np.cos(tau))
-
-    def du1(self, tau):
-        return self.u10 * np.sin(tau)
-
-    def ddu1(self, tau):
-        return self.u10 * np.cos(tau)
 
     def rigid(self):
         """The rigid rod's :class:`~moreau.scenes.friction_drive.FrictionDrive` at this frequency."""

@@ -22,6 +22,8 @@ times (:func:`memo_sincos`).
 
 import math
 
+import numpy as np
+
 from numba import njit
 
 __all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS"]
@@ -79,3 +81,26 @@ def rod_rows(G, r, j, rotor, n, sgn, u10, s, c, st, need_T):
     if need_T:
         G[r, 3 + n + j] = sgn * s
         G[r, 3 + n + rotor] = 1.0
+
+
+class StatorMotion:
+    """The prescribed base motion of a rod drive's rods, ``u1 = u10 (1 - cos(tau - delta))``.
+
+    A mixin of the rod drives: each sets ``u10`` (the amplitude over the rod
+    length, one per rod) and, with rods out of phase, ``delta`` (their phase
+    lags); ``tau - 0.0`` is ``tau`` exactly, so a drive in phase loses nothing.
+    """
+
+    delta = 0.0
+
+    def u1(self, tau):
+        return self.u10 * (1.0 - np.cos(tau - self.delta))
+
+    def du1(self, tau):
+        return self.u10 * np.sin(tau - self.delta)
+
+    def ddu1(self, tau):
+        return self.u10 * np.cos(tau - self.delta)
+
+    def __repr__(self):
+        return f"{type(self).__name__}(frequency={self.frequency!r}, params={self.params!r})"

@@ -86,7 +86,7 @@ from ...model.units import DriveUnits
 from numba import njit
 
 from ...compiled import CompiledModel
-from .rod import MEMO_SLOTS, memo_sincos, rod_forces, rod_gap, rod_rows
+from .rod import MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap, rod_rows
 from ...model.scene import Scene, params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ...analysis.steady_state import find_steady_state
@@ -165,7 +165,7 @@ class FrictionDriveParams:
 PAPER_DEFAULTS = FrictionDriveParams()
 
 
-class FrictionDrive(DriveUnits, Scene):
+class FrictionDrive(StatorMotion, DriveUnits, Scene):
     """The paper's friction drive at one drive frequency, in dimensionless form.
 
     Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
@@ -219,19 +219,6 @@ class FrictionDrive(DriveUnits, Scene):
         self.restitution = np.array([p.restitution])
         #: velocity scale of the motion (the stator velocity amplitude), for tolerances
         self.velocity_scale = self.u10
-
-    def __repr__(self):
-        return f"FrictionDrive(frequency={self.frequency!r}, params={self.params!r})"
-
-    # -- prescribed stator motion -------------------------------------------
-    def u1(self, tau):
-        return self.u10 * (1.0 - np.cos(tau))
-
-    def du1(self, tau):
-        return self.u10 * np.sin(tau)
-
-    def ddu1(self, tau):
-        return self.u10 * np.cos(tau)
 
     # -- the rod on the contact manifold ------------------------------------
     def contact_angle(self, tau):
