@@ -284,22 +284,10 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
 
     def __init__(self, params=None, frequency=185.0, **overrides):
         self.params = p = params_with(FlexibleRodDriveParams, params, overrides)
-        self.frequency = V.positive("frequency", frequency)
-        self.omega = 2.0 * math.pi * self.frequency
+        self._scale_one_rod(p, frequency)
         self.N = n = p.modes
         self.ndof = n + 2
         self.cyclic_coordinates = (n + 1,)
-        self.J = p.m2 / p.m
-        self.P = p.k / (p.m * self.omega ** 2)
-        self.u10 = p.x10 / p.length
-        self.force_scale = p.m * p.length * self.omega ** 2
-        self.fL = p.load / self.force_scale
-        self.fp = p.preload / self.force_scale
-        self.phi0 = p.phi0
-        self.sin_phi0 = math.sin(p.phi0)
-        self.mu = np.array([p.mu])
-        self.restitution = np.array([p.restitution])
-        self.velocity_scale = self.u10
         b, _, _, psi, beta = pinned_free_modes(n)
         rate = math.sqrt(p.EI / (p.m * p.length ** 3))      # rad/s per b^2
         self.bending_frequency = pinned_free_modes(1)[0][0] ** 2 * rate / (2.0 * math.pi)

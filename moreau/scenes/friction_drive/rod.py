@@ -26,6 +26,8 @@ import numpy as np
 
 from numba import njit
 
+from ..._validate import positive
+
 __all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS"]
 
 #: entries of ``par`` that :func:`memo_sincos` keeps for one argument, and what they
@@ -92,6 +94,28 @@ class StatorMotion:
     """
 
     delta = 0.0
+
+    def _scale_one_rod(self, p, frequency):
+        """The dimensionless numbers of one rod of SI parameters ``p`` driven at ``frequency``.
+
+        Time is ``tau = w t`` and forces are over ``m l w^2`` (see
+        :mod:`moreau.scenes.friction_drive`).
+        """
+        self.frequency = positive("frequency", frequency)
+        self.omega = 2.0 * math.pi * self.frequency
+        self.J = p.m2 / p.m
+        self.P = p.k / (p.m * self.omega ** 2)
+        self.u10 = p.x10 / p.length
+        self.force_scale = p.m * p.length * self.omega ** 2
+        self.fL = p.load / self.force_scale
+        #: dimensionless preload ``f_p = F_p / (m l w^2)`` (module docstring, "Preload")
+        self.fp = p.preload / self.force_scale
+        self.phi0 = p.phi0
+        self.sin_phi0 = math.sin(p.phi0)
+        self.mu = np.array([p.mu])
+        self.restitution = np.array([p.restitution])
+        #: velocity scale of the motion (the stator velocity amplitude), for tolerances
+        self.velocity_scale = self.u10
 
     def u1(self, tau):
         return self.u10 * (1.0 - np.cos(tau - self.delta))

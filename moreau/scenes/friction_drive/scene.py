@@ -203,22 +203,7 @@ class FrictionDrive(StatorMotion, DriveUnits, Scene):
             params = PAPER_DEFAULTS
         params = params_with(FrictionDriveParams, params, overrides)
         self.params = params
-        self.frequency = V.positive("frequency", frequency)
-        self.omega = 2.0 * math.pi * self.frequency
-        p = params
-        self.J = p.m2 / p.m
-        self.P = p.k / (p.m * self.omega ** 2)
-        self.u10 = p.x10 / p.length
-        self.force_scale = p.m * p.length * self.omega ** 2
-        self.fL = p.load / self.force_scale
-        #: dimensionless preload ``f_p = F_p / (m l w^2)`` (module docstring, "Preload")
-        self.fp = p.preload / self.force_scale
-        self.phi0 = p.phi0
-        self.sin_phi0 = math.sin(p.phi0)
-        self.mu = np.array([p.mu])
-        self.restitution = np.array([p.restitution])
-        #: velocity scale of the motion (the stator velocity amplitude), for tolerances
-        self.velocity_scale = self.u10
+        self._scale_one_rod(params, frequency)
 
     # -- the rod on the contact manifold ------------------------------------
     def contact_angle(self, tau):
