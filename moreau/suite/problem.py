@@ -85,10 +85,19 @@ class Problem:
         return make_scene(self.scene, **self.scene_parameters())
 
     def start(self, scene):
-        """``(q0, v0)`` at ``t = 0``, in the scene's units."""
+        """``(q0, v0)`` at ``t = 0``, in the scene's units: the case's start, for a
+        problem built on a case, else the scene's initial state."""
+        if self.case_class is not None:
+            return self._the_case().start()
         return scene.initial_state()
 
-    window = 1.0
+    @property
+    def window(self):
+        """The time window, in the scene's units: the case's, for a problem built on a
+        case, else 1 (a problem sets its own as a class attribute)."""
+        if self.case_class is not None:
+            return self._the_case().window
+        return 1.0
 
     def reference(self):
         raise NotImplementedError

@@ -27,15 +27,8 @@ class PainleveRodProblem(Problem):
     quick_steps = (100, 1000)
     case_class = PainleveRodCase
 
-    @property
-    def window(self):
-        return self._the_case().window
-
     def scene_parameters(self):
         return {"mu": 0.5}
-
-    def start(self, scene):
-        return self._the_case().start()
 
     _ref = None
 

@@ -20,13 +20,6 @@ class StoppingProblem(Problem):
     def scene_parameters(self):
         return {"mu": self.case_parameters()["mu"]}
 
-    @property
-    def window(self):
-        return self._the_case().window
-
-    def start(self, scene):
-        return self._the_case().start()
-
     def reference(self):
         case = self._the_case()
         _, v0 = case.start()

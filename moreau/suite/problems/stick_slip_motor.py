@@ -27,9 +27,6 @@ class StickSlipMotorProblem(Problem):
     quick_steps = (100, 1000)
     case_class = StickSlipCase
 
-    def start(self, scene):
-        return self._the_case().start()
-
     def reference(self):
         return {"displacement_per_period": float(self._the_case()._steady().displacement_per_period)}
 
