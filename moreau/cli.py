@@ -560,22 +560,9 @@ def _add_atlas(sub):
                    help="friction drive's own atlas: highest frequency [Hz] (default 12500)")
     p.add_argument("--quick", action="store_true", help="a coarse grid (24 x 12 per plane; "
                                                         "8 x 6 with --x/--y)")
-    p.add_argument("--out", default="out", help="output folder (default ./out)")
-    p.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run on this Dask scheduler (e.g. tcp://host:8786)")
-    p.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--no-plot", action="store_true", help="skip the figures")
-    p.add_argument("--netcdf", action="store_true",
-                   help="also write each table as NetCDF (.nc next to the CSV, on the plane's "
+    _add_points_options(p, "atlas", "the figures",
+                        "also write each table as NetCDF (.nc next to the CSV, on the plane's "
                         "grid, units as attributes; needs pip install -e \".[data]\")")
-    p.add_argument("--force", action="store_true",
-                   help="replace the files of an earlier atlas with other settings (refused "
-                        "otherwise)")
-    p.add_argument("--cold", action="store_true",
-                   help="start every point's shooting from rest (default: from its "
-                        "neighbour's orbit, with a cold start where that fails)")
     p.add_argument("--classify-periods", type=int, default=None, metavar="N",
                    help="budget of the plain run that names the motion of a point without a "
                         "periodic orbit (period-k, non-periodic with its mean, runaway); "
@@ -642,16 +629,37 @@ def _cmd_reproduce(args):
     print("  " + ", ".join(f"{k[:-2].replace('_', ' ')} {v:.1f} s" for k, v in res["_timings"].items()))
 
 
-def _add_reproduce(sub):
-    p = sub.add_parser("reproduce", help="the paper's section 4.3: data, figures and report.md")
-    p.add_argument("--out", default="moreau-results",
-                   help="output folder (default ./moreau-results); the cache lives in OUT/cache")
-    p.add_argument("--quick", action="store_true", help="coarse grids: a smoke run of a few seconds")
+def _add_pool_options(p):
+    """The worker pool's options, shared by every command that runs many points."""
     p.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the points on this Dask scheduler (e.g. tcp://host:8786)")
     p.add_argument("--jobs", type=int, default=-1,
                    help="local worker processes (default -1: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+
+
+def _add_points_options(p, what, figures, netcdf_help):
+    """Output, cache, pool and start options of a command that runs a grid of points
+    (an atlas, a sweep): ``what`` names its output, ``figures`` what --no-plot skips."""
+    p.add_argument("--out", default="out", help="output folder (default ./out)")
+    p.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
+    _add_pool_options(p)
+    p.add_argument("--no-plot", action="store_true", help=f"skip {figures}")
+    p.add_argument("--netcdf", action="store_true", help=netcdf_help)
+    p.add_argument("--force", action="store_true",
+                   help=f"replace the files of an earlier {what} with other settings (refused "
+                        "otherwise)")
+    p.add_argument("--cold", action="store_true",
+                   help="start every point's shooting from rest (default: from its "
+                        "neighbour's orbit, with a cold start where that fails)")
+
+
+def _add_reproduce(sub):
+    p = sub.add_parser("reproduce", help="the paper's section 4.3: data, figures and report.md")
+    p.add_argument("--out", default="moreau-results",
+                   help="output folder (default ./moreau-results); the cache lives in OUT/cache")
+    p.add_argument("--quick", action="store_true", help="coarse grids: a smoke run of a few seconds")
+    _add_pool_options(p)
     p.add_argument("--force", action="store_true",
                    help="replace the files of an earlier run with other settings (--quick "
                         "against a full run; refused otherwise)")
@@ -806,21 +814,9 @@ def build_parser():
                    help="fix another parameter (repeatable), e.g. --set mu=0.3 --set frequency=185")
     s.add_argument("--frequency", type=float, default=None,
                    help="drive frequency [Hz] when PARAM is not frequency")
-    s.add_argument("--out", default="out", help="output folder (default ./out)")
-    s.add_argument("--cache", default=None, help="cache folder (default OUT/cache)")
-    s.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                   help="run the points on this Dask scheduler (e.g. tcp://host:8786)")
-    s.add_argument("--jobs", type=int, default=-1, help="local worker processes (default: all cores)")
-    s.add_argument("--quiet", action="store_true", help="no progress bar")
-    s.add_argument("--no-plot", action="store_true", help="skip the figure")
-    s.add_argument("--netcdf", action="store_true",
-                   help="also write the table as NetCDF (.nc next to the CSV: the swept parameter "
+    _add_points_options(s, "run", "the figure",
+                        "also write the table as NetCDF (.nc next to the CSV: the swept parameter "
                         "as coordinate, units as attributes; needs pip install -e \".[data]\")")
-    s.add_argument("--force", action="store_true",
-                   help="replace the files of an earlier run with other settings (refused otherwise)")
-    s.add_argument("--cold", action="store_true",
-                   help="start every point's shooting from rest (default: from its "
-                        "neighbour's orbit, with a cold start where that fails)")
     _add_params(s, scheme_defaults=False)
     add_scene_options(s, with_set=False)
     s.set_defaults(func=_cmd_sweep)
