@@ -8,12 +8,13 @@ with the same settings (a resumed run) replaces the files, which it computes
 anew with the same content.
 """
 
+import csv
 import json
 import pathlib
 
 from .errors import InputError
 
-__all__ = ["claim_outputs"]
+__all__ = ["claim_outputs", "write_csv"]
 
 
 def _normal(settings):
@@ -75,3 +76,21 @@ def claim_outputs(stem, settings, force=False):
         differ = "not recorded"
     raise InputError(f"`--out` already holds {stem.name}.csv/.json from a run with other "
                      f"settings ({differ}): give `--force` to replace them, or another `--out`")
+
+
+def write_csv(path, rows, fields=None, **options):
+    """Write the dicts ``rows`` to the CSV file ``path``, a header first.
+
+    ``fields`` are the columns (default: the first row's keys); ``options``
+    go to :class:`csv.DictWriter` (``extrasaction``, ``restval``).
+
+    >>> import os, tempfile
+    >>> p = os.path.join(tempfile.mkdtemp(), "t.csv")
+    >>> write_csv(p, [{"a": 1, "b": 2.5}]) == p, open(p).read().split()
+    (True, ['a,b', '1,2.5'])
+    """
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0] if fields is None else fields), **options)
+        w.writeheader()
+        w.writerows(rows)
+    return path

@@ -23,14 +23,13 @@ Examples
 (2, ['ok'])
 """
 
-import csv
 import json
 import math
 
 import numpy as np
 
 from ..errors import InputError
-from ..outputs import claim_outputs
+from ..outputs import claim_outputs, write_csv
 from ..provenance import provenance
 from . import engine
 from .classify import CLASSIFY_COLUMNS, CLASSIFY_PERIODS
@@ -181,10 +180,7 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
     if out is None:
         return table
     csv_path = stem.with_name(stem.name + ".csv")
-    with open(csv_path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(table[0]))
-        w.writeheader()
-        w.writerows(table)
+    write_csv(csv_path, table)
     meta = {"scene": entry.name,
             "x": {"parameter": columns[xname], "points": int(xv.size),
                   "range": [float(xv.min()), float(xv.max())]},

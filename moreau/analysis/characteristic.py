@@ -51,6 +51,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq, minimize_scalar
 
+from ..outputs import write_csv
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import ConvergenceError, InputError, MoreauError, RunawayError
 from ..provenance import provenance
@@ -372,10 +373,7 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
     if out is not None:
         stem = out / characteristic_tag(entry.name, frequency or 0.0, scheme)
         csv_path = stem.with_name(stem.name + ".csv")
-        with open(csv_path, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(COLUMNS))
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(csv_path, rows, COLUMNS)
         side = dict(summary, csv=csv_path.name)
         json_path = stem.with_name(stem.name + ".json")
         json_path.write_text(json.dumps(side, indent=1, default=str))
@@ -476,10 +474,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
             stem = out / (f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_"
                           f"{_scheme_tag(scheme)}.partial")
             csv_path = stem.with_name(stem.name + ".csv")
-            with open(csv_path, "w", newline="") as fh:
-                w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
-                w.writeheader()
-                w.writerows(rows)
+            write_csv(csv_path, rows, EFFICIENCY_COLUMNS)
             stem.with_name(stem.name + ".json").write_text(json.dumps(
                 {"scene": entry.name, "scheme": scheme.name, "frequencies_Hz": freqs,
                  "partial": True, "frequencies_finished": len(rows), "csv": csv_path.name,
@@ -524,10 +519,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
     if out is not None:
         stem = out / f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_{_scheme_tag(scheme)}"
         csv_path = stem.with_name(stem.name + ".csv")
-        with open(csv_path, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=list(EFFICIENCY_COLUMNS))
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(csv_path, rows, EFFICIENCY_COLUMNS)
         side = dict(summary, csv=csv_path.name)
         stem.with_name(stem.name + ".json").write_text(json.dumps(side, indent=1, default=str))
         log(f"wrote {csv_path} and {stem.name}.json")

@@ -25,7 +25,6 @@ Examples
 (['ok', 'ok'], True)
 """
 
-import csv
 import json
 import math
 import os
@@ -36,7 +35,7 @@ import numpy as np
 from .._validate import finite_scalar, positive, positive_int
 from ..errors import InputError
 from ..integrators.base import SchemeOptions
-from ..outputs import claim_outputs
+from ..outputs import claim_outputs, write_csv
 from ..provenance import provenance
 from ..model import registry
 from . import engine
@@ -278,10 +277,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     if out is None:
         return table
     csv_path = stem.with_name(stem.name + ".csv")
-    with open(csv_path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(table[0]))
-        w.writeheader()
-        w.writerows(table)
+    write_csv(csv_path, table)
     meta = {"scene": entry.name, "swept_parameter": swept, "points": int(values.size),
             "range": [float(values.min()), float(values.max())], "frequency_Hz": frequency,
             "fixed_parameters": {k: v for k, v in points[0][0].items() if k != parameter},

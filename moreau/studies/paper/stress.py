@@ -58,7 +58,6 @@ Examples
 ['event-driven', 'mj-1/2']
 """
 
-import csv
 import json
 import logging
 import math
@@ -68,6 +67,7 @@ import time
 import numpy as np
 from tqdm import tqdm
 
+from ...outputs import write_csv
 from ...analysis import engine
 from ...analysis.compare import collect_rows
 from ...analysis.mj_steady_state import moreau_jean_steady_state
@@ -808,10 +808,7 @@ def write_stress_outputs(report, out, plot=True):
     """Write ``stress.csv``, ``stress.json`` and (with ``plot``) ``stress.png`` to ``out``."""
     paths = {}
     p = os.path.join(out, "stress.csv")
-    with open(p, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=FIELDS, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(report["rows"])
+    write_csv(p, report["rows"], FIELDS, extrasaction="ignore")
     paths["csv"] = p
     p = os.path.join(out, "stress.json")
     with open(p, "w") as fh:

@@ -7,7 +7,6 @@ ill-posed is recorded with its reason instead of a number; an interrupted
 sweep keeps the points it had finished.
 """
 
-import csv
 import math
 from dataclasses import asdict
 
@@ -21,6 +20,7 @@ from ...analysis import sweep as scene_sweep
 from ...analysis.engine import check_output_dir, make_scheme
 from ...errors import InputError, MoreauError
 from ...model import registry
+from ... import outputs
 from ...outputs import claim_outputs
 from ...scenes.friction_drive import PAPER_DEFAULTS, FrictionDrive, params_from_kwargs
 from .figures import sweep_figure
@@ -106,10 +106,7 @@ def sweep(parameter, values, params=None, frequency=None, progress=False, rtol=1
 
 def write_csv(rows, path):
     """Write sweep rows to ``path`` as CSV."""
-    with open(path, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0].keys()) if rows else ["value"])
-        w.writeheader()
-        w.writerows(rows)
+    outputs.write_csv(path, rows, list(rows[0].keys()) if rows else ["value"])
 
 
 def plot_sweep(rows, parameter, path, title=""):

@@ -20,6 +20,7 @@ import pathlib
 
 import numpy as np
 
+from ...outputs import write_csv
 from ..._validate import positive_int
 from ...analysis.mj_steady_state import moreau_jean_steady_state
 from ...analysis.period_k import full_state_of
@@ -153,10 +154,7 @@ def main(argv=None):
         for U_pp, U, x in loops:
             w.writerows((U_pp, a, b) for a, b in zip(U, x))
     rows = resonance_sweep(np.linspace(1000.0, 3000.0, positive_int("points", args.points)))
-    with open(out / "piezo_resonance.csv", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_csv(out / "piezo_resonance.csv", rows)
     if not args.no_plot:
         _figures(loops, rows, out)
     for r in rows:
