@@ -86,7 +86,7 @@ from ..model.scene import params_with
 from ..model.units import SIUnits
 
 __all__ = ["WoodpeckerToyParams", "WoodpeckerToy", "GLOCKER_STATE", "section_crossings",
-           "limit_cycle"]
+           "section_event", "limit_cycle"]
 
 #: Glocker's published state on the limit cycle: ``(y [m], phi_M [rad], phi_S [rad])``
 #: and ``(y' [m/s], phi_M' [rad/s], phi_S' [rad/s])``, four significant digits
@@ -168,8 +168,8 @@ class WoodpeckerToy(SIUnits, CompiledScene):
     --------
     >>> toy = WoodpeckerToy()
     >>> q0, v0 = toy.initial_state()
-    >>> [round(float(g), 6) for g in toy.gaps(q0, 0.0)]     # lower edge, upper edge, beak
-    [-6e-05, 0.12009, 0.79756]
+    >>> [round(float(g) * toy.length, 9) for g in toy.gaps(q0, 0.0)]  # lower, upper edge, beak [m]
+    [0.0, 0.0012, 0.007976]
     """
 
     ndof = 3
@@ -269,8 +269,8 @@ def section_crossings(t, q, v, level=GLOCKER_STATE[0][2]):
     --------
     >>> t = np.array([0.0, 1.0, 2.0])
     >>> q = np.array([[0.0, 0.0, 0.1], [-1.0, 0.0, -0.1], [-2.0, 0.0, -0.3]])
-    >>> section_crossings(t, q, -q, level=0.0).tolist()
-    [[0.5, -0.5, 0.5, -0.0]]
+    >>> section_crossings(t, q, q, level=0.0).tolist()
+    [[0.5, -0.5, -0.5, 0.0]]
     """
     t = np.asarray(t, dtype=float)
     q = np.asarray(q, dtype=float)
@@ -282,23 +282,43 @@ def section_crossings(t, q, v, level=GLOCKER_STATE[0][2]):
     return cols[idx] + f * (cols[idx + 1] - cols[idx])
 
 
+def section_event(level=GLOCKER_STATE[0][2]):
+    """An event function for :func:`moreau.integrators.simulate`: ``phi_S`` down through ``level``.
+
+    A run given ``events=[section_event()]`` locates every crossing of the
+    section (an event-driven run to its integration tolerance), and
+    :func:`limit_cycle` reads them.
+    """
+    def crossing(t, y):
+        return y[2] - level
+    crossing.direction = -1.0
+    return crossing
+
+
 def limit_cycle(scene, res):
     """Period [s], descent per period [m] and the section state [m/s, rad/s] of a run's last two cycles.
 
     The run's state crosses the section ``phi_S = -0.2788`` (downward) once a
-    cycle. On the way to the limit cycle the deviation alternates in sign
-    from one cycle to the next (a Poincaré multiplier near ``-0.84``), so
-    the values are the means over the last two cycles, which cancel that
-    alternation to first order. None where the run crossed fewer than three times.
+    cycle: at the located events of a run given ``events=[section_event()]``
+    (the first event function), else between its samples
+    (:func:`section_crossings`). On the way to the limit cycle the deviation
+    alternates in sign from one cycle to the next (a Poincaré multiplier near
+    ``-0.84``), so the values are the means over the last two cycles, which
+    cancel that alternation to first order.
 
     Returns
     -------
     dict or None
         ``period`` [s], ``descent`` (the drop of the sleeve per period, > 0) [m],
         ``speed`` (mean descent speed) [m/s], and ``ydot`` [m/s], ``phidot`` [rad/s]
-        at the section (the mean of the last two crossings).
+        at the section (the mean of the last two crossings); None where the run
+        crossed fewer than three times.
     """
-    c = section_crossings(res.t, res.q, res.v)
+    if getattr(res, "t_events", None) and len(res.t_events[0]):
+        ye = np.asarray(res.y_events[0], dtype=float)
+        c = np.column_stack([res.t_events[0], ye[:, 0], ye[:, 3], ye[:, 5]])
+    else:
+        c = section_crossings(res.t, res.q, res.v)
     if len(c) < 3:
         return None
     T, L = scene.time, scene.length
@@ -439,4 +459,7 @@ register_scene(SceneEntry(
                  "torsion spring, three frictional contacts (Glocker 1995; Leine, Glocker "
                  "and van Campen 2003)"),
     sweepable=("mu", "spring", "beak_restitution"),
+    # Moreau-Jean's sleeve height at 1000 steps over the case's window is 3.3 % off the
+    # reference (1.0 % at 4000 steps, 0.27 % at 16000: order 1)
+    mj_tolerance=5e-2,
 ))
