@@ -74,6 +74,20 @@ Rest
     and returns between them must declare its ``forcing_breakpoints``. After
     the Zeno closure of a bouncing ball the cost no longer grows with the window.
 
+Joints
+    A scene's joints (``n_joint_rows`` equality rows ``gE(q, t) = 0``) are
+    reduced to their acceleration level, ``WE a + wEbar = 0``, and join
+    every mode's equations beside the closed contacts' rows, their reactions
+    free in sign. Where the contact problem is posed (the mode decision at an
+    event, an impact) the joints' reactions are eliminated: the jointed
+    system answers a force ``f`` with ``(I - Z WE) M^-1 f``, ``Z = M^-1 WE^T
+    (WE M^-1 WE^T)^-1``, and an impact's velocity jump keeps ``WE v + wE =
+    0``. The drift the smooth phase leaves on the position and velocity
+    levels is removed by projecting the state onto the joints (with the
+    closed contacts, in the metric of ``M``) after each smooth phase and each
+    impact; ``constraint_drift`` of the result is the largest ``|gE|`` of its
+    samples.
+
 Known limits: a gap that dips below zero and comes back inside one
 integrator step is not seen (``max_step`` bounds the step); scenes with
 discontinuous forcing (a sawtooth drive) are integrated across the jumps by
