@@ -338,8 +338,9 @@ class WoodpeckerToyCase(CompareCase):
     """
 
     ref_scheme = "event-driven"
-    ref_rtols = (1e-6, 1e-8, 1e-10)
-    tight_rtol = 1e-12
+    # the reference at rtol 1e-10 is within 3e-11 of the one at 1e-12 (measured)
+    ref_rtols = (1e-6, 1e-8)
+    tight_rtol = 1e-10
     window = 4.0
     headline_name = "sleeve height at the end of the window"
     trajectory_scale = 0.5
