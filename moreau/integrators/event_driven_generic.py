@@ -74,6 +74,20 @@ Rest
     and returns between them must declare its ``forcing_breakpoints``. After
     the Zeno closure of a bouncing ball the cost no longer grows with the window.
 
+Joints
+    A scene's joints (``n_joint_rows`` equality rows ``gE(q, t) = 0``) are
+    reduced to their acceleration level, ``WE a + wEbar = 0``, and join
+    every mode's equations beside the closed contacts' rows, their reactions
+    free in sign. Where the contact problem is posed (the mode decision at an
+    event, an impact) the joints' reactions are eliminated: the jointed
+    system answers a force ``f`` with ``(I - Z WE) M^-1 f``, ``Z = M^-1 WE^T
+    (WE M^-1 WE^T)^-1``, and an impact's velocity jump keeps ``WE v + wE =
+    0``. The drift the smooth phase leaves on the position and velocity
+    levels is removed by projecting the state onto the joints (with the
+    closed contacts, in the metric of ``M``) after each smooth phase and each
+    impact; ``constraint_drift`` of the result is the largest ``|gE|`` of its
+    samples.
+
 Known limits: a gap that dips below zero and comes back inside one
 integrator step is not seen (``max_step`` bounds the step); scenes with
 discontinuous forcing (a sawtooth drive) are integrated across the jumps by
@@ -92,13 +106,14 @@ from scipy.integrate import solve_ivp
 from .._validate import nonnegative, positive, positive_int, relative_tolerance
 from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import METHODS as LCP_SOLVERS, build_friction_lcp, friction_impulses, solve_lcp
+from ..model.scene import joint_row_count
 from ..regimes import Regime
 from .base import Integrator, SchemeOptions, get_integrator, register_integrator
 from .contact_problem import MAX_PIECES_CONTACTS, friction_pieces
 from .result import Event
 
 __all__ = ["GenericEventDriven", "ContactModeSolver", "EventDrivenReference",
-           "contact_law_regimes", "contact_velocity_scale"]
+           "contact_law_regimes", "contact_velocity_scale", "project_onto_joints"]
 
 _F, _P, _N, _S = int(Regime.FLIGHT), int(Regime.POSITIVE), int(Regime.NEGATIVE), int(Regime.STICK)
 _SIGN = {_P: 1.0, _N: -1.0}
@@ -127,6 +142,29 @@ class ContactModeSolver:
         # row of each frictional contact in WT (-1 for frictionless contacts)
         self.trow = np.full(self.nc, -1, dtype=int)
         self.trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
+        #: the scene's joint (equality) rows, always active
+        self.nj = joint_row_count(scene)
+
+    def joint_rows(self, t, q, v):
+        """``(WE, wE, wEbar)`` of the scene's joints at ``(t, q, v)``."""
+        sc = self.scene
+        WE, wE = (np.asarray(x, dtype=float) for x in sc.joint_jacobians(q, t))
+        return WE.reshape(self.nj, self.ndof), wE.reshape(self.nj), np.asarray(
+            sc.joint_drift(q, v, t), dtype=float).reshape(self.nj)
+
+    def joint_solve(self, M, WE, cols):
+        """``M^-1 cols`` with the joints' reactions eliminated, and ``M^-1 WE^T S^-1`` (``S = WE M^-1 WE^T``).
+
+        The joints hold ``WE a + wEbar = 0`` (or ``WE dv = 0`` at an impact): the
+        response of the jointed system to the forces ``cols`` is ``(I - Z WE)
+        M^-1 cols`` with ``Z = M^-1 WE^T S^-1``, and a residual ``r`` of the
+        joint rows is removed by ``- Z r``.
+        """
+        X = np.linalg.solve(M, np.column_stack([WE.T, cols]))
+        MiWE, Y = X[:, :self.nj], X[:, self.nj:]
+        S = WE @ MiWE
+        Z = np.linalg.solve(S, MiWE.T).T
+        return Y - Z @ (WE @ Y), Z
 
     def kinematics(self, t, q, v):
         sc = self.scene
@@ -176,6 +214,10 @@ class ContactModeSolver:
         kin = self.kinematics(t, q, v)
         M, h, WN, wN, WT, wT, wNb, wTb = kin
         closed, stick, H, G, wbar = self._rows(mode, WN, WT, wNb, wTb)
+        if self.nj:
+            # the joints' rows after the contacts' (their reactions are free in sign)
+            WE, _, wEb = self.joint_rows(t, q, v)
+            H, G, wbar = np.vstack([H, WE]), np.vstack([G, WE]), np.concatenate([wbar, wEb])
         lamN = np.zeros(self.nc)
         lamT = np.zeros(self.nc)
         if H.shape[0] == 0:
@@ -401,6 +443,31 @@ def project_positions(scene, t, q, contacts, max_iter=4):
     return q
 
 
+def project_onto_joints(scene, t, q, contacts=(), max_iter=8):
+    """``q`` moved, in the metric of ``M``, onto the joints ``gE = 0`` and ``g = 0`` for ``contacts``.
+
+    Gauss-Newton steps ``dq = M^-1 W^T (W M^-1 W^T)^+ r`` on the stacked
+    residuals ``r = (g[contacts], gE)`` with rows ``W = (WN[contacts]; WE)``
+    (the pseudo-inverse takes redundant rows); stops when the residuals are
+    zero or the step is at round-off.
+    """
+    contacts = np.asarray(contacts, dtype=int)
+    M = scene.mass(q)
+    for _ in range(max_iter):
+        r = np.concatenate([np.asarray(scene.gaps(q, t), dtype=float)[contacts],
+                            np.asarray(scene.joint_residuals(q, t), dtype=float)])
+        if np.max(np.abs(r), initial=0.0) == 0.0:
+            break
+        W = np.vstack([np.asarray(scene.contact_jacobians(q, t)[0], dtype=float)[contacts],
+                       np.asarray(scene.joint_jacobians(q, t)[0], dtype=float)])
+        MiW = np.linalg.solve(M, W.T)
+        dq = MiW @ np.linalg.lstsq(W @ MiW, r, rcond=1e-12)[0]
+        q = q - dq
+        if np.max(np.abs(dq)) <= 4e-16 * max(1.0, float(np.max(np.abs(q)))):
+            break
+    return q
+
+
 def _one_of(name, value, allowed):
     if not isinstance(value, str) or value not in allowed:
         raise InputError(f"`{name}` must be one of {list(allowed)}, got {value!r}")
@@ -471,6 +538,10 @@ class GenericEventDriven(Integrator):
     """
 
     exact_motion = True
+    #: joints: their acceleration-level rows join every mode's equations (index
+    #: reduction), their velocity rows every impact's, and the state is projected onto
+    #: them after each smooth phase and each impact
+    solves_joints = True
 
     @dataclasses.dataclass(frozen=True)
     class Options(SchemeOptions):
@@ -515,6 +586,7 @@ class GenericEventDriven(Integrator):
         self.max_impacts = o.max_impacts
         self.lcp_method = o.lcp_method
         self.ms = ContactModeSolver(scene)
+        self._max_drift = 0.0
         nc = scene.ncontacts
         self.mode = np.zeros(nc, dtype=int)
         self._vscale = 0.0
@@ -563,6 +635,9 @@ class GenericEventDriven(Integrator):
     # -- recording ---------------------------------------------------------------
     def _sample_row(self, t, q, v, mode):
         ms = self.ms
+        if ms.nj:
+            self._max_drift = max(self._max_drift, float(np.max(np.abs(
+                self.scene.joint_residuals(q, t)), initial=0.0)))
         a, lamN, lamT, _, _, kin = ms.solve(t, q, v, mode)
         slip = ms.slip_velocities(q, v, t, kin)
         gap = self.scene.gaps(q, t)
@@ -576,11 +651,14 @@ class GenericEventDriven(Integrator):
 
     # -- projection onto the closed contacts' constraints ----------------------
     def _project_positions(self, t, q, contacts):
+        if self.ms.nj:
+            return project_onto_joints(self.scene, t, q, contacts)
         return project_positions(self.scene, t, q, contacts, max_iter=4)
 
     def _project(self, t, q, v, mode):
         closed = np.flatnonzero(mode != _F)
-        if closed.size == 0:
+        nj = self.ms.nj
+        if closed.size == 0 and not nj:
             return q, v
         sc = self.scene
         q = self._project_positions(t, q, closed)
@@ -588,6 +666,9 @@ class GenericEventDriven(Integrator):
         stick = [i for i in closed if mode[i] == _S and self.ms.trow[i] >= 0]
         H = np.vstack([WN[closed]] + ([WT[self.ms.trow[stick]]] if stick else []))
         w = np.concatenate([wN[closed]] + ([wT[self.ms.trow[stick]]] if stick else []))
+        if nj:
+            WE, wE, _ = self.ms.joint_rows(t, q, v)
+            H, w = np.vstack([H, WE]), np.concatenate([w, wE])
         MiH = np.linalg.solve(sc.mass(q), H.T)
         # lstsq: redundant closed contacts (a block flat on two corners) make H M^-1 H^T
         # singular; the projected velocity is unique all the same
@@ -596,7 +677,7 @@ class GenericEventDriven(Integrator):
         if self.jumps is not None:
             pN, pT = np.zeros(self.ms.nc), np.zeros(self.ms.nc)
             pN[closed] = lam[:closed.size]
-            pT[stick] = lam[closed.size:]
+            pT[stick] = lam[closed.size:closed.size + len(stick)]
             self.jumps.append((t, q.copy(), v.copy(), v_post.copy(), pN, pT, "projection"))
         return q, v_post
 
@@ -612,7 +693,14 @@ class GenericEventDriven(Integrator):
             rows.append(WT[ms.trow[fr]])
         J = np.vstack(rows)
         w = np.concatenate([wN[touching]] + ([wT[ms.trow[fr]]] if fr else []))
-        MiJ = np.linalg.solve(M, J.T)
+        if ms.nj:
+            # the joints' impulses eliminated: the jointed system's response, from the
+            # velocity on the joints (WE v + wE = 0 before and after)
+            WE, wE, _ = ms.joint_rows(t, q, v)
+            MiJ, Z = ms.joint_solve(M, WE, J.T)
+            v = v - Z @ (WE @ v + wE)
+        else:
+            MiJ = np.linalg.solve(M, J.T)
         W = J @ MiJ
         vrel = J @ v + w
         mu = ms.mu[touching]
@@ -755,7 +843,13 @@ class GenericEventDriven(Integrator):
         for k, i in enumerate(cone):
             H[nC + k] = G[nC + k] = WT[ms.trow[i]]
             wbar[nC + k] = wTb[ms.trow[i]]
-        X = np.linalg.solve(M, np.column_stack([h, G.T]))
+        if ms.nj:
+            # the joints' reactions eliminated (their rows hold at acceleration level)
+            WE, _, wEb = ms.joint_rows(t, q, v)
+            X, Z = ms.joint_solve(M, WE, np.column_stack([h, G.T]))
+            X[:, 0] -= Z @ wEb
+        else:
+            X = np.linalg.solve(M, np.column_stack([h, G.T]))
         A = H @ X[:, 1:]
         b = H @ X[:, 0] + wbar
         for k, i in enumerate(cand):
@@ -1043,6 +1137,12 @@ class GenericEventDriven(Integrator):
         self._record_state(self.t, self.q, self.v)
         return True
 
+    def result(self):
+        res = super().result()
+        if self.ms.nj:
+            res.constraint_drift = self._max_drift
+        return res
+
     def _step_impl(self):
         if self.t == self._last_event_t:
             self._stalled += 1
@@ -1122,6 +1222,9 @@ def _constant_forcing(scene, q, v, t0, t1):
     def values(s):
         out = [scene.forces(q, v, s), scene.gaps(q, s), *scene.contact_jacobians(q, s),
                *scene.contact_drift(q, v, s)]
+        if joint_row_count(scene):
+            out += [scene.joint_residuals(q, s), *scene.joint_jacobians(q, s),
+                    scene.joint_drift(q, v, s)]
         return [np.asarray(x, dtype=float) for x in out]
 
     ref = values(t0)
