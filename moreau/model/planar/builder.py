@@ -364,6 +364,40 @@ class Model:
             rec.update(kind=K.POLY, vertices=s.vertices)
         return rec
 
+    def add_clearance_revolute(self, body_i, point_i, body_j, point_j, hole_radius, pin_radius,
+                               mu=0.0, restitution=0.0):
+        """A revolute joint with clearance: a pin of ``body_j`` in a hole of ``body_i``; returns its contact's index.
+
+        The hole (radius ``hole_radius`` [m]) is centred at ``point_i`` of
+        ``body_i``, the pin (radius ``pin_radius``) at ``point_j`` of
+        ``body_j`` (body frames). It is one unilateral contact, not a joint
+        row: with ``d`` the pin's centre less the hole's and ``c =
+        hole_radius - pin_radius``, the gap is ``c - |d|`` and the normal
+        ``-d / |d|`` (kinematics in :mod:`moreau.model.planar`), with
+        Coulomb friction ``mu`` and Newton restitution ``restitution``
+        between the pin and the wall. Where ``d = 0`` its direction is not
+        defined: ``body_i``'s ``x`` axis stands for it (the gap is then ``c``,
+        the contact open). The pin must start inside the hole.
+        """
+        bi, bj = self._joint_bodies(body_i, body_j)
+        ri, rj = _vec2("point_i", point_i), _vec2("point_j", point_j)
+        Rh = positive("hole_radius", hole_radius)
+        Rp = nonnegative("pin_radius", pin_radius)
+        if not Rp < Rh:
+            raise InputError(f"`pin_radius` ({Rp!r}) must be less than `hole_radius` ({Rh!r}): "
+                             "the clearance is their difference")
+        gap = Rh - Rp - float(np.hypot(*(self._initial_point(bj, rj)
+                                         - self._initial_point(bi, ri))))
+        if gap < -1e-12 * Rh:
+            raise InputError(f"the pin of {bj.name!r} starts {-gap!r} m beyond the clearance "
+                             f"{Rh - Rp!r} m of the hole of {bi.name!r}: place `point_j` "
+                             "within the clearance of `point_i`")
+        mu = nonnegative("mu", mu)
+        e = in_closed_interval("restitution", restitution, 0.0, 1.0)
+        self.contacts.append(dict(kind=K.HOLE, A=bj.index, B=bi.index, rA=rj, rho=Rp,
+                                  p=(*ri, Rh), shape=None, mu=mu, restitution=e))
+        return len(self.contacts) - 1
+
     # -- forces ------------------------------------------------------------------------------
     def add_spring(self, body_i, point_i, body_j, point_j, stiffness, rest_length=None,
                    damping=0.0):
@@ -568,7 +602,7 @@ class Model:
             if rec["kind"] == K.PLANE:
                 px, py, nx, ny = rec["p"]
                 r[6:10] = [px / L, py / L, nx, ny]
-            elif rec["kind"] == K.POINTS:
+            elif rec["kind"] in (K.POINTS, K.HOLE):
                 r[6:9] = [rec["p"][0] / L, rec["p"][1] / L, rec["p"][2] / L]
             else:
                 r[6] = len(rec["vertices"])
