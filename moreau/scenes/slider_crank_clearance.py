@@ -99,7 +99,7 @@ class SliderCrankClearanceParams:
 
 def _checked(p):
     for name in ("crank_radius", "rod_length", "crank_speed", "rod_mass", "rod_inertia",
-                 "slider_mass", "slider_inertia", "clearance"):
+                 "slider_mass", "slider_inertia", "clearance", "pin_radius"):
         value = getattr(p, name)
         if not (math.isfinite(value) and value > 0.0):
             raise InputError(f"`{name}` must be finite and > 0, got {value!r}")
@@ -110,6 +110,10 @@ def _checked(p):
     if not p.clearance < 0.1 * p.rod_length:
         raise InputError(f"`clearance` ({p.clearance!r}) must be less than a tenth of "
                          f"`rod_length` ({p.rod_length!r}): a clearance joint, not a slot")
+    if not (math.isfinite(p.mu) and p.mu >= 0.0):
+        raise InputError(f"`mu` must be finite and >= 0, got {p.mu!r}")
+    if not 0.0 <= p.restitution <= 1.0:
+        raise InputError(f"`restitution` must be in [0, 1], got {p.restitution!r}")
     if not math.isfinite(p.gravity):
         raise InputError(f"`gravity` must be finite, got {p.gravity!r}")
     return p
