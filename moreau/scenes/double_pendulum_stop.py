@@ -184,15 +184,16 @@ class DoublePendulumStopCase(CompareCase):
     def start(self):
         return self.scene.initial_state()
 
-    def _energy0(self):
+    def initial_energy(self):
+        """The energy of the start, above the hanging rest (scene units)."""
         q0, v0 = self.start()
         return float(self.energy(q0[None], v0[None])[0])
 
     def reference(self, rtol):
-        return self._energy0(), []
+        return self.initial_energy(), []
 
     def reference_grid(self):
-        return np.full(GRID + 1, self._energy0())
+        return np.full(GRID + 1, self.initial_energy())
 
     def headline_of_run(self, res):
         return float(self.energy(res.q[-1:], res.v[-1:])[0])
@@ -200,7 +201,7 @@ class DoublePendulumStopCase(CompareCase):
     def _trajectory_error(self, res):
         # the energy's largest departure over every sample, relative to the initial energy
         e = self.energy(res.q, res.v)
-        return float(np.max(np.abs(e - self._energy0())) / abs(self._energy0()))
+        return float(np.max(np.abs(e - self.initial_energy())) / abs(self.initial_energy()))
 
     def _run_switches(self, res, h):
         # the reference is an invariant, not a trajectory: no switching times to compare
