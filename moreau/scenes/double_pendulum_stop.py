@@ -138,8 +138,11 @@ def pendulum_energy(scene, q, v):
     --------
     >>> sc = double_pendulum_stop()
     >>> q0, v0 = sc.initial_state()
-    >>> float(pendulum_energy(sc, q0[None], v0[None])[0])   # both centres at y = 0, at rest
+    >>> round(float(pendulum_energy(sc, q0[None], v0[None])[0]), 12)   # centres at y = 0, at rest
     0.0
+    >>> hanging = np.array([0.0, -0.5, -np.pi / 2, 0.0, -1.5, -np.pi / 2])
+    >>> float(pendulum_energy(sc, hanging[None], v0[None])[0])          # -(m g l/2 + m g 3l/2)
+    -2.0
     """
     q = np.atleast_2d(q)
     v = np.atleast_2d(v)
