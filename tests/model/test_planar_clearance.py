@@ -146,3 +146,54 @@ def test_a_clearance_joint_refuses_bad_input_naming_it():
     with pytest.raises(InputError, match="`body_j` must be a body of this model"):
         m.add_clearance_revolute(rod, (0.06, 0.0), other, (0.0, 0.0), 0.0105, 0.01)
     assert len(m.contacts) == 1          # nothing was added by the refused calls
+
+
+def _pin_in_slot():
+    # a disk whose pin (radius 0.015 m) moves in a slot of half-width 0.02 m along the
+    # ground's x axis, the pin 3 mm above the slot's centre line, thrown to the right
+    m = Model(gravity=(0.0, -9.81), length=0.1)
+    disk = m.add_body(0.5, 1e-4, position=(0.0, 0.003), velocity=(0.3, 0.0), name="disk")
+    rows = m.add_clearance_prismatic(m.ground, (0.0, 0.0), (1.0, 0.0), disk, (0.0, 0.0),
+                                     half_width=0.02, pin_radius=0.015, mu=0.3)
+    return m, disk, rows
+
+
+def test_a_clearance_prismatic_refuses_bad_input_naming_it():
+    m, disk, rows = _pin_in_slot()
+    assert rows == [0, 1]
+    with pytest.raises(InputError, match=r"`pin_radius` \(0.03\) must be less than "
+                                         r"`half_width` \(0.02\)"):
+        m.add_clearance_prismatic(m.ground, (0.0, 0.0), (1.0, 0.0), disk, (0.0, 0.0), 0.02,
+                                  0.03)
+    with pytest.raises(InputError, match="the pin of 'disk' starts 0.013 m off the slot's "
+                                         "centre line, beyond the clearance 0.005 m"):
+        m.add_clearance_prismatic(m.ground, (0.0, -0.01), (1.0, 0.0), disk, (0.0, 0.0), 0.02,
+                                  0.015)
+    with pytest.raises(InputError, match="`axis` of a prismatic joint must not be zero"):
+        m.add_clearance_prismatic(m.ground, (0.0, 0.0), (0.0, 0.0), disk, (0.0, 0.0), 0.02,
+                                  0.015)
+    assert len(m.contacts) == 2
+
+
+@pytest.mark.slow   # a model structure of its own: a numba compile (5-15 s on 2 shared cores)
+def test_a_pin_in_a_slot_has_the_walls_gaps_and_settles_on_the_lower_wall():
+    from moreau.check import check_scene
+    from moreau.integrators import simulate
+    m, disk, _ = _pin_in_slot()
+    sc = m.build("pin-in-slot")
+    q0, v0 = sc.initial_state()
+    # gaps W - R_p + s and W - R_p - s, s = 3 mm, in units of 0.1 m
+    np.testing.assert_allclose(sc.gaps(q0, 0.0), [0.008 / 0.1, 0.002 / 0.1], atol=1e-15)
+    report = check_scene(sc)
+    assert report.ok, report.summary()
+    res = simulate(sc, (0.0, 5.0), q0, v0, "moreau-jean", h=1e-2, projection=True)
+    assert res.status == 0, res.message
+    # it falls onto the lower wall (the pin's centre 5 mm below the centre line, the lower
+    # gap closed) and friction (mu = 0.3) brings it to rolling: the wall's impulse J on the
+    # pin's lowest point gives m (v - v0) = J, I w = R_p J, and rolling v = -w R_p, so
+    # v = v0 m / (m + I / R_p^2) (measured to 1e-15)
+    assert abs(res.q[-1, 1] + 0.005 / 0.1) < 1e-12 and abs(res.gap[-1, 0]) < 1e-12
+    v = v0[0] * 0.5 / (0.5 + 1e-4 / 0.015 ** 2)
+    R = 0.015 / 0.1
+    assert res.v[-1, 0] == pytest.approx(v, rel=1e-12)
+    assert res.v[-1, 2] == pytest.approx(-v / R, rel=1e-12) and abs(res.v[-1, 1]) < 1e-12

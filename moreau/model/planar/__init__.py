@@ -88,6 +88,8 @@ d''`` and ``(n . d')(t . d') / |d| + t . d''``. At ``d = 0`` the normal is
 undefined: ``B``'s ``x`` axis stands for ``d / |d|`` and the ``1 / |d|``
 terms are dropped there (below ``|d| = 1e-12 R_h``); the gap is then the
 whole clearance, far from closing, so the contact is open and nothing is NaN.
+A pin in a slot (:meth:`Model.add_clearance_prismatic`) is two points on
+lines, the slot's walls.
 
 All three give the rows ``W v + w = e . (v_A(C_A) - v_B(C_B))`` for ``e`` in
 ``{n, t}``: body ``A``'s entries ``(e_x, e_y, s_A x e)`` with ``s_A = C_A -
