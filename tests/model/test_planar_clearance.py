@@ -197,3 +197,38 @@ def test_a_pin_in_a_slot_has_the_walls_gaps_and_settles_on_the_lower_wall():
     R = 0.015 / 0.1
     assert res.v[-1, 0] == pytest.approx(v, rel=1e-12)
     assert res.v[-1, 2] == pytest.approx(-v / R, rel=1e-12) and abs(res.v[-1, 1]) < 1e-12
+
+
+@pytest.mark.slow   # a model structure of its own: a numba compile (5-15 s on 2 shared cores)
+def test_a_hole_in_a_driven_body_has_its_rheonomic_and_drift_terms():
+    # the hole on a driven crank (turning and translating), the pin on a free bar: the
+    # rows' rheonomic terms and the driven body's prescribed accelerations in the drift,
+    # against central differences in time and along the motion (check_scene), with friction
+    from moreau.check import check_scene
+    from moreau.model.planar import TimeFunction
+    m = Model(gravity=(0.0, -9.81), length=0.1)
+    crank = m.add_driven(x=TimeFunction(0.0, harmonics=[(0.01, 7.0, 0.3)]),
+                         theta=TimeFunction(0.2, rate=3.0, accel=1.5), name="crank")
+    c0, s0 = math.cos(0.2), math.sin(0.2)
+    hole = np.array([0.01 * math.sin(0.3) + 0.05 * c0, 0.05 * s0])
+    bar = m.add_body(0.3, 2e-4, position=(hole[0] + 0.0003 + 0.04, hole[1]), name="bar")
+    m.add_clearance_revolute(crank, (0.05, 0.0), bar, (-0.04, 0.0), hole_radius=0.0105,
+                             pin_radius=0.01, mu=0.4, restitution=0.5)
+    sc = m.build("driven-hole")
+    q0, v0 = sc.initial_state()
+    states = [(q0 + 0.003 * np.array([1.0, -0.5, 0.3]), v0 + np.array([0.5, -1.0, 2.0])),
+              (q0 + 0.003 * np.array([-0.7, 0.4, -1.0]), v0 + np.array([-1.5, 0.2, -3.0]))]
+    report = check_scene(sc, states=states, t=0.7)
+    assert report.ok, report.summary()
+    # measured 1.1e-10, 3.5e-11, 5.6e-10, 2.9e-10
+    for key in ("gap rates (WN, wN)", "rheonomic terms (wN against d/dt of the gaps)",
+                "normal drift (wNbar)", "tangential drift (wTbar)"):
+        assert report.errors[key] < 1e-7, (key, report.errors[key])
+    # the tangential row against the material points' velocities, the crank's included
+    t = 0.7
+    for q, v in states:
+        WN, wN, WT, wT = sc.contact_jacobians(q, t)
+        rel = _material_velocity(sc, q, v, t, 0) - _material_velocity(sc, q, v, t, 1)
+        n = sc.contact_frames(q, t)[0, 2:4]
+        assert abs((WT @ v + wT)[0] - np.array([n[1], -n[0]]) @ rel) < 1e-7
+        assert abs((WN @ v + wN)[0] - n @ rel) < 1e-7
