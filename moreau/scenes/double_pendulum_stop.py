@@ -18,7 +18,8 @@ is the classic test of impact schemes (e.g. Acary and Brogliato,
 parameters here are our own: ``l1 = l2 = 1 m``, ``m1 = m2 = 1 kg``,
 ``g = 9.81 m/s^2``, the wall at ``x = 0.8 m``, both links released at rest
 horizontal to the left (``theta1 = theta2 = pi``), ``e = 1``. The lower
-tip reaches the wall at ``t = 1.4 s`` and strikes it again and again.
+tip first reaches the wall at ``t = 0.76 s`` (2.39 in the scene's time) and strikes it
+again and again.
 
 Coordinates (the builder's): each link's ``x, y, theta`` of its centre,
 its body ``x`` axis from its upper joint to its lower end; units ``l1``,
