@@ -7,8 +7,8 @@ Multibody Systems with Imperfect Joints* (Springer, Lecture Notes in
 Applied and Computational Mechanics 34, 2008): a crank of ``0.05 m``
 driven at ``5000 rpm``, a connecting rod of ``0.12 m``, a slider on a
 horizontal guide, and a clearance of ``0.5 mm`` in the joint between the
-rod and the slider (those four values as the brief of this scene gives
-them). The journal's radius (``10 mm``, the bearing's ``10.5 mm``) and the
+rod and the slider (the example's values as they are usually quoted from
+these works). The journal's radius (``10 mm``, the bearing's ``10.5 mm``) and the
 masses and centroidal inertias (rod ``0.21 kg``, ``2.5e-4 kg m^2``; slider
 ``0.14 kg``, ``1e-4 kg m^2``; the driven crank's own inertia does not
 enter) are our reading of the publications' tables, not checked against
