@@ -8,13 +8,13 @@ Applied and Computational Mechanics 34, 2008): a crank of ``0.05 m``
 driven at ``5000 rpm``, a connecting rod of ``0.12 m``, a slider on a
 horizontal guide, and a clearance of ``0.5 mm`` in the joint between the
 rod and the slider (the example's values as they are usually quoted from
-these works). The journal's radius (``10 mm``, the bearing's ``10.5 mm``) and the
-masses and centroidal inertias (rod ``0.21 kg``, ``2.5e-4 kg m^2``; slider
-``0.14 kg``, ``1e-4 kg m^2``; the driven crank's own inertia does not
-enter) are our reading of the publications' tables, not checked against
-them here. Those
-works model the journal-bearing contact with a continuous (Hertzian,
-Lankarani-Nikravesh) force with restitution ``0.9``; here it is a rigid
+these works). The journal's radius (``10 mm``, the bearing's ``10.5
+mm``) and the masses and centroidal inertias (rod ``0.21 kg``, ``2.5e-4
+kg m^2``; slider ``0.14 kg``, ``1e-4 kg m^2``; the driven crank's own
+inertia does not enter) are our reading of the publications' tables, not
+checked against them here. Those works model the journal-bearing contact
+with a continuous (Hertzian, Lankarani-Nikravesh) force with restitution
+``0.9``; here it is a rigid
 unilateral contact with Newton's restitution ``e = 0.9`` (the
 non-smooth formulation of Flores, Leine and Glocker, *Multibody Syst.
 Dyn.* 23 (2010) 165-190, for a translational clearance), frictionless by
