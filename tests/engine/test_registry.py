@@ -17,9 +17,10 @@ NAMES = registry.scene_names()
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
     assert NAMES == ["ball-chain", "bidirectional-drive", "bouncing-ball", "disk-incline",
-                     "flexible-rod-drive", "friction-drive", "painleve-rod", "piezo-drive",
-                     "rocking-block", "rocking-block-built", "slider-crank", "sliding-block",
-                     "sliding-box", "stick-slip-motor"]
+                     "double-pendulum-stop", "flexible-rod-drive", "friction-drive",
+                     "painleve-rod", "piezo-drive", "rocking-block", "rocking-block-built",
+                     "slider-crank", "slider-crank-clearance", "sliding-block", "sliding-box",
+                     "stick-slip-motor"]
 
 
 @pytest.mark.parametrize("name", NAMES)

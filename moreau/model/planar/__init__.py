@@ -74,7 +74,24 @@ term ``rho_A (w_A - w_B)`` in it.
 ``d = P_A - P_B``, ``n = d / |d|``, ``g = |d| - rho_A - rho_B``, contact
 points ``C_A = P_A - rho_A n`` and ``C_B = P_B + rho_B n``.
 
-Both give the rows ``W v + w = e . (v_A(C_A) - v_B(C_B))`` for ``e`` in
+*Pin in a hole* (:meth:`Model.add_clearance_revolute`, a revolute joint
+with clearance: pin ``P_A`` of radius ``R_p`` on ``A``, hole centre
+``P_B`` of radius ``R_h`` on ``B``): ``d = P_A - P_B``, ``c = R_h - R_p``,
+``g = c - |d|``, ``n = -d / |d|`` (from the wall towards the centre, the
+direction of the force on the pin), contact points ``C_A = P_A - R_p n``
+and ``C_B = P_B - R_h n``. Then ``g' = -(d / |d|) . d' = n . d'``, and as
+``n . perp(d) = 0`` the contact points' levers add nothing to the normal
+row; ``t = (n_y, -n_x) = perp(d / |d|)`` and ``t . perp(d / |d|) = 1`` put
+``R_p w_A - R_h w_B`` in the slip. With ``n' = -t (t . d') / |d|`` and
+``t' = n (t . d') / |d|`` the drift terms are ``-(t . d')^2 / |d| + n .
+d''`` and ``(n . d')(t . d') / |d| + t . d''``. At ``d = 0`` the normal is
+undefined: ``B``'s ``x`` axis stands for ``d / |d|`` and the ``1 / |d|``
+terms are dropped there (below ``|d| = 1e-12 R_h``); the gap is then the
+whole clearance, far from closing, so the contact is open and nothing is NaN.
+A pin in a slot (:meth:`Model.add_clearance_prismatic`) is two points on
+lines, the slot's walls.
+
+All three give the rows ``W v + w = e . (v_A(C_A) - v_B(C_B))`` for ``e`` in
 ``{n, t}``: body ``A``'s entries ``(e_x, e_y, s_A x e)`` with ``s_A = C_A -
 X_A``, body ``B``'s the negatives with ``s_B = C_B - X_B``; a free body's
 go into ``W``, a driven body's times its prescribed velocity into the

@@ -34,6 +34,7 @@ from numba import njit
 from moreau.model.planar._kernels import (closest_feature, drift_plane, drift_points,
     frame_plane, frame_points, frame_poly, harmonic_part, lever, poly_part, spring_block,
     spring_terms, turn)
+from moreau.model.planar._kernels import drift_hole, frame_hole
 '''
 
 
@@ -118,6 +119,9 @@ def _frame(lines, st, i, indent="    "):
     elif kind == K.POINTS:
         lines.append(f"{indent}{out}, L = frame_points({args}, par[{o + 6}], par[{o + 7}], "
                      f"par[{o + 8}])")
+    elif kind == K.HOLE:
+        lines.append(f"{indent}{out}, L = frame_hole({args}, par[{o + 6}], par[{o + 7}], "
+                     f"par[{o + 8}])")
     else:
         nv, vo = _i(st.par[o + 6]), _i(st.par[o + 7])
         verts = ", ".join(f"par[{vo + m}]" for m in range(2 * nv))
@@ -201,6 +205,8 @@ def _drift(st):
             lines += ["    " + s for s in plane]
         elif kind == K.POINTS:
             lines += ["    " + s for s in points]
+        elif kind == K.HOLE:
+            lines.append(f"    dn, dt = drift_hole({dv}, nx, ny, rAx, rAy, ux, uy, L)")
         else:
             lines.append("    if L == 0.0:")
             lines += ["        " + s for s in plane]

@@ -30,7 +30,9 @@ Contact record (``CREC`` floats): ``kind``, body ``A``, body ``B``, the point
 ``PLANE`` a line of ``B`` (point ``p0``, unit normal ``n0``, body frame);
 ``POINTS`` a point ``rB`` of ``B`` with radius ``rhoB``; ``POLY`` a convex
 polygon of ``B`` (``nv`` counter-clockwise vertices at an offset; two
-vertices: a segment, two-sided).
+vertices: a segment, two-sided); ``HOLE`` a hole of ``B`` (centre ``h``,
+radius ``rhoB``) around the pin ``rA`` of radius ``rhoA`` (a revolute joint
+with clearance).
 
 Force record (``FREC`` floats): ``SPRING`` (bodies ``i, j``, points
 ``ri, rj``, stiffness, rest length, damping), ``TORSION`` (bodies ``i, j``,
@@ -285,3 +287,57 @@ def spring_block(ga, gb, rax, ray, rbx, rby, wb, Axx, Axy, Ayx, Ayy, Bxx, Bxy, B
             k02, k12, k22, c02, c12, c22 = a0, a1, a2, b0, b1, b2
     return (k00, k01, k02, k10, k11, k12, k20, k21, k22,
             c00, c01, c02, c10, c11, c12, c20, c21, c22)
+
+
+#: contact kind of a revolute joint with clearance: a pin of ``A`` in a hole of ``B``
+HOLE = 3
+
+
+@njit
+def frame_hole(xA, yA, cA, snA, rx, ry, rhoA, xB, yB, cB, snB, hx, hy, rhoB):
+    """A pin of ``A`` (centre ``r``, radius ``rhoA``) in a hole of ``B`` (centre ``h``, radius ``rhoB``).
+
+    Returns ``(g, nx, ny, sAx, sAy, sBx, sBy, rAx, rAy, rBx, rBy, L)``: the gap
+    ``rhoB - rhoA - |d|`` with ``d`` the pin's centre less the hole's, the
+    normal ``-d / |d|`` (from the wall towards the centre: the force on the
+    pin), the contact points' offsets ``r' + rho d / |d|`` and ``L = |d|``.
+    Below ``|d| = 1e-12 rhoB`` the direction of ``d`` is not defined: ``B``'s
+    ``x`` axis stands for it and ``L = 0`` tells :func:`drift_hole` (the gap
+    is then the whole clearance, far from closing).
+    """
+    rAx, rAy = turn(cA, snA, rx, ry)
+    rBx, rBy = turn(cB, snB, hx, hy)
+    dx = xA + rAx - xB - rBx
+    dy = yA + rAy - yB - rBy
+    L = math.sqrt(dx * dx + dy * dy)
+    g = rhoB - rhoA - L
+    if L > 1e-12 * rhoB:
+        ux, uy = dx / L, dy / L
+    else:
+        ux, uy = cB, snB
+        L = 0.0
+    return (g, -ux, -uy, rAx + rhoA * ux, rAy + rhoA * uy, rBx + rhoB * ux, rBy + rhoB * uy,
+            rAx, rAy, rBx, rBy, L)
+
+
+@njit
+def drift_hole(wA, wB, dVx, dVy, nx, ny, rAx, rAy, rBx, rBy, L):
+    """Velocity parts of the normal and tangential rows' rates of a pin in a hole.
+
+    With ``n = -d / L`` and ``t = (ny, -nx)``: ``-(t . d')^2 / L + n . d''`` and
+    ``(n . d')(t . d') / L + t . d''``, ``d'' = -wA^2 r'_A + wB^2 r'_B``; at
+    ``L = 0`` (the centre) without the terms in ``1 / L``.
+    """
+    ddx = dVx - wA * rAy + wB * rBy
+    ddy = dVy + wA * rAx - wB * rBx
+    qx = -wA * wA * rAx + wB * wB * rBx
+    qy = -wA * wA * rAy + wB * wB * rBy
+    tx, ty = ny, -nx
+    dn = nx * qx + ny * qy
+    dt = tx * qx + ty * qy
+    if L > 0.0:
+        dnd = nx * ddx + ny * ddy
+        dtd = tx * ddx + ty * ddy
+        dn -= dtd * dtd / L
+        dt += dnd * dtd / L
+    return dn, dt

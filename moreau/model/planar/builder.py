@@ -364,6 +364,86 @@ class Model:
             rec.update(kind=K.POLY, vertices=s.vertices)
         return rec
 
+    def add_clearance_revolute(self, body_i, point_i, body_j, point_j, hole_radius, pin_radius,
+                               mu=0.0, restitution=0.0):
+        """A revolute joint with clearance: a pin of ``body_j`` in a hole of ``body_i``; returns its contact's index.
+
+        The hole (radius ``hole_radius`` [m]) is centred at ``point_i`` of
+        ``body_i``, the pin (radius ``pin_radius``) at ``point_j`` of
+        ``body_j`` (body frames). It is one unilateral contact, not a joint
+        row: with ``d`` the pin's centre less the hole's and ``c =
+        hole_radius - pin_radius``, the gap is ``c - |d|`` and the normal
+        ``-d / |d|`` (kinematics in :mod:`moreau.model.planar`), with
+        Coulomb friction ``mu`` and Newton restitution ``restitution``
+        between the pin and the wall. Where ``d = 0`` its direction is not
+        defined: ``body_i``'s ``x`` axis stands for it (the gap is then ``c``,
+        the contact open). The pin must start inside the hole.
+        """
+        bi, bj = self._joint_bodies(body_i, body_j)
+        ri, rj = _vec2("point_i", point_i), _vec2("point_j", point_j)
+        Rh = positive("hole_radius", hole_radius)
+        Rp = nonnegative("pin_radius", pin_radius)
+        if not Rp < Rh:
+            raise InputError(f"`pin_radius` ({Rp!r}) must be less than `hole_radius` ({Rh!r}): "
+                             "the clearance is their difference")
+        gap = Rh - Rp - float(np.hypot(*(self._initial_point(bj, rj)
+                                         - self._initial_point(bi, ri))))
+        if gap < -1e-12 * Rh:
+            raise InputError(f"the pin of {bj.name!r} starts {-gap:.6g} m beyond the clearance "
+                             f"{Rh - Rp:.6g} m of the hole of {bi.name!r}: place `point_j` "
+                             "within the clearance of `point_i`")
+        mu = nonnegative("mu", mu)
+        e = in_closed_interval("restitution", restitution, 0.0, 1.0)
+        self.contacts.append(dict(kind=K.HOLE, A=bj.index, B=bi.index, rA=rj, rho=Rp,
+                                  p=(*ri, Rh), shape=None, mu=mu, restitution=e))
+        return len(self.contacts) - 1
+
+    def add_clearance_prismatic(self, body_i, point_i, axis, body_j, point_j, half_width,
+                                pin_radius, mu=0.0, restitution=0.0):
+        """A prismatic joint with clearance: a pin of ``body_j`` in a slot of ``body_i``; returns its two contacts' indices.
+
+        The slot of ``body_i`` runs along ``axis`` (its frame) through
+        ``point_i``, its walls ``half_width`` [m] either side; the pin
+        (radius ``pin_radius``) is centred at ``point_j`` of ``body_j``. Two
+        unilateral contacts, each the pin against one wall (a point against a
+        line, kinematics in :mod:`moreau.model.planar`): with ``n0`` the unit
+        normal to the axis and ``s = n0 . (P_j - Q_i)`` the pin's offset
+        from the slot's centre line, the gaps ``half_width - pin_radius + s``
+        (the wall on the ``-n0`` side, its normal ``n0``) and
+        ``half_width - pin_radius - s``. The slot is unbounded along its axis
+        and the pin turns freely in it. The pin must start inside the slot.
+        """
+        bi, bj = self._joint_bodies(body_i, body_j)
+        ri, rj = _vec2("point_i", point_i), _vec2("point_j", point_j)
+        u = _vec2("axis", axis)
+        ln = float(np.hypot(*u))
+        if ln == 0.0:
+            raise InputError("`axis` of a prismatic joint must not be zero")
+        W = positive("half_width", half_width)
+        Rp = nonnegative("pin_radius", pin_radius)
+        if not Rp < W:
+            raise InputError(f"`pin_radius` ({Rp!r}) must be less than `half_width` ({W!r}): "
+                             "the clearance is their difference")
+        mu = nonnegative("mu", mu)
+        e = in_closed_interval("restitution", restitution, 0.0, 1.0)
+        n0 = np.array([-u[1], u[0]]) / ln
+        # the pin's offset from the centre line, in body i's frame, at the initial poses
+        xi, yi, thi = self._initial_pose(bi)
+        c, s = math.cos(thi), math.sin(thi)
+        rel = self._initial_point(bj, rj) - self._initial_point(bi, ri)
+        off = float(n0 @ np.array([c * rel[0] + s * rel[1], -s * rel[0] + c * rel[1]]))
+        if abs(off) > W - Rp + 1e-12 * W:
+            raise InputError(f"the pin of {bj.name!r} starts {abs(off):.6g} m off the slot's "
+                             f"centre line, beyond the clearance {W - Rp:.6g} m of the slot of "
+                             f"{bi.name!r}: place `point_j` within the slot")
+        first = len(self.contacts)
+        for sign in (1.0, -1.0):
+            wall = ri - sign * W * n0
+            self.contacts.append(dict(kind=K.PLANE, A=bj.index, B=bi.index, rA=rj, rho=Rp,
+                                      p=(*wall, *(sign * n0)), shape=None, mu=mu,
+                                      restitution=e))
+        return [first, first + 1]
+
     # -- forces ------------------------------------------------------------------------------
     def add_spring(self, body_i, point_i, body_j, point_j, stiffness, rest_length=None,
                    damping=0.0):
@@ -568,7 +648,7 @@ class Model:
             if rec["kind"] == K.PLANE:
                 px, py, nx, ny = rec["p"]
                 r[6:10] = [px / L, py / L, nx, ny]
-            elif rec["kind"] == K.POINTS:
+            elif rec["kind"] in (K.POINTS, K.HOLE):
                 r[6:9] = [rec["p"][0] / L, rec["p"][1] / L, rec["p"][2] / L]
             else:
                 r[6] = len(rec["vertices"])
