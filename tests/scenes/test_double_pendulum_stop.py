@@ -52,3 +52,19 @@ def test_bad_models_and_schemes_without_joints_are_refused_by_name():
     with pytest.raises(InputError, match="`fast=True`: the compiled loop of 'moreau-jean' "
                                          "solves no joints"):
         simulate(sc, (0.0, 1.0), q0, v0, "moreau-jean", h=0.01, fast=True)
+
+
+def test_the_event_driven_reference_keeps_the_energy_through_the_strikes():
+    # issue 36: the reference keeps the frictionless e = 1 pendulum's energy to 1e-10,
+    # with its joints projected after each smooth phase and each impact
+    from moreau.scenes.double_pendulum_stop import pendulum_energy
+
+    sc = double_pendulum_stop()
+    q0, v0 = sc.initial_state()
+    res = simulate(sc, (0.0, 3.0), q0, v0, "event-driven")
+    assert res.status == 0
+    energy = pendulum_energy(sc, res.q, res.v)
+    assert np.max(np.abs(energy - energy[0])) < 1e-10
+    assert res.constraint_drift < 1e-10
+    # the tip does strike the wall in the window (once, near t = 2.376 in scene units)
+    assert [e.kind for e in res.events].count("impact") == 1
