@@ -104,14 +104,17 @@ def interpolated_piece(t, q, v, regime, force_N, force_T, slip, gap):
     return Piece(t, state, sample, y)
 
 
-def stack_rows(rows, n, nc):
-    """Recorded sample tuples as the arrays of :func:`interpolated_piece` (None if none)."""
+def stack_rows(rows, n, nc, nv=None):
+    """Recorded sample tuples as the arrays of :func:`interpolated_piece` (None if none).
+
+    ``n`` coordinates, ``nv`` velocities (default ``n``), ``nc`` contacts.
+    """
     if not rows:
         return None
     cols = list(zip(*rows))
     m = len(rows)
     return (np.array(cols[0], float), np.array(cols[1], float).reshape(m, n),
-            np.array(cols[2], float).reshape(m, n), np.array(cols[3], int).reshape(m, nc),
+            np.array(cols[2], float).reshape(m, n if nv is None else nv), np.array(cols[3], int).reshape(m, nc),
             *(np.array(c, float).reshape(m, nc) for c in cols[4:]))
 
 

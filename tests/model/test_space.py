@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from moreau.errors import InputError
-from moreau.model.space import Puck, SpaceModel, Sphere, advance_coordinates, is_spatial
+from moreau.model.scene import is_spatial
+from moreau.model.space import Puck, SpaceModel, Sphere, advance_coordinates
 from moreau.model.spatial import quat_exp, quat_multiply, rotation_matrix
 
 

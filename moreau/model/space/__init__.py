@@ -91,31 +91,7 @@ from ..scene import Scene
 from ..spatial import check_inertia, check_unit_quaternion, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
-           "point_rows", "velocity_count", "is_spatial", "advance_coordinates"]
-
-
-def velocity_count(scene):
-    """The number of velocities of ``scene``: ``nvel`` of a spatial one, else ``ndof``.
-
-    Examples
-    --------
-    >>> from moreau.scenes.bouncing_ball import BouncingBall
-    >>> velocity_count(BouncingBall())
-    1
-    """
-    return int(getattr(scene, "nvel", None) or scene.ndof)
-
-
-def is_spatial(scene):
-    """Whether ``scene`` is a spatial one (its orientations are quaternions, its friction a cone).
-
-    Examples
-    --------
-    >>> from moreau.scenes.bouncing_ball import BouncingBall
-    >>> is_spatial(BouncingBall())
-    False
-    """
-    return bool(getattr(scene, "spatial", False))
+           "point_rows", "advance_coordinates"]
 
 
 def tangent_basis(normal):
@@ -419,20 +395,21 @@ class SpaceScene(Scene):
         q = np.asarray(q, dtype=float)
         return [self._contact_geometry(q, i)[2:4] for i in range(self.ncontacts)]
 
-    def contact_jacobians(self, q, t):
+    def contact_rows(self, q):
+        """Every contact's three rows ``[n, t1, t2]`` against the velocities, shape (nc, 3, nvel)."""
         q = np.asarray(q, dtype=float)
-        nc = self.ncontacts
-        fi = list(self.frictional_index)
-        WN = np.zeros((nc, self.nvel))
-        WT = np.zeros((2 * len(fi), self.nvel))
-        for i in range(nc):
+        out = np.zeros((self.ncontacts, 3, self.nvel))
+        for i in range(self.ncontacts):
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
-            rows = point_rows(R, s, np.array([n, t1, t2]))
-            WN[i, 6 * b:6 * b + 6] = rows[0]
-            if i in fi:
-                j = fi.index(i)
-                WT[2 * j:2 * j + 2, 6 * b:6 * b + 6] = rows[1:]
-        return WN, np.zeros(nc), WT, np.zeros(WT.shape[0])
+            out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
+        return out
+
+    def contact_jacobians(self, q, t):
+        rows = self.contact_rows(q)
+        fi = self.frictional_index
+        WN = rows[:, 0, :].copy()
+        WT = rows[fi, 1:, :].reshape(2 * len(fi), self.nvel)
+        return WN, np.zeros(self.ncontacts), WT, np.zeros(WT.shape[0])
 
     def contact_drift(self, q, v, t):
         q = np.asarray(q, dtype=float)
