@@ -83,6 +83,26 @@ result's ``constraint_drift``: first order at ``theta = 1``, second at
 equality rows; ``fast=True`` is refused), and ``painleve="stop"`` acts on
 steps without joints only.
 
+*Spatial scenes* (:mod:`moreau.model.space`: ``q`` holds each body's centre
+and unit quaternion, ``v`` its centre velocity and body-frame angular
+velocity) take their own generic step. Each active contact has three rows
+``[n, t1, t2]``; the step's problem ``U = U_free + W p`` with ``W = H M^-1
+H^T`` is the spatial Coulomb problem of :mod:`moreau.contact.cone3d` (Newton's
+impact law on the normal row), solved on the cone the option ``cone`` names:
+``"exact"`` (Gauss–Seidel with the exact local solve and an Alart–Curnier
+Newton polish, certified by the De Saxcé natural-map residual) or an integer
+``d`` (the ``d``-direction polyhedral LCP by Lemke, default 8). An
+unsolved problem raises :class:`~moreau.errors.LCPError` with the residual.
+The centres move by ``h (theta v_{k+1} + (1 - theta) v_k)`` and each
+quaternion by the exponential map of the same weighted body rate
+(``p ⊗ exp(h omega / 2)``, unit to rounding). The forces, the gyroscopic
+``-omega x J omega`` included, enter at ``t_k`` and ``t_{k+1}`` with the state
+of ``t_k`` (explicitly: the cone solvers need a symmetric ``W``, which the
+gyroscopic Jacobian in ``W_hat`` would break); no shipped spatial scene
+spins an asymmetric body. A contact's recorded tangential force and slip
+are magnitudes, its regime ``P`` for slip in any direction. ``projection``
+is refused.
+
 *Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
 the same step in the compiled loop of :mod:`moreau.integrators._mj_kernels`,
 Lemke included (:func:`moreau.lcp.lemke.lemke_core`); a step on which Lemke

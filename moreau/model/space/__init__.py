@@ -42,7 +42,8 @@ offset ``s`` (world) from the body's centre:
   and ``g_i = n . (x + s_i - y0)``. Lying on its face the puck carries its
   weight at these points (three make the normal forces determinate); the
   face's distributed pressure is represented by them, which holds the
-  motion while the puck neither tips nor lifts a rim point.
+  motion while the puck neither tips nor lifts a rim point. A thin puck
+  (``c = 0``) may touch through its face's centre alone (``k = 1``).
 
 The body's material point at ``x + s`` moves at ``x' + (R omega) x s``. For
 a direction ``e`` (``n``, ``t1`` or ``t2``), ``e . ((R omega) x s) = omega .
@@ -88,7 +89,7 @@ import numpy as np
 from ..._validate import finite_array, finite_scalar, nonnegative, positive
 from ...errors import InputError
 from ..scene import Scene
-from ..spatial import check_inertia, check_unit_quaternion, rotation_matrix
+from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
            "point_rows", "advance_coordinates"]
@@ -136,7 +137,10 @@ def point_rows(R, s, directions):
     [[1.0, 0.0, 0.0, 0.0, -1.0, 0.0]]
     """
     e = np.asarray(directions, dtype=float)
-    return np.hstack([e, np.cross(s, e) @ R])
+    # s x e, row by row
+    c = np.column_stack([s[1] * e[:, 2] - s[2] * e[:, 1], s[2] * e[:, 0] - s[0] * e[:, 2],
+                         s[0] * e[:, 1] - s[1] * e[:, 0]])
+    return np.hstack([e, c @ R])
 
 
 def advance_coordinates(scene, q, v_mid, h):
@@ -154,7 +158,6 @@ def advance_coordinates(scene, q, v_mid, h):
     >>> q.round(12).tolist()
     [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
     """
-    from ..spatial import rotate_body
     q = np.asarray(q, dtype=float)
     v = np.asarray(v_mid, dtype=float)
     out = np.empty_like(q)
@@ -178,19 +181,25 @@ class Puck:
     """A flat cylinder (disk) of ``radius`` and ``thickness`` [m], axis the body's z.
 
     Its bottom face (``z = -thickness / 2``) touches a half-space through
-    ``rim_points`` points on its rim (see the module docstring), ``>= 3``.
+    ``rim_points`` points on its rim (see the module docstring), ``>= 3``;
+    or, for a thin puck (``thickness = 0``) with ``rim_points = 1``, through
+    its face's centre, the centre of mass: there friction has no tipping
+    moment, and a uniform pressure's resultant acts at the centre while the
+    puck slides without spin, so one contact carries the face exactly.
     """
 
     def __init__(self, radius, thickness, rim_points=3):
         self.radius = positive("radius", radius)
         self.thickness = nonnegative("thickness", thickness)
         if isinstance(rim_points, bool) or not isinstance(rim_points, (int, np.integer)) \
-                or rim_points < 3:
+                or not (rim_points >= 3 or (rim_points == 1 and self.thickness == 0.0)):
             raise InputError(f"`rim_points` must be an integer >= 3 (fewer do not hold a face "
-                             f"up), got {rim_points!r}")
+                             f"up), or 1 for a thin puck (thickness 0), got {rim_points!r}")
         self.rim_points = int(rim_points)
 
     def points(self, scale):
+        if self.rim_points == 1:
+            return np.zeros((1, 3))
         a = 2.0 * np.pi * np.arange(self.rim_points) / self.rim_points
         r = self.radius / scale
         return np.column_stack([r * np.cos(a), r * np.sin(a),
@@ -350,8 +359,11 @@ class SpaceScene(Scene):
         out = np.empty(self.nvel)
         for b in range(self.nbodies):
             w = v[6 * b + 3:6 * b + 6]
+            Jw = self.inertias[b] @ w
             out[6 * b:6 * b + 3] = self.masses[b] * self.gravity
-            out[6 * b + 3:6 * b + 6] = -np.cross(w, self.inertias[b] @ w)
+            out[6 * b + 3] = -(w[1] * Jw[2] - w[2] * Jw[1])
+            out[6 * b + 4] = -(w[2] * Jw[0] - w[0] * Jw[2])
+            out[6 * b + 5] = -(w[0] * Jw[1] - w[1] * Jw[0])
         return out
 
     def force_jacobians(self, q, v, t):
@@ -370,11 +382,14 @@ class SpaceScene(Scene):
         return K, C
 
     # -- contacts ----------------------------------------------------------------------
-    def _contact_geometry(self, q, i):
+    def _rotations(self, q):
+        return [rotation_matrix(q[7 * b + 3:7 * b + 7]) for b in range(self.nbodies)]
+
+    def _contact_geometry(self, q, i, Rs=None):
         c = self._contacts[i]
         b = c["body"]
         x = q[7 * b:7 * b + 3]
-        R = rotation_matrix(q[7 * b + 3:7 * b + 7] / np.linalg.norm(q[7 * b + 3:7 * b + 7]))
+        R = (Rs or self._rotations(q))[b]
         y0, n, t1, t2 = self._planes[c["plane"]]
         if c["point"] is None:
             s = -c["radius"] * n
@@ -385,8 +400,9 @@ class SpaceScene(Scene):
     def gaps(self, q, t):
         q = np.asarray(q, dtype=float)
         out = np.empty(self.ncontacts)
+        Rs = self._rotations(q)
         for i in range(self.ncontacts):
-            _, x, _, s, y0, n, _, _ = self._contact_geometry(q, i)
+            _, x, _, s, y0, n, _, _ = self._contact_geometry(q, i, Rs)
             out[i] = n @ (x + s - y0)
         return out
 
@@ -399,8 +415,9 @@ class SpaceScene(Scene):
         """Every contact's three rows ``[n, t1, t2]`` against the velocities, shape (nc, 3, nvel)."""
         q = np.asarray(q, dtype=float)
         out = np.zeros((self.ncontacts, 3, self.nvel))
+        Rs = self._rotations(q)
         for i in range(self.ncontacts):
-            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
+            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i, Rs)
             out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
         return out
 
