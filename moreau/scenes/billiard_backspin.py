@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import finite_array, finite_scalar, positive
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
@@ -135,7 +135,7 @@ def billiard_exact(params, t):
     return x, v, w
 
 
-class BilliardCase(CompareCase):
+class BilliardCase(SpatialCase):
     """The ball over the window: distance along ``x`` against the closed form."""
 
     headline_name = "distance along the cloth"

@@ -53,7 +53,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .._validate import finite_array, in_open_interval, nonnegative, positive, finite_scalar
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
@@ -210,7 +210,7 @@ def puck_incline_path(params, t):
     return _integrated(p, tt)
 
 
-class PuckInclineCase(CompareCase):
+class PuckInclineCase(SpatialCase):
     """The puck over the window: its drift across the slope against the reference path."""
 
     headline_name = "distance across the slope"

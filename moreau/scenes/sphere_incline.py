@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import finite_array, in_open_interval, nonnegative, positive
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
@@ -135,7 +135,7 @@ def sphere_incline_exact(params, t):
     return p.speed * tt + 0.5 * acc * tt ** 2, p.speed + acc * tt, p.speed / r + alpha * tt
 
 
-class SphereInclineCase(CompareCase):
+class SphereInclineCase(SpatialCase):
     """The sphere over the window: distance down the slope against the closed form."""
 
     headline_name = "distance down the slope"

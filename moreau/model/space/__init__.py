@@ -344,6 +344,8 @@ class SpaceScene(Scene):
         self._q0, self._v0 = q0, v0
         self._planes = [(p.point / L, p.normal, p.t1, p.t2) for p in model.planes]
         self._contacts = model.contacts
+        #: the body of each contact
+        self.contact_bodies = [c["body"] for c in model.contacts]
         self.mu = np.array([c["mu"] for c in model.contacts])
         self.restitution = np.array([c["e"] for c in model.contacts])
 
