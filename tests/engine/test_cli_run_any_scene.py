@@ -28,6 +28,11 @@ def test_run_writes_a_history_with_units_for_every_scene(name, scheme, tmp_path,
         assert main(argv) == 2
         assert "solves no joints" in capsys.readouterr().err
         return
+    if scheme == "event-driven" and getattr(scene, "spatial", False):
+        # nor does it step a spatial scene: refused by name
+        assert main(argv) == 2
+        assert "steps no spatial scene" in capsys.readouterr().err
+        return
     assert main(argv) == 0
     (path,) = tmp_path.glob("*.csv")
     assert path.name.startswith(f"history_{name}_{scheme}")

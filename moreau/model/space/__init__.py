@@ -88,7 +88,9 @@ import numpy as np
 
 from ..._validate import finite_array, finite_scalar, nonnegative, positive
 from ...errors import InputError
+from ..drawing import circle, contact, line
 from ..scene import Scene
+from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
@@ -447,6 +449,68 @@ class SpaceScene(Scene):
                 j = fi.index(i)
                 wT[2 * j], wT[2 * j + 1] = t1 @ a, t2 @ a
         return wN, wT
+
+    # -- SI units and drawing ------------------------------------------------------------
+    @property
+    def force(self):
+        """Newtons per unit of the scene's force, ``M L / T^2``."""
+        return self.mass_unit * self.length / self.time ** 2
+
+    def force_to_si(self, f):
+        """A force in the scene's units to newtons."""
+        return np.asarray(f, dtype=float) * self.force
+
+    def _qscale(self):
+        # centres in the length unit, quaternions dimensionless
+        return np.tile([self.length] * 3 + [1.0] * 4, self.nbodies)
+
+    def _vscale(self):
+        return np.tile([self.length / self.time] * 3 + [1.0 / self.time] * 3, self.nbodies)
+
+    def to_si(self, result):
+        """SI time histories of a run: ``t`` [s], ``q`` (centres [m], quaternions), ``v``
+        (centre velocities [m/s], body-frame angular velocities [rad/s]), ``force_N``,
+        ``force_T`` [N] (the tangential one a magnitude), ``slip_velocity`` [m/s] (a
+        magnitude), ``gap`` [m], ``regime``."""
+        L, T, F = self.length, self.time, self.force
+        return {"t": result.t * T, "q": result.q * self._qscale(), "v": result.v * self._vscale(),
+                "force_N": result.force_N * F, "force_T": result.force_T * F,
+                "slip_velocity": result.slip_velocity * (L / T), "gap": result.gap * L,
+                "regime": result.regime.copy()}
+
+    def si_columns(self, result):
+        """The SI histories of ``result`` as ``[(name, unit, column)]`` (``1`` for a quaternion's)."""
+        units = dict(SI_UNITS, q=["m"] * 3 + ["1"] * 4, v=["m/s"] * 3 + ["rad/s"] * 3)
+        units["q"] = units["q"] * self.nbodies
+        units["v"] = units["v"] * self.nbodies
+        return columns_of(self.to_si(result), units)
+
+    def shapes(self, q, t=0.0):
+        """A side view (the world's ``x``, ``z``) at SI coordinates ``q``: bodies, planes, contacts."""
+        qs = np.asarray(q, dtype=float) / self._qscale()
+        L = self.length
+        out = []
+        for y0, n, t1, _ in self._planes:
+            p0 = np.array([y0[0], y0[2]]) * L
+            d = np.array([n[2], -n[0]])
+            d = d / (np.hypot(*d) or 1.0) * 20.0 * L
+            out.append(line([p0 - d, p0 + d], "ground"))
+        for i, c in enumerate(self._contacts):
+            b = c["body"]
+            x = qs[7 * b:7 * b + 3] * L
+            if c["point"] is None:
+                out.append(circle((x[0], x[2]), c["radius"] * L))
+        for b in range(self.nbodies):
+            if not any(c["body"] == b and c["point"] is None for c in self._contacts):
+                x = qs[7 * b:7 * b + 3] * L
+                out.append(circle((x[0], x[2]), 0.05 * L))
+        Rs = self._rotations(qs)
+        for i in range(self.ncontacts):
+            _, x, _, s, _, n, _, _ = self._contact_geometry(qs, i, Rs)
+            p = (x + s) * L
+            nn = np.array([n[0], n[2]])
+            out.append(contact(i, (p[0], p[2]), nn / (np.hypot(*nn) or 1.0)))
+        return out
 
     def contact_bases(self):
         """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
