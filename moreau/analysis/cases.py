@@ -251,9 +251,14 @@ class SpatialCase(CompareCase):
     cone = "exact"
 
     def run_mj(self, n, theta, lcp):
+        # `lcp` "cone=d" or "cone=exact" forces that cone (compare's facet rows)
+        cone = self.cone
+        if isinstance(lcp, str) and lcp.startswith("cone="):
+            c = lcp.split("=", 1)[1]
+            cone = int(c) if c.isdigit() else c
         q0, v0 = self.start()
         return simulate(self.scene, (0.0, self.window), q0, v0, "moreau-jean",
-                        h=self.window / n, theta=theta, cone=self.cone)
+                        h=self.window / n, theta=theta, cone=cone)
 
 
 class DriveCase(CompareCase):

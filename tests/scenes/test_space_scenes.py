@@ -111,3 +111,18 @@ def test_the_polyhedral_cones_path_error_falls_with_the_directions_at_a_measured
     order = _order(ds, errs)
     assert 1.45 < order < 1.65, (order, errs)
     assert errs[-1] < 0.4
+
+
+def test_compare_on_a_spatial_scene_adds_the_facet_rows_and_their_order():
+    from moreau.analysis.compare import compare
+    rep = compare("puck-incline", steps=[50, 100], thetas=(1.0,), quick=True, progress=False)
+    facets = {r["lcp"]: r for r in rep["rows"] if str(r["lcp"]).startswith("cone=")}
+    assert sorted(facets) == ["cone=16", "cone=32", "cone=4", "cone=8", "cone=exact"]
+    assert all(r["status"] == 0 and r["steps_per_period"] == 200 for r in facets.values())
+    # measured at 200 steps: headline errors 1.36, 0.442, 0.154, 0.0477 (d = 4..32), exact
+    # cone 0.0073 (the step's own error); order 1.60 in 1/d
+    f = rep["facet_order"]
+    assert f["d"] == [4, 8, 16, 32] and 1.5 < f["order_headline"] < 1.7
+    assert facets["cone=exact"]["error"] < 0.2 * facets["cone=32"]["error"]
+    # no forced-LCP rows: a spatial step solves a cone
+    assert not any(r["lcp"] in ("lemke", "qp") for r in rep["rows"])
