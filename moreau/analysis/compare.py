@@ -134,7 +134,7 @@ QUICK_LCP_STEPS = (50,)
 #: the exact cone (issue 37)
 FACET_CONES = (4, 8, 16, 32, "exact")
 #: steps over the window of the facet rows (quick: the first)
-FACET_STEPS = (1000, 200)
+FACET_STEPS = (1000, 100)
 
 
 def fit_order(steps, errors):

@@ -27,11 +27,10 @@ def check_cone(value):
 
 def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
     """One step; returns ``(q1, v1, pN, pT, slip, regime)`` (``pT``, ``slip``: magnitudes)."""
-    M = scene.mass(q)
     f = scene.forces(q, v, t1)
     if theta != 1.0:
         f = theta * f + (1.0 - theta) * scene.forces(q, v, t0)
-    Minv = np.linalg.inv(M)
+    Minv = scene.mass_inverse(q)
     v_free = v + h * (Minv @ f)
     nc = scene.ncontacts
     pN, pT, slip = np.zeros(nc), np.zeros(nc), np.zeros(nc)

@@ -165,7 +165,9 @@ def advance_coordinates(scene, q, v_mid, h):
     out = np.empty_like(q)
     for b in range(q.size // 7):
         out[7 * b:7 * b + 3] = q[7 * b:7 * b + 3] + h * v[6 * b:6 * b + 3]
-        out[7 * b + 3:7 * b + 7] = rotate_body(q[7 * b + 3:7 * b + 7], v[6 * b + 3:6 * b + 6], h)
+        # unchecked: a scheme's own quaternions, unit to rounding
+        out[7 * b + 3:7 * b + 7] = rotate_body(q[7 * b + 3:7 * b + 7], v[6 * b + 3:6 * b + 6], h,
+                                               check=False)
     return out
 
 
@@ -344,6 +346,8 @@ class SpaceScene(Scene):
             v0[6 * b:6 * b + 3] = body["velocity"] * T / L
             v0[6 * b + 3:6 * b + 6] = body["angular_velocity"] * T
         self._q0, self._v0 = q0, v0
+        self._Minv = np.linalg.inv(self._M)
+        self._rot_cache = []
         self._planes = [(p.point / L, p.normal, p.t1, p.t2) for p in model.planes]
         self._contacts = model.contacts
         #: the body of each contact
@@ -357,6 +361,10 @@ class SpaceScene(Scene):
     # -- dynamics ----------------------------------------------------------------------
     def mass(self, q):
         return self._M.copy()
+
+    def mass_inverse(self, q):
+        """``M^-1`` (constant: the inertia is in the body frame, the velocities too)."""
+        return self._Minv.copy()
 
     def forces(self, q, v, t):
         v = np.asarray(v, dtype=float)
@@ -387,7 +395,16 @@ class SpaceScene(Scene):
 
     # -- contacts ----------------------------------------------------------------------
     def _rotations(self, q):
-        return [rotation_matrix(q[7 * b + 3:7 * b + 7]) for b in range(self.nbodies)]
+        # the last two states' rotations are kept: a step asks for them at its start and
+        # end, and the next step starts where this one ended
+        key = q.tobytes()
+        for k, Rs in self._rot_cache:
+            if k == key:
+                return Rs
+        Rs = [rotation_matrix(q[7 * b + 3:7 * b + 7] / np.linalg.norm(q[7 * b + 3:7 * b + 7]),
+                              check=False) for b in range(self.nbodies)]
+        self._rot_cache = [self._rot_cache[-1], (key, Rs)] if self._rot_cache else [(key, Rs)]
+        return Rs
 
     def _contact_geometry(self, q, i, Rs=None):
         c = self._contacts[i]
