@@ -283,6 +283,11 @@ class MoreauJean(TimeStepping):
         In ``[1/2, 1]``; 1 is the backward-Euler-like, dissipative choice.
     projection : bool
         Project positions back onto the contacts after every step.
+    cone : "exact" or int
+        On a spatial scene (:mod:`moreau.model.space`), the friction cone of
+        each step's problem: ``"exact"`` or the number ``d >= 3`` of the
+        polyhedral cone's directions (default 8); see "Spatial scenes" in the
+        module docstring. Planar scenes ignore it.
     lcp_method : {"auto", "lemke", "qp"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
