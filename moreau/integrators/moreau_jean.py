@@ -95,11 +95,17 @@ Newton polish, certified by the De Saxcé natural-map residual) or an integer
 unsolved problem raises :class:`~moreau.errors.LCPError` with the residual.
 The centres move by ``h (theta v_{k+1} + (1 - theta) v_k)`` and each
 quaternion by the exponential map of the same weighted body rate
-(``p ⊗ exp(h omega / 2)``, unit to rounding). The forces, the gyroscopic
-``-omega x J omega`` included, enter at ``t_k`` and ``t_{k+1}`` with the state
-of ``t_k`` (explicitly: the cone solvers need a symmetric ``W``, which the
-gyroscopic Jacobian in ``W_hat`` would break); no shipped spatial scene
-spins an asymmetric body. A contact's recorded tangential force and slip
+(``p ⊗ exp(h omega / 2)``, unit to rounding). The forces other than the
+gyroscopic one enter as in the planar step (with the state of ``t_k``); a
+body with an anisotropic inertia turns by its own implicit step, ``J
+(omega_free - omega_k) + h omega_t x J omega_t = h tau`` with ``omega_t =
+theta omega_free + (1 - theta) omega_k`` (Newton on the 3x3 system; at
+``theta = 1/2`` the implicit midpoint rule, which keeps a free body's energy
+and ``|J omega|`` to rounding), and the contact impulses are added to that
+free velocity through ``M^-1`` (a splitting: the cone solvers need the
+symmetric ``W = H M^-1 H^T``, which the gyroscopic Jacobian would break; its
+error is ``O(h)`` only where contacts act on a body spinning about a
+non-principal axis). A contact's recorded tangential force and slip
 are magnitudes, its regime ``P`` for slip in any direction. ``projection``
 is refused.
 

@@ -347,6 +347,9 @@ class SpaceScene(Scene):
             v0[6 * b + 3:6 * b + 6] = body["angular_velocity"] * T
         self._q0, self._v0 = q0, v0
         self._Minv = np.linalg.inv(self._M)
+        #: the bodies whose inertia is not isotropic: only their omega x J omega is not zero
+        self.gyroscopic_bodies = [b for b in range(nb) if np.max(np.abs(
+            self.inertias[b] - np.trace(self.inertias[b]) / 3.0 * np.eye(3))) > 0.0]
         self._rot_cache = []
         self._planes = [(p.point / L, p.normal, p.t1, p.t2) for p in model.planes]
         self._contacts = model.contacts
@@ -370,12 +373,17 @@ class SpaceScene(Scene):
         v = np.asarray(v, dtype=float)
         out = np.empty(self.nvel)
         for b in range(self.nbodies):
-            w = v[6 * b + 3:6 * b + 6]
-            Jw = self.inertias[b] @ w
             out[6 * b:6 * b + 3] = self.masses[b] * self.gravity
-            out[6 * b + 3] = -(w[1] * Jw[2] - w[2] * Jw[1])
-            out[6 * b + 4] = -(w[2] * Jw[0] - w[0] * Jw[2])
-            out[6 * b + 5] = -(w[0] * Jw[1] - w[1] * Jw[0])
+            out[6 * b + 3:6 * b + 6] = _gyro(self.inertias[b], v[6 * b + 3:6 * b + 6])
+        return out
+
+    def gyroscopic(self, v):
+        """The gyroscopic part ``-omega x J omega`` of :meth:`forces` (zero on the centres)."""
+        v = np.asarray(v, dtype=float)
+        out = np.zeros(self.nvel)
+        for b in self.gyroscopic_bodies:
+            # (an isotropic body's is zero but for rounding: it stays in the forces' rest)
+            out[6 * b + 3:6 * b + 6] = _gyro(self.inertias[b], v[6 * b + 3:6 * b + 6])
         return out
 
     def force_jacobians(self, q, v, t):
@@ -532,6 +540,13 @@ class SpaceScene(Scene):
     def contact_bases(self):
         """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
         return [self._planes[c["plane"]][1:] for c in self._contacts]
+
+
+def _gyro(J, w):
+    # -omega x J omega, written out (three components, no np.cross call)
+    Jw = J @ w
+    return np.array([-(w[1] * Jw[2] - w[2] * Jw[1]), -(w[2] * Jw[0] - w[0] * Jw[2]),
+                     -(w[0] * Jw[1] - w[1] * Jw[0])])
 
 
 def _cross_matrix(a):
