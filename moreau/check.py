@@ -59,7 +59,9 @@ from numpy.typing import ArrayLike
 from .errors import InputError, MoreauError
 from .compiled import evaluate_compiled
 from .integrators import simulate
-from .model.scene import Scene, joint_row_count
+from .model.scene import Scene, is_spatial, joint_row_count
+from .model.space import advance_coordinates
+from .model.spatial import quat_exp, quat_multiply, rotation_matrix
 
 __all__ = ["check_scene", "SceneReport"]
 
@@ -105,6 +107,82 @@ class SceneReport:
         lines += [f"  warning: {w}" for w in self.warnings]
         lines += [f"  {k}: {v:.2e}" for k, v in self.errors.items()]
         return "\n".join(lines)
+
+
+def _check_spatial(scene, states, t, fd_tol, seed):
+    """:func:`check_scene` on a spatial scene (:mod:`moreau.model.space`).
+
+    Positions move along the exponential map (``advance_coordinates``):
+    ``WN v`` against central differences of the gaps, ``WT v`` against those
+    of the contact points taken as material points of their bodies, the
+    drift against differences of the rows times a constant ``v``, and
+    ``dh/dv`` against differences of the forces; the mass matrix symmetric
+    positive definite. A spatial scene has no compiled model.
+    """
+    name = getattr(scene, "name", type(scene).__name__)
+    n, nv, nc = int(scene.ndof), int(scene.nvel), scene.ncontacts
+    nf = len(scene.frictional_index)
+    problems, errors = [], {}
+    if states is None:
+        q0, v0 = (np.asarray(a, dtype=float) for a in scene.initial_state())
+        rng = np.random.default_rng(seed)
+        states = [(q0, v0)]
+        for _ in range(3):
+            q = q0.copy()
+            for b in range(n // 7):
+                q[7 * b:7 * b + 3] += 0.05 * rng.standard_normal(3)
+                q[7 * b + 3:7 * b + 7] = quat_multiply(q[7 * b + 3:7 * b + 7],
+                                                       quat_exp(0.05 * rng.standard_normal(3)))
+            states.append((q, v0 + 0.5 * rng.standard_normal(nv)))
+    eps = 1e-6
+    worst = {"gap rates (WN, wN)": 0.0, "slip rates (WT, wT)": 0.0, "normal drift (wNbar)": 0.0,
+             "tangential drift (wTbar)": 0.0, "force Jacobians": 0.0}
+
+    def material(qq, q_at):
+        out = []
+        for i, (R0, s0) in enumerate(scene.contact_frames(q_at, t)):
+            b = scene.contact_bodies[i]
+            out.append(qq[7 * b:7 * b + 3] + rotation_matrix(qq[7 * b + 3:7 * b + 7]) @ (R0.T @ s0))
+        return np.array(out).reshape(nc, 3)
+
+    for q, v in states:
+        M = np.asarray(scene.mass(q), dtype=float)
+        if M.shape != (nv, nv) or _rel(M, M.T) > 1e-12 or np.any(np.linalg.eigvalsh(
+                0.5 * (M + M.T)) <= 0.0):
+            problems.append("`mass(q)` is not a symmetric positive definite (nvel, nvel) matrix")
+        qp = advance_coordinates(scene, q, v, eps)
+        qm = advance_coordinates(scene, q, -v, eps)
+        _, C = scene.force_jacobians(q, v, t)
+        fd = np.column_stack([(scene.forces(q, v + eps * e, t) - scene.forces(q, v - eps * e, t))
+                              / (2 * eps) for e in np.eye(nv)])
+        worst["force Jacobians"] = max(worst["force Jacobians"], _rel(C, fd))
+        if not nc:
+            continue
+        WN, wN, WT, wT = scene.contact_jacobians(q, t)
+        if WN.shape != (nc, nv) or WT.shape != (2 * nf, nv):
+            problems.append(f"`contact_jacobians` gives WN {WN.shape} and WT {WT.shape}, "
+                            f"expected ({nc}, {nv}) and ({2 * nf}, {nv})")
+            break
+        gdot = (scene.gaps(qp, t) - scene.gaps(qm, t)) / (2 * eps)
+        worst["gap rates (WN, wN)"] = max(worst["gap rates (WN, wN)"], _rel(WN @ v + wN, gdot))
+        pdot = (material(qp, q) - material(qm, q)) / (2 * eps)
+        bases = scene.contact_bases()
+        slip = np.array([[bases[i][1] @ pdot[i], bases[i][2] @ pdot[i]]
+                         for i in scene.frictional_index]).reshape(-1)
+        worst["slip rates (WT, wT)"] = max(worst["slip rates (WT, wT)"], _rel(WT @ v + wT, slip))
+        Jp, Jm = scene.contact_jacobians(qp, t), scene.contact_jacobians(qm, t)
+        wNb, wTb = scene.contact_drift(q, v, t)
+        worst["normal drift (wNbar)"] = max(worst["normal drift (wNbar)"], _rel(
+            wNb, (Jp[0] @ v - Jm[0] @ v) / (2 * eps)))
+        worst["tangential drift (wTbar)"] = max(worst["tangential drift (wTbar)"], _rel(
+            wTb, (Jp[2] @ v - Jm[2] @ v) / (2 * eps)))
+    for key, value in worst.items():
+        errors[key] = value
+        if value > fd_tol:
+            problems.append(f"{key}: differs from central differences along the "
+                            f"exponential-map motion by {value:.2e} (> {fd_tol:g})")
+    return SceneReport(name, not problems, problems, ["a spatial scene has no compiled model"],
+                       errors, len(states))
 
 
 def _rel(a, b):
@@ -246,6 +324,8 @@ def check_scene(scene: Scene, states: Sequence[tuple[ArrayLike, ArrayLike]] | No
     """
     if not isinstance(scene, Scene):
         raise InputError(f"`scene` must be a Scene instance, got {type(scene).__name__}")
+    if is_spatial(scene):
+        return _check_spatial(scene, states, t, fd_tol, seed)
     found, warnings, errors = {}, [], {}
 
     def note(msg, where):

@@ -121,8 +121,18 @@ def _field_type(field):
     kind = kind.replace(" ", "")
     if kind in ("str|bool", "bool|str"):
         return _auto_bool_value
+    if kind in ("str|int", "int|str"):
+        return _int_or_word
     base = kind.replace("|None", "")
     return {"float": float, "int": int, "bool": _bool_value, "str": str}.get(base)
+
+
+def _int_or_word(text):
+    """An integer where the text is one (``--cone 16``), else the word (``--cone exact``)."""
+    try:
+        return int(text)
+    except ValueError:
+        return text
 
 
 def _scene_flag_type(prm):

@@ -41,7 +41,7 @@ from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
-__all__ = ["CompareCase", "DriveCase", "SceneCase", "GRID", "switching_error", "flatten",
+__all__ = ["CompareCase", "DriveCase", "SceneCase", "SpatialCase", "GRID", "switching_error", "flatten",
            "contact_switches", "regime_switches", "switches", "drop_reversal_sticks"]
 
 TWO_PI = 2.0 * math.pi
@@ -238,6 +238,27 @@ class CompareCase:
         # stick at the first switch is recognised as a reversal too
         sw = [(float(t[0]), letters[0])] + switches(letters, t)
         return drop_reversal_sticks(sw, h)[1:]
+
+
+class SpatialCase(CompareCase):
+    """A spatial scene's case: its Moreau–Jean rows solve the exact friction cone.
+
+    The default cone of Moreau–Jean (8 directions) carries the facets' error
+    (:mod:`moreau.contact.cone3d`); the case's own rows measure the time
+    step's error, on the exact cone.
+    """
+
+    cone = "exact"
+
+    def run_mj(self, n, theta, lcp):
+        # `lcp` "cone=d" or "cone=exact" forces that cone (compare's facet rows)
+        cone = self.cone
+        if isinstance(lcp, str) and lcp.startswith("cone="):
+            c = lcp.split("=", 1)[1]
+            cone = int(c) if c.isdigit() else c
+        q0, v0 = self.start()
+        return simulate(self.scene, (0.0, self.window), q0, v0, "moreau-jean",
+                        h=self.window / n, theta=theta, cone=cone)
 
 
 class DriveCase(CompareCase):

@@ -114,12 +114,12 @@ from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, MoreauError
 from ..integrators.base import INTEGRATORS, SchemeOptions, propagate_interrupts
 from ..provenance import provenance
-from ..model.scene import Scene
+from ..model.scene import Scene, is_spatial
 from ..model.registry import get_entry
 from .cases import GRID, SceneCase, switching_error
 
 __all__ = ["pareto", "PARETO_TARGETS", "compare", "DEFAULT_STEPS", "write_outputs", "plot_work_precision",
-           "check_out_dir", "make_case", "case_parameters", "fit_order", "plateaus",
+           "check_out_dir", "make_case", "case_parameters", "fit_order", "facet_order", "plateaus",
            "switching_error", "run_row", "run_other_row", "other_schemes"]
 
 TWO_PI = 2.0 * math.pi
@@ -130,6 +130,11 @@ QUICK_STEPS = (50, 150, 500, 1500, 5000)
 #: steps per period of the forced-Lemke / forced-QP rows (QP costs ~16 ms a step)
 DEFAULT_LCP_STEPS = (50, 100, 200)
 QUICK_LCP_STEPS = (50,)
+#: the friction cones of a spatial scene's facet rows: the polyhedral LCP's directions, and
+#: the exact cone (issue 37)
+FACET_CONES = (4, 8, 16, 32, "exact")
+#: steps over the window of the facet rows (quick: the first)
+FACET_STEPS = (1000, 100)
 
 
 def fit_order(steps, errors):
@@ -380,7 +385,13 @@ def compare(scene: str | Scene, steps: Sequence[int] | None = None,
     }
     jobs = [("ref", None, None, rtol) for rtol in case.ref_rtols]
     jobs += [("mj", th, None, n) for th in thetas for n in steps]
-    jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
+    spatial = is_spatial(getattr(case, "scene", None))
+    if spatial:
+        # a spatial step solves the friction cone, not an LCP the option `lcp_method`
+        # picks: its rows force the cone instead, at one step count (the facets' error)
+        jobs += [("mj", 1.0, f"cone={c}", FACET_STEPS[1 if quick else 0]) for c in FACET_CONES]
+    else:
+        jobs += [("mj", 1.0, lcp, n) for lcp in ("lemke", "qp") for n in lcp_steps]
     jobs += [("other", name, key, value, fixed)
              for name, key, values, fixed in others
              for value in values]
@@ -393,6 +404,8 @@ def compare(scene: str | Scene, steps: Sequence[int] | None = None,
     report["interrupted"] = collect_rows(jobs, run, report["rows"], on_row, progress,
                                          desc=f"compare {scene}", unit="run")
     report["orders"] = _orders(report["rows"])
+    if spatial:
+        report["facet_order"] = facet_order(report["rows"])
     report["pareto"] = pareto(report["rows"])
     report["notes"] = plateaus(report["rows"])
     return report
@@ -475,6 +488,33 @@ def run_row(case, kind, theta, lcp, setting, repeat, ref_value, ref_switches):
     except MoreauError as exc:
         row.update(status=-1, message=f"{type(exc).__name__}: {exc}")
     return row
+
+
+def facet_order(rows):
+    """The polyhedral cone's rows (``lcp`` ``"cone=d"``): the errors' fitted order in ``1/d``.
+
+    Returns ``{"d": [...], "error": [...], "trajectory_error": [...], "order": p,
+    "order_headline": p}`` over the integer ``d`` of the rows that finished
+    (the error of each against the scene's reference).
+
+    Examples
+    --------
+    >>> rows = [dict(scheme="moreau-jean", lcp=f"cone={d}", status=0, error=1.0 / d ** 2,
+    ...              trajectory_error=1.0 / d) for d in (4, 8, 16)]
+    >>> f = facet_order(rows)
+    >>> round(f["order_headline"], 12), round(f["order"], 12)
+    (2.0, 1.0)
+    """
+    pts = sorted((int(r["lcp"].split("=", 1)[1]), r) for r in rows
+                 if r["scheme"] == "moreau-jean" and r["status"] == 0
+                 and str(r.get("lcp") or "").startswith("cone=")
+                 and r["lcp"].split("=", 1)[1].isdigit())
+    d = [p[0] for p in pts]
+    err = [p[1]["error"] for p in pts]
+    traj = [p[1]["trajectory_error"] for p in pts]
+    return {"d": d, "error": err, "trajectory_error": traj,
+            "order": fit_order(d, traj) if len(d) >= 2 else None,
+            "order_headline": fit_order(d, err) if len(d) >= 2 else None}
 
 
 def other_schemes(case, quick=False, names=None):
@@ -713,6 +753,11 @@ def format_table(report):
                                                  if th is not None else "")
                      + f": {g(o['order'], '.2f')} (trajectory), "
                      f"{g(o['order_headline'], '.2f')} (headline)")
+    if report.get("facet_order"):
+        f = report["facet_order"]
+        lines.append(f"facets (polyhedral cone, d = {f['d']}): order in 1/d "
+                     f"{g(f['order'], '.2f')} (trajectory), {g(f['order_headline'], '.2f')} "
+                     "(headline)")
     for p in report.get("pareto", []):
         lines.append(f"fastest to error {p['target']:g}: "
                      + (f"{p['label']} ({p['time_s'] * 1e3:.3g} ms, error {p['error']:.2e})"

@@ -206,6 +206,12 @@ def check_cone_problem(W, q, mu):
     return np.ascontiguousarray(W), np.ascontiguousarray(q), np.ascontiguousarray(mu_arr)
 
 
+def _trusted(W, q, mu):
+    # a caller's problem in the layout, from checked data: contiguous float arrays only
+    return (np.ascontiguousarray(W, dtype=float), np.ascontiguousarray(q, dtype=float),
+            np.ascontiguousarray(mu, dtype=float))
+
+
 # --------------------------------------------------------------------------- cone geometry
 
 @njit(cache=True, inline="always")
@@ -323,7 +329,7 @@ class PolyhedralLCP:
         return self.B @ z
 
 
-def build_polyhedral_lcp(W, q, mu, d=8):
+def build_polyhedral_lcp(W, q, mu, d=8, *, check=True):
     r"""Build the LCP ``(M, q_lcp)`` of the polyhedral friction cone.
 
     Derivation. Replace the disc ``|r_T| <= mu r_N`` by the polygon with
@@ -379,7 +385,7 @@ def build_polyhedral_lcp(W, q, mu, d=8):
     >>> lcp.M[5].tolist()                     # mu r_N - e^T beta
     [0.5, -1.0, -1.0, -1.0, -1.0, 0.0]
     """
-    W, q, mu = check_cone_problem(W, q, mu)
+    W, q, mu = check_cone_problem(W, q, mu) if check else _trusted(W, q, mu)
     D = facet_directions(d)
     d = D.shape[1]
     nc = mu.shape[0]
@@ -397,7 +403,7 @@ def build_polyhedral_lcp(W, q, mu, d=8):
     return PolyhedralLCP(M, B.T @ q, B, D)
 
 
-def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None):
+def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
     """Solve the spatial friction problem with the ``d``-direction polyhedral cone.
 
     Parameters
@@ -412,6 +418,9 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None):
         ``"auto"`` reports the QP as not applicable rather than guessing.
     tol : float, optional
         The LCP's violation bound (:func:`moreau.lcp.lcp_violation`).
+    check : bool
+        False skips :func:`check_cone_problem`, for a caller that built the
+        problem in its layout from checked data (a scheme's step).
 
     Returns
     -------
@@ -428,8 +437,8 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None):
     >>> sol.status, np.round(sol.r, 12).tolist(), np.round(sol.u, 12).tolist()
     ('converged', [1.0, -0.142857142857, 0.0], [0.0, 0.0, 0.0])
     """
-    W, q, mu = check_cone_problem(W, q, mu)
-    lcp = build_polyhedral_lcp(W, q, mu, d)
+    W, q, mu = check_cone_problem(W, q, mu) if check else _trusted(W, q, mu)
+    lcp = build_polyhedral_lcp(W, q, mu, d, check=False)
     res = solve_lcp(lcp.M, lcp.q, method, tol=tol)
     r = lcp.impulses(res.z)
     u = W @ r + q
@@ -699,7 +708,7 @@ def _newton(W, q, mu, r, max_iter, tol_sq):
 
 
 def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_from=1e-6,
-                r0=None):
+                r0=None, check=True):
     """Solve the spatial friction problem on the exact (round) Coulomb cone.
 
     Projected Gauss–Seidel over contacts with the exact local solve
@@ -728,6 +737,8 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
         Relative residual at which Newton takes over.
     r0 : array_like, optional
         Starting impulse (default zero).
+    check : bool
+        False skips :func:`check_cone_problem` (see :func:`solve_polyhedral`).
 
     Returns
     -------
@@ -747,7 +758,7 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
     ...             max_sweeps=1, max_newton=0).status
     'not converged'
     """
-    W, q, mu = check_cone_problem(W, q, mu)
+    W, q, mu = check_cone_problem(W, q, mu) if check else _trusted(W, q, mu)
     for name, value, low in (("max_sweeps", max_sweeps, 1), ("max_newton", max_newton, 0)):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < low:
             raise InputError(f"`{name}` must be an integer >= {low}, got {value!r}")

@@ -88,7 +88,7 @@ def interpolated_piece(t, q, v, regime, force_N, force_T, slip, gap):
     """
     y = np.hstack([q, v])
     cont = np.hstack([q, v, slip, gap])
-    n = q.shape[1]
+    n, nv = q.shape[1], v.shape[1]     # (a spatial scene: 7 coordinates, 6 velocities a body)
     nc = slip.shape[1]
 
     def state(s):
@@ -98,20 +98,23 @@ def interpolated_piece(t, q, v, regime, force_N, force_T, slip, gap):
         j = min(max(int(np.searchsorted(t, s, side="left")), 1), len(t) - 1)
         w = (s - t[j - 1]) / (t[j] - t[j - 1]) if t[j] > t[j - 1] else 1.0
         c = (1.0 - w) * cont[j - 1] + w * cont[j]
-        return (s, c[:n], c[n:2 * n], regime[j].copy(), force_N[j].copy(), force_T[j].copy(),
-                c[2 * n:2 * n + nc], c[2 * n + nc:])
+        return (s, c[:n], c[n:n + nv], regime[j].copy(), force_N[j].copy(), force_T[j].copy(),
+                c[n + nv:n + nv + nc], c[n + nv + nc:])
 
     return Piece(t, state, sample, y)
 
 
-def stack_rows(rows, n, nc):
-    """Recorded sample tuples as the arrays of :func:`interpolated_piece` (None if none)."""
+def stack_rows(rows, n, nc, nv=None):
+    """Recorded sample tuples as the arrays of :func:`interpolated_piece` (None if none).
+
+    ``n`` coordinates, ``nv`` velocities (default ``n``), ``nc`` contacts.
+    """
     if not rows:
         return None
     cols = list(zip(*rows))
     m = len(rows)
     return (np.array(cols[0], float), np.array(cols[1], float).reshape(m, n),
-            np.array(cols[2], float).reshape(m, n), np.array(cols[3], int).reshape(m, nc),
+            np.array(cols[2], float).reshape(m, n if nv is None else nv), np.array(cols[3], int).reshape(m, nc),
             *(np.array(c, float).reshape(m, nc) for c in cols[4:]))
 
 
@@ -356,7 +359,8 @@ class OutputTracker:
                 else:
                     _truncate(result, keep)
         if self.t_eval is not None:
-            _replace(result, self.samples, result.q.shape[1], result.gap.shape[1])
+            _replace(result, self.samples, result.q.shape[1], result.gap.shape[1],
+                     result.v.shape[1])
         return result
 
 
@@ -374,15 +378,17 @@ def _append(result, row):
         setattr(result, name, np.concatenate([arr, np.asarray(x, arr.dtype).reshape(1, *arr.shape[1:])]))
 
 
-def _replace(result, rows, n, nc):
+def _replace(result, rows, n, nc, nv=None):
+    nv = n if nv is None else nv
     if rows:
         cols = list(zip(*rows))
         arrays = [np.array(cols[0], float)]
-        arrays += [np.array(c, float).reshape(len(rows), n) for c in cols[1:3]]
+        arrays += [np.array(cols[1], float).reshape(len(rows), n),
+                   np.array(cols[2], float).reshape(len(rows), nv)]
         arrays += [np.array(cols[3], int).reshape(len(rows), nc)]
         arrays += [np.array(c, float).reshape(len(rows), nc) for c in cols[4:]]
     else:
-        arrays = [np.zeros(0), np.zeros((0, n)), np.zeros((0, n)), np.zeros((0, nc), int)]
+        arrays = [np.zeros(0), np.zeros((0, n)), np.zeros((0, nv)), np.zeros((0, nc), int)]
         arrays += [np.zeros((0, nc)) for _ in range(4)]
     for name, a in zip(_FIELDS, arrays):
         setattr(result, name, a)

@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from .._validate import finite_scalar
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
 from ..model import registry as scene_registry
-from ..model.scene import joint_row_count
+from ..model.scene import is_spatial, joint_row_count, velocity_count
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
 from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence,
@@ -332,6 +332,9 @@ class Integrator:
     #: True where the scheme solves a scene's joint (equality) rows; the others refuse a
     #: scene with joints by name, before any work
     solves_joints = False
+    #: True where the scheme steps spatial scenes (quaternion orientations, the friction
+    #: cone, :mod:`moreau.model.space`); the others refuse one by name, before any work
+    solves_space = False
 
     def __init__(self, scene, t0, q0, v0, t_bound):
         nj = joint_row_count(scene)
@@ -339,6 +342,11 @@ class Integrator:
             raise InputError(f"scheme {self.scheme!r} solves no joints: `scene` "
                              f"{getattr(scene, 'name', type(scene).__name__)!r} has {nj} joint "
                              f"(bilateral) rows; use 'moreau-jean'")
+        if is_spatial(scene) and not self.solves_space:
+            raise InputError(f"scheme {self.scheme!r} steps no spatial scene: `scene` "
+                             f"{getattr(scene, 'name', type(scene).__name__)!r} has spatial "
+                             "bodies (quaternion orientations, the spatial friction cone); use "
+                             "'moreau-jean'")
         self.scene = scene
         self.t0 = finite_scalar("t0", t0)
         self.t_bound = finite_scalar("t_bound", t_bound)
@@ -346,11 +354,11 @@ class Integrator:
             raise InputError(f"`t_bound` must be > `t0` ({self.t0!r}), got {self.t_bound!r}")
         n = scene.ndof
         self.q = _state_vector("q0", q0, n)
-        self.v = _state_vector("v0", v0, n)
+        self.v = _state_vector("v0", v0, velocity_count(scene))
         self.t = self.t0
         #: where the run started, to tell a diverged state from the failure it caused
         self._start = (self.q.copy(), self.v.copy(), self.t0)
-        self._judged = bounded_velocities(scene, n)
+        self._judged = bounded_velocities(scene, velocity_count(scene))
         self._v_limit = DIVERGENCE_GROWTH * max(1.0, float(np.max(np.abs(self.v[self._judged]),
                                                                   initial=0.0)))
         # a run must start where the model holds (a scene states its valid region)
@@ -501,7 +509,8 @@ class Integrator:
         n = self.scene.ndof
         return (np.array([s[0] for s in new], dtype=float),
                 np.array([s[1] for s in new], dtype=float).reshape(len(new), n),
-                np.array([s[2] for s in new], dtype=float).reshape(len(new), n))
+                np.array([s[2] for s in new], dtype=float).reshape(len(new),
+                                                                   velocity_count(self.scene)))
 
     def _keep_checked(self, count):
         """Keep ``count`` of the samples since the last check, drop the rest; mark them checked."""
@@ -556,7 +565,8 @@ class Integrator:
         # the samples recorded since the previous call, after the last one of before
         new = self._samples[self._seen:]
         self._seen = len(self._samples)
-        return join_to_last(self, stack_rows(new, self.scene.ndof, self.scene.ncontacts))
+        return join_to_last(self, stack_rows(new, self.scene.ndof, self.scene.ncontacts,
+                                             velocity_count(self.scene)))
 
     def _record(self, t, q, v, regime, force_N, force_T, slip, gap):
         self._samples.append((t, np.array(q, float), np.array(v, float),
@@ -568,15 +578,16 @@ class Integrator:
         """Assemble the samples recorded so far into a :class:`SimulationResult`."""
         nc = self.scene.ncontacts
         n = self.scene.ndof
+        nv = velocity_count(self.scene)
         if self._samples:
             cols = list(zip(*self._samples))
             t = np.array(cols[0], float)
-            q, v = np.array(cols[1]).reshape(-1, n), np.array(cols[2]).reshape(-1, n)
+            q, v = np.array(cols[1]).reshape(-1, n), np.array(cols[2]).reshape(-1, nv)
             reg = np.array(cols[3], int).reshape(len(t), -1)
             fN, fT, slip, gap = (np.array(c, float).reshape(len(t), -1) for c in cols[4:])
         else:
             t = np.zeros(0)
-            q = v = np.zeros((0, n))
+            q, v = np.zeros((0, n)), np.zeros((0, nv))
             reg = np.zeros((0, nc), int)
             fN = fT = slip = gap = np.zeros((0, nc))
         code = self.status_code

@@ -92,7 +92,8 @@ def sliding_regimes(scene, q, v, t):
     """
     nc = scene.ncontacts
     out = np.zeros(nc, dtype=np.int64)
-    if nc == 0:
+    if nc == 0 or getattr(scene, "spatial", False):
+        # a spatial contact slides in a plane: no sign, and no planar Painlevé detection
         return out
     fr = np.asarray(scene.frictional_index, dtype=int)
     if fr.size == 0:

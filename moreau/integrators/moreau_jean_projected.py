@@ -212,6 +212,7 @@ class MoreauJeanProjected(MoreauJean):
     projection = True
     #: its projection is onto the contacts only: a scene with joints is refused by name
     solves_joints = False
+    solves_space = False
     compare_settings = ("steps_per_period", (50, 100, 200, 500, 1000, 2000, 5000, 10000),
                         (100, 300, 1000), {})
 

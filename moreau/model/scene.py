@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with", "joint_row_count"]
+__all__ = ["Scene", "params_with", "joint_row_count", "velocity_count", "is_spatial"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
@@ -290,6 +290,30 @@ def joint_row_count(scene):
     0
     """
     return int(getattr(scene, "n_joint_rows", 0) or 0)
+
+
+def velocity_count(scene):
+    """The number of velocities of ``scene``: ``nvel`` of a spatial one, else ``ndof``.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> velocity_count(BouncingBall())
+    1
+    """
+    return int(getattr(scene, "nvel", None) or scene.ndof)
+
+
+def is_spatial(scene):
+    """Whether ``scene`` is a spatial one (its orientations are quaternions, its friction a cone).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBall
+    >>> is_spatial(BouncingBall())
+    False
+    """
+    return bool(getattr(scene, "spatial", False))
 
 
 def params_with(cls, params, overrides):

@@ -131,15 +131,18 @@ def quat_exp(v):
     return out
 
 
-def rotation_matrix(q):
+def rotation_matrix(q, check=True):
     """The body-to-world rotation matrix of a unit quaternion.
+
+    ``check=False`` skips the argument check, for a scheme whose quaternions
+    are unit by construction (its inner loop).
 
     Examples
     --------
     >>> np.round(rotation_matrix(quat_exp([0.0, 0.0, np.pi / 4])), 12).tolist()
     [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
     """
-    w, x, y, z = check_unit_quaternion(q)
+    w, x, y, z = check_unit_quaternion(q) if check else q
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
         [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
@@ -212,8 +215,11 @@ def gyroscopic_torque(J, omega):
     return np.cross(w, J @ w)
 
 
-def rotate_body(q, omega, h):
+def rotate_body(q, omega, h, check=True):
     """One exponential-map step ``q ⊗ exp((0, h omega / 2))``, ``omega`` in the body frame.
+
+    ``check=False`` skips the argument checks (a scheme's inner loop, on its own
+    unit quaternions and finite rates).
 
     Examples
     --------
@@ -221,11 +227,15 @@ def rotate_body(q, omega, h):
     >>> np.round(q, 12).tolist()
     [0.0, 1.0, 0.0, 0.0]
     """
-    q = check_unit_quaternion(q)
-    w = finite_array("omega", omega, shape=(3,))
-    h = positive("h", h)
+    if check:
+        q = check_unit_quaternion(q)
+        w = finite_array("omega", omega, shape=(3,))
+        h = positive("h", h)
+    else:
+        q = np.asarray(q, dtype=float)
+        w = omega
     out = np.empty(4)
-    _rotate(q, w[0], w[1], w[2], h, out)
+    _rotate(q, float(w[0]), float(w[1]), float(w[2]), float(h), out)
     return out
 
 

@@ -28,6 +28,9 @@ RUNS = [("moreau-jean", {}), ("moreau-jean", {"theta": 0.5}),
         ("moreau-jean", {"lcp_method": "lemke"}), ("schatzman-paoli", {}),
         ("nonsmooth-generalized-alpha", {}), ("studer-extrapolation", {}),
         ("time-discontinuous-galerkin", {})]
+SPATIAL_RUNS = [("moreau-jean", {})]
+#: the spatial scene whose exact-cone run is stored too (the Python step costs ~1 ms)
+SPATIAL_EXACT = "puck-incline"
 PATH = os.path.join(os.path.dirname(__file__), "..", "data", "golden_runs.npz")
 
 
@@ -72,13 +75,22 @@ def run(scene_name, scheme, options):
 
 def all_keys():
     """Every (scene, scheme, options) run; a scheme that solves no joints refuses a scene with
-    joints before any work (InputError naming it), so that pair has no run."""
+    joints before any work (InputError naming it), so that pair has no run; likewise a
+    scheme that steps no spatial scene (``solves_space``). A spatial scene's contact
+    problem is the friction cone, not an LCP chosen by ``lcp_method``: its runs are
+    Moreau–Jean's default (the 8-direction cone), and on the puck the exact cone too."""
     from moreau.integrators.base import get_integrator
-    from moreau.model.scene import joint_row_count
+    from moreau.model.scene import is_spatial, joint_row_count
     from moreau.scenes import registry
     out = []
     for s in registry.scene_names():
-        joints = joint_row_count(registry.make_scene(s)) > 0
+        scene = registry.make_scene(s)
+        joints = joint_row_count(scene) > 0
+        if is_spatial(scene):
+            out += [(s, scheme, opts) for scheme, opts in SPATIAL_RUNS]
+            if s == SPATIAL_EXACT:
+                out.append((s, "moreau-jean", {"cone": "exact"}))
+            continue
         out += [(s, scheme, opts) for scheme, opts in RUNS
                 if not joints or get_integrator(scheme).solves_joints]
     return out

@@ -16,11 +16,12 @@ NAMES = registry.scene_names()
 
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
-    assert NAMES == ["ball-chain", "bidirectional-drive", "bouncing-ball", "disk-incline",
-                     "double-pendulum-stop", "flexible-rod-drive", "friction-drive",
-                     "painleve-rod", "piezo-drive", "rocking-block", "rocking-block-built",
-                     "slider-crank", "slider-crank-clearance", "sliding-block", "sliding-box",
-                     "stick-slip-motor"]
+    assert NAMES == ["ball-chain", "bidirectional-drive", "billiard-backspin", "bouncing-ball",
+                     "disk-incline", "double-pendulum-stop", "flexible-rod-drive",
+                     "friction-drive", "painleve-rod", "piezo-drive", "puck-incline",
+                     "rocking-block", "rocking-block-built", "slider-crank",
+                     "slider-crank-clearance", "sliding-block", "sliding-box", "sphere-incline",
+                     "stick-slip-motor", "woodpecker-toy"]
 
 
 @pytest.mark.parametrize("name", NAMES)

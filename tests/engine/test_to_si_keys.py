@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from moreau.integrators import simulate
+from moreau.model.scene import velocity_count
 from moreau.scenes import registry
 from moreau.scenes.friction_drive import FrictionDrive
 from moreau.scenes.bidirectional_drive import BidirectionalDrive
@@ -33,9 +34,11 @@ def test_to_si_has_the_common_keys_with_their_shapes(name):
     si = scene.to_si(res)
     assert set(COMMON) <= set(si)
     n, ndof = res.q.shape
+    nv = res.v.shape[1]          # a spatial scene: 7 coordinates, 6 velocities a body
     nc = res.force_N.shape[1]
     assert si["t"].shape == (n,)
-    assert si["q"].shape == si["v"].shape == (n, ndof)
+    assert si["q"].shape == (n, ndof) and si["v"].shape == (n, nv)
+    assert nv == velocity_count(scene)
     for key in ("force_N", "force_T", "slip_velocity", "gap", "regime"):
         assert si[key].shape == (n, nc), key
     # the SI values are the dimensionless ones times the scene's own scales
@@ -45,7 +48,7 @@ def test_to_si_has_the_common_keys_with_their_shapes(name):
     assert np.array_equal(si["regime"], res.regime)
     # and the run's table has one column per coordinate and per contact
     names = [c[0] for c in scene.si_columns(res)]
-    assert names == (["t"] + [f"q_{i}" for i in range(ndof)] + [f"v_{i}" for i in range(ndof)]
+    assert names == (["t"] + [f"q_{i}" for i in range(ndof)] + [f"v_{i}" for i in range(nv)]
                      + [f"{k}_{j}" for k in COMMON[3:] for j in range(nc)])
 
 

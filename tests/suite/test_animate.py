@@ -9,7 +9,7 @@ from moreau.errors import InputError, MoreauError
 from moreau.scenes import registry
 from moreau.integrators.result import SimulationResult
 from moreau.model.drawing import scene_state
-from moreau.model.scene import Scene
+from moreau.model.scene import Scene, velocity_count
 from moreau.suite.animate import animate_run
 
 
@@ -19,7 +19,7 @@ def test_every_scene_draws_itself(name):
     q, _ = scene.initial_state()
     # the SI coordinates the run table holds: lengths scaled, angles in rad
     nc = scene.ncontacts
-    res = SimulationResult(t=np.zeros(1), q=q[None, :], v=np.zeros((1, scene.ndof)),
+    res = SimulationResult(t=np.zeros(1), q=q[None, :], v=np.zeros((1, velocity_count(scene))),
                            regime=np.zeros((1, nc), int), force_N=np.zeros((1, nc)),
                            force_T=np.zeros((1, nc)), slip_velocity=np.zeros((1, nc)),
                            gap=np.zeros((1, nc)))

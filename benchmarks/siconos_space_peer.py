@@ -1,0 +1,121 @@
+"""Siconos's 3D Moreau–Jean beside ours on the sphere on an incline: agreement and steps/s, one run.
+
+Run from the project's venv::
+
+    python benchmarks/siconos_space_peer.py [--steps 1000] [--theta 1]
+
+It runs :mod:`moreau.scenes.sphere_incline` at its defaults (slope 0.3 rad,
+``mu = 0.5``, launched rolling at 0.2 m/s; it rolls at ``(5/7) g sin(alpha)``)
+with Moreau–Jean and the exact cone and with the 8-direction cone, then the
+same problem in Siconos under the system interpreter (``/usr/bin/python3``,
+Debian's ``python3-siconos``; this file's ``--siconos`` mode, which does not
+import ``moreau``): a ``SphereNEDS`` (Newton–Euler sphere: centre, unit
+quaternion, body-frame angular velocity) on the plane ``z = 0`` of a
+``SphereNEDSPlanR`` relation, gravity tilted by the slope, Newton's impact
+law with 3D Coulomb friction (``NewtonImpactFrictionNSL``, size 3), the
+``MoreauJeanOSI`` at the same theta and the ``FrictionContact(3)`` one-step
+problem with its default fc3d solver. The table gives, for each, the
+distance and speed down the slope at the end of the window against the
+closed form, and the steps per second (wall clock of the stepping loop
+only; construction excluded).
+"""
+
+import argparse
+import json
+import math
+import subprocess
+import sys
+import time
+
+SYSTEM_PYTHON = "/usr/bin/python3"
+
+
+def siconos_run(job):
+    """The Siconos side (system interpreter): ``job`` is the problem in SI units."""
+    import numpy as np
+    import siconos.kernel as sk
+    from siconos.mechanics.collision.bodies import SphereNEDS, SphereNEDSPlanR
+
+    g, a, r, m = job["gravity"], job["slope"], job["radius"], job["mass"]
+    ds = SphereNEDS(r, m, np.eye(3) * 0.4 * m * r * r, [0.0, 0.0, r, 1.0, 0.0, 0.0, 0.0],
+                    [job["speed"], 0.0, 0.0, 0.0, job["speed"] / r, 0.0])
+    ds.setFExtPtr(np.array([m * g * math.sin(a), 0.0, -m * g * math.cos(a)]))
+    inter = sk.Interaction(sk.NewtonImpactFrictionNSL(0.0, 0.0, job["mu"], 3),
+                           SphereNEDSPlanR(r, 0.0, 0.0, 1.0, 0.0))
+    T, n = job["window"], job["steps"]
+    nsds = sk.NonSmoothDynamicalSystem(0.0, T)
+    nsds.insertDynamicalSystem(ds)
+    nsds.link(inter, ds)
+    sim = sk.TimeStepping(nsds, sk.TimeDiscretisation(0.0, T / n), sk.MoreauJeanOSI(job["theta"]),
+                          sk.FrictionContact(3))
+    steps = 0
+    t0 = time.perf_counter()
+    while sim.hasNextEvent():
+        sim.computeOneStep()
+        sim.nextStep()
+        steps += 1
+    seconds = time.perf_counter() - t0
+    q, v = list(ds.q()), list(ds.velocity())
+    return {"steps": steps, "seconds": seconds, "distance": q[0], "speed": v[0],
+            "quaternion_norm": math.sqrt(sum(x * x for x in q[3:7]))}
+
+
+def ours(steps, theta, cone):
+    from moreau.integrators import simulate
+    from moreau.scenes.sphere_incline import sphere_incline
+    sc = sphere_incline()
+    q0, v0 = sc.initial_state()
+    span = sc.default_window
+    simulate(sc, (0.0, span), q0, v0, "moreau-jean", h=span / 20, theta=theta, cone=cone)  # load
+    t0 = time.perf_counter()
+    res = simulate(sc, (0.0, span), q0, v0, "moreau-jean", h=span / steps, theta=theta,
+                   cone=cone, save_every=steps)
+    seconds = time.perf_counter() - t0
+    return sc, {"steps": steps, "seconds": seconds, "distance": res.q[-1, 0] * sc.length,
+                "speed": res.v[-1, 0] * sc.length / sc.time,
+                "quaternion_norm": float(sum(x * x for x in res.q[-1, 3:7]) ** 0.5)}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--steps", type=int, default=1000)
+    ap.add_argument("--theta", type=float, default=1.0)
+    ap.add_argument("--siconos", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args(argv)
+    if args.siconos:
+        print(json.dumps(siconos_run(json.load(sys.stdin))))
+        return
+    from moreau.scenes.sphere_incline import sphere_incline_exact
+    rows = []
+    for cone in ("exact", 8):
+        sc, row = ours(args.steps, args.theta, cone)
+        rows.append((f"moreau-jean cone={cone}", row))
+    p = sc.params
+    window = sc.default_window * sc.time
+    job = {"gravity": p.gravity, "slope": p.slope, "radius": p.radius, "mass": p.mass,
+           "mu": p.mu, "speed": p.speed, "window": window, "steps": args.steps,
+           "theta": args.theta}
+    done = subprocess.run([SYSTEM_PYTHON, __file__, "--siconos"], input=json.dumps(job),
+                          capture_output=True, text=True, timeout=600)
+    if done.returncode == 0:
+        rows.append(("siconos MoreauJeanOSI + fc3d", json.loads(done.stdout.splitlines()[-1])))
+    else:
+        print(f"siconos run failed: {done.stderr[-2000:]}")
+    s, sd, _ = sphere_incline_exact(p, [window])
+    print(f"sphere-incline, {args.steps} steps over {window:.4g} s, theta = {args.theta:g}: "
+          f"closed form s = {s[0]:.9g} m, s' = {sd[0]:.9g} m/s")
+    print(f"{'run':<30} {'s error [m]':>12} {'speed error [m/s]':>17} {'|q|-1':>9} "
+          f"{'steps/s':>9}")
+    for name, r in rows:
+        print(f"{name:<30} {r['distance'] - s[0]:12.3e} {r['speed'] - sd[0]:17.3e} "
+              f"{r['quaternion_norm'] - 1.0:9.1e} {r['steps'] / r['seconds']:9.0f}")
+    if len(rows) == 3:
+        a, b = rows[0][1], rows[2][1]
+        print(f"agreement (ours exact vs Siconos): s differs by "
+              f"{abs(a['distance'] - b['distance']):.3e} m, the speed by "
+              f"{abs(a['speed'] - b['speed']):.3e} m/s; steps/s ours/Siconos "
+              f"{(a['steps'] / a['seconds']) / (b['steps'] / b['seconds']):.2f}")
+
+
+if __name__ == "__main__":
+    main()

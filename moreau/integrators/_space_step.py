@@ -1,0 +1,102 @@
+"""Moreau–Jean's step on a spatial scene: the friction cone per contact, orientations on SO(3).
+
+See :mod:`moreau.integrators.moreau_jean` ("Spatial scenes") for the scheme.
+"""
+
+import numpy as np
+
+from ..contact.cone3d import solve_cone
+from ..errors import InputError, LCPError
+from ..model.space import advance_coordinates
+from ..regimes import Regime
+
+#: a contact whose slip after the step is below this fraction of the step's velocity
+#: scale counts as sticking
+SLIP_RTOL = 1e-9
+
+
+def check_cone(value):
+    """The ``cone`` option: ``"exact"`` or an integer number of directions ``>= 3``."""
+    if isinstance(value, str) and value == "exact":
+        return value
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 3:
+        raise InputError(f'`cone` must be "exact" or an integer number of directions >= 3, '
+                         f'got {value!r}')
+    return int(value)
+
+
+def _free_rotation(J, w0, impulse, h, theta):
+    """``w`` with ``J (w - w0) + h wt x J wt = impulse``, ``wt = theta w + (1 - theta) w0``.
+
+    Newton on the 3x3 system (its Jacobian ``J + h theta ([wt]x J - [J wt]x)``)
+    to rounding; at ``theta = 1/2`` the implicit midpoint rule, which keeps the
+    free body's energy ``1/2 w.J w`` and ``|J w|`` (quadratic invariants).
+    """
+    w = w0 + np.linalg.solve(J, impulse)
+    for _ in range(20):
+        wt = theta * w + (1.0 - theta) * w0
+        Jw = J @ wt
+        F = J @ (w - w0) + h * np.cross(wt, Jw) - impulse
+        A = J + h * theta * (_cross(wt) @ J - _cross(Jw))
+        dw = np.linalg.solve(A, F)
+        w = w - dw
+        if np.max(np.abs(dw)) <= 1e-15 * max(1.0, float(np.max(np.abs(w)))):
+            break
+    return w
+
+
+def _cross(a):
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
+
+
+def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
+    """One step; returns ``(q1, v1, pN, pT, slip, regime)`` (``pT``, ``slip``: magnitudes)."""
+    # the forces without the gyroscopic term, which the rotation's own implicit step takes
+    gyro = scene.gyroscopic(v)
+    f = scene.forces(q, v, t1) - gyro
+    if theta != 1.0:
+        f = theta * f + (1.0 - theta) * (scene.forces(q, v, t0) - gyro)
+    Minv = scene.mass_inverse(q)
+    v_free = v + h * (Minv @ f)
+    for b in scene.gyroscopic_bodies:
+        k = 6 * b + 3
+        v_free[k:k + 3] = _free_rotation(scene.inertias[b], v[k:k + 3], h * f[k:k + 3], h, theta)
+    nc = scene.ncontacts
+    pN, pT, slip = np.zeros(nc), np.zeros(nc), np.zeros(nc)
+    regime = np.zeros(nc, dtype=int)
+    v1 = v_free
+    if nc:
+        rows = scene.contact_rows(q)                    # (nc, 3, nvel): [n, t1, t2]
+        vN0 = rows[:, 0, :] @ v
+        g0 = scene.gaps(q, t0)
+        active = np.flatnonzero((g0 + 0.5 * h * vN0 <= 0.0) | closed)
+        if active.size:
+            H = rows[active].reshape(3 * active.size, -1)
+            MinvHT = Minv @ H.T
+            W = H @ MinvHT
+            W = 0.5 * (W + W.T)
+            U_free = H @ v_free
+            U_free[0::3] += e[active] * np.minimum(vN0[active], 0.0)
+            # (built in the layout from the scene's checked data)
+            sol = solve_cone(W, U_free, mu[active], cone, check=False)
+            counters["lcp_solves"] += 1
+            counters["max_residual"] = max(counters["max_residual"], sol.relative_residual)
+            if "pivots" in sol.iterations:
+                counters["pivots"] += int(sol.iterations["pivots"])
+            if not sol.success:
+                raise LCPError(f"the step's spatial friction problem at t = {t0!r} "
+                               f"({sol.method} cone, {active.size} contacts) was not solved: "
+                               f"{sol.status}, residual {sol.residual:.3g}; {sol.detail}")
+            r = sol.r.reshape(-1, 3)
+            v1 = v_free + MinvHT @ sol.r
+            U = (H @ v1).reshape(-1, 3)
+            scale = max(float(np.max(np.abs(U_free))), 1e-300)
+            pN[active] = r[:, 0]
+            pT[active] = np.hypot(r[:, 1], r[:, 2])
+            slip[active] = np.hypot(U[:, 1], U[:, 2])
+            for k, i in enumerate(active):
+                if pN[i] > 0.0:
+                    regime[i] = int(Regime.POSITIVE if mu[i] > 0.0 and slip[i] > SLIP_RTOL * scale
+                                    else Regime.STICK)
+    q1 = advance_coordinates(scene, q, theta * v1 + (1.0 - theta) * v, h)
+    return q1, v1, pN, pT, slip, regime

@@ -1,0 +1,553 @@
+r"""Spatial rigid bodies, their shapes and their contacts with a half-space.
+
+A :class:`SpaceModel` holds free rigid bodies and the ground's half-spaces,
+and contacts between a body's shape and a half-space; :meth:`SpaceModel.build`
+returns a :class:`SpaceScene`, which Moreau–Jean steps on SO(3)
+(:mod:`moreau.integrators.moreau_jean`, option ``cone``).
+
+Coordinates and velocities
+--------------------------
+Body ``b`` owns seven coordinates, its centre of mass ``x`` (3, world) and a
+unit quaternion ``p = (w, x, y, z)`` mapping body to world (``R(p)``,
+:func:`moreau.model.spatial.rotation_matrix`), and six velocities, the
+centre's velocity ``x'`` (3, world) and the angular velocity ``omega`` (3,
+body frame). So a scene's ``ndof = 7 nb`` counts coordinates and ``nvel =
+6 nb`` velocities; ``q' = (x', 1/2 p ⊗ (0, omega))`` is not ``v``, and a
+scheme moves the orientation by the exponential map
+(:func:`moreau.model.spatial.rotate_body`).
+
+Equations of motion (Newton–Euler, body frame for the rotation):
+
+.. math::
+
+    m \ddot x = m g + F_c, \qquad
+    J \dot\omega = -\omega \times J\omega + \tau_c,
+
+so ``mass(q) = diag(m I, J)`` per body (constant), ``forces = (m g, -omega x
+J omega)``, and ``dh/dv`` has the gyroscopic block ``-([omega]x J - [J
+omega]x)`` (:meth:`SpaceScene.force_jacobians`).
+
+Contact kinematics
+------------------
+Every contact is a point of a body against a ground half-space ``{y : n . (y
+- y0) >= 0}`` with a fixed unit normal ``n`` and two fixed unit tangents
+``t1, t2`` (``(n, t1, t2)`` right-handed). A contact point sits at the
+offset ``s`` (world) from the body's centre:
+
+* a :class:`Sphere` of radius ``rho``: ``s = -rho n`` (the support point),
+  ``g = n . (x - y0) - rho``;
+* a :class:`Puck` (a flat cylinder of radius ``a`` and thickness ``c``): its
+  bottom face, ``z = -c/2`` in the body frame, touches through ``k`` rim
+  points ``b_i = (a cos 2 pi i/k, a sin 2 pi i/k, -c/2)``, ``s_i = R b_i``
+  and ``g_i = n . (x + s_i - y0)``. Lying on its face the puck carries its
+  weight at these points (three make the normal forces determinate); the
+  face's distributed pressure is represented by them, which holds the
+  motion while the puck neither tips nor lifts a rim point. A thin puck
+  (``c = 0``) may touch through its face's centre alone (``k = 1``).
+
+The body's material point at ``x + s`` moves at ``x' + (R omega) x s``. For
+a direction ``e`` (``n``, ``t1`` or ``t2``), ``e . ((R omega) x s) = omega .
+R^T (s x e)``, so the row of ``e`` in the body's six columns is
+
+.. math::
+
+    (e^T, \; (R^T (s \times e))^T),
+
+one formula for the gap rate (``e = n``; for the sphere ``s x n = 0``) and
+the two slip rates. Differentiating a row times ``v`` at zero accelerations
+(``d(R omega)/dt = R omega'``: the body-frame rate's own turning term
+``omega x omega`` is zero) gives the drift ``e . (w x (w x s))`` with ``w =
+R omega`` for a material point (the puck); the sphere's support point is
+not material, ``s = -rho n`` is constant, its drift is zero.
+
+Every row is held to central differences of the gap and of the material
+point's position along the exponential-map motion in ``tests/model``.
+
+Examples
+--------
+A ball of radius 0.1 m on the floor, sliding at 1 m/s without spin:
+
+>>> import numpy as np
+>>> m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.1)
+>>> floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+>>> ball = m.add_body(1.0, [0.004] * 3, position=(0.0, 0.0, 0.1), velocity=(1.0, 0.0, 0.0))
+>>> m.add_contact(ball, Sphere(0.1), floor, mu=0.2)
+[0]
+>>> sc = m.build("ball")
+>>> q0, v0 = sc.initial_state()
+>>> sc.ndof, sc.nvel, float(sc.gaps(q0, 0.0)[0])
+(7, 6, 0.0)
+>>> WN, wN, WT, wT = sc.contact_jacobians(q0, 0.0)
+>>> (WT @ v0 * sc.length / sc.time).round(12).tolist()   # the slip [t1, t2], m/s
+[1.0, 0.0]
+"""
+
+import math
+
+import numpy as np
+
+from ..._validate import finite_array, finite_scalar, nonnegative, positive
+from ...errors import InputError
+from ..drawing import circle, contact, line
+from ..scene import Scene
+from ..units import SI_UNITS, columns_of
+from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
+
+__all__ = ["Sphere", "Puck", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
+           "point_rows", "advance_coordinates"]
+
+
+def tangent_basis(normal):
+    """Two unit tangents ``(t1, t2)`` of a unit normal, ``(n, t1, t2)`` right-handed.
+
+    ``t1`` is the unit part of ``e_k`` orthogonal to ``n``, for the axis
+    ``e_k`` least aligned with ``n`` (ties to the first); ``t2 = n x t1``.
+
+    Examples
+    --------
+    >>> [t.tolist() for t in tangent_basis([0.0, 0.0, 1.0])]
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]
+    """
+    n = np.asarray(normal, dtype=float)
+    e = np.zeros(3)
+    e[int(np.argmin(np.abs(n)))] = 1.0
+    t1 = e - (e @ n) * n
+    t1 /= np.linalg.norm(t1)
+    return t1, np.cross(n, t1)
+
+
+def point_rows(R, s, directions):
+    """The rows ``(e^T, (R^T (s x e))^T)`` of the velocity of the point ``x + s`` along each ``e``.
+
+    Parameters
+    ----------
+    R : ndarray, shape (3, 3)
+        Body-to-world rotation.
+    s : ndarray, shape (3,)
+        The point's offset from the centre, world frame.
+    directions : ndarray, shape (k, 3)
+        Unit directions, world frame.
+
+    Returns
+    -------
+    ndarray, shape (k, 6)
+        Against the body's velocities ``(x', omega)`` (omega in the body frame).
+
+    Examples
+    --------
+    >>> point_rows(np.eye(3), np.array([0.0, 0.0, -1.0]), np.eye(3)[:1]).tolist()
+    [[1.0, 0.0, 0.0, 0.0, -1.0, 0.0]]
+    """
+    e = np.asarray(directions, dtype=float)
+    # s x e, row by row
+    c = np.column_stack([s[1] * e[:, 2] - s[2] * e[:, 1], s[2] * e[:, 0] - s[0] * e[:, 2],
+                         s[0] * e[:, 1] - s[1] * e[:, 0]])
+    return np.hstack([e, c @ R])
+
+
+def advance_coordinates(scene, q, v_mid, h):
+    """``q`` moved over ``h`` at the velocities ``v_mid``: centres by ``h x'``, orientations on SO(3).
+
+    Each body's quaternion becomes ``p ⊗ exp((0, h omega / 2))``
+    (:func:`moreau.model.spatial.rotate_body`), unit to rounding.
+
+    Examples
+    --------
+    >>> m = SpaceModel()
+    >>> b = m.add_body(1.0, [1.0, 1.0, 1.0])
+    >>> sc = m.build("free")
+    >>> q = advance_coordinates(sc, sc.initial_state()[0], [1.0, 0, 0, 0, 0, np.pi], 1.0)
+    >>> q.round(12).tolist()
+    [1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    """
+    q = np.asarray(q, dtype=float)
+    v = np.asarray(v_mid, dtype=float)
+    out = np.empty_like(q)
+    for b in range(q.size // 7):
+        out[7 * b:7 * b + 3] = q[7 * b:7 * b + 3] + h * v[6 * b:6 * b + 3]
+        # unchecked: a scheme's own quaternions, unit to rounding
+        out[7 * b + 3:7 * b + 7] = rotate_body(q[7 * b + 3:7 * b + 7], v[6 * b + 3:6 * b + 6], h,
+                                               check=False)
+    return out
+
+
+class Sphere:
+    """A sphere of ``radius`` [m] about the body's centre of mass."""
+
+    def __init__(self, radius):
+        self.radius = positive("radius", radius)
+
+    def points(self, scale):
+        return None
+
+
+class Puck:
+    """A flat cylinder (disk) of ``radius`` and ``thickness`` [m], axis the body's z.
+
+    Its bottom face (``z = -thickness / 2``) touches a half-space through
+    ``rim_points`` points on its rim (see the module docstring), ``>= 3``;
+    or, for a thin puck (``thickness = 0``) with ``rim_points = 1``, through
+    its face's centre, the centre of mass: there friction has no tipping
+    moment, and a uniform pressure's resultant acts at the centre while the
+    puck slides without spin, so one contact carries the face exactly.
+    """
+
+    def __init__(self, radius, thickness, rim_points=3):
+        self.radius = positive("radius", radius)
+        self.thickness = nonnegative("thickness", thickness)
+        if isinstance(rim_points, bool) or not isinstance(rim_points, (int, np.integer)) \
+                or not (rim_points >= 3 or (rim_points == 1 and self.thickness == 0.0)):
+            raise InputError(f"`rim_points` must be an integer >= 3 (fewer do not hold a face "
+                             f"up), or 1 for a thin puck (thickness 0), got {rim_points!r}")
+        self.rim_points = int(rim_points)
+
+    def points(self, scale):
+        if self.rim_points == 1:
+            return np.zeros((1, 3))
+        a = 2.0 * np.pi * np.arange(self.rim_points) / self.rim_points
+        r = self.radius / scale
+        return np.column_stack([r * np.cos(a), r * np.sin(a),
+                                np.full(a.size, -0.5 * self.thickness / scale)])
+
+
+class HalfSpace:
+    """The ground's half-space ``{y : normal . (y - point) >= 0}``; tangents default to :func:`tangent_basis`."""
+
+    def __init__(self, point, normal, tangent=None):
+        self.point = finite_array("point", point, shape=(3,))
+        n = finite_array("normal", normal, shape=(3,))
+        nn = float(np.linalg.norm(n))
+        if nn == 0.0:
+            raise InputError("`normal` must be a nonzero vector")
+        self.normal = n / nn
+        if tangent is None:
+            self.t1, self.t2 = tangent_basis(self.normal)
+        else:
+            t = finite_array("tangent", tangent, shape=(3,))
+            t = t - (t @ self.normal) * self.normal
+            if float(np.linalg.norm(t)) < 1e-12:
+                raise InputError("`tangent` must not be parallel to `normal`")
+            self.t1 = t / np.linalg.norm(t)
+            self.t2 = np.cross(self.normal, self.t1)
+
+
+class SpaceModel:
+    """Free rigid bodies in space and their contacts with the ground's half-spaces.
+
+    Parameters
+    ----------
+    gravity : array_like, shape (3,)
+        [m/s^2], world frame.
+    length, mass : float
+        The scene's units of length [m] and mass [kg]; its time unit is
+        ``sqrt(length / |gravity|)`` (1 s without gravity), so that gravity
+        is of size 1 inside.
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, 0.0), length=1.0, mass=1.0):
+        self.gravity = finite_array("gravity", gravity, shape=(3,))
+        self.length = positive("length", length)
+        self.mass_unit = positive("mass", mass)
+        g = float(np.linalg.norm(self.gravity))
+        self.time = math.sqrt(self.length / g) if g > 0.0 else 1.0
+        self.bodies = []
+        self.planes = []
+        self.contacts = []
+
+    def add_body(self, mass, inertia, position=(0.0, 0.0, 0.0), orientation=(1.0, 0.0, 0.0, 0.0),
+                 velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0), name=None):
+        """Add a free body; SI values, ``angular_velocity`` in the body frame. Returns its index.
+
+        ``inertia`` (about the centre, body frame) is three principal moments
+        or a 3x3 matrix (:func:`moreau.model.spatial.check_inertia`: positive,
+        symmetric, the triangle inequality); ``orientation`` a unit quaternion.
+        """
+        m = positive("mass", mass)
+        J = check_inertia(inertia)
+        p = check_unit_quaternion(orientation, "orientation")
+        x = finite_array("position", position, shape=(3,))
+        xd = finite_array("velocity", velocity, shape=(3,))
+        w = finite_array("angular_velocity", angular_velocity, shape=(3,))
+        self.bodies.append({"mass": m, "inertia": J, "position": x, "orientation": p / np.linalg.norm(p),
+                            "velocity": xd, "angular_velocity": w,
+                            "name": name or f"body {len(self.bodies)}"})
+        return len(self.bodies) - 1
+
+    def add_half_space(self, point, normal, tangent=None):
+        """Add a ground half-space (:class:`HalfSpace`, SI point); returns its index."""
+        self.planes.append(HalfSpace(point, normal, tangent))
+        return len(self.planes) - 1
+
+    def add_contact(self, body, shape, plane, mu=0.0, restitution=0.0):
+        """Contacts of ``body``'s ``shape`` with the half-space ``plane``; returns their indices.
+
+        A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point.
+        """
+        if isinstance(body, bool) or not isinstance(body, (int, np.integer)) \
+                or not 0 <= body < len(self.bodies):
+            raise InputError(f"`body` must be the index of an added body (0..{len(self.bodies) - 1}), "
+                             f"got {body!r}")
+        if isinstance(plane, bool) or not isinstance(plane, (int, np.integer)) \
+                or not 0 <= plane < len(self.planes):
+            raise InputError(f"`plane` must be the index of an added half-space, got {plane!r}")
+        if not isinstance(shape, (Sphere, Puck)):
+            raise InputError(f"`shape` must be a Sphere or a Puck, got {type(shape).__name__}")
+        mu = nonnegative("mu", mu)
+        e = finite_scalar("restitution", restitution)
+        if not 0.0 <= e <= 1.0:
+            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        pts = shape.points(self.length)
+        out = []
+        for k in range(1 if pts is None else len(pts)):
+            self.contacts.append({"body": int(body), "plane": int(plane), "mu": mu, "e": e,
+                                  "radius": shape.radius / self.length if pts is None else 0.0,
+                                  "point": None if pts is None else pts[k]})
+            out.append(len(self.contacts) - 1)
+        return out
+
+    def build(self, name, default_window=None):
+        """The :class:`SpaceScene` of the model, in the scene's units."""
+        if not self.bodies:
+            raise InputError("the model has no body: add one with `add_body`")
+        return SpaceScene(self, name, default_window)
+
+
+class SpaceScene(Scene):
+    """A scene of spatial rigid bodies (:class:`SpaceModel`); ``ndof = 7 nb``, ``nvel = 6 nb``.
+
+    Contacts have three rows each, ``[N, T1, T2]``: ``WT`` holds the two
+    tangent rows of each frictional contact, in turn (``2 nf`` rows), and a
+    scheme solves the spatial Coulomb cone on them.
+    """
+
+    spatial = True
+
+    def __init__(self, model, name, default_window=None):
+        L, M, T = model.length, model.mass_unit, model.time
+        self.name = name
+        self.length, self.time, self.mass_unit = L, T, M
+        self.time_unit_s = T
+        self.default_window = default_window
+        nb = len(model.bodies)
+        self.nbodies = nb
+        self.ndof, self.nvel = 7 * nb, 6 * nb
+        self.body_names = [b["name"] for b in model.bodies]
+        self.masses = np.array([b["mass"] / M for b in model.bodies])
+        self.inertias = np.array([b["inertia"] / (M * L * L) for b in model.bodies])
+        self.gravity = model.gravity * T * T / L
+        self._M = np.zeros((self.nvel, self.nvel))
+        for b in range(nb):
+            self._M[6 * b:6 * b + 3, 6 * b:6 * b + 3] = self.masses[b] * np.eye(3)
+            self._M[6 * b + 3:6 * b + 6, 6 * b + 3:6 * b + 6] = self.inertias[b]
+        q0, v0 = np.empty(self.ndof), np.empty(self.nvel)
+        for b, body in enumerate(model.bodies):
+            q0[7 * b:7 * b + 3] = body["position"] / L
+            q0[7 * b + 3:7 * b + 7] = body["orientation"]
+            v0[6 * b:6 * b + 3] = body["velocity"] * T / L
+            v0[6 * b + 3:6 * b + 6] = body["angular_velocity"] * T
+        self._q0, self._v0 = q0, v0
+        self._Minv = np.linalg.inv(self._M)
+        #: the bodies whose inertia is not isotropic: only their omega x J omega is not zero
+        self.gyroscopic_bodies = [b for b in range(nb) if np.max(np.abs(
+            self.inertias[b] - np.trace(self.inertias[b]) / 3.0 * np.eye(3))) > 0.0]
+        self._rot_cache = []
+        self._planes = [(p.point / L, p.normal, p.t1, p.t2) for p in model.planes]
+        self._contacts = model.contacts
+        #: the body of each contact
+        self.contact_bodies = [c["body"] for c in model.contacts]
+        self.mu = np.array([c["mu"] for c in model.contacts])
+        self.restitution = np.array([c["e"] for c in model.contacts])
+
+    def initial_state(self):
+        return self._q0.copy(), self._v0.copy()
+
+    # -- dynamics ----------------------------------------------------------------------
+    def mass(self, q):
+        return self._M.copy()
+
+    def mass_inverse(self, q):
+        """``M^-1`` (constant: the inertia is in the body frame, the velocities too)."""
+        return self._Minv.copy()
+
+    def forces(self, q, v, t):
+        v = np.asarray(v, dtype=float)
+        out = np.empty(self.nvel)
+        for b in range(self.nbodies):
+            out[6 * b:6 * b + 3] = self.masses[b] * self.gravity
+            out[6 * b + 3:6 * b + 6] = _gyro(self.inertias[b], v[6 * b + 3:6 * b + 6])
+        return out
+
+    def gyroscopic(self, v):
+        """The gyroscopic part ``-omega x J omega`` of :meth:`forces` (zero on the centres)."""
+        v = np.asarray(v, dtype=float)
+        out = np.zeros(self.nvel)
+        for b in self.gyroscopic_bodies:
+            # (an isotropic body's is zero but for rounding: it stays in the forces' rest)
+            out[6 * b + 3:6 * b + 6] = _gyro(self.inertias[b], v[6 * b + 3:6 * b + 6])
+        return out
+
+    def force_jacobians(self, q, v, t):
+        """``(dh/dq, dh/dv)``, shapes (nvel, ndof) and (nvel, nvel): only the gyroscopic block.
+
+        ``d(omega x J omega)/d omega = [omega]x J - [J omega]x`` with ``[a]x b = a x b``.
+        """
+        v = np.asarray(v, dtype=float)
+        K = np.zeros((self.nvel, self.ndof))
+        C = np.zeros((self.nvel, self.nvel))
+        for b in range(self.nbodies):
+            w = v[6 * b + 3:6 * b + 6]
+            J = self.inertias[b]
+            C[6 * b + 3:6 * b + 6, 6 * b + 3:6 * b + 6] = -(_cross_matrix(w) @ J
+                                                           - _cross_matrix(J @ w))
+        return K, C
+
+    # -- contacts ----------------------------------------------------------------------
+    def _rotations(self, q):
+        # the last two states' rotations are kept: a step asks for them at its start and
+        # end, and the next step starts where this one ended
+        key = q.tobytes()
+        for k, Rs in self._rot_cache:
+            if k == key:
+                return Rs
+        Rs = [rotation_matrix(q[7 * b + 3:7 * b + 7] / np.linalg.norm(q[7 * b + 3:7 * b + 7]),
+                              check=False) for b in range(self.nbodies)]
+        self._rot_cache = [self._rot_cache[-1], (key, Rs)] if self._rot_cache else [(key, Rs)]
+        return Rs
+
+    def _contact_geometry(self, q, i, Rs=None):
+        c = self._contacts[i]
+        b = c["body"]
+        x = q[7 * b:7 * b + 3]
+        R = (Rs or self._rotations(q))[b]
+        y0, n, t1, t2 = self._planes[c["plane"]]
+        if c["point"] is None:
+            s = -c["radius"] * n
+        else:
+            s = R @ c["point"]
+        return b, x, R, s, y0, n, t1, t2
+
+    def gaps(self, q, t):
+        q = np.asarray(q, dtype=float)
+        out = np.empty(self.ncontacts)
+        Rs = self._rotations(q)
+        for i in range(self.ncontacts):
+            _, x, _, s, y0, n, _, _ = self._contact_geometry(q, i, Rs)
+            out[i] = n @ (x + s - y0)
+        return out
+
+    def contact_frames(self, q, t):
+        """``(R, s)`` per contact: the body's rotation and the contact point's offset (world)."""
+        q = np.asarray(q, dtype=float)
+        return [self._contact_geometry(q, i)[2:4] for i in range(self.ncontacts)]
+
+    def contact_rows(self, q):
+        """Every contact's three rows ``[n, t1, t2]`` against the velocities, shape (nc, 3, nvel)."""
+        q = np.asarray(q, dtype=float)
+        out = np.zeros((self.ncontacts, 3, self.nvel))
+        Rs = self._rotations(q)
+        for i in range(self.ncontacts):
+            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i, Rs)
+            out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
+        return out
+
+    def contact_jacobians(self, q, t):
+        rows = self.contact_rows(q)
+        fi = self.frictional_index
+        WN = rows[:, 0, :].copy()
+        WT = rows[fi, 1:, :].reshape(2 * len(fi), self.nvel)
+        return WN, np.zeros(self.ncontacts), WT, np.zeros(WT.shape[0])
+
+    def contact_drift(self, q, v, t):
+        q = np.asarray(q, dtype=float)
+        v = np.asarray(v, dtype=float)
+        fi = list(self.frictional_index)
+        wN = np.zeros(self.ncontacts)
+        wT = np.zeros(2 * len(fi))
+        for i in range(self.ncontacts):
+            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
+            if self._contacts[i]["point"] is None:
+                continue            # a sphere's support point: s = -rho n is constant
+            w = R @ v[6 * b + 3:6 * b + 6]
+            a = np.cross(w, np.cross(w, s))
+            wN[i] = n @ a
+            if i in fi:
+                j = fi.index(i)
+                wT[2 * j], wT[2 * j + 1] = t1 @ a, t2 @ a
+        return wN, wT
+
+    # -- SI units and drawing ------------------------------------------------------------
+    @property
+    def force(self):
+        """Newtons per unit of the scene's force, ``M L / T^2``."""
+        return self.mass_unit * self.length / self.time ** 2
+
+    def force_to_si(self, f):
+        """A force in the scene's units to newtons."""
+        return np.asarray(f, dtype=float) * self.force
+
+    def _qscale(self):
+        # centres in the length unit, quaternions dimensionless
+        return np.tile([self.length] * 3 + [1.0] * 4, self.nbodies)
+
+    def _vscale(self):
+        return np.tile([self.length / self.time] * 3 + [1.0 / self.time] * 3, self.nbodies)
+
+    def to_si(self, result):
+        """SI time histories of a run: ``t`` [s], ``q`` (centres [m], quaternions), ``v``
+        (centre velocities [m/s], body-frame angular velocities [rad/s]), ``force_N``,
+        ``force_T`` [N] (the tangential one a magnitude), ``slip_velocity`` [m/s] (a
+        magnitude), ``gap`` [m], ``regime``."""
+        L, T, F = self.length, self.time, self.force
+        return {"t": result.t * T, "q": result.q * self._qscale(), "v": result.v * self._vscale(),
+                "force_N": result.force_N * F, "force_T": result.force_T * F,
+                "slip_velocity": result.slip_velocity * (L / T), "gap": result.gap * L,
+                "regime": result.regime.copy()}
+
+    def si_columns(self, result):
+        """The SI histories of ``result`` as ``[(name, unit, column)]`` (``1`` for a quaternion's)."""
+        units = dict(SI_UNITS, q=["m"] * 3 + ["1"] * 4, v=["m/s"] * 3 + ["rad/s"] * 3)
+        units["q"] = units["q"] * self.nbodies
+        units["v"] = units["v"] * self.nbodies
+        return columns_of(self.to_si(result), units)
+
+    def shapes(self, q, t=0.0):
+        """A side view (the world's ``x``, ``z``) at SI coordinates ``q``: bodies, planes, contacts."""
+        qs = np.asarray(q, dtype=float) / self._qscale()
+        L = self.length
+        out = []
+        for y0, n, t1, _ in self._planes:
+            p0 = np.array([y0[0], y0[2]]) * L
+            d = np.array([n[2], -n[0]])
+            d = d / (np.hypot(*d) or 1.0) * 20.0 * L
+            out.append(line([p0 - d, p0 + d], "ground"))
+        for i, c in enumerate(self._contacts):
+            b = c["body"]
+            x = qs[7 * b:7 * b + 3] * L
+            if c["point"] is None:
+                out.append(circle((x[0], x[2]), c["radius"] * L))
+        for b in range(self.nbodies):
+            if not any(c["body"] == b and c["point"] is None for c in self._contacts):
+                x = qs[7 * b:7 * b + 3] * L
+                out.append(circle((x[0], x[2]), 0.05 * L))
+        Rs = self._rotations(qs)
+        for i in range(self.ncontacts):
+            _, x, _, s, _, n, _, _ = self._contact_geometry(qs, i, Rs)
+            p = (x + s) * L
+            nn = np.array([n[0], n[2]])
+            out.append(contact(i, (p[0], p[2]), nn / (np.hypot(*nn) or 1.0)))
+        return out
+
+    def contact_bases(self):
+        """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
+        return [self._planes[c["plane"]][1:] for c in self._contacts]
+
+
+def _gyro(J, w):
+    # -omega x J omega, written out (three components, no np.cross call)
+    Jw = J @ w
+    return np.array([-(w[1] * Jw[2] - w[2] * Jw[1]), -(w[2] * Jw[0] - w[0] * Jw[2]),
+                     -(w[0] * Jw[1] - w[1] * Jw[0])])
+
+
+def _cross_matrix(a):
+    return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])

@@ -1,0 +1,186 @@
+"""A sphere on a rough incline in space: rolling at ``(5/7) g sin(alpha)``, slipping below ``mu = (2/7) tan(alpha)``.
+
+A uniform sphere (mass ``m``, radius ``r``, ``J = (2/5) m r^2``) on a plane
+inclined at ``alpha``, one frictional contact (Coulomb ``mu``), launched
+rolling down the slope at ``speed``. With ``s`` the distance down the slope
+and ``w`` the rotation about the across-slope axis, rolling ``s' = r w`` and
+``m s'' = m g sin(alpha) - F``, ``J w' = r F`` give
+
+.. math::
+
+    s'' = \\frac{g \\sin\\alpha}{1 + J / (m r^2)} = \\tfrac57 g \\sin\\alpha, \\qquad
+    F = \\tfrac27 m g \\sin\\alpha,
+
+which needs ``F <= mu m g cos(alpha)``: ``mu >= (2/7) tan(alpha)``. Below
+it the sphere slips from the start, ``s'' = g (sin(alpha) - mu cos(alpha))``
+and ``r w' = (5/2) mu g cos(alpha)``; the slip rate ``g (sin(alpha) - (7/2)
+mu cos(alpha))`` is positive, so it never rolls again (the textbook result,
+e.g. Meriam and Kraige, Engineering Mechanics: Dynamics, the rolling sphere
+on an incline; Goldstein, Poole and Safko, Classical Mechanics, 3rd ed.,
+2002, ch. 5).
+
+The scene is stated in the incline's frame: ``x`` down the slope, ``y``
+across, ``z`` the plane's normal, gravity ``g (sin(alpha), 0, -cos(alpha))``;
+units: lengths in ``r``, time in ``sqrt(r / g)``, mass in ``m``
+(:class:`moreau.model.space.SpaceModel`). Coordinates: the centre (3) and
+the unit quaternion (4); velocities: the centre's (3) and the body-frame
+angular velocity (3).
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import finite_array, in_open_interval, nonnegative, positive
+from ..analysis.cases import GRID, SpatialCase
+from ..errors import InputError
+from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.scene import params_with
+from ..model.space import SpaceModel, Sphere
+
+__all__ = ["SphereInclineParams", "sphere_incline", "sphere_incline_exact", "rolls"]
+
+
+@dataclass(frozen=True)
+class SphereInclineParams:
+    """SI parameters of the sphere on an incline.
+
+    Attributes
+    ----------
+    mass : float
+        [kg], > 0.
+    radius : float
+        [m], > 0.
+    slope : float
+        Inclination ``alpha`` [rad], in (0, pi/2).
+    mu : float
+        Coulomb friction, >= 0.
+    gravity : float
+        [m/s^2], > 0.
+    speed : float
+        Initial speed down the slope [m/s], rolling, >= 0.
+    """
+
+    mass: float = 1.0
+    radius: float = 0.05
+    slope: float = 0.3
+    mu: float = 0.5
+    gravity: float = 9.81
+    speed: float = 0.2
+
+    def __post_init__(self):
+        for name in ("mass", "radius", "gravity"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        object.__setattr__(self, "speed", nonnegative("speed", self.speed))
+        object.__setattr__(self, "slope",
+                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+
+
+def rolls(p):
+    """Whether the sphere rolls: ``mu >= (2/7) tan(alpha)``.
+
+    Examples
+    --------
+    >>> rolls(SphereInclineParams(slope=0.3, mu=0.0884)), rolls(SphereInclineParams(mu=0.0883))
+    (True, False)
+    """
+    return p.mu >= 2.0 / 7.0 * math.tan(p.slope)
+
+
+def sphere_incline(params=None, **overrides):
+    """The scene (a :class:`~moreau.model.space.SpaceScene`) of the sphere on the incline.
+
+    Examples
+    --------
+    >>> sc = sphere_incline()
+    >>> q0, v0 = sc.initial_state()
+    >>> q0.tolist(), round(float(v0[4] * v0[0] ** -1), 12)      # rolling: w = s' / r
+    ([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0], 1.0)
+    """
+    p = params_with(SphereInclineParams, params, overrides)
+    g, a, r = p.gravity, p.slope, p.radius
+    m = SpaceModel(gravity=(g * math.sin(a), 0.0, -g * math.cos(a)), length=r, mass=p.mass)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0))
+    ball = m.add_body(p.mass, [0.4 * p.mass * r * r] * 3, position=(0.0, 0.0, r),
+                      velocity=(p.speed, 0.0, 0.0), angular_velocity=(0.0, p.speed / r, 0.0),
+                      name="sphere")
+    m.add_contact(ball, Sphere(r), floor, mu=p.mu)
+    sc = m.build("sphere-incline", default_window=10.0)
+    sc.params = p
+    return sc
+
+
+def sphere_incline_exact(params, t):
+    """``(s, s', w)``: distance and speed down the slope, rotation rate, at times ``t`` [s] (SI).
+
+    Examples
+    --------
+    >>> s, sd, w = sphere_incline_exact(SphereInclineParams(speed=0.0), [1.0])
+    >>> round(float(sd[0]) / (9.81 * math.sin(0.3)), 12)     # rolling: 5/7 g sin(alpha)
+    0.714285714286
+    """
+    p = params if isinstance(params, SphereInclineParams) else SphereInclineParams(**params)
+    tt = np.atleast_1d(finite_array("t", t)).astype(float)
+    if np.any(tt < 0.0):
+        raise InputError("`t` must be >= 0")
+    g, a, r = p.gravity, p.slope, p.radius
+    if rolls(p):
+        acc = 5.0 / 7.0 * g * math.sin(a)
+        alpha = acc / r
+    else:
+        acc = g * (math.sin(a) - p.mu * math.cos(a))
+        alpha = 2.5 * p.mu * g * math.cos(a) / r
+    return p.speed * tt + 0.5 * acc * tt ** 2, p.speed + acc * tt, p.speed / r + alpha * tt
+
+
+class SphereInclineCase(SpatialCase):
+    """The sphere over the window: distance down the slope against the closed form."""
+
+    headline_name = "distance down the slope"
+    window = 10.0
+
+    def __init__(self, **params):
+        self.scene = sphere_incline(**params)
+        self.p = self.scene.params
+        self._params = dict(params)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.scene.initial_state()
+
+    def coordinate(self, q):
+        return q[:, 0]
+
+    def reference(self, rtol):
+        s, _, _ = sphere_incline_exact(self.p, [self.window * self.scene.time])
+        return float(s[0]) / self.scene.length, [(0.0, "S" if rolls(self.p) else "P")]
+
+    def reference_grid(self):
+        s, _, _ = sphere_incline_exact(self.p, np.linspace(0.0, self.window, GRID + 1)
+                                       * self.scene.time)
+        return s / self.scene.length
+
+    def headline_of_run(self, res):
+        return float(res.q[-1, 0])
+
+    def _run_switches(self, res, h):
+        return []
+
+
+register_scene(SceneEntry(
+    name="sphere-incline",
+    factory=sphere_incline,
+    parameters=parameters_of(SphereInclineParams, {"mass": "kg", "radius": "m", "slope": "rad",
+                                                   "mu": "", "gravity": "m/s^2",
+                                                   "speed": "m/s"}),
+    description=("sphere rolling down a rough incline in space at (5/7) g sin(alpha), slipping "
+                 "below mu = (2/7) tan(alpha) (closed form)"),
+    case=SphereInclineCase,
+    reference="exact",
+    sweepable=("mu", "slope", "speed"),
+    mj_tolerance=1e-2,
+))

@@ -1,0 +1,102 @@
+"""Spatial bodies and their contact rows against central differences along the exponential-map motion."""
+
+import numpy as np
+import pytest
+
+from moreau.errors import InputError
+from moreau.model.scene import is_spatial
+from moreau.model.space import Puck, SpaceModel, Sphere, advance_coordinates
+from moreau.model.spatial import quat_exp, quat_multiply, rotation_matrix
+
+
+def _scene(tilt):
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+    floor = m.add_half_space((0.0, 0.0, -0.01), (0.2, -0.1, 1.0))
+    p = quat_exp(0.5 * np.asarray(tilt))
+    ball = m.add_body(2.0, [0.002, 0.002, 0.002], position=(0.0, 0.0, 0.06), orientation=p)
+    puck = m.add_body(0.5, [0.003, 0.003, 0.005], position=(0.3, 0.1, 0.03), orientation=p)
+    m.add_contact(ball, Sphere(0.05), floor, mu=0.3)
+    m.add_contact(puck, Puck(0.08, 0.02), floor, mu=0.4)
+    return m.build("two")
+
+
+def _motion(sc, q, v, eps):
+    # q moved by eps along the velocities v (centres straight, orientations by exp)
+    return advance_coordinates(sc, q, v, eps) if eps > 0 else advance_coordinates(sc, q, -v, -eps)
+
+
+def _material_points(sc, q, q_at):
+    # each contact's point, as the material point of its body fixed at q_at (body frame)
+    out = []
+    for i, (R0, s0) in enumerate(sc.contact_frames(q_at, 0.0)):
+        b = sc._contacts[i]["body"]
+        R = rotation_matrix(q[7 * b + 3:7 * b + 7])
+        out.append(q[7 * b:7 * b + 3] + R @ (R0.T @ s0))
+    return np.array(out)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_rows_are_the_rates_of_the_gaps_and_of_the_material_contact_points(seed):
+    rng = np.random.default_rng(seed)
+    sc = _scene(0.3 * rng.standard_normal(3))
+    q, _ = sc.initial_state()
+    v = rng.standard_normal(sc.nvel)
+    eps = 1e-6
+    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
+    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
+    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
+    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
+    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
+    bases = sc.contact_bases()
+    slip = np.array([[t1 @ pd, t2 @ pd] for (n, t1, t2), pd in zip(bases, pdot)]).ravel()
+    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
+    # drift: d/dt (W v) at constant velocities (zero accelerations)
+    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
+    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
+    wNb, wTb = sc.contact_drift(q, v, 0.0)
+    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    assert np.max(np.abs(wNb[1:])) > 1e-3     # the puck's rows do turn
+
+
+def test_the_gyroscopic_jacobian_against_differences_and_the_quaternion_moves_on_so3():
+    rng = np.random.default_rng(5)
+    sc = _scene([0.1, 0.2, 0.3])
+    q, _ = sc.initial_state()
+    v = rng.standard_normal(sc.nvel)
+    _, C = sc.force_jacobians(q, v, 0.0)
+    eps = 1e-6
+    fd = np.column_stack([(sc.forces(q, v + eps * e, 0.0) - sc.forces(q, v - eps * e, 0.0))
+                          / (2 * eps) for e in np.eye(sc.nvel)])
+    assert np.max(np.abs(C - fd)) < 1e-8 and np.max(np.abs(C)) > 1e-3
+    q1 = q
+    for _ in range(1000):
+        q1 = advance_coordinates(sc, q1, v, 0.01)
+    assert abs(np.linalg.norm(q1[3:7]) - 1.0) < 1e-14
+    # the exponential map is the flow of a constant body rate: 1000 steps = one of 10
+    one = quat_multiply(q[3:7], quat_exp(0.5 * 10.0 * v[3:6]))
+    assert np.max(np.abs(q1[3:7] - one)) < 1e-12
+    assert is_spatial(sc) and sc.mass(q).shape == (12, 12)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"orientation": (1.0, 0.0, 0.0, 0.1)}, "`orientation` must be a unit quaternion"),
+    ({"inertia": (-1.0, 1.0, 1.0)}, "`inertia` must be positive definite"),
+    ({"inertia": (1.0, 1.0, 3.0)}, "`inertia` must satisfy the triangle inequality"),
+])
+def test_a_bad_body_is_refused_by_name(kwargs, match):
+    m = SpaceModel()
+    args = {"mass": 1.0, "inertia": (1.0, 1.0, 1.0), **kwargs}
+    with pytest.raises(InputError, match=match):
+        m.add_body(**args)
+
+
+def test_a_bad_shape_or_contact_is_refused_by_name():
+    m = SpaceModel()
+    with pytest.raises(InputError, match="`rim_points` must be an integer >= 3"):
+        Puck(0.1, 0.01, rim_points=2)
+    b = m.add_body(1.0, (1.0, 1.0, 1.0))
+    f = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    with pytest.raises(InputError, match="`mu` must be >= 0"):
+        m.add_contact(b, Sphere(1.0), f, mu=-0.1)
+    with pytest.raises(InputError, match="`plane` must be the index"):
+        m.add_contact(b, Sphere(1.0), 3)
