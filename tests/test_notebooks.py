@@ -22,6 +22,24 @@ assert len(rows) == 15 and all(r["status"] == "ok" for r in rows)
 assert atlas["label"].shape == (14, 8)
 assert not out.exists()     # the tour removed its temporary folder
 """,
+    "pendulum_on_a_stop.ipynb": """
+assert report.ok and scene.ndof == 3 and scene.n_joint_rows == 2
+assert all(r.status == 0 for r in runs.values()) and ref.status == 0
+# the drift plotted is the result's: its largest value is constraint_drift
+assert abs(np.max(drift(runs[1.0])) - runs[1.0].constraint_drift * scene.length) <= 1e-15
+# theta = 1/2 holds the pin better than theta = 1 by more than an order of magnitude
+assert runs[0.5].constraint_drift < 0.1 * runs[1.0].constraint_drift
+assert ref.constraint_drift < 1e-10
+# the reference's first rebound: the energy and Newton's law, e omega
+assert abs(after - e * omega) <= 1e-8 * omega
+# at rest on the stop: the angle and the force of statics (N = m g / 2)
+for r in runs.values():
+    si = scene.to_si(r)
+    assert np.all(np.abs(si["v"][-10:]) < 1e-9)
+    assert abs(si["force_N"][-1, 0] - mass * g / 2) <= 1e-9 * mass * g
+err = {theta: abs(scene.to_si(r)["q"][-1, 2] - theta_rest) for theta, r in runs.items()}
+assert err[0.5] < 1e-4 and err[1.0] < 1e-2 and err[0.5] < 0.1 * err[1.0]
+""",
     "scheme_comparison.ipynb": """
 assert {r["scheme"] for r in report["rows"]} == {"event-driven", "moreau-jean"}
 # the time histories: every scheme on the same t_eval, within a small distance of the reference
