@@ -73,6 +73,24 @@ def test_bad_drives_raise_input_error(make, match):
         make()
 
 
+def test_a_drive_subclass_is_refused_and_the_methods_are_the_compiled_model():
+    class Steeper(SineDrive):
+        def _eval(self, t):
+            s, ds, dds = super()._eval(t)
+            return 2.0 * s, 2.0 * ds, 2.0 * dds
+
+    # the compiled model, which the Python methods evaluate, would not know the subclass's s
+    with pytest.raises(InputError, match=r"`drive` must be a SineDrive or a SawtoothDrive, "
+                                         r"got a subclass Steeper"):
+        StickSlipMotor(drive=Steeper())
+    motor = StickSlipMotor(drive=SineDrive(0.3, 0.7))
+    tau = 1.234
+    _, ds, dds = motor.drive(tau)
+    WN, wN, WT, wT = motor.contact_jacobians([0.0, 0.0], tau)
+    assert WT.tolist() == [[1.0, 0.0]] and abs(wT[0] + ds) <= 1e-15
+    assert abs(motor.contact_drift([0.0, 0.0], [0.0, 0.0], tau)[1][0] + dds) <= 1e-15
+
+
 def test_reference_rejects_what_it_cannot_solve():
     with pytest.raises(InputError, match=r"`load` must be smaller in size than the sliding "
                                          r"friction `mu` \* `normal_force`"):

@@ -39,7 +39,7 @@ from ...compiled import CompiledModel
 from ..._validate import check_fields, finite_scalar, in_open_interval, positive, restitution
 from ...errors import InputError
 from ...model.drawing import contact, polygon
-from ...model.scene import Scene
+from ...model.compiled_scene import CompiledScene
 from ...model.units import SIUnits
 from ...model.scene import params_with
 from ...analysis.cases import GRID, CompareCase, regime_switches
@@ -285,9 +285,17 @@ class SawtoothDrive(_Drive):
 
 
 def make_drive(drive):
-    """A drive object from ``"sine"``, ``"sawtooth"`` or a drive instance."""
-    if isinstance(drive, _Drive):
+    """A drive object from ``"sine"``, ``"sawtooth"`` or a drive instance.
+
+    A subclass of a drive is refused: the scene's compiled model, which its
+    Python methods evaluate, knows ``s(tau)`` of these two drives only.
+    """
+    if type(drive) in (SineDrive, SawtoothDrive):
         return drive
+    if isinstance(drive, _Drive):
+        raise InputError(f"`drive` must be a SineDrive or a SawtoothDrive, got a subclass "
+                         f"{type(drive).__name__}: the scene's compiled model evaluates the "
+                         "stator's motion of these two drives only")
     if drive == "sine":
         return SineDrive()
     if drive == "sawtooth":
@@ -331,7 +339,7 @@ class StickSlipMotorParams:
         check_fields(self, restitution, "restitution")
 
 
-class StickSlipMotor(SIUnits, Scene):
+class StickSlipMotor(SIUnits, CompiledScene):
     """Slider pressed on a stator that vibrates along the slider's path.
 
     Parameters
@@ -427,25 +435,7 @@ class StickSlipMotor(SIUnits, Scene):
                          (x - 0.5 * X, y + X)]),
                 contact(0, (x, y), (0.0, 1.0), (1.0, 0.0))]
 
-    # -- Scene interface ----------------------------------------------------
-    def mass(self, q):
-        return np.eye(2)
-
-    def forces(self, q, v, t):
-        return np.array([-self.fL, -self.n])
-
-    def gaps(self, q, t):
-        return np.array([float(q[1])])
-
-    def contact_jacobians(self, q, t):
-        _, ds, _ = self.drive(t)
-        return (np.array([[0.0, 1.0]]), np.zeros(1),
-                np.array([[1.0, 0.0]]), np.array([-float(ds)]))
-
-    def contact_drift(self, q, v, t):
-        _, _, dds = self.drive(t)
-        return np.zeros(1), np.array([-float(dds)])
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def forcing_breakpoints(self, t0, t1):
         """The drive's breakpoints (where ``s''`` jumps) in ``(t0, t1)``, every period."""
         b = np.asarray(getattr(self.drive, "breakpoints", ()), float)
@@ -468,15 +458,11 @@ class StickSlipMotor(SIUnits, Scene):
         d = self.drive
         if isinstance(d, SineDrive):
             par[2], par[3], par[4] = 0.0, d.b, d.psi
-        elif isinstance(d, SawtoothDrive):
+        else:                   # a SawtoothDrive (make_drive admits no other)
             m = len(d._starts)
             par[2], par[5] = 1.0, m
             par[6:6 + m], par[10:10 + m] = d._starts, d._acc
             par[14:14 + m], par[18:18 + m] = d._vel, d._pos
-        else:
-            return None
-        if type(d) not in (SineDrive, SawtoothDrive):
-            return None     # a drive subclass may change s(tau)
         return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
 
