@@ -113,8 +113,17 @@ the pendulum at ``theta = 1/2``: 2.17e-3, 5.19e-4, 1.32e-4, 3.32e-5 at ``h =
 0.04 .. 0.005``; on the slider-crank 4.6e-5 .. 7.2e-7 over ``n = 100 ..
 800`` steps, and its slider's position and velocity at order 2; at ``theta
 = 1`` order 1 on both). The position-level drift ``|gE|`` is reported as
-the result's ``constraint_drift``; it is not corrected (``projection=True``
-is refused for joints). Joints take the generic step (the compiled loop
+the result's ``constraint_drift``. With ``joint_projection=True`` it is
+held at rounding: after every step the positions are projected onto the
+joints, ``q_{k+1}`` moved to the mass-weighted nearest point with ``gE = 0``
+by Gauss–Newton iterations ``q += M^-1 G^T d`` with ``(G M^-1 G^T) d = -gE``
+(velocities left alone, the iterations counted in
+``projection_iterations``). The correction is the drift's growth over the
+step, ``O(h^3)`` or ``O(h^2)``, so the scheme keeps its order (measured on
+the pendulum at ``theta = 1/2``: drift below 1e-14, energy error 2.4e-3,
+5.5e-4, 1.35e-4, 3.3e-5 at ``h = 0.04 .. 0.005``, order 2). ``projection=True``
+(onto the contacts, which would not keep the joints) is refused with joints.
+Joints take the generic step (the compiled loop
 solves no equality rows; ``fast=True`` is refused), and
 ``painleve="stop"`` acts on steps without joints only.
 
@@ -189,6 +198,7 @@ after a step, 0 if none); ``projection_iterations``.
 """
 
 import dataclasses
+from typing import ClassVar
 
 import numpy as np
 
@@ -202,7 +212,8 @@ from .contact_problem import one_contact_impulse, one_contact_residual, solve_co
 from ._mj_kernels import mj_loop, prev_regimes
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
-                            FixedStepOptions, TimeStepping, check_lcp_options, check_scene_contacts,
+                            FixedStepOptions, TimeStepping, bool_option, check_lcp_options,
+                            check_scene_contacts,
                             check_step, check_step_fits, check_work, compiled_model_of,
                             next_time)
 
@@ -295,7 +306,11 @@ class MoreauJean(TimeStepping):
     theta : float
         In ``[1/2, 1]``; 1 is the backward-Euler-like, dissipative choice.
     projection : bool
-        Project positions back onto the contacts after every step.
+        Project positions back onto the contacts after every step (refused
+        with joints).
+    joint_projection : bool
+        Project positions onto the joints after every step (a scene with
+        joints only; see the module docstring's *Drift*).
     lcp_method : {"auto", "lemke", "qp"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
@@ -375,8 +390,10 @@ class MoreauJean(TimeStepping):
     class Options(ThetaOptions):
         """Options of :class:`MoreauJean` (those of every fixed-step scheme,
         :class:`~moreau.integrators.time_stepping.FixedStepOptions`, the
-        θ-method's, :class:`ThetaOptions`, and ``projection``)."""
+        θ-method's, :class:`ThetaOptions`, ``projection`` and ``joint_projection``)."""
         projection: bool = False
+        joint_projection: bool = False
+        _rules: ClassVar[dict] = {"joint_projection": bool_option("joint_projection")}
 
     def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound, options, **keywords)
@@ -402,6 +419,9 @@ class MoreauJean(TimeStepping):
             self._closed[:] = c0.reshape(-1)
         self._n_eq = joint_row_count(self.scene)
         self._max_drift = 0.0
+        if getattr(self, "joint_projection", False) and not self._n_eq:
+            raise InputError(f"`joint_projection` projects the positions onto the joints; scene "
+                             f"{self.scene.name!r} has no joint rows: use joint_projection=False")
         if self._n_eq:
             self._check_joints()
 
@@ -411,9 +431,9 @@ class MoreauJean(TimeStepping):
         sc = self.scene
         if self.projection:
             raise InputError("`projection` projects onto the contacts only; the scene has "
-                             f"{self._n_eq} joint rows, whose drift is not corrected (no "
-                             "projection or Baumgarte stabilisation of joints yet): use "
-                             "projection=False")
+                             f"{self._n_eq} joint rows, which it would not keep: use "
+                             "projection=False (and joint_projection=True to project onto "
+                             "the joints)")
         WE, _ = sc.joint_jacobians(self.q, self.t0)
         WE = np.asarray(WE, dtype=float)
         A = WE @ np.linalg.solve(np.asarray(sc.mass(self.q), dtype=float), WE.T)
@@ -487,6 +507,8 @@ class MoreauJean(TimeStepping):
         closed = pN > 0.0
         if self.projection and nc:
             q1 = self._project(q1, t1, closed)
+        if self._n_eq and self.joint_projection:
+            q1 = self._project_joints(q1, t1)
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             # no NaN may leave the integrator: stop here, keep the last good state
             self.counters["steps"] -= 1
@@ -644,6 +666,20 @@ class MoreauJean(TimeStepping):
             MinvWT = np.linalg.solve(M, WN.T)
             d = np.linalg.solve(WN @ MinvWT, -g[sel])
             q = q + MinvWT @ d
+            self.counters["projection_iterations"] += 1
+        return q
+
+    def _project_joints(self, q, t):
+        """Mass-weighted Gauss–Newton projection of ``q`` onto the joints, ``gE(q, t) = 0``."""
+        sc = self.scene
+        M = np.asarray(sc.mass(q), dtype=float)
+        for _ in range(PROJECTION_MAXITER):
+            gE = np.asarray(sc.joint_residuals(q, t), dtype=float)
+            if np.max(np.abs(gE), initial=0.0) <= PROJECTION_TOL:
+                break
+            G = np.asarray(sc.joint_jacobians(q, t)[0], dtype=float)
+            MinvGT = np.linalg.solve(M, G.T)
+            q = q + MinvGT @ np.linalg.solve(G @ MinvGT, -gE)
             self.counters["projection_iterations"] += 1
         return q
 
