@@ -419,6 +419,7 @@ class MoreauJean(TimeStepping):
             self._closed[:] = c0.reshape(-1)
         self._n_eq = joint_row_count(self.scene)
         self._max_drift = 0.0
+        self._end_gap = None
         if getattr(self, "joint_projection", False) and not self._n_eq:
             raise InputError(f"`joint_projection` projects the positions onto the joints; scene "
                              f"{self.scene.name!r} has no joint rows: use joint_projection=False")
@@ -491,7 +492,9 @@ class MoreauJean(TimeStepping):
         v1 = v_free
         vN0 = np.zeros(nc)
         if nc:
-            g0 = np.asarray(sc.gaps(q, t0), dtype=float)
+            # the gaps at the end of the step before, when this step starts from its state
+            g0 = (self._end_gap[2] if self._end_gap is not None and self._end_gap[0] is q
+                  and self._end_gap[1] == t0 else np.asarray(sc.gaps(q, t0), dtype=float))
             WN0, wN0, _, _ = sc.contact_jacobians(q, t0)
             vN0 = np.asarray(WN0, dtype=float) @ v + np.asarray(wN0, dtype=float)
             active = (g0 + 0.5 * h * vN0 <= 0.0) | self._closed
@@ -527,10 +530,11 @@ class MoreauJean(TimeStepping):
         self._closed = closed
         self._k += 1
         self.t, self.q, self.v = t1, q1, v1
+        self._end_gap = (q1, t1, gap)
 
         fN, fT = pN / h, pT / h
         if self._pending_initial:
-            self._record(t0, q, v, regime, fN, fT, slip, np.asarray(sc.gaps(q, t0), float) if nc else gap)
+            self._record(t0, q, v, regime, fN, fT, slip, g0 if nc else gap)
             self._pending_initial = False
         last = t1 >= self.t_bound
         if self._k % self.save_every == 0 or last:
