@@ -94,11 +94,12 @@ evaluated at, and a frictionless contact with ``e = 1`` the second (its
 ``p_N > 0`` only with ``H v_{k+1} = -H v_k``, both at ``q_k``). The double
 pendulum against its wall keeps its energy to rounding (1.4e-14 over a
 strike at ``h = 0.005``); with ``M(q)`` or a nonlinear force the
-trapezoidal rule's ``O(h^2)`` error remains. The rows on ``v_{k+1}``
-alone, as before, left ``P^T G v_theta = -P^T G (v_{k+1} - v_k) / 2``
+trapezoidal rule's ``O(h^2)`` error remains. Rows on ``v_{k+1}`` alone
+(``G v_{k+1} + w = 0``) would leave ``P^T G v_theta = P^T G v_k / 2``
 with ``G v_k = O(h)`` and ``P = O(h)``: ``O(h^2)`` a step, a first-order
-energy error (0.706, 0.390, 0.205 at ``h = 0.04, 0.02, 0.01`` on the
-pendulum, at the Jacobian's half or end point alike).
+energy error (measured with such rows on the pendulum: 0.706, 0.390,
+0.205 at ``h = 0.04, 0.02, 0.01``, the Jacobian at the half or the end
+point alike).
 
 *Drift.* Along the segment from ``q_k`` to ``q_{k+1}``::
 
