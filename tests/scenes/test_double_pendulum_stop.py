@@ -13,11 +13,12 @@ from moreau.scenes.double_pendulum_stop import DoublePendulumStopCase, double_pe
 def test_energy_is_kept_to_the_schemes_order_through_an_impact():
     # frictionless, e = 1: the energy is conserved (2 in the scene's units, above the
     # hanging rest). Moreau-Jean theta = 1/2 over [0, 3] (the tip strikes the wall once, at
-    # t = 2.4), h = 0.04, 0.02, 0.01. Measured: largest energy error 0.706, 0.390, 0.205
-    # (order 0.86, 0.92; 0.106, 0.054 at h = 0.005, 0.0025: order 0.95, 0.98); joint drift
-    # 5.28e-3, 1.37e-3, 3.58e-4 (order 1.95, 1.94). The energy is first order even before
-    # the impact (0.0478, 0.0243 at t = 2.2, h = 0.01, 0.005: order 0.97): the joints'
-    # impulses on the velocity-level rows do work O(h^2) a step
+    # t = 2.4), h = 0.04, 0.02, 0.01. With the joint rows on the midpoint velocity the joint
+    # and contact impulses do no work on it, and with a constant mass matrix and gravity the
+    # step keeps the energy exactly (moreau_jean's module docstring): measured largest
+    # energy error 8.9e-16, 3.1e-15, 2.7e-15 (1.4e-14 at h = 0.005; it was first order,
+    # 0.706, 0.390, 0.205, with the rows on the end velocity); joint drift 2.17e-3, 5.19e-4,
+    # 1.32e-4, 3.32e-5 (order 2.06, 1.97, 1.99)
     case = DoublePendulumStopCase()
     sc = case.scene
     q0, v0 = sc.initial_state()
@@ -30,10 +31,39 @@ def test_energy_is_kept_to_the_schemes_order_through_an_impact():
         assert np.any(res.force_N[:, 0] > 0.0)                   # it struck the wall
         errors.append(float(np.max(np.abs(case.energy(res.q, res.v) - e0))))
         drifts.append(res.constraint_drift)
+    # better than second order: conserved to rounding at every step
+    assert max(errors) < 1e-12 * e0, errors
     for k in range(2):
-        assert 0.8 < math.log2(errors[k] / errors[k + 1]) < 1.2, errors
         assert 1.8 < math.log2(drifts[k] / drifts[k + 1]) < 2.2, drifts
-    assert errors[-1] < 0.12 * e0
+    assert drifts[-1] < 2e-4
+
+
+def test_the_joint_projection_keeps_the_joints_to_rounding_and_the_energy_at_order_two():
+    # joint_projection=True: after each step q_{k+1} is projected onto gE = 0 (mass-weighted
+    # Gauss-Newton). Measured over [0, 3], theta = 1/2: drift 6.8e-15, 8.1e-15, 9.9e-15 at
+    # h = 0.04, 0.02, 0.01; energy error 2.40e-3, 5.50e-4, 1.35e-4 (order 2.12, 2.03: the
+    # projection's O(h^3) position change a step moves the potential)
+    case = DoublePendulumStopCase()
+    sc = case.scene
+    q0, v0 = sc.initial_state()
+    e0 = case.energy(q0[None], v0[None])[0]
+    errors = []
+    for h in (0.04, 0.02, 0.01):
+        res = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=h, theta=0.5,
+                       joint_projection=True)
+        assert res.status == 0, res.message
+        assert res.constraint_drift < 1e-13
+        assert res.stats["projection_iterations"] >= res.stats["steps"]
+        errors.append(float(np.max(np.abs(case.energy(res.q, res.v) - e0))))
+    for k in range(2):
+        assert 1.8 < math.log2(errors[k] / errors[k + 1]) < 2.3, errors
+    from moreau.scenes.bouncing_ball import BouncingBall
+    with pytest.raises(InputError, match="`joint_projection` projects the positions onto the "
+                                         "joints; scene 'bouncing-ball' has no joint rows"):
+        simulate(BouncingBall(), (0.0, 1.0), [1.0], [0.0], "moreau-jean", h=0.01,
+                 joint_projection=True)
+    with pytest.raises(InputError, match="`joint_projection` must be True or False"):
+        simulate(sc, (0.0, 1.0), q0, v0, "moreau-jean", h=0.01, joint_projection=1)
 
 
 def test_bad_models_and_schemes_without_joints_are_refused_by_name():

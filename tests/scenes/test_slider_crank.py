@@ -42,8 +42,9 @@ def _errors(theta, n):
 @pytest.mark.parametrize("theta, order", [(1.0, 1.0), (0.5, 2.0)])
 def test_moreau_jean_converges_to_the_closed_form_at_its_order(theta, order):
     # measured (h = window / n, n = 100 .. 800): theta = 1: position 5.8e-3 .. 7.2e-4,
-    # velocity 2.9e-3 .. 3.6e-4, drift 1.2e-2 .. 1.5e-3 (ratios 2.00); theta = 1/2:
-    # position 9.5e-5 .. 1.5e-6, velocity 3.1e-5 .. 4.7e-7, drift 9.4e-5 .. 1.4e-6 (ratios 4.0)
+    # velocity 2.9e-3 .. 3.6e-4, drift 1.2e-2 .. 1.5e-3 (ratios 2.00); theta = 1/2 (joint
+    # rows on the midpoint velocity): position 5.2e-5 .. 8.1e-7, velocity 1.2e-4 .. 1.8e-6,
+    # drift 4.6e-5 .. 7.2e-7 (ratios 4.0)
     coarse, fine = _errors(theta, 100), _errors(theta, 200)
     for k, what in enumerate(("position", "velocity", "constraint drift")):
         rate = math.log2(coarse[k] / fine[k])

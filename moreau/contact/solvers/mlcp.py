@@ -146,6 +146,8 @@ def solve(problem, *, max_iter=None, tol=None, inner="auto", rank_rtol=RANK_RTOL
     k = problem.n_eq
     if k == 0:
         return solve_problem(problem, inner, max_iter=max_iter, tol=tol)
+    if problem.n_contacts == 0:
+        return _equalities_only(problem, tol, rank_rtol)
     reduced, recover = eliminate_equalities(problem, rank_rtol)
     nc = problem.n_contacts
     if reduced.n_rows:
@@ -177,6 +179,30 @@ def solve(problem, *, max_iter=None, tol=None, inner="auto", rank_rtol=RANK_RTOL
     return ContactSolution(p, p_eq, pN, pT, SOLVED, residual, method, iterations,
                            f"Solved: equality rows eliminated, violation {viol:.3g} on the "
                            f"caller's data.", path, lcp)
+
+
+def _equalities_only(problem, tol, rank_rtol):
+    # no contact rows: p_E = -A^-1 a, certified like the general case (its friction MLCP is
+    # (W, u_E - eq_target) itself), without building the empty contact part
+    k = problem.n_eq
+    W = problem.W
+    a = problem.u_free[:k] - problem.eq_target
+    C = W[:k, k:]
+    block = equality_block(W[:k, :k], rhs=a, coupling=C, rtol=rank_rtol,
+                           label="equality (bilateral) rows")
+    p = free_part(block, C, a, np.zeros(0))
+    viol = mlcp_violation(W, a, k, p)
+    residual = mlcp_residual(W, a, k, p)
+    bound = DEFAULT_TOL if tol is None else float(tol)
+    none = np.zeros(0)
+    if not viol <= bound:
+        return ContactSolution(p, p, none, none, FAILED, residual, "mlcp", 0,
+                               f"the solution of the reduced problem fails the check on the "
+                               f"caller's data: violation {viol:.3g} > tol {bound:.3g}",
+                               ("mlcp",), None)
+    return ContactSolution(p, p, none, none, SOLVED, residual, "mlcp", 0,
+                           f"Solved: equality rows eliminated, violation {viol:.3g} on the "
+                           f"caller's data.", ("mlcp",), None)
 
 
 register_solver("mlcp", solve, equality_rows=True,
