@@ -285,6 +285,10 @@ def _column_ints(F):
     e = ex.astype(np.int64) - 53
     K = max(0, -int(e[nz].min())) if nz.any() else 0
     sh = np.where(nz, e + K, 0)
+    if sh.size == 0 or int(sh.max()) <= 9:
+        # |m| < 2^53 shifted by at most 9 bits stays below 2^62: exact in int64
+        # (data of one scale, the usual case), converted to Python integers at once
+        return np.left_shift(m, sh).tolist(), K
     # the shifts as one object-array operation: Python integers, no per-entry bytecode
     return np.left_shift(m.astype(object), sh.astype(object)).tolist(), K
 
@@ -443,9 +447,11 @@ def exact_step(M, q, d, basis, entering):
                         r = i
                     break
     # the pivot: b_r / a_r in row r, b_i - a_i b_r / a_r in the others (the
-    # row denominators cancel in a_i / a_r)
+    # row denominators cancel in a_i / a_r); a row with a_i = 0 keeps b_i, the
+    # same rational with smaller integers (int / int rounds correctly either way)
     br, ar = bq[r], ae[r]
-    b = [(bq[i] * ar - ae[i] * br) / (ar * den[i]) if i != r else br / ar for i in range(n)]
+    b = [br / ar if i == r else ((bq[i] * ar - ae[i] * br) / (ar * den[i]) if ae[i]
+                                 else bq[i] / den[i]) for i in range(n)]
     return "pivot", basis[r], b
 
 
