@@ -219,7 +219,7 @@ def test_exact_step_takes_each_step_of_the_reference_path(prob):
         assert bx == [float(v) for v in b]
 
 
-@settings(deadline=None)
+@settings(deadline=None, max_examples=50)
 @given(st.sampled_from(["one scale", "any"]).flatmap(lambda kind: st.lists(
     st.integers(-40, 40).map(lambda k: k / 10) if kind == "one scale"
     else st.floats(allow_nan=False, allow_infinity=False), min_size=1, max_size=12)),
