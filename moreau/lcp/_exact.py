@@ -474,8 +474,13 @@ def basis_point(M, q, J):
     z = [0.0] * n
     if k == 0:
         return z
-    cols = [M[J, j] for j in J] + [-q[J]]
-    ints, _ = _column_ints(np.array(cols, dtype=float))
+    # the columns of M_JJ, then -q_J, as the rows of one array (one gather: an
+    # index list per column costs more than the elimination at small k)
+    Ji = np.asarray(J, dtype=np.intp)
+    cols = np.empty((k + 1, k))
+    cols[:k] = M[np.ix_(Ji, Ji)].T
+    cols[k] = -q[Ji]
+    ints, _ = _column_ints(cols)
     # Bareiss's fraction-free elimination on [M_JJ | -q_J] (every entry stays
     # an integer minor), then back-substitution for X = det z_J, also in integers
     T = [[ints[c][a] for c in range(k + 1)] for a in range(k)]
