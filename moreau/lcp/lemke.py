@@ -863,10 +863,12 @@ def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_
     pos = iwork[n:]
     if status == _NEED_SEEN:
         seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
+        entering = np.int64(ray_out[n])
+        # the ray stays zero unless the path ends on one
+        ray_out[n] = 0.0
         status, pivots, residual = _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos,
-                                         n, np.int64(pivots), np.int64(ray_out[n]), max_iter,
-                                         tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER),
-                                         seen)
+                                         n, np.int64(pivots), entering, max_iter, tol, exact_ok,
+                                         mmax, qmax, qsum, np.int64(MAX_ITER), seen)
     if status == _NEED_REPAIR:
         status = SOLVED
         zsave = z_out.copy()
