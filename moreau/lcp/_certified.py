@@ -31,7 +31,7 @@ def _two_prod(a, b):
     return p, al * bl - (((p - ah * bh) - al * bh) - ah * bl)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _dot2_row(M, q, z, i, n):
     # q_i + sum_j M_ij z_j in twice the working precision (Dot2): returns the
     # value and a bound on its error, 2 eps |value| + ((n + 2) eps)^2 sum |terms|
@@ -53,7 +53,7 @@ def _dot2_row(M, q, z, i, n):
     return v, 2.0 * _EPS * abs(v) + g * g * mag
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def residual(M, q, z, w, mmax, qmax):
     # w = M z + q from the data, and the violation of lcp_violation:
     # max |min(mmax z_i, w_i)| / qmax, scaled by the data only, at its worst
@@ -102,7 +102,7 @@ def _two_sum(a, b):
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _grow(e, m, b):
     # Shewchuk's Grow-Expansion with zero elimination: e[:m], a nonoverlapping
     # expansion in increasing magnitude, becomes one of its sum plus b, in place

@@ -285,6 +285,10 @@ def _column_ints(F):
     e = ex.astype(np.int64) - 53
     K = max(0, -int(e[nz].min())) if nz.any() else 0
     sh = np.where(nz, e + K, 0)
+    if sh.size == 0 or int(sh.max()) <= 9:
+        # |m| < 2^53 shifted by at most 9 bits stays below 2^62: exact in int64
+        # (data of one scale, the usual case), converted to Python integers at once
+        return np.left_shift(m, sh).tolist(), K
     # the shifts as one object-array operation: Python integers, no per-entry bytecode
     return np.left_shift(m.astype(object), sh.astype(object)).tolist(), K
 
@@ -443,9 +447,11 @@ def exact_step(M, q, d, basis, entering):
                         r = i
                     break
     # the pivot: b_r / a_r in row r, b_i - a_i b_r / a_r in the others (the
-    # row denominators cancel in a_i / a_r)
+    # row denominators cancel in a_i / a_r); a row with a_i = 0 keeps b_i, the
+    # same rational with smaller integers (int / int rounds correctly either way)
     br, ar = bq[r], ae[r]
-    b = [(bq[i] * ar - ae[i] * br) / (ar * den[i]) if i != r else br / ar for i in range(n)]
+    b = [br / ar if i == r else ((bq[i] * ar - ae[i] * br) / (ar * den[i]) if ae[i]
+                                 else bq[i] / den[i]) for i in range(n)]
     return "pivot", basis[r], b
 
 
@@ -468,8 +474,13 @@ def basis_point(M, q, J):
     z = [0.0] * n
     if k == 0:
         return z
-    cols = [M[J, j] for j in J] + [-q[J]]
-    ints, _ = _column_ints(np.array(cols, dtype=float))
+    # the columns of M_JJ, then -q_J, as the rows of one array (one gather: an
+    # index list per column costs more than the elimination at small k)
+    Ji = np.asarray(J, dtype=np.intp)
+    cols = np.empty((k + 1, k))
+    cols[:k] = M[np.ix_(Ji, Ji)].T
+    cols[k] = -q[Ji]
+    ints, _ = _column_ints(cols)
     # Bareiss's fraction-free elimination on [M_JJ | -q_J] (every entry stays
     # an integer minor), then back-substitution for X = det z_J, also in integers
     T = [[ints[c][a] for c in range(k + 1)] for a in range(k)]

@@ -161,6 +161,13 @@ ROUND = 2.0**16 * np.finfo(float).eps
 # internal statuses: the compiled pivoting hands over to the exact path
 _HANDOFF_TIE = 100
 _HANDOFF_CYCLE = 101
+# internal statuses of the compiled path that allocates nothing (_core, _path): a
+# path that needs the hash set of visited bases, or a solution whose residual
+# check failed and whose basis must be re-solved, goes on in _continue
+_NEED_SEEN = 102
+_NEED_REPAIR = 103
+# _plain_stage: the data need scaling, nothing was pivoted
+_NOT_PLAIN = 104
 # the output buffer of _solve_packed: z, w, the ray (n + 1) and the scaling of a
 # hand-over (2 n + 3), _OUT n + 4 floats
 _OUT = 5
@@ -232,7 +239,7 @@ def _padded(n):
     return ((n + 1 + 7) // 8) * 8
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _row_scales(T, b, pos, n, i, qsum):
     # (S, Sb): the size of the entries that make up row i of the tableau (its
     # own entries and its row of B^-1), and that of its right-hand side
@@ -251,7 +258,7 @@ def _row_scales(T, b, pos, n, i, qsum):
     return max(s, binv), max(abs(b[i]), binv * qsum)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _lex_compare(T, b, pos, n, i, k, ai, ak, qsum, exact_ok, rhs_only):
     # Compare rows i and k of [b | B^-1] / a lexicographically (with rhs_only,
     # their ratios b / a alone): -1 or 1 when
@@ -308,7 +315,7 @@ def _key(v):
     return x ^ ((x >> 31) & 0x1FFFFFFFF)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _pivot(T, b, col, n, r, s):
     # Exchange the basic variable of row r with the non-basic one of slot s
     # in the condensed tableau x_B + T[:n, :n+1] x_N = b; col holds T[:n, s].
@@ -344,7 +351,7 @@ def _pivot(T, b, col, n, r, s):
     b[r] = b_r
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _copy_into(dst, src):
     # an explicit loop: a slice assignment (dst[:] = src) makes numba compile its
     # shape-mismatch error path, about 3 s of every cold start
@@ -352,7 +359,7 @@ def _copy_into(dst, src):
         dst[k] = src[k]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _extract_z(b, pos, n, z_out):
     for j in range(n):
         p = pos[n + j]
@@ -444,7 +451,7 @@ def _resolve_basis(M, q, pos, n, z_out):
     return eliminate(A, x, m, 0.0, 1e3 * np.finfo(np.float64).eps * amax, pcol, z_out, J) == m
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _noise_scale(T, pos, M, d, n, i, entering):
     # sum_j |B^-1_ij| |A_ej|: the size of the terms that make up entry i of
     # the entering column B^-1 A_e, hence the scale of its rounding error.
@@ -526,10 +533,22 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
-    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, np.bool_(False))
+    status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol,
+                                     np.bool_(False))
+    if status == _NEED_SEEN or status == _NEED_REPAIR:
+        status, pivots, residual = _continue(M, q, d, z_out, w_out, ray_out, work, iwork,
+                                             max_iter, tol, np.bool_(False), status, pivots,
+                                             residual)
+    return status, pivots, residual
 
 
-@njit(cache=True)
+# _core, _path and _core_resume allocate nothing and are compiled without numba's
+# reference counting (_nrt=False): on a small LCP the atomic increments and
+# decrements of the arrays passed and viewed cost more than the pivoting. A
+# function compiled so may only call functions that allocate nothing either;
+# what needs memory (the hash set of a long path, the re-solve of a basis)
+# returns _NEED_SEEN or _NEED_REPAIR to _continue, which its callers run
+@njit(cache=True, _nrt=False)
 def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     # lemke_core (the public entry documents it). With exact_ok, a tie that
     # floating point cannot decide, or a repeated basis, returns _HANDOFF_TIE
@@ -618,16 +637,20 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     # np.int64, not the constants: literal arguments would type (and compile) a
     # second _path beside _core_resume's
     return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(pivots),
-                 entering, max_iter, tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER))
+                 entering, max_iter, tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER),
+                 iwork[:1])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, entering,
-          max_iter, tol, exact_ok, mmax, qmax, qsum, status):
+          max_iter, tol, exact_ok, mmax, qmax, qsum, status, seen):
     # Lemke's path from the tableau (T, b) of the basis (basis, pos) with
     # `entering` to enter next, to its end (status MAX_ITER; another status:
     # the path has ended already, only the terminal point is made); _core
-    # after its first pivot, and _core_resume from a basis the exact path decided
+    # after its first pivot, and _core_resume from a basis the exact path
+    # decided. `seen` is the hash set of visited states (_SEEN_SIZE zeros), or
+    # of length 1 when none is allocated yet: the path then returns
+    # _NEED_SEEN, with `entering` in ray_out[n], when its watch begins
     z0 = 2 * n
     # (basis, entering) identified by the XOR of its variables' keys: an exact
     # lexicographic path never repeats one, so a repeat is rounding having
@@ -637,16 +660,18 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
     hb = 0
     for i in range(n):
         hb ^= _key(basis[i])
-    # a placeholder of length 1 (a view: no allocation on the short paths);
-    # the set itself is allocated when the watch starts
-    seen = pos[:1]
     nseen = 0
-    watch = 2 * n + 15 + pivots
+    # a set handed in (by _continue) is fresh: the watch goes on at once
+    watch = 2 * n + 15 + pivots if seen.shape[0] == 1 else pivots
 
     while status == MAX_ITER and pivots < max_iter:
         if pivots >= watch:
-            if seen.shape[0] == 1 or 4 * nseen >= 3 * seen.shape[0]:
-                seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
+            if seen.shape[0] == 1:
+                ray_out[n] = entering
+                return _NEED_SEEN, pivots, np.inf
+            if 4 * nseen >= 3 * seen.shape[0]:
+                for k in range(seen.shape[0]):
+                    seen[k] = 0
                 nseen = 0
             state = hb ^ _key(entering + 3 * n)
             if state == 0:
@@ -805,7 +830,47 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
             break
     residual = _residual(M, q, z_out, w_out, mmax, qmax)
     if status == SOLVED and not residual <= tol:
-        # accumulated rounding: re-solve the terminal basis from the data
+        # accumulated rounding: _continue re-solves the terminal basis from the data
+        return _NEED_REPAIR, pivots, residual
+    if not residual < np.inf:
+        for k in range(n):
+            z_out[k] = 0.0
+        residual = _residual(M, q, z_out, w_out, mmax, qmax)
+    return status, pivots, residual
+
+
+@njit(cache=True)
+def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok, status,
+              pivots, residual):
+    # the rest of a path _core or _core_resume handed back (_NEED_SEEN: the
+    # path goes on with a hash set of visited states; _NEED_REPAIR: the
+    # solution's basis is re-solved from the data), with the tableau, basis
+    # and outputs where they left them
+    n = q.shape[0]
+    mmax = 0.0
+    qmax = 0.0
+    qsum = 0.0
+    for i in range(n):
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+    for i in range(n):
+        qmax = max(qmax, abs(q[i]))
+        qsum += abs(q[i])
+    T = work
+    b = work[n + 1]
+    col = work[n + 2]
+    basis = iwork[:n]
+    pos = iwork[n:]
+    if status == _NEED_SEEN:
+        seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
+        entering = np.int64(ray_out[n])
+        # the ray stays zero unless the path ends on one
+        ray_out[n] = 0.0
+        status, pivots, residual = _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos,
+                                         n, np.int64(pivots), entering, max_iter, tol, exact_ok,
+                                         mmax, qmax, qsum, np.int64(MAX_ITER), seen)
+    if status == _NEED_REPAIR:
+        status = SOLVED
         zsave = z_out.copy()
         wsave = w_out.copy()
         ok = _resolve_basis(M, q, pos, n, z_out)
@@ -816,10 +881,10 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
             _copy_into(z_out, zsave)
             _copy_into(w_out, wsave)
             status = BREAKDOWN
-    if not residual < np.inf:
-        for k in range(n):
-            z_out[k] = 0.0
-        residual = _residual(M, q, z_out, w_out, mmax, qmax)
+        if not residual < np.inf:
+            for k in range(n):
+                z_out[k] = 0.0
+            residual = _residual(M, q, z_out, w_out, mmax, qmax)
     return status, pivots, residual
 
 
@@ -833,7 +898,7 @@ _RESUME_RAY = 2
 _REBUILD_TOL = 1e-8
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, start):
     # Lemke's path on (M, q, d) from a basis the exact path (moreau.lcp._exact.exact_step)
     # has decided: start = (basis of each row (n), entering variable, mode,
@@ -940,7 +1005,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
         status = SECONDARY_RAY
     return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(start[n + 2]),
                  np.int64(entering), max_iter, tol, np.bool_(True), mmax, qmax, qsum,
-                 np.int64(status))
+                 np.int64(status), iwork[:1])
 
 
 @njit(cache=True)
@@ -976,17 +1041,23 @@ def lemke_kernel(M, q, z_out, w_out, max_iter, tol):
         As for :func:`lemke_core`.
     """
     n = q.shape[0]
-    d = np.ones(n)
-    ray = np.empty(n + 1)
-    work = np.empty((n + 3, _padded(n)))
-    iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, z_out, w_out, ray, work, iwork, max_iter, tol, np.bool_(False),
-                         np.bool_(False), ray[:0])
+    out = np.empty(_OUT * n + 4)
+    fbuf = np.empty(_fbuf_size(n))
+    ibuf = np.empty(4 * n + 1, dtype=np.int64)
+    d = fbuf[_fbuf_size(n) - n:]
+    for i in range(n):
+        d[i] = 1.0
+    status, pivots, residual = _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol,
+                                              np.bool_(False), np.bool_(False))
+    for i in range(n):
+        z_out[i] = out[i]
+        w_out[i] = out[n + i]
+    return status, pivots, residual
 
 
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def balance(M, q, sexp):
     """Power-of-two balancing of ``LCP(M, q)`` (compiled; callable from Python).
 
@@ -1070,7 +1141,7 @@ def _times_pow2(x, k):
     return math.ldexp(x, k)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _balance_rows_to_q(M, q, rexp, cexp):
     # the second balancing, for when the symmetric one leaves a row's q far
     # below the others (diag(1e300, 1e-300), q = (-1, -1): D q = (-1e-300, -1),
@@ -1093,7 +1164,7 @@ def _balance_rows_to_q(M, q, rexp, cexp):
     return _unit_exponents(M, q, rexp, cexp)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _balance_ruiz(M, q, rexp, cexp, sweeps):
     # the third balancing: rows and columns equilibrated apart (R M C), each
     # by the geometric mean of its largest and smallest nonzero entry, in
@@ -1119,7 +1190,7 @@ def _balance_ruiz(M, q, rexp, cexp, sweeps):
     return _unit_exponents(M, q, rexp, cexp)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _geo_exponent(M, e0, rexp, cexp, k, row):
     # half the summed exponents of the largest and smallest nonzero entry of
     # row (or column) k of 2^e0 R M C: the power of two to divide it by
@@ -1137,7 +1208,7 @@ def _geo_exponent(M, e0, rexp, cexp, k, row):
     return (math.frexp(hi)[1] + math.frexp(lo)[1]) // 2
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _unit_exponents(M, q, rexp, cexp):
     # (ka, kb) bringing max|R M C| and max|R q| to [0.5, 1)
     n = q.shape[0]
@@ -1177,6 +1248,10 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
         # from a basis the exact path decided (start: see _core_resume)
         status, pivots, residual = _core_resume(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
                                                 max_iter, tol, start)
+    if status == _NEED_SEEN or status == _NEED_REPAIR:
+        status, pivots, residual = _continue(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
+                                             max_iter, tol, np.bool_(exact_ok or start.shape[0] > 0),
+                                             status, pivots, residual)
     if status == INVALID_INPUT or status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         # a hand-over carries the basis in ray_out: nothing to map back
         return status, pivots, residual
@@ -1203,7 +1278,7 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
     return status, pivots, residual
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def unit_farkas(M, q):
     """The first ``i`` for which ``e_i`` is a Farkas vector of ``LCP(M, q)``, or -1 (compiled).
 
@@ -1321,31 +1396,74 @@ def _ray_proves(M, q, ray):
     return farkas_float(M, q, y) == 1
 
 
-@njit(cache=True)
-def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, scale_d,
-                  exact_ok, info):
-    # Lemke on the symmetrically balanced data (balance): a uniformly scaled
-    # problem pivots exactly as the unscaled one, and the matrix class is
-    # kept. Where its answer fails on the caller's data, again with rows
-    # scaled to their q (_balance_rows_to_q), then with rows and columns
-    # equilibrated apart (_balance_ruiz). On a hand-over to the exact path
-    # (exact_ok), info (2 n + 3) receives the scaling of the data pivoted on
-    # (_handoff_info), for the exact step and the resume to use the same.
+@njit(cache=True, _nrt=False)
+def _plain_stage(M, q, d, out, fbuf, ibuf, max_iter, tol, exact_ok):
+    # The first stage of _lemke_rest, which allocates nothing: the balancing
+    # exponents (balance, into ibuf[3 n + 1:]) and, on data of one moderate
+    # scale, Lemke on them as given (_core, the tableau in fbuf). Returns
+    # (status, pivots, residual, ka, kb), status _NOT_PLAIN when the data need
+    # the scaled stages. Buffers: out as for _solve_packed, fbuf of
+    # _fbuf_size(n) floats, ibuf of 4 n + 1 integers.
     n = q.shape[0]
-    sexp = np.zeros(n, dtype=np.int64)
+    m = _padded(n)
+    work = fbuf[:(n + 3) * m].reshape((n + 3, m))
+    iwork = ibuf[:3 * n + 1]
+    sexp = ibuf[3 * n + 1:]
+    for i in range(n):
+        sexp[i] = 0
     ok, ka, kb = balance(M, q, sexp)
     if not ok:
         # NaN or inf: _core refuses them
-        return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok)
+        status, pivots, residual = _core(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1],
+                                         work, iwork, max_iter, tol, exact_ok)
+        return status, pivots, residual, ka, kb
     plain = -_PLAIN_RANGE <= ka <= _PLAIN_RANGE and -_PLAIN_RANGE <= kb <= _PLAIN_RANGE
     for i in range(n):
         plain = plain and sexp[i] == 0
+    if not plain:
+        return _NOT_PLAIN, 0, np.inf, ka, kb
+    # data of one moderate scale: the pivoting's tests are all relative, so
+    # pivoting on them as given is what the normalised copy would do (the
+    # property tests scale by 2^k and compare), minus the copy
+    status, pivots, residual = _core(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1], work,
+                                     iwork, max_iter, tol, exact_ok)
+    return status, pivots, residual, ka, kb
+
+
+@njit(cache=True, inline="always")
+def _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, scale_d, exact_ok):
+    # Lemke on the symmetrically balanced data (balance): a uniformly scaled
+    # problem pivots exactly as the unscaled one, and the matrix class is
+    # kept. The common case (data of one scale, a solution or the pivot limit)
+    # ends in _plain_stage; the rest in _lemke_rest.
+    n = q.shape[0]
+    status, pivots, residual, ka, kb = _plain_stage(M, q, d, out, fbuf, ibuf, max_iter, tol,
+                                                    exact_ok)
+    if status == SOLVED or status == MAX_ITER or status == INVALID_INPUT:
+        return status, pivots, residual
+    m = _padded(n)
+    return _lemke_rest(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1],
+                       fbuf[:(n + 3) * m].reshape((n + 3, m)), ibuf[:3 * n + 1], ibuf[3 * n + 1:],
+                       ka, kb, max_iter, tol, scale_d, exact_ok, out[3 * n + 1:], status, pivots,
+                       residual)
+
+
+@njit(cache=True)
+def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_iter, tol, scale_d,
+                exact_ok, info, status, pivots, residual):
+    # After _plain_stage (its outcome in status, pivots, residual; _NOT_PLAIN
+    # when it did not pivot): where the answer fails on the caller's data,
+    # Lemke again on the balanced data, then with rows scaled to their q
+    # (_balance_rows_to_q), then with rows and columns equilibrated apart
+    # (_balance_ruiz). On a hand-over to the exact path (exact_ok), info
+    # (2 n + 3) receives the scaling of the data pivoted on (_handoff_info),
+    # for the exact step and the resume to use the same.
+    n = q.shape[0]
+    plain = status != _NOT_PLAIN
     if plain:
-        # data of one moderate scale: the pivoting's tests are all relative, so
-        # pivoting on them as given is what the normalised copy would do (the
-        # property tests scale by 2^k and compare), minus the copy
-        status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork,
-                                         max_iter, tol, exact_ok)
+        if status == _NEED_SEEN or status == _NEED_REPAIR:
+            status, pivots, residual = _continue(M, q, d, z_out, w_out, ray_out, work, iwork,
+                                                 max_iter, tol, exact_ok, status, pivots, residual)
         if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
             _handoff_info(info, sexp, sexp, np.int64(0), np.int64(0), np.bool_(False),
                           np.bool_(True))
@@ -1407,7 +1525,7 @@ def _lemke_scaled(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sc
     return status, pivots, residual
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _ray_is_farkas(M, q, y, tol):
     # moreau.lcp.certify.farkas_vector(M, q, y, tol) is not None, compiled:
     # y >= 0 (to -tol after scaling to max 1), q.y < 0 and
@@ -1455,10 +1573,20 @@ def _solve_packed(M, q, d, out, max_iter, tol, scale_d=True):
     if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n or out.shape[0] < _OUT * n + 4:
         # the unchecked path must never read out of bounds
         return INVALID_INPUT, 0, np.inf
-    work = np.empty((n + 3, _padded(n)))
-    iwork = np.empty(3 * n + 1, dtype=np.int64)
-    return _lemke_scaled(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1], work, iwork,
-                         max_iter, tol, scale_d, np.bool_(True), out[3 * n + 1:])
+    # the tableau and the covering vector in one allocation, the integer work in another
+    fbuf = np.empty(_fbuf_size(n))
+    ibuf = np.empty(4 * n + 1, dtype=np.int64)
+    dd = fbuf[_fbuf_size(n) - n:]
+    for i in range(n):
+        dd[i] = d[i]
+    return _solve_buffers(M, q, dd, out, fbuf, ibuf, max_iter, tol, scale_d, np.bool_(True))
+
+
+@njit(cache=True, _nrt=False)
+def _fbuf_size(n):
+    # floats of the buffer of _solve_buffers: the tableau (n + 3 rows of
+    # _padded(n)) and the covering vector
+    return (n + 3) * _padded(n) + n
 
 
 @njit(cache=True)
@@ -1512,7 +1640,7 @@ def _violation(M, q, z):
     return _residual(M, q, z, np.empty(n), mmax, qmax)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _handoff_info(info, rexp, cexp, ka, kb, scale_d, plain):
     # the scaling of the data a hand-over happened on: (2^ka R M C, 2^kb R q)
     # with covering 2^rexp d (scale_d) or d, R = diag(2^rexp), C = diag(2^cexp);
@@ -1530,8 +1658,18 @@ def _handoff_info(info, rexp, cexp, ka, kb, scale_d, plain):
 def _solve_packed_ones(M, q, out, max_iter, tol):
     # covering vector of ones made here: one array argument less to type on
     # every call from Python. np.bool_, not the literal False: numba would compile
-    # _solve_packed a second time for the literal (measured 19.5 s on a cold cache)
-    return _solve_packed(M, q, np.ones(q.shape[0]), out, max_iter, tol, np.bool_(False))
+    # _solve_buffers a second time for the literal
+    n = q.shape[0]
+    if M.shape[0] != n or M.shape[1] != n or out.shape[0] < _OUT * n + 4:
+        # the unchecked path must never read out of bounds
+        return INVALID_INPUT, 0, np.inf
+    fbuf = np.empty(_fbuf_size(n))
+    ibuf = np.empty(4 * n + 1, dtype=np.int64)
+    d = fbuf[_fbuf_size(n) - n:]
+    for i in range(n):
+        d[i] = 1.0
+    return _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, np.bool_(False),
+                          np.bool_(True))
 
 
 class _LemkeResult(LCPResult):

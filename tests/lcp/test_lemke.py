@@ -286,6 +286,26 @@ def test_kernel_is_callable_from_compiled_code():
         np.testing.assert_allclose(ws[k], Ms[k] @ zs[k] + qs[k], atol=1e-14)
 
 
+def test_core_on_a_long_path_leaves_the_ray_zero_and_the_solution_exact():
+    # Murty's order 6: 2^6 = 64 pivots, past the 2 n + 16 after which the visited
+    # bases are hashed (the compiled path hands over to allocate the set and goes
+    # on); the solution (0, ..., 0, z_n) and a ray output that stays zero
+    inst = murty(6)
+    n = 6
+    z = np.full(n, 7.0)
+    w = np.full(n, 7.0)
+    ray = np.full(n + 1, 7.0)
+    work, iwork = lemke_workspace(n)
+    st, piv, res = lemke_core(inst.M, inst.q, np.ones(n), z, w, ray, work, iwork, 1000, 1e-9)
+    assert (st, piv) == (SOLVED, 2**n)
+    np.testing.assert_array_equal(z, inst.z)
+    np.testing.assert_array_equal(ray, 0.0)
+    # with a pivot limit inside the watched part: MAX_ITER at the limit, the ray zero
+    st, piv, _ = lemke_core(inst.M, inst.q, np.ones(n), z, w, ray, work, iwork, 40, 1e-9)
+    assert (st, piv) == (MAX_ITER, 40)
+    np.testing.assert_array_equal(ray, 0.0)
+
+
 def test_kernel_reports_invalid_input_as_a_status():
     M = np.eye(2)
     q = np.array([-1.0, np.nan])

@@ -37,6 +37,8 @@ n = 40 case below is such data):
 * Murty's exponential examples (``2^n`` pivots).
 """
 
+from fractions import Fraction
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -44,7 +46,7 @@ from hypothesis import strategies as st
 
 from moreau.lcp import INFEASIBLE, MAX_ITER, SECONDARY_RAY, solve_lcp
 from moreau.lcp.instances import murty
-from moreau.lcp._exact import exact_step
+from moreau.lcp._exact import _column_ints, exact_step
 from moreau.lcp.lemke import lemke_core, lemke_workspace
 
 from .conftest import assert_certified
@@ -215,6 +217,21 @@ def test_exact_step_takes_each_step_of_the_reference_path(prob):
         kind, left, bx = exact_step(M, q, np.ones(n), rows, entering)
         assert (kind, left) == (("ray", None) if leaving is None else ("pivot", leaving))
         assert bx == [float(v) for v in b]
+
+
+@settings(deadline=None, max_examples=50)
+@given(st.sampled_from(["one scale", "any"]).flatmap(lambda kind: st.lists(
+    st.integers(-40, 40).map(lambda k: k / 10) if kind == "one scale"
+    else st.floats(allow_nan=False, allow_infinity=False), min_size=1, max_size=12)),
+    st.integers(1, 3))
+def test_column_ints_are_the_data_times_one_power_of_two(vals, rows):
+    # data of one scale take the int64 shortcut, the others Python integers: either
+    # way each entry is an integer a with a / 2^K equal to the float exactly
+    F = np.array(vals * rows, dtype=float).reshape(rows, len(vals))
+    ints, K = _column_ints(F)
+    for row, frow in zip(ints, F):
+        assert [type(a) for a in row] == [int] * len(row)
+        assert [Fraction(a, 1 << K) for a in row] == [Fraction(float(x)) for x in frow]
 
 
 def test_exact_step_refuses_a_basis_that_is_not_lexicographically_positive():
