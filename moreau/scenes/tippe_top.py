@@ -42,7 +42,11 @@ here): the inverted state is a minimum iff ``C (R + a) > A R`` and
     J^2 > \frac{m g a\, C^2 (R + a)^4}{R\,[C (R + a) - A R]},
 
 the upright state is not iff ``A R > C (R - a)`` and ``J^2 > m g a C^2 (R -
-a)^4 / (R [A R - C (R - a)])``. Spun at ``n0`` about its axis at the tilt
+a)^4 / (R [A R - C (R - a)])``. With ``gamma = A / C`` the first pair is the
+classical condition ``1 - alpha < gamma < 1 + alpha`` for inversion, and
+the bound on ``J`` is Rauch-Wojciechowski and Rutstam's threshold ``lambda >
+sqrt(m g R^3 C alpha) (1 + alpha)^2 / sqrt(1 + alpha - gamma)`` ("Dynamics of
+an inverting tippe top", SIGMA 10 (2014) 017). Spun at ``n0`` about its axis at the tilt
 ``theta0``, ``J = C n0 (R cos theta0 - a)``: for the default top the
 upright state is unstable above ``n0 = 21.8 rad/s`` and the inverted state
 stable above ``n0 = 120.3 rad/s`` (:func:`spin_thresholds`); between the two

@@ -42,6 +42,11 @@ def test_moreau_jean_keeps_jelletts_integral_while_friction_dissipates():
 def test_the_spin_thresholds_bound_where_friction_leaves_the_top():
     n_up, n_inv = spin_thresholds()
     assert 21.0 < n_up < 22.5 and 119.0 < n_inv < 121.0
+    # the published threshold on Jellett's integral (Rauch-Wojciechowski and Rutstam 2014):
+    # lambda_thres = sqrt(m g R^3 C alpha) (1 + alpha)^2 / sqrt(1 + alpha - A / C)
+    m, g, R, al, A, C = 6e-3, 9.81, 0.015, 0.2, 8e-7, 7e-7
+    lam = math.sqrt(m * g * R ** 3 * C * al) * (1 + al) ** 2 / math.sqrt(1 + al - A / C)
+    assert n_inv * C * (R * math.cos(0.1) - al * R) == pytest.approx(lam, rel=1e-12)
     # above the inversion threshold the least energy at J is inverted; just below it is not,
     # and below the lower threshold the upright state is the least
     assert final_tilt(spin=1.001 * n_inv) == pytest.approx(math.pi, abs=1e-9)
