@@ -21,7 +21,7 @@ def test_discovery_finds_every_scene_module_that_registers_one():
                      "friction-drive", "painleve-rod", "piezo-drive", "puck-incline",
                      "rocking-block", "rocking-block-built", "slider-crank",
                      "slider-crank-clearance", "sliding-block", "sliding-box", "sphere-incline",
-                     "stick-slip-motor", "woodpecker-toy"]
+                     "stick-slip-motor", "tippe-top", "woodpecker-toy"]
 
 
 @pytest.mark.parametrize("name", NAMES)

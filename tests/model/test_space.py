@@ -100,3 +100,40 @@ def test_a_bad_shape_or_contact_is_refused_by_name():
         m.add_contact(b, Sphere(1.0), f, mu=-0.1)
     with pytest.raises(InputError, match="`plane` must be the index"):
         m.add_contact(b, Sphere(1.0), 3)
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_an_eccentric_sphere_rows_and_drift_against_differences(seed):
+    # a sphere whose centre is off the centre of mass (the tippe top): its support point is
+    # not material, only the centre's offset R c turns with the body
+    rng = np.random.default_rng(seed)
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.02)
+    floor = m.add_half_space((0.0, 0.0, -0.01), (0.1, 0.2, 1.0))
+    c = np.array([0.002, -0.001, 0.004])
+    top = m.add_body(0.01, [1e-6, 1.2e-6, 0.9e-6], position=(0.0, 0.0, 0.01),
+                     orientation=quat_exp(0.5 * rng.standard_normal(3)))
+    m.add_contact(top, Sphere(0.015, centre=c), floor, mu=0.3)
+    sc = m.build("eccentric")
+    q, _ = sc.initial_state()
+    v = rng.standard_normal(sc.nvel)
+    # the gap: the sphere's lowest point along the normal, from points sampled on its surface
+    R = rotation_matrix(q[3:7])
+    u = rng.standard_normal((200000, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    n = np.array([0.1, 0.2, 1.0]) / np.linalg.norm([0.1, 0.2, 1.0])
+    pts = q[:3] * 0.02 + R @ c + 0.015 * u
+    assert abs(sc.gaps(q, 0.0)[0] * 0.02 - np.min((pts - (0.0, 0.0, -0.01)) @ n)) < 1e-6
+    eps = 1e-6
+    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
+    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
+    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
+    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
+    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
+    (_, t1, t2), = sc.contact_bases()
+    slip = np.array([t1 @ pdot[0], t2 @ pdot[0]])
+    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
+    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
+    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
+    wNb, wTb = sc.contact_drift(q, v, 0.0)
+    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    assert abs(wNb[0]) > 1e-3 and np.max(np.abs(wTb)) > 1e-3    # the offset does turn

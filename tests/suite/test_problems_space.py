@@ -23,3 +23,12 @@ def test_the_pucks_problem_shows_the_eight_facets_error():
     prob = get_problem("puck-incline")
     row = run_cell(prob, "moreau-jean", "N=200", {"h": prob.window / 200})
     assert row["outcome"] == "inaccurate" and 0.4 < row["errors"]["across"] < 0.5
+
+
+@pytest.mark.slow
+def test_the_tippe_top_problem_ends_inverted():
+    prob = get_problem("tippe-top")
+    assert prob.reference() == {"axis": -1.0}
+    row = run_cell(prob, "moreau-jean", "N=2000", {"h": prob.window / 2000, "cone": "exact"})
+    # measured: cos(theta) -0.99868 at the end, an error of 6.6e-4 of the range
+    assert row["outcome"] == "ok" and row["max_error"] < 2e-3

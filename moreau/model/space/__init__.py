@@ -35,7 +35,9 @@ Every contact is a point of a body against a ground half-space ``{y : n . (y
 offset ``s`` (world) from the body's centre:
 
 * a :class:`Sphere` of radius ``rho``: ``s = -rho n`` (the support point),
-  ``g = n . (x - y0) - rho``;
+  ``g = n . (x - y0) - rho``; a sphere whose centre sits at ``c`` (body
+  frame) from the centre of mass (an eccentric sphere, the tippe top):
+  ``s = R c - rho n`` and ``g = n . (x + R c - y0) - rho``;
 * a :class:`Puck` (a flat cylinder of radius ``a`` and thickness ``c``): its
   bottom face, ``z = -c/2`` in the body frame, touches through ``k`` rim
   points ``b_i = (a cos 2 pi i/k, a sin 2 pi i/k, -c/2)``, ``s_i = R b_i``
@@ -58,7 +60,9 @@ the two slip rates. Differentiating a row times ``v`` at zero accelerations
 (``d(R omega)/dt = R omega'``: the body-frame rate's own turning term
 ``omega x omega`` is zero) gives the drift ``e . (w x (w x s))`` with ``w =
 R omega`` for a material point (the puck); the sphere's support point is
-not material, ``s = -rho n`` is constant, its drift is zero.
+not material, only its centre's offset ``R c`` turns with the body (``d(R
+c)/dt = w x R c``, ``-rho n`` is constant), so its drift is ``e . (w x (w
+x R c))``, zero for a centred sphere.
 
 Every row is held to central differences of the gap and of the material
 point's position along the exponential-map motion in ``tests/model``.
@@ -172,10 +176,16 @@ def advance_coordinates(scene, q, v_mid, h):
 
 
 class Sphere:
-    """A sphere of ``radius`` [m] about the body's centre of mass."""
+    """A sphere of ``radius`` [m] whose centre is at ``centre`` [m] (body frame) from the centre of mass.
 
-    def __init__(self, radius):
+    The default ``centre = (0, 0, 0)`` is a sphere about the centre of mass;
+    an eccentric sphere (the tippe top) has its centre of mass off the
+    sphere's centre.
+    """
+
+    def __init__(self, radius, centre=(0.0, 0.0, 0.0)):
         self.radius = positive("radius", radius)
+        self.centre = finite_array("centre", centre, shape=(3,))
 
     def points(self, scale):
         return None
@@ -301,7 +311,9 @@ class SpaceModel:
         for k in range(1 if pts is None else len(pts)):
             self.contacts.append({"body": int(body), "plane": int(plane), "mu": mu, "e": e,
                                   "radius": shape.radius / self.length if pts is None else 0.0,
-                                  "point": None if pts is None else pts[k]})
+                                  "point": None if pts is None else pts[k],
+                                  "centre": (shape.centre / self.length if pts is None
+                                             and np.any(shape.centre != 0.0) else None)})
             out.append(len(self.contacts) - 1)
         return out
 
@@ -422,6 +434,8 @@ class SpaceScene(Scene):
         y0, n, t1, t2 = self._planes[c["plane"]]
         if c["point"] is None:
             s = -c["radius"] * n
+            if c["centre"] is not None:
+                s = s + R @ c["centre"]
         else:
             s = R @ c["point"]
         return b, x, R, s, y0, n, t1, t2
@@ -465,8 +479,11 @@ class SpaceScene(Scene):
         wT = np.zeros(2 * len(fi))
         for i in range(self.ncontacts):
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
-            if self._contacts[i]["point"] is None:
-                continue            # a sphere's support point: s = -rho n is constant
+            c = self._contacts[i]
+            if c["point"] is None:
+                if c["centre"] is None:
+                    continue        # a sphere's support point: s = -rho n is constant
+                s = R @ c["centre"]     # only the sphere's centre turns with the body
             w = R @ v[6 * b + 3:6 * b + 6]
             a = np.cross(w, np.cross(w, s))
             wN[i] = n @ a
@@ -524,6 +541,8 @@ class SpaceScene(Scene):
             b = c["body"]
             x = qs[7 * b:7 * b + 3] * L
             if c["point"] is None:
+                if c["centre"] is not None:
+                    x = x + self._rotations(qs)[b] @ c["centre"] * L
                 out.append(circle((x[0], x[2]), c["radius"] * L))
         for b in range(self.nbodies):
             if not any(c["body"] == b and c["point"] is None for c in self._contacts):

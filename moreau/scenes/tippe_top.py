@@ -1,0 +1,279 @@
+r"""The tippe top: an eccentric sphere spun on a rough plane turns its symmetry axis from up to down.
+
+A sphere of radius ``R`` and mass ``m`` has its centre of mass at ``a = alpha
+R`` below the sphere's centre on its symmetry axis ``e3`` (moments ``A``
+about a diameter through the centre of mass, ``C`` about ``e3``); it spins
+at ``n0`` about ``e3``, tilted by ``theta0`` from the upward vertical, on a
+plane with Coulomb friction ``mu``. The default parameters are Leine and
+Glocker's tippe top (R. I. Leine, Ch. Glocker, "A set-valued force law for
+spatial Coulomb–Contensou friction", Eur. J. Mech. A/Solids 22 (2003)
+193–216, as used by Siconos's tippe-top example): ``m = 6 g``, ``R = 15
+mm``, ``a = 3 mm``, ``A = 8e-7``, ``C = 7e-7 kg m^2``, ``mu = 0.3``, ``n0 =
+180 rad/s``, ``theta0 = 0.1 rad``; their stem is left out (the eccentric
+sphere of Or, SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden
+and Romero, SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and
+Watanabe, SIAM J. Appl. Dyn. Syst. 4 (2005) 1159), and so is the drilling
+(Contensou) friction.
+
+Jellett's integral and the spin thresholds
+------------------------------------------
+With ``d = R z - a e3`` (``z`` the upward vertical) the contact point is
+at ``-d`` from the centre of mass, so the contact force has no moment about
+``d`` and ``J = L . d`` (``L`` the angular momentum about the centre of mass)
+is conserved for any contact force: ``dJ/dt = (r x F) . d - a L . (omega x
+e3)``, both zero for an axisymmetric body (Jellett's integral). Friction
+dissipates energy at fixed ``J``; the states it can rest in are the minima
+over the tilt ``theta`` of the least energy at that ``J`` (the kinetic
+energy ``J^2 / (2 d.Id)`` of the rotation ``omega`` parallel to ``d``, the
+least with ``L . d = J``):
+
+.. math::
+
+    V(\theta) = m g (R - a\cos\theta)
+      + \frac{J^2}{2\,[C (R\cos\theta - a)^2 + A R^2 \sin^2\theta]} .
+
+Expanding ``V`` about ``theta = pi`` (the inverted state, ``J = C n (R +
+a)``) and about ``theta = 0`` (``J = C n (R - a)``) gives the classical
+conditions (the energetics of Bou-Rabee, Marsden and Romero 2004, derived
+here): the inverted state is a minimum iff ``C (R + a) > A R`` and
+
+.. math::
+
+    J^2 > \frac{m g a\, C^2 (R + a)^4}{R\,[C (R + a) - A R]},
+
+the upright state is not iff ``A R > C (R - a)`` and ``J^2 > m g a C^2 (R -
+a)^4 / (R [A R - C (R - a)])``. With ``gamma = A / C`` the first pair is the
+classical condition ``1 - alpha < gamma < 1 + alpha`` for inversion, and
+the bound on ``J`` is Rauch-Wojciechowski and Rutstam's threshold ``lambda >
+sqrt(m g R^3 C alpha) (1 + alpha)^2 / sqrt(1 + alpha - gamma)`` ("Dynamics of
+an inverting tippe top", SIGMA 10 (2014) 017). Spun at ``n0`` about its axis at the tilt
+``theta0``, ``J = C n0 (R cos theta0 - a)``: for the default top the
+upright state is unstable above ``n0 = 21.8 rad/s`` and the inverted state
+stable above ``n0 = 120.3 rad/s`` (:func:`spin_thresholds`); between the two
+the top rises to the tilt that minimises ``V`` and hangs there
+(:func:`final_tilt`).
+
+Sliding matters: a top whose contact point rolls without slipping keeps
+``J`` and its energy, and does not rise. Moreau–Jean's step decides when
+the contact point of the nearly upright top stops slipping, so the time at
+which a run inverts depends on the step (Siconos's example notes the same
+of its Moreau–Jean runs of this top); the final state does not.
+
+The model: the symmetry axis is the body's ``z``, the sphere's centre at
+``(0, 0, a)`` from the centre of mass (:class:`moreau.model.space.Sphere`
+with ``centre``); units: lengths in ``R``, time in ``sqrt(R / g)``, mass in
+``m``.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._validate import in_open_interval, positive
+from ..analysis.cases import GRID, SpatialCase
+from ..errors import InputError
+from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.scene import params_with
+from ..model.space import SpaceModel, Sphere
+from ..model.spatial import quat_exp, rotation_matrix
+
+__all__ = ["TippeTopParams", "tippe_top", "spin_thresholds", "final_tilt", "axis_height"]
+
+
+@dataclass(frozen=True)
+class TippeTopParams:
+    """SI parameters of the tippe top (Leine and Glocker 2003, without the stem).
+
+    Attributes
+    ----------
+    mass : float
+        [kg], > 0.
+    radius : float
+        The sphere's radius ``R`` [m], > 0.
+    offset : float
+        ``alpha = a / R``: the centre of mass below the sphere's centre, in (0, 1).
+    inertia_transverse, inertia_axial : float
+        ``A`` and ``C`` [kg m^2] about the centre of mass, > 0, with ``C <= 2 A``.
+    mu : float
+        Coulomb friction, > 0.
+    gravity : float
+        [m/s^2], > 0.
+    spin : float
+        ``n0`` [rad/s] about the symmetry axis, > 0.
+    tilt : float
+        ``theta0`` [rad], the axis from the upward vertical, in (0, pi/2).
+    """
+
+    mass: float = 6e-3
+    radius: float = 0.015
+    offset: float = 0.2
+    inertia_transverse: float = 8e-7
+    inertia_axial: float = 7e-7
+    mu: float = 0.3
+    gravity: float = 9.81
+    spin: float = 180.0
+    tilt: float = 0.1
+
+    def __post_init__(self):
+        for name in ("mass", "radius", "inertia_transverse", "inertia_axial", "mu", "gravity",
+                     "spin"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "offset", in_open_interval("offset", self.offset, 0.0, 1.0))
+        object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
+        if self.inertia_axial > 2.0 * self.inertia_transverse:
+            raise InputError(f"`inertia_axial` must be <= 2 inertia_transverse (the triangle "
+                             f"inequality), got {self.inertia_axial!r}")
+
+
+def _jellett(p):
+    R, a = p.radius, p.offset * p.radius
+    return p.inertia_axial * p.spin * (R * math.cos(p.tilt) - a)
+
+
+def spin_thresholds(params=None, **overrides):
+    """``(n_up, n_inv)`` [rad/s]: the spin above which the upright state is unstable, and
+    above which the inverted state is stable (``inf`` where the inertia rules it out).
+
+    Examples
+    --------
+    >>> [round(n, 1) for n in spin_thresholds()]
+    [21.8, 120.3]
+    """
+    p = params_with(TippeTopParams, params, overrides)
+    m, g, R, a = p.mass, p.gravity, p.radius, p.offset * p.radius
+    A, C = p.inertia_transverse, p.inertia_axial
+    # J = C n0 (R cos theta0 - a) against the J^2 bounds of the module docstring
+    k = C * (R * math.cos(p.tilt) - a)
+    up = A * R - C * (R - a)
+    inv = C * (R + a) - A * R
+    n_up = math.sqrt(m * g * a * C * C * (R - a) ** 4 / (R * up)) / k if up > 0 else math.inf
+    n_inv = math.sqrt(m * g * a * C * C * (R + a) ** 4 / (R * inv)) / k if inv > 0 else math.inf
+    return n_up, n_inv
+
+
+def final_tilt(params=None, **overrides):
+    """The tilt [rad] of the least energy at the top's Jellett integral: where friction leaves it.
+
+    ``pi`` above the inversion threshold, an intermediate tilt between the
+    two thresholds, ``0`` below both (:func:`spin_thresholds`).
+
+    Examples
+    --------
+    >>> round(final_tilt(), 6), round(math.degrees(final_tilt(spin=100.0)), 1)
+    (3.141593, 147.0)
+    """
+    p = params_with(TippeTopParams, params, overrides)
+    m, g, R, a = p.mass, p.gravity, p.radius, p.offset * p.radius
+    A, C = p.inertia_transverse, p.inertia_axial
+    J = _jellett(p)
+
+    def V(th):
+        return m * g * (R - a * np.cos(th)) + J * J / (
+            2.0 * (C * (R * np.cos(th) - a) ** 2 + A * R * R * np.sin(th) ** 2))
+
+    th = np.linspace(0.0, math.pi, 20001)
+    k = int(np.argmin(V(th)))
+    if 0 < k < th.size - 1:
+        # golden-section polish inside the bracketing grid cells
+        lo, hi = th[k - 1], th[k + 1]
+        r = 0.5 * (math.sqrt(5.0) - 1.0)
+        for _ in range(80):
+            x1, x2 = hi - r * (hi - lo), lo + r * (hi - lo)
+            if V(x1) < V(x2):
+                hi = x2
+            else:
+                lo = x1
+        return 0.5 * (lo + hi)
+    return float(th[k])
+
+
+def axis_height(q):
+    """The symmetry axis' vertical component ``cos(theta)`` of each state (rows of ``q``).
+
+    Examples
+    --------
+    >>> float(axis_height(tippe_top().initial_state()[0][None, :])[0]) == math.cos(0.1)
+    True
+    """
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    return np.array([rotation_matrix(r[3:7] / np.linalg.norm(r[3:7]), check=False)[2, 2]
+                     for r in q])
+
+
+def tippe_top(params=None, **overrides):
+    """The scene (a :class:`~moreau.model.space.SpaceScene`) of the tippe top on the plane.
+
+    Examples
+    --------
+    >>> sc = tippe_top()
+    >>> q0, v0 = sc.initial_state()
+    >>> sc.ncontacts, abs(float(sc.gaps(q0, 0.0)[0])) < 1e-15, round(float(v0[5] / sc.time), 9)
+    (1, True, 180.0)
+    """
+    p = params_with(TippeTopParams, params, overrides)
+    R, a = p.radius, p.offset * p.radius
+    m = SpaceModel(gravity=(0.0, 0.0, -p.gravity), length=R, mass=p.mass)
+    table = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0))
+    # tilted about y by theta0 (quat_exp takes half the rotation vector)
+    orient = quat_exp(np.array([0.0, 0.5 * p.tilt, 0.0]))
+    Rm = rotation_matrix(orient)
+    top = m.add_body(p.mass, [p.inertia_transverse, p.inertia_transverse, p.inertia_axial],
+                     position=np.array([0.0, 0.0, R]) - Rm @ np.array([0.0, 0.0, a]),
+                     orientation=orient, angular_velocity=(0.0, 0.0, p.spin), name="top")
+    m.add_contact(top, Sphere(R, centre=(0.0, 0.0, a)), table, mu=p.mu)
+    sc = m.build("tippe-top", default_window=100.0)
+    sc.params = p
+    return sc
+
+
+class TippeTopCase(SpatialCase):
+    """The top over the window: its axis' height ``cos(theta)`` at the end, against where
+    friction leaves it (:func:`final_tilt`: ``-1``, inverted, at the defaults)."""
+
+    headline_name = "axis height cos(theta)"
+    window = 100.0
+
+    def __init__(self, **params):
+        self.scene = tippe_top(**params)
+        self.p = self.scene.params
+        self._params = dict(params)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.scene.initial_state()
+
+    def coordinate(self, q):
+        return axis_height(q)
+
+    def reference(self, rtol):
+        return math.cos(final_tilt(self.p)), [(0.0, "P")]
+
+    def reference_grid(self):
+        # no closed-form history: the final state over the grid's last point only
+        return np.full(GRID + 1, math.cos(final_tilt(self.p)))
+
+    def headline_of_run(self, res):
+        return float(axis_height(res.q[-1:])[0])
+
+    def _run_switches(self, res, h):
+        return []
+
+
+register_scene(SceneEntry(
+    name="tippe-top",
+    factory=tippe_top,
+    parameters=parameters_of(TippeTopParams, {"mass": "kg", "radius": "m", "offset": "",
+                                              "inertia_transverse": "kg m^2",
+                                              "inertia_axial": "kg m^2", "mu": "",
+                                              "gravity": "m/s^2", "spin": "rad/s",
+                                              "tilt": "rad"}),
+    description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
+                 "threshold set by Jellett's integral, it turns its axis from up to down"),
+    case=TippeTopCase,
+    reference="exact",
+    sweepable=("mu", "spin", "tilt", "offset"),
+    mj_tolerance=5e-2,
+))
