@@ -124,11 +124,13 @@ def main():
     ap.add_argument("--sizes", type=int, nargs="+", default=[100, 1000, 10_000])
     ap.add_argument("--tol", type=float, default=1e-8)
     ap.add_argument("--no-siconos", action="store_true")
+    ap.add_argument("--no-lemke", action="store_true", help="skip the dense Lemke runs")
     args = ap.parse_args()
     run(10, "nsgs", args.tol)
     run(10, "apgd", args.tol)
     for N in args.sizes:
-        for solver in ("lemke", "nsgs", "apgd") if N <= 100 else ("nsgs", "apgd"):
+        dense = N <= 100 and not args.no_lemke
+        for solver in ("lemke", "nsgs", "apgd") if dense else ("nsgs", "apgd"):
             print(json.dumps(run(N, solver, args.tol)), flush=True)
     if not args.no_siconos:
         print(json.dumps({"siconos_mj": siconos_mj(100)}), flush=True)
