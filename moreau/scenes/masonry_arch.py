@@ -66,7 +66,11 @@ that grows from zero with the thickness deficit (measured at ten
 voussoirs: ``3.5e-2 R`` at ``t / R = 0.100`` and ``1.2e-2 R`` at 0.105,
 1.3 % below the limit). The bound lies eight orders above the rest's
 noise and far below a mechanism's motion, so the bisection
-(:func:`minimal_thickness`) is limited by its bracket, not by the bound.
+(:func:`minimal_thickness`) is limited by its bracket, not by the bound:
+at ten voussoirs, from [0.09, 0.13] to a bracket of 0.2 %, it gives
+0.10742 against the limit analysis's 0.10746 (-0.04 %; Milankovitch's
+continuous 0.1075: -0.07 %), its last two collapses at 0.10719 and
+0.10734 moving ``1.3e-3 R`` and ``5.6e-4 R``.
 
 Scales
 ------
@@ -77,10 +81,11 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import linprog
 
 from .._validate import nonnegative, positive, positive_int
-from ..analysis.cases import GRID, CompareCase
 from ..errors import InputError
+from ..integrators import simulate
 from ..model.planar import HalfPlane, Model, Polygon
 from ..model.scene import params_with
 
@@ -233,7 +238,6 @@ def masonry_arch(params=None, **overrides):
 # -- the exact limit (safe theorem, an LP) ----------------------------------------------------
 
 def _thrust_fits(n, thickness, mu):
-    from scipy.optimize import linprog
     geo = voussoir_geometry(n, thickness)
     ri, re = 1.0 - 0.5 * thickness, 1.0 + 0.5 * thickness
     th = geo["theta"]
@@ -337,7 +341,6 @@ def stands(window=STAND_WINDOW, h=STAND_H, bound=STAND_BOUND, lcp_method="auto",
     >>> stands(window=1.0, voussoirs=4, thickness=0.3)[0]   # doctest: +SKIP
     True
     """
-    from ..integrators import simulate
     sc = masonry_arch(**params)
     q0, v0 = sc.initial_state()
     res = simulate(sc, (0.0, float(window)), q0, v0, "moreau-jean", h=h, lcp_method=lcp_method)
@@ -373,41 +376,3 @@ def minimal_thickness(voussoirs, lo=0.05, hi=0.2, tol=1e-3, **kwargs):
         else:
             lo = mid
     return 0.5 * (lo + hi), log
-
-
-# -- comparison case ---------------------------------------------------------------------------
-
-class MasonryArchCase(CompareCase):
-    """A standing arch (the default, twice its limit thickness): it stays at rest.
-
-    The reference is exact: a thrust line fits (:func:`limit_thickness`), so
-    rest is the motion; the headline is the height of the crown's voussoir
-    at the end of the window (the voussoir right of the crown for an even
-    number).
-    """
-
-    headline_name = "height of the crown voussoir's centroid"
-
-    def __init__(self, **params):
-        self.scene = masonry_arch(**params)
-        self._params = dict(params)
-        self.window = 2.0
-        self._k = self.scene.ndof // 6
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
-
-    def reference(self, rtol):
-        return float(self.start()[0][3 * self._k + 1]), []
-
-    def reference_grid(self):
-        return np.full(GRID + 1, self.start()[0][3 * self._k + 1])
-
-    def coordinate(self, q):
-        return q[:, 3 * self._k + 1]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 3 * self._k + 1])
