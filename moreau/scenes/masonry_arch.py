@@ -13,8 +13,8 @@ problem"; Heyman 1966, "The stone skeleton", Int. J. Solids Struct. 2,
 Published values
 ----------------
 For a continuous semicircular arch with radial joints ("radial
-stereotomy") and enough friction Milankovitch (1907) found ``t / R =
-0.1075``, the intrados hinge at about 54.5 deg from the crown; Heyman's
+stereotomy") and enough friction Milankovitch (1907, "Theorie der
+Druckkurven", Z. Math. Phys. 55, 1-27) found ``t / R = 0.1075``, the intrados hinge at about 54.5 deg from the crown; Heyman's
 simplified weight distribution gives 0.106. Makris and Alexakis 2013 ("The
 effect of stereotomy on the shape of the thrust-line and the minimum
 thickness of semicircular masonry arches", Arch. Appl. Mech. 83,
@@ -48,7 +48,7 @@ line of action crosses it between its corners, inside the friction cone.
 The half-planes are offset by :data:`PRELOAD` (1e-12 ``R``) into the
 neighbour, so that every contact starts closed (a rounding gap of
 ``+1e-16`` would open it for the first step of Moreau–Jean's index set,
-``g + (h/2) g' <= 0``, and drop the voussoir by ``g h^2``).
+``g + (h/2) g' <= 0``, and drop the voussoir by a step of free fall).
 
 Stand or collapse
 -----------------
