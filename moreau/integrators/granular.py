@@ -29,7 +29,8 @@ pair starts at zero).
 
 If the warm-started solve ends above ``tol``, it is run again from zero
 (a warm start can stall where the impulses are not unique, a hyperstatic
-pile) and the better of the two is kept; ``sweeps`` counts both.
+pile), and that answer replaces it only if it meets ``tol``; ``sweeps``
+counts both.
 
 *Status.* Every step records its number of candidate and active contacts,
 NSGS's sweeps, its certified residual (the natural map recomputed on the
@@ -49,7 +50,7 @@ from ..contact.solvers.nsgs import solve_nsgs
 from ..errors import InputError
 from ..model.granular import DiskSystem
 
-__all__ = ["GranularResult", "simulate_disks"]
+__all__ = ["GranularResult", "simulate_disks", "settle"]
 
 
 class GranularResult:
@@ -68,7 +69,9 @@ class GranularResult:
     steps : dict of ndarray
         One entry per step taken: ``"t"`` (its end), ``"candidates"``,
         ``"contacts"`` (active), ``"sweeps"``, ``"residual"``,
-        ``"converged"``.
+        ``"converged"``, and ``"wall_impulse"``, shape ``(steps, n_walls, 2)``:
+        the sums of the normal and of the tangential impulses the disks
+        received from each wall over the step (tangential along ``t = (-n_y, n_x)``).
     status : int
         0 every step's solve met ``tol``; 1 some did not (the run went on:
         :attr:`unconverged`); -3 the run stopped at the first that did not
@@ -110,7 +113,7 @@ def _speeds(v):
 
 def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6,
                    max_sweeps=2000, check_every=4, save_every=1, on_unconverged="report",
-                   t0=0.0, callback=None):
+                   t0=0.0, callback=None, warm=None):
     """Run Moreau–Jean on ``system`` for ``n_steps`` steps of ``h`` (module docstring).
 
     Parameters
@@ -142,6 +145,11 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
     callback : callable, optional
         ``callback(k, t, x, v)`` after each step; returning True ends the run
         (status 0, as if its end were reached).
+    warm : (ContactSet, ndarray), optional
+        The impulses a run ended with (:attr:`GranularResult.impulses`) to
+        warm start the first step: a run continued where another stopped
+        keeps its contact forces (a static packing's forces are not unique;
+        its history picks them).
 
     Returns
     -------
@@ -177,11 +185,18 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
     rmin = float(np.min(system.radii))
     t = float(t0)
     ts, xs, phis, vs = [t], [x.copy()], [phi.copy()], [v.copy()]
-    rec = {k: [] for k in ("t", "candidates", "contacts", "sweeps", "residual", "converged")}
+    rec = {k: [] for k in ("t", "candidates", "contacts", "sweeps", "residual", "converged",
+                           "wall_impulse")}
+    nw = system.n_walls
     timing = {"broad_phase": 0.0, "assembly": 0.0, "solve": 0.0}
     prev_keys = np.zeros(0, dtype=np.int64)
     prev_r = np.zeros((0, 2))
-    closed_keys = np.zeros(0, dtype=np.int64)
+    if warm is not None and warm[0] is not None:
+        prev_keys = np.asarray(warm[0].key, dtype=np.int64)
+        prev_r = np.asarray(warm[1], dtype=float).reshape(-1, 2)
+        if prev_r.shape[0] != prev_keys.size:
+            raise InputError("`warm` must be (ContactSet, impulses) with two impulses a contact")
+    closed_keys = prev_keys[prev_r[:, 0] > 0.0]
     status, message = 0, ""
     last = (None, np.zeros(0))
     restarts = 0
@@ -193,6 +208,8 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         vb = vel[cs.b, :2]
         va = np.where((cs.a >= 0)[:, None], vel[np.maximum(cs.a, 0), :2], 0.0)
         uN = np.einsum("ij,ij->i", cs.normal, vb - va)
+        if system.n_walls:
+            uN += system.contact_offsets(cs)[0::2]
         active = (cs.gap + 0.5 * h * uN <= 0.0) | np.isin(cs.key, closed_keys)
         ia = np.flatnonzero(active)
         act = type(cs)(*(f[ia] for f in cs))
@@ -203,7 +220,7 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         if na:
             H = system.jacobian(act)
             W = system.delassus(H)
-            q = H @ v_free
+            q = H @ v_free + system.contact_offsets(act)
             q[0::2] += act.e * np.minimum(uN[ia], 0.0)
             r0 = np.zeros((na, 2))
             if prev_keys.size:
@@ -222,8 +239,10 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
                 cold = solve_nsgs(W, q, act.mu, tol=tol, max_sweeps=max_sweeps,
                                   check_every=check_every)
                 sweeps += cold.iterations
-                restarts += 1
-                if cold.residual < sol.residual:
+                if cold.converged:
+                    # (only then: in a deep pile the warm start carries the iterations of the
+                    # steps before, and an unconverged cold answer would throw them away)
+                    restarts += 1
                     sol = cold
             c3 = time.process_time()
             r = sol.r
@@ -247,8 +266,13 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         prev_keys, prev_r = act.key, rp
         closed_keys = act.key[rp[:, 0] > 0.0] if na else np.zeros(0, dtype=np.int64)
         last = (act, r)
+        on_wall = act.a < 0
+        wall = -1 - act.a[on_wall]
+        wall_imp = np.column_stack([np.bincount(wall, rp[on_wall, 0], minlength=nw),
+                                    np.bincount(wall, rp[on_wall, 1], minlength=nw)])
         for key, val in (("t", t), ("candidates", cs.size), ("contacts", na), ("sweeps", sweeps),
-                         ("residual", residual), ("converged", converged)):
+                         ("residual", residual), ("converged", converged),
+                         ("wall_impulse", wall_imp)):
             rec[key].append(val)
         stop = callback is not None and bool(callback(k, t, x, v))
         if not (np.all(np.isfinite(x)) and np.all(np.isfinite(v))):
@@ -272,8 +296,9 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         if stop:
             break
     steps = {key: np.array(val, dtype=bool if key == "converged" else
-                           float if key in ("t", "residual") else np.int64)
+                           float if key in ("t", "residual", "wall_impulse") else np.int64)
              for key, val in rec.items()}
+    steps["wall_impulse"] = steps["wall_impulse"].reshape(-1, nw, 2)
     bad = int(np.count_nonzero(~steps["converged"]))
     if status == 0:
         if bad:
@@ -287,3 +312,32 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
     timing["cold_restarts"] = restarts
     return GranularResult(np.array(ts), np.array(xs), np.array(phis), np.array(vs), steps,
                           status, message, timing, last, tol)
+
+
+def settle(system, x0, v0, h, *, max_steps=20_000, speed_tol=1e-3, min_steps=50, phi0=None,
+           warm=None, **options):
+    """Run :func:`simulate_disks` until every disk is slower than ``speed_tol`` (or ``max_steps``).
+
+    Records the first and last states only. ``options`` go to
+    :func:`simulate_disks` (``tol``, ``max_sweeps``, ``theta``, ...).
+
+    Returns
+    -------
+    GranularResult
+        Its last state is the settled one; ``steps`` holds every step.
+
+    Examples
+    --------
+    >>> from moreau.model.granular import DiskSystem, HalfPlane
+    >>> sys = DiskSystem([0.5], [1.0], walls=[HalfPlane((0, 0), (0, 1))])
+    >>> res = settle(sys, [[0.0, 1.0]], [[0.0, 0.0, 0.0]], 0.01)
+    >>> res.status, res.steps["t"].size < 20_000, round(float(res.x[-1, 0, 1]), 1)
+    (0, True, 0.5)
+    """
+    speed_tol = positive("speed_tol", speed_tol)
+
+    def at_rest(k, t, x, v):
+        return k + 1 >= min_steps and float(np.max(np.abs(v[:, :2]), initial=0.0)) < speed_tol
+
+    return simulate_disks(system, x0, v0, max_steps, h, phi0=phi0, save_every=max_steps,
+                          callback=at_rest, warm=warm, **options)

@@ -59,10 +59,14 @@ import scipy.sparse as sps
 from numba import njit
 
 from .. import _jit_cache
-from .._validate import finite_array, finite_scalar, nonnegative
+from .._validate import finite_array, finite_scalar, nonnegative, positive
 from ..errors import InputError
+from .drawing import circle, contact, line
+from .scene import Scene
+from .units import SIUnits
 
-__all__ = ["HalfPlane", "Segment", "DiskSystem", "ContactSet", "grid_pairs", "brute_pairs",
+__all__ = ["HalfPlane", "Segment", "DiskSystem", "DiskScene", "ContactSet", "grid_pairs",
+           "brute_pairs", "random_fill",
            "disk_wall_contacts"]
 
 #: numba's cache pickles the module's name with the machine code; only the package's own
@@ -75,22 +79,30 @@ _HALF_PLANE, _SEGMENT = 0, 1
 class HalfPlane(NamedTuple):
     """The fixed half-plane ``{p : n . (p - point) <= 0}``; disks stay on the side ``n`` points to.
 
-    ``normal`` is normalised by :class:`DiskSystem`.
+    ``normal`` is normalised by :class:`DiskSystem`. ``surface_speed``: the
+    wall's material slides along itself at this speed along ``t = (-n_y, n_x)``
+    (a belt; the wall stays where it is, only the slip at its contacts
+    changes).
     """
 
     point: tuple
     normal: tuple
     mu: float = None
     restitution: float = None
+    surface_speed: float = 0.0
 
 
 class Segment(NamedTuple):
-    """A fixed segment from ``start`` to ``end``, touched from either side and at its ends."""
+    """A fixed segment from ``start`` to ``end``, touched from either side and at its ends.
+
+    ``surface_speed``: its material slides from ``start`` towards ``end`` at this speed.
+    """
 
     start: tuple
     end: tuple
     mu: float = None
     restitution: float = None
+    surface_speed: float = 0.0
 
 
 class ContactSet(NamedTuple):
@@ -108,7 +120,8 @@ class ContactSet(NamedTuple):
     mu, e : ndarray
         Friction coefficient and restitution of each contact.
     key : ndarray of int64
-        A number per pair of bodies, the same at every state: ``(a + n_walls) * N + b``.
+        A number per pair of bodies, the same at every state and in any system that
+        numbers the bodies alike: ``a * 2**32 + b``.
     """
 
     a: np.ndarray
@@ -372,7 +385,7 @@ class DiskSystem:
         self.n_disks = n
         self.inertias = 0.5 * masses * radii ** 2
         self.inv_mass = np.column_stack([1.0 / masses, 1.0 / masses, 1.0 / self.inertias]).ravel()
-        kind, p0, p1, wmu, we = [], [], [], [], []
+        kind, p0, p1, wmu, we, wvel = [], [], [], [], [], []
         for k, w in enumerate(walls):
             if isinstance(w, HalfPlane):
                 nrm = finite_array(f"walls[{k}].normal", w.normal, shape=(2,))
@@ -382,6 +395,7 @@ class DiskSystem:
                 kind.append(_HALF_PLANE)
                 p0.append(finite_array(f"walls[{k}].point", w.point, shape=(2,)))
                 p1.append(nrm / length)
+                along = np.array([-nrm[1], nrm[0]]) / length
             elif isinstance(w, Segment):
                 a = finite_array(f"walls[{k}].start", w.start, shape=(2,))
                 b = finite_array(f"walls[{k}].end", w.end, shape=(2,))
@@ -390,6 +404,7 @@ class DiskSystem:
                 kind.append(_SEGMENT)
                 p0.append(a)
                 p1.append(b)
+                along = (b - a) / float(np.hypot(*(b - a)))
             else:
                 raise InputError(f"`walls[{k}]` must be a HalfPlane or a Segment, got "
                                  f"{type(w).__name__}")
@@ -400,6 +415,7 @@ class DiskSystem:
                 raise InputError(f"`walls[{k}].restitution` must lie in [0, 1], got {e!r}")
             wmu.append(m)
             we.append(e)
+            wvel.append(finite_scalar(f"walls[{k}].surface_speed", w.surface_speed) * along)
         self.walls = tuple(walls)
         self.n_walls = len(kind)
         self._kind = np.array(kind, dtype=np.int64)
@@ -407,6 +423,8 @@ class DiskSystem:
         self._p1 = np.array(p1, dtype=float).reshape(-1, 2)
         self._wall_mu = np.array(wmu, dtype=float)
         self._wall_e = np.array(we, dtype=float)
+        #: the velocity of each wall's material, shape (n_walls, 2)
+        self.wall_velocity = np.array(wvel, dtype=float).reshape(-1, 2)
 
     @property
     def ndof(self):
@@ -448,13 +466,12 @@ class DiskSystem:
             raise InputError("a disk's centre lies on a segment wall: its contact has no normal")
         a = np.concatenate([i, -1 - w])
         bb = np.concatenate([j, b])
-        N = self.n_disks
         return ContactSet(
             a=a, b=bb, gap=np.concatenate([g_pair, g_wall]),
             normal=np.concatenate([n_pair, n_wall]),
             mu=np.concatenate([np.full(i.size, self.mu), self._wall_mu[w]]),
             e=np.concatenate([np.full(i.size, self.restitution), self._wall_e[w]]),
-            key=(a + self.n_walls) * N + bb)
+            key=a * (1 << 32) + bb)
 
     def jacobian(self, contacts):
         """The contact Jacobian ``H`` (CSR, ``2 nc x 3 N``), rows ``[N_i, T_i]`` interleaved.
@@ -486,9 +503,250 @@ class DiskSystem:
         H.sum_duplicates()
         return H
 
+    def contact_offsets(self, contacts):
+        """``w`` with ``u = H v + w``: the walls' surface velocities, interleaved ``[N_i, T_i]``.
+
+        A contact with a wall whose material moves at ``V`` has
+        ``u_N -= n . V`` (zero: ``V`` is along the wall) and ``u_T -= t . V``.
+        """
+        c = contacts
+        w = np.zeros(2 * c.size)
+        on_wall = np.flatnonzero(c.a < 0)
+        if on_wall.size and np.any(self.wall_velocity):
+            V = self.wall_velocity[-1 - c.a[on_wall]]
+            n = c.normal[on_wall]
+            w[2 * on_wall] = -np.einsum("ij,ij->i", n, V)
+            w[2 * on_wall + 1] = -(-n[:, 1] * V[:, 0] + n[:, 0] * V[:, 1])
+        return w
+
     def delassus(self, H):
         """``W = H M^-1 H^T`` in CSR, ``M^-1`` diagonal (applied per body)."""
         W = sps.csr_array(H @ sps.diags_array(self.inv_mass) @ H.T)
         W.sum_duplicates()
         W.sort_indices()
         return W
+
+
+def random_fill(n, width, r_min, r_max, *, x0=0.0, y0=0.0, seed=0):
+    """``n`` disks of radii uniform in ``[r_min, r_max]`` on a loose square lattice, no overlap.
+
+    Rows of ``floor(width / (2.04 r_max))`` disks from ``(x0, y0)`` upward,
+    each centre moved by up to ``0.01 r_max`` at random (seeded): a start
+    for a packing made by letting them fall (a disordered packing needs
+    several radii).
+
+    Returns
+    -------
+    radii : ndarray, shape (n,)
+    x : ndarray, shape (n, 2)
+
+    Examples
+    --------
+    >>> radii, x = random_fill(5, 4.2, 0.4, 0.5, seed=1)
+    >>> x.shape, bool(np.all(radii >= 0.4)), sorted(set(np.round(x[:, 1]).tolist()))
+    ((5, 2), True, [1.0, 2.0])
+    """
+    n = int(n)
+    if n < 1:
+        raise InputError(f"`n` must be >= 1, got {n!r}")
+    if not 0.0 < r_min <= r_max:
+        raise InputError(f"`r_min` and `r_max` must satisfy 0 < r_min <= r_max, got {r_min!r}, "
+                         f"{r_max!r}")
+    pitch = 2.04 * r_max
+    cols = int(width // pitch)
+    if cols < 1:
+        raise InputError(f"`width` must hold one disk of radius `r_max` ({pitch:g}), got "
+                         f"{width!r}")
+    rng = np.random.default_rng(seed)
+    radii = rng.uniform(r_min, r_max, n)
+    k = np.arange(n)
+    x = np.column_stack([x0 + 0.5 * pitch + (k % cols) * pitch,
+                         y0 + 0.5 * pitch + (k // cols) * pitch])
+    x += rng.uniform(-0.01 * r_max, 0.01 * r_max, (n, 2))
+    return radii, x
+
+
+class DiskScene(SIUnits, Scene):
+    """The :class:`~moreau.model.scene.Scene` of a :class:`DiskSystem` with its contacts fixed at a start.
+
+    The candidate contacts are those within ``margin`` at the start ``x0``
+    (:meth:`DiskSystem.contacts`), fixed for good: every scheme runs this
+    scene like any other. It holds while the disks touch only those
+    candidates: its valid region is "every touching pair is a candidate of
+    the start", checked on every recorded state (a scheme stops with status
+    -6 where a pair outside them closes). A flow that changes its contacts
+    runs with the broad phase every step instead
+    (:func:`moreau.integrators.granular.simulate_disks`).
+
+    Coordinates ``(x_i, y_i, phi_i)`` per disk; the drift terms of the rows
+    (module docstring) with ``n' = (t . v_rel) t / |d|`` and
+    ``t' = -(t . v_rel) n / |d|`` for two disks at distance ``|d|`` (and a
+    disk at a segment's end): ``wNbar = (t . v_rel)^2 / |d|``,
+    ``wTbar = -(t . v_rel)(n . v_rel) / |d|``; a half-plane or a segment's
+    side has a constant normal, no drift.
+
+    Parameters
+    ----------
+    system : DiskSystem
+    x0 : array_like, shape (N, 2)
+    v0 : array_like, shape (N, 3), optional
+    margin : float
+        Candidate gap at the start.
+    name : str
+    length, time, force : float
+        SI size [m], [s], [N] of the system's units.
+    default_window : float
+        A run's length when none is named, in the system's time.
+
+    Examples
+    --------
+    >>> sys = DiskSystem([0.5, 0.5], [1.0, 1.0], walls=[HalfPlane((0, 0), (0, 1))], mu=0.3)
+    >>> sc = DiskScene(sys, [[0.0, 0.5], [1.0, 0.6]], margin=0.2)
+    >>> sc.ncontacts, sc.ndof, np.round(sc.gaps(sc.initial_state()[0], 0.0), 12).tolist()
+    (3, 6, [0.004987562112, 0.0, 0.1])
+    """
+
+    valid_region = "every touching pair of bodies is a candidate contact of the start"
+
+    def __init__(self, system, x0, v0=None, *, margin=0.5, name="disks", length=1.0, time=1.0,
+                 force=1.0, default_window=1.0):
+        if not isinstance(system, DiskSystem):
+            raise InputError(f"`system` must be a DiskSystem, got {type(system).__name__}")
+        N = system.n_disks
+        self.system = system
+        x0 = finite_array("x0", x0, shape=(N, 2))
+        v0 = np.zeros((N, 3)) if v0 is None else finite_array("v0", v0, shape=(N, 3))
+        self._q0 = np.column_stack([x0, np.zeros(N)]).ravel()
+        self._v0 = v0.ravel().copy()
+        cs = system.contacts(x0, positive("margin", margin))
+        self._a, self._b = cs.a, cs.b
+        self._keys = np.sort(cs.key)
+        self.mu, self.restitution = cs.mu.copy(), cs.e.copy()
+        self.ndof = 3 * N
+        self.name = name
+        self.length, self.time, self.force = float(length), float(time), float(force)
+        self.default_window = float(default_window)
+        self.angle_coordinates = tuple(range(2, 3 * N, 3))
+        self._M = np.diag(1.0 / system.inv_mass)
+        self._h = np.tile(np.array([system.gravity[0], system.gravity[1], 0.0]), N) \
+            * np.repeat(system.masses, 3)
+
+    def _qscale(self):
+        s = np.full(self.ndof, self.length)
+        s[2::3] = 1.0
+        return s
+
+    def mass(self, q):
+        return self._M.copy()
+
+    def forces(self, q, v, t):
+        return self._h.copy()
+
+    def force_jacobians(self, q, v, t):
+        return np.zeros((self.ndof, self.ndof)), np.zeros((self.ndof, self.ndof))
+
+    def _geometry(self, q):
+        """Gap, unit normal, and the distance the normal turns over (inf: it does not turn)."""
+        sysm = self.system
+        x = np.asarray(q, dtype=float).reshape(-1, 3)[:, :2]
+        a, b = self._a, self._b
+        nc = a.size
+        gap = np.empty(nc)
+        nrm = np.empty((nc, 2))
+        turn = np.full(nc, np.inf)
+        pair = a >= 0
+        d = x[b[pair]] - x[a[pair]]
+        dist = np.hypot(d[:, 0], d[:, 1])
+        nrm[pair] = d / dist[:, None]
+        gap[pair] = dist - sysm.radii[a[pair]] - sysm.radii[b[pair]]
+        turn[pair] = dist
+        for k in np.flatnonzero(~pair):
+            w = -1 - a[k]
+            c = x[b[k]]
+            p0, p1 = sysm._p0[w], sysm._p1[w]
+            if sysm._kind[w] == _HALF_PLANE:
+                nrm[k] = p1
+                gap[k] = p1 @ (c - p0) - sysm.radii[b[k]]
+                continue
+            e = p1 - p0
+            s = (c - p0) @ e / (e @ e)
+            foot = p0 + min(1.0, max(0.0, s)) * e
+            dd = c - foot
+            dist = float(np.hypot(*dd))
+            nrm[k] = dd / dist
+            gap[k] = dist - sysm.radii[b[k]]
+            if not 0.0 < s < 1.0:
+                turn[k] = dist
+        return x, gap, nrm, turn
+
+    def gaps(self, q, t):
+        return self._geometry(q)[1]
+
+    def _rows(self, q):
+        x, gap, n, turn = self._geometry(q)
+        cs = ContactSet(self._a, self._b, gap, n, self.mu, self.restitution,
+                        self._a * (1 << 32) + self._b)
+        H = self.system.jacobian(cs).toarray()
+        return cs, H, self.system.contact_offsets(cs), turn
+
+    def contact_jacobians(self, q, t):
+        _, H, w, _ = self._rows(q)
+        f = self.frictional_index
+        return H[0::2], w[0::2], H[1::2][f], w[1::2][f]
+
+    def contact_drift(self, q, v, t):
+        cs, H, w, turn = self._rows(q)
+        v = np.asarray(v, dtype=float).reshape(-1, 3)
+        sysm = self.system
+        vrel = v[cs.b, :2].copy()
+        pair = cs.a >= 0
+        vrel[pair] -= v[cs.a[pair], :2]
+        wall = np.flatnonzero(~pair)
+        vrel[wall] -= sysm.wall_velocity[-1 - cs.a[wall]]
+        n = cs.normal
+        t_ = np.column_stack([-n[:, 1], n[:, 0]])
+        ut = np.einsum("ij,ij->i", t_, vrel)
+        un = np.einsum("ij,ij->i", n, vrel)
+        finite = np.isfinite(turn)
+        wN = np.where(finite, ut * ut / np.where(finite, turn, 1.0), 0.0)
+        wT = np.where(finite, -ut * un / np.where(finite, turn, 1.0), 0.0)
+        return wN, wT[self.frictional_index]
+
+    def inside_valid_region(self, t, q, v):
+        q = np.asarray(q, dtype=float).reshape(np.shape(t) + (self.ndof,))
+        out = np.ones(np.shape(t), dtype=bool)
+        for k in range(out.size):
+            x = q[k].reshape(-1, 3)[:, :2]
+            try:
+                keys = self.system.contacts(x, 0.0).key
+            except InputError:
+                out[k] = False
+                continue
+            out[k] = bool(np.all(np.isin(keys, self._keys)))
+        return out
+
+    def initial_state(self):
+        return self._q0.copy(), self._v0.copy()
+
+    def shapes(self, q, t=0.0):
+        """Disks, walls and the candidate contacts at SI coordinates ``q`` (:mod:`moreau.model.drawing`)."""
+        qs = np.asarray(q, dtype=float) / self._qscale()
+        x, gap, n, _ = self._geometry(qs)
+        L = self.length
+        out = []
+        sysm = self.system
+        span = float(np.ptp(x[:, 0]) + np.ptp(x[:, 1]) + 4.0 * np.max(sysm.radii))
+        for w in range(sysm.n_walls):
+            p0, p1 = sysm._p0[w], sysm._p1[w]
+            if sysm._kind[w] == _HALF_PLANE:
+                along = np.array([-p1[1], p1[0]])
+                ends = [p0 - span * along, p0 + span * along]
+            else:
+                ends = [p0, p1]
+            out.append(line([e * L for e in ends], role="ground"))
+        for i in range(sysm.n_disks):
+            out.append(circle(x[i] * L, sysm.radii[i] * L))
+        for k in range(self._a.size):
+            p = x[self._b[k]] - sysm.radii[self._b[k]] * n[k]
+            out.append(contact(k, p * L, n[k], (-n[k, 1], n[k, 0])))
+        return out
