@@ -298,7 +298,7 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
     steps = {key: np.array(val, dtype=bool if key == "converged" else
                            float if key in ("t", "residual", "wall_impulse") else np.int64)
              for key, val in rec.items()}
-    steps["wall_impulse"] = steps["wall_impulse"].reshape(-1, nw, 2)
+    steps["wall_impulse"] = steps["wall_impulse"].reshape(steps["t"].size, nw, 2)
     bad = int(np.count_nonzero(~steps["converged"]))
     if status == 0:
         if bad:
