@@ -28,6 +28,10 @@ RUNS = [("moreau-jean", {}), ("moreau-jean", {"theta": 0.5}),
         ("moreau-jean", {"lcp_method": "lemke"}), ("schatzman-paoli", {}),
         ("nonsmooth-generalized-alpha", {}), ("studer-extrapolation", {}),
         ("time-discontinuous-galerkin", {})]
+#: the granular scenes (tests/engine/test_conformance.py's GRANULAR) store no runs: their
+#: registered Scene is a start with its contacts fixed, 50 contacts on the generic Python
+#: step of every scheme, while their physics runs on moreau.integrators.granular
+GRANULAR = {"granular-column", "silo"}
 PATH = os.path.join(os.path.dirname(__file__), "..", "data", "golden_runs.npz")
 
 
@@ -78,6 +82,8 @@ def all_keys():
     from moreau.scenes import registry
     out = []
     for s in registry.scene_names():
+        if s in GRANULAR:
+            continue
         joints = joint_row_count(registry.make_scene(s)) > 0
         out += [(s, scheme, opts) for scheme, opts in RUNS
                 if not joints or get_integrator(scheme).solves_joints]

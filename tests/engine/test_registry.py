@@ -17,9 +17,9 @@ NAMES = registry.scene_names()
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
     assert NAMES == ["ball-chain", "bidirectional-drive", "bouncing-ball", "disk-incline",
-                     "flexible-rod-drive", "friction-drive", "painleve-rod", "piezo-drive",
-                     "rocking-block", "rocking-block-built", "slider-crank", "sliding-block",
-                     "sliding-box", "stick-slip-motor"]
+                     "flexible-rod-drive", "friction-drive", "granular-column", "painleve-rod",
+                     "piezo-drive", "rocking-block", "rocking-block-built", "silo", "slider-crank",
+                     "sliding-block", "sliding-box", "stick-slip-motor"]
 
 
 @pytest.mark.parametrize("name", NAMES)
