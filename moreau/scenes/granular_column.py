@@ -85,7 +85,7 @@ class GranularColumnParams:
         The random radii and start jitter.
     """
 
-    width: float = 0.03
+    width: float = 0.02
     aspect: float = 1.0
     diameter: float = 0.005
     spread: float = 0.8
