@@ -50,3 +50,16 @@ def test_the_janssen_fit_recovers_k_from_a_saturating_load():
     # m_sat = rho W lam, K = W / (2 mu_w lam)
     assert f["m_sat"] == pytest.approx(80.0, rel=1e-6)
     assert f["K"] == pytest.approx(6.0 / (2 * 0.5 * 80.0 / (0.75 * 6.0)), rel=1e-6)
+
+
+@pytest.mark.slow
+def test_the_silo_floor_load_saturates_as_janssen_predicts():
+    # measured (12 pours of 30 disks, W = 6 d, mu_wall = 0.5): m_sat = 58.9, lam = 12.9 d,
+    # K = 0.46; deviations from the fitted law -8 % .. +12.4 %, 7.8 % rms: the pour-to-pour
+    # scatter of a statically indeterminate load exceeds issue 38's 10 % at three pours
+    r = fill(12, per_pour=30)
+    f = fit_janssen(r["mass"], r["m_app"], rho=r["rho"], width=r["width"], mu_wall=0.5)
+    assert np.sqrt(np.mean(f["deviation"] ** 2)) <= 0.10 and f["max_deviation"] <= 0.15
+    # saturated: the last pours add (almost) nothing to the floor's load, the walls carry it
+    assert r["m_app"][-1] < 0.35 * r["mass"][-1] and r["mass"][-1] > 3.0 * f["m_sat"]
+    assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
