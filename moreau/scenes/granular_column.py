@@ -24,6 +24,13 @@ in the experiments, as ``lambda a`` for small ``a`` and as a power of
   discrete-grain simulation*, J. Fluid Mech. 545 (2005) 1-27: runout
   linear in ``a`` for small ``a`` and a power ``a^(2/3)`` for large ``a``.
 
+Measured at six grains wide (``runout_study`` with ``width = 6 d``, ``mu = 0.5``, ``e = 0``,
+``h = 0.01``): ``a`` = 2.32, 4.38, 8.70 ran out 2.48, 5.21, 10.68 (the last still
+creeping at ``80 sqrt(d / g)``): about linear in ``a`` (exponent 1.1 between them), not
+the ``a^(2/3)`` of the experiments at large ``a``; a column six grains wide is far
+below the experiments' and Staron and Hinch's sizes, and rigid disks roll without
+resistance, so a thin front keeps creeping.
+
 :func:`collapse` runs one column with the broad phase every step
 (:func:`moreau.integrators.granular.simulate_disks`); :func:`runout_study`
 runs several aspect ratios and fits both laws (:func:`fit_runout`).
