@@ -83,9 +83,10 @@ def test_moreau_jean_agrees_with_the_reference_within_the_stated_tolerance(name)
 # box more than 120 s) and 15-85 s over half a period of a drive (2.4e5 steps of 0.5-1 ms a
 # window: 5-30 min each). The default run takes a twentieth of each window, without the
 # compliant schemes, without three of the five drives (the friction drive and the
-# stick-slip motor, with their own references, stay) and without the granular scenes (54
-# coordinates on every scheme's generic Python step); the full matrix runs with the long
-# checks (-m slow), the compliant schemes over one period of a drive (not ten).
+# stick-slip motor, with their own references, stay) and without the granular scenes (their
+# twentieth is free fall; 20 pairs, 7 s on the loaded machine, kept out of the default run's
+# budget); the full matrix runs with the long checks (-m slow), the compliant schemes over
+# one period of a drive (not ten).
 
 registry.discover()
 from moreau.integrators import INTEGRATORS, simulate  # noqa: E402
