@@ -1,0 +1,267 @@
+"""Disks filling a vertical channel between two rough walls: Janssen's saturation of the floor's load.
+
+Grains poured into a silo hang part of their weight on its walls by
+friction, so that the load on the floor saturates with the fill height
+instead of growing like a liquid's (H. A. Janssen, *Versuche über
+Getreidedruck in Silozellen*, Z. Ver. Dtsch. Ing. 39 (1895) 1045-1049;
+English translation and comment: M. Sperl, *Experiments on corn pressure in
+silo cells*, Granular Matter 8 (2006) 59-65).
+
+Janssen's argument in two dimensions (a channel of width ``W``, per unit
+depth; the form used with 2D packings by J. W. Landry, G. S. Grest and
+S. J. Plimpton, *Discrete element simulations of stress distributions in
+silos: crossover from two to three dimensions*, Phys. Rev. E 67 (2003)
+041303; R. M. Nedderman, *Statics and Kinematics of Granular Materials*,
+Cambridge University Press 1992, for the plane case), derived here: a slice
+``dz`` at depth ``z`` carries the mean vertical stress ``s(z)``, presses the
+walls with ``K s`` and, the wall friction fully mobilised, hangs ``mu_w K s``
+on each of the two walls, so ``W ds/dz = rho g W - 2 mu_w K s`` and::
+
+    s(z) = rho g lam (1 - exp(-z / lam)),    lam = W / (2 mu_w K).
+
+The floor carries ``W s(h)``: with the poured mass ``m = rho W h`` the
+apparent mass on the floor is ``m_app = m_sat (1 - exp(-m / m_sat))``,
+``m_sat = rho W lam``, and ``K = rho W^2 / (2 mu_w m_sat)`` (``rho`` the
+mass per unit area of the packing). The fit of ``m_sat`` to the measured
+``m_app(m)`` gives ``K`` (:func:`fit_janssen`).
+
+The friction at the walls is mobilised upward the way the experiments with
+moving walls do it (G. Ovarlez, C. Fond and E. Clément, Phys. Rev. E 67
+(2003) 060302; Y. Bertho, F. Giorgiutti-Dauphiné and J.-P. Hulin, Phys.
+Rev. Lett. 90 (2003) 144301): after each pour has settled, both walls slide
+up along themselves for a short while, then stop; the floor's load is then
+measured over a few steps at rest (:func:`fill`). Rigid grains carry a
+statically indeterminate load: it depends on this history, and it scatters
+from one pour to the next.
+
+The registered scene (``make_scene("silo")``) is a silo's first pour at its
+start (the disks on a loose lattice above the floor) as a
+:class:`~moreau.model.granular.DiskScene`, its contacts fixed to those within
+half a diameter at the start; :func:`fill` runs the pours with the broad
+phase every step (:func:`moreau.integrators.granular.simulate_disks`).
+Units: the ``diameter`` ``d``, ``sqrt(d / g)``, the mass ``density d^2``.
+"""
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import minimize_scalar
+
+from .._validate import in_closed_interval, nonnegative, positive, positive_int
+from ..errors import InputError
+from ..integrators.granular import settle, simulate_disks
+from ..model.granular import DiskScene, DiskSystem, HalfPlane, random_fill
+from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.scene import params_with
+
+__all__ = ["SiloParams", "silo", "silo_system", "fill", "fit_janssen", "janssen"]
+
+
+@dataclass(frozen=True)
+class SiloParams:
+    """SI parameters of the silo (see the module docstring).
+
+    Attributes
+    ----------
+    width : float
+        ``W`` [m], between the walls.
+    per_pour : int
+        Disks poured at a time.
+    diameter : float
+        The largest grain's diameter [m].
+    spread : float
+        Smallest over largest radius, in ``(0, 1]``.
+    density : float
+        Mass per unit area of the grains [kg/m^2].
+    mu, mu_wall, mu_floor : float
+        Friction between grains, with the walls, with the floor.
+    restitution : float
+    gravity : float
+        [m/s^2].
+    wall_speed : float
+        How fast the walls slide up after a pour [m/s].
+    seed : int
+    """
+
+    width: float = 0.03
+    per_pour: int = 18
+    diameter: float = 0.005
+    spread: float = 0.8
+    density: float = 10.0
+    mu: float = 0.5
+    mu_wall: float = 0.5
+    mu_floor: float = 0.5
+    restitution: float = 0.0
+    gravity: float = 9.81
+    wall_speed: float = 0.011
+    seed: int = 0
+
+    def __post_init__(self):
+        for name in ("width", "diameter", "density", "gravity"):
+            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        object.__setattr__(self, "per_pour", positive_int("per_pour", self.per_pour))
+        object.__setattr__(self, "spread", in_closed_interval("spread", self.spread, 1e-3, 1.0))
+        for name in ("mu", "mu_wall", "mu_floor", "wall_speed"):
+            object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
+        object.__setattr__(self, "restitution",
+                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
+        object.__setattr__(self, "seed", positive_int("seed", int(self.seed) + 1) - 1)
+        if self.width / self.diameter < 2.05:
+            raise InputError(f"`width` must hold two grains (>= 2.05 `diameter`), got "
+                             f"{self.width!r} m for {self.diameter!r} m grains")
+
+
+def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):
+    """The silo's :class:`DiskSystem` for disks of ``radii`` (grain units): floor, left, right wall.
+
+    ``wall_speed`` (grain units): both walls' surfaces slide up at it.
+    """
+    p = params_with(SiloParams, params, overrides)
+    W = p.width / p.diameter
+    walls = [HalfPlane((0.0, 0.0), (0.0, 1.0), mu=p.mu_floor),
+             HalfPlane((0.0, 0.0), (1.0, 0.0), mu=p.mu_wall, surface_speed=wall_speed),
+             HalfPlane((W, 0.0), (-1.0, 0.0), mu=p.mu_wall, surface_speed=-wall_speed)]
+    radii = np.asarray(radii, dtype=float)
+    return DiskSystem(radii, math.pi * radii ** 2, walls=walls, mu=p.mu,
+                      restitution=p.restitution, gravity=(0.0, -1.0))
+
+
+def silo(params=None, **overrides):
+    """The registered scene: the first pour at its start (a :class:`DiskScene`, module docstring).
+
+    Examples
+    --------
+    >>> sc = silo()
+    >>> sc.name, sc.ndof, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) >= 0.0))
+    ('silo', 54, True)
+    """
+    p = params_with(SiloParams, params, overrides)
+    W = p.width / p.diameter
+    radii, x0 = random_fill(p.per_pour, W, 0.5 * p.spread, 0.5, seed=p.seed)
+    d = p.diameter
+    return DiskScene(silo_system(radii, p), x0, margin=0.5, name="silo", length=d,
+                     time=math.sqrt(d / p.gravity), force=p.density * d * d * p.gravity,
+                     default_window=2.0)
+
+
+def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measure_steps=40,
+         tol=1e-6, **overrides):
+    """Pour ``pours`` times; after each, settle, slide the walls up, settle, and weigh the floor.
+
+    Each pour drops ``per_pour`` disks (a loose lattice just above the
+    pile, :func:`~moreau.model.granular.random_fill`); the runs keep their
+    contact impulses from one to the next (warm start), the settling runs
+    solve to ``100 tol``, the weighing to ``tol``.
+
+    Returns
+    -------
+    dict of ndarray
+        Per pour: ``mass`` poured and ``m_app`` (the floor's normal force
+        over ``g``, mean over ``measure_steps`` steps), in units of
+        ``density d^2``; ``height`` (the top of the pile, in ``d``),
+        ``wall_friction`` (the walls' upward force over ``g``),
+        ``wall_normal``, ``unconverged`` (steps above tolerance in the
+        weighing), ``max_residual``; and ``rho``, the packing's mass per
+        unit area at the last pour (its mass over ``W`` times its height).
+    """
+    p = params_with(SiloParams, params, overrides)
+    W = p.width / p.diameter
+    V = p.wall_speed / math.sqrt(p.diameter * p.gravity)
+    x = np.zeros((0, 2))
+    v = np.zeros((0, 3))
+    phi = np.zeros(0)
+    radii = np.zeros(0)
+    warm = None
+    top = 0.0
+    out = {k: [] for k in ("mass", "m_app", "height", "wall_friction", "wall_normal",
+                           "unconverged", "max_residual")}
+    loose = dict(theta=1.0, tol=100.0 * tol, max_sweeps=500)
+    for k in range(positive_int("pours", pours)):
+        r_new, x_new = random_fill(p.per_pour, W, 0.5 * p.spread, 0.5, y0=top + 0.2,
+                                   seed=p.seed + 7919 * k)
+        radii = np.concatenate([radii, r_new])
+        x = np.concatenate([x, x_new])
+        v = np.concatenate([v, np.zeros((p.per_pour, 3))])
+        phi = np.concatenate([phi, np.zeros(p.per_pour)])
+        fixed = silo_system(radii, p)
+        moving = silo_system(radii, p, wall_speed=V)
+        run = settle(fixed, x, v, h, phi0=phi, warm=warm, max_steps=settle_steps,
+                     speed_tol=2e-3, **loose)
+        if V > 0.0 and slide_steps:
+            run = simulate_disks(moving, run.x[-1], run.v[-1], slide_steps, h, phi0=run.phi[-1],
+                                 warm=run.impulses, save_every=slide_steps, **loose)
+            run = settle(fixed, run.x[-1], run.v[-1], h, phi0=run.phi[-1], warm=run.impulses,
+                         max_steps=settle_steps, speed_tol=1e-3, **loose)
+        meas = simulate_disks(fixed, run.x[-1], run.v[-1], measure_steps, h, phi0=run.phi[-1],
+                              warm=run.impulses, theta=1.0, tol=tol, max_sweeps=3000,
+                              save_every=measure_steps)
+        x, v, phi, warm = meas.x[-1], meas.v[-1], meas.phi[-1], meas.impulses
+        wi = meas.steps["wall_impulse"] / h
+        top = float(np.max(x[:, 1] + radii))
+        out["mass"].append(float(fixed.masses.sum()))
+        out["m_app"].append(float(np.mean(wi[:, 0, 0])))
+        out["height"].append(top)
+        # (left wall: t = (0, 1) points up; right wall: t = (0, -1))
+        out["wall_friction"].append(float(np.mean(wi[:, 1, 1] - wi[:, 2, 1])))
+        out["wall_normal"].append(float(np.mean(wi[:, 1, 0] + wi[:, 2, 0])))
+        out["unconverged"].append(int(meas.unconverged.size))
+        out["max_residual"].append(meas.max_residual)
+    res = {k: np.array(val) for k, val in out.items()}
+    res["rho"] = float(res["mass"][-1] / (W * res["height"][-1]))
+    res["width"] = W
+    return res
+
+
+def janssen(m, m_sat):
+    """Janssen's apparent mass ``m_sat (1 - exp(-m / m_sat))``.
+
+    Examples
+    --------
+    >>> round(float(janssen(1e-9, 2.0) / 1e-9), 6), float(janssen(1e3, 2.0))
+    (1.0, 2.0)
+    """
+    return m_sat * -np.expm1(-np.asarray(m, dtype=float) / m_sat)
+
+
+def fit_janssen(mass, m_app, *, rho, width, mu_wall):
+    """Least-squares ``m_sat`` of :func:`janssen` to ``m_app(mass)``, and the ``K`` it gives.
+
+    Returns
+    -------
+    dict
+        ``m_sat``, ``lam`` (``m_sat / (rho W)``, in the units of ``width``),
+        ``K`` (``W / (2 mu_wall lam)``), ``deviation`` (each point's
+        ``m_app / janssen - 1``) and ``max_deviation``.
+
+    Examples
+    --------
+    >>> m = np.array([1.0, 2.0, 4.0, 8.0])
+    >>> f = fit_janssen(m, janssen(m, 3.0), rho=1.0, width=2.0, mu_wall=0.5)
+    >>> round(f["m_sat"], 6), round(f["K"], 6), f["max_deviation"] < 1e-6
+    (3.0, 1.333333, True)
+    """
+    m = np.asarray(mass, dtype=float)
+    y = np.asarray(m_app, dtype=float)
+    if m.shape != y.shape or m.size < 2:
+        raise InputError("`mass` and `m_app` must be two arrays of the same length >= 2")
+    best = minimize_scalar(lambda s: float(np.sum((janssen(m, s) - y) ** 2)),
+                           bounds=(1e-3 * float(np.max(y)), 1e3 * float(np.max(m))),
+                           method="bounded", options={"xatol": 1e-10})
+    m_sat = float(best.x)
+    lam = m_sat / (rho * width)
+    dev = y / janssen(m, m_sat) - 1.0
+    return {"m_sat": m_sat, "lam": lam, "K": width / (2.0 * mu_wall * lam), "deviation": dev,
+            "max_deviation": float(np.max(np.abs(dev)))}
+
+
+register_scene(SceneEntry(
+    name="silo",
+    factory=silo,
+    parameters=parameters_of(SiloParams, {
+        "width": "m", "per_pour": "", "diameter": "m", "spread": "", "density": "kg/m^2",
+        "mu": "", "mu_wall": "", "mu_floor": "", "restitution": "", "gravity": "m/s^2",
+        "wall_speed": "m/s", "seed": ""}),
+    description=("disks poured between two rough walls: Janssen's saturation of the floor's "
+                 "load (contacts found every step by a broad phase in its study)"),
+))
