@@ -56,6 +56,7 @@ from numba import njit
 from numba.core import types as nbtypes
 
 from .. import _jit_cache
+from .._jit_cache import dependency_files
 from .._log import note
 from . import _mj_kernels
 from ._mj_kernels import no_gaps
@@ -98,39 +99,6 @@ def _import_path(f):
     except (ImportError, AttributeError):
         return None
     return f"{module}:{qualname}" if obj is f else None
-
-
-def dependency_files(functions):
-    """Source files of ``functions`` and of every compiled function they call by name.
-
-    Follows globals (``helper(...)``) and module attributes (``mod.helper(...)``)
-    that are numba functions, recursively.
-    """
-    files, seen, todo = [], set(), list(functions)
-    while todo:
-        f = todo.pop()
-        if id(f) in seen:
-            continue
-        seen.add(id(f))
-        py = getattr(f, "py_func", None)
-        if py is None:
-            continue
-        path = py.__code__.co_filename
-        if path not in files:
-            files.append(path)
-        names, codes = set(), [py.__code__]
-        while codes:
-            code = codes.pop()
-            names.update(code.co_names)
-            codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
-        for name in names:
-            val = py.__globals__.get(name)
-            if isinstance(val, types.ModuleType):
-                todo.extend(getattr(val, n) for n in names
-                            if hasattr(getattr(val, n, None), "py_func"))
-            elif hasattr(val, "py_func"):
-                todo.append(val)
-    return sorted(files)
 
 
 def _constants(model):
