@@ -18,6 +18,7 @@ slower, never stale.
 
 import hashlib
 import os
+import types
 
 try:
     # numba's internal cache classes: another numba version may not have this one
@@ -25,7 +26,7 @@ try:
 except ImportError:
     NullCache = None
 
-__all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code"]
+__all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code", "dependency_files"]
 
 
 def sources_digest(paths):
@@ -122,6 +123,45 @@ def has_cached_code(dispatcher):
     except Exception:
         # a null cache, another numba version: nothing known to be on disk
         return False
+
+
+def dependency_files(functions):
+    """Source files of ``functions`` and of every compiled function they call by name.
+
+    Follows globals (``helper(...)``) and module attributes (``mod.helper(...)``)
+    that are numba functions, recursively.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import _mass
+    >>> [p.rsplit("/", 1)[-1] for p in dependency_files([_mass])]
+    ['bouncing_ball.py']
+    """
+    files, seen, todo = [], set(), list(functions)
+    while todo:
+        f = todo.pop()
+        if id(f) in seen:
+            continue
+        seen.add(id(f))
+        py = getattr(f, "py_func", None)
+        if py is None:
+            continue
+        path = py.__code__.co_filename
+        if path not in files:
+            files.append(path)
+        names, codes = set(), [py.__code__]
+        while codes:
+            code = codes.pop()
+            names.update(code.co_names)
+            codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
+        for name in names:
+            val = py.__globals__.get(name)
+            if isinstance(val, types.ModuleType):
+                todo.extend(getattr(val, n) for n in names
+                            if hasattr(getattr(val, n, None), "py_func"))
+            elif hasattr(val, "py_func"):
+                todo.append(val)
+    return sorted(files)
 
 
 def _disable_disk_cache(disp):

@@ -76,6 +76,7 @@ from typing import Any, Optional
 
 import numpy as np
 
+from . import _jit_cache
 from .errors import InputError
 
 __all__ = ["CompiledModel", "evaluate_compiled", "check_compiled_model", "MODEL_FUNCTIONS"]
@@ -159,10 +160,31 @@ class CompiledModel:
         object.__setattr__(self, "ncontacts", int(self.ncontacts))
         object.__setattr__(self, "const_mass", bool(self.const_mass))
         object.__setattr__(self, "has_jacobians", bool(self.has_jacobians))
+        _bind_caches(self.functions().values())
 
     def functions(self):
         """``{name: function}`` of the functions given (``gaps`` only when set)."""
         return {k: getattr(self, k) for k in MODEL_FUNCTIONS if getattr(self, k) is not None}
+
+
+def _bind_caches(functions):
+    """Tie the disk cache of each model function to its sources before any use in this process.
+
+    Whichever path uses a function first (a scene's Python methods, a compiled
+    loop, a check), its cache entry then carries the same stamp
+    (:func:`moreau._jit_cache.bind_cache_to_sources`): with the stamp set by
+    some paths only, a process that came in by the other one found the entry
+    stale, compiled the function again and overwrote it for the next.
+    """
+    for f in functions:
+        if getattr(f, "_moreau_cache_bound", False) or getattr(f, "signatures", None):
+            # bound already, or compiled (or loaded) in this process: its stamp is used
+            continue
+        _jit_cache.bind_cache_to_sources([f], _jit_cache.dependency_files([f]))
+        try:
+            f._moreau_cache_bound = True
+        except AttributeError:
+            pass
 
 
 def evaluate_compiled(model, q, v, t):

@@ -171,3 +171,35 @@ def test_a_loop_is_tied_to_the_kernels_of_other_schemes_it_calls():
     core = _loops.shared_core(_studer_kernels.studer_loop, ())      # built, never compiled here
     digest = _jit_cache.sources_digest(_loops._template_sources(_studer_kernels.studer_loop))
     assert core._cache._cache_file._source_stamp[1][1] == digest
+
+
+FIRST_USE = textwrap.dedent("""
+    import sys
+    import numpy as np
+    from moreau.integrators import _loops
+    from moreau.scenes import BouncingBall
+    ball = BouncingBall()
+    q, v = ball.initial_state()
+    model = ball.compiled_model()
+    if sys.argv[1] == "loop":
+        _loops._model_prefix(model)            # what a compiled loop does first
+        model.mass(model.par, np.asarray(q, float), np.zeros((1, 1)))
+    else:
+        ball.mass(q)                           # the scene's Python method
+    print(sum(model.mass.stats.cache_hits.values()))
+    """)
+
+
+def test_a_model_function_cached_by_one_path_is_loaded_by_the_other(tmp_path):
+    # the stamp of a model function's cache entry must not depend on the path that used
+    # it first in a process: else each process that comes in by the other path compiles
+    # it again and overwrites the entry for the next
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path),
+               PYTHONPATH=os.pathsep.join([ROOT, os.environ.get("PYTHONPATH", "")]))
+    hits = []
+    for first in ("loop", "method", "loop"):
+        out = subprocess.run([sys.executable, "-c", FIRST_USE, first], capture_output=True,
+                             text=True, env=env, cwd=ROOT, timeout=600)
+        assert out.returncode == 0, out.stderr
+        hits.append(int(out.stdout.split()[-1]))
+    assert hits == [0, 1, 1]

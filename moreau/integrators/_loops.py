@@ -56,6 +56,7 @@ from numba import njit
 from numba.core import types as nbtypes
 
 from .. import _jit_cache
+from .._jit_cache import dependency_files
 from .._log import note
 from . import _mj_kernels
 from ._mj_kernels import no_gaps
@@ -77,6 +78,10 @@ SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli"
 #: compile pays for itself after C / (1 - r) more seconds of work; moving there bounds
 #: a run's cost by about twice that of the best choice made in advance
 TIER_UP_SECONDS = 20.0
+#: the clock of that time: the calling thread's CPU time, the currency of the compile it
+#: is weighed against; on a machine shared with other work, wall time would also count
+#: the waits for a core, and compile a loop (10-25 CPU s) that the run does not repay
+_SHARED_CLOCK = getattr(time, "thread_time", time.process_time)
 #: what a first compile takes (README: 16-19 s for the first scene with Lemke and
 #: the QP path, 5-10 s for each later one)
 COMPILE_SECONDS = "5-20"
@@ -94,39 +99,6 @@ def _import_path(f):
     except (ImportError, AttributeError):
         return None
     return f"{module}:{qualname}" if obj is f else None
-
-
-def dependency_files(functions):
-    """Source files of ``functions`` and of every compiled function they call by name.
-
-    Follows globals (``helper(...)``) and module attributes (``mod.helper(...)``)
-    that are numba functions, recursively.
-    """
-    files, seen, todo = [], set(), list(functions)
-    while todo:
-        f = todo.pop()
-        if id(f) in seen:
-            continue
-        seen.add(id(f))
-        py = getattr(f, "py_func", None)
-        if py is None:
-            continue
-        path = py.__code__.co_filename
-        if path not in files:
-            files.append(path)
-        names, codes = set(), [py.__code__]
-        while codes:
-            code = codes.pop()
-            names.update(code.co_names)
-            codes.extend(c for c in code.co_consts if isinstance(c, types.CodeType))
-        for name in names:
-            val = py.__globals__.get(name)
-            if isinstance(val, types.ModuleType):
-                todo.extend(getattr(val, n) for n in names
-                            if hasattr(getattr(val, n, None), "py_func"))
-            elif hasattr(val, "py_func"):
-                todo.append(val)
-    return sorted(files)
 
 
 def _constants(model):
@@ -275,7 +247,7 @@ class SharedRunner:
     - ``"shared"``: the scheme's shared loop, always;
     - ``"auto"``: the model's own loop where it costs nothing (compiled in
       this process or fresh in numba's disk cache), else the shared loop,
-      keeping the time spent there. Once that passes
+      keeping the CPU time spent there. Once that passes
       :data:`TIER_UP_SECONDS`, it compiles the model's own loop and runs
       that from then on: a long run pays at most about twice what it would
       have with the best choice made in advance, and a short one pays no
@@ -301,7 +273,7 @@ class SharedRunner:
         self._specials = {}     # variant (stand-ins or not) -> the model's own loop
         self._looked = set()    # variants whose own loop has been considered
         self._kernels_ready = not self._deciders
-        self.seconds = {False: 0.0, True: 0.0}   # in the shared loop, per variant
+        self.seconds = {False: 0.0, True: 0.0}   # CPU s in the shared loop, per variant
 
     @property
     def tier_up(self):
@@ -360,9 +332,9 @@ class SharedRunner:
             self._bind(args)
         if not stub and not self._kernels_ready:
             self._compile_kernels()
-        t0 = time.perf_counter()
+        t0 = _SHARED_CLOCK()
         out = self._core(*(self._stub_prefix if stub else self._prefix), *args)
-        self.seconds[stub] += time.perf_counter() - t0
+        self.seconds[stub] += _SHARED_CLOCK() - t0
         if self.tier_up and self.seconds[stub] > TIER_UP_SECONDS:
             # the model's own loop, with the same stand-ins as this call (a single-contact
             # run's compiles no Lemke either); a run that needs them gets the other variant
