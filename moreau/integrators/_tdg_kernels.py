@@ -158,7 +158,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              q, v, out):
+              hn, record_initial, q, v, out):
     """One time-discontinuous Galerkin step from ``(q, v)`` at ``tk`` (see :mod:`._driver`).
 
     ``opts`` is the tableau and the projection, ``(cs, a_st, b_st,

@@ -84,7 +84,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              q, v, out):
+              hn, record_initial, q, v, out):
     """A Moreau–Jean step, then the direct projection of ``q1`` (see the module docstring).
 
     ``opts`` is ``(theta,)``, ``memo`` ``(closed,)`` as Moreau–Jean's.
@@ -106,7 +106,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         reg0[i] = reg[i]
     st = _mj_step(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS,
                   HAS_JAC, HAS_GAPS, lcp_step, mws, par, mu, e, (opts[0], False), memo, lcp_ctl,
-                  stats, k, k0, tk, t1, hk, q, v, out)
+                  stats, k, k0, tk, t1, hk, hn, record_initial, q, v, out)
     if st != OK or nc == 0:
         return st
     # the penetration is that of the projected positions
