@@ -3,7 +3,7 @@
 The reference (``--reference``, e.g. a checkout of ``main``) is loaded as a
 second package, ``moreau_ref``: its ``moreau/`` folder is copied to a
 temporary folder under that name (the package imports itself relatively;
-the few absolute imports are rewritten). Each (scheme, scene) pair is then
+the few absolute imports and the registries' import paths are rewritten). Each (scheme, scene) pair is then
 run through ``simulate`` by both packages, alternately, and the best CPU time
 (``time.process_time``) of ``--repeats`` runs is kept, after a warm-up run
 that compiles (or loads from numba's cache) the scheme's shared loop. With
@@ -47,6 +47,8 @@ def load_reference(root):
                 with open(path) as f:
                     text = f.read()
                 new = pattern.sub(r"\1\2 moreau_ref\3", text)
+                # the registries' import paths ("moreau.scenes", "module:function" hooks)
+                new = re.sub(r"([\"'])moreau\.", r"\1moreau_ref.", new)
                 if new != text:
                     with open(path, "w") as f:
                         f.write(new)

@@ -61,8 +61,9 @@ from ._contact_step import (  # noqa: F401
     new_stats, prev_regimes, set_painleve_stop)
 from . import _contact_step, _driver, _step_parts
 from ._driver import grid_step, loop_template, record_sample  # noqa: F401
-from ._step_parts import (COND_MAX, _invert_gj, _invert_small, affine_rows, contact_block,  # noqa: F401
-                          gap_block, gaps_at, gather_rows, index_set, invert, record_contacts)
+from ._step_parts import (COND_MAX, _invert_gj, _invert_small, add_impulse, all_finite,  # noqa: F401
+                          contact_block, gap_block, gaps_at, gather_rows, index_set, invert,
+                          record_contacts, slip_rows)
 
 __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
@@ -297,17 +298,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 stats[S_WARM] += 1.0
         if res > stats[S_RES]:
             stats[S_RES] = res
-        for i in range(n):
-            acc = vf[i]
-            for c in range(m):
-                acc += WiHT[i, c] * p[c]
-            v1[i] = acc
-        for r in range(nfa):
-            tr = na + r
-            acc = Uf[tr]
-            for c in range(m):
-                acc += Wd[tr, c] * p[c]
-            slip[fa[r]] = acc
+        add_impulse(WiHT, p, vf, v1, m, n)
+        slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
 
     for i in range(n):
         q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
@@ -367,11 +359,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     q1[i] += acc
             gaps_current = False
             stats[S_PROJ] += 1.0
-    finite = True
-    for i in range(n):
-        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-            finite = False
-    if not finite:
+    if not all_finite(q1, v1, n):
         return NUMERICAL
     if nc > 0 and not gaps_current:
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)

@@ -23,8 +23,9 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
                           lcp_buffers, record_sample)
 from ._mj_kernels import grid_step  # noqa: F401
 from ._driver import loop_template
-from ._step_parts import (affine_rows, gap_block, gaps_at, gather_rows, index_set, invert,
-                          record_contacts, rows_times, solve_one, times_ht)
+from ._step_parts import (add_impulse, affine_rows, all_finite, gap_block, gaps_at, gather_rows,
+                          index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
+                          times_ht)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -210,17 +211,9 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     return LCP_HANDBACK
                 stats[S_PIVOTS] += piv
                 stats[S_LCP] += 1.0
-            for i in range(n):
-                acc_v = dx0[i]
-                for c in range(mb):
-                    acc_v += JiHT[i, c] * lam[c]
-                dx0[i] = acc_v
+            add_impulse(JiHT, lam, dx0, dx0, mb, n)
             # the slip at v*: the impulse stage replaces it where it runs
-            for rr in range(nfb):
-                acc_v = Uf[nb + rr]
-                for c in range(mb):
-                    acc_v += Wd[nb + rr, c] * lam[c]
-                slip[fb[rr]] = acc_v
+            slip_rows(Wd, Uf, lam, fb, nb, nfb, mb, slip)
         dmax = 0.0
         xmax = 0.0
         for i in range(n):
@@ -302,17 +295,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                         Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
             if res > stats[S_RES]:
                 stats[S_RES] = res
-            for i in range(n):
-                acc_v = vs[i]
-                for c in range(m):
-                    acc_v += MiHT[i, c] * p[c]
-                v1[i] = acc_v
-            for rr in range(nfa):
-                tr = na + rr
-                acc_v = Uf[tr]
-                for c in range(m):
-                    acc_v += Wd[tr, c] * p[c]
-                slip[fa[rr]] = acc_v
+            add_impulse(MiHT, p, vs, v1, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
         if position_level:
             # Gauss-Newton with complementarity on the active contacts' gaps
             for _ in range(POSITION_MAXITER):
@@ -409,11 +393,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     for c in range(na):
                         acc_v += X[i, c] * nu[c]
                     q1[i] += acc_v
-    finite = True
-    for i in range(n):
-        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-            finite = False
-    if not finite:
+    if not all_finite(q1, v1, n):
         return NUMERICAL
     if nc > 0:
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)

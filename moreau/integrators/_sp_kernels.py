@@ -28,8 +28,9 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
                           lcp_buffers)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 from ._driver import loop_template
-from ._step_parts import (affine_rows, contact_block, gather_rows, gaps_at, index_set, invert,
-                          record_contacts, rows_times, solve_one, times_ht)
+from ._step_parts import (add_impulse, affine_rows, contact_block, gather_rows, gaps_at,
+                          index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
+                          times_ht)
 
 __all__ = ["sp_loop"]
 
@@ -191,17 +192,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 stats[S_LCP] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
-            for i in range(n):
-                a_i = 0.0
-                for c in range(m):
-                    a_i += MiHT[i, c] * p[c]
-                dvc[i] = a_i
-            for r in range(nfa):
-                tr = na + r
-                a_i = Uf[tr]
-                for c in range(m):
-                    a_i += Wd[tr, c] * p[c]
-                slipn[fa[r]] = a_i
+            add_impulse(MiHT, p, dvc, dvc, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slipn)
         if solved:
             break
         solved = True

@@ -18,7 +18,8 @@ from ._contact_step import S_DIRECT, S_LCP, S_PEN, _classify, _one_contact, _res
 from ._driver import spliced
 
 __all__ = ["invert", "gaps_at", "index_set", "gather_rows", "affine_rows", "times_ht",
-           "rows_times", "contact_block", "solve_one", "record_contacts", "gap_block", "COND_MAX"]
+           "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows", "all_finite",
+           "record_contacts", "gap_block", "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
 COND_MAX = 1e14
@@ -292,6 +293,37 @@ def solve_one(Wnn, Wnt, Wtn, Wtt, uN, uT, fr, mu, e, vpre, lcp_ctl, stats, count
         pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e, vpre)
         res = _residual(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e, vpre, pn, 0.0)
     return pn, pt, ok, res
+
+
+@spliced
+def add_impulse(X, p, u, out, m, n):
+    """``out = u + X p`` (``X = M^-1 H^T``: the velocity ``u`` moved by the impulses ``p``;
+    ``out`` may be ``u``)."""
+    for i in range(n):
+        acc = u[i]
+        for c in range(m):
+            acc += X[i, c] * p[c]
+        out[i] = acc
+
+
+@spliced
+def slip_rows(W, U, p, fa, na, nfa, m, slip):
+    """The slip velocity ``U_T + W_T p`` of each frictional active contact after the impulses."""
+    for r in range(nfa):
+        acc = U[na + r]
+        for c in range(m):
+            acc += W[na + r, c] * p[c]
+        slip[fa[r]] = acc
+
+
+@spliced
+def all_finite(a, b, n):
+    """Whether the ``n`` first entries of ``a`` and ``b`` are finite (a step's state)."""
+    finite = True
+    for i in range(n):
+        if not (math.isfinite(a[i]) and math.isfinite(b[i])):
+            finite = False
+    return finite
 
 
 @spliced

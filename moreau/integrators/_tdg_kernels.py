@@ -11,8 +11,6 @@ Lemke's method for several contacts (no warm start). Like
 holds the model's functions and sizes as frozen globals.
 """
 
-import math
-
 import numpy as np
 from numba import njit
 
@@ -20,8 +18,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
                           _residual, _stop_at, grid_step, lcp_buffers, record_sample)
 from ._driver import loop_template
-from ._step_parts import (gap_block, gaps_at, gather_rows, index_set, invert, record_contacts,
-                          times_ht)
+from ._step_parts import (affine_rows, all_finite, gap_block, gaps_at, gather_rows, index_set,
+                          invert, record_contacts, rows_times, times_ht)
 
 __all__ = ["tdg_loop"]
 
@@ -43,11 +41,8 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
     """
     m = na + nfa
     need = False
+    affine_rows(Hm, wm, vfree, U, m, n)
     for r in range(m):
-        acc = wm[r]
-        for j in range(n):
-            acc += Hm[r, j] * vfree[j]
-        U[r] = acc
         p[r] = 0.0
     for r in range(na):
         i = ia[r]
@@ -58,12 +53,7 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
     if not need:
         # no contact needs to push: a zero normal impulse bounds the friction to zero
         return OK
-    for r in range(m):
-        for c in range(m):
-            acc = 0.0
-            for j in range(n):
-                acc += Hm[r, j] * Dir[j, c]
-            Wd[r, c] = acc
+    rows_times(Hm, Dir, Wd, m, n)
     stats[S_LCP] += 1.0
     if na == 1 and not force_lemke:
         stats[S_DIRECT] += 1.0
@@ -285,11 +275,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             Vs[st_i, i] = vi[i]
         if na > 0:
             times_ht(Mi, H, Dirs[st_i], m, n)
-    finite = True
-    for i in range(n):
-        if not (math.isfinite(qi[i]) and math.isfinite(vi[i])):
-            finite = False
-    if not finite:
+    if not all_finite(qi, vi, n):
         return NUMERICAL
     nh = 0
     if na > 0:
