@@ -17,6 +17,7 @@ Usage::
 """
 
 import argparse
+import hashlib
 import importlib
 import os
 import re
@@ -35,10 +36,21 @@ SCENES = ("bouncing-ball", "rocking-block")
 
 def load_reference(root):
     """The package of the checkout ``root`` imported as ``moreau_ref``."""
-    tmp = tempfile.mkdtemp(prefix="moreau_ref_")
+    src = os.path.join(root, "moreau")
+    digest = hashlib.sha256()
+    for folder, dirs, names in sorted(os.walk(src)):
+        dirs.sort()
+        for name in sorted(names):
+            if name.endswith(".py"):
+                with open(os.path.join(folder, name), "rb") as f:
+                    digest.update(name.encode() + f.read())
+    # one copy per reference contents: a later run loads its loops from numba's cache
+    tmp = os.path.join(tempfile.gettempdir(), "moreau_ref_" + digest.hexdigest()[:16])
     dst = os.path.join(tmp, "moreau_ref")
-    shutil.copytree(os.path.join(root, "moreau"), dst,
-                    ignore=shutil.ignore_patterns("__pycache__"))
+    sys.path.insert(0, tmp)
+    if os.path.isdir(dst):
+        return importlib.import_module("moreau_ref")
+    shutil.copytree(src, dst, ignore=shutil.ignore_patterns("__pycache__"))
     pattern = re.compile(r"^(\s*)(from|import) moreau(\.|\s)", re.M)
     for folder, _, names in os.walk(dst):
         for name in names:
@@ -52,7 +64,6 @@ def load_reference(root):
                 if new != text:
                     with open(path, "w") as f:
                         f.write(new)
-    sys.path.insert(0, tmp)
     return importlib.import_module("moreau_ref")
 
 

@@ -27,7 +27,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
                           S_PIVOTS, S_RES, SINGULAR, _lcp_size, _lcp_step, _lcp_step_unused,
                           lcp_buffers)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
-from ._driver import loop_template, spliced
+from ._driver import loop_template
 from ._step_parts import (add_impulse, affine_rows, contact_block, gather_rows, gaps_at,
                           index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
                           times_ht)
@@ -74,69 +74,129 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
     force_lemke = lcp_ctl[0] != 0
     ...  # the steps (moreau.integrators._driver.loop_template)
-    if k == k0:
-        # the call's first node: its mass, forces, gaps and impulse (solved again: a node
-        # is counted once, by the call that reached it)
-        mass_fn(par, q, M)
-        ok = invert(M, Mi, wk, n)
-        if not ok:
-            return SINGULAR
-        forces_fn(par, q, vf, tk, D, False)
+    # node k's impulse was solved by the step before in this call, except at its first step
+    solved = k > k0
+    while True:
+        if solved:
+            # -- the step from node k to k + 1: positions, the next node's forces and gaps
+            for i in range(n):
+                vh[i] = up[i] + dvc[i]
+                q1[i] = q[i] + hk * vh[i]
+                # what the forces see at the next node (see the scheme's module docstring)
+                vf1[i] = vh[i] + 0.5 * hk * acc[i] + 0.5 * dvc[i]
+            if not const_mass:
+                mass_fn(par, q1, M)
+                ok = invert(M, Mi, wk, n)
+                if not ok:
+                    return SINGULAR
+            forces_fn(par, q1, vf1, t1, D, False)
+            finite = True
+            for i in range(n):
+                a_i = 0.0
+                for j in range(n):
+                    a_i += Mi[i, j] * D[j, 0]
+                acc[i] = a_i
+                vv1[i] = vh[i] + 0.5 * hk * a_i
+                if not (math.isfinite(q1[i]) and math.isfinite(vv1[i])):
+                    finite = False
+            if not finite:
+                return NUMERICAL
+            if nc > 0:
+                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
+                for i in range(nc):
+                    pN[i] = pNn[i]
+                    pT[i] = pTn[i]
+                    slip[i] = slipn[i]
+                    cl[i] = pNn[i] > 0.0
+                record_contacts(Gq, nc, pN, pT, mu, reg, stats)
+            # the node ahead: its time, the step that leaves it, its gaps
+            tn = t1
+            hm = hn
+            Gn = Gq
+        else:
+            # the call's first node: its mass, forces and gaps
+            mass_fn(par, q, M)
+            ok = invert(M, Mi, wk, n)
+            if not ok:
+                return SINGULAR
+            forces_fn(par, q, vf, tk, D, False)
+            for i in range(n):
+                a_i = 0.0
+                for j in range(n):
+                    a_i += Mi[i, j] * D[j, 0]
+                acc[i] = a_i
+                q1[i] = q[i]
+                vv1[i] = vv[i]
+            if nc > 0:
+                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, tk, G0)
+            for i in range(nc):
+                cl[i] = closed[i]
+            tn = tk
+            hm = hk
+            Gn = G0
+        # a node solved again at a call's start is counted once, by the call that reached it
+        count = solved or record_initial
+        # -- the node's contact impulse (position q1, Verlet velocity vv1, acceleration acc)
         for i in range(n):
-            a_i = 0.0
-            for j in range(n):
-                a_i += Mi[i, j] * D[j, 0]
-            acc[i] = a_i
-            q1[i] = q[i]
-            vv1[i] = vv[i]
+            up[i] = vv1[i] + 0.5 * hm * acc[i]
+            um[i] = vv1[i] - 0.5 * hm * acc[i]
+            dvc[i] = 0.0
+        for i in range(nc):
+            pNn[i] = 0.0
+            pTn[i] = 0.0
+            slipn[i] = 0.0
         if nc > 0:
-            gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, tk, G0)
-        for i in range(nc):
-            cl[i] = closed[i]
-        st = _solve_node(contacts_fn, lcp_step, par, mu, e, lcp_ctl, stats, n, nc, force_lemke,
-                         q1, vv1, acc, G0, cl, tk, hk, record_initial, Mi, up, um, dvc, G1, UN,
-                         act, ia, fa, pNn, pTn, slipn, H, w, MiHT, Wd, Uf, p, base, trow, Ml, ql,
-                         dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol)
-        if st != OK:
-            return st
-    # -- the step from node k to k + 1: positions, the next node's forces and gaps
-    for i in range(n):
-        vh[i] = up[i] + dvc[i]
-        q1[i] = q[i] + hk * vh[i]
-        # what the forces see at the next node (see the scheme's module docstring)
-        vf1[i] = vh[i] + 0.5 * hk * acc[i] + 0.5 * dvc[i]
-    if not const_mass:
-        mass_fn(par, q1, M)
-        ok = invert(M, Mi, wk, n)
-        if not ok:
-            return SINGULAR
-    forces_fn(par, q1, vf1, t1, D, False)
-    finite = True
-    for i in range(n):
-        a_i = 0.0
-        for j in range(n):
-            a_i += Mi[i, j] * D[j, 0]
-        acc[i] = a_i
-        vv1[i] = vh[i] + 0.5 * hk * a_i
-        if not (math.isfinite(q1[i]) and math.isfinite(vv1[i])):
-            finite = False
-    if not finite:
-        return NUMERICAL
-    if nc > 0:
-        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
-        for i in range(nc):
-            pN[i] = pNn[i]
-            pT[i] = pTn[i]
-            slip[i] = slipn[i]
-            cl[i] = pNn[i] > 0.0
-        record_contacts(Gq, nc, pN, pT, mu, reg, stats)
-    # -- node k + 1, one step ahead: its impulse, with the step that will leave it
-    st = _solve_node(contacts_fn, lcp_step, par, mu, e, lcp_ctl, stats, n, nc, force_lemke, q1,
-                     vv1, acc, Gq, cl, t1, hn, True, Mi, up, um, dvc, G1, UN, act, ia, fa, pNn,
-                     pTn, slipn, H, w, MiHT, Wd, Uf, p, base, trow, Ml, ql, dl, zl, wl, rayl,
-                     work, iwork, lay, Ab, xb, idx, pcol)
-    if st != OK:
-        return st
+            contacts_fn(par, q1, tn + 0.5 * hm, G1, False, True)
+            for i in range(nc):
+                sp = G1[i, 1]
+                sm = G1[i, 1]
+                for j in range(n):
+                    sp += G1[i, 3 + j] * up[j]
+                    sm += G1[i, 3 + j] * um[j]
+                UN[i] = (1.0 + e[i]) * Gn[i, 0] / hm + sp - e[i] * sm
+                act[i] = UN[i] <= 0.0 or cl[i]
+        na, nfa = index_set(act, mu, nc, ia, fa)
+        if na == 1 and not force_lemke:
+            # the restitution is in UN already: the contact's own law has e = 0
+            i = ia[0]
+            fr = nfa == 1
+            Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Mi, MiHT, up, n, fr)
+            pn, pt, ok, res = solve_one(Wnn, Wnt, Wtn, Wtt, UN[i], uT, fr, mu[i], 0.0, 0.0,
+                                        lcp_ctl, stats, count)
+            if not ok:
+                return PAINLEVE
+            if fr:
+                slipn[i] = uT + Wtn * pn + Wtt * pt
+            pNn[i] = pn
+            pTn[i] = pt
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+            for j in range(n):
+                dvc[j] = MiHT[j, 0] * pn + MiHT[j, 1] * pt
+        elif na > 0:
+            m = na + nfa
+            gather_rows(G1, ia, fa, na, nfa, n, H, w)
+            affine_rows(H, w, up, Uf, m, n)
+            for r in range(na):
+                Uf[r] = UN[ia[r]]
+            times_ht(Mi, H, MiHT, m, n)
+            rows_times(H, MiHT, Wd, m, n)
+            L = _lcp_size(na, ia, mu, base, trow)
+            lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pNn, pTn, L, base, trow,
+                                           Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                           lcp_ctl, Ab, xb, idx, pcol, False)
+            if lst != 0:
+                return LCP_HANDBACK
+            if count:
+                stats[S_PIVOTS] += piv
+                stats[S_LCP] += 1.0
+            if res > stats[S_RES]:
+                stats[S_RES] = res
+            add_impulse(MiHT, p, dvc, dvc, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slipn)
+        if solved:
+            break
+        solved = True
     # node k + 1 solved: its central velocity, and what the next call starts from
     for j in range(n):
         v1[j] = vv1[j] + 0.5 * dvc[j]
@@ -145,82 +205,6 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     for i in range(nc):
         closed[i] = cl[i]
     return OK
-
-
-@spliced
-def _solve_node(contacts_fn, lcp_step, par, mu, e, lcp_ctl, stats, n, nc, force_lemke, q, vv,
-                acc, G, cl, t, h, count, Mi, up, um, dvc, G1, UN, act, ia, fa, pN, pT, slip, H,
-                w, MiHT, Wd, Uf, p, base, trow, Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab,
-                xb, idx, pcol):
-    """The contact impulse of the node ``(t, q)`` for the step ``h`` that leaves it; a status.
-
-    ``vv`` is the node's Verlet velocity, ``acc`` its acceleration, ``G``
-    holds its gaps and ``cl`` the contacts closed there. Writes ``up`` and
-    ``um`` (``vv +- (h/2) acc``), the velocity jump ``dvc = M^-1 H^T p``,
-    the impulses ``pN``, ``pT`` and the slip velocities; ``count`` says
-    whether the solve enters the statistics.
-    """
-    st = OK
-    for i in range(n):
-        up[i] = vv[i] + 0.5 * h * acc[i]
-        um[i] = vv[i] - 0.5 * h * acc[i]
-        dvc[i] = 0.0
-    for i in range(nc):
-        pN[i] = 0.0
-        pT[i] = 0.0
-        slip[i] = 0.0
-    if nc > 0:
-        contacts_fn(par, q, t + 0.5 * h, G1, False, True)
-        for i in range(nc):
-            sp = G1[i, 1]
-            sm = G1[i, 1]
-            for j in range(n):
-                sp += G1[i, 3 + j] * up[j]
-                sm += G1[i, 3 + j] * um[j]
-            UN[i] = (1.0 + e[i]) * G[i, 0] / h + sp - e[i] * sm
-            act[i] = UN[i] <= 0.0 or cl[i]
-    na, nfa = index_set(act, mu, nc, ia, fa)
-    if na == 1 and not force_lemke:
-        # the restitution is in UN already: the contact's own law has e = 0
-        i = ia[0]
-        fr = nfa == 1
-        Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Mi, MiHT, up, n, fr)
-        pn, pt, ok, res = solve_one(Wnn, Wnt, Wtn, Wtt, UN[i], uT, fr, mu[i], 0.0, 0.0,
-                                    lcp_ctl, stats, count)
-        if not ok:
-            st = PAINLEVE
-        else:
-            if fr:
-                slip[i] = uT + Wtn * pn + Wtt * pt
-            pN[i] = pn
-            pT[i] = pt
-            if res > stats[S_RES]:
-                stats[S_RES] = res
-            for j in range(n):
-                dvc[j] = MiHT[j, 0] * pn + MiHT[j, 1] * pt
-    elif na > 0:
-        m = na + nfa
-        gather_rows(G1, ia, fa, na, nfa, n, H, w)
-        affine_rows(H, w, up, Uf, m, n)
-        for r in range(na):
-            Uf[r] = UN[ia[r]]
-        times_ht(Mi, H, MiHT, m, n)
-        rows_times(H, MiHT, Wd, m, n)
-        L = _lcp_size(na, ia, mu, base, trow)
-        lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl,
-                                       zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb, idx,
-                                       pcol, False)
-        if lst != 0:
-            st = LCP_HANDBACK
-        else:
-            if count:
-                stats[S_PIVOTS] += piv
-                stats[S_LCP] += 1.0
-            if res > stats[S_RES]:
-                stats[S_RES] = res
-            add_impulse(MiHT, p, dvc, dvc, m, n)
-            slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
-    return st
 
 
 sp_loop = loop_template("sp_loop", globals())
