@@ -13,8 +13,6 @@ Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
 :func:`moreau.integrators._loops.runner_for` compiles in the model's namespace.
 """
 
-import math
-
 import numpy as np
 from numba import njit
 
