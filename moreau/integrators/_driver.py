@@ -35,6 +35,7 @@ the loop, the rest once a step, so that the workspace is unpacked once.
 """
 
 import ast
+import functools
 import inspect
 import textwrap
 
@@ -308,6 +309,12 @@ def _marker_at(body):
                  and isinstance(st.value, ast.Constant) and st.value.value is Ellipsis), None)
 
 
+@functools.lru_cache(maxsize=None)
+def _is_step_rule(py):
+    """Whether the Python function ``py`` is a step rule (its body holds the marker ``...``)."""
+    return _marker_at(_strip_docstring(_function_def(py).body)) is not None
+
+
 def _split_at_marker(body):
     """A step rule's statements: ``(setup, per_step)``, before and after its ``...``."""
     body = _strip_docstring(body)
@@ -353,7 +360,7 @@ class _Splicer:
             return None, None
         if py in _SPLICED:
             return "helper", py
-        if _marker_at(_strip_docstring(_function_def(py).body)) is not None:
+        if _is_step_rule(py):
             return "step", py
         return None, None
 
