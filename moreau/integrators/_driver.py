@@ -13,10 +13,13 @@ loop template with :func:`loop_template`:
 - ``step_workspace(n, nc, opts, lcp_ctl)``: its buffers, one tuple, allocated once a call;
 - ``step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS,
   CONST_MASS, HAS_JAC, HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo,
-  lcp_ctl, stats, k, k0, tk, t1, hk, q, v, out)``, inlined
-  (``numba.njit(inline="always")``): one step from ``(q, v)`` at ``tk`` to
-  ``(q1, v1)`` at ``t1``, ``out`` being ``(q1, v1, pN, pT, slip, reg, G0,
-  Gq)``. It writes the impulses ``pN``, ``pT``, the slip velocities, the
+  lcp_ctl, stats, k, k0, tk, t1, hk, hn, record_initial, q, v, out)``,
+  inlined (``numba.njit(inline="always")``): one step from ``(q, v)`` at
+  ``tk`` to ``(q1, v1)`` at ``t1``, ``out`` being ``(q1, v1, pN, pT, slip,
+  reg, G0, Gq)``. ``hn`` is the length of the step after this one (``h``
+  where this one is the last): a scheme that solves a node one step ahead of
+  the state it commits (Schatzman–Paoli) needs it. ``record_initial`` is
+  true on the run's first step (its start state not yet recorded). It writes the impulses ``pN``, ``pT``, the slip velocities, the
   regimes, the contact rows at the start (``G0``, whose gap column the driver
   carries over from the step before) and the gaps at the end (``Gq``'s column
   0), and returns a status. ``opts`` is a
@@ -32,6 +35,7 @@ the loop, the rest once a step, so that the workspace is unpacked once.
 """
 
 import ast
+import functools
 import inspect
 import textwrap
 
@@ -40,7 +44,7 @@ from numba import njit
 
 from ._contact_step import CTL_IA, OK
 
-__all__ = ["drive", "grid_step", "record_sample", "loop_template", "STEP_FUNCTIONS"]
+__all__ = ["drive", "grid_step", "record_sample", "loop_template", "spliced", "STEP_FUNCTIONS"]
 
 #: the names under which a scheme module gives its step (see the module docstring)
 STEP_FUNCTIONS = ("step_workspace", "step_rule")
@@ -162,10 +166,12 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
         tk, t1, hk, last = grid_step(t0, k, h, t_bound)
         if tk >= t_bound:
             break
+        # the step after this one (the nominal one after the last): unused, it costs nothing
+        hn = h if last else grid_step(t0, k + 1, h, t_bound)[2]
         status = step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn,  # noqa: F821
                            NDOF, NCONTACTS, CONST_MASS, HAS_JAC, HAS_GAPS,  # noqa: F821
                            _lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats,  # noqa: F821
-                           k, k0, tk, t1, hk, q, v, out)
+                           k, k0, tk, t1, hk, hn, record_initial, q, v, out)
         if status != OK:
             break
         if record_initial:
@@ -207,9 +213,12 @@ def loop_template(name, namespace):
     ``return X`` becoming ``status = X`` and a break out of the step. Called
     (even inlined by numba), the step rule unpacked its workspace on every
     step, and the reference counts of its thirty arrays made a step of the
-    friction drive about six times slower. The template's qualified name is
-    ``name`` (numba names a function's disk-cache files after it); its source
-    is kept in ``__moreau_source__`` for the shared loop's rewrite.
+    friction drive about six times slower. Calls of :func:`spliced` helpers
+    and of another scheme's step rule are spliced in the same way
+    (:class:`_Splicer`). The template's qualified name is ``name`` (numba
+    names a function's disk-cache files after it); its source is kept in
+    ``__moreau_source__`` for the shared loop's rewrite, and the files
+    spliced into it in ``__moreau_sources__``.
     """
     for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
         namespace.setdefault(own, globals()[own])
@@ -217,16 +226,15 @@ def loop_template(name, namespace):
     fdef = tree.body[0]
     fdef.name = name
     step = namespace["step_rule"].py_func
-    sdef = ast.parse(textwrap.dedent(inspect.getsource(step))).body[0]
-    body = sdef.body
-    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
-            and isinstance(body[0].value.value, str):
-        body = body[1:]
-    mark = next(i for i, st in enumerate(body) if isinstance(st, ast.Expr)
-                and isinstance(st.value, ast.Constant) and st.value.value is Ellipsis)
-    setup, per_step = body[:mark], body[mark + 1:]
+    sdef = _function_def(step)
+    setup, per_step = _split_at_marker(sdef.body)
     if per_step and isinstance(per_step[-1], ast.Return):
         per_step = per_step[:-1]       # the step's `return OK`
+    splicer = _Splicer(namespace)
+    setup = splicer.stmts(setup)
+    per_step = splicer.stmts(per_step)
+    # the setups of the step rules it calls run after its own, which gives them their workspace
+    setup += splicer.setup
     per_step = _returns_to_breaks(per_step)
     loop_at = next(i for i, st in enumerate(fdef.body) if isinstance(st, ast.While))
     loop = fdef.body[loop_at]
@@ -250,7 +258,181 @@ def loop_template(name, namespace):
     fn.__module__ = namespace["__name__"]
     fn.__doc__ = drive.__doc__
     fn.__moreau_source__ = source
+    fn.__moreau_sources__ = tuple(sorted(splicer.files))
     return fn
+
+
+#: the helpers :func:`loop_template` splices in where a step rule calls them (their Python functions)
+_SPLICED = set()
+
+
+def spliced(fn):
+    """Decorator: a piece of step rule that :func:`loop_template` splices in at each call.
+
+    The helper is written like a numba function; it is also compiled as one
+    (``njit(inline="always")``) for a caller that is not spliced. At a call
+    ``f(...)``, ``x = f(...)`` or ``a, b = f(...)`` in a step rule (or in
+    another helper) its body replaces the call, its locals renamed apart
+    and its parameters replaced by the arguments: no call, no arguments
+    passed, so the arrays' reference counts cost nothing per step and the
+    arithmetic is the caller's own, to the bit. Its parameters are never
+    assigned, and its only ``return`` is its last statement.
+    """
+    fdef = _function_def(fn)
+    params = {a.arg for a in fdef.args.args}
+    stored = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
+              and isinstance(n.ctx, ast.Store)}
+    if stored & params:
+        raise TypeError(f"spliced helper {fn.__name__} assigns its parameters "
+                        f"{sorted(stored & params)}")
+    returns = [n for n in ast.walk(fdef) if isinstance(n, ast.Return)]
+    body = _strip_docstring(fdef.body)
+    if returns and not (len(returns) == 1 and body and body[-1] is returns[0]):
+        raise TypeError(f"spliced helper {fn.__name__} returns before its last statement")
+    _SPLICED.add(fn)
+    return njit(inline="always", error_model="numpy")(fn)
+
+
+def _function_def(fn):
+    return ast.parse(textwrap.dedent(inspect.getsource(fn))).body[0]
+
+
+def _strip_docstring(body):
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant) \
+            and isinstance(body[0].value.value, str):
+        return body[1:]
+    return body
+
+
+def _marker_at(body):
+    return next((i for i, st in enumerate(body) if isinstance(st, ast.Expr)
+                 and isinstance(st.value, ast.Constant) and st.value.value is Ellipsis), None)
+
+
+@functools.lru_cache(maxsize=None)
+def _is_step_rule(py):
+    """Whether the Python function ``py`` is a step rule (its body holds the marker ``...``)."""
+    return _marker_at(_strip_docstring(_function_def(py).body)) is not None
+
+
+def _split_at_marker(body):
+    """A step rule's statements: ``(setup, per_step)``, before and after its ``...``."""
+    body = _strip_docstring(body)
+    mark = _marker_at(body)
+    return body[:mark], body[mark + 1:]
+
+
+class _Rename(ast.NodeTransformer):
+    def __init__(self, names):
+        self.names = names
+
+    def visit_Name(self, node):
+        if node.id in self.names:
+            return ast.copy_location(ast.Name(id=self.names[node.id], ctx=node.ctx), node)
+        return node
+
+
+class _Splicer:
+    """Splices the calls of :func:`spliced` helpers and of step rules into a step rule's source.
+
+    A helper's body replaces its call, its last ``return X`` becoming an
+    assignment to the call's target. A step rule called by another (the
+    projected Moreau–Jean calls Moreau–Jean's) gives its statements before
+    ``...`` to :attr:`setup` (they run once a call, after the caller's) and
+    the rest replaces the call, its last ``return X`` assigned to the
+    target and its other returns the caller's; an argument that is not a
+    name is bound once, in :attr:`setup`, so it must not change from step to
+    step. The globals a spliced body reads are added to the namespace, under
+    another name where the namespace binds the name to something else.
+    """
+
+    def __init__(self, namespace):
+        self.ns = namespace
+        self.count = 0
+        self.setup = []
+        self.files = set()
+
+    def _callee(self, node):
+        if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)):
+            return None, None
+        py = getattr(self.ns.get(node.func.id), "py_func", None)
+        if py is None:
+            return None, None
+        if py in _SPLICED:
+            return "helper", py
+        if _is_step_rule(py):
+            return "step", py
+        return None, None
+
+    def stmts(self, stmts):
+        out = []
+        for st in stmts:
+            call, target = None, None
+            if isinstance(st, ast.Expr):
+                call = st.value
+            elif isinstance(st, ast.Assign) and len(st.targets) == 1:
+                call, target = st.value, st.targets[0]
+            kind, py = self._callee(call)
+            if kind is None:
+                for field in ("body", "orelse"):
+                    if isinstance(getattr(st, field, None), list):
+                        setattr(st, field, self.stmts(getattr(st, field)))
+                out.append(st)
+            else:
+                out.extend(self._expand(kind, py, call, target))
+        return out
+
+    def _expand(self, kind, py, call, target):
+        if call.keywords:
+            raise TypeError(f"a spliced call of {py.__name__} takes positional arguments only")
+        self.count += 1
+        tag = f"_{py.__name__.strip('_')}{self.count}_"
+        fdef = _function_def(py)
+        params = [a.arg for a in fdef.args.args]
+        if len(params) != len(call.args):
+            raise TypeError(f"{py.__name__} takes {len(params)} arguments, "
+                            f"a spliced call gives {len(call.args)}")
+        names, bind = {}, []
+        for p, arg in zip(params, call.args):
+            if isinstance(arg, ast.Name):
+                names[p] = arg.id
+            else:
+                names[p] = tag + p
+                bind.append(ast.Assign(targets=[ast.Name(id=tag + p, ctx=ast.Store())],
+                                       value=arg))
+        stored = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
+                  and isinstance(n.ctx, ast.Store)}
+        for nm in stored - set(params):
+            names[nm] = tag + nm
+        self._globals(py, fdef, set(params) | stored, names)
+        self.files.add(py.__code__.co_filename)
+        body = [_Rename(names).visit(st) for st in _strip_docstring(fdef.body)]
+        if kind == "helper":
+            setup, per_step = [], body
+        else:
+            setup, per_step = _split_at_marker(body)
+            setup, bind = bind + setup, []
+        if per_step and isinstance(per_step[-1], ast.Return):
+            ret = per_step.pop()
+            if target is not None:
+                per_step.append(ast.Assign(targets=[target], value=ret.value))
+        self.setup += self.stmts(setup)
+        return bind + self.stmts(per_step)
+
+    def _globals(self, py, fdef, local, names):
+        """Bind the globals ``py``'s body reads in the namespace (renamed where taken)."""
+        for nm in sorted({n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)} - local):
+            if nm not in py.__globals__:
+                continue            # a builtin
+            val = py.__globals__[nm]
+            have = self.ns.get(nm, val)
+            if have is val or (type(have) is type(val) and isinstance(val, (int, float, bool))
+                               and have == val):
+                self.ns.setdefault(nm, val)
+                continue
+            alias = f"{nm}__{py.__module__.rsplit('.', 1)[-1]}"
+            self.ns[alias] = val
+            names[nm] = alias
 
 
 def _has_return(stmts):

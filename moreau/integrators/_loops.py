@@ -142,7 +142,9 @@ def _template_sources(template):
     sources = list(_mj_kernels.KERNEL_SOURCES)
     # a driver's template runs the code of _driver.py in its scheme module's namespace
     module_file = sys.modules[template.__module__].__file__
-    for path in [module_file] + dependency_files([types.SimpleNamespace(py_func=template)]):
+    # and the files of the helpers and step rules spliced into it (moreau.integrators._driver)
+    for path in [module_file] + list(getattr(template, "__moreau_sources__", ())) \
+            + dependency_files([types.SimpleNamespace(py_func=template)]):
         if path not in sources:
             sources.append(path)
     return sources

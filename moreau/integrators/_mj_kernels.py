@@ -59,8 +59,11 @@ from ._contact_step import (  # noqa: F401
     _lcp_step_unused, _one_contact, _one_contact_fr, _regime_solve, _residual, _residual_parts,
     _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
     new_stats, prev_regimes, set_painleve_stop)
-from . import _contact_step, _driver
+from . import _contact_step, _driver, _step_parts
 from ._driver import grid_step, loop_template, record_sample  # noqa: F401
+from ._step_parts import (COND_MAX, _invert_gj, _invert_small, add_impulse, all_finite,  # noqa: F401
+                          contact_block, gap_block, gaps_at, gather_rows, index_set, invert,
+                          record_contacts, slip_rows)
 
 __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
@@ -68,135 +71,6 @@ __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "S
 # shared with moreau_jean.py (kept as literals so that numba freezes them)
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
-COND_MAX = 1e14
-
-@njit(cache=True)
-def _invert_small(A, out, n):
-    """``out = A^-1`` for ``n <= 3`` in closed form; False when ``A`` is singular.
-
-    Singular means to working precision: a 1-norm condition number of 1e14 or
-    more, or a non-finite entry. Loop-free and call-free on purpose: LLVM
-    inlines it into the loops and prunes the arrays' reference counts only
-    around straight-line code.
-    """
-    ok = True
-    na = 0.0
-    ni = 0.0
-    if n == 1:
-        a = A[0, 0]
-        ok = math.isfinite(a)
-        out[0, 0] = 1.0 / a
-        na = abs(a)
-        ni = abs(out[0, 0])
-    elif n == 2:
-        a = A[0, 0]
-        b = A[0, 1]
-        c = A[1, 0]
-        d = A[1, 1]
-        ok = math.isfinite(a) and math.isfinite(b) and math.isfinite(c) and math.isfinite(d)
-        det = a * d - b * c
-        out[0, 0] = d / det
-        out[0, 1] = -b / det
-        out[1, 0] = -c / det
-        out[1, 1] = a / det
-        na = max(abs(a) + abs(c), abs(b) + abs(d))
-        ni = max(abs(out[0, 0]) + abs(out[1, 0]), abs(out[0, 1]) + abs(out[1, 1]))
-    else:
-        a00 = A[0, 0]
-        a01 = A[0, 1]
-        a02 = A[0, 2]
-        a10 = A[1, 0]
-        a11 = A[1, 1]
-        a12 = A[1, 2]
-        a20 = A[2, 0]
-        a21 = A[2, 1]
-        a22 = A[2, 2]
-        ok = (math.isfinite(a00) and math.isfinite(a01) and math.isfinite(a02)
-              and math.isfinite(a10) and math.isfinite(a11) and math.isfinite(a12)
-              and math.isfinite(a20) and math.isfinite(a21) and math.isfinite(a22))
-        # adjugate over the determinant
-        c00 = a11 * a22 - a12 * a21
-        c01 = a02 * a21 - a01 * a22
-        c02 = a01 * a12 - a02 * a11
-        c10 = a12 * a20 - a10 * a22
-        c11 = a00 * a22 - a02 * a20
-        c12 = a02 * a10 - a00 * a12
-        c20 = a10 * a21 - a11 * a20
-        c21 = a01 * a20 - a00 * a21
-        c22 = a00 * a11 - a01 * a10
-        det = a00 * c00 + a01 * c10 + a02 * c20
-        out[0, 0] = c00 / det
-        out[0, 1] = c01 / det
-        out[0, 2] = c02 / det
-        out[1, 0] = c10 / det
-        out[1, 1] = c11 / det
-        out[1, 2] = c12 / det
-        out[2, 0] = c20 / det
-        out[2, 1] = c21 / det
-        out[2, 2] = c22 / det
-        na = max(abs(a00) + abs(a10) + abs(a20),
-                 max(abs(a01) + abs(a11) + abs(a21), abs(a02) + abs(a12) + abs(a22)))
-        ni = max(abs(out[0, 0]) + abs(out[1, 0]) + abs(out[2, 0]),
-                 max(abs(out[0, 1]) + abs(out[1, 1]) + abs(out[2, 1]),
-                     abs(out[0, 2]) + abs(out[1, 2]) + abs(out[2, 2])))
-    # the arrays' last use, on the path where all branches have merged
-    touched = A.size + out.size
-    # `na * ni < COND_MAX` is False for nan too
-    return ok and na * ni < COND_MAX and touched > 0
-
-
-@njit(cache=True, error_model="numpy")
-def _invert_gj(A, out, work, n):
-    """``out = A^-1`` by Gauss-Jordan with partial pivoting (any ``n``); False when singular."""
-    for i in range(n):
-        for j in range(n):
-            if not math.isfinite(A[i, j]):
-                return False
-    for i in range(n):
-        for j in range(n):
-            work[i, j] = A[i, j]
-            out[i, j] = 1.0 if i == j else 0.0
-    for c in range(n):
-        piv = c
-        best = abs(work[c, c])
-        for r in range(c + 1, n):
-            if abs(work[r, c]) > best:
-                best = abs(work[r, c])
-                piv = r
-        if best == 0.0:
-            return False
-        if piv != c:
-            for j in range(n):
-                tmp = work[c, j]
-                work[c, j] = work[piv, j]
-                work[piv, j] = tmp
-                tmp = out[c, j]
-                out[c, j] = out[piv, j]
-                out[piv, j] = tmp
-        inv = 1.0 / work[c, c]
-        for j in range(n):
-            work[c, j] *= inv
-            out[c, j] *= inv
-        for r in range(n):
-            if r != c:
-                fct = work[r, c]
-                if fct != 0.0:
-                    for j in range(n):
-                        work[r, j] -= fct * work[c, j]
-                        out[r, j] -= fct * out[c, j]
-    na = 0.0
-    ni = 0.0
-    for j in range(n):
-        sa = 0.0
-        si = 0.0
-        for i in range(n):
-            sa += abs(A[i, j])
-            si += abs(out[i, j])
-        na = max(na, sa)
-        ni = max(ni, si)
-    return na * ni < COND_MAX
-
-
 
 # inlined: allocated in the loop's own function, the buffers' shapes are known to LLVM
 # (a model's own loop of a two-contact scene ran 7-9 % slower with them from a call)
@@ -232,7 +106,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              q, v, out):
+              hn, record_initial, q, v, out):
     """One Moreau–Jean step from ``(q, v)`` at ``tk`` to ``(q1, v1)`` at ``t1`` (see :mod:`._driver`).
 
     ``opts`` is ``(theta, projection)``, ``memo`` ``(closed,)``: the contacts
@@ -293,10 +167,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             for j in range(n):
                 Wh[i, j] = M[i, j]
     if not (constant_W and flags[0] != 0):
-        if n <= 3:
-            ok = _invert_small(Wh, Wi, n)
-        else:
-            ok = _invert_gj(Wh, Wi, wk, n)
+        ok = invert(Wh, Wi, wk, n)
         if not ok:
             return SINGULAR
         flags[0] = 1
@@ -308,27 +179,16 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         v1[i] = vf[i]
 
     # -- contacts
-    # int64, not the literal 0: numba types a call by its first-seen argument types, and
-    # a literal would compile the contact solves a second time for it
-    na = np.int64(0)
-    nfa = 0
     for i in range(nc):
         pN[i] = 0.0
         pT[i] = 0.0
         slip[i] = 0.0
-    if nc > 0:
-        for i in range(nc):
-            acc = G0[i, 1]
-            for j in range(n):
-                acc += G0[i, 3 + j] * v[j]
-            vN0[i] = acc
-            active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
-            if active[i]:
-                ia[na] = i
-                na += 1
-                if mu[i] > 0.0:
-                    fa[nfa] = i
-                    nfa += 1
+        acc = G0[i, 1]
+        for j in range(n):
+            acc += G0[i, 3 + j] * v[j]
+        vN0[i] = acc
+        active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
+    na, nfa = index_set(active, mu, nc, ia, fa)
     if na > 0:
         contacts_fn(par, q, t1, G1, False, True)
     if na == 1 and not force_lemke:
@@ -337,31 +197,10 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         # that with the sizes known at compile time it is straight-line code
         i = ia[0]
         fr = nfa == 1
-        for j in range(n):
-            acc = 0.0
-            acc2 = 0.0
-            for l in range(n):
-                acc += Wi[j, l] * G1[i, 3 + l]
-                acc2 += Wi[j, l] * G1[i, 3 + n + l]
-            WiHT[j, 0] = acc
-            WiHT[j, 1] = acc2
-        Wnn = 0.0
-        uN = G1[i, 1]
-        for j in range(n):
-            Wnn += G1[i, 3 + j] * WiHT[j, 0]
-            uN += G1[i, 3 + j] * vf[j]
+        Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Wi, WiHT, vf, n, fr)
         stats[S_LCP] += 1.0
         stats[S_DIRECT] += 1.0
         if fr:
-            Wnt = 0.0
-            Wtn = 0.0
-            Wtt = 0.0
-            uT = G1[i, 2]
-            for j in range(n):
-                Wnt += G1[i, 3 + j] * WiHT[j, 1]
-                Wtn += G1[i, 3 + n + j] * WiHT[j, 0]
-                Wtt += G1[i, 3 + n + j] * WiHT[j, 1]
-                uT += G1[i, 3 + n + j] * vf[j]
             pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
             # a tangential impact is taken by the generic step, which records it (or
             # stops there with painleve="stop"); it is rare, the test is not
@@ -393,16 +232,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
     elif na > 0:
         m = na + nfa
-        for r in range(na):
-            i = ia[r]
-            for j in range(n):
-                H[r, j] = G1[i, 3 + j]
-            w[r] = G1[i, 1]
-        for r in range(nfa):
-            i = fa[r]
-            for j in range(n):
-                H[na + r, j] = G1[i, 3 + n + j]
-            w[na + r] = G1[i, 2]
+        gather_rows(G1, ia, fa, na, nfa, n, H, w)
         for c in range(m):
             cnt = 0
             for j in range(n):
@@ -468,17 +298,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 stats[S_WARM] += 1.0
         if res > stats[S_RES]:
             stats[S_RES] = res
-        for i in range(n):
-            acc = vf[i]
-            for c in range(m):
-                acc += WiHT[i, c] * p[c]
-            v1[i] = acc
-        for r in range(nfa):
-            tr = na + r
-            acc = Uf[tr]
-            for c in range(m):
-                acc += Wd[tr, c] * p[c]
-            slip[fa[r]] = acc
+        add_impulse(WiHT, p, vf, v1, m, n)
+        slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
 
     for i in range(n):
         q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
@@ -493,10 +314,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         # M^-1 of a constant mass matrix is kept from the last projection
         pinv = const_mass and flags[1] != 0
         for _ in range(PROJECTION_MAXITER):
-            if HAS_GAPS:  # noqa: F821
-                gaps_fn(par, q1, t1, Gq)
-            else:
-                contacts_fn(par, q1, t1, Gq, True, False)
+            gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
             gaps_current = True
             anysel = False
             gmax = 0.0
@@ -509,10 +327,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             if (not anysel) or gmax <= PROJECTION_TOL:
                 break
             if not pinv:
-                if n <= 3:
-                    ok = _invert_small(M, Mi, n)
-                else:
-                    ok = _invert_gj(M, Mi, wk, n)
+                ok = invert(M, Mi, wk, n)
                 if not ok:
                     return NUMERICAL
                 pinv = True
@@ -524,33 +339,15 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     ia[s] = i
                     s += 1
             # X = M^-1 WN_sel^T, S = WN_sel X, S d = -g_sel, q += X d
+            gap_block(Gq, ia, s, Mi, X, S, n)
             if s == 1:
                 # one contact (the common case): a scalar division, no solver call
-                i0 = ia[0]
-                sc = 0.0
-                for i in range(n):
-                    acc = 0.0
-                    for j in range(n):
-                        acc += Mi[i, j] * Gq[i0, 3 + j]
-                    X[i, 0] = acc
-                    sc += Gq[i0, 3 + i] * acc
-                d0 = -Gq[i0, 0] / sc
+                d0 = -Gq[ia[0], 0] / S[0, 0]
                 for i in range(n):
                     q1[i] += X[i, 0] * d0
             else:
                 for c in range(s):
-                    for i in range(n):
-                        acc = 0.0
-                        for j in range(n):
-                            acc += Mi[i, j] * Gq[ia[c], 3 + j]
-                        X[i, c] = acc
                     rs[c] = -Gq[ia[c], 0]
-                for r in range(s):
-                    for c in range(s):
-                        acc = 0.0
-                        for j in range(n):
-                            acc += Gq[ia[r], 3 + j] * X[j, c]
-                        S[r, c] = acc
                 # S is regular where the selected gaps are independent; an
                 # exactly singular one is a numerical failure, as before
                 if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
@@ -562,22 +359,11 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     q1[i] += acc
             gaps_current = False
             stats[S_PROJ] += 1.0
-    finite = True
-    for i in range(n):
-        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-            finite = False
-    if not finite:
+    if not all_finite(q1, v1, n):
         return NUMERICAL
-    if nc > 0:
-        if not gaps_current:
-            if HAS_GAPS:  # noqa: F821
-                gaps_fn(par, q1, t1, Gq)
-            else:
-                contacts_fn(par, q1, t1, Gq, True, False)
-        for i in range(nc):
-            if -Gq[i, 0] > stats[S_PEN]:
-                stats[S_PEN] = -Gq[i, 0]
-            reg[i] = _classify(pN[i], pT[i], mu[i])
+    if nc > 0 and not gaps_current:
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
+    record_contacts(Gq, nc, pN, pT, mu, reg, stats)
     for i in range(nc):
         closed[i] = cnew[i]
     return OK
@@ -597,7 +383,7 @@ def no_gaps(par, q, t, G):
 
 #: every source whose compiled code ends up in this module's functions and in
 #: the runners built on mj_loop (Lemke is linked in; globals are frozen in)
-KERNEL_SOURCES = (__file__, _driver.__file__) + _contact_step.KERNEL_SOURCES
+KERNEL_SOURCES = (__file__, _driver.__file__, _step_parts.__file__) + _contact_step.KERNEL_SOURCES
 
 # numba checks a cached kernel against this file only: tie it to all of them so
 # that editing Lemke cannot leave stale machine code in use

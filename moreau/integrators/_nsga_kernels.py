@@ -13,17 +13,17 @@ Like :func:`moreau.integrators._mj_kernels.mj_loop` it is a template that
 :func:`moreau.integrators._loops.runner_for` compiles in the model's namespace.
 """
 
-import math
-
 import numpy as np
 from numba import njit
 
-from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
-                          S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa: F401
+                          S_PIVOTS, S_RES, SINGULAR, _lcp_size, _lcp_step, _lcp_step_unused,
                           lcp_buffers, record_sample)
 from ._mj_kernels import grid_step  # noqa: F401
 from ._driver import loop_template
+from ._step_parts import (add_impulse, affine_rows, all_finite, gap_block, gaps_at, gather_rows,
+                          index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
+                          times_ht)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -104,13 +104,14 @@ def step_workspace(n, nc, opts, lcp_ctl):
     tmpe = np.zeros(ncm)
     return (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p,
             base, trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT,
-            lam, dx0, JiHT, Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe)
+            lam, dx0, JiHT, Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe,
+            np.zeros(ncm, dtype=np.bool_))
 
 
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              q, v, out):
+              hn, record_initial, q, v, out):
     """One nonsmooth generalized-α step from ``(q, v)`` at ``tk`` (see :mod:`._driver`).
 
     ``opts`` is ``(coef, position_level)`` with ``coef = (alpha_m, alpha_f,
@@ -129,7 +130,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     q1, v1, pN, pT, slip, reg, G0, Gq = out
     (M, Mi, J, Ji, wk, D, x, r, a1, qs, vs, Gs, vN0, pNi, pTi, ia, fa, H, w, MiHT, Wd, Uf, p, base,
      trow, lw, mu0, Ml2, lay2, Wn, gn, nu, nuN, nuT, X, ib, fb, lamN, lamT, lam, dx0, JiHT,
-     Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe) = ws
+     Ml3, lay3, eqr, unr, iu, Wee, Weei, wke, Ws, gs2, nuu, tmpe, act) = ws
     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
     am = coef[0]
     af = coef[1]
@@ -140,18 +141,11 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     ...  # the steps (moreau.integrators._driver.loop_template)
     # -- the smooth step: Newton on acc_{n+1}, with the smooth forces of the closed contacts
     kv = hk * gamma * cfac
-    nb = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-    nfb = 0
     for i in range(nc):
         lamN[i] = 0.0
         lamT[i] = 0.0
         slip[i] = 0.0
-        if closed[i]:
-            ib[nb] = i
-            nb += 1
-            if mu[i] > 0.0:
-                fb[nfb] = i
-                nfb += 1
+    nb, nfb = index_set(closed, mu, nc, ib, fb)
     mb = nb + nfb
     for i in range(n):
         x[i] = acc[i]
@@ -172,10 +166,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     jj -= cfac * (hk * hk * beta * D[i, 1 + j] + hk * gamma * D[i, 1 + n + j])
                 J[i, j] = jj
             r[i] = acc_r
-        if n <= 3:
-            ok = _invert_small(J, Ji, n)
-        else:
-            ok = _invert_gj(J, Ji, wk, n)
+        ok = invert(J, Ji, wk, n)
         if not ok:
             return SINGULAR
         for i in range(n):
@@ -187,47 +178,25 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             # the contact velocities at v*(x + dx) are affine in the smooth forces:
             # U = U_free + kv H J^-1 H^T lam
             contacts_fn(par, qs, t1, Gs, False, True)  # noqa: F821
-            for rr in range(nb):
-                i = ib[rr]
-                for j in range(n):
-                    H[rr, j] = Gs[i, 3 + j]
-                w[rr] = Gs[i, 1]
-            for rr in range(nfb):
-                i = fb[rr]
-                for j in range(n):
-                    H[nb + rr, j] = Gs[i, 3 + n + j]
-                w[nb + rr] = Gs[i, 2]
-            for c in range(mb):
-                for i in range(n):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += Ji[i, j] * H[c, j]
-                    JiHT[i, c] = acc_v
+            gather_rows(Gs, ib, fb, nb, nfb, n, H, w)
+            times_ht(Ji, H, JiHT, mb, n)
+            rows_times(H, JiHT, Wd, mb, n)
             for rr in range(mb):
                 acc_v = w[rr]
                 for j in range(n):
                     acc_v += H[rr, j] * (vs[j] + kv * dx0[j])
                 Uf[rr] = acc_v
                 for c in range(mb):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += H[rr, j] * JiHT[j, c]
-                    Wd[rr, c] = kv * acc_v
+                    Wd[rr, c] = kv * Wd[rr, c]
             if nb == 1 and not force_lemke:
                 i = ib[0]
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-                if nfb == 1:
-                    ln, lt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                              Uf[1], mu[i], 0.0, 0.0)
-                    ok = ok and not _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
-                                             0.0, 0.0)
-                    lam[1] = lt
-                else:
-                    ln, lt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, 0.0,
-                                              0.0)
+                fr = nfb == 1
+                ln, lt, ok, res = solve_one(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1],
+                                            fr, mu[i], 0.0, 0.0, lcp_ctl, stats, True)
                 if not ok:
                     return PAINLEVE
+                if fr:
+                    lam[1] = lt
                 lam[0] = ln
                 lamN[i] = ln
                 lamT[i] = lt
@@ -240,17 +209,9 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     return LCP_HANDBACK
                 stats[S_PIVOTS] += piv
                 stats[S_LCP] += 1.0
-            for i in range(n):
-                acc_v = dx0[i]
-                for c in range(mb):
-                    acc_v += JiHT[i, c] * lam[c]
-                dx0[i] = acc_v
+            add_impulse(JiHT, lam, dx0, dx0, mb, n)
             # the slip at v*: the impulse stage replaces it where it runs
-            for rr in range(nfb):
-                acc_v = Uf[nb + rr]
-                for c in range(mb):
-                    acc_v += Wd[nb + rr, c] * lam[c]
-                slip[fb[rr]] = acc_v
+            slip_rows(Wd, Uf, lam, fb, nb, nfb, mb, slip)
         dmax = 0.0
         xmax = 0.0
         for i in range(n):
@@ -269,23 +230,13 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         v1[i] = vs[i]
         q1[i] = qs[i]
     # -- contacts at the predicted position
-    na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-    nfa = 0
+    if nc > 0:
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qs, t1, Gs)
     for i in range(nc):
         pNi[i] = 0.0
         pTi[i] = 0.0
-    if nc > 0:
-        if HAS_GAPS:  # noqa: F821
-            gaps_fn(par, qs, t1, Gs)  # noqa: F821
-        else:
-            contacts_fn(par, qs, t1, Gs, True, False)  # noqa: F821
-        for i in range(nc):
-            if Gs[i, 0] <= CONTACT_TOL or closed[i]:
-                ia[na] = i
-                na += 1
-                if mu[i] > 0.0:
-                    fa[nfa] = i
-                    nfa += 1
+        act[i] = Gs[i, 0] <= CONTACT_TOL or closed[i]
+    na, nfa = index_set(act, mu, nc, ia, fa)
     if na > 0:
         # a contact carrying a smooth normal force meets its law at v* already: the
         # impulse problem is solved only when an active contact carries none
@@ -302,63 +253,26 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     acc_v += G0[i, 3 + j] * v[j]
                 vN0[i] = acc_v
             mass_fn(par, qs, M)  # noqa: F821
-            if n <= 3:
-                ok = _invert_small(M, Mi, n)
-            else:
-                ok = _invert_gj(M, Mi, wk, n)
+            ok = invert(M, Mi, wk, n)
             have_mi = True
             if not ok:
                 return SINGULAR
             contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
             m = na + nfa
-            for rr in range(na):
-                i = ia[rr]
-                for j in range(n):
-                    H[rr, j] = Gs[i, 3 + j]
-                w[rr] = Gs[i, 1]
-            for rr in range(nfa):
-                i = fa[rr]
-                for j in range(n):
-                    H[na + rr, j] = Gs[i, 3 + n + j]
-                w[na + rr] = Gs[i, 2]
-            for c in range(m):
-                for i in range(n):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += Mi[i, j] * H[c, j]
-                    MiHT[i, c] = acc_v
-            for rr in range(m):
-                acc_v = w[rr]
-                for j in range(n):
-                    acc_v += H[rr, j] * vs[j]
-                Uf[rr] = acc_v
-                for c in range(m):
-                    acc_v = 0.0
-                    for j in range(n):
-                        acc_v += H[rr, j] * MiHT[j, c]
-                    Wd[rr, c] = acc_v
+            gather_rows(Gs, ia, fa, na, nfa, n, H, w)
+            times_ht(Mi, H, MiHT, m, n)
+            affine_rows(H, w, vs, Uf, m, n)
+            rows_times(H, MiHT, Wd, m, n)
             if na == 1 and not force_lemke:
                 i = ia[0]
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-                if nfa == 1:
-                    pn, pt, ok = _one_contact(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0],
-                                              Uf[1], mu[i], e[i], vN0[i])
-                    if not ok or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[i], Uf[0], Uf[1],
-                                          e[i], vN0[i]):
-                        return PAINLEVE
-                    res = _residual(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1], mu[i],
-                                    e[i], vN0[i], pn, pt)
-                    p[0] = pn
+                fr = nfa == 1
+                pn, pt, ok, res = solve_one(Wd[0, 0], Wd[0, 1], Wd[1, 0], Wd[1, 1], Uf[0], Uf[1],
+                                            fr, mu[i], e[i], vN0[i], lcp_ctl, stats, True)
+                if not ok:
+                    return PAINLEVE
+                p[0] = pn
+                if fr:
                     p[1] = pt
-                else:
-                    pn, pt, ok = _one_contact(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i],
-                                              vN0[i])
-                    if not ok:
-                        return PAINLEVE
-                    res = _residual(Wd[0, 0], 0.0, 0.0, 0.0, Uf[0], 0.0, 0.0, e[i], vN0[i], pn,
-                                    0.0)
-                    p[0] = pn
                 pNi[i] = pn
                 pTi[i] = pt
             else:
@@ -379,24 +293,12 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                         Uf[rr] -= e[ia[rr]] * min(vN0[ia[rr]], 0.0)
             if res > stats[S_RES]:
                 stats[S_RES] = res
-            for i in range(n):
-                acc_v = vs[i]
-                for c in range(m):
-                    acc_v += MiHT[i, c] * p[c]
-                v1[i] = acc_v
-            for rr in range(nfa):
-                tr = na + rr
-                acc_v = Uf[tr]
-                for c in range(m):
-                    acc_v += Wd[tr, c] * p[c]
-                slip[fa[rr]] = acc_v
+            add_impulse(MiHT, p, vs, v1, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
         if position_level:
             # Gauss-Newton with complementarity on the active contacts' gaps
             for _ in range(POSITION_MAXITER):
-                if HAS_GAPS:  # noqa: F821
-                    gaps_fn(par, q1, t1, Gq)  # noqa: F821
-                else:
-                    contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
                 # done when no gap is negative and every held contact's gap is zero
                 gmin = 0.0
                 gheld = 0.0
@@ -408,28 +310,15 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     break
                 if not have_mi:
                     mass_fn(par, qs, M)  # noqa: F821
-                    if n <= 3:
-                        ok = _invert_small(M, Mi, n)
-                    else:
-                        ok = _invert_gj(M, Mi, wk, n)
+                    ok = invert(M, Mi, wk, n)
                     have_mi = True
                     if not ok:
                         return SINGULAR
                 if n > 0:
                     contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+                gap_block(Gq, ia, na, Mi, X, Wn, n)
                 for c in range(na):
-                    for i in range(n):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += Mi[i, j] * Gq[ia[c], 3 + j]
-                        X[i, c] = acc_v
                     gn[c] = Gq[ia[c], 0]
-                for rr in range(na):
-                    for c in range(na):
-                        acc_v = 0.0
-                        for j in range(n):
-                            acc_v += Gq[ia[rr], 3 + j] * X[j, c]
-                        Wn[rr, c] = acc_v
                 ne = 0
                 nun = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
                 for rr in range(na):
@@ -458,10 +347,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     for a_ in range(ne):
                         for b_ in range(ne):
                             Wee[a_, b_] = Wn[eqr[a_], eqr[b_]]
-                    if ne <= 3:
-                        ok = _invert_small(Wee, Weei, ne)
-                    else:
-                        ok = _invert_gj(Wee, Weei, wke, ne)
+                    ok = invert(Wee, Weei, wke, ne)
                     if not ok:
                         return SINGULAR
                     if nun > 0:
@@ -505,30 +391,18 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     for c in range(na):
                         acc_v += X[i, c] * nu[c]
                     q1[i] += acc_v
-    finite = True
-    for i in range(n):
-        if not (math.isfinite(q1[i]) and math.isfinite(v1[i])):
-            finite = False
-    if not finite:
+    if not all_finite(q1, v1, n):
         return NUMERICAL
     if nc > 0:
-        if HAS_GAPS:  # noqa: F821
-            gaps_fn(par, q1, t1, Gq)  # noqa: F821
-        else:
-            contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
         for i in range(nc):
-            if -Gq[i, 0] > stats[S_PEN]:
-                stats[S_PEN] = -Gq[i, 0]
             # the step's whole percussion: smooth force over the step plus the impulse
             pN[i] = hk * lamN[i] + pNi[i]
             pT[i] = hk * lamT[i] + pTi[i]
-            reg[i] = _classify(pN[i], pT[i], mu[i])
+        record_contacts(Gq, nc, pN, pT, mu, reg, stats)
     if k == k0 and nc > 0:
         # the gaps at the call's first state, which the driver records there
-        if HAS_GAPS:  # noqa: F821
-            gaps_fn(par, q, tk, G0)  # noqa: F821
-        else:
-            contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, tk, G0)
     for i in range(nc):
         closed[i] = pNi[i] > 0.0 or lamN[i] > 0.0
     for j in range(n):

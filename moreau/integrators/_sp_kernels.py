@@ -1,117 +1,125 @@
-"""The compiled Schatzman–Paoli loop: a template compiled once per model.
+"""The compiled Schatzman–Paoli step rule, spliced into the compiled driver.
 
 The same step as :class:`moreau.integrators.schatzman_paoli.SchatzmanPaoli`
 (see its module docstring for the derivation), on the functions of a
 :class:`moreau.compiled.CompiledModel`, with the contact problem of
-:mod:`moreau.integrators._mj_kernels` (the one-contact enumeration, Lemke
-for several contacts; no warm start). Like
-:func:`moreau.integrators._mj_kernels.mj_loop` it is a template:
-:func:`moreau.integrators._loops.runner_for` compiles it in a namespace that
-holds the model's functions and sizes as frozen globals.
+:mod:`moreau.integrators._contact_step` (the one-contact enumeration, Lemke
+for several contacts; no warm start), run by
+:mod:`moreau.integrators._driver`.
+
+A node's contact impulse completes the node's velocity
+``v = vv + M^-1 H^T p / 2``, so the step from node ``k`` to ``k + 1``
+solves node ``k + 1`` one step ahead of the state the driver commits (with
+the driver's ``hn``, the step that will leave it). The node's solution stays
+in the step rule's workspace for the next step of the call; the call's first
+node is solved again at its first step (the statistics count it only on a
+run's first call). On :data:`LCP_HANDBACK` or :data:`PAINLEVE` the state is
+the last node whose impulse was solved; the caller takes the step from it in
+Python.
 """
 
 import math
 
 import numpy as np
+from numba import njit
 
-from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP, S_PEN,  # noqa: F401
-                          S_PIVOTS, S_RES, SINGULAR, _classify, _invert_gj, _invert_small,
-                          _lcp_size, _lcp_step, _lcp_step_unused, _one_contact, _residual, _stop_at,
-                          lcp_buffers, record_sample)
-from ._mj_kernels import grid_step
+from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa: F401
+                          S_PIVOTS, S_RES, SINGULAR, _lcp_size, _lcp_step, _lcp_step_unused,
+                          lcp_buffers)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
+from ._driver import loop_template
+from ._step_parts import (add_impulse, affine_rows, contact_block, gather_rows, gaps_at,
+                          index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
+                          times_ht)
 
 __all__ = ["sp_loop"]
 
 
-def sp_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, vv, vf, closed, save_every,
-            record_initial, lcp_ctl, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip,
-            rec_gap, stats):
-    """Run up to ``nmax`` Schatzman–Paoli steps of a compiled model in one call.
-
-    Arguments, statuses and outputs as :func:`moreau.integrators._mj_kernels.mj_loop`
-    (no ``theta``, no projection), plus ``vv`` and ``vf`` (float64[n]), the
-    Verlet velocity that carries the recursion and the velocity the forces
-    see at the current node, overwritten like ``q`` and ``v``; ``closed`` is
-    the index set the current node's contact problem starts from.
-
-    Each node's contact impulse is solved once, before the step that leaves
-    it, and completes the node's velocity ``v = vv + M^-1 H^T p / 2``; the
-    call's first node is solved again (the statistics count it only on a
-    run's first call). On :data:`LCP_HANDBACK` or :data:`PAINLEVE` the state
-    is the last node whose impulse was solved; the caller takes the step
-    from it in Python.
-    """
-    n = NDOF  # noqa: F821  (the model's namespace)
-    nc = NCONTACTS  # noqa: F821
-    const_mass = CONST_MASS  # noqa: F821
-    force_lemke = lcp_ctl[0] != 0
-    M = np.zeros((n, n))
-    Mi = np.empty((n, n))
-    wk = np.empty((n, n))
-    D = np.zeros((n, 1 + 2 * n))
-    acc = np.empty(n)
-    up = np.empty(n)
-    um = np.empty(n)
-    vh = np.empty(n)
-    dvc = np.zeros(n)
-    q1 = np.empty(n)
-    vv1 = np.empty(n)
-    vf1 = np.empty(n)
+# inlined, as Moreau–Jean's: the buffers' shapes stay visible to LLVM
+@njit(inline="always")
+def step_workspace(n, nc, opts, lcp_ctl):
+    """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     ncm = max(nc, 1)
     mrows = 2 * ncm
-    G0 = np.zeros((ncm, 3 + 2 * n))
-    G1 = np.zeros((ncm, 3 + 2 * n))
-    Gi = np.zeros((ncm, 1))
-    UN = np.zeros(ncm)
-    pN = np.zeros(ncm)
-    pT = np.zeros(ncm)
-    slip = np.zeros(ncm)
-    pNp = np.zeros(ncm)
-    pTp = np.zeros(ncm)
-    slipp = np.zeros(ncm)
-    cl = np.zeros(ncm, dtype=np.bool_)
-    reg = np.zeros(ncm, dtype=np.int64)
-    ia = np.zeros(ncm, dtype=np.int64)
-    fa = np.zeros(ncm, dtype=np.int64)
-    H = np.zeros((mrows, n))
-    MiHT = np.zeros((n, mrows))
-    Wd = np.zeros((mrows, mrows))
-    Uf = np.zeros(mrows)
-    p = np.zeros(mrows)
-    base = np.zeros(ncm, dtype=np.int64)
-    trow = np.zeros(ncm, dtype=np.int64)
-    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lcp_buffers(ncm)
+    return (np.zeros((n, n)), np.empty((n, n)), np.empty((n, n)), np.zeros((n, 1 + 2 * n)),
+            np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.zeros(n), np.empty(n),
+            np.empty(n), np.zeros((ncm, 3 + 2 * n)), np.zeros(ncm), np.zeros(ncm), np.zeros(ncm),
+            np.zeros(ncm), np.zeros(ncm, dtype=np.bool_), np.zeros(ncm, dtype=np.int64),
+            np.zeros(ncm, dtype=np.int64), np.zeros((mrows, n)), np.zeros((n, mrows)),
+            np.zeros((mrows, mrows)), np.zeros(mrows), np.zeros(mrows), np.zeros(mrows),
+            np.zeros(ncm, dtype=np.bool_), np.zeros(ncm, dtype=np.int64),
+            np.zeros(ncm, dtype=np.int64), lcp_buffers(ncm))
 
-    nrec = 0
-    k = k0              # the last node whose impulse is solved and whose state is committed
-    kn = k0             # the node being solved: k, or k + 1 ahead of the commit
-    ahead = False
-    final = False       # node kn is the end of the run
-    hkp = h
-    status = OK
-    to_save = save_every - k0 % save_every
+
+@njit(inline="always", error_model="numpy")
+def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
+              HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
+              hn, record_initial, q, v, out):
+    """One Schatzman–Paoli step from node ``k`` to node ``k + 1``, whose impulse it then solves.
+
+    ``opts`` is empty; ``memo`` is ``(vv, vf, closed)``: the Verlet velocity
+    that carries the recursion, the velocity the forces see at the node and
+    the index set its contact problem starts from, updated after a step
+    taken. The recorded impulses are node ``k``'s (those of the step), the
+    velocity ``v1`` is node ``k + 1``'s central one, completed by its own
+    impulse (see :mod:`moreau.integrators.schatzman_paoli`).
+    """
+    n = NDOF
+    nc = NCONTACTS
+    const_mass = CONST_MASS
+    q1, v1, pN, pT, slip, reg, G0, Gq = out
+    vv, vf, closed = memo
+    (M, Mi, wk, D, acc, up, um, vh, dvc, vv1, vf1, G1, UN, pNn, pTn, slipn, cl, ia, fa, H, MiHT,
+     Wd, Uf, p, w, act, base, trow, lw) = ws
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
+    force_lemke = lcp_ctl[0] != 0
+    ...  # the steps (moreau.integrators._driver.loop_template)
+    # node k's impulse was solved by the step before in this call, except at its first step
+    solved = k > k0
     while True:
-        if final:
-            tk = t_bound
-            hk = h      # no step leaves the last node: the nominal one completes its velocity
-            t1 = t_bound
-            last = False
+        if solved:
+            # -- the step from node k to k + 1: positions, the next node's forces and gaps
+            for i in range(n):
+                vh[i] = up[i] + dvc[i]
+                q1[i] = q[i] + hk * vh[i]
+                # what the forces see at the next node (see the scheme's module docstring)
+                vf1[i] = vh[i] + 0.5 * hk * acc[i] + 0.5 * dvc[i]
+            if not const_mass:
+                mass_fn(par, q1, M)
+                ok = invert(M, Mi, wk, n)
+                if not ok:
+                    return SINGULAR
+            forces_fn(par, q1, vf1, t1, D, False)
+            finite = True
+            for i in range(n):
+                a_i = 0.0
+                for j in range(n):
+                    a_i += Mi[i, j] * D[j, 0]
+                acc[i] = a_i
+                vv1[i] = vh[i] + 0.5 * hk * a_i
+                if not (math.isfinite(q1[i]) and math.isfinite(vv1[i])):
+                    finite = False
+            if not finite:
+                return NUMERICAL
+            if nc > 0:
+                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
+                for i in range(nc):
+                    pN[i] = pNn[i]
+                    pT[i] = pTn[i]
+                    slip[i] = slipn[i]
+                    cl[i] = pNn[i] > 0.0
+                record_contacts(Gq, nc, pN, pT, mu, reg, stats)
+            # the node ahead: its time, the step that leaves it, its gaps
+            tn = t1
+            hm = hn
+            Gn = Gq
         else:
-            tk, t1, hk, last = grid_step(t0, kn, h, t_bound)
-        if not ahead:
             # the call's first node: its mass, forces and gaps
-            if tk >= t_bound:
-                break
-            mass_fn(par, q, M)  # noqa: F821
-            if n <= 3:
-                ok = _invert_small(M, Mi, n)
-            else:
-                ok = _invert_gj(M, Mi, wk, n)
+            mass_fn(par, q, M)
+            ok = invert(M, Mi, wk, n)
             if not ok:
-                status = SINGULAR
-                break
-            forces_fn(par, q, vf, tk, D, False)  # noqa: F821
+                return SINGULAR
+            forces_fn(par, q, vf, tk, D, False)
             for i in range(n):
                 a_i = 0.0
                 for j in range(n):
@@ -120,202 +128,83 @@ def sp_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, vv, vf, closed, save_eve
                 q1[i] = q[i]
                 vv1[i] = vv[i]
             if nc > 0:
-                if HAS_GAPS:  # noqa: F821
-                    gaps_fn(par, q, tk, G0)  # noqa: F821
-                else:
-                    contacts_fn(par, q, tk, G0, True, False)  # noqa: F821
+                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, tk, G0)
             for i in range(nc):
                 cl[i] = closed[i]
-                Gi[i, 0] = G0[i, 0]
-        count = ahead or record_initial
-        # -- the contact impulse of node kn (position q1, Verlet velocity vv1, acceleration acc)
+            tn = tk
+            hm = hk
+            Gn = G0
+        # a node solved again at a call's start is counted once, by the call that reached it
+        count = solved or record_initial
+        # -- the node's contact impulse (position q1, Verlet velocity vv1, acceleration acc)
         for i in range(n):
-            up[i] = vv1[i] + 0.5 * hk * acc[i]
-            um[i] = vv1[i] - 0.5 * hk * acc[i]
+            up[i] = vv1[i] + 0.5 * hm * acc[i]
+            um[i] = vv1[i] - 0.5 * hm * acc[i]
             dvc[i] = 0.0
-        na = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
-        nfa = 0
         for i in range(nc):
-            pN[i] = 0.0
-            pT[i] = 0.0
-            slip[i] = 0.0
+            pNn[i] = 0.0
+            pTn[i] = 0.0
+            slipn[i] = 0.0
         if nc > 0:
-            contacts_fn(par, q1, tk + 0.5 * hk, G1, False, True)  # noqa: F821
+            contacts_fn(par, q1, tn + 0.5 * hm, G1, False, True)
             for i in range(nc):
                 sp = G1[i, 1]
                 sm = G1[i, 1]
                 for j in range(n):
                     sp += G1[i, 3 + j] * up[j]
                     sm += G1[i, 3 + j] * um[j]
-                UN[i] = (1.0 + e[i]) * G0[i, 0] / hk + sp - e[i] * sm
-                if UN[i] <= 0.0 or cl[i]:
-                    ia[na] = i
-                    na += 1
-                    if mu[i] > 0.0:
-                        fa[nfa] = i
-                        nfa += 1
+                UN[i] = (1.0 + e[i]) * Gn[i, 0] / hm + sp - e[i] * sm
+                act[i] = UN[i] <= 0.0 or cl[i]
+        na, nfa = index_set(act, mu, nc, ia, fa)
         if na == 1 and not force_lemke:
+            # the restitution is in UN already: the contact's own law has e = 0
             i = ia[0]
-            for j in range(n):
-                a_j = 0.0
-                a_j2 = 0.0
-                for l in range(n):
-                    a_j += Mi[j, l] * G1[i, 3 + l]
-                    a_j2 += Mi[j, l] * G1[i, 3 + n + l]
-                MiHT[j, 0] = a_j
-                MiHT[j, 1] = a_j2
-            Wnn = 0.0
-            for j in range(n):
-                Wnn += G1[i, 3 + j] * MiHT[j, 0]
-            uN = UN[i]
-            if count:
-                stats[S_LCP] += 1.0
-                stats[S_DIRECT] += 1.0
-            if nfa == 1:
-                Wnt = 0.0
-                Wtn = 0.0
-                Wtt = 0.0
-                uT = G1[i, 2]
-                for j in range(n):
-                    Wnt += G1[i, 3 + j] * MiHT[j, 1]
-                    Wtn += G1[i, 3 + n + j] * MiHT[j, 0]
-                    Wtt += G1[i, 3 + n + j] * MiHT[j, 1]
-                    uT += G1[i, 3 + n + j] * up[j]
-                pn, pt, ok = _one_contact(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], 0.0, 0.0)
-                if not ok or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, 0.0, 0.0):
-                    status = PAINLEVE
-                    break
-                res = _residual(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], 0.0, 0.0, pn, pt)
-                slip[i] = uT + Wtn * pn + Wtt * pt
-            else:
-                pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, 0.0, 0.0)
-                if not ok:
-                    status = PAINLEVE
-                    break
-                res = _residual(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, 0.0, 0.0, pn, 0.0)
-            pN[i] = pn
-            pT[i] = pt
+            fr = nfa == 1
+            Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Mi, MiHT, up, n, fr)
+            pn, pt, ok, res = solve_one(Wnn, Wnt, Wtn, Wtt, UN[i], uT, fr, mu[i], 0.0, 0.0,
+                                        lcp_ctl, stats, count)
+            if not ok:
+                return PAINLEVE
+            if fr:
+                slipn[i] = uT + Wtn * pn + Wtt * pt
+            pNn[i] = pn
+            pTn[i] = pt
             if res > stats[S_RES]:
                 stats[S_RES] = res
             for j in range(n):
                 dvc[j] = MiHT[j, 0] * pn + MiHT[j, 1] * pt
         elif na > 0:
             m = na + nfa
+            gather_rows(G1, ia, fa, na, nfa, n, H, w)
+            affine_rows(H, w, up, Uf, m, n)
             for r in range(na):
-                i = ia[r]
-                for j in range(n):
-                    H[r, j] = G1[i, 3 + j]
-                Uf[r] = UN[i]
-            for r in range(nfa):
-                i = fa[r]
-                a_i = G1[i, 2]
-                for j in range(n):
-                    H[na + r, j] = G1[i, 3 + n + j]
-                    a_i += G1[i, 3 + n + j] * up[j]
-                Uf[na + r] = a_i
-            for c in range(m):
-                for i in range(n):
-                    a_i = 0.0
-                    for j in range(n):
-                        a_i += Mi[i, j] * H[c, j]
-                    MiHT[i, c] = a_i
-            for r in range(m):
-                for c in range(m):
-                    a_i = 0.0
-                    for j in range(n):
-                        a_i += H[r, j] * MiHT[j, c]
-                    Wd[r, c] = a_i
+                Uf[r] = UN[ia[r]]
+            times_ht(Mi, H, MiHT, m, n)
+            rows_times(H, MiHT, Wd, m, n)
             L = _lcp_size(na, ia, mu, base, trow)
-            lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                            Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                            lcp_ctl, Ab, xb, idx, pcol, False)
+            lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pNn, pTn, L, base, trow,
+                                           Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
+                                           lcp_ctl, Ab, xb, idx, pcol, False)
             if lst != 0:
-                status = LCP_HANDBACK
-                break
+                return LCP_HANDBACK
             if count:
                 stats[S_PIVOTS] += piv
                 stats[S_LCP] += 1.0
             if res > stats[S_RES]:
                 stats[S_RES] = res
-            for i in range(n):
-                a_i = 0.0
-                for c in range(m):
-                    a_i += MiHT[i, c] * p[c]
-                dvc[i] = a_i
-            for r in range(nfa):
-                tr = na + r
-                a_i = Uf[tr]
-                for c in range(m):
-                    a_i += Wd[tr, c] * p[c]
-                slip[fa[r]] = a_i
-        # -- node kn solved: commit it (a node ahead) and record its sample
-        if ahead:
-            if record_initial:
-                # the run's first sample, once its step is certain to be taken here
-                record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                              nrec, t0 + k0 * h, q, v, reg, pNp, pTp, hkp, slipp, Gi, n, nc)
-                nrec += 1
-                record_initial = False
-            for j in range(n):
-                q[j] = q1[j]
-                vv[j] = vv1[j]
-                vf[j] = vf1[j]
-                v[j] = vv1[j] + 0.5 * dvc[j]
-            for i in range(nc):
-                closed[i] = cl[i]
-            k = kn
-            to_save -= 1
-            if to_save == 0:
-                to_save = save_every
-            if to_save == save_every or final:
-                record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                              nrec, tk, q, v, reg, pNp, pTp, hkp, slipp, G0, n, nc)
-                nrec += 1
-        if final or k - k0 >= nmax:
+            add_impulse(MiHT, p, dvc, dvc, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slipn)
+        if solved:
             break
-        # -- the step from node k to k + 1: positions, the next node's forces and gaps
-        for i in range(n):
-            vh[i] = up[i] + dvc[i]
-            q1[i] = q[i] + hk * vh[i]
-            # what the forces see at the next node (see the scheme's module docstring)
-            vf1[i] = vh[i] + 0.5 * hk * acc[i] + 0.5 * dvc[i]
-        if not const_mass:
-            mass_fn(par, q1, M)  # noqa: F821
-            if n <= 3:
-                ok = _invert_small(M, Mi, n)
-            else:
-                ok = _invert_gj(M, Mi, wk, n)
-            if not ok:
-                status = SINGULAR
-                break
-        forces_fn(par, q1, vf1, t1, D, False)  # noqa: F821
-        finite = True
-        for i in range(n):
-            a_i = 0.0
-            for j in range(n):
-                a_i += Mi[i, j] * D[j, 0]
-            acc[i] = a_i
-            vv1[i] = vh[i] + 0.5 * hk * a_i
-            if not (math.isfinite(q1[i]) and math.isfinite(vv1[i])):
-                finite = False
-        if not finite:
-            status = NUMERICAL
-            break
-        if nc > 0:
-            if HAS_GAPS:  # noqa: F821
-                gaps_fn(par, q1, t1, G0)  # noqa: F821
-            else:
-                contacts_fn(par, q1, t1, G0, True, False)  # noqa: F821
-            for i in range(nc):
-                if -G0[i, 0] > stats[S_PEN]:
-                    stats[S_PEN] = -G0[i, 0]
-                reg[i] = _classify(pN[i], pT[i], mu[i])
-                pNp[i] = pN[i]
-                pTp[i] = pT[i]
-                slipp[i] = slip[i]
-                cl[i] = pN[i] > 0.0
-        hkp = hk
-        kn = k + 1
-        ahead = True
-        final = last
-    return status, k, nrec
+        solved = True
+    # node k + 1 solved: its central velocity, and what the next call starts from
+    for j in range(n):
+        v1[j] = vv1[j] + 0.5 * dvc[j]
+        vv[j] = vv1[j]
+        vf[j] = vf1[j]
+    for i in range(nc):
+        closed[i] = cl[i]
+    return OK
+
+
+sp_loop = loop_template("sp_loop", globals())

@@ -52,7 +52,7 @@ from ._contact_step import (LCP_HANDBACK, NUMERICAL, OK, S_PEN, S_PROJ,  # noqa:
                             SHARED_INDIRECT, _lcp_size, _lcp_step, _lcp_step_unused,
                             lcp_buffers)
 from ._driver import loop_template
-from ._mj_kernels import _invert_gj, _invert_small
+from ._step_parts import gap_block, gaps_at, invert
 from ._mj_kernels import step_rule as _mj_step
 from ._mj_kernels import step_workspace as _mj_workspace
 from .moreau_jean import MoreauJean, ThetaOptions
@@ -84,7 +84,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              q, v, out):
+              hn, record_initial, q, v, out):
     """A Moreau–Jean step, then the direct projection of ``q1`` (see the module docstring).
 
     ``opts`` is ``(theta,)``, ``memo`` ``(closed,)`` as Moreau–Jean's.
@@ -106,7 +106,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         reg0[i] = reg[i]
     st = _mj_step(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS,
                   HAS_JAC, HAS_GAPS, lcp_step, mws, par, mu, e, (opts[0], False), memo, lcp_ctl,
-                  stats, k, k0, tk, t1, hk, q, v, out)
+                  stats, k, k0, tk, t1, hk, hn, record_initial, q, v, out)
     if st != OK or nc == 0:
         return st
     # the penetration is that of the projected positions
@@ -125,7 +125,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             break
         if not have_mi:
             mass_fn(par, q1, M)
-            ok = _invert_small(M, Mi, n) if n <= 3 else _invert_gj(M, Mi, wk, n)
+            ok = invert(M, Mi, wk, n)
             if not ok:
                 return NUMERICAL
             have_mi = True
@@ -136,19 +136,9 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 ia[s] = i
                 s += 1
         # X = M^-1 WN_A^T, S = WN_A X, the LCP 0 <= tau ⊥ g_A + S tau >= 0
+        gap_block(Gq, ia, s, Mi, X, S, n)
         for c in range(s):
-            for i in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += Mi[i, j] * Gq[ia[c], 3 + j]
-                X[i, c] = acc
             gv[c] = Gq[ia[c], 0]
-        for r in range(s):
-            for c in range(s):
-                acc = 0.0
-                for j in range(n):
-                    acc += Gq[ia[r], 3 + j] * X[j, c]
-                S[r, c] = acc
         if s == 1:
             tau[0] = max(0.0, -gv[0] / S[0, 0])
         else:
@@ -167,10 +157,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 acc += X[i, c] * tau[c]
             q1[i] += acc
         stats[S_PROJ] += 1.0
-        if HAS_GAPS:
-            gaps_fn(par, q1, t1, Gq)
-        else:
-            contacts_fn(par, q1, t1, Gq, True, False)
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
     for i in range(n):
         if not math.isfinite(q1[i]):
             return NUMERICAL

@@ -193,7 +193,7 @@ class SchatzmanPaoli(TimeStepping):
     def _fast_block(self):
         q, v, vv, vf = self.q.copy(), self.v.copy(), self._v_verlet.copy(), self._v_force.copy()
         closed = self._closed.copy()
-        status = self._run_block(sp_loop, (q, v, vv, vf, closed), (self._lcp_ctl,))
+        status = self._run_block(sp_loop, (q, v, (), (vv, vf, closed)), (self._lcp_ctl,))
         self.q, self.v, self._v_verlet, self._v_force, self._closed = q, v, vv, vf, closed
         self._after_block(status, numerical=EXPLICIT_BLOWUP)
 

@@ -1,0 +1,53 @@
+"""The driver's splicer: a helper's body replaces its call, with its own rules checked first."""
+
+import ast
+
+import pytest
+
+from moreau.integrators import (_contact_step, _driver, _sp_kernels, _step_parts,
+                                moreau_jean_projected)
+from moreau.integrators._driver import spliced
+
+
+def test_a_helper_that_assigns_its_parameter_is_refused():
+    def bump(x):
+        x = x + 1
+        return x
+    with pytest.raises(TypeError, match=r"assigns its parameters \['x'\]"):
+        spliced(bump)
+
+
+def test_a_helper_that_returns_before_its_end_is_refused():
+    def early(x):
+        if x > 0:
+            return 1
+        return 0
+    with pytest.raises(TypeError, match="returns before its last statement"):
+        spliced(early)
+
+
+def _calls(source):
+    return {n.func.id for n in ast.walk(ast.parse(source))
+            if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
+
+
+def test_the_step_rules_and_their_helpers_are_spliced_not_called():
+    # Schatzman–Paoli's loop calls no helper of _step_parts nor a step rule; the projected
+    # Moreau–Jean's holds Moreau–Jean's step, its locals renamed apart from its own
+    for loop in (_sp_kernels.sp_loop, moreau_jean_projected.mjp_loop):
+        called = _calls(loop.__moreau_source__)
+        assert not called & {"step_rule", "_mj_step", "invert", "gaps_at", "index_set",
+                             "gather_rows", "contact_block", "solve_one", "record_contacts"}
+        assert any(f.endswith("_step_parts.py") for f in loop.__moreau_sources__)
+    src = moreau_jean_projected.mjp_loop.__moreau_source__
+    assert "_step_rule1_th, _step_rule1_projection = _step_rule1_opts" in src
+
+
+def test_a_global_of_a_helper_that_the_namespace_binds_otherwise_is_renamed():
+    ns = {"record_contacts": _step_parts.record_contacts, "S_PEN": -1}
+    out = ast.unparse(ast.Module(_driver._Splicer(ns).stmts(
+        ast.parse("record_contacts(G, nc, pN, pT, mu, reg, stats)").body), []))
+    assert "record_contacts(" not in out and "stats[S_PEN___step_parts]" in out
+    assert ns["S_PEN___step_parts"] == _contact_step.S_PEN and ns["S_PEN"] == -1
+    # the helper's locals are renamed apart, its parameters replaced by the arguments
+    assert "for _record_contacts1_i in range(nc)" in out
