@@ -41,7 +41,7 @@ from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
-__all__ = ["CompareCase", "DriveCase", "SceneCase", "SpatialCase", "GRID", "switching_error", "flatten",
+__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "GRID", "switching_error", "flatten",
            "contact_switches", "regime_switches", "switches", "drop_reversal_sticks"]
 
 TWO_PI = 2.0 * math.pi
@@ -240,7 +240,29 @@ class CompareCase:
         return drop_reversal_sticks(sw, h)[1:]
 
 
-class SpatialCase(CompareCase):
+class FactoryCase(CompareCase):
+    """A case on one scene, ``scene_factory(**params)``, from its initial state.
+
+    A subclass names its factory (``scene_factory = staticmethod(make)``); the
+    case keeps the scene, its SI parameters as ``p`` (where the scene has
+    them), and reports the scene's keyword parameters with the window.
+    """
+
+    scene_factory = None
+
+    def __init__(self, **params):
+        self._params = dict(params)
+        self.scene = type(self).scene_factory(**params)
+        self.p = getattr(self.scene, "params", None)
+
+    def parameters(self):
+        return dict(self._params, window=self.window)
+
+    def start(self):
+        return self.scene.initial_state()
+
+
+class SpatialCase(FactoryCase):
     """A spatial scene's case: its Moreau–Jean rows solve the exact friction cone.
 
     The default cone of Moreau–Jean (8 directions) carries the facets' error

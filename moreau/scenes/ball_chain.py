@@ -47,7 +47,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import (check_fields, finite_array, finite_scalar, in_closed_interval,
                          nonnegative, positive, positive_int, restitution)
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ..model.drawing import circle, contact
@@ -319,7 +319,7 @@ def simultaneous_impact(masses, v, e):
 
 # -- comparison case -----------------------------------------------------------------------------
 
-class BallChainCase(CompareCase):
+class BallChainCase(FactoryCase):
     """The striker's impact on the chain: where the last ball is two time units after it.
 
     The reference is the model's exact answer, one simultaneous impact at
@@ -332,16 +332,11 @@ class BallChainCase(CompareCase):
 
     headline_name = "position of the last ball after the impacts"
 
+    scene_factory = BallChain
+
     def __init__(self, **params):
-        self.scene = BallChain(**params)
-        self._params = dict(params)
+        super().__init__(**params)
         self.window = self.scene.impact_time + 2.0
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
 
     def _last_ball(self, t):
         sc = self.scene

@@ -141,16 +141,7 @@ class BilliardCase(SpatialCase):
     headline_name = "distance along the cloth"
     window = 20.0
 
-    def __init__(self, **params):
-        self.scene = billiard_backspin(**params)
-        self.p = self.scene.params
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = staticmethod(billiard_backspin)
 
     def coordinate(self, q):
         return q[:, 0]

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import check_fields, finite_array, in_open_interval, nonnegative, positive
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
 from ..model.planar import Circle, HalfPlane, Model
 from ..model.scene import params_with
@@ -133,22 +133,13 @@ def disk_incline_exact(params, t):
     return s, p.speed + acc * tt, p.speed / r + alpha * tt
 
 
-class DiskInclineCase(CompareCase):
+class DiskInclineCase(FactoryCase):
     """The disk over the window: distance down the slope against the closed form."""
 
     headline_name = "distance down the slope"
     window = 10.0
 
-    def __init__(self, **params):
-        self.scene = disk_incline(**params)
-        self.p = self.scene.params
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = staticmethod(disk_incline)
 
     def coordinate(self, q):
         a = self.p.slope

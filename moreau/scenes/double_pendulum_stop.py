@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Point, Segment
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -152,7 +152,7 @@ def pendulum_energy(scene, q, v):
     return 0.5 * np.einsum("ij,jk,ik->i", v, M, v) - q @ f
 
 
-class DoublePendulumStopCase(CompareCase):
+class DoublePendulumStopCase(FactoryCase):
     """The energy after the window against its initial value (conserved at ``e = 1``, ``mu = 0``).
 
     Energies are counted from the pendulum hanging at rest (both links
@@ -167,9 +167,10 @@ class DoublePendulumStopCase(CompareCase):
     #: the first strike (t = 2.4) and the swing back
     window = 3.0
 
+    scene_factory = staticmethod(double_pendulum_stop)
+
     def __init__(self, **params):
-        self._params = dict(params)
-        self.scene = double_pendulum_stop(**params)
+        super().__init__(**params)
         p = params_with(DoublePendulumStopParams, None, params)
         if p.restitution != 1.0 or p.mu != 0.0:
             raise InputError("the double pendulum's case compares energies: it needs "
@@ -181,12 +182,6 @@ class DoublePendulumStopCase(CompareCase):
     def energy(self, q, v):
         """The energy above the hanging rest of every sample (scene units)."""
         return pendulum_energy(self.scene, q, v) - self._rest
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
 
     def initial_energy(self):
         """The energy of the start, above the hanging rest (scene units)."""

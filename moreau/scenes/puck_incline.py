@@ -216,16 +216,7 @@ class PuckInclineCase(SpatialCase):
     headline_name = "distance across the slope"
     window = 16.0
 
-    def __init__(self, **params):
-        self.scene = puck_incline(**params)
-        self.p = self.scene.params
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = staticmethod(puck_incline)
 
     def coordinate(self, q):
         return q[:, 1]

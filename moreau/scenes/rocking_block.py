@@ -71,7 +71,7 @@ from scipy.integrate import quad, solve_ivp
 
 from .._validate import (check_fields, finite_array, finite_scalar, nonnegative, positive,
                          restitution)
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
@@ -336,21 +336,13 @@ class RockingBlock(SIUnits, CompiledScene):
         return theta, omega
 
 
-class RockingBlockCase(CompareCase):
+class RockingBlockCase(FactoryCase):
     """The block from its release to halfway through its second rocking phase: tilt against the exact rocking."""
 
     headline_name = "tilt at the end of the window"
     window = 1.0
 
-    def __init__(self, **params):
-        self.scene = RockingBlock(**params)
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = RockingBlock
 
     def coordinate(self, q):
         return q[:, 2]

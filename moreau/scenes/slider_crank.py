@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, TWO_PI, CompareCase
+from ..analysis.cases import GRID, TWO_PI, FactoryCase
 from ..errors import InputError
 from ..model.planar import Model, Polygon, Segment, TimeFunction
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -146,25 +146,20 @@ def slider_crank(params=None, **overrides):
         "slider-crank", default_window=TWO_PI)
 
 
-class SliderCrankCase(CompareCase):
+class SliderCrankCase(FactoryCase):
     """One crank turn: the slider's position against the closed form."""
 
     headline_name = "slider position at the end of the window"
     window = 0.75 * TWO_PI
     trajectory_scale = 0.25
 
+    scene_factory = staticmethod(slider_crank)
+
     def __init__(self, **params):
-        self._params = dict(params)
-        self.scene = slider_crank(**params)
+        super().__init__(**params)
         p = params_with(SliderCrankParams, None, params)
         # in the scene's units (length l, time 1 / omega)
         self._r, self._l = p.crank_radius / p.rod_length, 1.0
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
 
     def coordinate(self, q):
         return q[:, 3]

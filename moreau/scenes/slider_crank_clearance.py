@@ -58,7 +58,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, TWO_PI, CompareCase
+from ..analysis.cases import GRID, TWO_PI, FactoryCase
 from ..errors import InputError
 from ..model.planar import Circle, Model, Polygon, Segment, TimeFunction
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -164,7 +164,7 @@ def slider_crank_clearance(params=None, **overrides):
         "slider-crank-clearance", default_window=TWO_PI)
 
 
-class SliderCrankClearanceCase(CompareCase):
+class SliderCrankClearanceCase(FactoryCase):
     """Three quarters of a crank turn: the slider's position against the ideal mechanism's closed form.
 
     The clearance keeps the slider within about ``c`` of the ideal position
@@ -175,17 +175,12 @@ class SliderCrankClearanceCase(CompareCase):
     window = 0.75 * TWO_PI
     trajectory_scale = 0.25
 
+    scene_factory = staticmethod(slider_crank_clearance)
+
     def __init__(self, **params):
-        self._params = dict(params)
-        self.scene = slider_crank_clearance(**params)
+        super().__init__(**params)
         p = params_with(SliderCrankClearanceParams, None, params)
         self._r, self._l = p.crank_radius / p.rod_length, 1.0
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
 
     def coordinate(self, q):
         return q[:, 3]

@@ -141,16 +141,7 @@ class SphereInclineCase(SpatialCase):
     headline_name = "distance down the slope"
     window = 10.0
 
-    def __init__(self, **params):
-        self.scene = sphere_incline(**params)
-        self.p = self.scene.params
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = staticmethod(sphere_incline)
 
     def coordinate(self, q):
         return q[:, 0]

@@ -234,16 +234,7 @@ class TippeTopCase(SpatialCase):
     headline_name = "axis height cos(theta)"
     window = 100.0
 
-    def __init__(self, **params):
-        self.scene = tippe_top(**params)
-        self.p = self.scene.params
-        self._params = dict(params)
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
+    scene_factory = staticmethod(tippe_top)
 
     def coordinate(self, q):
         return axis_height(q)

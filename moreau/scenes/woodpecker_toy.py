@@ -75,7 +75,7 @@ import numpy as np
 from numba import njit
 
 from .._validate import in_closed_interval, nonnegative, positive
-from ..analysis.cases import GRID, CompareCase
+from ..analysis.cases import GRID, FactoryCase
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..integrators import simulate
@@ -329,7 +329,7 @@ def limit_cycle(scene, res):
             "phidot": float(0.5 * (c[-1, 3] + c[-2, 3]) / T)}
 
 
-class WoodpeckerToyCase(CompareCase):
+class WoodpeckerToyCase(FactoryCase):
     """From Glocker's state through most of a cycle: the sleeve's height against the event-driven reference.
 
     The window (4 time units, 0.128 s) holds the sleeve sliding and jamming
@@ -345,16 +345,11 @@ class WoodpeckerToyCase(CompareCase):
     headline_name = "sleeve height at the end of the window"
     trajectory_scale = 0.5
 
+    scene_factory = WoodpeckerToy
+
     def __init__(self, **params):
-        self._params = dict(params)
-        self.scene = WoodpeckerToy(**params)
+        super().__init__(**params)
         self._grid = None
-
-    def parameters(self):
-        return dict(self._params, window=self.window)
-
-    def start(self):
-        return self.scene.initial_state()
 
     def _reference_run(self, rtol):
         q0, v0 = self.start()
