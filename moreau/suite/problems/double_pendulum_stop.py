@@ -32,13 +32,6 @@ class DoublePendulumStopProblem(Problem):
     steps = (500, 5000, 20000)
     quick_steps = (500, 5000)
 
-    @property
-    def window(self):
-        return self._the_case().window
-
-    def start(self, scene):
-        return self._the_case().start()
-
     def reference(self):
         e0 = self._the_case().initial_energy()
         return {"energy_end": e0, "energy_lowest": e0}

@@ -30,13 +30,6 @@ class PuckInclineProblem(Problem):
     quick_steps = (100, 1000)
     case_class = PuckInclineCase
 
-    @property
-    def window(self):
-        return self._the_case().window
-
-    def start(self, scene):
-        return self._the_case().start()
-
     def reference(self):
         case = self._the_case()
         sc = case.scene

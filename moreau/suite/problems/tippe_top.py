@@ -29,13 +29,6 @@ class TippeTopProblem(Problem):
     quick_steps = (2000,)
     case_class = TippeTopCase
 
-    @property
-    def window(self):
-        return self._the_case().window
-
-    def start(self, scene):
-        return self._the_case().start()
-
     def reference(self):
         return {"axis": math.cos(final_tilt(self._the_case().p))}
 
