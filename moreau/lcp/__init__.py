@@ -121,7 +121,8 @@ def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
         # comes first; the exact path only when it fails.
         second = qp.solve(M, q, tol=lemke.DEFAULT_TOL if tol is None else tol,
                           check_input=check_input, friction=friction)
-        if second.status == SOLVED or second.status == INFEASIBLE:
+        if second.status == SOLVED:
+            # (a proof of infeasibility stays Lemke's, whose ray names its matrix class)
             second.path = ("lemke", "qp")
             second.detail = (f"{second.detail} Lemke first: its path needed more than "
                              f"{lemke.DEFER_STEPS} steps decided in exact arithmetic, so the QP "
