@@ -22,7 +22,12 @@ check_input, friction, ...)``; :data:`METHODS` maps names to them.
     visited (:mod:`moreau.lcp.decide`): a solution found is returned
     certified, every piece shown empty in exact arithmetic gives
     :data:`NO_SOLUTION`. On any other failure the QP method, with the path
-    recorded in ``result.path``.
+    recorded in ``result.path``. Where Lemke's path would need more than
+    ``lemke.DEFER_STEPS`` (4) steps decided in exact arithmetic (degenerate,
+    over-constrained contact problems, where each exact step costs
+    milliseconds to seconds), the QP at Lemke's tolerance comes first; its
+    solution is taken when it passes the check on the data (path ``("lemke",
+    "qp")``), else Lemke's path is finished exactly as above.
 
 Success means the same for every method: ``z`` passed
 :func:`lcp_violation` ``<= tol`` (``z >= -tol_z``, ``w = M z + q >=
