@@ -2023,7 +2023,26 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
     if status == BREAKDOWN and defer:
         return None
     if status == BREAKDOWN:
-        # the float path could not go on from a basis the exact path reached
+        # the float path could not go on from a basis the exact path reached:
+        # the exact path goes on from that basis (lexicographically positive,
+        # as the exact step kept it; _exact.exact_lemke checks it again), not afresh
+        if start[n + 1] == _RESUME_SOLVED:
+            # z0 left in the exact step: the exact path ends there, at the point
+            # of that complementary basis, computed exactly and checked on the data
+            J = [int(v) - n for v in start[:n] if n <= v < 2 * n]
+            z = _exact.basis_point(M, q, J)
+            if z is not None:
+                out[:n] = z
+                out[n:2 * n] = M @ out[:n] + q
+                residual = float(_violation(M, q, out[:n]))
+                if residual <= tol:
+                    note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} "
+                            f"of the path {'were' if steps > 1 else 'was'} decided in exact "
+                            f"arithmetic, the last one ending the path, the rest in floating point.")
+                    return _packed_result(M, q, out, SOLVED, int(start[n + 2]), residual, note)
+        if start[n + 1] == _RESUME_PATH:
+            return _exact_finish(M, q, covering, out, first, int(start[n + 2]), max_iter, tol,
+                                 start[:n].astype(np.int64).tolist(), int(start[n]))
         return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol)
     if status == SOLVED:
         # the point of the terminal basis in exact arithmetic, correctly rounded
@@ -2035,12 +2054,15 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             out[n:2 * n] = M @ out[:n] + q
             residual = float(_violation(M, q, out[:n]))
             status = SOLVED if residual <= tol else BREAKDOWN
-    why = ("a lexicographic tie that floating point could not separate" if first == _HANDOFF_TIE
-           else "a repeated basis (rounding had decided a tie wrongly)")
-    note = (f"Pivoting met {why}; {steps} step{'s' if steps > 1 else ''} of the path "
+    note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} of the path "
             f"{'were' if steps > 1 else 'was'} decided in exact arithmetic, the rest in "
             f"floating point.")
     return _packed_result(M, q, out, status, pivots, residual, note)
+
+
+def _why(handoff):
+    return ("a lexicographic tie that floating point could not separate" if handoff == _HANDOFF_TIE
+            else "a repeated basis (rounding had decided a tie wrongly)")
 
 
 def _ray_or_unit_proof(M, q, ray):
