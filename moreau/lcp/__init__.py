@@ -22,7 +22,12 @@ check_input, friction, ...)``; :data:`METHODS` maps names to them.
     visited (:mod:`moreau.lcp.decide`): a solution found is returned
     certified, every piece shown empty in exact arithmetic gives
     :data:`NO_SOLUTION`. On any other failure the QP method, with the path
-    recorded in ``result.path``.
+    recorded in ``result.path``. Where Lemke's path would need more than
+    ``lemke.DEFER_STEPS`` (4) steps decided in exact arithmetic (degenerate,
+    over-constrained contact problems, where each exact step costs
+    milliseconds to seconds), the QP at Lemke's tolerance comes first; its
+    solution is taken when it passes the check on the data (path ``("lemke",
+    "qp")``), else Lemke's path is finished exactly as above.
 
 Success means the same for every method: ``z`` passed
 :func:`lcp_violation` ``<= tol`` (``z >= -tol_z``, ``w = M z + q >=
@@ -112,7 +117,23 @@ def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
                 or not 0 <= enumerate_max_n <= 20):
             raise InputError(f"`enumerate_max_n` must be an integer in [0, 20] (2^n pieces are "
                              f"visited), got {enumerate_max_n!r}")
-    first = lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
+    first = lemke._solve(M, q, max_iter, tol, check_input, None, True)
+    second = None
+    if first is None:
+        # Lemke's path needs more than a few steps in exact arithmetic (degenerate,
+        # over-constrained problems: each step on Python integers of thousands of
+        # bits, seconds in all). The QP, certified on the data to Lemke's tolerance,
+        # comes first; the exact path only when it fails.
+        second = qp.solve(M, q, tol=lemke.DEFAULT_TOL if tol is None else tol,
+                          check_input=check_input, friction=friction)
+        if second.status == SOLVED:
+            # (a proof of infeasibility stays Lemke's, whose ray names its matrix class)
+            second.path = ("lemke", "qp")
+            second.detail = (f"{second.detail} Lemke first: its path needed more than "
+                             f"{lemke.DEFER_STEPS} steps decided in exact arithmetic, so the QP "
+                             f"was tried before finishing it exactly.")
+            return second
+        first = lemke.solve(M, q, max_iter=max_iter, tol=tol, check_input=check_input)
     if first.status == SOLVED or first.status == INFEASIBLE:
         return first
     if first.status == SECONDARY_RAY:
@@ -120,7 +141,9 @@ def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
                                     tol, enumerate_max_n)
         if decided is not None:
             return decided
-    second = qp.solve(M, q, tol=tol, check_input=check_input, friction=friction)
+    if second is None or tol is None:
+        # (a QP run above at Lemke's tolerance is reused where the tolerance is the same)
+        second = qp.solve(M, q, tol=tol, check_input=check_input, friction=friction)
     second.path = first.path + ("qp",)
     second.detail = f"{second.detail} Lemke first: {first.message}"
     if second.status not in (SOLVED, INFEASIBLE) and first.residual < second.residual:

@@ -1877,7 +1877,7 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     return _solve(M, q, max_iter, tol, check_input, covering)
 
 
-def _solve(M, q, max_iter, tol, check_input, covering):
+def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     # positional twin of solve(): the entry point calls it directly, since a
     # keyword call costs a noticeable part of a 4-variable solve
     # types and shapes are checked on every path (an unchecked call must not
@@ -1919,7 +1919,7 @@ def _solve(M, q, max_iter, tol, check_input, covering):
         _raise_nonfinite(M, q, covering)
     if status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         return _exact_steps(M, q, covering, out, status, pivots, max_iter,
-                            DEFAULT_TOL if tol is None else tol)
+                            DEFAULT_TOL if tol is None else tol, defer)
     return _packed_result(M, q, out, status, pivots, residual, "")
 
 
@@ -1943,7 +1943,14 @@ def _packed_result(M, q, out, status, pivots, residual, note):
     return res
 
 
-def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
+#: with ``defer`` (the ``auto`` method), the exact steps a path may take before
+#: it is handed back undecided; the arch's friction LCPs measured 1 to 4 steps
+#: where the path then ends in floating point, and 24 then a whole exact path
+#: (0.6 s at n = 40, 19 s at n = 88: Python integers of thousands of bits)
+DEFER_STEPS = 4
+
+
+def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=False):
     # The compiled pivoting met a tie rounding could not decide, or a repeated
     # basis. That step is decided in exact arithmetic (_exact.exact_step, on
     # the data as scaled by the run that handed over: powers of two, so the
@@ -1953,7 +1960,10 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
     # (_exact_finish) only where a hand-over state repeats, where the basis is
     # not lexicographically positive for the data (an earlier decision of
     # rounding was wrong) or too close to singular to be followed in floating
-    # point, and past 2 n + 16 exact steps.
+    # point, and past 2 n + 16 exact steps. With defer, None instead of a
+    # whole exact path or a path of more than DEFER_STEPS exact steps: the
+    # caller (auto) tries a certified alternative first, then calls again
+    # without defer.
     n = q.shape[0]
     d = np.ones(n) if covering is None else covering
     first = handoff
@@ -1966,6 +1976,8 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
         basis = out[2 * n:3 * n].astype(np.int64)
         entering = int(out[3 * n])
         key = (frozenset(basis.tolist()), entering)
+        if defer and (key in seen or steps >= DEFER_STEPS):
+            return None
         if key in seen or steps > 2 * n + 16:
             return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
                                  basis.tolist(), entering)
@@ -1981,6 +1993,8 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
             qs = np.ldexp(q, ex + kb)
             ds = np.ldexp(d, ex) if info[2 * n + 2] != 0.0 else d
         step = _exact.exact_step(Ms, qs, ds, basis, entering)
+        if step is None and defer:
+            return None
         if step is None:
             return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
                                  basis.tolist(), entering)
@@ -2006,8 +2020,29 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
             out[n:2 * n] = q
             break
         status, pivots, residual = _resume_packed(M, q, d, out, start, max_iter, tol)
+    if status == BREAKDOWN and defer:
+        return None
     if status == BREAKDOWN:
-        # the float path could not go on from a basis the exact path reached
+        # the float path could not go on from a basis the exact path reached:
+        # the exact path goes on from that basis (lexicographically positive,
+        # as the exact step kept it; _exact.exact_lemke checks it again), not afresh
+        if start[n + 1] == _RESUME_SOLVED:
+            # z0 left in the exact step: the exact path ends there, at the point
+            # of that complementary basis, computed exactly and checked on the data
+            J = [int(v) - n for v in start[:n] if n <= v < 2 * n]
+            z = _exact.basis_point(M, q, J)
+            if z is not None:
+                out[:n] = z
+                out[n:2 * n] = M @ out[:n] + q
+                residual = float(_violation(M, q, out[:n]))
+                if residual <= tol:
+                    note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} "
+                            f"of the path {'were' if steps > 1 else 'was'} decided in exact "
+                            f"arithmetic, the last one ending the path, the rest in floating point.")
+                    return _packed_result(M, q, out, SOLVED, int(start[n + 2]), residual, note)
+        if start[n + 1] == _RESUME_PATH:
+            return _exact_finish(M, q, covering, out, first, int(start[n + 2]), max_iter, tol,
+                                 start[:n].astype(np.int64).tolist(), int(start[n]))
         return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol)
     if status == SOLVED:
         # the point of the terminal basis in exact arithmetic, correctly rounded
@@ -2019,12 +2054,15 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol):
             out[n:2 * n] = M @ out[:n] + q
             residual = float(_violation(M, q, out[:n]))
             status = SOLVED if residual <= tol else BREAKDOWN
-    why = ("a lexicographic tie that floating point could not separate" if first == _HANDOFF_TIE
-           else "a repeated basis (rounding had decided a tie wrongly)")
-    note = (f"Pivoting met {why}; {steps} step{'s' if steps > 1 else ''} of the path "
+    note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} of the path "
             f"{'were' if steps > 1 else 'was'} decided in exact arithmetic, the rest in "
             f"floating point.")
     return _packed_result(M, q, out, status, pivots, residual, note)
+
+
+def _why(handoff):
+    return ("a lexicographic tie that floating point could not separate" if handoff == _HANDOFF_TIE
+            else "a repeated basis (rounding had decided a tie wrongly)")
 
 
 def _ray_or_unit_proof(M, q, ray):
