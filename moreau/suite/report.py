@@ -23,7 +23,7 @@ import json
 import math
 import os
 
-from ..errors import MoreauError
+from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
 from ..provenance import provenance
 from .animate import write_animation
@@ -166,7 +166,8 @@ def animate_problem(name, path, frames=30):
     """A short animation of problem ``name``: its event-driven run over the window, drawn.
 
     Where the event-driven run stops (the Painlevé rod's jam, which it does
-    not take), Moreau–Jean's run at its finest quick step is drawn instead.
+    not take) or refuses the scene (a spatial one), Moreau–Jean's run at its
+    finest quick step is drawn instead.
     Returns ``(path, None)``, or ``(None, cause)`` where both runs stop or
     the scene cannot draw itself.
     """
@@ -177,7 +178,13 @@ def animate_problem(name, path, frames=30):
     try:
         for scheme in ("event-driven", "moreau-jean"):
             label, opts = settings_of(scheme, prob, scene, quick=True)[-1]
-            res = simulate(scene, (0.0, prob.window), q0, v0, scheme, **opts)
+            try:
+                res = simulate(scene, (0.0, prob.window), q0, v0, scheme, **opts)
+            except InputError as exc:
+                # a scheme that refuses the scene by name (the event-driven reference
+                # steps no spatial scene): the next one draws it
+                causes.append(f"{scheme} refused it: {exc}")
+                continue
             if res.success:
                 break
             causes.append(f"the {scheme} run stopped: {res.message}")

@@ -78,3 +78,14 @@ def test_animate_default_run_of_every_scene(tmp_path, name):
     path, frames = animate_run(str(run), str(tmp_path / "a.gif"), max_frames=8)
     with Image.open(path) as im:
         assert im.n_frames == frames == 8
+
+
+def test_the_suite_animates_a_spatial_problem_with_moreau_jean(tmp_path):
+    # the event-driven reference refuses a spatial scene by name: the page's animation is
+    # Moreau-Jean's run instead, not a "no animation" line
+    from moreau.suite.report import animate_problem
+
+    path, cause = animate_problem("puck-incline", str(tmp_path / "puck.gif"), frames=6)
+    assert cause is None and path.endswith("puck.gif")
+    with Image.open(path) as im:
+        assert im.n_frames == 6
