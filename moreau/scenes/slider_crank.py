@@ -154,10 +154,11 @@ class SliderCrankCase(FactoryCase):
     trajectory_scale = 0.25
 
     scene_factory = staticmethod(slider_crank)
+    params_class = SliderCrankParams
 
     def __init__(self, **params):
         super().__init__(**params)
-        p = params_with(SliderCrankParams, None, params)
+        p = params_with(self.params_class, None, params)
         # in the scene's units (length l, time 1 / omega)
         self._r, self._l = p.crank_radius / p.rod_length, 1.0
 

@@ -56,14 +56,13 @@ the ideal mechanism's: the slider's position to within about ``c``.
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
-from ..analysis.cases import GRID, TWO_PI, FactoryCase
+from ..analysis.cases import TWO_PI
 from ..errors import InputError
 from ..model.planar import Circle, Model, Polygon, Segment, TimeFunction
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
-from .slider_crank import slider_kinematics
+from .slider_crank import SliderCrankCase
 
 __all__ = ["SliderCrankClearanceParams", "slider_crank_clearance_model",
            "slider_crank_clearance"]
@@ -164,39 +163,16 @@ def slider_crank_clearance(params=None, **overrides):
         "slider-crank-clearance", default_window=TWO_PI)
 
 
-class SliderCrankClearanceCase(FactoryCase):
+class SliderCrankClearanceCase(SliderCrankCase):
     """Three quarters of a crank turn: the slider's position against the ideal mechanism's closed form.
 
     The clearance keeps the slider within about ``c`` of the ideal position
-    (its tolerance in the registry is a few ``c / l``).
+    (its tolerance in the registry is a few ``c / l``); the reference (the
+    ideal mechanism) has no contact switches to compare against.
     """
 
-    headline_name = "slider position at the end of the window"
-    window = 0.75 * TWO_PI
-    trajectory_scale = 0.25
-
     scene_factory = staticmethod(slider_crank_clearance)
-
-    def __init__(self, **params):
-        super().__init__(**params)
-        p = params_with(SliderCrankClearanceParams, None, params)
-        self._r, self._l = p.crank_radius / p.rod_length, 1.0
-
-    def coordinate(self, q):
-        return q[:, 3]
-
-    def reference(self, rtol):
-        return float(slider_kinematics(self.window, self._r, self._l)[0]), []
-
-    def reference_grid(self):
-        return slider_kinematics(np.linspace(0.0, self.window, GRID + 1), self._r, self._l)[0]
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 3])
-
-    def _run_switches(self, res, h):
-        # the reference (the ideal mechanism) has no contact switches to compare against
-        return []
+    params_class = SliderCrankClearanceParams
 
 
 register_scene(SceneEntry(
