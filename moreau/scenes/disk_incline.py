@@ -42,7 +42,8 @@ from ..model.planar import Circle, HalfPlane, Model
 from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
-__all__ = ["DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact"]
+__all__ = ["DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact",
+           "incline_motion", "rolls_down"]
 
 
 @dataclass(frozen=True)
@@ -109,6 +110,38 @@ def disk_incline(params=None, **overrides):
     return sc
 
 
+def rolls_down(p, k):
+    """Whether a round body of inertia ``k m r^2`` rolls down the incline of parameters ``p``
+    (``slope``, ``mu``): ``mu >= k tan(alpha) / (1 + k)`` (``tan(alpha) / 3`` for a disk).
+
+    >>> [rolls_down(DiskInclineParams(slope=0.3, mu=mu), 0.5) for mu in (0.104, 0.103)]
+    [True, False]
+    """
+    return p.mu >= k / (1.0 + k) * math.tan(p.slope)
+
+
+def incline_motion(p, t, k):
+    """``(s, s', w)``: distance and speed down the slope and rotation rate at times ``t`` [s]
+    (SI) of a round body of inertia ``k m r^2`` started rolling at ``p.speed`` down the
+    incline of parameters ``p`` (``slope``, ``mu``, ``radius``, ``gravity``).
+
+    Rolling, ``m a = m g sin(alpha) - F`` and ``k m r^2 a / r = F r`` give ``a = g
+    sin(alpha) / (1 + k)`` with ``F = k m a <= mu m g cos(alpha)`` (:func:`rolls_down`);
+    slipping, ``a = g (sin(alpha) - mu cos(alpha))`` and ``w' = mu g cos(alpha) / (k r)``.
+    """
+    tt = np.atleast_1d(finite_array("t", t)).astype(float)
+    if np.any(tt < 0.0):
+        raise InputError("`t` must be >= 0")
+    g, a, r = p.gravity, p.slope, p.radius
+    if rolls_down(p, k):
+        acc = g * math.sin(a) / (1.0 + k)
+        alpha = acc / r
+    else:
+        acc = g * (math.sin(a) - p.mu * math.cos(a))
+        alpha = p.mu * g * math.cos(a) / (k * r)
+    return p.speed * tt + 0.5 * acc * tt ** 2, p.speed + acc * tt, p.speed / r + alpha * tt
+
+
 def disk_incline_exact(params, t):
     """``(s, s', w)``: distance and speed down the slope and rotation at times ``t`` [s] (SI).
 
@@ -119,18 +152,7 @@ def disk_incline_exact(params, t):
     0.666666666667
     """
     p = params if isinstance(params, DiskInclineParams) else DiskInclineParams(**params)
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
-    g, a, r = p.gravity, p.slope, p.radius
-    if p.mu >= math.tan(a) / 3.0:
-        acc = 2.0 / 3.0 * g * math.sin(a)
-        alpha = acc / r
-    else:
-        acc = g * (math.sin(a) - p.mu * math.cos(a))
-        alpha = 2.0 * p.mu * g * math.cos(a) / r
-    s = p.speed * tt + 0.5 * acc * tt ** 2
-    return s, p.speed + acc * tt, p.speed / r + alpha * tt
+    return incline_motion(p, t, 0.5)
 
 
 class DiskInclineCase(FactoryCase):
@@ -147,8 +169,7 @@ class DiskInclineCase(FactoryCase):
 
     def reference(self, rtol):
         s, _, _ = disk_incline_exact(self.p, [self.window * self.scene.time])
-        return float(s[0]) / self.scene.length, [(0.0, "S" if self.p.mu >= math.tan(
-            self.p.slope) / 3.0 else "P")]
+        return float(s[0]) / self.scene.length, [(0.0, "S" if rolls_down(self.p, 0.5) else "P")]
 
     def reference_grid(self):
         s, _, _ = disk_incline_exact(self.p, np.linspace(0.0, self.window, GRID + 1)

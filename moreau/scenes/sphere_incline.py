@@ -32,12 +32,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, in_open_interval, nonnegative, positive
+from .._validate import in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
-from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
+from .disk_incline import incline_motion, rolls_down
 
 __all__ = ["SphereInclineParams", "sphere_incline", "sphere_incline_exact", "rolls"]
 
@@ -86,7 +86,7 @@ def rolls(p):
     >>> rolls(SphereInclineParams(slope=0.3, mu=0.0884)), rolls(SphereInclineParams(mu=0.0883))
     (True, False)
     """
-    return p.mu >= 2.0 / 7.0 * math.tan(p.slope)
+    return rolls_down(p, 0.4)
 
 
 def sphere_incline(params=None, **overrides):
@@ -122,17 +122,7 @@ def sphere_incline_exact(params, t):
     0.714285714286
     """
     p = params if isinstance(params, SphereInclineParams) else SphereInclineParams(**params)
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
-    g, a, r = p.gravity, p.slope, p.radius
-    if rolls(p):
-        acc = 5.0 / 7.0 * g * math.sin(a)
-        alpha = acc / r
-    else:
-        acc = g * (math.sin(a) - p.mu * math.cos(a))
-        alpha = 2.5 * p.mu * g * math.cos(a) / r
-    return p.speed * tt + 0.5 * acc * tt ** 2, p.speed + acc * tt, p.speed / r + alpha * tt
+    return incline_motion(p, t, 0.4)
 
 
 class SphereInclineCase(SpatialCase):
