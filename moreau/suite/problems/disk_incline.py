@@ -27,11 +27,13 @@ class DiskInclineProblem(Problem):
     steps = (100, 1000, 10000)
     quick_steps = (100, 1000)
     case_class = DiskInclineCase
+    #: the closed form ``(s, s', w)`` at SI times
+    exact = staticmethod(disk_incline_exact)
 
     def reference(self):
         case = self._the_case()
         sc = case.scene
-        s, sd, w = disk_incline_exact(case.p, [self.window * sc.time])
+        s, sd, w = self.exact(case.p, [self.window * sc.time])
         return {"distance": float(s[0]) / sc.length,
                 "speed": float(sd[0]) * sc.time / sc.length,
                 "rolling_speed": float(w[0]) * case.p.radius * sc.time / sc.length}
