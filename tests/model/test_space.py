@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from moreau.errors import InputError
+from moreau.errors import IllPosedError, InputError
 from moreau.model.scene import is_spatial
-from moreau.model.space import Puck, SpaceModel, Sphere, advance_coordinates
+from moreau.model.space import Disk, Puck, SpaceModel, Sphere, advance_coordinates
 from moreau.model.spatial import quat_exp, quat_multiply, rotation_matrix
 
 
@@ -137,3 +137,69 @@ def test_an_eccentric_sphere_rows_and_drift_against_differences(seed):
     wNb, wTb = sc.contact_drift(q, v, 0.0)
     assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
     assert abs(wNb[0]) > 1e-3 and np.max(np.abs(wTb)) > 1e-3    # the offset does turn
+
+
+def _disk_scene(rng):
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+    normal = np.array([0.2, -0.1, 1.0])
+    floor = m.add_half_space((0.0, 0.0, -0.01), normal)
+    disk = m.add_body(0.3, [0.0002, 0.0002, 0.0004], position=(0.01, 0.02, 0.04),
+                      orientation=quat_exp(0.5 * (np.array([0.9, 0.3, 0.0])
+                                                  + 0.3 * rng.standard_normal(3))))
+    m.add_contact(disk, Disk(0.05), floor, mu=0.5)
+    return m.build("disk"), normal / np.linalg.norm(normal)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_disks_rim_point_gap_rows_and_drift_against_sampling_and_differences(seed):
+    rng = np.random.default_rng(seed)
+    sc, n = _disk_scene(rng)
+    q, _ = sc.initial_state()
+    v = rng.standard_normal(sc.nvel)
+    # the gap: the rim's lowest point along the normal, from 200000 points on the rim
+    R = rotation_matrix(q[3:7])
+    phi = np.linspace(0.0, 2.0 * np.pi, 200000, endpoint=False)
+    rim = q[:3] * 0.05 + 0.05 * (np.outer(np.cos(phi), R[:, 0]) + np.outer(np.sin(phi), R[:, 1]))
+    lowest = np.min((rim - (0.0, 0.0, -0.01)) @ n)
+    assert abs(sc.gaps(q, 0.0)[0] * 0.05 - lowest) < 1e-11
+    # and the contact point is that lowest rim point
+    (R0, s0), = sc.contact_frames(q, 0.0)
+    k = int(np.argmin((rim - (0.0, 0.0, -0.01)) @ n))
+    assert np.linalg.norm((q[:3] + s0) * 0.05 - rim[k]) < 1e-5
+    eps = 1e-6
+    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
+    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
+    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
+    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
+    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
+    (_, t1, t2), = sc.contact_bases()
+    slip = np.array([t1 @ pdot[0], t2 @ pdot[0]])
+    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
+    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
+    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
+    wNb, wTb = sc.contact_drift(q, v, 0.0)
+    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    # the rim point slides round the rim: its drift is not a material point's
+    s = s0
+    w = R @ v[3:6]
+    material = np.cross(w, np.cross(w, s)) @ n
+    assert abs(wNb[0]) > 1e-3 and abs(wNb[0] - material) > 1e-3
+
+
+def test_a_disk_lying_flat_is_refused_by_name():
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81))
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    flat = m.add_body(1.0, [0.25, 0.25, 0.5], position=(0.0, 0.0, 0.0))
+    with pytest.raises(InputError, match="`orientation` of a Disk's body must tilt its axis"):
+        m.add_contact(flat, Disk(1.0), floor)
+    with pytest.raises(InputError, match="`radius` must be > 0"):
+        Disk(0.0)
+    # a run that brings the disk flat stops there, naming the configuration
+    tilted = m.add_body(1.0, [0.25, 0.25, 0.5], position=(0.0, 0.0, 0.5),
+                        orientation=quat_exp(np.array([0.25, 0.0, 0.0])))
+    m.add_contact(tilted, Disk(1.0), floor)
+    sc = m.build("disks")
+    q, _ = sc.initial_state()
+    q[10:14] = (1.0, 0.0, 0.0, 0.0)
+    with pytest.raises(IllPosedError, match="a disk lies flat on a half-space"):
+        sc.gaps(q, 0.0)

@@ -47,6 +47,21 @@ offset ``s`` (world) from the body's centre:
   motion while the puck neither tips nor lifts a rim point. A thin puck
   (``c = 0``) may touch through its face's centre alone (``k = 1``).
 
+* a :class:`Disk` (a thin rim of radius ``r`` about the body's z axis, its
+  centre the centre of mass) touches through the rim's lowest point. With
+  the axis ``a = R e_z`` and ``u`` the unit part of ``n`` in the disk's plane,
+
+  .. math::
+
+      u = \frac{n - (n . a)\, a}{\sigma}, \quad \sigma = |n - (n . a) a|
+        = \sqrt{1 - (n . a)^2}, \qquad s = -r u, \quad g = n . (x - y0) - r \sigma
+
+  (the rim's points are ``x + r (cos phi e1 + sin phi e2)`` for ``(e1, e2)``
+  spanning the plane; ``n .`` of them is least where the in-plane direction is
+  ``-u``). Lying flat (``a`` parallel to ``n``, ``sigma = 0``) every rim
+  point is lowest and the contact point is undefined: it is refused by name
+  (:data:`FLAT_SIN`), when the contact is added and during a run.
+
 The body's material point at ``x + s`` moves at ``x' + (R omega) x s``. For
 a direction ``e`` (``n``, ``t1`` or ``t2``), ``e . ((R omega) x s) = omega .
 R^T (s x e)``, so the row of ``e`` in the body's six columns is
@@ -62,7 +77,18 @@ the two slip rates. Differentiating a row times ``v`` at zero accelerations
 R omega`` for a material point (the puck); the sphere's support point is
 not material, only its centre's offset ``R c`` turns with the body (``d(R
 c)/dt = w x R c``, ``-rho n`` is constant), so its drift is ``e . (w x (w
-x R c))``, zero for a centred sphere.
+x R c))``, zero for a centred sphere. The disk's rim point is not material
+either: it slides round the rim as the axis turns, ``s' = -r u'``, and the
+drift is ``e . (w x s')`` with
+
+.. math::
+
+    u' = \frac{\dot m - (u . \dot m)\, u}{\sigma}, \quad
+    \dot m = -(n . \dot a)\, a - (n . a)\, \dot a, \quad \dot a = w \times a
+
+(``m = n - (n . a) a``). Because the rim point is the lowest, the gap's rate
+is the material point's normal velocity (the rate of ``r sigma`` is ``-r u .
+\dot m``, which equals ``n . (w x s)``): the same row serves the gap and the slip.
 
 Every row is held to central differences of the gap and of the material
 point's position along the exponential-map motion in ``tests/model``.
@@ -91,14 +117,18 @@ import math
 import numpy as np
 
 from ..._validate import finite_array, finite_scalar, nonnegative, positive
-from ...errors import InputError
+from ...errors import IllPosedError, InputError
 from ..drawing import circle, contact, line
 from ..scene import Scene
 from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
-__all__ = ["Sphere", "Puck", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
-           "point_rows", "advance_coordinates"]
+__all__ = ["Sphere", "Puck", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
+           "point_rows", "advance_coordinates", "FLAT_SIN"]
+
+#: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
+#: has no single lowest point (the rim point's direction is rounding over this sine)
+FLAT_SIN = 1e-8
 
 
 def tangent_basis(normal):
@@ -220,6 +250,50 @@ class Puck:
                                 np.full(a.size, -0.5 * self.thickness / scale)])
 
 
+class Disk:
+    """A thin disk: a rim of ``radius`` [m] about the body's z axis, centred on the centre of mass.
+
+    It touches a half-space at its rim's lowest point, one contact at any
+    tilt but flat (see the module docstring); a disk lying on its face is a
+    :class:`Puck`.
+
+    Examples
+    --------
+    >>> Disk(0.05).radius
+    0.05
+    """
+
+    def __init__(self, radius):
+        self.radius = positive("radius", radius)
+
+    def points(self, scale):
+        return None
+
+
+def rim_offset(R, n, radius):
+    """``(s, sigma, u)``: the rim's lowest point's offset ``s = -radius u`` (world) from
+    the disk's centre, for the body rotation ``R`` and the half-space's unit normal ``n``.
+
+    Raises :class:`~moreau.errors.IllPosedError` where the disk lies flat
+    (``sigma = |n - (n . a) a| <= FLAT_SIN``, ``a = R e_z``).
+
+    Examples
+    --------
+    >>> s, sigma, u = rim_offset(np.eye(3), np.array([0.0, 1.0, 0.0]), 2.0)
+    >>> s.tolist(), sigma
+    ([0.0, -2.0, 0.0], 1.0)
+    """
+    a = R[:, 2]
+    m = n - (n @ a) * a
+    sigma = math.sqrt(m @ m)
+    if sigma <= FLAT_SIN:
+        raise IllPosedError(f"a disk lies flat on a half-space (its axis parallel to the "
+                            f"normal, sine {sigma:.3g} <= FLAT_SIN): its rim has no single "
+                            f"lowest point")
+    u = m / sigma
+    return -radius * u, sigma, u
+
+
 class HalfSpace:
     """The ground's half-space ``{y : normal . (y - point) >= 0}``; tangents default to :func:`tangent_basis`."""
 
@@ -291,7 +365,9 @@ class SpaceModel:
     def add_contact(self, body, shape, plane, mu=0.0, restitution=0.0):
         """Contacts of ``body``'s ``shape`` with the half-space ``plane``; returns their indices.
 
-        A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point.
+        A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point,
+        a :class:`Disk` one (its rim's lowest point; refused, naming
+        ``orientation``, where the body lies flat on the half-space).
         """
         if isinstance(body, bool) or not isinstance(body, (int, np.integer)) \
                 or not 0 <= body < len(self.bodies):
@@ -300,16 +376,29 @@ class SpaceModel:
         if isinstance(plane, bool) or not isinstance(plane, (int, np.integer)) \
                 or not 0 <= plane < len(self.planes):
             raise InputError(f"`plane` must be the index of an added half-space, got {plane!r}")
-        if not isinstance(shape, (Sphere, Puck)):
-            raise InputError(f"`shape` must be a Sphere or a Puck, got {type(shape).__name__}")
+        if not isinstance(shape, (Sphere, Puck, Disk)):
+            raise InputError(f"`shape` must be a Sphere, a Puck or a Disk, got "
+                             f"{type(shape).__name__}")
         mu = nonnegative("mu", mu)
         e = finite_scalar("restitution", restitution)
         if not 0.0 <= e <= 1.0:
             raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        if isinstance(shape, Disk):
+            R = rotation_matrix(self.bodies[body]["orientation"], check=False)
+            n = self.planes[plane].normal
+            if float(np.linalg.norm(n - (n @ R[:, 2]) * R[:, 2])) <= FLAT_SIN:
+                raise InputError("`orientation` of a Disk's body must tilt its axis (the "
+                                 "body's z) off the half-space's normal: lying flat, its rim "
+                                 "has no single lowest point (use a Puck)")
+            self.contacts.append({"kind": "rim", "body": int(body), "plane": int(plane),
+                                  "mu": mu, "e": e, "radius": shape.radius / self.length,
+                                  "point": None, "centre": None})
+            return [len(self.contacts) - 1]
         pts = shape.points(self.length)
         out = []
         for k in range(1 if pts is None else len(pts)):
-            self.contacts.append({"body": int(body), "plane": int(plane), "mu": mu, "e": e,
+            self.contacts.append({"kind": "sphere" if pts is None else "point",
+                                  "body": int(body), "plane": int(plane), "mu": mu, "e": e,
                                   "radius": shape.radius / self.length if pts is None else 0.0,
                                   "point": None if pts is None else pts[k],
                                   "centre": (shape.centre / self.length if pts is None
@@ -432,7 +521,9 @@ class SpaceScene(Scene):
         x = q[7 * b:7 * b + 3]
         R = (Rs or self._rotations(q))[b]
         y0, n, t1, t2 = self._planes[c["plane"]]
-        if c["point"] is None:
+        if c["kind"] == "rim":
+            s = rim_offset(R, n, c["radius"])[0]
+        elif c["point"] is None:
             s = -c["radius"] * n
             if c["centre"] is not None:
                 s = s + R @ c["centre"]
@@ -480,12 +571,15 @@ class SpaceScene(Scene):
         for i in range(self.ncontacts):
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
             c = self._contacts[i]
-            if c["point"] is None:
-                if c["centre"] is None:
-                    continue        # a sphere's support point: s = -rho n is constant
-                s = R @ c["centre"]     # only the sphere's centre turns with the body
             w = R @ v[6 * b + 3:6 * b + 6]
-            a = np.cross(w, np.cross(w, s))
+            if c["kind"] == "rim":
+                a = np.cross(w, _rim_point_rate(R, n, c["radius"], w))
+            else:
+                if c["point"] is None:
+                    if c["centre"] is None:
+                        continue        # a sphere's support point: s = -rho n is constant
+                    s = R @ c["centre"]     # only the sphere's centre turns with the body
+                a = np.cross(w, np.cross(w, s))
             wN[i] = n @ a
             if i in fi:
                 j = fi.index(i)
@@ -540,7 +634,14 @@ class SpaceScene(Scene):
         for i, c in enumerate(self._contacts):
             b = c["body"]
             x = qs[7 * b:7 * b + 3] * L
-            if c["point"] is None:
+            if c["kind"] == "rim":
+                # the rim seen from the side: its points' (x, z), an ellipse's outline
+                R = self._rotations(qs)[b]
+                phi = np.linspace(0.0, 2.0 * np.pi, 49)
+                rim = x + c["radius"] * L * (np.outer(np.cos(phi), R[:, 0])
+                                             + np.outer(np.sin(phi), R[:, 1]))
+                out.append(line(rim[:, [0, 2]]))
+            elif c["point"] is None:
                 if c["centre"] is not None:
                     x = x + self._rotations(qs)[b] @ c["centre"] * L
                 out.append(circle((x[0], x[2]), c["radius"] * L))
@@ -559,6 +660,15 @@ class SpaceScene(Scene):
     def contact_bases(self):
         """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
         return [self._planes[c["plane"]][1:] for c in self._contacts]
+
+
+def _rim_point_rate(R, n, radius, w):
+    # s' = -r u' of the rim's lowest point as the axis turns at w (module docstring)
+    a = R[:, 2]
+    _, sigma, u = rim_offset(R, n, radius)
+    ad = np.cross(w, a)
+    md = -(n @ ad) * a - (n @ a) * ad
+    return -radius * (md - (u @ md) * u) / sigma
 
 
 def _gyro(J, w):
