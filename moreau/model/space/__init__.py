@@ -124,7 +124,7 @@ from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
-           "point_rows", "advance_coordinates", "FLAT_SIN"]
+           "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN"]
 
 #: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
 #: has no single lowest point (the rim point's direction is rounding over this sine)
@@ -280,7 +280,7 @@ def rim_offset(R, n, radius):
     Examples
     --------
     >>> s, sigma, u = rim_offset(np.eye(3), np.array([0.0, 1.0, 0.0]), 2.0)
-    >>> s.tolist(), sigma
+    >>> (s + 0.0).tolist(), sigma
     ([0.0, -2.0, 0.0], 1.0)
     """
     a = R[:, 2]
