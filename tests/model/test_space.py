@@ -5,7 +5,7 @@ import pytest
 
 from moreau.errors import IllPosedError, InputError
 from moreau.model.scene import is_spatial
-from moreau.model.space import Disk, Puck, SpaceModel, Sphere, advance_coordinates
+from moreau.model.space import Box, Disk, Puck, SpaceModel, Sphere, advance_coordinates
 from moreau.model.spatial import quat_exp, quat_multiply, rotation_matrix
 
 
@@ -203,3 +203,75 @@ def test_a_disk_lying_flat_is_refused_by_name():
     q[10:14] = (1.0, 0.0, 0.0, 0.0)
     with pytest.raises(IllPosedError, match="a disk lies flat on a half-space"):
         sc.gaps(q, 0.0)
+
+
+def _box_on_incline(slope, mu, speed, corners=(0, 1, 2, 3), orientation=(1.0, 0.0, 0.0, 0.0)):
+    g, (hx, hy, hz), M = 9.81, (0.1, 0.075, 0.05), 2.0
+    m = SpaceModel(gravity=(g * np.sin(slope), 0.0, -g * np.cos(slope)), length=hx, mass=M)
+    f = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0))
+    J = [M / 3 * (hy * hy + hz * hz), M / 3 * (hx * hx + hz * hz), M / 3 * (hx * hx + hy * hy)]
+    b = m.add_body(M, J, position=(0.0, 0.0, hz), velocity=(speed, 0.0, 0.0),
+                   orientation=orientation)
+    m.add_contact(b, Box((hx, hy, hz), corners=corners), f, mu=mu)
+    return m.build("box")
+
+
+def test_a_box_slides_down_an_incline_at_g_sin_alpha_minus_mu_g_cos_alpha():
+    # four bottom corners share the weight (statically indeterminate); the centre's
+    # acceleration is not: a = g (sin(alpha) - mu cos(alpha)), constant, so Moreau-Jean's
+    # velocity is exact at every step and theta = 1/2 (the trapezoidal rule) exact in position
+    from moreau.integrators import simulate
+    slope, mu, v0 = 0.4, 0.3, 0.5
+    sc = _box_on_incline(slope, mu, v0)
+    q0, v = sc.initial_state()
+    res = simulate(sc, (0.0, 1.0), q0, v, "moreau-jean", h=0.1, theta=0.5, cone="exact")
+    a = 9.81 * (np.sin(slope) - mu * np.cos(slope))
+    t = res.t * sc.time
+    assert np.allclose(res.v[:, 0] * sc.length / sc.time, v0 + a * t, rtol=1e-12, atol=0)
+    assert np.allclose(res.q[:, 0] * sc.length, v0 * t + 0.5 * a * t * t, rtol=1e-12, atol=0)
+    # it neither turns nor lifts a corner, and every step's corners carry the weight's normal part
+    assert np.max(np.abs(res.v[:, 3:])) < 1e-9 and np.max(np.abs(res.gap)) < 1e-14
+    assert np.allclose(res.force_N[1:].sum(axis=1), np.cos(slope), rtol=1e-12)
+
+
+def test_a_box_at_rest_on_an_incline_below_its_friction_angle_stays_at_rest():
+    from moreau.integrators import simulate
+    slope = 0.4
+    sc = _box_on_incline(slope, 1.01 * np.tan(slope), 0.0)
+    q0, v = sc.initial_state()
+    res = simulate(sc, (0.0, 1.0), q0, v, "moreau-jean", h=0.1, cone="exact")
+    assert np.max(np.abs(res.v)) < 1e-12 and np.max(np.abs(res.q[-1] - q0)) < 1e-12
+    # (the corners' friction, indeterminate, may pull across the slope too: the sum of its
+    # magnitudes bounds the weight's slope part, 1 being m g in the scene's units)
+    assert np.all(res.force_T[1:].sum(axis=1) >= np.sin(slope) * (1.0 - 1e-12))
+    assert np.all(res.force_T <= res.force_N * 1.01 * np.tan(slope) * (1.0 + 1e-9))
+    assert np.allclose(res.force_N[1:].sum(axis=1), np.cos(slope), rtol=1e-12)
+
+
+def test_a_boxs_corners_gaps_and_rows_against_differences():
+    rng = np.random.default_rng(7)
+    sc = _box_on_incline(0.3, 0.5, 0.0, corners=range(8),
+                         orientation=quat_exp(0.5 * rng.standard_normal(3)))
+    q, _ = sc.initial_state()
+    R = rotation_matrix(q[3:7])
+    corners = np.array([[sx, sy, sz] for sz in (-1, 1) for sy in (-1, 1) for sx in (-1, 1)])
+    heights = q[2] + corners * [1.0, 0.75, 0.5] @ R.T @ [0.0, 0.0, 1.0]
+    assert np.allclose(sc.gaps(q, 0.0), heights, rtol=0, atol=1e-15)
+    v = rng.standard_normal(sc.nvel)
+    eps = 1e-6
+    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
+    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
+    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
+    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
+    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
+    assert np.max(np.abs(sc.contact_drift(q, v, 0.0)[0] - dN)) < 1e-7
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"half_extents": (0.1, 0.0, 0.1)}, "`half_extents` must be > 0"),
+    ({"half_extents": (0.1, 0.1, 0.1), "corners": (0, 8)}, "`corners` must be distinct corner"),
+    ({"half_extents": (0.1, 0.1, 0.1), "corners": (1, 1)}, "`corners` must be distinct corner"),
+])
+def test_a_bad_box_is_refused_by_name(kwargs, match):
+    with pytest.raises(InputError, match=match):
+        Box(**kwargs)

@@ -45,7 +45,9 @@ offset ``s`` (world) from the body's centre:
   weight at these points (three make the normal forces determinate); the
   face's distributed pressure is represented by them, which holds the
   motion while the puck neither tips nor lifts a rim point. A thin puck
-  (``c = 0``) may touch through its face's centre alone (``k = 1``).
+  (``c = 0``) may touch through its face's centre alone (``k = 1``);
+* a :class:`Box` touches through the corners it names, material points
+  ``b_k = (+-hx, +-hy, +-hz)`` as the puck's.
 
 * a :class:`Disk` (a thin rim of radius ``r`` about the body's z axis, its
   centre the centre of mass) touches through the rim's lowest point. With
@@ -123,7 +125,7 @@ from ..scene import Scene
 from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
-__all__ = ["Sphere", "Puck", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
+__all__ = ["Sphere", "Puck", "Box", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
            "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN"]
 
 #: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
@@ -250,6 +252,40 @@ class Puck:
                                 np.full(a.size, -0.5 * self.thickness / scale)])
 
 
+class Box:
+    """A box of half-edges ``half_extents`` [m] (body x, y, z) about the centre of mass, touching
+    through its corners ``corners`` (default all eight).
+
+    Corner ``k`` is ``(+-hx, +-hy, +-hz)`` with the sign of ``x`` from bit 0 of
+    ``k`` (set: ``+``), of ``y`` from bit 1, of ``z`` from bit 2: the corners
+    ``0..3`` are the bottom face's (``z = -hz``). Each corner is a material
+    point, a contact of its own (as a :class:`Puck`'s rim points); a scene
+    names only the corners that can touch.
+
+    Examples
+    --------
+    >>> Box((0.1, 0.2, 0.3), corners=(0, 3)).points(0.1).tolist()
+    [[-1.0, -2.0, -3.0], [1.0, 2.0, -3.0]]
+    """
+
+    def __init__(self, half_extents, corners=None):
+        self.half_extents = finite_array("half_extents", half_extents, shape=(3,))
+        if np.any(self.half_extents <= 0.0):
+            raise InputError(f"`half_extents` must be > 0, got {self.half_extents.tolist()}")
+        if corners is None:
+            corners = range(8)
+        ks = list(corners)
+        if not ks or any(isinstance(k, bool) or not isinstance(k, (int, np.integer))
+                         or not 0 <= k < 8 for k in ks) or len(set(ks)) != len(ks):
+            raise InputError(f"`corners` must be distinct corner numbers in 0..7, got {corners!r}")
+        self.corners = [int(k) for k in ks]
+
+    def points(self, scale):
+        k = np.array(self.corners)
+        signs = np.column_stack([2 * (k & 1) - 1, 2 * ((k >> 1) & 1) - 1, 2 * ((k >> 2) & 1) - 1])
+        return signs * self.half_extents / scale
+
+
 class Disk:
     """A thin disk: a rim of ``radius`` [m] about the body's z axis, centred on the centre of mass.
 
@@ -365,7 +401,8 @@ class SpaceModel:
     def add_contact(self, body, shape, plane, mu=0.0, restitution=0.0):
         """Contacts of ``body``'s ``shape`` with the half-space ``plane``; returns their indices.
 
-        A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point,
+        A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point, a
+        :class:`Box` one per named corner,
         a :class:`Disk` one (its rim's lowest point; refused, naming
         ``orientation``, where the body lies flat on the half-space).
         """
@@ -376,8 +413,8 @@ class SpaceModel:
         if isinstance(plane, bool) or not isinstance(plane, (int, np.integer)) \
                 or not 0 <= plane < len(self.planes):
             raise InputError(f"`plane` must be the index of an added half-space, got {plane!r}")
-        if not isinstance(shape, (Sphere, Puck, Disk)):
-            raise InputError(f"`shape` must be a Sphere, a Puck or a Disk, got "
+        if not isinstance(shape, (Sphere, Puck, Box, Disk)):
+            raise InputError(f"`shape` must be a Sphere, a Puck, a Box or a Disk, got "
                              f"{type(shape).__name__}")
         mu = nonnegative("mu", mu)
         e = finite_scalar("restitution", restitution)
