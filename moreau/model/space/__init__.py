@@ -48,6 +48,9 @@ offset ``s`` (world) from the body's centre:
   (``c = 0``) may touch through its face's centre alone (``k = 1``);
 * a :class:`Box` touches through the corners it names, material points
   ``b_k = (+-hx, +-hy, +-hz)`` as the puck's.
+* a :class:`Capsule` (radius ``r`` about the segment ``z in [-l, l]``)
+  touches as its two end spheres, eccentric spheres with ``c = (0, 0, +-l)``:
+  the segment's lowest point along ``n`` is an end (both, lying parallel).
 
 * a :class:`Disk` (a thin rim of radius ``r`` about the body's z axis, its
   centre the centre of mass) touches through the rim's lowest point. With
@@ -125,7 +128,7 @@ from ..scene import Scene
 from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
-__all__ = ["Sphere", "Puck", "Box", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
+__all__ = ["Sphere", "Puck", "Box", "Capsule", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
            "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN"]
 
 #: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
@@ -286,6 +289,30 @@ class Box:
         return signs * self.half_extents / scale
 
 
+class Capsule:
+    """A capsule: the points within ``radius`` [m] of the segment ``z in [-half_length, half_length]``
+    on the body's z axis, about the centre of mass.
+
+    Against a half-space the segment's lowest point is one of its ends (both
+    when it lies parallel to the plane), so the capsule touches as two
+    eccentric spheres (:class:`Sphere` with ``centre = (0, 0, +-half_length)``),
+    two contacts.
+
+    Examples
+    --------
+    >>> [s.centre.tolist() for s in Capsule(0.1, 0.3).spheres()]
+    [[0.0, 0.0, -0.3], [0.0, 0.0, 0.3]]
+    """
+
+    def __init__(self, radius, half_length):
+        self.radius = positive("radius", radius)
+        self.half_length = positive("half_length", half_length)
+
+    def spheres(self):
+        return [Sphere(self.radius, (0.0, 0.0, -self.half_length)),
+                Sphere(self.radius, (0.0, 0.0, self.half_length))]
+
+
 class Disk:
     """A thin disk: a rim of ``radius`` [m] about the body's z axis, centred on the centre of mass.
 
@@ -402,7 +429,7 @@ class SpaceModel:
         """Contacts of ``body``'s ``shape`` with the half-space ``plane``; returns their indices.
 
         A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point, a
-        :class:`Box` one per named corner,
+        :class:`Box` one per named corner, a :class:`Capsule` two (its end spheres),
         a :class:`Disk` one (its rim's lowest point; refused, naming
         ``orientation``, where the body lies flat on the half-space).
         """
@@ -413,9 +440,12 @@ class SpaceModel:
         if isinstance(plane, bool) or not isinstance(plane, (int, np.integer)) \
                 or not 0 <= plane < len(self.planes):
             raise InputError(f"`plane` must be the index of an added half-space, got {plane!r}")
-        if not isinstance(shape, (Sphere, Puck, Box, Disk)):
-            raise InputError(f"`shape` must be a Sphere, a Puck, a Box or a Disk, got "
-                             f"{type(shape).__name__}")
+        if not isinstance(shape, (Sphere, Puck, Box, Capsule, Disk)):
+            raise InputError(f"`shape` must be a Sphere, a Puck, a Box, a Capsule or a Disk, "
+                             f"got {type(shape).__name__}")
+        if isinstance(shape, Capsule):
+            return [k for s in shape.spheres()
+                    for k in self.add_contact(body, s, plane, mu, restitution)]
         mu = nonnegative("mu", mu)
         e = finite_scalar("restitution", restitution)
         if not 0.0 <= e <= 1.0:
