@@ -267,7 +267,7 @@ class Box:
 
     Examples
     --------
-    >>> Box((0.1, 0.2, 0.3), corners=(0, 3)).points(0.1).tolist()
+    >>> Box((1.0, 2.0, 3.0), corners=(0, 3)).points(1.0).tolist()
     [[-1.0, -2.0, -3.0], [1.0, 2.0, -3.0]]
     """
 
