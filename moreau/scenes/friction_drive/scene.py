@@ -87,7 +87,8 @@ from numba import njit
 
 from ...compiled import CompiledModel
 from .rod import MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap, rod_rows
-from ...model.scene import Scene, params_with
+from ...model.compiled_scene import CompiledScene
+from ...model.scene import params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ...analysis.steady_state import find_steady_state
 from ...integrators import simulate
@@ -165,11 +166,16 @@ class FrictionDriveParams:
 PAPER_DEFAULTS = FrictionDriveParams()
 
 
-class FrictionDrive(StatorMotion, DriveUnits, Scene):
+class FrictionDrive(StatorMotion, DriveUnits, CompiledScene):
     """The paper's friction drive at one drive frequency, in dimensionless form.
 
     Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
-    time ``tau = w t`` with ``w = 2 pi f``. One frictional contact.
+    time ``tau = w t`` with ``w = 2 pi f``. One frictional contact. The model
+    methods (``mass``, ``forces``, ``gaps``, ...) evaluate the compiled model,
+    where the equations are written once
+    (:class:`~moreau.model.compiled_scene.CompiledScene`); the closed forms on
+    the contact manifold (:meth:`contact_angle`, :meth:`coefficients`,
+    :meth:`contact_forces`) are the walker's own.
 
     Parameters
     ----------
@@ -281,38 +287,7 @@ class FrictionDrive(StatorMotion, DriveUnits, Scene):
         """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""
         return 1.0 - float(self.mu[0]) * np.tan(phi)
 
-    # -- Scene interface ------------------------------------------------------
-    def mass(self, q):
-        return np.diag([1.0 / 3.0, self.J])
-
-    def forces(self, q, v, t):
-        phi = q[0]
-        return np.array([self.P * math.cos(phi) * (self.sin_phi0 - math.sin(phi))
-                         - 0.5 * self.ddu1(t) * math.cos(phi) + self.fp * math.cos(phi), -self.fL])
-
-    def force_jacobians(self, q, v, t):
-        phi = q[0]
-        s, c = math.sin(phi), math.cos(phi)
-        K = np.zeros((2, 2))
-        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * self.ddu1(t) * s - self.fp * s
-        return K, np.zeros((2, 2))
-
-    def gaps(self, q, t):
-        return np.array([self.sin_phi0 - math.sin(q[0]) - self.u1(t)])
-
-    def contact_jacobians(self, q, t):
-        phi = q[0]
-        WN = np.array([[-math.cos(phi), 0.0]])
-        WT = np.array([[math.sin(phi), 1.0]]) if self.mu[0] > 0 else np.zeros((0, 2))
-        wT = np.zeros(WT.shape[0])
-        return WN, np.array([-self.du1(t)]), WT, wT
-
-    def contact_drift(self, q, v, t):
-        phi, dphi = q[0], v[0]
-        wNbar = np.array([dphi * dphi * math.sin(phi) - self.ddu1(t)])
-        wTbar = np.array([dphi * dphi * math.cos(phi)]) if self.mu[0] > 0 else np.zeros(0)
-        return wNbar, wTbar
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def slip_velocity(self, q, v):
         """Tangential relative velocity ``u2' + sin(phi) phi'`` (defined also for mu = 0)."""
         return v[1] + math.sin(q[0]) * v[0]
