@@ -62,7 +62,7 @@ velocity, so rod ``b``'s Painlevé configuration is *positive* slip with
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -73,7 +73,7 @@ from ..model.units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from .friction_drive.rod import (MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap,
+from .friction_drive.rod import (MEMO_SLOTS, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
                                   rod_rows)
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import params_with
@@ -85,7 +85,7 @@ __all__ = ["BidirectionalDriveParams", "BidirectionalDrive"]
 
 
 @dataclass(frozen=True)
-class BidirectionalDriveParams:
+class BidirectionalDriveParams(RodParams):
     """Physical parameters of the two-rod drive, in SI units.
 
     The rod, spring, rotor, friction, load and restitution parameters mean
@@ -109,12 +109,6 @@ class BidirectionalDriveParams:
     (2e-06, 0.0, 0.0)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10_a: float = 2.0e-6
     x10_b: float = 2.0e-6
     phase: float = 0.0
@@ -122,10 +116,7 @@ class BidirectionalDriveParams:
     restitution: float = 0.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu")
+        super().__post_init__()
         V.check_fields(self, V.finite_scalar, "load", "phase")
         V.check_fields(self, V.restitution, "restitution")
         for name in ("x10_a", "x10_b"):
@@ -136,10 +127,6 @@ class BidirectionalDriveParams:
                     f"{self.length * math.sin(self.phi0) / 2!r} m so that the rod stays above "
                     f"the horizontal in contact, got {x!r}")
             object.__setattr__(self, name, x)
-
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
     def rod(self, which):
         """The :class:`FrictionDriveParams` of rod ``"a"`` or ``"b"`` alone.

@@ -88,7 +88,7 @@ approach the rigid rod's at that rate.
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
@@ -102,7 +102,7 @@ from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import params_with
-from .friction_drive.rod import StatorMotion
+from .friction_drive.rod import OneRod, RodParams, StatorMotion
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
@@ -178,7 +178,7 @@ def _modes(name, value):
 
 
 @dataclass(frozen=True)
-class FlexibleRodDriveParams:
+class FlexibleRodDriveParams(RodParams):
     """Physical parameters of the flexible-rod drive, in SI units.
 
     Parameters
@@ -204,12 +204,6 @@ class FlexibleRodDriveParams:
     (2, 0.1)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10: float = 2.0e-6
     load: float = 0.0
     restitution: float = 0.0
@@ -235,12 +229,8 @@ class FlexibleRodDriveParams:
                              "has none here")
         return FrictionDriveParams(**{k: getattr(self, k) for k in names})
 
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
-
-class FlexibleRodDrive(StatorMotion, DriveUnits, CompiledScene):
+class FlexibleRodDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     """The friction drive with an Euler–Bernoulli tilt rod of ``N`` bending modes.
 
     Coordinates ``q = (phi, eta_1 .. eta_N, u2)``: the rod's mean-axis angle,
@@ -279,8 +269,6 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, CompiledScene):
     """
 
     name = "flexible-rod-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     #: the rod angle is in rad; the modal amplitudes and the rotor are lengths
     angle_coordinates = (0,)
@@ -345,14 +333,6 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, CompiledScene):
     def shapes(self, q, t=0.0):
         """The stator's hinge, the rod (the chord to its bent tip) and the rotor (``q[-1]`` [m]) at ``t`` [s]."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=self.ndof - 1)
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state at ``tau = 0`` (:meth:`rest_state`)."""
-        return self.rest_state()
 
     def contact_frequencies(self):
         """Natural frequencies [Hz] of the rod with its tip held on the rotor, at rest at ``phi0``.

@@ -91,7 +91,7 @@ the loop has no minor loops; the hysteresis depends on the voltage alone
 """
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -102,6 +102,7 @@ from .. import _validate as V
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
+from .friction_drive.rod import OneRod, RodParams
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ..model.drawing import rod_drive_shapes
@@ -116,7 +117,7 @@ TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
-class PiezoDriveParams:
+class PiezoDriveParams(RodParams):
     """Physical parameters of the voltage-driven friction drive, in SI units.
 
     Parameters
@@ -153,12 +154,6 @@ class PiezoDriveParams:
     2e-06
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     load: float = 0.0
     restitution: float = 0.0
     preload: float = 0.01
@@ -173,11 +168,9 @@ class PiezoDriveParams:
     u_sat: float = 150.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length", "m1", "k1", "gain", "voltage",
-                       "beta")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu", "c1", "preload")
+        super().__post_init__()
+        V.check_fields(self, V.positive, "m1", "k1", "gain", "voltage", "beta")
+        V.check_fields(self, V.nonnegative, "c1", "preload")
         V.check_fields(self, V.finite_scalar, "load")
         V.check_fields(self, V.restitution, "restitution")
         a = V.finite_scalar("alpha", self.alpha)
@@ -194,10 +187,6 @@ class PiezoDriveParams:
                 and us == math.inf):
             us = V.positive("u_sat", us)
         object.__setattr__(self, "u_sat", float(us))
-
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
 
 PIEZO_DEFAULTS = PiezoDriveParams()
@@ -326,7 +315,7 @@ def _drift_rig(par, q, v, t, Dr):
 STATORS = ("dynamic", "rigid")
 
 
-class PiezoDrive(DriveUnits, CompiledScene):
+class PiezoDrive(OneRod, DriveUnits, CompiledScene):
     """The friction drive with a voltage-driven piezo stack under a mass–spring–damper stator.
 
     Coordinates ``q = (phi, u2, u1)`` (rod angle, rotor, stator; ``q = (phi,
@@ -364,8 +353,6 @@ class PiezoDrive(DriveUnits, CompiledScene):
     """
 
     name = "piezo-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = TWO_PI
     cyclic_coordinates = (1,)
     angle_coordinates = (0,)
@@ -521,14 +508,6 @@ class PiezoDrive(DriveUnits, CompiledScene):
     def shapes(self, q, t=0.0):
         """The stator's hinge (moving with the stack), the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m])."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state :meth:`rest_state`."""
-        return self.rest_state()
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""

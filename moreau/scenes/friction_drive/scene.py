@@ -74,7 +74,7 @@ preload), so with ``preload = 0`` every result is the same to the last bit.
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -86,7 +86,8 @@ from ...model.units import DriveUnits
 from numba import njit
 
 from ...compiled import CompiledModel
-from .rod import MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap, rod_rows
+from .rod import (MEMO_SLOTS, OneRod, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
+                  rod_rows)
 from ...model.compiled_scene import CompiledScene
 from ...model.scene import params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
@@ -98,7 +99,7 @@ __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
 
 @dataclass(frozen=True)
-class FrictionDriveParams:
+class FrictionDriveParams(RodParams):
     """Physical parameters of the friction drive, in SI units.
 
     Parameters
@@ -134,22 +135,14 @@ class FrictionDriveParams:
     (0.2, 2e-05)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10: float = 2.0e-6
     load: float = 0.0
     restitution: float = 0.0
     preload: float = 0.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length", "x10")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu")
+        super().__post_init__()
+        V.check_fields(self, V.positive, "x10")
         V.check_fields(self, V.finite_scalar, "load")
         V.check_fields(self, V.restitution, "restitution")
         V.check_fields(self, V.nonnegative, "preload")
@@ -158,15 +151,11 @@ class FrictionDriveParams:
                 f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
                 f"so that the rod stays above the horizontal in contact, got {self.x10!r}")
 
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
-
 
 PAPER_DEFAULTS = FrictionDriveParams()
 
 
-class FrictionDrive(StatorMotion, DriveUnits, CompiledScene):
+class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     """The paper's friction drive at one drive frequency, in dimensionless form.
 
     Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
@@ -196,8 +185,6 @@ class FrictionDrive(StatorMotion, DriveUnits, CompiledScene):
 
     ndof = 2
     name = "friction-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     cyclic_coordinates = (1,)
     #: the scene's own high-precision event-driven scheme, which
@@ -295,14 +282,6 @@ class FrictionDrive(StatorMotion, DriveUnits, CompiledScene):
     def rest_state(self):
         """State at ``tau = 0`` with the rod in contact and everything at rest."""
         return np.array([self.phi0, 0.0]), np.array([0.0, 0.0])
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state :meth:`rest_state` (rod on the rotor at ``phi0``, all at rest)."""
-        return self.rest_state()
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
