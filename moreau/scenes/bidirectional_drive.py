@@ -62,7 +62,7 @@ velocity, so rod ``b``'s Painlevé configuration is *positive* slip with
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -73,9 +73,10 @@ from ..model.units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from .friction_drive.rod import (MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap,
+from .friction_drive.rod import (MEMO_SLOTS, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
                                   rod_rows)
-from ..model.scene import Scene, params_with
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..analysis.cases import DriveCase
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
@@ -84,7 +85,7 @@ __all__ = ["BidirectionalDriveParams", "BidirectionalDrive"]
 
 
 @dataclass(frozen=True)
-class BidirectionalDriveParams:
+class BidirectionalDriveParams(RodParams):
     """Physical parameters of the two-rod drive, in SI units.
 
     The rod, spring, rotor, friction, load and restitution parameters mean
@@ -108,12 +109,6 @@ class BidirectionalDriveParams:
     (2e-06, 0.0, 0.0)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10_a: float = 2.0e-6
     x10_b: float = 2.0e-6
     phase: float = 0.0
@@ -121,10 +116,7 @@ class BidirectionalDriveParams:
     restitution: float = 0.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu")
+        super().__post_init__()
         V.check_fields(self, V.finite_scalar, "load", "phase")
         V.check_fields(self, V.restitution, "restitution")
         for name in ("x10_a", "x10_b"):
@@ -135,10 +127,6 @@ class BidirectionalDriveParams:
                     f"{self.length * math.sin(self.phi0) / 2!r} m so that the rod stays above "
                     f"the horizontal in contact, got {x!r}")
             object.__setattr__(self, name, x)
-
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
     def rod(self, which):
         """The :class:`FrictionDriveParams` of rod ``"a"`` or ``"b"`` alone.
@@ -228,12 +216,15 @@ def params_from_kwargs(**kwargs):
     return BidirectionalDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
 
 
-class BidirectionalDrive(StatorMotion, DriveUnits, Scene):
+class BidirectionalDrive(StatorMotion, DriveUnits, CompiledScene):
     """Two mirror-image rods driving one rotor, in the paper's dimensionless form.
 
     Coordinates ``q = (phi_a, phi_b, u2)``, velocities their derivatives in
     ``tau = w t``; contacts ``0`` (rod ``a``) and ``1`` (rod ``b``), both
-    frictional when ``mu > 0``. See the module docstring for the derivation.
+    frictional when ``mu > 0``. See the module docstring for the derivation;
+    the model methods (``mass``, ``forces``, ``gaps``, ...) evaluate the
+    compiled model, where the equations are written once
+    (:class:`~moreau.model.compiled_scene.CompiledScene`).
 
     Parameters
     ----------
@@ -281,48 +272,7 @@ class BidirectionalDrive(StatorMotion, DriveUnits, Scene):
         #: velocity scale of the motion (the larger stator velocity amplitude), for tolerances
         self.velocity_scale = float(np.max(self.u10)) if np.max(self.u10) > 0 else 1.0
 
-    # -- Scene interface ------------------------------------------------------
-    def mass(self, q):
-        return np.diag([1.0 / 3.0, 1.0 / 3.0, self.J])
-
-    def forces(self, q, v, t):
-        phi = np.asarray(q[:2], dtype=float)
-        c = np.cos(phi)
-        rod = self.P * c * (self.sin_phi0 - np.sin(phi)) - 0.5 * self.ddu1(t) * c
-        return np.array([rod[0], rod[1], -self.fL])
-
-    def force_jacobians(self, q, v, t):
-        K = np.zeros((3, 3))
-        dd1 = self.ddu1(t)
-        for r in range(2):
-            s, c = math.sin(q[r]), math.cos(q[r])
-            K[r, r] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * dd1[r] * s
-        return K, np.zeros((3, 3))
-
-    def gaps(self, q, t):
-        return self.sin_phi0 - np.sin(np.asarray(q[:2], dtype=float)) - self.u1(t)
-
-    def contact_jacobians(self, q, t):
-        phi = np.asarray(q[:2], dtype=float)
-        WN = np.zeros((2, 3))
-        WN[0, 0], WN[1, 1] = -math.cos(phi[0]), -math.cos(phi[1])
-        if self.params.mu > 0.0:
-            WT = np.zeros((2, 3))
-            WT[0, 0] = math.sin(phi[0])
-            WT[1, 1] = -math.sin(phi[1])
-            WT[:, 2] = 1.0
-        else:
-            WT = np.zeros((0, 3))
-        return WN, -self.du1(t), WT, np.zeros(WT.shape[0])
-
-    def contact_drift(self, q, v, t):
-        phi = np.asarray(q[:2], dtype=float)
-        w2 = np.asarray(v[:2], dtype=float) ** 2
-        wNbar = w2 * np.sin(phi) - self.ddu1(t)
-        wTbar = self._side * w2 * np.cos(phi) if self.params.mu > 0.0 else np.zeros(0)
-        return wNbar, wTbar
-
-    # -- conveniences -----------------------------------------------------------
+    # -- conveniences (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def slip_velocities(self, q, v):
         """Slip velocities ``u2' + s_r sin(phi_r) phi_r'`` of both rods (defined also for mu = 0)."""
         return v[2] + self._side * np.sin(np.asarray(q[:2], float)) * np.asarray(v[:2], float)

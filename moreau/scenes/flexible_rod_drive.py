@@ -88,7 +88,7 @@ approach the rigid rod's at that rate.
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numba import njit
@@ -100,8 +100,9 @@ from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
-from ..model.scene import Scene, params_with
-from .friction_drive.rod import StatorMotion
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
+from .friction_drive.rod import OneRod, RodParams, StatorMotion
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
@@ -177,7 +178,7 @@ def _modes(name, value):
 
 
 @dataclass(frozen=True)
-class FlexibleRodDriveParams:
+class FlexibleRodDriveParams(RodParams):
     """Physical parameters of the flexible-rod drive, in SI units.
 
     Parameters
@@ -203,12 +204,6 @@ class FlexibleRodDriveParams:
     (2, 0.1)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10: float = 2.0e-6
     load: float = 0.0
     restitution: float = 0.0
@@ -234,18 +229,16 @@ class FlexibleRodDriveParams:
                              "has none here")
         return FrictionDriveParams(**{k: getattr(self, k) for k in names})
 
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
-
-class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
+class FlexibleRodDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     """The friction drive with an Euler–Bernoulli tilt rod of ``N`` bending modes.
 
     Coordinates ``q = (phi, eta_1 .. eta_N, u2)``: the rod's mean-axis angle,
     the modal amplitudes (deflection over ``l`` per unit mode shape) and the
     rotor position; time ``tau = w t``. One frictional contact at the tip. See
-    the module docstring for the derivation.
+    the module docstring for the derivation; the model methods (``mass``,
+    ``forces``, ``gaps``, ...) evaluate the compiled model, where the
+    equations are written once (:class:`~moreau.model.compiled_scene.CompiledScene`).
 
     Parameters
     ----------
@@ -276,8 +269,6 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
     """
 
     name = "flexible-rod-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     #: the rod angle is in rad; the modal amplitudes and the rotor are lengths
     angle_coordinates = (0,)
@@ -323,68 +314,7 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
                 "bending_frequencies_Hz": [float(f) for f in self.bending_frequencies],
                 "bending_over_drive_frequency": float(self.bending_frequency / self.frequency)}
 
-    # -- Scene interface ------------------------------------------------------
-    def mass(self, q):
-        return np.diag(np.concatenate([[1.0 / 3.0], np.ones(self.N), [self.J]]))
-
-    def forces(self, q, v, t):
-        n = self.N
-        phi, eta, deta = q[0], np.asarray(q[1:1 + n], float), np.asarray(v[1:1 + n], float)
-        s, c = math.sin(phi), math.cos(phi)
-        dd1 = self.ddu1(t)
-        h = np.empty(n + 2)
-        h[0] = self.P * c * (self.sin_phi0 - s) - dd1 * (0.5 * c - s * float(self.beta @ eta))
-        h[0] += self.fp * c
-        h[1:1 + n] = (-dd1 * c * self.beta - self.Omega ** 2 * eta
-                      - 2.0 * self.zeta * self.Omega * deta)
-        h[n + 1] = -self.fL
-        return h
-
-    def force_jacobians(self, q, v, t):
-        n = self.N
-        phi, eta = q[0], np.asarray(q[1:1 + n], float)
-        s, c = math.sin(phi), math.cos(phi)
-        dd1 = self.ddu1(t)
-        K = np.zeros((n + 2, n + 2))
-        C = np.zeros((n + 2, n + 2))
-        K[0, 0] = (self.P * (-s * (self.sin_phi0 - s) - c * c)
-                   + dd1 * (0.5 * s + c * float(self.beta @ eta)) - self.fp * s)
-        K[0, 1:1 + n] = dd1 * s * self.beta
-        K[1:1 + n, 0] = dd1 * s * self.beta
-        K[1:1 + n, 1:1 + n] = np.diag(-self.Omega ** 2)
-        C[1:1 + n, 1:1 + n] = np.diag(-2.0 * self.zeta * self.Omega)
-        return K, C
-
-    def gaps(self, q, t):
-        phi = q[0]
-        return np.array([self.sin_phi0 - math.sin(phi) - self.tip_deflection(q) * math.cos(phi)
-                         - self.u1(t)])
-
-    def contact_jacobians(self, q, t):
-        n = self.N
-        phi, d = q[0], self.tip_deflection(q)
-        s, c = math.sin(phi), math.cos(phi)
-        WN = np.zeros((1, n + 2))
-        WN[0, 0] = -c + d * s
-        WN[0, 1:1 + n] = -self.psi * c
-        if self.mu[0] > 0:
-            WT = np.zeros((1, n + 2))
-            WT[0, 0] = s + d * c
-            WT[0, 1:1 + n] = self.psi * s
-            WT[0, n + 1] = 1.0
-        else:
-            WT = np.zeros((0, n + 2))
-        return WN, np.array([-self.du1(t)]), WT, np.zeros(WT.shape[0])
-
-    def contact_drift(self, q, v, t):
-        phi, dphi = q[0], v[0]
-        d, dd = self.tip_deflection(q), self.tip_deflection(v)
-        s, c = math.sin(phi), math.cos(phi)
-        wNbar = np.array([dphi * dphi * (s + d * c) + 2.0 * dphi * dd * s - self.ddu1(t)])
-        wTbar = (np.array([dphi * dphi * (c - d * s) + 2.0 * dphi * dd * c])
-                 if self.mu[0] > 0 else np.zeros(0))
-        return wNbar, wTbar
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def slip_velocity(self, q, v):
         """Tangential relative velocity ``WT v`` at the tip (defined also for mu = 0)."""
         phi, d, dd = q[0], self.tip_deflection(q), self.tip_deflection(v)
@@ -403,14 +333,6 @@ class FlexibleRodDrive(StatorMotion, DriveUnits, Scene):
     def shapes(self, q, t=0.0):
         """The stator's hinge, the rod (the chord to its bent tip) and the rotor (``q[-1]`` [m]) at ``t`` [s]."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=self.ndof - 1)
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state at ``tau = 0`` (:meth:`rest_state`)."""
-        return self.rest_state()
 
     def contact_frequencies(self):
         """Natural frequencies [Hz] of the rod with its tip held on the rotor, at rest at ``phi0``.

@@ -91,7 +91,7 @@ the loop has no minor loops; the hysteresis depends on the voltage alone
 """
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
@@ -102,11 +102,13 @@ from .. import _validate as V
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
+from .friction_drive.rod import OneRod, RodParams
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
-from ..model.scene import Scene, params_with
+from ..model.compiled_scene import CompiledScene
+from ..model.scene import params_with
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
 __all__ = ["PiezoDriveParams", "PiezoDrive", "HysteresisFit", "identify_hysteresis"]
@@ -115,7 +117,7 @@ TWO_PI = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
-class PiezoDriveParams:
+class PiezoDriveParams(RodParams):
     """Physical parameters of the voltage-driven friction drive, in SI units.
 
     Parameters
@@ -152,12 +154,6 @@ class PiezoDriveParams:
     2e-06
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     load: float = 0.0
     restitution: float = 0.0
     preload: float = 0.01
@@ -172,11 +168,9 @@ class PiezoDriveParams:
     u_sat: float = 150.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length", "m1", "k1", "gain", "voltage",
-                       "beta")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu", "c1", "preload")
+        super().__post_init__()
+        V.check_fields(self, V.positive, "m1", "k1", "gain", "voltage", "beta")
+        V.check_fields(self, V.nonnegative, "c1", "preload")
         V.check_fields(self, V.finite_scalar, "load")
         V.check_fields(self, V.restitution, "restitution")
         a = V.finite_scalar("alpha", self.alpha)
@@ -193,10 +187,6 @@ class PiezoDriveParams:
                 and us == math.inf):
             us = V.positive("u_sat", us)
         object.__setattr__(self, "u_sat", float(us))
-
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
 
 
 PIEZO_DEFAULTS = PiezoDriveParams()
@@ -325,12 +315,15 @@ def _drift_rig(par, q, v, t, Dr):
 STATORS = ("dynamic", "rigid")
 
 
-class PiezoDrive(DriveUnits, Scene):
+class PiezoDrive(OneRod, DriveUnits, CompiledScene):
     """The friction drive with a voltage-driven piezo stack under a mass–spring–damper stator.
 
     Coordinates ``q = (phi, u2, u1)`` (rod angle, rotor, stator; ``q = (phi,
     u2)`` for a rigid stator), time ``tau = w t``; one frictional contact.
-    See the module docstring for the model and its derivation.
+    See the module docstring for the model and its derivation; the model
+    methods (``mass``, ``forces``, ``gaps``, ...) evaluate the compiled model,
+    where the equations are written once
+    (:class:`~moreau.model.compiled_scene.CompiledScene`).
 
     Parameters
     ----------
@@ -360,8 +353,6 @@ class PiezoDrive(DriveUnits, Scene):
     """
 
     name = "piezo-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = TWO_PI
     cyclic_coordinates = (1,)
     angle_coordinates = (0,)
@@ -468,70 +459,7 @@ class PiezoDrive(DriveUnits, Scene):
         down = quad(falling, 0.0, 1.0, **opts)[0]
         return p.gain * p.voltage ** 2 * (up - down)
 
-    # -- Scene interface ------------------------------------------------------------
-    def mass(self, q):
-        if self.ndof == 2:
-            return np.diag([1.0 / 3.0, self.J])
-        half_c = 0.5 * math.cos(q[0])
-        return np.array([[1.0 / 3.0, 0.0, half_c], [0.0, self.J, 0.0], [half_c, 0.0, 1.0 + self.J1]])
-
-    def forces(self, q, v, t):
-        s, c = math.sin(q[0]), math.cos(q[0])
-        w, _, ddw = _stroke(self._par, float(t))
-        rod = self.P * c * (self.sin_phi0 - s) + self.fp * c
-        if self.ndof == 2:
-            return np.array([rod - 0.5 * ddw * c, -self.fL])
-        return np.array([rod, -self.fL,
-                         0.5 * v[0] ** 2 * s + self.K1 * (w - q[2]) - self.C1 * v[2]])
-
-    def force_jacobians(self, q, v, t):
-        s, c = math.sin(q[0]), math.cos(q[0])
-        n = self.ndof
-        K, C = np.zeros((n, n)), np.zeros((n, n))
-        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) - self.fp * s
-        if n == 2:
-            K[0, 0] += 0.5 * _stroke(self._par, float(t))[2] * s
-            return K, C
-        K[2, 0] = 0.5 * v[0] ** 2 * c
-        K[2, 2] = -self.K1
-        C[2, 0] = v[0] * s
-        C[2, 2] = -self.C1
-        return K, C
-
-    def _stator(self, q, t):
-        # (u1, u1') of the stator: a coordinate, or the prescribed free stroke
-        if self.ndof == 3:
-            return q[2], None
-        w, dw, _ = _stroke(self._par, float(t))
-        return w, dw
-
-    def gaps(self, q, t):
-        return np.array([self.sin_phi0 - math.sin(q[0]) - self._stator(q, t)[0]])
-
-    def contact_jacobians(self, q, t):
-        n = self.ndof
-        WN = np.zeros((1, n))
-        WN[0, 0] = -math.cos(q[0])
-        if n == 3:
-            WN[0, 2] = -1.0
-            wN = np.zeros(1)
-        else:
-            wN = np.array([-self._stator(q, t)[1]])
-        if self.mu[0] > 0:
-            WT = np.zeros((1, n))
-            WT[0, 0], WT[0, 1] = math.sin(q[0]), 1.0
-        else:
-            WT = np.zeros((0, n))
-        return WN, wN, WT, np.zeros(WT.shape[0])
-
-    def contact_drift(self, q, v, t):
-        w2 = v[0] ** 2
-        wNbar = w2 * math.sin(q[0])
-        if self.ndof == 2:
-            wNbar -= _stroke(self._par, float(t))[2]
-        wTbar = np.array([w2 * math.cos(q[0])]) if self.mu[0] > 0 else np.zeros(0)
-        return np.array([wNbar]), wTbar
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def amplification(self, harmonics=7):
         """Largest dynamic amplification ``|H(k f)|`` of the stator over the first harmonics.
 
@@ -580,14 +508,6 @@ class PiezoDrive(DriveUnits, Scene):
     def shapes(self, q, t=0.0):
         """The stator's hinge (moving with the stack), the rod (``q[0]`` [rad]) and the rotor (``q[1]`` [m])."""
         return rod_drive_shapes(self, q, t, rods=[(0, 1.0)], rotor=1)
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state :meth:`rest_state`."""
-        return self.rest_state()
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""

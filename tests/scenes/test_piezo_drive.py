@@ -223,6 +223,63 @@ def test_the_contact_force_pushes_the_stator_down_at_rest():
     assert abs(s.gaps(q, 0.0)[0]) <= 1e-15
 
 
+def _fd(f, x, i, h=1e-5):
+    # central 6th-order difference of f along coordinate i
+    e = np.zeros_like(x)
+    e[i] = h
+    return (f(x + 3 * e) - 9 * f(x + 2 * e) + 45 * f(x + e) - 45 * f(x - e) + 9 * f(x - 2 * e)
+            - f(x - 3 * e)) / (60 * h)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_dynamic_stator_equations_from_the_lagrangian_of_the_geometry(seed):
+    """M, h, the contact rows and drift of q = (phi, u2, u1) from T, V and the stack's force.
+
+    Written from the geometry (stator block at height u1, rod centre and tip, rotor),
+    differentiated numerically: the scene's methods are its compiled model, written once.
+    """
+    rng = np.random.default_rng(seed)
+    s = PiezoDrive(frequency=float(rng.uniform(300.0, 3000.0)), preload=float(rng.uniform(0, 0.02)),
+                   mu=0.3, load=float(rng.uniform(-1e-3, 1e-3)))
+    s0, J, J1 = s.sin_phi0, s.J, s.J1
+
+    def T(q, v):
+        # stator block J1 at (0, u1); rod centre (cos phi / 2, u1 + sin phi / 2), inertia 1/12
+        xc, yc = -0.5 * np.sin(q[0]) * v[0], v[2] + 0.5 * np.cos(q[0]) * v[0]
+        return 0.5 * J1 * v[2] ** 2 + 0.5 * (xc * xc + yc * yc) + v[0] ** 2 / 24 + 0.5 * J * v[1] ** 2
+
+    def V(q):
+        return 0.5 * s.P * (s0 - np.sin(q[0])) ** 2 + s.fp * (s0 - np.sin(q[0]))
+
+    q = np.array([rng.uniform(0.5, 1.1), rng.normal(), rng.normal() * 1e-3])
+    v = rng.normal(size=3) * 0.01
+    tau = float(rng.uniform(0.0, TWO_PI))
+    X = np.r_[q, v]
+    M = np.array([[_fd(lambda y: _fd(lambda w: T(q, w), y, j), v, i) for j in range(3)]
+                  for i in range(3)])
+    np.testing.assert_allclose(s.mass(q), M, rtol=0, atol=1e-7)
+
+    def p(x, i):
+        return _fd(lambda w: T(x[:3], w), x[3:], i)
+
+    dLdq = np.array([_fd(lambda x: T(x[:3], x[3:]) - V(x[:3]), X, i) for i in range(3)])
+    dpdt = np.array([sum(_fd(lambda x: p(x, i), X, j) * v[j] for j in range(3)) for i in range(3)])
+    w = float(s.free_stroke(tau)[0])
+    stack = np.array([0.0, -s.fL, s.K1 * (w - q[2]) - s.C1 * v[2]])
+    np.testing.assert_allclose(s.forces(q, v, tau), dLdq - dpdt + stack, rtol=1e-6,
+                               atol=1e-8 * (1.0 + s.P + s.K1))
+    gN = lambda x: s0 - (x[2] + np.sin(x[0]))      # noqa: E731 (rotor surface minus tip height)
+    gT = lambda x: x[1] - np.cos(x[0])              # noqa: E731
+    WN, wN, WT, wT = s.contact_jacobians(q, tau)
+    np.testing.assert_allclose(WN[0], [_fd(gN, q, i) for i in range(3)], atol=1e-9)
+    np.testing.assert_allclose(WT[0], [_fd(gT, q, i) for i in range(3)], atol=1e-9)
+    assert wN.tolist() == [0.0] and wT.tolist() == [0.0]
+    path = lambda h: np.array([gN(q + h * v), gT(q + h * v)])    # noqa: E731
+    np.testing.assert_allclose(np.concatenate(s.contact_drift(q, v, tau)),
+                               (path(1e-3) - 2 * path(0.0) + path(-1e-3)) / 1e-6,
+                               rtol=1e-5, atol=1e-9)
+
+
 def test_moreau_jean_converges_to_the_event_driven_run_with_a_dynamic_stator():
     s = PiezoDrive(frequency=1400.0)
     q0, v0 = s.initial_state()

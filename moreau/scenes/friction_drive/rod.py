@@ -21,14 +21,16 @@ times (:func:`memo_sincos`).
 """
 
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from numba import njit
 
+from ... import _validate as V
 from ..._validate import positive
 
-__all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS"]
+__all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS", "RodParams", "OneRod"]
 
 #: entries of ``par`` that :func:`memo_sincos` keeps for one argument, and what they
 #: start at: an argument with its sine and cosine, exact ones, so that ``par`` is
@@ -83,6 +85,63 @@ def rod_rows(G, r, j, rotor, n, sgn, u10, s, c, st, need_T):
     if need_T:
         G[r, 3 + n + j] = sgn * s
         G[r, 3 + n + rotor] = 1.0
+
+
+@dataclass(frozen=True)
+class RodParams:
+    """The parameters every rod drive shares, in SI units (the paper's values by default).
+
+    The rod drives' parameter classes extend it, so that these fields come
+    first, in this order, with these defaults and rules, in each of them.
+
+    Parameters
+    ----------
+    m, m2, k, length, phi0, mu : float
+        Rod and rotor masses [kg], spring stiffness [N/m] and rod length [m],
+        each > 0; the rod's tilt at rest [rad], in (0, pi/2); the friction
+        coefficient, >= 0 (as in
+        :class:`~moreau.scenes.friction_drive.FrictionDriveParams`).
+
+    Examples
+    --------
+    >>> RodParams(mu=0.2).with_(m=1e-5)
+    RodParams(m=1e-05, m2=0.002, k=10000.0, length=0.001, phi0=0.7853981633974483, mu=0.2)
+    """
+
+    m: float = 2.0e-5
+    m2: float = 2.0e-3
+    k: float = 1.0e4
+    length: float = 1.0e-3
+    phi0: float = math.pi / 4
+    mu: float = 0.1
+
+    def __post_init__(self):
+        V.check_fields(self, V.positive, "m", "m2", "k", "length")
+        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
+                                                            "in the open interval (0, pi/2)"))
+        V.check_fields(self, V.nonnegative, "mu")
+
+    def with_(self, **changes):
+        """Copy with some parameters changed (validated again)."""
+        return replace(self, **changes)
+
+
+class OneRod:
+    """What the drives of one rod at angle ``q[0]`` share: its valid region and first state.
+
+    A mixin; the scene defines ``rest_state()``.
+    """
+
+    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
+    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
+
+    def inside_valid_region(self, t, q, v):
+        phi = np.asarray(q)[:, 0]
+        return (phi > 0.0) & (phi < 0.5 * math.pi)
+
+    def initial_state(self):
+        """The rest state :meth:`rest_state` at ``tau = 0``."""
+        return self.rest_state()
 
 
 class StatorMotion:

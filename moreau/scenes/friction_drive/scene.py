@@ -74,7 +74,7 @@ preload), so with ``preload = 0`` every result is the same to the last bit.
 """
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -86,8 +86,10 @@ from ...model.units import DriveUnits
 from numba import njit
 
 from ...compiled import CompiledModel
-from .rod import MEMO_SLOTS, StatorMotion, memo_sincos, rod_forces, rod_gap, rod_rows
-from ...model.scene import Scene, params_with
+from .rod import (MEMO_SLOTS, OneRod, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
+                  rod_rows)
+from ...model.compiled_scene import CompiledScene
+from ...model.scene import params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
 from ...analysis.steady_state import find_steady_state
 from ...integrators import simulate
@@ -97,7 +99,7 @@ __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 
 
 @dataclass(frozen=True)
-class FrictionDriveParams:
+class FrictionDriveParams(RodParams):
     """Physical parameters of the friction drive, in SI units.
 
     Parameters
@@ -133,22 +135,14 @@ class FrictionDriveParams:
     (0.2, 2e-05)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
     x10: float = 2.0e-6
     load: float = 0.0
     restitution: float = 0.0
     preload: float = 0.0
 
     def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length", "x10")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu")
+        super().__post_init__()
+        V.check_fields(self, V.positive, "x10")
         V.check_fields(self, V.finite_scalar, "load")
         V.check_fields(self, V.restitution, "restitution")
         V.check_fields(self, V.nonnegative, "preload")
@@ -157,19 +151,20 @@ class FrictionDriveParams:
                 f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
                 f"so that the rod stays above the horizontal in contact, got {self.x10!r}")
 
-    def with_(self, **changes):
-        """Copy with some parameters changed (validated again)."""
-        return replace(self, **changes)
-
 
 PAPER_DEFAULTS = FrictionDriveParams()
 
 
-class FrictionDrive(StatorMotion, DriveUnits, Scene):
+class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     """The paper's friction drive at one drive frequency, in dimensionless form.
 
     Coordinates ``q = (phi, u2)``, velocities ``v = (dphi/dtau, du2/dtau)``,
-    time ``tau = w t`` with ``w = 2 pi f``. One frictional contact.
+    time ``tau = w t`` with ``w = 2 pi f``. One frictional contact. The model
+    methods (``mass``, ``forces``, ``gaps``, ...) evaluate the compiled model,
+    where the equations are written once
+    (:class:`~moreau.model.compiled_scene.CompiledScene`); the closed forms on
+    the contact manifold (:meth:`contact_angle`, :meth:`coefficients`,
+    :meth:`contact_forces`) are the walker's own.
 
     Parameters
     ----------
@@ -190,8 +185,6 @@ class FrictionDrive(StatorMotion, DriveUnits, Scene):
 
     ndof = 2
     name = "friction-drive"
-    #: the rod's geometry (tip towards the rotor, contact above the hinge) holds only there
-    valid_region = "0 < phi < pi/2 (the rod leans towards the rotor from below its upright position)"
     period = 2.0 * math.pi
     cyclic_coordinates = (1,)
     #: the scene's own high-precision event-driven scheme, which
@@ -281,38 +274,7 @@ class FrictionDrive(StatorMotion, DriveUnits, Scene):
         """``1 - mu tan(phi)``; the contact problem is well posed only where it is > 0."""
         return 1.0 - float(self.mu[0]) * np.tan(phi)
 
-    # -- Scene interface ------------------------------------------------------
-    def mass(self, q):
-        return np.diag([1.0 / 3.0, self.J])
-
-    def forces(self, q, v, t):
-        phi = q[0]
-        return np.array([self.P * math.cos(phi) * (self.sin_phi0 - math.sin(phi))
-                         - 0.5 * self.ddu1(t) * math.cos(phi) + self.fp * math.cos(phi), -self.fL])
-
-    def force_jacobians(self, q, v, t):
-        phi = q[0]
-        s, c = math.sin(phi), math.cos(phi)
-        K = np.zeros((2, 2))
-        K[0, 0] = self.P * (-s * (self.sin_phi0 - s) - c * c) + 0.5 * self.ddu1(t) * s - self.fp * s
-        return K, np.zeros((2, 2))
-
-    def gaps(self, q, t):
-        return np.array([self.sin_phi0 - math.sin(q[0]) - self.u1(t)])
-
-    def contact_jacobians(self, q, t):
-        phi = q[0]
-        WN = np.array([[-math.cos(phi), 0.0]])
-        WT = np.array([[math.sin(phi), 1.0]]) if self.mu[0] > 0 else np.zeros((0, 2))
-        wT = np.zeros(WT.shape[0])
-        return WN, np.array([-self.du1(t)]), WT, wT
-
-    def contact_drift(self, q, v, t):
-        phi, dphi = q[0], v[0]
-        wNbar = np.array([dphi * dphi * math.sin(phi) - self.ddu1(t)])
-        wTbar = np.array([dphi * dphi * math.cos(phi)]) if self.mu[0] > 0 else np.zeros(0)
-        return wNbar, wTbar
-
+    # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def slip_velocity(self, q, v):
         """Tangential relative velocity ``u2' + sin(phi) phi'`` (defined also for mu = 0)."""
         return v[1] + math.sin(q[0]) * v[0]
@@ -320,14 +282,6 @@ class FrictionDrive(StatorMotion, DriveUnits, Scene):
     def rest_state(self):
         """State at ``tau = 0`` with the rod in contact and everything at rest."""
         return np.array([self.phi0, 0.0]), np.array([0.0, 0.0])
-
-    def inside_valid_region(self, t, q, v):
-        phi = np.asarray(q)[:, 0]
-        return (phi > 0.0) & (phi < 0.5 * math.pi)
-
-    def initial_state(self):
-        """The rest state :meth:`rest_state` (rod on the rotor at ``phi0``, all at rest)."""
-        return self.rest_state()
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
