@@ -17,10 +17,14 @@ Layout of ``par`` (integers stored as floats)
 the body, contact and force tables; ``ndof``; gravity ``(gx, gy)``; number
 and offset of the joint records.
 
-Body record (``BREC`` floats): ``kind`` (0 fixed, 1 free, 2 driven), first
-coordinate index (free bodies), mass, inertia, then a fixed body's pose
-``(x, y, theta)`` with ``cos theta, sin theta``, or the offsets of a driven
-body's three time functions.
+Body record (``BREC`` floats): ``kind`` (0 fixed, 1 free, 2 driven, 3
+guided), first coordinate index (free bodies), mass, inertia, then a fixed
+body's pose ``(x, y, theta)`` with ``cos theta, sin theta``, or the offsets
+of a driven body's three time functions. A guided body (some coordinates
+free, the others prescribed) keeps its inertia about its frame's origin,
+then per coordinate ``x, y, theta`` one code: its coordinate index where it
+is free, ``-1 - offset`` of its time function where it is prescribed; then
+its centre of mass ``(cx, cy)`` in its frame.
 
 Time function at offset ``o``: ``c0, c1, c2, nh, (A, w, phi) * nh``, the value
 ``c0 + c1 t + c2 t^2 / 2 + sum A sin(w t + phi)``.
@@ -35,7 +39,8 @@ radius ``rhoB``) around the pin ``rA`` of radius ``rhoA`` (a revolute joint
 with clearance).
 
 Force record (``FREC`` floats): ``SPRING`` (bodies ``i, j``, points
-``ri, rj``, stiffness, rest length, damping), ``TORSION`` (bodies ``i, j``,
+``ri, rj``, stiffness, rest length, damping), ``AXIAL`` (the same, then the
+world direction ``(ex, ey)`` its length is measured along), ``TORSION`` (bodies ``i, j``,
 stiffness, rest angle, damping), ``FORCE`` (body, point, offsets of the time
 functions of the world components), ``TORQUE`` (body, offset of its time
 function).
@@ -56,9 +61,9 @@ BREC = 10
 CREC = 14
 FREC = 12
 
-FIXED, FREE, DRIVEN = 0, 1, 2
+FIXED, FREE, DRIVEN, GUIDED = 0, 1, 2, 3
 PLANE, POINTS, POLY = 0, 1, 2
-SPRING, TORSION, FORCE, TORQUE = 0, 1, 2, 3
+SPRING, TORSION, FORCE, TORQUE, AXIAL = 0, 1, 2, 3, 4
 JPOINT, JLINE, JANGLE = 0, 1, 2
 
 
@@ -74,6 +79,19 @@ def harmonic_part(f, d1, d2, A, w, ph, t):
     s = math.sin(w * t + ph)
     c = math.cos(w * t + ph)
     return f + A * s, d1 + A * w * c, d2 - A * w * w * s
+
+
+#: the phase that makes a harmonic a cosine, evaluated as one (``sin(w t + pi/2)`` would
+#: round ``pi/2``: its rate at ``t = 0`` would be ``A w 6e-17``, not 0)
+QUARTER = 0.5 * math.pi
+
+
+@njit
+def cosine_part(f, d1, d2, A, w, t):
+    """``(f, f', f'')`` plus those of ``A cos(w t)``, the harmonic of phase :data:`QUARTER`."""
+    c = math.cos(w * t)
+    s = math.sin(w * t)
+    return f + A * c, d1 - A * w * s, d2 - A * w * w * c
 
 
 @njit
@@ -252,6 +270,24 @@ def spring_terms(xi, yi, ci, si, vxi, vyi, wi, pix, piy, xj, yj, cj, sj, vxj, vy
     return (-f * ex, -f * ey,
             -(ex * (k * ex + ux) + f / ln * Ixx), -(ex * (k * ey + uy) + f / ln * Ixy),
             -(ey * (k * ex + ux) + f / ln * Ixy), -(ey * (k * ey + uy) + f / ln * Iyy),
+            -c * ex * ex, -c * ex * ey, -c * ey * ey, rix, riy, rjx, rjy)
+
+
+@njit
+def axial_spring_terms(xi, yi, ci, si, vxi, vyi, wi, pix, piy, xj, yj, cj, sj, vxj, vyj, wj,
+                       pjx, pjy, k, l0, c, ex, ey):
+    """A spring-dashpot along the fixed world direction ``e``: the terms of :func:`spring_terms`.
+
+    Its length is ``l = e . P`` with ``P = P_i - P_j``, its tension ``f = k (l
+    - l0) + c l'``, the force on ``P_i`` is ``F = -f e``; ``e`` does not turn,
+    so ``dF/dP = -k e e^T`` and ``dF/dP' = -c e e^T``.
+    """
+    rix, riy = turn(ci, si, pix, piy)
+    rjx, rjy = turn(cj, sj, pjx, pjy)
+    ln = ex * (xi + rix - xj - rjx) + ey * (yi + riy - yj - rjy)
+    ld = ex * (vxi - wi * riy - vxj + wj * rjy) + ey * (vyi + wi * rix - vyj - wj * rjx)
+    f = k * (ln - l0) + c * ld
+    return (-f * ex, -f * ey, -k * ex * ex, -k * ex * ey, -k * ey * ex, -k * ey * ey,
             -c * ex * ex, -c * ex * ey, -c * ey * ey, rix, riy, rjx, rjy)
 
 
