@@ -35,7 +35,7 @@ from moreau.model.planar._kernels import (closest_feature, drift_plane, drift_po
     frame_plane, frame_points, frame_poly, harmonic_part, lever, poly_part, spring_block,
     spring_terms, turn)
 from moreau.model.planar._kernels import drift_hole, frame_hole
-from moreau.model.planar._kernels import axial_spring_terms, cosine_part
+from moreau.model.planar._kernels import axial_spring_terms, kept_harmonic, kept_sincos
 '''
 
 
@@ -87,13 +87,8 @@ def _time_function(lines, st, off, names, indent):
     lines.append(f"{indent}{f}, {d1}, {d2} = poly_part({p}[{off}], {p}[{off + 1}], "
                  f"{p}[{off + 2}], t)")
     for h in range(_i(st.par[off + 3])):
-        a = off + 4 + 3 * h
-        if st.par[a + 2] == K.QUARTER:
-            lines.append(f"{indent}{f}, {d1}, {d2} = cosine_part({f}, {d1}, {d2}, {p}[{a}], "
-                         f"{p}[{a + 1}], t)")
-            continue
-        lines.append(f"{indent}{f}, {d1}, {d2} = harmonic_part({f}, {d1}, {d2}, {p}[{a}], "
-                     f"{p}[{a + 1}], {p}[{a + 2}], t)")
+        a = off + 4 + K.HREC * h
+        lines.append(f"{indent}{f}, {d1}, {d2} = kept_harmonic({p}, {a}, {f}, {d1}, {d2}, t)")
 
 
 def _bodies(lines, st, used, with_v, indent="    "):
@@ -131,7 +126,10 @@ def _bodies(lines, st, used, with_v, indent="    "):
                                            ("th", "w", "al"))):
                 _time_function(lines, st, _i(st.par[o + 7 + j]), (f"{a}{k}", f"{b}{k}", f"{c}{k}"),
                                indent)
-        lines.append(f"{indent}c{k} = math.cos(th{k}); s{k} = math.sin(th{k})")
+        if kind == K.FREE:
+            lines.append(f"{indent}c{k} = math.cos(th{k}); s{k} = math.sin(th{k})")
+        else:
+            lines.append(f"{indent}s{k}, c{k} = kept_sincos(par, {d}, th{k})")
 
 
 def _frame(lines, st, i, indent="    "):

@@ -24,10 +24,14 @@ of a driven body's three time functions. A guided body (some coordinates
 free, the others prescribed) keeps its inertia about its frame's origin,
 then per coordinate ``x, y, theta`` one code: its coordinate index where it
 is free, ``-1 - offset`` of its time function where it is prescribed; then
-its centre of mass ``(cx, cy)`` in its frame.
+its centre of mass ``(cx, cy)`` in its frame. A driven or guided body's
+second entry is the offset of the memory of its angle's sine and cosine
+(:func:`kept_sincos`).
 
-Time function at offset ``o``: ``c0, c1, c2, nh, (A, w, phi) * nh``, the value
-``c0 + c1 t + c2 t^2 / 2 + sum A sin(w t + phi)``.
+Time function at offset ``o``: ``c0, c1, c2, nh, (A, w, phi, x, sin x, cos x) *
+nh``, the value ``c0 + c1 t + c2 t^2 / 2 + sum A sin(w t + phi)``; each harmonic
+keeps the last argument ``x`` of its sine and cosine with their values
+(:func:`kept_sincos`).
 
 Contact record (``CREC`` floats): ``kind``, body ``A``, body ``B``, the point
 ``rA`` of ``A`` (body frame) and its radius ``rhoA``, then by kind:
@@ -61,6 +65,11 @@ BREC = 10
 CREC = 14
 FREC = 12
 
+#: floats of a harmonic of a time function: A, w, phi and the memory of its sine and cosine
+HREC = 6
+#: what a memory of :func:`kept_sincos` starts at: an argument with its sine and cosine
+KEPT_SLOTS = (0.0, 0.0, 1.0)
+
 FIXED, FREE, DRIVEN, GUIDED = 0, 1, 2, 3
 PLANE, POINTS, POLY = 0, 1, 2
 SPRING, TORSION, FORCE, TORQUE, AXIAL = 0, 1, 2, 3, 4
@@ -87,11 +96,41 @@ QUARTER = 0.5 * math.pi
 
 
 @njit
-def cosine_part(f, d1, d2, A, w, t):
-    """``(f, f', f'')`` plus those of ``A cos(w t)``, the harmonic of phase :data:`QUARTER`."""
-    c = math.cos(w * t)
-    s = math.sin(w * t)
-    return f + A * c, d1 - A * w * s, d2 - A * w * w * c
+def kept_sincos(par, j, x):
+    """``(sin x, cos x)``, from ``par[j + 1], par[j + 2]`` when ``par[j]`` is ``x``, else computed and kept there.
+
+    A scheme's step evaluates a model's functions several times at one time
+    and one state: a driven body's angle and a harmonic's phase are then the
+    same from call to call, and their sines and cosines are computed once.
+    The kept values are those the library returns for that argument, so
+    every result is the same to the last bit (a zero hits only a zero of its
+    own sign). The slots start at ``(0, 0, 1)``, consistent.
+    """
+    key = par[j]
+    if x == key and (x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, key)):
+        return par[j + 1], par[j + 2]
+    s = math.sin(x)
+    c = math.cos(x)
+    par[j] = x
+    par[j + 1] = s
+    par[j + 2] = c
+    return s, c
+
+
+@njit
+def kept_harmonic(par, a, f, d1, d2, t):
+    """``(f, f', f'')`` plus those of the harmonic at ``par[a:a + 6]`` (``A, w, phi`` and its memory).
+
+    A phase of :data:`QUARTER` is the cosine ``A cos(w t)``.
+    """
+    A = par[a]
+    w = par[a + 1]
+    ph = par[a + 2]
+    if ph == QUARTER:
+        s, c = kept_sincos(par, a + 3, w * t)
+        return f + A * c, d1 - A * w * s, d2 - A * w * w * c
+    s, c = kept_sincos(par, a + 3, w * t + ph)
+    return f + A * s, d1 + A * w * c, d2 - A * w * w * s
 
 
 @njit

@@ -96,7 +96,7 @@ class TimeFunction:
         out = [self.value / unit, self.rate * time / unit, self.accel * time ** 2 / unit,
                float(len(self.harmonics))]
         for A, w, ph in self.harmonics:
-            out += [A / unit, w * time, ph]
+            out += [A / unit, w * time, ph, *K.KEPT_SLOTS]
         return out
 
 
@@ -738,8 +738,11 @@ class Model:
             if rec["kind"] == K.FREE:
                 r[1], r[2], r[3] = dof, rec["mass"] / Mu, rec["inertia"] / (Mu * L * L)
                 dof += 3
-            else:
+            elif rec["kind"] == K.FIXED:
                 r[1] = -1
+            else:
+                # the memory of the angle's sine and cosine (the kernels' kept_sincos)
+                r[1] = ("T", put(K.KEPT_SLOTS))
             if rec["kind"] == K.FIXED:
                 th = rec["pose"][2]
                 r[4:9] = [rec["pose"][0] / L, rec["pose"][1] / L, th, math.cos(th), math.sin(th)]
