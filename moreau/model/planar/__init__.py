@@ -4,7 +4,8 @@ A :class:`Model` holds bodies in maximal coordinates (each free body's
 ``x, y, theta`` of its centre of mass, in the order added), fixed bodies
 and driven ones (a prescribed :class:`TimeFunction` motion: cranks,
 stators), guided ones (some coordinates prescribed, the others free: a
-rod hinged on a moving stator, a slider on a guide), shapes (:class:`Point`, :class:`Circle`, :class:`Segment`, convex
+rod hinged on a moving stator, a slider on a guide), shapes
+(:class:`Point`, :class:`Circle`, :class:`Segment`, convex
 :class:`Polygon`, :class:`HalfPlane`), contacts between shapes with their
 own ``mu`` and ``e``, and forces (gravity, springs and dashpots between body
 points, along their distance or along a fixed direction, torsion springs,

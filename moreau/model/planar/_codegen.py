@@ -339,9 +339,9 @@ def _spring(lines, st, o):
             continue
         ends.append((body, sg, r, dofs))
         op = "+=" if sg > 0 else "-="
-        lines.append("    " + "; ".join(
-            f"D[{dj}, 0] {op} {val}" for dj, val in zip(dofs, ("Fx", "Fy", f"{r}x * Fy - {r}y * Fx"))
-            if dj is not None))
+        values = ("Fx", "Fy", f"{r}x * Fy - {r}y * Fx")
+        lines.append("    " + "; ".join(f"D[{dj}, 0] {op} {val}" for dj, val in zip(dofs, values)
+                                        if dj is not None))
     if not ends:
         return
     lines.append("    if need_jac:")

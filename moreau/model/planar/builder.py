@@ -725,10 +725,18 @@ class Model:
         tail = []
         base = [0.0] * K.HEADER
 
-        def put(values):
-            # the offset the values will have once the tables are laid out
+        shared = {}
+
+        def put(values, share=False):
+            # the offset the values will have once the tables are laid out; equal time
+            # functions share one record (and so the memory of their harmonics)
+            values = tuple(float(x) for x in values)
+            if share and values in shared:
+                return shared[values]
             off = len(tail)
-            tail.extend(float(x) for x in values)
+            tail.extend(values)
+            if share:
+                shared[values] = off
             return off
 
         brecs, dof = [], 0
@@ -748,8 +756,9 @@ class Model:
                 r[4:9] = [rec["pose"][0] / L, rec["pose"][1] / L, th, math.cos(th), math.sin(th)]
             elif rec["kind"] == K.DRIVEN:
                 fx, fy, ft = rec["motion"]
-                r[7:10] = [("T", put(fx.packed(L, T))), ("T", put(fy.packed(L, T))),
-                           ("T", put(ft.packed(1.0, T)))]
+                r[7:10] = [("T", put(fx.packed(L, T), share=True)),
+                           ("T", put(fy.packed(L, T), share=True)),
+                           ("T", put(ft.packed(1.0, T), share=True))]
             elif rec["kind"] == K.GUIDED:
                 cx, cy = rec["centre"]
                 r[2] = rec["mass"] / Mu
@@ -759,7 +768,7 @@ class Model:
                         r[4 + j] = dof
                         dof += 1
                     else:
-                        r[4 + j] = ("N", put(f.packed(1.0 if j == 2 else L, T)))
+                        r[4 + j] = ("N", put(f.packed(1.0 if j == 2 else L, T), share=True))
                 r[7:9] = [cx / L, cy / L]
             brecs.append(r)
         crecs = []
@@ -791,10 +800,10 @@ class Model:
                           rec["c"] / (F * L * T)]
             elif rec["kind"] == K.FORCE:
                 r[1:6] = [rec["i"], rec["r"][0] / L, rec["r"][1] / L,
-                          ("T", put(rec["f"][0].packed(F, T))),
-                          ("T", put(rec["f"][1].packed(F, T)))]
+                          ("T", put(rec["f"][0].packed(F, T), share=True)),
+                          ("T", put(rec["f"][1].packed(F, T), share=True))]
             else:
-                r[1:3] = [rec["i"], ("T", put(rec["f"].packed(F * L, T)))]
+                r[1:3] = [rec["i"], ("T", put(rec["f"].packed(F * L, T), share=True))]
             frecs.append(r)
         jrecs = []
         for rec in self.joints:
