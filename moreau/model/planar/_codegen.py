@@ -21,6 +21,7 @@ call).
 import hashlib
 import importlib
 import os
+import re
 import sys
 import tempfile
 
@@ -84,11 +85,20 @@ def _time_function(lines, st, off, names, indent):
     # value, rate and acceleration of the time function at `off` into the three `names`
     p = "par"
     f, d1, d2 = names
+    if _constant(st, off):
+        # c0 + t (0 + 0 t / 2) is c0, its rates 0: read, not computed
+        lines.append(f"{indent}{f} = {p}[{off}]; {d1} = 0.0; {d2} = 0.0")
+        return
     lines.append(f"{indent}{f}, {d1}, {d2} = poly_part({p}[{off}], {p}[{off + 1}], "
                  f"{p}[{off + 2}], t)")
     for h in range(_i(st.par[off + 3])):
         a = off + 4 + K.HREC * h
         lines.append(f"{indent}{f}, {d1}, {d2} = kept_harmonic({p}, {a}, {f}, {d1}, {d2}, t)")
+
+
+def _constant(st, off):
+    """Whether the time function at ``off`` is a constant (no rate, acceleration or harmonic)."""
+    return st.par[off + 1] == 0.0 and st.par[off + 2] == 0.0 and _i(st.par[off + 3]) == 0
 
 
 def _bodies(lines, st, used, with_v, indent="    "):
@@ -128,8 +138,42 @@ def _bodies(lines, st, used, with_v, indent="    "):
                                indent)
         if kind == K.FREE:
             lines.append(f"{indent}c{k} = math.cos(th{k}); s{k} = math.sin(th{k})")
+        elif _prescribed_constant_angle(st, k):
+            # the builder wrote the constant angle's sine and cosine into its memory
+            lines.append(f"{indent}s{k} = par[{d + 1}]; c{k} = par[{d + 2}]")
         else:
             lines.append(f"{indent}s{k}, c{k} = kept_sincos(par, {d}, th{k})")
+
+
+def _prescribed_constant_angle(st, k):
+    kind, _, o = st.body(k)
+    if kind == K.DRIVEN:
+        return _constant(st, _i(st.par[o + 9]))
+    code = st.par[o + 6]
+    return kind == K.GUIDED and code < 0 and _constant(st, -1 - _i(code))
+
+
+def _prune(lines):
+    """Drop the top-level assignments of a generated function whose names are not read after them.
+
+    A body's sine and cosine kept in ``par`` (:func:`kept_sincos`) is a call
+    that writes memory, which LLVM keeps even where its values go unused (a
+    guided body whose angle is prescribed, with a given force on its free
+    translation only); every other dropped line is pure.
+    """
+    out = list(lines)
+    changed = True
+    while changed:
+        changed = False
+        for i in range(len(out) - 1, -1, -1):
+            m = re.match(r"^    ([A-Za-z_]\w*(?:, [A-Za-z_]\w*)*) = [^;=]*$", out[i])
+            if m is None:
+                continue
+            later = "\n".join(out[i + 1:])
+            if not any(re.search(rf"\b{name}\b", later) for name in m.group(1).split(", ")):
+                del out[i]
+                changed = True
+    return out
 
 
 def _frame(lines, st, i, indent="    "):
@@ -512,7 +556,7 @@ def source_of(par):
     if st.nj:
         gens += (_joints, _joint_drift)
     for gen in gens:
-        parts.append("\n\n" + "\n".join(gen(st)) + "\n")
+        parts.append("\n\n" + "\n".join(_prune(gen(st))) + "\n")
     return "".join(parts)
 
 

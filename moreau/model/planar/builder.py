@@ -749,8 +749,12 @@ class Model:
             elif rec["kind"] == K.FIXED:
                 r[1] = -1
             else:
-                # the memory of the angle's sine and cosine (the kernels' kept_sincos)
-                r[1] = ("T", put(K.KEPT_SLOTS))
+                # the memory of the angle's sine and cosine (the kernels' kept_sincos); a
+                # constant angle's are written here once (the generated code reads them)
+                th = rec["motion"][2]
+                const = th is not None and not th.harmonics and th.rate == 0 and th.accel == 0
+                r[1] = ("T", put((th.value, math.sin(th.value), math.cos(th.value)) if const
+                                 else K.KEPT_SLOTS))
             if rec["kind"] == K.FIXED:
                 th = rec["pose"][2]
                 r[4:9] = [rec["pose"][0] / L, rec["pose"][1] / L, th, math.cos(th), math.sin(th)]
