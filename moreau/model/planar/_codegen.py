@@ -285,6 +285,17 @@ def _contacts(st):
     return lines
 
 
+def _gaps(st):
+    # the gaps alone (the engine's call at each step's end), without the rows
+    lines = ["@njit(cache=True)", "def gaps(par, q, t, G):"]
+    _bodies(lines, st, _contact_bodies(st), with_v=False)
+    for i in range(st.nc):
+        _frame(lines, st, i)
+        lines.append(f"    G[{i}, 0] = g")
+    lines.append("    return")
+    return lines
+
+
 def _drift(st):
     lines = ["@njit(cache=True)", "def drift(par, q, v, t, Dr):"]
     _bodies(lines, st, _contact_bodies(st), with_v=True)
@@ -552,7 +563,7 @@ def source_of(par):
     """The generated module's source for the packed description ``par``."""
     st = _Structure(par)
     parts = [_HEAD]
-    gens = (_mass, _forces, _contacts, _drift, _poses, _frames)
+    gens = (_mass, _forces, _contacts, _drift, _poses, _frames, _gaps)
     if st.nj:
         gens += (_joints, _joint_drift)
     for gen in gens:

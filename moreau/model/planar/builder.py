@@ -969,7 +969,7 @@ class PlanarScene(SIUnits, Scene):
         """
         f = self._fn
         return CompiledModel(f.mass, f.forces, f.contacts, f.drift, self.par, self.ndof,
-                             self.ncontacts, True, self._has_jac)
+                             self.ncontacts, True, self._has_jac, gaps=f.gaps)
 
     def poses(self, q, t):
         """``(x, y, theta)`` of every body (the ground first), scene units, shape (bodies, 3)."""
