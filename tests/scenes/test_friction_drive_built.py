@@ -133,3 +133,16 @@ def test_the_built_drives_steady_state_is_the_hand_written_ones(theta):
     assert np.all(np.abs(np.asarray(sb.state0) - np.asarray(sa.state0)) <= 1e-12 * scale)
     assert abs(sb.displacement_per_period - sa.displacement_per_period) <= \
         1e-12 * abs(sa.displacement_per_period)
+
+
+@pytest.mark.slow
+def test_the_generic_reference_on_the_built_drive_meets_the_walker():
+    # two methods on the two statements: the walker's closed-form contact segments on the
+    # hand-written drive, the generic event-driven scheme (ODE segments, root-found events)
+    # on the built one; the steady displacement per period to 1e-10 (measured 6.7e-12)
+    hand, built = _pair(185.0)
+    sa = find_steady_state(hand, statistical=False)
+    sb = find_steady_state(built, statistical=False)
+    assert sa.mode == sb.mode == "NP"
+    assert abs(sb.displacement_per_period - sa.displacement_per_period) <= \
+        1e-10 * abs(sa.displacement_per_period)
