@@ -3,10 +3,13 @@
 A :class:`Model` holds bodies in maximal coordinates (each free body's
 ``x, y, theta`` of its centre of mass, in the order added), fixed bodies
 and driven ones (a prescribed :class:`TimeFunction` motion: cranks,
-stators), shapes (:class:`Point`, :class:`Circle`, :class:`Segment`, convex
+stators), guided ones (some coordinates prescribed, the others free: a
+rod hinged on a moving stator, a slider on a guide), shapes
+(:class:`Point`, :class:`Circle`, :class:`Segment`, convex
 :class:`Polygon`, :class:`HalfPlane`), contacts between shapes with their
 own ``mu`` and ``e``, and forces (gravity, springs and dashpots between body
-points, torsion springs, given forces and torques). :meth:`Model.build`
+points, along their distance or along a fixed direction, torsion springs,
+given forces and torques). :meth:`Model.build`
 returns a scene that every scheme and analysis takes. Its compiled model
 is numba source generated from the model's structure (which bodies are free,
 fixed or driven, each contact's kind, each force), with every number in
@@ -107,6 +110,35 @@ point, ``n' = t (t . d') / |d|`` and ``t' = -n (t . d') / |d|`` give
 ``d'' = -w_A^2 r'_A + w_B^2 r'_B``. A driven body's prescribed
 accelerations add the row's entries times them. Every term is held to
 central differences by :func:`moreau.check_scene` on every built model.
+
+Guided bodies
+-------------
+:meth:`Model.add_guided` adds a body some of whose coordinates ``x, y,
+theta`` are prescribed functions of time and the others free. Its ``x, y``
+are those of its frame's origin ``X``, its centre of mass is ``X + R c``
+(``c`` in its frame, mass ``m``, centroidal inertia ``I``). The rows above
+hold with ``X`` for the body's position (they are kinematics of material
+points): a free coordinate's entry goes into ``W``, a prescribed one's
+entry times its prescribed rate into ``w``, and times its prescribed
+acceleration into the drift terms. Its kinetic energy is ``T = m |X' + w
+perp(R c)|^2 / 2 + I w^2 / 2``. With ``c = 0`` the mass matrix of its free
+coordinates is ``diag(m, m, I)`` as for a free body. With ``c != 0`` the
+builder asks for ``x`` and ``y`` prescribed (a body turning about a moving
+pivot), and Lagrange's equation for ``theta`` reads, with ``a = X''``,
+``dT/dw = m X' . perp(R c) + (I + m |c|^2) w`` and ``dT/dtheta = -m w X'
+. R c``::
+
+    (I + m |c|^2) theta'' = (R c) x m (g - a) + (the applied torques about X)
+
+since ``d/dt (m X' . perp(R c)) = m a . perp(R c) - m w X' . R c`` and
+``perp(u) . v = u x v``. Its derivative in ``theta`` is ``-(R c) . m (g -
+a)`` (``d(R c)/dtheta = perp(R c)`` and ``perp(u) x v = -u . v``).
+
+An axial spring (:meth:`Model.add_axial_spring`) measures its length along
+a fixed world direction ``e``: ``l = e . (P_i - P_j)``, tension ``f = k (l -
+l0) + c l'``, ``F = -f e`` on ``P_i``; ``dF/dP = -k e e^T``, ``dF/dP' = -c e
+e^T``, and the generalized forces and their Jacobians follow as for the
+spring below.
 
 Forces: a spring-dashpot of tension ``f = k (l - l0) + c l'`` along ``e =
 (P_i - P_j) / l`` puts ``F = -f e`` on ``P_i``, its generalized force

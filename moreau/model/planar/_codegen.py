@@ -21,6 +21,7 @@ call).
 import hashlib
 import importlib
 import os
+import re
 import sys
 import tempfile
 
@@ -35,6 +36,7 @@ from moreau.model.planar._kernels import (closest_feature, drift_plane, drift_po
     frame_plane, frame_points, frame_poly, harmonic_part, lever, poly_part, spring_block,
     spring_terms, turn)
 from moreau.model.planar._kernels import drift_hole, frame_hole
+from moreau.model.planar._kernels import axial_spring_terms, kept_harmonic, kept_sincos
 '''
 
 
@@ -60,6 +62,16 @@ class _Structure:
         o = self.ob + K.BREC * k
         return _i(self.par[o]), _i(self.par[o + 1]), o
 
+    def dofs(self, k):
+        """Body ``k``'s coordinate index of ``x``, ``y``, ``theta``, each ``None`` where not free."""
+        kind, d, o = self.body(k)
+        if kind == K.FREE:
+            return (d, d + 1, d + 2)
+        if kind == K.GUIDED:
+            return tuple(_i(self.par[o + 4 + j]) if self.par[o + 4 + j] >= 0 else None
+                         for j in range(3))
+        return (None, None, None)
+
     def contact(self, i):
         o = self.oc + K.CREC * i
         return _i(self.par[o]), _i(self.par[o + 1]), _i(self.par[o + 2]), o
@@ -73,12 +85,20 @@ def _time_function(lines, st, off, names, indent):
     # value, rate and acceleration of the time function at `off` into the three `names`
     p = "par"
     f, d1, d2 = names
+    if _constant(st, off):
+        # c0 + t (0 + 0 t / 2) is c0, its rates 0: read, not computed
+        lines.append(f"{indent}{f} = {p}[{off}]; {d1} = 0.0; {d2} = 0.0")
+        return
     lines.append(f"{indent}{f}, {d1}, {d2} = poly_part({p}[{off}], {p}[{off + 1}], "
                  f"{p}[{off + 2}], t)")
     for h in range(_i(st.par[off + 3])):
-        a = off + 4 + 3 * h
-        lines.append(f"{indent}{f}, {d1}, {d2} = harmonic_part({f}, {d1}, {d2}, {p}[{a}], "
-                     f"{p}[{a + 1}], {p}[{a + 2}], t)")
+        a = off + 4 + K.HREC * h
+        lines.append(f"{indent}{f}, {d1}, {d2} = kept_harmonic({p}, {a}, {f}, {d1}, {d2}, t)")
+
+
+def _constant(st, off):
+    """Whether the time function at ``off`` is a constant (no rate, acceleration or harmonic)."""
+    return st.par[off + 1] == 0.0 and st.par[off + 2] == 0.0 and _i(st.par[off + 3]) == 0
 
 
 def _bodies(lines, st, used, with_v, indent="    "):
@@ -99,12 +119,61 @@ def _bodies(lines, st, used, with_v, indent="    "):
             # a fixed body's cosine and sine are kept in its record
             lines.append(f"{indent}c{k} = par[{o + 7}]; s{k} = par[{o + 8}]")
             continue
+        elif kind == K.GUIDED:
+            # each free coordinate from q and v, each prescribed one from its time function
+            for j, (a, b, c) in enumerate((("x", "vx", "ax"), ("y", "vy", "ay"),
+                                           ("th", "w", "al"))):
+                code = st.par[o + 4 + j]
+                if code >= 0:
+                    dj = _i(code)
+                    lines.append(f"{indent}{a}{k} = q[{dj}]; {b}{k} = "
+                                 f"{f'v[{dj}]' if with_v else '0.0'}; {c}{k} = 0.0")
+                else:
+                    _time_function(lines, st, -1 - _i(code), (f"{a}{k}", f"{b}{k}", f"{c}{k}"),
+                                   indent)
         else:
             for j, (a, b, c) in enumerate((("x", "vx", "ax"), ("y", "vy", "ay"),
                                            ("th", "w", "al"))):
                 _time_function(lines, st, _i(st.par[o + 7 + j]), (f"{a}{k}", f"{b}{k}", f"{c}{k}"),
                                indent)
-        lines.append(f"{indent}c{k} = math.cos(th{k}); s{k} = math.sin(th{k})")
+        if kind == K.FREE:
+            lines.append(f"{indent}c{k} = math.cos(th{k}); s{k} = math.sin(th{k})")
+        elif _prescribed_constant_angle(st, k):
+            # the builder wrote the constant angle's sine and cosine into its memory
+            lines.append(f"{indent}s{k} = par[{d + 1}]; c{k} = par[{d + 2}]")
+        else:
+            lines.append(f"{indent}s{k}, c{k} = kept_sincos(par, {d}, th{k})")
+
+
+def _prescribed_constant_angle(st, k):
+    kind, _, o = st.body(k)
+    if kind == K.DRIVEN:
+        return _constant(st, _i(st.par[o + 9]))
+    code = st.par[o + 6]
+    return kind == K.GUIDED and code < 0 and _constant(st, -1 - _i(code))
+
+
+def _prune(lines):
+    """Drop the top-level assignments of a generated function whose names are not read after them.
+
+    A body's sine and cosine kept in ``par`` (:func:`kept_sincos`) is a call
+    that writes memory, which LLVM keeps even where its values go unused (a
+    guided body whose angle is prescribed, with a given force on its free
+    translation only); every other dropped line is pure.
+    """
+    out = list(lines)
+    changed = True
+    while changed:
+        changed = False
+        for i in range(len(out) - 1, -1, -1):
+            m = re.match(r"^    ([A-Za-z_]\w*(?:, [A-Za-z_]\w*)*) = [^;=]*$", out[i])
+            if m is None:
+                continue
+            later = "\n".join(out[i + 1:])
+            if not any(re.search(rf"\b{name}\b", later) for name in m.group(1).split(", ")):
+                del out[i]
+                changed = True
+    return out
 
 
 def _frame(lines, st, i, indent="    "):
@@ -141,6 +210,19 @@ def _rows(lines, st, i, A, B, e, col0, wcol, indent):
         if kind == K.FREE:
             lines.append(f"{indent}G[{i}, {col0 + d}] = {sg}{ex}; G[{i}, {col0 + d + 1}] = "
                          f"{sg}{ey}; G[{i}, {col0 + d + 2}] = {sg}l")
+        elif kind == K.GUIDED:
+            # a free coordinate's entry into W, a prescribed one's velocity into w
+            terms = []
+            for dj, entry, vel in zip(st.dofs(body), (ex, ey, "l"),
+                                      (f"vx{body}", f"vy{body}", f"w{body}")):
+                if dj is None:
+                    terms.append(f"{entry} * {vel}")
+                else:
+                    lines.append(f"{indent}G[{i}, {col0 + dj}] = {sg}{entry}")
+            if terms:
+                name = f"w{'A' if sg == '' else 'B'}"
+                lines.append(f"{indent}{name} = {sg}({' + '.join(terms)})")
+                w_terms.append(name)
         else:
             lines.append(f"{indent}w{'A' if sg == '' else 'B'} = {sg}({ex} * vx{body} + {ey} * "
                          f"vy{body} + l * w{body})")
@@ -156,6 +238,12 @@ def _acc_terms(st, A, B, e):
         if st.body(body)[0] == K.DRIVEN:
             out.append(f" {sg} ({ex} * ax{body} + {ey} * ay{body} + lever({sx}, {sy}, {ex}, "
                        f"{ey}) * al{body})")
+        elif st.body(body)[0] == K.GUIDED:
+            terms = [f"{entry} * {acc}{body}" for dj, entry, acc in
+                     zip(st.dofs(body), (ex, ey, f"lever({sx}, {sy}, {ex}, {ey})"),
+                         ("ax", "ay", "al")) if dj is None]
+            if terms:
+                out.append(f" {sg} ({' + '.join(terms)})")
     return "".join(out)
 
 
@@ -173,6 +261,11 @@ def _mass(st):
         if kind == K.FREE:
             lines.append(f"    M[{d}, {d}] = par[{o + 2}]; M[{d + 1}, {d + 1}] = par[{o + 2}]; "
                          f"M[{d + 2}, {d + 2}] = par[{o + 3}]")
+        elif kind == K.GUIDED:
+            # a guided body's inertia is about its frame's origin (par[o + 3])
+            for j, dj in enumerate(st.dofs(k)):
+                if dj is not None:
+                    lines.append(f"    M[{dj}, {dj}] = par[{o + (3 if j == 2 else 2)}]")
     return lines
 
 
@@ -188,6 +281,17 @@ def _contacts(st):
         lines.append("    if need_T:")
         lines.append("        tx = ny; ty = -nx")
         _rows(lines, st, i, A, B, ("tx", "ty"), 3 + n, 2, "        ")
+    lines.append("    return")
+    return lines
+
+
+def _gaps(st):
+    # the gaps alone (the engine's call at each step's end), without the rows
+    lines = ["@njit(cache=True)", "def gaps(par, q, t, G):"]
+    _bodies(lines, st, _contact_bodies(st), with_v=False)
+    for i in range(st.nc):
+        _frame(lines, st, i)
+        lines.append(f"    G[{i}, 0] = g")
     lines.append("    return")
     return lines
 
@@ -229,34 +333,46 @@ def _forces(st):
         if kind == K.FREE:
             lines.append(f"    D[{d}, 0] += par[{o + 2}] * par[7]; "
                          f"D[{d + 1}, 0] += par[{o + 2}] * par[8]")
+        elif kind == K.GUIDED:
+            for dj, gj in zip(st.dofs(k)[:2], (7, 8)):
+                if dj is not None:
+                    lines.append(f"    D[{dj}, 0] += par[{o + 2}] * par[{gj}]")
     used = set()
     for f in range(st.nf):
         kind, o = st.force(f)
         used.add(_i(st.par[o + 1]))
-        if kind in (K.SPRING, K.TORSION):
+        if kind in (K.SPRING, K.TORSION, K.AXIAL):
             used.add(_i(st.par[o + 2]))
-    _bodies(lines, st, used, with_v=True)
+    turning = [k for k in range(st.nb) if st.body(k)[0] == K.GUIDED
+               and st.dofs(k) == (None, None, st.dofs(k)[2]) and st.dofs(k)[2] is not None]
+    _bodies(lines, st, used | set(turning), with_v=True)
+    for k in turning:
+        _turning(lines, st, k)
     for f in range(st.nf):
         kind, o = st.force(f)
-        if kind == K.SPRING:
+        if kind in (K.SPRING, K.AXIAL):
             _spring(lines, st, o)
         elif kind == K.TORSION:
             _torsion(lines, st, o)
         elif kind == K.FORCE:
             b = _i(st.par[o + 1])
-            d = st.body(b)[1]
+            dx, dy, dt = st.dofs(b)
             _time_function(lines, st, _i(st.par[o + 4]), ("fx", "f1", "f2"), "    ")
             _time_function(lines, st, _i(st.par[o + 5]), ("fy", "f1", "f2"), "    ")
             lines.append(f"    rx, ry = turn(c{b}, s{b}, par[{o + 2}], par[{o + 3}])")
-            lines.append(f"    D[{d}, 0] += fx; D[{d + 1}, 0] += fy; "
-                         f"D[{d + 2}, 0] += rx * fy - ry * fx")
-            lines.append("    if need_jac:")
-            lines.append(f"        D[{d + 2}, {1 + d + 2}] -= rx * fx + ry * fy")
+            adds = [f"D[{dj}, 0] += {val}" for dj, val in
+                    ((dx, "fx"), (dy, "fy"), (dt, "rx * fy - ry * fx")) if dj is not None]
+            if adds:
+                lines.append("    " + "; ".join(adds))
+            if dt is not None:
+                lines.append("    if need_jac:")
+                lines.append(f"        D[{dt}, {1 + dt}] -= rx * fx + ry * fy")
         else:
             b = _i(st.par[o + 1])
-            d = st.body(b)[1]
+            dt = st.dofs(b)[2]
             _time_function(lines, st, _i(st.par[o + 2]), ("tau", "f1", "f2"), "    ")
-            lines.append(f"    D[{d + 2}, 0] += tau")
+            if dt is not None:
+                lines.append(f"    D[{dt}, 0] += tau")
     lines.append("    return")
     return lines
 
@@ -264,34 +380,42 @@ def _forces(st):
 def _spring(lines, st, o):
     n = st.n
     i, j = _i(st.par[o + 1]), _i(st.par[o + 2])
-    lines.append(f"    Fx, Fy, Axx, Axy, Ayx, Ayy, Bxx, Bxy, Byy, rix, riy, rjx, rjy = spring_terms("
+    axial = _i(st.par[o]) == K.AXIAL
+    terms = "axial_spring_terms" if axial else "spring_terms"
+    axis = f", par[{o + 10}], par[{o + 11}]" if axial else ""
+    lines.append(f"    Fx, Fy, Axx, Axy, Ayx, Ayy, Bxx, Bxy, Byy, rix, riy, rjx, rjy = {terms}("
                  f"x{i}, y{i}, c{i}, s{i}, vx{i}, vy{i}, w{i}, par[{o + 3}], par[{o + 4}], "
                  f"x{j}, y{j}, c{j}, s{j}, vx{j}, vy{j}, w{j}, par[{o + 5}], par[{o + 6}], "
-                 f"par[{o + 7}], par[{o + 8}], par[{o + 9}])")
+                 f"par[{o + 7}], par[{o + 8}], par[{o + 9}]{axis})")
     ends = []
     for body, sg, r in ((i, 1.0, "ri"), (j, -1.0, "rj")):
-        kind, d, _ = st.body(body)
-        if kind != K.FREE:
+        dofs = st.dofs(body)
+        if dofs == (None, None, None):
             continue
-        ends.append((body, sg, r, d))
+        ends.append((body, sg, r, dofs))
         op = "+=" if sg > 0 else "-="
-        lines.append(f"    D[{d}, 0] {op} Fx; D[{d + 1}, 0] {op} Fy; "
-                     f"D[{d + 2}, 0] {op} {r}x * Fy - {r}y * Fx")
+        values = ("Fx", "Fy", f"{r}x * Fy - {r}y * Fx")
+        lines.append("    " + "; ".join(f"D[{dj}, 0] {op} {val}" for dj, val in zip(dofs, values)
+                                        if dj is not None))
     if not ends:
         return
     lines.append("    if need_jac:")
-    for body, sg, r, d in ends:
+    for body, sg, r, dofs in ends:
         # d(r'_a x F_a)/dtheta_a at fixed F_a = -r'_a . F_a, F_a = sg F
         op = "-=" if sg > 0 else "+="
-        lines.append(f"        D[{d + 2}, {1 + d + 2}] {op} {r}x * Fx + {r}y * Fy")
+        if dofs[2] is not None:
+            lines.append(f"        D[{dofs[2]}, {1 + dofs[2]}] {op} {r}x * Fx + {r}y * Fy")
     for ba, ga, ra, da in ends:
         for bb, gb, rb, db in ends:
             lines.append(f"        b = spring_block({ga}, {gb}, {ra}x, {ra}y, {rb}x, {rb}y, w{bb}, "
                          "Axx, Axy, Ayx, Ayy, Bxx, Bxy, Byy)")
             for r in range(3):
-                lines.append("        " + "; ".join(
-                    f"D[{da + r}, {1 + db + c}] += b[{3 * r + c}]; "
-                    f"D[{da + r}, {1 + n + db + c}] += b[{9 + 3 * r + c}]" for c in range(3)))
+                row = "; ".join(
+                    f"D[{da[r]}, {1 + db[c]}] += b[{3 * r + c}]; "
+                    f"D[{da[r]}, {1 + n + db[c]}] += b[{9 + 3 * r + c}]" for c in range(3)
+                    if da[r] is not None and db[c] is not None)
+                if row:
+                    lines.append("        " + row)
 
 
 def _torsion(lines, st, o):
@@ -299,8 +423,9 @@ def _torsion(lines, st, o):
     i, j = _i(st.par[o + 1]), _i(st.par[o + 2])
     lines.append(f"    tau = -par[{o + 3}] * (th{i} - th{j} - par[{o + 4}]) - par[{o + 5}] * "
                  f"(w{i} - w{j})")
-    ends = [(d, g) for body, g in ((i, 1), (j, -1))
-            for kind, d, _ in [st.body(body)] if kind == K.FREE]
+    # each end's angle index (d + 2 of a free body, a guided body's free angle)
+    ends = [(st.dofs(body)[2] - 2, g) for body, g in ((i, 1), (j, -1))
+            if st.dofs(body)[2] is not None]
     for d, g in ends:
         lines.append(f"    D[{d + 2}, 0] {'+=' if g > 0 else '-='} tau")
     if ends:
@@ -310,6 +435,19 @@ def _torsion(lines, st, o):
             op = "-=" if ga * gb > 0 else "+="
             lines.append(f"        D[{da + 2}, {1 + db + 2}] {op} par[{o + 3}]; "
                          f"D[{da + 2}, {1 + n + db + 2}] {op} par[{o + 5}]")
+
+
+def _turning(lines, st, k):
+    # a guided body turning about its frame's origin, moved as prescribed: gravity and the
+    # origin's acceleration act at its centre of mass, a torque (R c) x m (g - a) about the
+    # origin, whose derivative in theta is -(R c) . m (g - a)
+    o = st.body(k)[2]
+    d = st.dofs(k)[2]
+    lines.append(f"    rcx, rcy = turn(c{k}, s{k}, par[{o + 7}], par[{o + 8}])")
+    lines.append(f"    gx = par[{o + 2}] * (par[7] - ax{k}); gy = par[{o + 2}] * (par[8] - ay{k})")
+    lines.append(f"    D[{d}, 0] += rcx * gy - rcy * gx")
+    lines.append("    if need_jac:")
+    lines.append(f"        D[{d}, {1 + d}] -= rcx * gx + rcy * gy")
 
 
 def _poses(st):
@@ -425,11 +563,11 @@ def source_of(par):
     """The generated module's source for the packed description ``par``."""
     st = _Structure(par)
     parts = [_HEAD]
-    gens = (_mass, _forces, _contacts, _drift, _poses, _frames)
+    gens = (_mass, _forces, _contacts, _drift, _poses, _frames, _gaps)
     if st.nj:
         gens += (_joints, _joint_drift)
     for gen in gens:
-        parts.append("\n\n" + "\n".join(gen(st)) + "\n")
+        parts.append("\n\n" + "\n".join(_prune(gen(st))) + "\n")
     return "".join(parts)
 
 

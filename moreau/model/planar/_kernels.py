@@ -17,13 +17,21 @@ Layout of ``par`` (integers stored as floats)
 the body, contact and force tables; ``ndof``; gravity ``(gx, gy)``; number
 and offset of the joint records.
 
-Body record (``BREC`` floats): ``kind`` (0 fixed, 1 free, 2 driven), first
-coordinate index (free bodies), mass, inertia, then a fixed body's pose
-``(x, y, theta)`` with ``cos theta, sin theta``, or the offsets of a driven
-body's three time functions.
+Body record (``BREC`` floats): ``kind`` (0 fixed, 1 free, 2 driven, 3
+guided), first coordinate index (free bodies), mass, inertia, then a fixed
+body's pose ``(x, y, theta)`` with ``cos theta, sin theta``, or the offsets
+of a driven body's three time functions. A guided body (some coordinates
+free, the others prescribed) keeps its inertia about its frame's origin,
+then per coordinate ``x, y, theta`` one code: its coordinate index where it
+is free, ``-1 - offset`` of its time function where it is prescribed; then
+its centre of mass ``(cx, cy)`` in its frame. A driven or guided body's
+second entry is the offset of the memory of its angle's sine and cosine
+(:func:`kept_sincos`).
 
-Time function at offset ``o``: ``c0, c1, c2, nh, (A, w, phi) * nh``, the value
-``c0 + c1 t + c2 t^2 / 2 + sum A sin(w t + phi)``.
+Time function at offset ``o``: ``c0, c1, c2, nh, (A, w, phi, x, sin x, cos x) *
+nh``, the value ``c0 + c1 t + c2 t^2 / 2 + sum A sin(w t + phi)``; each harmonic
+keeps the last argument ``x`` of its sine and cosine with their values
+(:func:`kept_sincos`).
 
 Contact record (``CREC`` floats): ``kind``, body ``A``, body ``B``, the point
 ``rA`` of ``A`` (body frame) and its radius ``rhoA``, then by kind:
@@ -35,7 +43,8 @@ radius ``rhoB``) around the pin ``rA`` of radius ``rhoA`` (a revolute joint
 with clearance).
 
 Force record (``FREC`` floats): ``SPRING`` (bodies ``i, j``, points
-``ri, rj``, stiffness, rest length, damping), ``TORSION`` (bodies ``i, j``,
+``ri, rj``, stiffness, rest length, damping), ``AXIAL`` (the same, then the
+world direction ``(ex, ey)`` its length is measured along), ``TORSION`` (bodies ``i, j``,
 stiffness, rest angle, damping), ``FORCE`` (body, point, offsets of the time
 functions of the world components), ``TORQUE`` (body, offset of its time
 function).
@@ -56,9 +65,14 @@ BREC = 10
 CREC = 14
 FREC = 12
 
-FIXED, FREE, DRIVEN = 0, 1, 2
+#: floats of a harmonic of a time function: A, w, phi and the memory of its sine and cosine
+HREC = 6
+#: what a memory of :func:`kept_sincos` starts at: an argument with its sine and cosine
+KEPT_SLOTS = (0.0, 0.0, 1.0)
+
+FIXED, FREE, DRIVEN, GUIDED = 0, 1, 2, 3
 PLANE, POINTS, POLY = 0, 1, 2
-SPRING, TORSION, FORCE, TORQUE = 0, 1, 2, 3
+SPRING, TORSION, FORCE, TORQUE, AXIAL = 0, 1, 2, 3, 4
 JPOINT, JLINE, JANGLE = 0, 1, 2
 
 
@@ -73,6 +87,49 @@ def harmonic_part(f, d1, d2, A, w, ph, t):
     """``(f, f', f'')`` plus those of ``A sin(w t + ph)``."""
     s = math.sin(w * t + ph)
     c = math.cos(w * t + ph)
+    return f + A * s, d1 + A * w * c, d2 - A * w * w * s
+
+
+#: the phase that makes a harmonic a cosine, evaluated as one (``sin(w t + pi/2)`` would
+#: round ``pi/2``: its rate at ``t = 0`` would be ``A w 6e-17``, not 0)
+QUARTER = 0.5 * math.pi
+
+
+@njit
+def kept_sincos(par, j, x):
+    """``(sin x, cos x)``, from ``par[j + 1], par[j + 2]`` when ``par[j]`` is ``x``, else computed and kept there.
+
+    A scheme's step evaluates a model's functions several times at one time
+    and one state: a driven body's angle and a harmonic's phase are then the
+    same from call to call, and their sines and cosines are computed once.
+    The kept values are those the library returns for that argument, so
+    every result is the same to the last bit (a zero hits only a zero of its
+    own sign). The slots start at ``(0, 0, 1)``, consistent.
+    """
+    key = par[j]
+    if x == key and (x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, key)):
+        return par[j + 1], par[j + 2]
+    s = math.sin(x)
+    c = math.cos(x)
+    par[j] = x
+    par[j + 1] = s
+    par[j + 2] = c
+    return s, c
+
+
+@njit
+def kept_harmonic(par, a, f, d1, d2, t):
+    """``(f, f', f'')`` plus those of the harmonic at ``par[a:a + 6]`` (``A, w, phi`` and its memory).
+
+    A phase of :data:`QUARTER` is the cosine ``A cos(w t)``.
+    """
+    A = par[a]
+    w = par[a + 1]
+    ph = par[a + 2]
+    if ph == QUARTER:
+        s, c = kept_sincos(par, a + 3, w * t)
+        return f + A * c, d1 - A * w * s, d2 - A * w * w * c
+    s, c = kept_sincos(par, a + 3, w * t + ph)
     return f + A * s, d1 + A * w * c, d2 - A * w * w * s
 
 
@@ -252,6 +309,24 @@ def spring_terms(xi, yi, ci, si, vxi, vyi, wi, pix, piy, xj, yj, cj, sj, vxj, vy
     return (-f * ex, -f * ey,
             -(ex * (k * ex + ux) + f / ln * Ixx), -(ex * (k * ey + uy) + f / ln * Ixy),
             -(ey * (k * ex + ux) + f / ln * Ixy), -(ey * (k * ey + uy) + f / ln * Iyy),
+            -c * ex * ex, -c * ex * ey, -c * ey * ey, rix, riy, rjx, rjy)
+
+
+@njit
+def axial_spring_terms(xi, yi, ci, si, vxi, vyi, wi, pix, piy, xj, yj, cj, sj, vxj, vyj, wj,
+                       pjx, pjy, k, l0, c, ex, ey):
+    """A spring-dashpot along the fixed world direction ``e``: the terms of :func:`spring_terms`.
+
+    Its length is ``l = e . P`` with ``P = P_i - P_j``, its tension ``f = k (l
+    - l0) + c l'``, the force on ``P_i`` is ``F = -f e``; ``e`` does not turn,
+    so ``dF/dP = -k e e^T`` and ``dF/dP' = -c e e^T``.
+    """
+    rix, riy = turn(ci, si, pix, piy)
+    rjx, rjy = turn(cj, sj, pjx, pjy)
+    ln = ex * (xi + rix - xj - rjx) + ey * (yi + riy - yj - rjy)
+    ld = ex * (vxi - wi * riy - vxj + wj * rjy) + ey * (vyi + wi * rix - vyj - wj * rjx)
+    f = k * (ln - l0) + c * ld
+    return (-f * ex, -f * ey, -k * ex * ex, -k * ex * ey, -k * ey * ex, -k * ey * ey,
             -c * ex * ex, -c * ex * ey, -c * ey * ey, rix, riy, rjx, rjy)
 
 

@@ -45,7 +45,9 @@ class TimeFunction:
     value, rate, accel : float
         The polynomial part.
     harmonics : sequence of (amplitude, angular_frequency, phase)
-        ``w`` in rad/s.
+        ``w`` in rad/s. A phase of ``math.pi / 2`` makes the harmonic the
+        cosine ``A cos(w t)``, evaluated as one (exact at ``t = 0``, where
+        ``sin(w t + pi/2)`` would round ``pi/2``).
 
     Examples
     --------
@@ -79,6 +81,11 @@ class TimeFunction:
         d1 = self.rate + self.accel * t
         d2 = self.accel
         for A, w, ph in self.harmonics:
+            if ph == K.QUARTER:
+                f += A * math.cos(w * t)
+                d1 -= A * w * math.sin(w * t)
+                d2 -= A * w * w * math.cos(w * t)
+                continue
             f += A * math.sin(w * t + ph)
             d1 += A * w * math.cos(w * t + ph)
             d2 -= A * w * w * math.sin(w * t + ph)
@@ -89,7 +96,7 @@ class TimeFunction:
         out = [self.value / unit, self.rate * time / unit, self.accel * time ** 2 / unit,
                float(len(self.harmonics))]
         for A, w, ph in self.harmonics:
-            out += [A / unit, w * time, ph]
+            out += [A / unit, w * time, ph, *K.KEPT_SLOTS]
         return out
 
 
@@ -196,7 +203,7 @@ class Body:
         self.model, self.index, self.kind, self.name = model, index, kind, name
 
     def __repr__(self):
-        return f"Body({self.name!r}, {('fixed', 'free', 'driven')[self.kind]})"
+        return f"Body({self.name!r}, {('fixed', 'free', 'driven', 'guided')[self.kind]})"
 
 
 class _ShapeRef:
@@ -253,9 +260,14 @@ class Model:
             raise InputError(f"`{name}` must be a body of this model, got {body!r}")
         return body
 
+    def _movable(self, body):
+        # a body with a coordinate of its own: free, or guided with a free coordinate
+        return body.kind == K.FREE or (body.kind == K.GUIDED and any(
+            f is None for f in self.bodies[body.index]["motion"]))
+
     def _free(self, name, body):
         self._body(name, body)
-        if body.kind != K.FREE:
+        if not self._movable(body):
             raise InputError(f"`{name}` must be a free body: a given force on {body!r} moves nothing")
         return body
 
@@ -269,6 +281,56 @@ class Model:
                              "has no equations of motion: make it fixed or driven)")
         rec = dict(kind=K.FREE, mass=m, inertia=positive("inertia", inertia),
                    pose=(*_vec2("position", position), finite_scalar("angle", angle)),
+                   vel=(*_vec2("velocity", velocity),
+                        finite_scalar("angular_velocity", angular_velocity)))
+        return self._add(rec, name)
+
+    def add_guided(self, mass, inertia, x=None, y=None, theta=None, position=(0.0, 0.0),
+                   angle=0.0, velocity=(0.0, 0.0), angular_velocity=0.0, centre=(0.0, 0.0),
+                   name=None):
+        """A body with some coordinates prescribed and the others free: a rod hinged on a moving stator, a slider on a guide.
+
+        Each of ``x``, ``y`` [m] and ``theta`` [rad] is ``None`` (free: its
+        initial value and rate from ``position``, ``velocity``, ``angle``,
+        ``angular_velocity``) or a number or :class:`TimeFunction`
+        (prescribed). Unlike :meth:`add_body`, ``x, y`` are the coordinates
+        of the origin of the body's frame, and ``centre`` [m] is its centre of
+        mass in that frame (``inertia`` about the centre, kg m^2): a body
+        turning about a moving pivot has ``x`` and ``y`` prescribed and its
+        frame's origin at the pivot. A centre off the origin needs ``x`` and
+        ``y`` prescribed (otherwise the translations and the turn would share
+        a mass matrix that is not diagonal). The free coordinates follow
+        those of the bodies added before, in the order ``x, y, theta``.
+
+        Equations (derived in :mod:`moreau.model.planar`, "Guided bodies"):
+        a free ``x`` or ``y`` has the mass; a free ``theta`` the inertia
+        about the origin, ``inertia + mass |centre|^2``, and with the origin
+        at ``a(t)`` the torque ``(R centre) x mass (g - a)`` of gravity and of
+        the frame's acceleration.
+
+        Examples
+        --------
+        >>> m = Model(gravity=(0.0, -9.81))
+        >>> rod = m.add_guided(1.0, 1.0 / 12.0, x=0.0, y=0.0, centre=(0.5, 0.0))
+        >>> sc = m.build()
+        >>> sc.ndof, round(float(sc.mass([0.0])[0, 0]), 12), round(float(sc.forces([0.0], [0.0], 0.0)[0]), 12)
+        (1, 0.333333333333, -0.5)
+        """
+        m = finite_scalar("mass", mass)
+        if m <= 0.0:
+            raise InputError(f"`mass` of a body must be > 0, got {m!r}")
+        motion = tuple(None if f is None else TimeFunction.of(nm, f)
+                       for nm, f in (("x", x), ("y", y), ("theta", theta)))
+        if all(f is not None for f in motion):
+            raise InputError("`x`, `y` and `theta` are all prescribed: that is a driven body "
+                             "(`add_driven`); leave at least one `None` (free)")
+        c = _vec2("centre", centre)
+        if np.any(c != 0.0) and (motion[0] is None or motion[1] is None):
+            raise InputError("`centre` off the frame's origin needs `x` and `y` prescribed "
+                             "(a body turning about a pivot); with a free translation put the "
+                             "frame's origin at the centre of mass")
+        rec = dict(kind=K.GUIDED, mass=m, inertia=positive("inertia", inertia), motion=motion,
+                   centre=c, pose=(*_vec2("position", position), finite_scalar("angle", angle)),
                    vel=(*_vec2("velocity", velocity),
                         finite_scalar("angular_velocity", angular_velocity)))
         return self._add(rec, name)
@@ -315,8 +377,7 @@ class Model:
                 raise InputError(f"`{name}` must be a shape added to this model")
         if a.body is b.body:
             raise InputError("`a` and `b` are shapes of one body: a body does not touch itself")
-        if self.bodies[a.body.index]["kind"] != K.FREE and \
-                self.bodies[b.body.index]["kind"] != K.FREE:
+        if not self._movable(a.body) and not self._movable(b.body):
             raise InputError("`a` and `b` are both on fixed or driven bodies: one must be free")
         mu = nonnegative("mu", mu)
         e = in_closed_interval("restitution", restitution, 0.0, 1.0)
@@ -466,6 +527,33 @@ class Model:
             raise InputError("`rest_length` must be > 0: a spring of zero length has no direction")
         self.forces.append(rec)
 
+    def add_axial_spring(self, body_i, point_i, body_j, point_j, axis, stiffness,
+                         rest_length=None, damping=0.0):
+        """A linear spring and dashpot acting along the fixed world direction ``axis`` between two body points.
+
+        Its length is ``l = e . (P_i - P_j)`` with ``e`` the unit ``axis``
+        (a spring held in a guide, a suspension): tension ``stiffness (l -
+        rest_length) + damping l'`` [N], the force ``-tension e`` on
+        ``point_i`` of ``body_i`` and its opposite on ``point_j`` of
+        ``body_j`` (body frames). ``rest_length`` [m] defaults to the initial
+        ``l`` and may be negative.
+        """
+        bi, bj = self._body("body_i", body_i), self._body("body_j", body_j)
+        if bi is bj:
+            raise InputError("`body_i` and `body_j` are one body: a spring joins two bodies")
+        u = _vec2("axis", axis)
+        ln = float(np.hypot(*u))
+        if ln == 0.0:
+            raise InputError("`axis` of a spring must not be zero")
+        rec = dict(kind=K.AXIAL, i=bi.index, j=bj.index, ri=_vec2("point_i", point_i),
+                   rj=_vec2("point_j", point_j), k=nonnegative("stiffness", stiffness),
+                   c=nonnegative("damping", damping), axis=u / ln,
+                   l0=None if rest_length is None else finite_scalar("rest_length", rest_length))
+        if rec["l0"] is None:
+            pi, pj = (self._initial_point(b, r) for b, r in ((bi, rec["ri"]), (bj, rec["rj"])))
+            rec["l0"] = float(rec["axis"] @ (pi - pj))
+        self.forces.append(rec)
+
     def add_damper(self, body_i, point_i, body_j, point_j, damping):
         """A linear dashpot between two body points (a spring of zero stiffness)."""
         self.add_spring(body_i, point_i, body_j, point_j, 0.0, rest_length=None,
@@ -502,6 +590,10 @@ class Model:
         bi, bj = self._body("body_i", body_i), self._body("body_j", body_j)
         if bi is bj:
             raise InputError("`body_i` and `body_j` are one body: a joint joins two bodies")
+        for nm, b in (("body_i", bi), ("body_j", bj)):
+            if b.kind == K.GUIDED:
+                raise InputError(f"`{nm}` is a guided body: its prescribed coordinates are its "
+                                 "joints; a joint joins free, fixed or driven bodies")
         if bi.kind != K.FREE and bj.kind != K.FREE:
             raise InputError("`body_i` and `body_j` are both fixed or driven: a joint needs a "
                              "free body")
@@ -553,10 +645,7 @@ class Model:
     def _check_joints(self):
         """Refuse joints whose rows are dependent at the initial poses, naming them."""
         rows = JointRows(self)
-        q0 = np.array([x for b in self.bodies if b["kind"] == K.FREE for x in b["pose"]])
-        L = self.units()[0]
-        q0[0::3] /= L
-        q0[1::3] /= L
+        q0 = self.initial_coordinates()[0]
         W, _ = rows.jacobians(q0, 0.0)
         names = [j["joint"] for j in self.joints
                  for _ in range(2 if j["kind"] == K.JPOINT else 1)]
@@ -590,7 +679,25 @@ class Model:
         rec = self.bodies[body.index]
         if rec["kind"] == K.DRIVEN:
             return tuple(f(0.0)[0] for f in rec["motion"])
+        if rec["kind"] == K.GUIDED:
+            return tuple(p if f is None else f(0.0)[0] for f, p in zip(rec["motion"], rec["pose"]))
         return rec["pose"]
+
+    def initial_coordinates(self):
+        """``(q0, v0, angles)``: the free coordinates' initial values and rates in scene units, and which are angles."""
+        L, _, T = self.units()
+        q0, v0, angles = [], [], []
+        for b in self.bodies:
+            free = (True,) * 3 if b["kind"] == K.FREE else (
+                tuple(f is None for f in b["motion"]) if b["kind"] == K.GUIDED else ())
+            for j, is_free in enumerate(free):
+                if is_free:
+                    scale = 1.0 if j == 2 else L
+                    if j == 2:
+                        angles.append(len(q0))
+                    q0.append(b["pose"][j] / scale)
+                    v0.append(b["vel"][j] * T / scale)
+        return np.array(q0), np.array(v0), tuple(angles)
 
     def _initial_point(self, body, r):
         x, y, th = self._initial_pose(body)
@@ -604,7 +711,8 @@ class Model:
         if L is None:
             L = max([s.shape.extent() for s in self.shapes], default=0.0) or 1.0
         if Mu is None:
-            Mu = max([b["mass"] for b in self.bodies if b["kind"] == K.FREE], default=1.0)
+            Mu = max([b["mass"] for b in self.bodies if b["kind"] in (K.FREE, K.GUIDED)],
+                     default=1.0)
         if T is None:
             g = float(np.hypot(*self.gravity))
             T = math.sqrt(L / g) if g > 0.0 else 1.0
@@ -617,10 +725,18 @@ class Model:
         tail = []
         base = [0.0] * K.HEADER
 
-        def put(values):
-            # the offset the values will have once the tables are laid out
+        shared = {}
+
+        def put(values, share=False):
+            # the offset the values will have once the tables are laid out; equal time
+            # functions share one record (and so the memory of their harmonics)
+            values = tuple(float(x) for x in values)
+            if share and values in shared:
+                return shared[values]
             off = len(tail)
-            tail.extend(float(x) for x in values)
+            tail.extend(values)
+            if share:
+                shared[values] = off
             return off
 
         brecs, dof = [], 0
@@ -630,15 +746,34 @@ class Model:
             if rec["kind"] == K.FREE:
                 r[1], r[2], r[3] = dof, rec["mass"] / Mu, rec["inertia"] / (Mu * L * L)
                 dof += 3
-            else:
+            elif rec["kind"] == K.FIXED:
                 r[1] = -1
+            else:
+                # the memory of the angle's sine and cosine (the kernels' kept_sincos); a
+                # constant angle's are written here once (the generated code reads them)
+                th = rec["motion"][2]
+                const = th is not None and not th.harmonics and th.rate == 0 and th.accel == 0
+                r[1] = ("T", put((th.value, math.sin(th.value), math.cos(th.value)) if const
+                                 else K.KEPT_SLOTS))
             if rec["kind"] == K.FIXED:
                 th = rec["pose"][2]
                 r[4:9] = [rec["pose"][0] / L, rec["pose"][1] / L, th, math.cos(th), math.sin(th)]
             elif rec["kind"] == K.DRIVEN:
                 fx, fy, ft = rec["motion"]
-                r[7:10] = [("T", put(fx.packed(L, T))), ("T", put(fy.packed(L, T))),
-                           ("T", put(ft.packed(1.0, T)))]
+                r[7:10] = [("T", put(fx.packed(L, T), share=True)),
+                           ("T", put(fy.packed(L, T), share=True)),
+                           ("T", put(ft.packed(1.0, T), share=True))]
+            elif rec["kind"] == K.GUIDED:
+                cx, cy = rec["centre"]
+                r[2] = rec["mass"] / Mu
+                r[3] = (rec["inertia"] + rec["mass"] * (cx * cx + cy * cy)) / (Mu * L * L)
+                for j, f in enumerate(rec["motion"]):
+                    if f is None:
+                        r[4 + j] = dof
+                        dof += 1
+                    else:
+                        r[4 + j] = ("N", put(f.packed(1.0 if j == 2 else L, T), share=True))
+                r[7:9] = [cx / L, cy / L]
             brecs.append(r)
         crecs = []
         for rec in self.contacts:
@@ -658,19 +793,21 @@ class Model:
         for rec in self.forces:
             r = [0.0] * K.FREC
             r[0] = rec["kind"]
-            if rec["kind"] == K.SPRING:
+            if rec["kind"] in (K.SPRING, K.AXIAL):
                 r[1:10] = [rec["i"], rec["j"], rec["ri"][0] / L, rec["ri"][1] / L,
                            rec["rj"][0] / L, rec["rj"][1] / L, rec["k"] * L / F,
                            rec["l0"] / L, rec["c"] * L / (F * T)]
+                if rec["kind"] == K.AXIAL:
+                    r[10:12] = [rec["axis"][0], rec["axis"][1]]
             elif rec["kind"] == K.TORSION:
                 r[1:6] = [rec["i"], rec["j"], rec["k"] / (F * L), rec["th0"],
                           rec["c"] / (F * L * T)]
             elif rec["kind"] == K.FORCE:
                 r[1:6] = [rec["i"], rec["r"][0] / L, rec["r"][1] / L,
-                          ("T", put(rec["f"][0].packed(F, T))),
-                          ("T", put(rec["f"][1].packed(F, T)))]
+                          ("T", put(rec["f"][0].packed(F, T), share=True)),
+                          ("T", put(rec["f"][1].packed(F, T), share=True))]
             else:
-                r[1:3] = [rec["i"], ("T", put(rec["f"].packed(F * L, T)))]
+                r[1:3] = [rec["i"], ("T", put(rec["f"].packed(F * L, T), share=True))]
             frecs.append(r)
         jrecs = []
         for rec in self.joints:
@@ -692,7 +829,9 @@ class Model:
         base[:] = [len(brecs), len(crecs), len(frecs), ob, oc, of, dof, g[0], g[1],
                    len(jrecs), oj]
         par = base + [x for r in brecs + crecs + frecs + jrecs for x in r]
-        par = [ot + x[1] if isinstance(x, tuple) else x for x in par] + tail
+        # "T": an offset into the tail; "N": a guided body's prescribed coordinate, -1 - offset
+        par = [(ot + x[1] if x[0] == "T" else -1 - (ot + x[1])) if isinstance(x, tuple) else x
+               for x in par] + tail
         return np.array(par, dtype=float), dof
 
     def build(self, name="planar-model", valid_region=None, inside=None, default_window=None):
@@ -709,7 +848,7 @@ class Model:
         default_window : float, optional
             A run's natural length in the scene's time.
         """
-        if not any(b["kind"] == K.FREE for b in self.bodies):
+        if not any(self._movable(b["body"]) for b in self.bodies):
             raise InputError("the model has no free body: add one with `add_body`")
         if self.joints:
             self._check_joints()
@@ -732,17 +871,13 @@ class PlanarScene(SIUnits, Scene):
         self.length, self.time, self.force = L, T, Mu * L / T ** 2
         self.mu = np.array([c["mu"] for c in model.contacts], dtype=float)
         self.restitution = np.array([c["restitution"] for c in model.contacts], dtype=float)
-        self.angle_coordinates = tuple(range(2, self.ndof, 3))
+        q0, v0, self.angle_coordinates = model.initial_coordinates()
         self.valid_region = valid_region
         self._inside = inside
         self.default_window = default_window
-        self._has_jac = len(model.forces) > 0
-        q0, v0 = [], []
-        for b in model.bodies:
-            if b["kind"] == K.FREE:
-                q0 += [b["pose"][0] / L, b["pose"][1] / L, b["pose"][2]]
-                v0 += [b["vel"][0] * T / L, b["vel"][1] * T / L, b["vel"][2] * T]
-        self._q0, self._v0 = np.array(q0), np.array(v0)
+        self._has_jac = len(model.forces) > 0 or any(b["kind"] == K.GUIDED
+                                                     for b in model.bodies)
+        self._q0, self._v0 = q0, v0
         self._fn = _codegen.compiled_functions(self.par)
         self._joints = JointRows(model) if model.joints else None
         self.n_joint_rows = 0 if self._joints is None else self._joints.nrows
@@ -760,7 +895,7 @@ class PlanarScene(SIUnits, Scene):
 
     def _qscale(self):
         s = np.full(self.ndof, self.length)
-        s[2::3] = 1.0
+        s[list(self.angle_coordinates)] = 1.0
         return s
 
     def _qv(self, q, v=None):
@@ -834,7 +969,7 @@ class PlanarScene(SIUnits, Scene):
         """
         f = self._fn
         return CompiledModel(f.mass, f.forces, f.contacts, f.drift, self.par, self.ndof,
-                             self.ncontacts, True, self._has_jac)
+                             self.ncontacts, True, self._has_jac, gaps=f.gaps)
 
     def poses(self, q, t):
         """``(x, y, theta)`` of every body (the ground first), scene units, shape (bodies, 3)."""
@@ -875,8 +1010,7 @@ class PlanarScene(SIUnits, Scene):
             def world(p, x=x, y=y, c=c, s=s):
                 return (x + c * p[0] - s * p[1], y + s * p[0] + c * p[1])
 
-            role = "ground" if self.description.bodies[ref.body.index]["kind"] != K.FREE \
-                else "body"
+            role = "body" if self.description._movable(ref.body) else "ground"
             sh = ref.shape
             if isinstance(sh, Circle):
                 out.append(circle(world(sh.centre), sh.radius, role))
