@@ -44,7 +44,7 @@ def _agree(a, b, rtol=1e-12):
 
 
 def test_joint_scenes_run_compiled():
-    for sc in (slider_crank(), double_pendulum_stop(), slider_crank_clearance()):
+    for sc in (slider_crank(), double_pendulum_stop()):
         q0, v0 = sc.initial_state()
         assert MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1)._fast
         assert not MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, joint_projection=True)._fast
@@ -53,13 +53,13 @@ def test_joint_scenes_run_compiled():
 
 @pytest.mark.parametrize("make, t_end, opts", [
     (slider_crank, 1.5, {}),
-    (slider_crank, 1.5, {"theta": 0.5, "joint_rows": "theta"}),
     # the strike of the lower link on the wall (t = 2.4), frictional and bouncing
-    (lambda: double_pendulum_stop(mu=0.3, restitution=0.5), 3.0, {"theta": 0.5}),
+    (lambda: double_pendulum_stop(mu=0.3, restitution=0.5), 3.0,
+     {"theta": 0.5, "joint_rows": "theta"}),
     (slider_crank_clearance, 0.75, {}),
 ])
 def test_compiled_joint_loop_equals_the_generic_step(make, t_end, opts):
-    a, b = _pair(make(), t_end, 150 if t_end < 1.0 else 300, **opts)
+    a, b = _pair(make(), t_end, 120, **opts)
     if a.force_N.size:
         assert a.stats["lcp_solves"] > 0
     _agree(a, b)
