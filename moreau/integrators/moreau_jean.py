@@ -506,7 +506,6 @@ class MoreauJean(TimeStepping):
         if model is None or joints is None or self.lcp_method != "auto" \
                 or self.joint_projection or self._space:
             return None
-        self._joints_fn = joints
         return model
 
     def _check_joints(self):
@@ -665,7 +664,7 @@ class MoreauJean(TimeStepping):
                np.empty((ns, nc)), np.empty((ns, nc)))
         st = np.zeros(len(J_STAT_NAMES))
         status, k, nrec = run_joint_block(
-            m.mass, m.forces, m.contacts, self._joints_fn, n, nc, self._n_eq,
+            m.mass, m.forces, m.contacts, sc.compiled_joints(), n, nc, self._n_eq,
             m.has_jacobians, m.par, np.ascontiguousarray(self.mu_c, dtype=float),
             np.ascontiguousarray(self.e_c, dtype=float), float(self.t0), float(self.h),
             float(self.t_bound), self._k, getattr(self, "_block_limit", FAST_BLOCK), q, v,
