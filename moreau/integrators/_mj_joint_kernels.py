@@ -61,15 +61,16 @@ def _mlcp_check(W, Uf, target, k, pE, pn, pt, mu, e, vN0, fr):
 
     The friction MLCP of one contact on the caller's data: variables
     ``x = (p_E, pN[, t+, t-, beta])``, matrix ``[[A, C S], [S^T D, S^T B S +
-    friction rows]]``, ``q = (u_E - target, u_N + e min(vN0, 0)[, u_T, -u_T, 0])``.
+    friction rows]]``, ``q = (u_E - target, u_N + e min(vN0, 0)[, u_T, -u_T, 0])``;
+    the equality rows alone (``x = p_E``, ``M = A``) where ``pn < 0`` (no contact).
     """
-    L = 4 if fr else 1
+    L = 0 if pn < 0.0 else 4 if fr else 1
     m = k + L
     Mm = np.zeros((m, m))
     qm = np.zeros(m)
     x = np.zeros(m)
     # S: the contact variables' columns in the stacked rows (N, then T)
-    S = np.zeros((2, L))
+    S = np.zeros((2, max(L, 1)))
     S[0, 0] = 1.0
     if fr:
         S[1, 1] = 1.0
@@ -96,9 +97,10 @@ def _mlcp_check(W, Uf, target, k, pE, pn, pt, mu, e, vN0, fr):
                 for s in range(nr):
                     acc += S[r, a] * W[k + r, k + s] * S[s, b]
             Mm[k + a, k + b] = acc
-    qm[k] = Uf[k] + e * min(vN0, 0.0)
-    x[k] = pn
-    if fr:
+    if L > 0:
+        qm[k] = Uf[k] + e * min(vN0, 0.0)
+        x[k] = pn
+    if L > 1:
         qm[k + 1] = Uf[k + 1]
         qm[k + 2] = -Uf[k + 1]
         Mm[k + 1, k + 3] = 1.0
@@ -326,11 +328,16 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
                 p[nj + 1] = pt
         for r in range(nj):
             p[r] = pE[r]
+        # the answer checked on the whole problem as the generic step checks it (a failure
+        # is its to report)
         if na == 1:
             viol, res = _mlcp_check(W, Uf, target, nj, pE, pn, pt, mu[ic], e[ic], vN0[ic], fr)
-            if not viol <= DEFAULT_TOL:
-                status = LCP_HANDBACK
-                break
+        else:
+            viol, res = _mlcp_check(W, Uf, target, nj, pE, -1.0, 0.0, 0.0, 0.0, 0.0, False)
+        if not viol <= DEFAULT_TOL:
+            status = LCP_HANDBACK
+            break
+        if na == 1:
             pN[ic] = pn
             pT[ic] = pt
             stats[0] += 1.0
