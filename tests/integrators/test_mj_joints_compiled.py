@@ -94,3 +94,24 @@ def test_forced_compiled_joints_with_a_forced_solver_is_refused():
     with pytest.raises(InputError, match="`fast=True`: the compiled loop of 'moreau-jean' "
                                          "solves no joints of this scene"):
         MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True, lcp_method="lemke")
+
+
+def test_the_loops_rank_test_is_the_generic_steps():
+    # the loop's shortcut (k cond_1 below 1e10: regular without an SVD) decides as
+    # equality_block's SVD does, across the bound and the rank tolerance
+    from moreau.integrators._mj_joint_kernels import _regular
+    from moreau.lcp.mlcp import RankDeficientError, equality_block
+    rng = np.random.default_rng(3)
+    for k in (1, 2, 4, 6):
+        for log_cond in (0, 6, 9, 10.5, 11.5, 12.5, 14, 20):
+            U, _ = np.linalg.qr(rng.standard_normal((k, k)))
+            s = np.logspace(0, -log_cond, k)
+            A = (U * s) @ U.T
+            try:
+                equality_block(A)
+                full = True
+            except RankDeficientError:
+                full = False
+            assert _regular(A, k) == full, (k, log_cond)
+    assert not _regular(np.zeros((2, 2)), 2)
+    assert not _regular(np.array([[1.0, np.nan], [0.0, 1.0]]), 2)
