@@ -136,9 +136,14 @@ keep the contacts: a correction may move a contact into its obstacle
 over ``[0, 10]``: largest penetration 2.3e-3 with it, 0 without; the
 velocity-level contact rows take over at the next step). ``projection=True``
 (onto the contacts, which would not keep the joints) is refused with joints.
-Joints take the generic step (the compiled loop
-solves no equality rows; ``fast=True`` is refused), and
-``painleve="stop"`` acts on steps without joints only.
+On the compiled path (a scene that gives its joint rows compiled,
+``compiled_joints()``: the planar builder's) the joints run in their own
+loop, :mod:`moreau.integrators._mj_joint_kernels`: the same mixed LCP with
+the equality rows eliminated and the contact in closed form; a step with
+several active contacts (Lemke) is handed to the generic step. With
+``joint_projection`` or a forced ``lcp_method`` a scene with joints takes
+the generic step (``fast=True`` is then refused). ``painleve="stop"`` acts
+on steps without joints only.
 
 *Spatial scenes* (:mod:`moreau.model.space`: ``q`` holds each body's centre
 and unit quaternion, ``v`` its centre velocity and body-frame angular
@@ -248,6 +253,8 @@ from ..model.scene import is_spatial, joint_row_count
 from ..regimes import Regime
 from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
+from ._blocks import FAST_BLOCK
+from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
 from ._mj_kernels import mj_loop, prev_regimes
 from ._space_step import check_cone, space_step
 # the time-stepping checks lived here; their names stay importable from this module
@@ -490,6 +497,17 @@ class MoreauJean(TimeStepping):
         if self._n_eq:
             self._check_joints()
 
+    def _joint_model(self, model, options):
+        # the compiled loop of joints: the scene's joint rows as a compiled function, the
+        # contact problem by the closed form as "auto" solves it (a forced solver, and the
+        # joints' projection, take the generic step)
+        joints = getattr(self.scene, "compiled_joints", None)
+        joints = joints() if joints is not None else None
+        if model is None or joints is None or self.lcp_method != "auto" \
+                or self.joint_projection or self._space:
+            return None
+        return model
+
     def _check_joints(self):
         # refused before any work: what the generic step does not do with joints, and
         # joint rows that are dependent at the start (redundant or inconsistent joints)
@@ -633,7 +651,53 @@ class MoreauJean(TimeStepping):
         if self._k % self.save_every == 0 or t1 >= self.t_bound:
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
+    def _joint_block(self):
+        """One block of the compiled loop of joints (:mod:`._mj_joint_kernels`)."""
+        sc, m = self.scene, self._model
+        n, nc = sc.ndof, sc.ncontacts
+        q, v = self.q.copy(), self.v.copy()
+        closed = np.ascontiguousarray(self._closed, dtype=bool).copy()
+        reg = np.ascontiguousarray(self._regimes_before(), dtype=np.int64).copy()
+        ns = FAST_BLOCK // self.save_every + 2
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+               np.empty((ns, nc)), np.empty((ns, nc)))
+        st = np.zeros(len(J_STAT_NAMES))
+        status, k, nrec = run_joint_block(
+            m.mass, m.forces, m.contacts, sc.compiled_joints(), n, nc, self._n_eq,
+            m.has_jacobians, m.par, np.ascontiguousarray(self.mu_c, dtype=float),
+            np.ascontiguousarray(self.e_c, dtype=float), float(self.t0), float(self.h),
+            float(self.t_bound), self._k, getattr(self, "_block_limit", FAST_BLOCK), q, v,
+            float(self.theta), self.joint_rows == "theta", closed, reg, self.save_every,
+            self._pending_initial, *buf, st)
+        ndone = k - self._k
+        if nrec:
+            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
+        if ndone:
+            self._pending_initial = False
+        self._k = k
+        t = self.t0 + k * self.h
+        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        self.q, self.v, self._closed = q, v, closed
+        self._regimes_before()[:] = reg
+        c = self.counters
+        c["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
+        c["lcp_solves"] += int(st[0])
+        c["max_residual"] = max(c["max_residual"], float(st[1]))
+        c["max_penetration"] = max(c["max_penetration"], float(st[2]))
+        self._max_drift = max(self._max_drift, float(st[3]))
+        # a step the loop leaves (several contacts, a rank-deficient joint block, a case the
+        # closed form does not decide) is the generic step's, which solves it or says why not
+        self._after_block(
+            status,
+            singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
+                      "t = {t!r}; reduce `h` or use a smaller `theta`"),
+            numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
+                       "too large for an explicit part of the forces)"))
+
     def _fast_block(self):
+        if self._n_eq:
+            return self._joint_block()
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(mj_loop, (q, v, (float(self.theta), bool(self.projection)),
                                            (closed,)), (self._lcp_ctl,))

@@ -335,13 +335,14 @@ class TimeStepping(CompiledRecording, Integrator):
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
         model = compiled_model_of(scene)
         if joint_row_count(scene):
-            # the compiled loops solve no equality rows: a scene with joints takes the
-            # generic step
-            if options.fast is True:
+            # a scheme's compiled loop solves no equality rows unless it has a loop of its
+            # own for them (Moreau–Jean); otherwise a scene with joints takes the generic step
+            model = self._joint_model(model, options)
+            if model is None and options.fast is True:
                 raise InputError(f"`fast=True`: the compiled loop of {self.scheme!r} solves no "
-                                 f"joints, and the scene has {joint_row_count(scene)} joint "
-                                 "rows; use fast='auto' or False (the generic step)")
-            model = None
+                                 f"joints of this scene ({joint_row_count(scene)} joint rows) "
+                                 f"with these options; use fast='auto' or False (the generic "
+                                 "step)")
         self._choose_compiled(options.fast, model, self.lcp_method,
                               getattr(options, "lemke_max_iter", None),
                               warm_start=self._warm_start())
@@ -354,6 +355,10 @@ class TimeStepping(CompiledRecording, Integrator):
 
     def _setup_scheme(self):
         """The scheme's own start state (the options and the contacts are set)."""
+
+    def _joint_model(self, model, options):
+        """The compiled model to run a scene with joints on, or None for the generic step."""
+        return None
 
     def _warm_start(self):
         """Whether the compiled path warm-starts its contact problems."""

@@ -964,12 +964,22 @@ class PlanarScene(SIUnits, Scene):
     def compiled_model(self):
         """The compiled model: the functions generated for this model's structure, with its ``par``.
 
-        It holds no joint rows: the time-stepping schemes take their generic
-        step on a model with joints.
+        It holds no joint rows (:meth:`compiled_joints` gives them): Moreau–Jean
+        runs a model with joints in its own compiled loop, the other schemes
+        take their generic step.
         """
         f = self._fn
         return CompiledModel(f.mass, f.forces, f.contacts, f.drift, self.par, self.ndof,
                              self.ncontacts, True, self._has_jac, gaps=f.gaps)
+
+    def compiled_joints(self):
+        """The generated ``joints(par, q, t, G, need_gap)`` of the joint rows (the rows of
+        :class:`JointRows`, with :meth:`compiled_model`'s ``par``), or None without joints.
+
+        Moreau–Jean's compiled loop for joints reads it
+        (:mod:`moreau.integrators._mj_joint_kernels`).
+        """
+        return None if self._joints is None else self._fn.joints
 
     def poses(self, q, t):
         """``(x, y, theta)`` of every body (the ground first), scene units, shape (bodies, 3)."""
