@@ -249,6 +249,7 @@ from ..regimes import Regime
 from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
 from ._mj_kernels import mj_loop, prev_regimes
+from ._space_kernels import space_loop, space_tables
 from ._space_step import check_cone, space_step
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
@@ -522,9 +523,27 @@ class MoreauJean(TimeStepping):
         return self._closed.copy()
 
     # -- one step -------------------------------------------------------------
+    def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
+        if not self._space:
+            return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
+        # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
+        tables = None
+        if fast is not False and lcp_method != "qp":
+            tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
+        if fast is True and tables is None:
+            raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
+                             f"points against half-spaces; scene {self.scene.name!r} has other "
+                             "contacts: use fast='auto' or False (the generic step)")
+        super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
+
+    def _runner(self, template):
+        if self._space:
+            return space_loop
+        return super()._runner(template)
+
     def _step_impl(self):
         if self._fast:
-            return self._fast_block()
+            return self._space_block() if self._space else self._fast_block()
         return self._generic_step()
 
     def _generic_step(self):
@@ -632,6 +651,15 @@ class MoreauJean(TimeStepping):
             self._pending_initial = False
         if self._k % self.save_every == 0 or t1 >= self.t_bound:
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
+
+    def _space_block(self):
+        q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
+        status = self._run_block(space_loop, (q, v, self._model.tables, float(self.theta),
+                                              closed), ())
+        self.q, self.v, self._closed = q, v, closed
+        # a contact problem the loop does not finish (the exact cone's Newton polish, a Lemke
+        # failure) is the generic step's, which solves it or raises with its diagnosis
+        self._after_block(status)
 
     def _fast_block(self):
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
