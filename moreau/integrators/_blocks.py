@@ -213,7 +213,8 @@ def result_of_rows(integrator, blocks):
         t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*blocks))
     else:
         t = np.zeros(0)
-        q = v = np.zeros((0, n))
+        q = np.zeros((0, n))
+        v = np.zeros((0, velocity_count(integrator.scene)))
         reg = np.zeros((0, nc), dtype=np.int64)
         fN = fT = slip = gap = np.zeros((0, nc))
     code = integrator.status_code

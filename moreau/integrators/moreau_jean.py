@@ -528,7 +528,7 @@ class MoreauJean(TimeStepping):
             return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
         # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
         tables = None
-        if fast is not False and lcp_method != "qp":
+        if fast is not False:
             tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
         if fast is True and tables is None:
             raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
