@@ -826,7 +826,7 @@ def natural_map_sq(r, u, mu):
 
     Examples
     --------
-    >>> natural_map_sq(np.zeros(3), np.array([-1.0, 3.0, 4.0]), np.array([0.5]))
+    >>> round(natural_map_sq(np.zeros(3), np.array([-1.0, 3.0, 4.0]), np.array([0.5])), 12)
     0.8
     """
     return _natural_sq(r, u, mu)
