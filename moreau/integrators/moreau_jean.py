@@ -164,7 +164,14 @@ symmetric ``W = H M^-1 H^T``, which the gyroscopic Jacobian would break; its
 error is ``O(h)`` only where contacts act on a body spinning about a
 non-principal axis). A contact's recorded tangential force and slip
 are magnitudes, its regime ``P`` for slip in any direction. ``projection``
-is refused.
+is refused. The step runs in the compiled loop of
+:mod:`moreau.integrators._space_kernels` for scenes whose contacts are
+spheres and material points (pucks) against half-spaces (all shipped
+ones), the same step to rounding; a contact problem the loop does not
+finish (the exact cone where Gauss–Seidel alone misses the tolerance and
+the Newton polish is needed, which happens with several contacts on one
+body; a Lemke failure) is handed to the Python step, which stays the
+reference (``fast=False``).
 
 *Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
 the same step in the compiled loop of :mod:`moreau.integrators._mj_kernels`,
