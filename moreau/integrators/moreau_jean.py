@@ -255,7 +255,7 @@ from ..model.scene import is_spatial, joint_row_count
 from ..regimes import Regime
 from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
-from ._mj_kernels import mj_loop, prev_regimes
+from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
 from ._space_kernels import space_loop, space_tables
 from ._space_step import check_cone, space_step
 # the time-stepping checks lived here; their names stay importable from this module
@@ -267,6 +267,9 @@ from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
+
+#: most Python steps taken in a row on a spatial scene after hand-backs of the compiled loop
+_MAX_PYTHON_RUN = 64
 
 # |p_T| within this relative distance of mu p_N counts as slip: the LCP and
 # the enumeration reach the friction-cone boundary only up to rounding
@@ -488,6 +491,9 @@ class MoreauJean(TimeStepping):
         self._n_eq = joint_row_count(self.scene)
         self._max_drift = 0.0
         self._space = is_spatial(self.scene)
+        # the Python steps left after the compiled spatial loop handed back a first step,
+        # and how many it takes the next time (see _space_block)
+        self._python_steps_left, self._python_run = 0, 1
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
@@ -660,10 +666,23 @@ class MoreauJean(TimeStepping):
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
     def _space_block(self):
+        if self._python_steps_left:
+            # the loop handed back its first step twice in a row: the next ones go to the
+            # Python step directly (the same step), for twice as many each time up to
+            # _MAX_PYTHON_RUN, rather than the loop's work done twice on each
+            self._python_steps_left -= 1
+            return self._generic_step()
+        k0 = self._k
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(space_loop, (q, v, self._model.tables, float(self.theta),
                                               closed), ())
         self.q, self.v, self._closed = q, v, closed
+        if status == LCP_HANDBACK:
+            if self._k == k0:
+                self._python_run = min(2 * self._python_run, _MAX_PYTHON_RUN)
+                self._python_steps_left = self._python_run
+            else:
+                self._python_run = 1
         # a contact problem the loop does not finish (the exact cone's Newton polish, a Lemke
         # failure) is the generic step's, which solves it or raises with its diagnosis
         self._after_block(status)
