@@ -11,6 +11,9 @@ the scene's shapes against its half-spaces
 (:meth:`moreau.model.space.SpaceScene.contact_table`), the Delassus matrix
 ``W = H M^-1 H^T`` of the active contacts, then the cone:
 
+(the cone's solver is an argument called through a pointer,
+:func:`space_solver`, so that a run compiles and links only its own):
+
 * ``"exact"``: :func:`moreau.contact.cone3d.exact_gauss_seidel`, the exact
   solver's Gauss–Seidel phase with its exact local solve; where it would
   need the Newton polish the step is handed back (:data:`LCP_HANDBACK`) to
@@ -30,8 +33,10 @@ spatial scene in ``tests/integrators/test_space_compiled.py``.
 
 import math
 
+import numba
 import numpy as np
 from numba import njit
+from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from ..contact import cone3d as _cone3d
@@ -43,7 +48,8 @@ from . import _contact_step, _driver
 from ._contact_step import LCP_HANDBACK, NUMERICAL, OK, S_LCP, S_PEN, S_PIVOTS, S_RES
 from ._driver import grid_step
 
-__all__ = ["SpaceTables", "space_tables", "space_loop", "EXACT_TOL", "EXACT_POLISH_FROM", "EXACT_SWEEPS"]
+__all__ = ["SpaceTables", "space_tables", "space_loop", "space_solver", "run_space_loop",
+           "SOLVE_SIGNATURE", "EXACT_TOL", "EXACT_POLISH_FROM", "EXACT_SWEEPS"]
 
 #: :func:`moreau.contact.cone3d.solve_exact`'s defaults, which the Python step uses
 EXACT_TOL, EXACT_POLISH_FROM, EXACT_SWEEPS = 1e-10, 1e-6, 500
@@ -260,13 +266,77 @@ def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, ma
 
 
 @njit(cache=True)
-def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed, save_every,
-               record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
+    # the exact cone where Gauss–Seidel converges; status 1 where Newton's polish is needed
+    u = Uf.copy()
+    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                     EXACT_SWEEPS)
+    return np.int64(0 if ok else 1), np.int64(0), res, qn
+
+
+@njit(cache=True)
+def _polyhedral_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
+    # the d-direction LCP by Lemke; its status (0: solved), pivots, the exact cone's
+    # natural-map residual at the answer and ||Uf||
+    status, pivots = _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork,
+                                 max_iter, r)
+    n3 = Uf.shape[0]
+    u = np.empty(n3)
+    qn = 0.0
+    for a in range(n3):
+        acc = Uf[a]
+        for c in range(n3):
+            acc += W[a, c] * r[c]
+        u[a] = acc
+        qn += Uf[a] * Uf[a]
+    return status, pivots, math.sqrt(natural_map_sq(r, u, mu_a)), math.sqrt(qn)
+
+
+_A1 = nbtypes.float64[::1]
+_A2 = nbtypes.float64[:, ::1]
+_INT = nbtypes.int64
+#: the signature of the cone solvers, which the loop calls through a pointer: a run with
+#: one cone neither compiles nor links the other (Lemke is a third of the loop's compile)
+SOLVE_SIGNATURE = nbtypes.Tuple((_INT, _INT, nbtypes.float64, nbtypes.float64))(
+    _A2, _A1, _A1, _A2, _INT, _INT, _A2, _A1, _A1, _A1, _A1, _A1, _A2, nbtypes.int64[::1], _INT,
+    _A1)
+
+
+def space_solver(cone):
+    """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`."""
+    fn = _exact_solve if cone == "exact" else _polyhedral_solve
+    if not fn.signatures:
+        fn.compile(SOLVE_SIGNATURE)
+    return fn
+
+
+def run_space_loop(*args):
+    """:func:`space_loop` with the solver (argument 13) passed as a pointer, not linked in.
+
+    The loop is compiled once for the argument types with the solver typed
+    by :data:`SOLVE_SIGNATURE` (from numba's disk cache where it is there).
+    """
+    if not _LOOP:
+        types = [numba.typeof(a) for a in args]
+        types[13] = nbtypes.FunctionType(SOLVE_SIGNATURE)
+        space_loop.compile(tuple(types))
+        space_loop.disable_compile()
+        _LOOP.append(True)
+    return space_loop(*args)
+
+
+_LOOP = []
+
+
+@njit(cache=True)
+def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed, solve,
+               save_every, record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
                stats):
     """Up to ``nmax`` Moreau–Jean steps of a spatial scene from ``(q, v)`` at ``t0 + k0 h``.
 
     ``tables`` is :func:`space_tables`'s tuple, ``closed`` the contacts
-    closed in the step before (updated), ``par`` unused (the block runner's
+    closed in the step before (updated), ``solve`` the cone's solver
+    (:func:`space_solver`, called through a pointer), ``par`` unused (the block runner's
     slot of a compiled model's parameters). The recording buffers and
     ``stats`` are those of every compiled block. Returns ``(status, k,
     nrec)``: ``OK``, :data:`LCP_HANDBACK` (the contact problem of step ``k``
@@ -405,30 +475,12 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             Uf = Uf_all[:n3].copy()
             mu_a = mu_all[:na].copy()
             r = np.zeros(n3)
-            if d == 0:
-                u = Uf.copy()
-                ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                                 EXACT_SWEEPS)
-                if not ok:
-                    status = LCP_HANDBACK
-                    break
-            else:
-                lst, piv = _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work,
-                                       iwork, maxit[na], r)
-                if lst != 0:
-                    status = LCP_HANDBACK
-                    break
-                stats[S_PIVOTS] += piv
-                u = np.empty(n3)
-                qn = 0.0
-                for a in range(n3):
-                    acc = Uf[a]
-                    for c in range(n3):
-                        acc += W[a, c] * r[c]
-                    u[a] = acc
-                    qn += Uf[a] * Uf[a]
-                qn = math.sqrt(qn)
-                res = math.sqrt(natural_map_sq(r, u, mu_a))
+            lst, piv, res, qn = solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work,
+                                      iwork, maxit[na], r)
+            if lst != 0:
+                status = LCP_HANDBACK
+                break
+            stats[S_PIVOTS] += piv
             stats[S_LCP] += 1
             stats[S_RES] = max(stats[S_RES], res / qn if qn > 0.0 else res)
             for a in range(na):

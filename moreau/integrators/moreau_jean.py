@@ -256,7 +256,7 @@ from ..regimes import Regime
 from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
 from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
-from ._space_kernels import space_loop, space_tables
+from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
@@ -551,7 +551,7 @@ class MoreauJean(TimeStepping):
 
     def _runner(self, template):
         if self._space:
-            return space_loop
+            return run_space_loop
         return super()._runner(template)
 
     def _step_impl(self):
@@ -674,8 +674,8 @@ class MoreauJean(TimeStepping):
             return self._generic_step()
         k0 = self._k
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
-        status = self._run_block(space_loop, (q, v, self._model.tables, float(self.theta),
-                                              closed), ())
+        status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
+                                         space_solver(self.cone)), ())
         self.q, self.v, self._closed = q, v, closed
         if status == LCP_HANDBACK:
             if self._k == k0:
