@@ -316,6 +316,13 @@ def run_space_loop(*args):
     The loop is compiled once for the argument types with the solver typed
     by :data:`SOLVE_SIGNATURE` (from numba's disk cache where it is there).
     """
+    # one signature whatever the caller's scalars (an integer t0, a numpy bool)
+    args = list(args)
+    for i in (3, 4, 5, 11):
+        args[i] = float(args[i])
+    for i in (6, 7, 14):
+        args[i] = int(args[i])
+    args[15] = bool(args[15])
     if not _LOOP:
         types = [numba.typeof(a) for a in args]
         types[13] = nbtypes.FunctionType(SOLVE_SIGNATURE)
