@@ -666,10 +666,11 @@ class MoreauJean(TimeStepping):
             self._record(t1, q1, v1, regime, fN, fT, slip, gap)
 
     def _space_block(self):
-        if self._python_steps_left:
+        if self._python_steps_left and not hasattr(self, "_block_limit"):
             # the loop handed back its first step twice in a row: the next ones go to the
             # Python step directly (the same step), for twice as many each time up to
-            # _MAX_PYTHON_RUN, rather than the loop's work done twice on each
+            # _MAX_PYTHON_RUN, rather than the loop's work done twice on each (a replay
+            # to a sample, _block_limit, runs the block as the first run did)
             self._python_steps_left -= 1
             return self._generic_step()
         k0 = self._k

@@ -161,6 +161,15 @@ def test_exact_gauss_seidel_is_solve_exact_where_it_converges():
     assert converged >= 20 and missed >= 5
 
 
+def test_integer_times_run_the_same_compiled_loop():
+    # the loop has one compiled signature: an integer span is cast, not refused
+    sc = registry.make_scene("billiard-backspin")
+    q0, v0 = sc.initial_state()
+    a = simulate(sc, (0, 2), q0, v0, "moreau-jean", h=0.25)
+    b = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.25)
+    assert a.status == b.status == 0 and np.array_equal(a.q, b.q) and len(a.t) == 9
+
+
 def test_fast_false_keeps_the_python_step_and_fast_true_is_accepted():
     sc = registry.make_scene("sphere-incline")
     q0, v0 = sc.initial_state()
