@@ -580,7 +580,8 @@ class SpaceScene(Scene):
         """
         out = np.zeros((self.ncontacts, 18))
         for i, c in enumerate(self._contacts):
-            if set(c) != {"body", "plane", "mu", "e", "radius", "point", "centre"}:
+            # a contact's shape is read from these keys only: any other kind has no row
+            if not set(c) <= _TABLE_KEYS or c.get("kind", "sphere") not in ("sphere", "point"):
                 return None
             y0, n, t1, t2 = self._planes[c["plane"]]
             if c["point"] is not None:
@@ -591,6 +592,10 @@ class SpaceScene(Scene):
                 kind, offset = 0, np.zeros(3)
             out[i] = np.concatenate([[c["body"], kind, c["radius"]], offset, y0, n, t1, t2])
         return out
+
+
+#: the keys of a contact that :meth:`SpaceScene.contact_table` knows
+_TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre"}
 
 
 def _gyro(J, w):
