@@ -14,6 +14,8 @@ from moreau.regimes import Regime
 from moreau.scenes import registry
 
 SPATIAL = [s for s in registry.scene_names() if is_spatial(registry.make_scene(s))]
+#: those whose every contact the compiled loop knows (spheres and material points)
+COMPILED = [s for s in SPATIAL if registry.make_scene(s).contact_table() is not None]
 FIELDS = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap")
 
 
@@ -43,7 +45,7 @@ def _python_steps(monkeypatch):
 
 @pytest.mark.parametrize("options", [{"cone": "exact"}, {"cone": 8, "theta": 0.5}],
                          ids=["exact", "d8-theta-half"])
-@pytest.mark.parametrize("name", SPATIAL)
+@pytest.mark.parametrize("name", COMPILED)
 def test_the_compiled_loop_is_the_python_step_on_every_spatial_scene(name, options, monkeypatch):
     sc = registry.make_scene(name)
     q0, v0 = sc.initial_state()
@@ -168,6 +170,18 @@ def test_integer_times_run_the_same_compiled_loop():
     a = simulate(sc, (0, 2), q0, v0, "moreau-jean", h=0.25)
     b = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.25)
     assert a.status == b.status == 0 and np.array_equal(a.q, b.q) and len(a.t) == 9
+
+
+def test_a_contact_the_loop_does_not_know_takes_the_python_step():
+    # a contact of another kind than a sphere or a material point has no compiled row
+    assert {"sphere-incline", "billiard-backspin", "puck-incline", "tippe-top"} <= set(COMPILED)
+    sc = _two_balls()
+    sc._contacts[2] = dict(sc._contacts[2], kind="rim")
+    q0, v0 = sc.initial_state()
+    assert sc.contact_table() is None
+    assert not MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1)._fast
+    with pytest.raises(InputError, match="`fast=True`: the compiled spatial step knows"):
+        MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True)
 
 
 def test_fast_false_keeps_the_python_step_and_fast_true_is_accepted():
