@@ -266,22 +266,22 @@ def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, ma
 
 
 @njit(cache=True)
-def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
+def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r, u):
     # the exact cone where Gauss–Seidel converges; status 1 where Newton's polish is needed
-    u = Uf.copy()
+    u[:] = Uf
     ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
                                      EXACT_SWEEPS)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
 @njit(cache=True)
-def _polyhedral_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
+def _polyhedral_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r,
+                      u):
     # the d-direction LCP by Lemke; its status (0: solved), pivots, the exact cone's
     # natural-map residual at the answer and ||Uf||
     status, pivots = _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork,
                                  max_iter, r)
     n3 = Uf.shape[0]
-    u = np.empty(n3)
     qn = 0.0
     for a in range(n3):
         acc = Uf[a]
@@ -299,7 +299,7 @@ _INT = nbtypes.int64
 #: one cone neither compiles nor links the other (Lemke is a third of the loop's compile)
 SOLVE_SIGNATURE = nbtypes.Tuple((_INT, _INT, nbtypes.float64, nbtypes.float64))(
     _A2, _A1, _A1, _A2, _INT, _INT, _A2, _A1, _A1, _A1, _A1, _A1, _A2, nbtypes.int64[::1], _INT,
-    _A1)
+    _A1, _A1)
 
 
 def space_solver(cone):
@@ -390,6 +390,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     rayl = np.zeros(Lmax + 1)
     work, iwork = lemke_workspace(Lmax)
     qt = np.empty(4)
+    W = np.empty((0, 0))
+    Uf = np.empty(0)
+    mu_a = np.empty(0)
+    r = np.empty(0)
+    u = np.empty(0)
     for b in range(nb):
         _rotation(q, b, R)
     nrec = 0
@@ -475,15 +480,23 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                         for j in range(6):
                             acc += rows[ia[a // 3], a % 3, j] * MHT[c, j]
                     Wf[a, c] = acc
-            W = np.empty((n3, n3))
+            if n3 != W.shape[0]:
+                # the solvers take contiguous arrays of the problem's size: new ones only
+                # when the number of active contacts changes
+                W = np.empty((n3, n3))
+                Uf = np.empty(n3)
+                mu_a = np.empty(na)
+                r = np.empty(n3)
+                u = np.empty(n3)
             for a in range(n3):
                 for c in range(n3):
                     W[a, c] = 0.5 * (Wf[a, c] + Wf[c, a])
-            Uf = Uf_all[:n3].copy()
-            mu_a = mu_all[:na].copy()
-            r = np.zeros(n3)
+                Uf[a] = Uf_all[a]
+                r[a] = 0.0
+            for a in range(na):
+                mu_a[a] = mu_all[a]
             lst, piv, res, qn = solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work,
-                                      iwork, maxit[na], r)
+                                      iwork, maxit[na], r, u)
             if lst != 0:
                 status = LCP_HANDBACK
                 break
