@@ -471,15 +471,19 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                         acc += rows[i, kk, j] * vfree[6 * b + j]
                     Uf_all[row] = acc
                 Uf_all[3 * a] += e[i] * min(vN0[i], 0.0)
-            for a in range(n3):
-                ba = int(ct[ia[a // 3], 0])
-                for c in range(n3):
-                    bc = int(ct[ia[c // 3], 0])
-                    acc = 0.0
-                    if ba == bc:
-                        for j in range(6):
-                            acc += rows[ia[a // 3], a % 3, j] * MHT[c, j]
-                    Wf[a, c] = acc
+            # W = H M^-1 H^T by contact pairs: zero between two bodies' contacts
+            for a in range(na):
+                i = ia[a]
+                ba = int(ct[i, 0])
+                for c in range(na):
+                    same = ba == int(ct[ia[c], 0])
+                    for kk in range(3):
+                        for ll in range(3):
+                            acc = 0.0
+                            if same:
+                                for j in range(6):
+                                    acc += rows[i, kk, j] * MHT[3 * c + ll, j]
+                            Wf[3 * a + kk, 3 * c + ll] = acc
             if n3 != W.shape[0]:
                 # the solvers take contiguous arrays of the problem's size: new ones only
                 # when the number of active contacts changes
