@@ -13,9 +13,10 @@ from moreau.model.space import Puck, SpaceModel, Sphere
 from moreau.regimes import Regime
 from moreau.scenes import registry
 
-SPATIAL = [s for s in registry.scene_names() if is_spatial(registry.make_scene(s))]
-#: those whose every contact the compiled loop knows (spheres and material points)
-COMPILED = [s for s in SPATIAL if registry.make_scene(s).contact_table() is not None]
+_SPATIAL = {s: sc for s in registry.scene_names()
+            if is_spatial(sc := registry.make_scene(s))}
+#: the spatial scenes whose every contact the compiled loop knows (spheres and material points)
+COMPILED = [s for s, sc in _SPATIAL.items() if sc.contact_table() is not None]
 FIELDS = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap")
 
 
