@@ -88,6 +88,8 @@ __all__ = [
     "local_solve",
     "solve_exact",
     "solve_cone",
+    "exact_gauss_seidel",
+    "natural_map_sq",
     "CONVERGED",
     "NOT_CONVERGED",
 ]
@@ -813,6 +815,75 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
               f"(tol {tol:g} x ||q||).")
     return ConeSolution(r, u, status, res, res / qn if qn > 0 else res,
                         {"sweeps": int(sweeps), "newton": int(newton)}, "exact", detail)
+
+
+@njit(cache=True)
+def natural_map_sq(r, u, mu):
+    """The squared natural-map residual ``||r - proj_K(r - û)||^2`` with ``u`` given, compiled.
+
+    :func:`cone_residual` without the checks and the product ``u = W r + q``,
+    for compiled callers (a time-stepping loop).
+
+    Examples
+    --------
+    >>> round(natural_map_sq(np.zeros(3), np.array([-1.0, 3.0, 4.0]), np.array([0.5])), 12)
+    0.8
+    """
+    return _natural_sq(r, u, mu)
+
+
+@njit(cache=True)
+def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
+    """:func:`solve_exact`'s path where Gauss–Seidel alone converges, compiled.
+
+    From ``r`` with ``u = W r + q`` (both updated in place), the exact local
+    Gauss–Seidel sweeps of :func:`solve_exact` up to its Newton switch; where
+    they reach ``tol`` the answer ends as :func:`solve_exact`'s does (its
+    projection on the cone kept when that costs nothing against the bound),
+    on contiguous float arrays checked by the caller. Where they do not,
+    :func:`solve_exact` would go on with Newton: the caller hands the problem
+    to it.
+
+    Returns
+    -------
+    converged : bool
+        ``residual <= tol ||q||``; False where Newton's polish is needed.
+    residual : float
+        The natural-map residual of ``r`` on the data (after the sweeps).
+    qnorm : float
+        ``||q||``.
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5]); q = np.array([-1.0, 3.0, 4.0])
+    >>> r = np.zeros(3); u = q.copy()
+    >>> ok, res, qn = exact_gauss_seidel(W, q, np.array([0.5]), r, u, 1e-10, 1e-6, 500)
+    >>> bool(ok), np.round(r, 12).tolist(), qn
+    (True, [1.0, -0.3, -0.4], 5.0990195135927845)
+    """
+    n = q.shape[0]
+    qn = 0.0
+    for j in range(n):
+        qn += q[j] * q[j]
+    qn = math.sqrt(qn)
+    scale = qn if qn > 0.0 else 1.0
+    tol_sq = (tol * scale) ** 2
+    switch_sq = (max(tol, polish_from) * scale) ** 2
+    _, res = _pgs(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL)
+    if res > tol_sq:
+        return False, math.sqrt(res), qn
+    r_in = _project_all(r, mu)
+    u_in = np.empty(n)
+    for j in range(n):
+        acc = q[j]
+        for k in range(n):
+            acc += W[j, k] * r_in[k]
+        u_in[j] = acc
+    if _natural_sq(r_in, u_in, mu) <= max(res, tol_sq):
+        r[:] = r_in
+        u[:] = u_in
+    res = math.sqrt(_natural_sq(r, u, mu))
+    return res <= tol * scale, res, qn
 
 
 def solve_cone(W, q, mu, cone="exact", **options):

@@ -15,6 +15,7 @@ import copy
 import numpy as np
 
 from ..errors import InputError, MoreauError
+from ..model.scene import velocity_count
 from ._loops import runner_for
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, PAINLEVE, SINGULAR, STAT_NAMES,
                           new_lcp_control, new_stats)
@@ -76,13 +77,13 @@ class CompiledRecording:
         """
         n, nc = self.scene.ndof, self.scene.ncontacts
         ns = FAST_BLOCK // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
+        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, velocity_count(self.scene))),
                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
                np.empty((ns, nc)), np.empty((ns, nc)))
         st = self._stats
         st[:] = 0.0
         m = self._model
-        status, k, nrec = runner_for(m, template, self.scene)(
+        status, k, nrec = self._runner(template)(
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k,
             getattr(self, "_block_limit", FAST_BLOCK),
             *before, self.save_every, self._pending_initial, *after, *buf, st)
@@ -99,6 +100,10 @@ class CompiledRecording:
             c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
         c["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
         return status
+
+    def _runner(self, template):
+        """The compiled loop of ``template`` on the run's model (:func:`runner_for`)."""
+        return runner_for(self._model, template, self.scene)
 
     def _after_block(self, status, handback=(LCP_HANDBACK, PAINLEVE),
                      singular="the mass matrix is singular at t = {t!r}",
@@ -208,7 +213,8 @@ def result_of_rows(integrator, blocks):
         t, q, v, reg, fN, fT, slip, gap = (np.concatenate(c) for c in zip(*blocks))
     else:
         t = np.zeros(0)
-        q = v = np.zeros((0, n))
+        q = np.zeros((0, n))
+        v = np.zeros((0, velocity_count(integrator.scene)))
         reg = np.zeros((0, nc), dtype=np.int64)
         fN = fT = slip = gap = np.zeros((0, nc))
     code = integrator.status_code

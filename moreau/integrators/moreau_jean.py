@@ -169,7 +169,14 @@ symmetric ``W = H M^-1 H^T``, which the gyroscopic Jacobian would break; its
 error is ``O(h)`` only where contacts act on a body spinning about a
 non-principal axis). A contact's recorded tangential force and slip
 are magnitudes, its regime ``P`` for slip in any direction. ``projection``
-is refused.
+is refused. The step runs in the compiled loop of
+:mod:`moreau.integrators._space_kernels` for scenes whose contacts are
+spheres and material points (pucks) against half-spaces (all shipped
+ones), the same step to rounding; a contact problem the loop does not
+finish (the exact cone where Gauss–Seidel alone misses the tolerance and
+the Newton polish is needed, which happens with several contacts on one
+body; a Lemke failure) is handed to the Python step, which stays the
+reference (``fast=False``).
 
 *Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
 the same step in the compiled loop of :mod:`moreau.integrators._mj_kernels`,
@@ -255,7 +262,8 @@ from .base import register_integrator
 from .contact_problem import one_contact_impulse, one_contact_residual, solve_contact_problem
 from ._blocks import FAST_BLOCK
 from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
-from ._mj_kernels import mj_loop, prev_regimes
+from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
+from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
@@ -266,6 +274,9 @@ from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F
 
 __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classify_impulse",
            "LCP_METHODS"]
+
+#: most Python steps taken in a row on a spatial scene after hand-backs of the compiled loop
+_MAX_PYTHON_RUN = 64
 
 # |p_T| within this relative distance of mu p_N counts as slip: the LCP and
 # the enumeration reach the friction-cone boundary only up to rounding
@@ -487,6 +498,9 @@ class MoreauJean(TimeStepping):
         self._n_eq = joint_row_count(self.scene)
         self._max_drift = 0.0
         self._space = is_spatial(self.scene)
+        # the Python steps left after the compiled spatial loop handed back a first step,
+        # and how many it takes the next time (see _space_block)
+        self._python_steps_left, self._python_run = 0, 1
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
@@ -540,9 +554,27 @@ class MoreauJean(TimeStepping):
         return self._closed.copy()
 
     # -- one step -------------------------------------------------------------
+    def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
+        if not self._space:
+            return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
+        # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
+        tables = None
+        if fast is not False:
+            tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
+        if fast is True and tables is None:
+            raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
+                             f"points against half-spaces; scene {self.scene.name!r} has other "
+                             "contacts: use fast='auto' or False (the generic step)")
+        super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
+
+    def _runner(self, template):
+        if self._space:
+            return run_space_loop
+        return super()._runner(template)
+
     def _step_impl(self):
         if self._fast:
-            return self._fast_block()
+            return self._space_block() if self._space else self._fast_block()
         return self._generic_step()
 
     def _generic_step(self):
@@ -694,6 +726,29 @@ class MoreauJean(TimeStepping):
                       "t = {t!r}; reduce `h` or use a smaller `theta`"),
             numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
                        "too large for an explicit part of the forces)"))
+
+    def _space_block(self):
+        if self._python_steps_left and not hasattr(self, "_block_limit"):
+            # the loop handed back its first step twice in a row: the next ones go to the
+            # Python step directly (the same step), for twice as many each time up to
+            # _MAX_PYTHON_RUN, rather than the loop's work done twice on each (a replay
+            # to a sample, _block_limit, runs the block as the first run did)
+            self._python_steps_left -= 1
+            return self._generic_step()
+        k0 = self._k
+        q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
+        status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
+                                         space_solver(self.cone)), ())
+        self.q, self.v, self._closed = q, v, closed
+        if status == LCP_HANDBACK:
+            if self._k == k0:
+                self._python_run = min(2 * self._python_run, _MAX_PYTHON_RUN)
+                self._python_steps_left = self._python_run
+            else:
+                self._python_run = 1
+        # a contact problem the loop does not finish (the exact cone's Newton polish, a Lemke
+        # failure) is the generic step's, which solves it or raises with its diagnosis
+        self._after_block(status)
 
     def _fast_block(self):
         if self._n_eq:

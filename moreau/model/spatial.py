@@ -62,6 +62,7 @@ __all__ = [
     "check_inertia",
     "gyroscopic_torque",
     "rotate_body",
+    "rotate_into",
     "free_rigid_body",
     "kinetic_energy",
     "world_angular_momentum",
@@ -100,6 +101,22 @@ def _rotate(q, w0, w1, w2, h, out):
     n = math.sqrt(out[0] ** 2 + out[1] ** 2 + out[2] ** 2 + out[3] ** 2)
     for i in range(4):
         out[i] /= n
+
+
+@njit(cache=True)
+def rotate_into(q, w0, w1, w2, h, out):
+    """:func:`rotate_body`'s step ``q ⊗ exp((0, h omega / 2))`` into ``out``, compiled, unchecked.
+
+    For compiled loops, on their own unit quaternions and finite rates.
+
+    Examples
+    --------
+    >>> out = np.empty(4)
+    >>> rotate_into(np.array([1.0, 0.0, 0.0, 0.0]), np.pi, 0.0, 0.0, 1.0, out)
+    >>> np.round(out, 12).tolist()
+    [0.0, 1.0, 0.0, 0.0]
+    """
+    _rotate(q, w0, w1, w2, h, out)
 
 
 def quat_multiply(p, q):

@@ -728,6 +728,43 @@ class SpaceScene(Scene):
         """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
         return [self._planes[c["plane"]][1:] for c in self._contacts]
 
+    def contact_table(self):
+        """Every contact's data in one float array for a compiled step, or None.
+
+        Row ``i``: ``[body, kind, radius, c (3), y0 (3), n (3), t1 (3), t2
+        (3)]`` in the scene's units, ``kind`` 0 for a sphere about the centre
+        of mass (``s = -radius n``), 1 for an eccentric sphere (``s = R c -
+        radius n``, ``c`` its centre) and 2 for a material point (``s = R
+        c``, ``c`` the point), as in the module docstring. None where a
+        contact is of none of these kinds.
+
+        Examples
+        --------
+        >>> m = SpaceModel(gravity=(0.0, 0.0, -9.81))
+        >>> b = m.add_body(1.0, [0.004] * 3, position=(0.0, 0.0, 0.1))
+        >>> _ = m.add_contact(b, Sphere(0.1), m.add_half_space((0, 0, 0), (0, 0, 1)), mu=0.2)
+        >>> m.build("ball").contact_table()[0, :3].tolist()
+        [0.0, 0.0, 0.1]
+        """
+        out = np.zeros((self.ncontacts, 18))
+        for i, c in enumerate(self._contacts):
+            # a contact's shape is read from these keys only: any other kind has no row
+            if not set(c) <= _TABLE_KEYS or c.get("kind", "sphere") not in ("sphere", "point"):
+                return None
+            y0, n, t1, t2 = self._planes[c["plane"]]
+            if c["point"] is not None:
+                kind, offset = 2, c["point"]
+            elif c["centre"] is not None:
+                kind, offset = 1, c["centre"]
+            else:
+                kind, offset = 0, np.zeros(3)
+            out[i] = np.concatenate([[c["body"], kind, c["radius"]], offset, y0, n, t1, t2])
+        return out
+
+
+#: the keys of a contact that :meth:`SpaceScene.contact_table` knows
+_TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre"}
+
 
 def _rim_point_rate(R, n, radius, w):
     # s' = -r u' of the rim's lowest point as the axis turns at w (module docstring)

@@ -1,0 +1,194 @@
+"""Moreau–Jean's compiled spatial loop against the Python step it replaces by default."""
+
+import numpy as np
+import pytest
+
+import moreau.integrators.moreau_jean as mj_module
+from moreau.contact.cone3d import exact_gauss_seidel, solve_exact
+from moreau.errors import InputError
+from moreau.integrators import simulate
+from moreau.integrators.moreau_jean import MoreauJean
+from moreau.model.scene import is_spatial
+from moreau.model.space import Puck, SpaceModel, Sphere
+from moreau.regimes import Regime
+from moreau.scenes import registry
+
+_SPATIAL = {s: sc for s in registry.scene_names()
+            if is_spatial(sc := registry.make_scene(s))}
+#: the spatial scenes whose every contact the compiled loop knows (spheres and material points)
+COMPILED = [s for s, sc in _SPATIAL.items() if sc.contact_table() is not None]
+FIELDS = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap")
+
+
+def _assert_same(a, b, fields=FIELDS, rtol=1e-12):
+    # relative to each history's own size; the gaps, zero to rounding while a contact is
+    # closed, to the scene's length unit (the size of its bodies)
+    for f in fields:
+        x, y = getattr(a, f), getattr(b, f)
+        assert x.shape == y.shape, f
+        scale = float(np.max(np.abs(x), initial=0.0))
+        if f == "gap":
+            scale = max(scale, 1.0)
+        assert np.max(np.abs(x - y), initial=0.0) <= rtol * max(scale, 1e-300), f
+
+
+def _python_steps(monkeypatch):
+    # counts the steps the Python step takes (a compiled run hands it the steps it leaves)
+    calls = [0]
+    step = mj_module.space_step
+
+    def counting(*args, **kwargs):
+        calls[0] += 1
+        return step(*args, **kwargs)
+    monkeypatch.setattr(mj_module, "space_step", counting)
+    return calls
+
+
+@pytest.mark.parametrize("options", [{"cone": "exact"}, {"cone": 8, "theta": 0.5}],
+                         ids=["exact", "d8-theta-half"])
+@pytest.mark.parametrize("name", COMPILED)
+def test_the_compiled_loop_is_the_python_step_on_every_spatial_scene(name, options, monkeypatch):
+    sc = registry.make_scene(name)
+    q0, v0 = sc.initial_state()
+    h = (sc.period or sc.default_span()) / 1000
+    ref = simulate(sc, (0.0, 60 * h), q0, v0, "moreau-jean", h=h, fast=False, **options)
+    calls = _python_steps(monkeypatch)
+    mj = MoreauJean(sc, 0.0, q0, v0, 60 * h, h=h, **options)
+    assert mj._fast
+    while mj.status == "running":
+        mj.step()
+    res = mj.result()
+    # one contact: every step in the loop, none handed back
+    assert calls[0] == 0 and res.status == 0
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+    assert res.stats["lcp_solves"] == ref.stats["lcp_solves"] > 0
+    assert res.stats["max_residual"] == pytest.approx(ref.stats["max_residual"], rel=1e-9,
+                                                      abs=1e-15)
+
+
+def _puck_and_ball(mu_puck, mu_ball=0.3, spin=20.0):
+    # two bodies, five contacts: a three-point puck spinning across the floor and a ball
+    # rolling into a tilted wall (length unit 5 cm, time unit 71 ms)
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    wall = m.add_half_space((0.2, 0.0, 0.0), (-1.0, 0.0, 0.2))
+    J = 0.2 * 0.05 ** 2
+    p = m.add_body(0.2, [0.25 * J, 0.25 * J, 0.5 * J], position=(0.0, 0.0, 0.005),
+                   velocity=(0.8, 0.3, 0.0) if spin else (0.0, 0.0, 0.0),
+                   angular_velocity=(0.0, 0.0, spin))
+    m.add_contact(p, Puck(0.05, 0.01, rim_points=3), floor, mu=mu_puck)
+    b = m.add_body(0.1, [0.4 * 0.1 * 0.03 ** 2] * 3, position=(0.1, 0.1, 0.03),
+                   velocity=(1.0, -0.2, 0.0), angular_velocity=(5.0, 0.0, 0.0))
+    m.add_contact(b, Sphere(0.03), floor, mu=mu_ball)
+    m.add_contact(b, Sphere(0.03), wall, mu=mu_ball, restitution=0.5)
+    return m.build("puck-and-ball")
+
+
+def _two_balls():
+    # two bodies, three contacts: a ball rolling into a tilted wall, another sliding with spin
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.03)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    wall = m.add_half_space((0.1, 0.0, 0.0), (-1.0, 0.0, 0.2))
+    J = 0.4 * 0.1 * 0.03 ** 2
+    a = m.add_body(0.1, [J] * 3, position=(0.0, 0.0, 0.03), velocity=(1.0, -0.2, 0.0),
+                   angular_velocity=(5.0, 0.0, 0.0))
+    m.add_contact(a, Sphere(0.03), floor, mu=0.3)
+    m.add_contact(a, Sphere(0.03), wall, mu=0.3, restitution=0.5)
+    b = m.add_body(0.1, [J] * 3, position=(0.0, 0.2, 0.03), velocity=(-0.5, 0.3, 0.0),
+                   angular_velocity=(0.0, 20.0, -10.0))
+    m.add_contact(b, Sphere(0.03), floor, mu=0.2)
+    return m.build("two-balls")
+
+
+def test_several_contacts_and_bodies_in_the_loop_with_the_polyhedral_cone(monkeypatch):
+    sc = _two_balls()
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 4.0), q0, v0, "moreau-jean", h=0.02, fast=False, cone=8)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 4.0), q0, v0, "moreau-jean", h=0.02, cone=8)
+    assert calls[0] == 0
+    # the first ball hits the wall and bounces back while both slide on the floor
+    assert np.max(ref.force_N[:, 1]) > 0.0 and np.min(ref.v[:, 0]) < 0.0
+    assert {Regime.POSITIVE, Regime.STICK} <= set(ref.regime[:, 0]) | set(ref.regime[:, 2])
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+
+
+def test_a_statically_indeterminate_stick_keeps_the_motion():
+    # mu = 1.5, the puck at rest on its three points: their tangential impulses are not
+    # determined by the rigid body, and Lemke's two paths may split them otherwise
+    sc = _puck_and_ball(1.5, spin=0.0)
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.02, fast=False, cone=8)
+    res = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.02, cone=8)
+    assert np.all(ref.regime[-1, :3] == Regime.STICK)
+    _assert_same(ref, res, fields=("t", "q", "v", "force_N", "slip_velocity", "gap"))
+    assert np.array_equal(ref.regime, res.regime)
+
+
+def test_the_exact_cone_hands_gauss_seidel_s_misses_to_the_python_solver(monkeypatch):
+    # three contacts on one body: Gauss–Seidel alone stalls above the tolerance, and the
+    # Python step (with its Newton polish) takes the step; the run is the Python one
+    sc = _puck_and_ball(0.3)
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.01, fast=False, cone="exact")
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.01, cone="exact")
+    assert 0 < calls[0] <= 20
+    _assert_same(ref, res)
+
+
+def test_exact_gauss_seidel_is_solve_exact_where_it_converges():
+    rng = np.random.default_rng(7)
+    converged = missed = 0
+    for _ in range(60):
+        nc = int(rng.integers(1, 4))
+        A = rng.normal(size=(3 * nc, 3 * nc))
+        W = A @ A.T + 0.1 * np.eye(3 * nc)
+        W = 0.5 * (W + W.T)
+        q = rng.normal(size=3 * nc)
+        mu = rng.uniform(0.0, 1.0, nc)
+        r, u = np.zeros(3 * nc), q.copy()
+        ok, res, qn = exact_gauss_seidel(W, q, mu, r, u, 1e-10, 1e-6, 500)
+        ref = solve_exact(W, q, mu)
+        assert qn == pytest.approx(np.linalg.norm(q), rel=1e-15)
+        if ok:
+            converged += 1
+            assert res <= 1e-10 * qn
+            assert np.array_equal(r, ref.r)
+        else:
+            # where solve_exact needs its Newton polish the kernel says so
+            missed += 1
+            assert ref.iterations["newton"] > 0 and res > 1e-10 * qn
+    assert converged >= 20 and missed >= 5
+
+
+def test_integer_times_run_the_same_compiled_loop():
+    # the loop has one compiled signature: an integer span is cast, not refused
+    sc = registry.make_scene("billiard-backspin")
+    q0, v0 = sc.initial_state()
+    a = simulate(sc, (0, 2), q0, v0, "moreau-jean", h=0.25)
+    b = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.25)
+    assert a.status == b.status == 0 and np.array_equal(a.q, b.q) and len(a.t) == 9
+
+
+def test_a_contact_the_loop_does_not_know_takes_the_python_step():
+    # a contact of another kind than a sphere or a material point has no compiled row
+    assert {"sphere-incline", "billiard-backspin", "puck-incline", "tippe-top"} <= set(COMPILED)
+    sc = _two_balls()
+    sc._contacts[2] = dict(sc._contacts[2], kind="rim")
+    q0, v0 = sc.initial_state()
+    assert sc.contact_table() is None
+    assert not MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1)._fast
+    with pytest.raises(InputError, match="`fast=True`: the compiled spatial step knows"):
+        MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True)
+
+
+def test_fast_false_keeps_the_python_step_and_fast_true_is_accepted():
+    sc = registry.make_scene("sphere-incline")
+    q0, v0 = sc.initial_state()
+    assert not MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=False)._fast
+    assert MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True)._fast
+    with pytest.raises(InputError, match="`fast=True` solves contacts"):
+        MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True, lcp_method="qp")
