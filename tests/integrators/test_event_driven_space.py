@@ -1,0 +1,91 @@
+"""The spatial event-driven reference (one persistent contact) against the scenes' closed forms."""
+
+import math
+
+import numpy as np
+import pytest
+
+from moreau.errors import InputError
+from moreau.integrators import simulate
+from moreau.model.space import Puck, Sphere, SpaceModel
+from moreau.scenes.billiard_backspin import billiard_backspin, billiard_exact, rolling_onset
+from moreau.scenes.bouncing_ball import BouncingBall
+from moreau.scenes.rolling_disk import rolling_disk, rolling_disk_exact, tilt_and_heading
+from moreau.scenes.sphere_incline import sphere_incline, sphere_incline_exact
+
+SCHEME = "event-driven-space"
+
+
+def test_sphere_rolls_down_the_incline_at_five_sevenths_g_sin_alpha():
+    sc = sphere_incline()
+    res = simulate(sc, (0.0, 10.0), *sc.initial_state(), SCHEME)
+    assert res.success and not res.events
+    assert set(res.regime[:, 0].tolist()) == {3}       # STICK throughout
+    t = res.t * sc.time
+    s, sd, w = sphere_incline_exact(sc.params, t)
+    L, T = sc.length, sc.time
+    assert np.max(np.abs(res.q[:, 0] * L - s)) <= 1e-10 * s[-1]
+    assert np.max(np.abs(res.v[:, 0] * L / T - sd)) <= 1e-10 * sd[-1]
+    assert np.max(np.abs(res.v[:, 4] / T - w)) <= 1e-10 * w[-1]
+    # the acceleration itself: 5/7 g sin(alpha)
+    p = sc.params
+    acc = (res.v[-1, 0] - res.v[0, 0]) * L / T / (t[-1] - t[0])
+    assert abs(acc / (5.0 / 7.0 * p.gravity * math.sin(p.slope)) - 1.0) <= 1e-10
+
+
+def test_billiard_ball_rolls_from_the_closed_form_time_at_the_closed_form_speed():
+    sc = billiard_backspin()
+    res = simulate(sc, (0.0, 20.0), *sc.initial_state(), SCHEME)
+    t_star, v_star = rolling_onset(sc.params)
+    (ev,) = res.events
+    assert ev.kind == "transition" and (ev.before.letter, ev.after.letter) == ("P", "S")
+    assert abs(ev.t * sc.time - t_star) <= 1e-10 * t_star
+    L, T = sc.length, sc.time
+    assert abs(res.v[-1, 0] * L / T - v_star) <= 1e-10 * v_star
+    assert abs(res.v[-1, 4] * L / T - v_star) <= 1e-10 * v_star      # rolling: r w = v
+    x, vx, _ = billiard_exact(sc.params, res.t * T)
+    assert np.max(np.abs(res.q[:, 0] * L - x)) <= 1e-10 * x[-1]
+    assert np.max(np.abs(res.v[:, 0] * L / T - vx)) <= 1e-10 * sc.params.speed
+    assert res.stats["quaternion_norm_drift"] <= 1e-12
+
+
+def test_rolling_disk_keeps_its_steady_precession_over_a_quarter_period():
+    sc = rolling_disk()
+    res = simulate(sc, (0.0, sc.default_window), *sc.initial_state(), SCHEME)
+    assert res.success and not res.events
+    x, quat = rolling_disk_exact(sc.params, res.t * sc.time)
+    tilt, heading = tilt_and_heading(res.q)
+    tilt_x, heading_x = tilt_and_heading(np.hstack([x / sc.length, quat]))
+    assert abs(heading_x[-1] - 0.5 * math.pi) <= 1e-12       # a quarter period
+    assert np.max(np.abs(tilt - tilt_x)) <= 1e-10
+    assert np.max(np.abs(heading - heading_x)) <= 1e-10
+    assert np.max(np.abs(res.q[:, :3] * sc.length - x)) <= 1e-10 * sc.params.radius
+
+
+def test_a_contact_that_would_lift_off_stops_the_run_by_name():
+    # a ball under a ceiling: gravity pulls it off, the normal force is -m g at the start
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.1)
+    ceiling = m.add_half_space((0.0, 0.0, 0.2), (0.0, 0.0, -1.0))
+    ball = m.add_body(1.0, [0.004] * 3, position=(0.0, 0.0, 0.1), velocity=(1.0, 0.0, 0.0))
+    m.add_contact(ball, Sphere(0.1), ceiling, mu=0.3)
+    sc = m.build("ceiling")
+    res = simulate(sc, (0.0, 1.0), *sc.initial_state(), SCHEME)
+    assert not res.success and res.status == -2
+    assert "lift-off at t = 0" in res.message and "models no flight" in res.message
+    assert res.events[0].kind == "liftoff"
+
+
+def test_a_scene_it_cannot_keep_is_refused_by_name():
+    with pytest.raises(InputError, match="'event-driven-space' steps spatial scenes only"):
+        simulate(BouncingBall(), (0.0, 1.0), [1.0], [0.0], SCHEME)
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.1)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    puck = m.add_body(1.0, [0.01, 0.01, 0.02], position=(0.0, 0.0, 0.0))
+    m.add_contact(puck, Puck(0.1, 0.0), floor, mu=0.3)
+    sc = m.build("puck")
+    with pytest.raises(InputError, match="keeps one persistent contact: `scene` 'puck' has 3"):
+        simulate(sc, (0.0, 1.0), *sc.initial_state(), SCHEME)
+    q0, v0 = billiard_backspin().initial_state()
+    q0[2] += 0.5
+    with pytest.raises(InputError, match="must start on the contact"):
+        simulate(billiard_backspin(), (0.0, 1.0), q0, v0, SCHEME)
