@@ -208,10 +208,9 @@ class SpaceEventDriven(Integrator):
         lamN = -(rows[0] @ Mf + wN[0]) / coef
         return Mf + MG * lamN, lamN, -self.mu * lamN * s, u, coef
 
-    def _rates(self, t, y, mode, direction):
+    def _rates(self, t, y, a):
         n = self.scene.ndof
         q, v = y[:n], y[n:]
-        a = self.solve(t, q, v, mode, direction)[0]
         out = np.empty_like(y)
         for b in range(self.nb):
             out[7 * b:7 * b + 3] = v[6 * b:6 * b + 3]
@@ -295,15 +294,24 @@ class SpaceEventDriven(Integrator):
             ev.terminal, ev.direction = True, -1.0
             return ev
 
+        cache = {}
+
+        def evaluate(t, y):
+            # DOP853 evaluates its last stage where the event functions are checked next
+            key = (t, y.tobytes())
+            if cache.get("key") != key:
+                cache["key"], cache["val"] = key, self.solve(t, y[:n], y[n:], mode, d)
+            return cache["val"]
+
         def part(k):
-            return lambda t, y: self.solve(t, y[:n], y[n:], mode, d)[k]
+            return lambda t, y: evaluate(t, y)[k]
 
         lam_n = part(1)
         fscale = max(abs(lamN0), 1e-300)
         events = [make(lam_n, lamN0 <= 1e-12 * fscale)]
         if mode == _STICK and self.mu > 0.0:
             def cone(t, y):
-                _, lamN, lamT, _, _ = self.solve(t, y[:n], y[n:], mode, d)
+                _, lamN, lamT, _, _ = evaluate(t, y)
                 return self.mu * lamN - math.hypot(lamT[0], lamT[1])
             events.append(make(cone, self.mu * lamN0 - math.hypot(*lamT0) <= 1e-12 * fscale))
         elif mode == _SLIDE and self.mu > 0.0:
@@ -311,7 +319,7 @@ class SpaceEventDriven(Integrator):
             events.append(make(part(4), False))
         kinds = ["liftoff", "transition", "painleve"][:len(events)]
         self.counters["segments"] += 1
-        sol = solve_ivp(lambda t, y: self._rates(t, y, mode, d), (t0, self.t_bound), y0,
+        sol = solve_ivp(lambda t, y: self._rates(t, y, evaluate(t, y)[0]), (t0, self.t_bound), y0,
                         method="DOP853", rtol=self.options.rtol, atol=self.options.atol,
                         events=events, dense_output=True, max_step=self.options.max_step)
         if sol.status < 0:
