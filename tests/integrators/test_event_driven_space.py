@@ -10,32 +10,52 @@ from moreau.integrators import simulate
 from moreau.model.space import Puck, Sphere, SpaceModel
 from moreau.scenes.billiard_backspin import billiard_backspin, billiard_exact, rolling_onset
 from moreau.scenes.bouncing_ball import BouncingBall
+from moreau.scenes.puck_incline import puck_incline, puck_incline_path
 from moreau.scenes.rolling_disk import rolling_disk, rolling_disk_exact, tilt_and_heading
 from moreau.scenes.sphere_incline import sphere_incline, sphere_incline_exact
 
 SCHEME = "event-driven-space"
 
 
-def test_sphere_rolls_down_the_incline_at_five_sevenths_g_sin_alpha():
-    sc = sphere_incline()
-    res = simulate(sc, (0.0, 10.0), *sc.initial_state(), SCHEME)
+@pytest.mark.parametrize("mu", [0.0884, 0.0883])
+def test_sphere_on_the_incline_rolls_at_five_sevenths_g_sin_alpha_above_the_slip_threshold(mu):
+    # slope 0.3: rolling needs mu >= (2/7) tan(0.3) = 0.08836; just below it the sphere,
+    # started rolling, slips at once (the cone cannot hold the rolling friction)
+    sc = sphere_incline(mu=mu)
+    p = sc.params
+    assert (mu >= 2.0 / 7.0 * math.tan(p.slope)) == (mu == 0.0884)
+    res = simulate(sc, (0.0, 10.0), *sc.initial_state(), SCHEME, sample_dt=0.5)
     assert res.success and not res.events
-    assert set(res.regime[:, 0].tolist()) == {3}       # STICK throughout
+    rolling = mu == 0.0884
+    assert set(res.regime[:, 0].tolist()) == {3 if rolling else 1}     # STICK or sliding
     t = res.t * sc.time
-    s, sd, w = sphere_incline_exact(sc.params, t)
+    s, sd, w = sphere_incline_exact(p, t)
     L, T = sc.length, sc.time
     assert np.max(np.abs(res.q[:, 0] * L - s)) <= 1e-10 * s[-1]
     assert np.max(np.abs(res.v[:, 0] * L / T - sd)) <= 1e-10 * sd[-1]
     assert np.max(np.abs(res.v[:, 4] / T - w)) <= 1e-10 * w[-1]
-    # the acceleration itself: 5/7 g sin(alpha)
-    p = sc.params
     acc = (res.v[-1, 0] - res.v[0, 0]) * L / T / (t[-1] - t[0])
-    assert abs(acc / (5.0 / 7.0 * p.gravity * math.sin(p.slope)) - 1.0) <= 1e-10
+    exact = (5.0 / 7.0 * p.gravity * math.sin(p.slope) if rolling
+             else p.gravity * (math.sin(p.slope) - mu * math.cos(p.slope)))
+    assert abs(acc / exact - 1.0) <= 1e-10
+    assert (np.max(res.slip_velocity) <= 1e-14) == rolling
+
+
+def test_puck_launched_across_the_incline_follows_the_closed_form_path():
+    # mu = tan(slope): the slip direction turns from across the slope towards down it
+    sc = puck_incline()
+    res = simulate(sc, (0.0, 16.0), *sc.initial_state(), SCHEME, sample_dt=1.0)
+    assert res.success and not res.events
+    z = puck_incline_path(sc.params, res.t * sc.time)
+    L, T = sc.length, sc.time
+    scale = float(np.max(np.abs(z[:, :2])))
+    assert np.max(np.abs(res.q[:, :2] * L - z[:, :2])) <= 1e-10 * scale
+    assert np.max(np.abs(res.v[:, :2] * L / T - z[:, 2:])) <= 1e-10 * sc.params.speed
 
 
 def test_billiard_ball_rolls_from_the_closed_form_time_at_the_closed_form_speed():
     sc = billiard_backspin()
-    res = simulate(sc, (0.0, 20.0), *sc.initial_state(), SCHEME)
+    res = simulate(sc, (0.0, 20.0), *sc.initial_state(), SCHEME, sample_dt=0.5)
     t_star, v_star = rolling_onset(sc.params)
     (ev,) = res.events
     assert ev.kind == "transition" and (ev.before.letter, ev.after.letter) == ("P", "S")
@@ -51,7 +71,8 @@ def test_billiard_ball_rolls_from_the_closed_form_time_at_the_closed_form_speed(
 
 def test_rolling_disk_keeps_its_steady_precession_over_a_quarter_period():
     sc = rolling_disk()
-    res = simulate(sc, (0.0, sc.default_window), *sc.initial_state(), SCHEME)
+    res = simulate(sc, (0.0, sc.default_window), *sc.initial_state(), SCHEME,
+                   sample_dt=sc.default_window / 16)
     assert res.success and not res.events
     x, quat = rolling_disk_exact(sc.params, res.t * sc.time)
     tilt, heading = tilt_and_heading(res.q)
