@@ -110,3 +110,46 @@ def test_a_scene_it_cannot_keep_is_refused_by_name():
     q0[2] += 0.5
     with pytest.raises(InputError, match="must start on the contact"):
         simulate(billiard_backspin(), (0.0, 1.0), q0, v0, SCHEME)
+
+
+def _egg(mu):
+    # a ball of radius 0.1 m with its centre of mass 3 cm below the sphere's centre, rolling:
+    # the friction that rolling needs swings with the turning offset, past the cone at mu = 0.1
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.1)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    # contact point at s = (0, 0, -0.07) from the centre of mass: x' = -w x s rolls
+    egg = m.add_body(1.0, [0.004] * 3, position=(0.0, 0.0, 0.07), velocity=(0.35, 0.0, 0.0),
+                     angular_velocity=(0.0, 5.0, 0.0))
+    m.add_contact(egg, Sphere(0.1, centre=(0.0, 0.0, 0.03)), floor, mu=mu)
+    return m.build("egg")
+
+
+def test_rolling_turns_to_sliding_where_the_cone_saturates_and_back_where_the_slip_ends():
+    sc = _egg(0.1)
+    res = simulate(sc, (0.0, 6.0), *sc.initial_state(), SCHEME, sample_dt=0.25)
+    assert res.success
+    ev1, ev2 = res.events
+    assert (ev1.before.letter, ev1.after.letter, ev2.before.letter, ev2.after.letter) == (
+        "S", "P", "P", "S")
+    # at the first event the rolling friction (the stick rows' forces, assembled here from
+    # the scene) sits on the cone: mu lamN = |lamT|
+    k = int(np.flatnonzero(res.t == ev1.t)[0])
+    q, v = res.q[k], res.v[k]
+    H = sc.contact_rows(q)[0]
+    Minv = sc.mass_inverse(q)
+    wN, wT = sc.contact_drift(q, v, ev1.t)
+    lam = np.linalg.solve(H @ Minv @ H.T, -(H @ Minv @ sc.forces(q, v, ev1.t)
+                                           + np.array([wN[0], *wT])))
+    assert abs(0.1 * lam[0] - np.hypot(lam[1], lam[2])) <= 1e-9 * lam[0]
+    # the slip is zero up to the first event and after the second, and not between
+    k2 = int(np.flatnonzero(res.t == ev2.t)[-1])
+    assert np.max(res.slip_velocity[:k, 0]) <= 1e-13
+    assert np.max(res.slip_velocity[k2:, 0]) <= 1e-13
+    assert np.min(res.slip_velocity[k + 1:k2, 0]) > 1e-4
+    # rolling keeps the energy, sliding dissipates it
+    m = sc.masses[0]
+    energy = np.array([0.5 * (m * v[:3] @ v[:3] + v[3:] @ sc.inertias[0] @ v[3:])
+                       - m * sc.gravity[2] * q[2] for q, v in zip(res.q, res.v)])
+    assert np.ptp(energy[:k + 1]) <= 1e-10 * energy[0]
+    assert np.ptp(energy[k2:]) <= 1e-10 * energy[0]
+    assert energy[k2] < energy[k] - 1e-3 * energy[0] and np.all(np.diff(energy[k:k2 + 1]) <= 1e-12)
