@@ -99,8 +99,8 @@ class SpaceEventDriven(Integrator):
     --------
     >>> from moreau.scenes.billiard_backspin import billiard_backspin, rolling_onset
     >>> from moreau.integrators import simulate
-    >>> sc = billiard_backspin()
-    >>> res = simulate(sc, (0.0, 20.0), *sc.initial_state(), "event-driven-space")
+    >>> sc = billiard_backspin(speed=0.5, spin=0.0)
+    >>> res = simulate(sc, (0.0, 1.5), *sc.initial_state(), "event-driven-space", sample_dt=0.5)
     >>> (ev,) = res.events
     >>> t_star, _ = rolling_onset(sc.params)
     >>> ev.kind, abs(ev.t * sc.time - t_star) < 1e-12
@@ -198,7 +198,9 @@ class SpaceEventDriven(Integrator):
             return Mf + MH @ lam, lam[0], lam[1:], u, 1.0
         speed = math.hypot(u[0], u[1])
         s = u / speed if speed > self._vtol() else direction
-        G = rows[0] - self.mu * (s @ rows[1:])
+        G = rows[0] - self.mu * (s @ rows[1:]) if self.mu > 0.0 else rows[0]
+        if self.mu == 0.0:
+            s = np.zeros(2)
         MG = self.Minv @ G
         coef = float(rows[0] @ MG)
         if coef <= 0.0:
@@ -247,7 +249,10 @@ class SpaceEventDriven(Integrator):
         rows = self.scene.contact_rows(q)[0]
         u = self._slip(rows, v)
         speed = math.hypot(u[0], u[1])
-        if speed > self._vtol():
+        if self.mu == 0.0:
+            # frictionless: the normal row alone, whatever the slip
+            mode, d = _SLIDE, None
+        elif speed > self._vtol():
             mode, d = _SLIDE, u / speed
         else:
             self.q, self.v = q, v = self._restart(q, v, _STICK)

@@ -41,6 +41,17 @@ def test_sphere_on_the_incline_rolls_at_five_sevenths_g_sin_alpha_above_the_slip
     assert (np.max(res.slip_velocity) <= 1e-14) == rolling
 
 
+def test_a_frictionless_sphere_slides_at_g_sin_alpha_and_keeps_its_spin():
+    sc = sphere_incline(mu=0.0)
+    res = simulate(sc, (0.0, 4.0), *sc.initial_state(), SCHEME, sample_dt=1.0)
+    assert res.success and not res.events and set(res.regime[:, 0].tolist()) == {1}
+    p, L, T = sc.params, sc.length, sc.time
+    t = res.t * T
+    assert np.max(np.abs(res.v[:, 0] * L / T - (p.speed + p.gravity * math.sin(p.slope) * t))) \
+        <= 1e-12 * p.gravity * t[-1]
+    assert np.max(np.abs(res.v[:, 4] / T - p.speed / p.radius)) <= 1e-12 * p.speed / p.radius
+
+
 def test_puck_launched_across_the_incline_follows_the_closed_form_path():
     # mu = tan(slope): the slip direction turns from across the slope towards down it
     sc = puck_incline()
@@ -55,7 +66,7 @@ def test_puck_launched_across_the_incline_follows_the_closed_form_path():
 
 def test_billiard_ball_rolls_from_the_closed_form_time_at_the_closed_form_speed():
     sc = billiard_backspin()
-    res = simulate(sc, (0.0, 20.0), *sc.initial_state(), SCHEME, sample_dt=0.5)
+    res = simulate(sc, (0.0, 10.0), *sc.initial_state(), SCHEME, sample_dt=0.5)
     t_star, v_star = rolling_onset(sc.params)
     (ev,) = res.events
     assert ev.kind == "transition" and (ev.before.letter, ev.after.letter) == ("P", "S")
