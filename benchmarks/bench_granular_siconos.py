@@ -1,16 +1,25 @@
-"""One granular step's 2D contact problem at 1e3 and 1e4 contacts: our NSGS against Siconos's fc2d NSGS.
+"""One granular step's 2D contact problem, 1e3 and 1e4 contacts: our NSGS against Siconos's NSGS.
 
-The problem. A box (a rough floor and two walls, ``mu = 0.5``) of disks of
-radii uniform in ``[0.4, 0.5]`` (mass proportional to the area, ``g = 1``),
-filled by :func:`moreau.model.granular.random_fill` (about twice as wide as
-tall) and let fall by :func:`moreau.integrators.granular.simulate_disks`
-(``theta = 1``, ``h = 1e-2``, NSGS to ``1e-6``) for ``--fall`` steps: a
-pile still compacting, every disk in contact. The state after those steps,
-with the last step's impulses, is kept in a temporary directory (never in
-the repository) so that a second run does not let it fall again. The
-problem timed is the *next* step's, built as :func:`simulate_disks` builds
-it (:func:`step_problem`: the broad phase, the active set, ``W = H M^-1
-H^T`` in CSR, ``q = H v_free`` with the impact law): FCLib's local 2D
+Two problems, each the contact problem of one Moreau–Jean step of a run:
+
+``pile-RxC``
+    the triangular packing of ``bench_granular.py`` (unit disks, ``R``
+    rows of ``C``, in a box, ``mu = 0.5``) at rest under gravity after ten
+    steps: a settled, hyperstatic pile, whose warm start is nearly its answer;
+``box-N``
+    ``N`` disks of radii uniform in ``[0.4, 0.5]`` (mass proportional to
+    the area, ``g = 1``) in a box (a rough floor and two walls, ``mu =
+    0.5``), filled by :func:`moreau.model.granular.random_fill` (about twice
+    as wide as tall) and let fall by
+    :func:`moreau.integrators.granular.simulate_disks` (``theta = 1``, ``h =
+    1e-2``, NSGS to ``1e-6``) for ``--fall`` steps: a pile still compacting.
+    The state after those steps, with the last step's impulses, is kept in a
+    temporary directory (never in the repository), so that a second run does
+    not let it fall again.
+
+The problem timed is the *next* step's, built as :func:`simulate_disks`
+builds it (:func:`step_problem`: the broad phase, the active set, ``W = H
+M^-1 H^T`` in CSR, ``q = H v_free`` with the impact law): FCLib's local 2D
 problem ``(W, q, mu)``, with the warm start ``r0`` the run would use (the
 last step's impulses, matched by pair).
 
@@ -18,7 +27,7 @@ Interchange. The problem is written by :func:`moreau.contact.fclib.write_fclib`
 (``r0`` as FCLib's first guess) and read back by
 :func:`~moreau.contact.fclib.read_fclib`; the round trip is checked bit for
 bit and both solvers take the arrays as read. Siconos takes them as arrays:
-Debian's ``python3-siconos`` (4.5) has no FCLib reader in
+Debian's ``python3-siconos`` (4.4) has no FCLib reader in
 ``siconos.numerics`` (it is built without FCLib) and the system interpreter
 has no h5py. ``W`` reaches Siconos as its sparse block matrix (2 x 2 blocks),
 through ``benchmarks/siconos_fc2d_peer.py`` under ``/usr/bin/python3``.
@@ -129,8 +138,9 @@ def fallen(n_disks, steps, *, seed=1, cache=CACHE, log=print):
 
 
 def pile(rows, cols, warmup=10):
-    """``bench_granular.py``'s triangular packing at rest after ``warmup`` steps: ``(system, x, v, keys, r)``."""
-    spec = importlib.util.spec_from_file_location("_bench_granular", os.path.join(HERE, "bench_granular.py"))
+    """``bench_granular.py``'s packing after ``warmup`` steps: ``(system, x, v, keys, r)``."""
+    spec = importlib.util.spec_from_file_location("_bench_granular",
+                                                  os.path.join(HERE, "bench_granular.py"))
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     system, x = mod.packing(rows, cols)
@@ -187,7 +197,7 @@ def solve_ours(W, q, mu, r0, tol, budget):
 
 
 def round_trip(W, q, mu, r0, path):
-    """Write ``(W, q, mu)`` (``r0`` as the first guess) to FCLib, read it back, check it bit for bit.
+    """Write ``(W, q, mu)`` (``r0`` the first guess) to FCLib, read it back, check it bit for bit.
 
     Returns the problem as read: ``(W, q, mu, r0)``."""
     write_fclib(path, W, q, mu, title="granular box step", guesses=[(r0, W @ r0 + q)],
@@ -215,7 +225,7 @@ def timed(fn, repeat):
 
 
 def run_siconos(problems, args, tmp):
-    """Siconos's fc2d NSGS on ``problems`` ({name: (W, q, mu, r0)}), cold and warm, on the ladder."""
+    """Siconos's NSGS on ``problems`` ({name: (W, q, mu, r0)}), cold and warm, on the ladder."""
     files = []
     for name, (W, q, mu, r0) in problems.items():
         path = os.path.join(tmp, f"{name}.npz")
@@ -242,9 +252,15 @@ def run_siconos(problems, args, tmp):
         ours = problem_residual(W, q, mu, np.load(res["r_file"]))[0]
         rows.append({"problem": res["name"], "start": "warm" if run["warm"] else "cold",
                      "solver": "siconos", "its_tol": run["tol"], "sweeps": res["iterations"],
-                     "cpu": statistics.median(res["seconds"]), "wall": statistics.median(res["wall"]),
+                     "cpu": statistics.median(res["seconds"]),
+                     "wall": statistics.median(res["wall"]),
                      "residual": ours, "its_error": res["error"], "info": res["info"]})
-    return rows, answer.get("version")
+    try:
+        version = subprocess.run(["dpkg-query", "-W", "-f=${Version}", "python3-siconos"],
+                                 capture_output=True, text=True, timeout=30).stdout.strip()
+    except (OSError, subprocess.TimeoutExpired):
+        version = ""
+    return rows, version or answer.get("version")
 
 
 def main(argv=None):
@@ -254,7 +270,8 @@ def main(argv=None):
     ap.add_argument("--problems", default="pile-10x42,pile-10x420,box-850",
                     help="comma-separated: pile-RxC (bench_granular.py's packing at rest, R rows "
                          "of C disks) or box-N (N disks fallen --fall steps)")
-    ap.add_argument("--fall", type=int, default=400, help="steps the fill falls before the step timed")
+    ap.add_argument("--fall", type=int, default=400,
+                    help="steps the fill of a box falls before the step timed")
     ap.add_argument("--tol", type=float, default=1e-6)
     ap.add_argument("--budget", type=int, default=20_000, help="sweeps of a solve, both solvers")
     ap.add_argument("--repeat", type=int, default=5)
@@ -303,14 +320,17 @@ def main(argv=None):
     print(" | ".join(head))
     for name in problems:
         for start in ("cold", "warm"):
-            mine = [r for r in rows if (r["problem"], r["start"], r["solver"]) == (name, start, "ours")]
-            sic = [r for r in rows if (r["problem"], r["start"], r["solver"]) == (name, start, "siconos")]
+            mine = [r for r in rows if (r["problem"], r["start"], r["solver"]) ==
+                    (name, start, "ours")]
+            sic = [r for r in rows if (r["problem"], r["start"], r["solver"]) ==
+                   (name, start, "siconos")]
             equal = next((r for r in sic if r["residual"] <= args.tol), None)
             for r in mine + sic:
                 label = r["solver"] + (" @ equal" if r is equal else "")
                 ratio = r["cpu"] / mine[0]["cpu"] if mine else math.nan
                 print(" | ".join([name, str(contacts[name]), start, label, f"{r['its_tol']:.1e}",
-                                  str(r["sweeps"]), f"{1e3 * r['cpu']:.2f}", f"{1e3 * r['wall']:.2f}",
+                                  str(r["sweeps"]), f"{1e3 * r['cpu']:.2f}",
+                                  f"{1e3 * r['wall']:.2f}",
                                   f"{r['residual']:.2e}", f"{r['its_error']:.2e}", f"{ratio:.2f}"]))
 
 

@@ -68,7 +68,9 @@ def main():
             opts.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(run["max_iter"])
             r = np.zeros(n)
             u = np.zeros(n)
-            start = np.ascontiguousarray(data["r0"], dtype=float) if run.get("warm") else np.zeros(n)
+            start = np.zeros(n)
+            if run.get("warm"):
+                start = np.ascontiguousarray(data["r0"], dtype=float)
 
             def solve():
                 r[:] = start
