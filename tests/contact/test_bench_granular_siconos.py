@@ -63,12 +63,13 @@ def test_both_answers_meet_the_tolerance_in_our_residual(bench, fallen, tmp_path
         if "not importable" in reason or "did not run" in reason:
             pytest.skip(f"/usr/bin/python3 has no Siconos with scipy: {reason}")
         pytest.fail(reason)
-    assert len(rows) == 2 * len(bench["LADDER"])
     for row in rows:
         assert row["info"] == 0, row
         # Siconos's own error and our residual differ in normalisation, not by orders
         assert row["residual"] <= 10 * row["its_tol"], row
     for start in ("cold", "warm"):
-        tightest = [row for row in rows if row["start"] == start][-1]
-        assert tightest["its_tol"] == pytest.approx(TOL / 100)
-        assert tightest["residual"] <= TOL
+        ladder = [row for row in rows if row["start"] == start]
+        # down the ladder until an answer meets TOL in our residual, and no further
+        assert 1 <= len(ladder) <= len(bench["LADDER"])
+        assert ladder[-1]["residual"] <= TOL
+        assert all(row["residual"] > TOL for row in ladder[:-1])
