@@ -7,7 +7,8 @@ not import ``moreau``. Reads one JSON object from stdin::
 
     {"problems": [{"name": str, "file": "p.npz"}, ...],   # CSR W (indptr, indices, data), q, mu
      "runs": [{"tol": float, "max_iter": int}, ...],      # one timing per problem and run
-     "rounds": int, "budget": seconds, "out": "dir"}
+     "rounds": int, "budget": seconds, "out": "dir",
+     "repeat": int}                                       # optional: see below
 
 and prints one JSON object ``{"available": true, "version": ..., "results":
 [{"name", "run", "info", "iterations", "error", "seconds": [per round],
@@ -22,7 +23,10 @@ tolerance (``SICONOS_DPARAM_TOL``), ``max_iter`` its sweep budget; with
 ``tol = 0`` the solve runs exactly ``max_iter`` sweeps (the per-sweep cost).
 Each round times solves for about ``budget`` CPU seconds (``time.process_time``)
 and reports the mean; the impulses of the last solve are saved for the caller,
-which computes its own residual on them.
+which computes its own residual on them. With ``"repeat": k`` in the job, each
+run instead times ``k`` single solves (after one untimed), CPU and wall time
+each (``"seconds"`` and ``"wall"``). A run with ``"warm": true`` starts from
+the problem file's ``r0`` (a time-stepping run's warm start) instead of zero.
 """
 
 import json
@@ -64,28 +68,40 @@ def main():
             opts.iparam[sn.SICONOS_IPARAM_MAX_ITER] = int(run["max_iter"])
             r = np.zeros(n)
             u = np.zeros(n)
+            start = np.zeros(n)
+            if run.get("warm"):
+                start = np.ascontiguousarray(data["r0"], dtype=float)
 
             def solve():
-                r[:] = 0.0
+                r[:] = start
                 u[:] = 0.0
                 return sn.fc2d_driver(problem, r, u, opts)
 
             t0 = time.perf_counter()
             status = solve()
             dt = time.perf_counter() - t0
-            num = max(1, min(1000, int(budget / max(dt, 1e-7))))
-            samples = [dt] if dt > 5 * budget else []
-            for _ in range(0 if samples else rounds):
-                t0 = time.process_time()
-                for _ in range(num):
+            wall = []
+            if "repeat" in job:
+                samples = []
+                for _ in range(int(job["repeat"])):
+                    t0, c0 = time.perf_counter(), time.process_time()
                     status = solve()
-                samples.append((time.process_time() - t0) / num)
+                    samples.append(time.process_time() - c0)
+                    wall.append(time.perf_counter() - t0)
+            else:
+                num = max(1, min(1000, int(budget / max(dt, 1e-7))))
+                samples = [dt] if dt > 5 * budget else []
+                for _ in range(0 if samples else rounds):
+                    t0 = time.process_time()
+                    for _ in range(num):
+                        status = solve()
+                    samples.append((time.process_time() - t0) / num)
             r_file = os.path.join(job["out"], f"siconos_{prob['name']}_{k}.npy")
             np.save(r_file, r)
             out.append({"name": prob["name"], "run": k, "info": int(status),
                         "iterations": int(opts.iparam[sn.SICONOS_IPARAM_ITER_DONE]),
                         "error": float(opts.dparam[sn.SICONOS_DPARAM_RESIDU]),
-                        "seconds": samples, "r_file": r_file})
+                        "seconds": samples, "wall": wall, "r_file": r_file})
     version = getattr(siconos, "__version__", "unknown")
     print(json.dumps({"available": True, "version": version, "results": out}))
 
