@@ -68,8 +68,9 @@ def test_the_top_inverts_above_the_threshold_and_not_below(spin, inverts):
     c = axis_height(res.q)
     if inverts:
         # measured: cos(theta) -0.9987 at 3.9 s, the axis through horizontal at 1.49 s; that
-        # time is the step's (1.15, 1.49, 2.14, 3.37 s at h = 0.1, 0.05, 0.025, 0.0125 units:
-        # when the nearly upright top's contact point stops slipping)
+        # time is the step's (1.15, 1.49, 2.14, 3.37 s at h = 0.1, 0.05, 0.025, 0.0125 units):
+        # the step's dissipation turns the top, whose exact motion in this model rolls
+        # upright (tests/suite/test_problems_space.py)
         assert c[-1] < -0.99
         t_flip = res.t[np.argmax(c < 0.0)] * sc.time
         assert 1.0 < t_flip < 2.0
