@@ -55,8 +55,9 @@ last factor about the body's axis), from ``R_0`` the axis tilted by
 ``theta`` about ``y`` (:func:`rolling_disk_exact`). The time-stepping
 schemes keep the tilt and the precession rate to their order
 (``tests/scenes/test_rolling_disk.py``: order one at either ``theta``, as
-the rolling rows are taken at the step's start); the event-driven reference steps
-no spatial scene, so the reference here is this closed form alone.
+the rolling rows are taken at the step's start); the event-driven reference
+(``event-driven-space``) keeps the tilt and the heading of this closed form to
+about 1e-12 over a quarter period (``tests/integrators/test_event_driven_space.py``).
 
 The model: one :class:`~moreau.model.space.Disk` contact on the floor;
 units: lengths in ``a``, time in ``sqrt(a / g)``, mass in ``m``. The
