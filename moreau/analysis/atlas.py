@@ -34,7 +34,7 @@ from . import engine
 from .classify import CLASSIFY_COLUMNS, CLASSIFY_PERIODS
 from .engine import ED_REFERENCE, check_output_dir
 from .sweep import (VALUE_COLUMNS, MAX_POINTS, plan_points, require_xarray, sweep_tag,
-                    write_netcdf_beside, write_sidecar)
+                    write_netcdf_beside, write_points_sidecar)
 
 __all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure", "classify_budget", "ATLAS_COLUMNS"]
 
@@ -194,7 +194,7 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
             "starts": _counts(table, "start"), "classifications": _counts(table, "classification"),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
-    write_sidecar(stem, meta, csv_path, len(table), stats, log)
+    write_points_sidecar(stem, meta, csv_path, len(table), stats, log)
     if netcdf:
         write_netcdf_beside(stem, table, [columns[xname], columns[yname]], log)
     if plot:

@@ -45,7 +45,7 @@ from .scheme_settings import make_scheme
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
            "MAX_POINTS", "rows_to_xarray", "rows_to_netcdf", "netcdf_attrs", "require_xarray",
-           "write_netcdf_beside", "write_sidecar", "UNIT_SUFFIXES", "stability_panel"]
+           "write_netcdf_beside", "write_points_sidecar", "UNIT_SUFFIXES", "stability_panel"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
@@ -285,7 +285,7 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
             "continuation": bool(continuation),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
-    write_sidecar(stem, meta, csv_path, len(table), stats, log)
+    write_points_sidecar(stem, meta, csv_path, len(table), stats, log)
     if netcdf:
         write_netcdf_beside(stem, table, [swept], log)
     if plot:
@@ -477,7 +477,7 @@ def rows_to_netcdf(rows, dims, path, attrs=None):
     return path
 
 
-def write_sidecar(stem, meta, csv_path, points, stats, log=print):
+def write_points_sidecar(stem, meta, csv_path, points, stats, log=print):
     """Write ``meta`` as ``STEM.json``, the sidecar of the table at ``csv_path`` (a sweep's, an
     atlas's), and log both with the table's ``points`` and the engine's ``stats`` (computed,
     from the cache). Returns the sidecar's path."""

@@ -7,6 +7,14 @@ run written out, in the same order, to the bit. The contact rows a model
 writes are ``G[i] = (g, wN, wT, WN[0:n], WT[0:n])`` (:mod:`moreau.compiled`);
 ``ia`` lists the active contacts and ``fa`` the frictional ones among them,
 the normal rows first, then the tangential ones.
+
+The sequences several schemes share are here: the step's start and active
+set (:func:`start_contacts`), the contact problem's assembly
+(:func:`dense_delassus`, :func:`sparse_delassus`, :func:`restitution_shift`),
+its solution (:func:`solve_one`, :func:`one_row_impulse`,
+:func:`lemke_solve`) and the update (:func:`add_impulse`, :func:`slip_rows`,
+:func:`record_contacts`). A part written with ``spliced(step_returns=True)``
+may end the step with a status, as the step rule itself would.
 """
 
 import math
