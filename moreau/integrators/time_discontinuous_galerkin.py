@@ -154,14 +154,7 @@ class TimeDiscontinuousGalerkin(TimeStepping):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.model.scene import Scene
-    >>> class Spring(Scene):
-    ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
-    ...     def mass(self, q): return np.eye(1)
-    ...     def forces(self, q, v, t): return -q
-    ...     def gaps(self, q, t): return q + 10.0
-    ...     def contact_jacobians(self, q, t):
-    ...         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+    >>> from moreau.model.examples import Spring
     >>> res = simulate(Spring(), (0.0, np.pi / 2), [1.0], [0.0], "time-discontinuous-galerkin",
     ...                h=np.pi / 200, degree=2)
     >>> bool(abs(res.q[-1, 0]) < 1e-6)
