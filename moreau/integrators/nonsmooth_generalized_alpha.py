@@ -338,10 +338,7 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")
             return
-        gap = np.asarray(sc.gaps(q1, t1), float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         # the step's whole percussion: smooth force over the step plus the impulse
         PN, PT = h * lamN + pN, h * lamT + pT
         regime = np.array([int(classify_impulse(PN[i], PT[i], self.mu_c[i]))

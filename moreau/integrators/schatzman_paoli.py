@@ -258,10 +258,7 @@ class SchatzmanPaoli(TimeStepping):
             self.counters["steps"] -= 1     # the base class counts this failed step
             self._fail(-5, EXPLICIT_BLOWUP.format(t=t0, h=h))
             return
-        gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
         self._prev_reg = regime
         fN, fT = pN / h, pT / h

@@ -293,10 +293,7 @@ class TimeDiscontinuousGalerkin(TimeStepping):
             held = ia[lam[-1][:na] > 0.0]
             if self.projection and held.size:
                 q1 = project_positions(sc, t1, q1, held)
-        gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
         self._prev_reg = regime
         self._closed = pN > 0.0

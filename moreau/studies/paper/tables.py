@@ -126,9 +126,7 @@ def write_sidecar(path, params, name, parameter, values, frequency, extra, check
         "range": [float(values[0]), float(values[-1])],
         "frequency_Hz": frequency,
         "parameters_SI": asdict(params),
-        "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
-                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                             "options": scheme.options},
+        "reference_scheme": scheme.record,
         "cross_checks": [{"name": c.name, "theta": c.theta, "steps_per_period": c.steps_per_period}
                          for c in checks],
         "valid_range": {k: v for k, v in extra.items()},
