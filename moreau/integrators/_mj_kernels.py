@@ -63,7 +63,7 @@ from . import _contact_step, _driver, _step_parts
 from ._driver import grid_step, loop_template, record_sample, spliced  # noqa: F401
 from ._step_parts import (COND_MAX, _invert_gj, _invert_small, add_impulse, all_finite,  # noqa: F401
                           contact_block, gap_block, gaps_at, gather_rows, index_set, invert,
-                          lemke_solve, record_contacts, restitution_shift, slip_rows,
+                          lemke_solve, move_by, record_contacts, restitution_shift, slip_rows,
                           sparse_delassus, start_contacts)
 
 __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
@@ -307,11 +307,7 @@ def project_positions(projection, nc, n, mass_fn, gaps_fn, contacts_fn, HAS_GAPS
                 # exactly singular one is a numerical failure, as before
                 if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
                     return NUMERICAL
-                for i in range(n):
-                    acc = 0.0
-                    for c in range(s):
-                        acc += X[i, c] * dd[c]
-                    q1[i] += acc
+                move_by(X, dd, q1, s, n)
             gaps_current = False
             stats[S_PROJ] += 1.0
     return gaps_current

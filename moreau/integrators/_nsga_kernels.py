@@ -22,7 +22,7 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
 from ._mj_kernels import grid_step  # noqa: F401
 from ._driver import loop_template, spliced
 from ._step_parts import (add_impulse, all_finite, dense_delassus, gap_block, gaps_at, gather_rows,
-                          index_set, invert, lemke_solve, one_row_impulse, record_contacts,
+                          index_set, invert, lemke_solve, move_by, one_row_impulse, record_contacts,
                           restitution_shift, rows_times, slip_rows, times_ht)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
@@ -344,11 +344,7 @@ def correct_positions(mass_fn, gaps_fn, contacts_fn, lcp_step, HAS_GAPS, par, qs
                 for b_ in range(ne):
                     acc_v -= Weei[a_, b_] * tmpe[b_]
                 nu[eqr[a_]] = acc_v
-        for i in range(n):
-            acc_v = 0.0
-            for c in range(na):
-                acc_v += X[i, c] * nu[c]
-            q1[i] += acc_v
+        move_by(X, nu, q1, na, n)
 
 
 @njit(inline="always", error_model="numpy")

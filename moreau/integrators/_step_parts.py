@@ -29,7 +29,8 @@ from ._driver import spliced
 __all__ = ["invert", "gaps_at", "index_set", "gather_rows", "affine_rows", "times_ht",
            "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows", "all_finite",
            "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
-           "restitution_shift", "lemke_solve", "dense_delassus", "one_row_impulse", "COND_MAX"]
+           "restitution_shift", "lemke_solve", "move_by", "dense_delassus", "one_row_impulse",
+           "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
 COND_MAX = 1e14
@@ -324,6 +325,16 @@ def slip_rows(W, U, p, fa, na, nfa, m, slip):
         for c in range(m):
             acc += W[na + r, c] * p[c]
         slip[fa[r]] = acc
+
+
+@spliced
+def move_by(X, d, q, m, n):
+    """``q += X d`` over ``m`` columns (a position projection's step along ``X = A^-1 WN^T``)."""
+    for i in range(n):
+        acc = 0.0
+        for c in range(m):
+            acc += X[i, c] * d[c]
+        q[i] += acc
 
 
 @spliced
