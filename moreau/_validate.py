@@ -170,3 +170,29 @@ def relative_tolerance(name, value, floor=True):
                          f"float64 rounding (eps = 2.2e-16) bounds what an error estimate can "
                          f"certify, and a looser one keeps no two digits; got {x!r}")
     return x
+
+
+def cyclic_coordinate(scene, cyclic):
+    """The index of the scene's coordinate ``cyclic`` that does not enter its dynamics.
+
+    ``None`` takes the scene's one ``cyclic_coordinates`` entry (refused where
+    it declares none, or several).
+
+    Examples
+    --------
+    >>> class Rotor:                  # a scene's two attributes read here
+    ...     ndof, cyclic_coordinates = 3, (2,)
+    >>> cyclic_coordinate(Rotor(), None)
+    2
+    >>> cyclic_coordinate(Rotor(), 3)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `cyclic` must name a coordinate of the scene (0..2) that does not enter its dynamics, got 3
+    """
+    if cyclic is None:
+        cyc = tuple(getattr(scene, "cyclic_coordinates", ()))
+        cyclic = cyc[0] if len(cyc) == 1 else None
+    if cyclic is None or not 0 <= int(cyclic) < scene.ndof:
+        raise InputError(f"`cyclic` must name a coordinate of the scene (0..{scene.ndof - 1}) "
+                         f"that does not enter its dynamics, got {cyclic!r}")
+    return int(cyclic)

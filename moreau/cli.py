@@ -648,6 +648,18 @@ def _add_pool_options(p):
     p.add_argument("--quiet", action="store_true", help="no progress bar")
 
 
+def _add_output_options(p, what, out=True):
+    """The output folder, progress bar, figure and overwrite options of a command whose files
+    are ``what`` (a run, a comparison)."""
+    if out:
+        p.add_argument("--out", default="out", help="output folder (default ./out)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--no-plot", action="store_true", help="skip the figure")
+    p.add_argument("--force", action="store_true",
+                   help=f"replace the files of an earlier {what} with other settings (refused "
+                        "otherwise)")
+
+
 def _add_points_options(p, what, figures, netcdf_help):
     """Output, cache, pool and start options of a command that runs a grid of points
     (an atlas, a sweep): ``what`` names its output, ``figures`` what --no-plot skips."""
@@ -841,11 +853,7 @@ def build_parser():
                    help="time-stepping schemes: steps over the whole run")
     r.add_argument("--samples", type=int, default=2000,
                    help="samples written, evenly spaced in time (default 2000)")
-    r.add_argument("--out", default="out", help="output folder (default ./out)")
-    r.add_argument("--quiet", action="store_true", help="no progress bar")
-    r.add_argument("--no-plot", action="store_true", help="skip the figure")
-    r.add_argument("--force", action="store_true",
-                   help="replace the files of an earlier run with other settings (refused otherwise)")
+    _add_output_options(r, "run")
     _add_params(r, scheme_defaults=False)
     add_scene_options(r)
     r.set_defaults(func=_cmd_run)
@@ -873,11 +881,7 @@ def build_parser():
     b.add_argument("--no-shoot", action="store_true",
                    help="do not start from a shot periodic orbit (only the transient)")
     b.add_argument("--json", action="store_true", help="print one JSON object")
-    b.add_argument("--out", default="out", help="output folder (default ./out)")
-    b.add_argument("--quiet", action="store_true", help="no progress bar")
-    b.add_argument("--no-plot", action="store_true", help="skip the figure")
-    b.add_argument("--force", action="store_true",
-                   help="replace the files of an earlier run with other settings (refused otherwise)")
+    _add_output_options(b, "run")
     _add_params(b, scheme_defaults=False)
     add_scene_options(b)
     b.set_defaults(func=_cmd_bifurcation)
@@ -922,11 +926,7 @@ def build_parser():
     c.add_argument("--quick", action="store_true", help="fewer points, one timing per run")
     c.add_argument("--out", default="out", help="output folder (default ./out)")
     c.add_argument("--json", action="store_true", help="print one JSON object")
-    c.add_argument("--quiet", action="store_true", help="no progress bar")
-    c.add_argument("--no-plot", action="store_true", help="skip the figure")
-    c.add_argument("--force", action="store_true",
-                   help="replace the files of an earlier comparison with other settings "
-                        "(refused otherwise)")
+    _add_output_options(c, "comparison", out=False)
     c.set_defaults(func=_cmd_compare)
     add_suite_commands(sub)     # moreau suite, moreau animate
     return parser

@@ -23,7 +23,6 @@ Examples
 (2, ['ok'])
 """
 
-import json
 import math
 
 import numpy as np
@@ -35,7 +34,7 @@ from . import engine
 from .classify import CLASSIFY_COLUMNS, CLASSIFY_PERIODS
 from .engine import ED_REFERENCE, check_output_dir
 from .sweep import (VALUE_COLUMNS, MAX_POINTS, plan_points, require_xarray, sweep_tag,
-                    write_netcdf_beside)
+                    write_netcdf_beside, write_points_sidecar)
 
 __all__ = ["run_scene_atlas", "atlas_tag", "mode_map_figure", "classify_budget", "ATLAS_COLUMNS"]
 
@@ -189,18 +188,13 @@ def run_scene_atlas(scene, x, y, fixed=None, frequency=None, scheme=ED_REFERENCE
             "frequency_Hz": frequency,
             "fixed_parameters": {k: v for k, v in points[0][0].items()
                                  if k not in (xname, yname)},
-            "scheme": {"name": scheme.name, "theta": scheme.theta,
-                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                       "options": scheme.options},
+            "scheme": scheme.record,
             "modes": _mode_counts(table),
             "continuation": bool(continuation), "classify_periods": int(classify),
             "starts": _counts(table, "start"), "classifications": _counts(table, "classification"),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
-    json_path = stem.with_name(stem.name + ".json")
-    json_path.write_text(json.dumps(meta, indent=1, default=str))
-    log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
-        f"{stats['cached']} from the cache) and {json_path.name}")
+    write_points_sidecar(stem, meta, csv_path, len(table), stats, log)
     if netcdf:
         write_netcdf_beside(stem, table, [columns[xname], columns[yname]], log)
     if plot:

@@ -100,17 +100,7 @@ def characteristic_tag(scene, frequency, scheme):
     >>> characteristic_tag("friction-drive", 185.0, ED_REFERENCE)
     'characteristic_friction-drive_185Hz_event-driven'
     """
-    return "_".join([f"characteristic_{scene}", f"{frequency:g}Hz", _scheme_tag(scheme)])
-
-
-def _scheme_tag(scheme):
-    parts = [scheme.name]
-    if scheme.theta is not None:
-        parts.append(f"theta{scheme.theta:g}")
-    if scheme.steps_per_period is not None:
-        parts.append(f"N{scheme.steps_per_period}")
-    parts += [f"{k}{v:g}" if isinstance(v, float) else f"{k}{v}" for k, v in scheme[4]]
-    return "_".join(parts)
+    return "_".join([f"characteristic_{scene}", f"{frequency:g}Hz", scheme.full_label])
 
 
 class _Curve:
@@ -472,7 +462,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
             if out is None or not rows:
                 raise
             stem = out / (f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_"
-                          f"{_scheme_tag(scheme)}.partial")
+                          f"{scheme.full_label}.partial")
             csv_path = stem.with_name(stem.name + ".csv")
             write_csv(csv_path, rows, EFFICIENCY_COLUMNS)
             stem.with_name(stem.name + ".json").write_text(json.dumps(
@@ -517,7 +507,7 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
                             "rtol": scheme.rtol, "options": scheme.options},
     }
     if out is not None:
-        stem = out / f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_{_scheme_tag(scheme)}"
+        stem = out / f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_{scheme.full_label}"
         csv_path = stem.with_name(stem.name + ".csv")
         write_csv(csv_path, rows, EFFICIENCY_COLUMNS)
         side = dict(summary, csv=csv_path.name)

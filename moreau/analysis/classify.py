@@ -46,7 +46,7 @@ from ..errors import InputError, MoreauError
 from ..integrators import get_integrator
 from ..integrators.base import scheme_options as options_of
 from ..model import registry
-from .periodic_shooting import period_map_options
+from .periodic_shooting import one_sample_per_period, period_map_options
 from .runaway import certain_runaway, runaway_in
 from .section_runs import section_states
 from .statistical import BATCHES, MAX_LAG1, batch_means, mser5_truncation
@@ -54,7 +54,6 @@ from .statistical import BATCHES, MAX_LAG1, batch_means, mser5_truncation
 __all__ = ["classify_long_run", "classification_columns", "sequence_period", "CLASSIFY_COLUMNS",
            "CLASSIFY_PERIODS", "MAX_PERIOD_K"]
 
-TWO_PI = 2.0 * math.pi
 #: the longest period the sampled sequence is tested for
 MAX_PERIOD_K = 8
 #: drive periods a failed atlas point is run for at most
@@ -117,14 +116,7 @@ def _run_scheme(scene, scheme):
 
 def _sampled_options(run, options):
     opts = period_map_options(run, dict(options))
-    takes = options_of(get_integrator(run)) or ()
-    if "h" in takes and "save_every" in takes:
-        opts["save_every"] = int(round(TWO_PI / opts["h"]))
-    elif "sample_dt" in takes:
-        opts["sample_dt"] = TWO_PI
-    elif "samples_per_period" in takes:
-        opts["samples_per_period"] = 1
-    return opts
+    return one_sample_per_period(options_of(get_integrator(run)) or (), opts)
 
 
 def _start(scene, start):

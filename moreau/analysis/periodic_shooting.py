@@ -26,7 +26,7 @@ import time
 import numpy as np
 from scipy.linalg import null_space
 
-from .._validate import positive, positive_int
+from .._validate import cyclic_coordinate, positive, positive_int
 from ..errors import ConvergenceError, InputError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import check_options, scheme_options as options_of
@@ -39,7 +39,7 @@ from .floquet import period_map_jacobian, sorted_multipliers
 from .steady_solvers import register_steady_solver
 
 __all__ = ["shoot_periodic", "free_bases", "period_map_options", "bracket_scalar",
-           "guess_options", "period_mode"]
+           "guess_options", "period_mode", "one_sample_per_period"]
 
 TWO_PI = 2.0 * math.pi
 
@@ -133,6 +133,29 @@ def period_map_options(scheme, options):
         raise InputError(f"`steps_per_period` applies to time-stepping schemes; scheme "
                          f"{scheme!r} chooses its own steps")
     return opts
+
+
+def one_sample_per_period(takes, options):
+    """``options`` with the sampling setting that asks a scheme for one sample per drive period.
+
+    ``takes`` are the options the scheme accepts; it also records whatever it
+    records at events. A scheme without a sampling setting keeps ``options``.
+
+    Examples
+    --------
+    >>> one_sample_per_period(("h", "save_every"), {"h": TWO_PI / 100})["save_every"]
+    100
+    >>> one_sample_per_period(("sample_dt",), {})
+    {'sample_dt': 6.283185307179586}
+    """
+    out = dict(options)
+    if "h" in takes and "save_every" in takes:
+        out["save_every"] = int(round(TWO_PI / out["h"]))
+    elif "sample_dt" in takes:
+        out["sample_dt"] = TWO_PI
+    elif "samples_per_period" in takes:
+        out["samples_per_period"] = 1
+    return out
 
 
 def period_mode(scene, res, ts, span):
@@ -249,13 +272,7 @@ def shoot_periodic(scene, scheme="event-driven", section_tau=0.0, q0=None, v0=No
     >>> ss.mode                                  # doctest: +SKIP
     'NP|F'
     """
-    if cyclic is None:
-        cyc = tuple(getattr(scene, "cyclic_coordinates", ()))
-        cyclic = cyc[0] if len(cyc) == 1 else None
-    if cyclic is None or not 0 <= int(cyclic) < scene.ndof:
-        raise InputError(f"`cyclic` must name a coordinate of the scene (0..{scene.ndof - 1}) "
-                         f"that does not enter its dynamics, got {cyclic!r}")
-    cyclic = int(cyclic)
+    cyclic = cyclic_coordinate(scene, cyclic)
     rtol = positive("rtol", rtol)
     max_iter = positive_int("max_iter", max_iter)
     periods = positive_int("periods", periods)

@@ -103,6 +103,23 @@ class Scheme(tuple):
             return "ed"
         if self.name == "moreau-jean" and not self[4]:
             return f"mj_theta{self.theta:g}"
+        return self.full_label
+
+    @property
+    def record(self):
+        """The scheme as a JSON sidecar records it (name, theta, steps, rtol, options)."""
+        return {"name": self.name, "theta": self.theta, "steps_per_period": self.steps_per_period,
+                "rtol": self.rtol, "options": self.options}
+
+    @property
+    def full_label(self):
+        """:attr:`label` without the short forms: the scheme's name, its step and its options.
+
+        Examples
+        --------
+        >>> Scheme.moreau_jean(1.0, 1000).full_label
+        'moreau-jean_theta1_N1000'
+        """
         parts = [self.name]
         if self.theta is not None:
             parts.append(f"theta{self.theta:g}")

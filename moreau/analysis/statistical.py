@@ -100,12 +100,12 @@ import numpy as np
 # that loads the command line
 from scipy.special import stdtrit
 
-from .._validate import finite_scalar, positive, positive_int
+from .._validate import cyclic_coordinate, finite_scalar, positive, positive_int
 from ..errors import BudgetExhaustedError, ConvergenceError, InputError, MoreauError, RunawayError
 from ..integrators import get_integrator
 from ..integrators.base import SchemeOptions, check_options, scheme_options as options_of
 from ..integrators.result import SteadyState
-from .periodic_shooting import period_map_options
+from .periodic_shooting import one_sample_per_period, period_map_options
 from .runaway import runaway_in
 from .section_runs import section_states
 
@@ -211,18 +211,6 @@ def batch_means(y, batches=BATCHES, confidence=0.95):
     den = float(dev @ dev)
     lag1 = float(dev[:-1] @ dev[1:]) / den if den > 0.0 else 0.0
     return mean, half, lag1
-
-
-def _sampling(scheme, takes, opts):
-    # ask the scheme for one sample per drive period (plus whatever it records at events)
-    out = dict(opts)
-    if "h" in takes and "save_every" in takes:
-        out["save_every"] = int(round(TWO_PI / out["h"]))
-    elif "sample_dt" in takes:
-        out["sample_dt"] = TWO_PI
-    elif "samples_per_period" in takes:
-        out["samples_per_period"] = 1
-    return out
 
 
 def _run_periods(scene, scheme, q, v, ts, m, cyclic, opts):
@@ -588,13 +576,7 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
     if isinstance(scheme, SchemeOptions):
         scheme_options = {**scheme.without_step("`steps_per_period`"), **(scheme_options or {})}
         scheme = scheme.scheme
-    if cyclic is None:
-        cyc = tuple(getattr(scene, "cyclic_coordinates", ()))
-        cyclic = cyc[0] if len(cyc) == 1 else None
-    if cyclic is None or not 0 <= int(cyclic) < scene.ndof:
-        raise InputError(f"`cyclic` must name a coordinate of the scene (0..{scene.ndof - 1}) "
-                         f"that does not enter its dynamics, got {cyclic!r}")
-    cyclic = int(cyclic)
+    cyclic = cyclic_coordinate(scene, cyclic)
     precision, confidence, max_periods, starts, spread = check_statistical_options(
         precision, confidence, max_periods, starts, spread)
     if starts > 1 and getattr(scene, "velocity_scale", None) is None:
@@ -612,7 +594,7 @@ def statistical_steady_state(scene, scheme="event-driven", q0=None, v0=None, sec
     if scheme == "moreau-jean" and "projection" in takes:
         opts.setdefault("projection", True)
     check_options(scheme, opts, scene)
-    run_opts = _sampling(scheme, takes, opts)
+    run_opts = one_sample_per_period(takes, opts)
     given = q0 is not None and v0 is not None
     if not given:
         q0, v0 = scene.initial_state()

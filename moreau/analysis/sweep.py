@@ -45,7 +45,7 @@ from .scheme_settings import make_scheme
 
 __all__ = ["run_scene_sweep", "plan_points", "sweep_tag", "sweep_values", "VALUE_COLUMNS",
            "MAX_POINTS", "rows_to_xarray", "rows_to_netcdf", "netcdf_attrs", "require_xarray",
-           "write_netcdf_beside", "UNIT_SUFFIXES", "stability_panel"]
+           "write_netcdf_beside", "write_points_sidecar", "UNIT_SUFFIXES", "stability_panel"]
 
 #: bound on the points of one sweep (each a steady state: about 1e5 s of CPU at the limit)
 MAX_POINTS = 10**5
@@ -281,16 +281,11 @@ def run_scene_sweep(scene, parameter, values, fixed=None, frequency=None, scheme
     meta = {"scene": entry.name, "swept_parameter": swept, "points": int(values.size),
             "range": [float(values.min()), float(values.max())], "frequency_Hz": frequency,
             "fixed_parameters": {k: v for k, v in points[0][0].items() if k != parameter},
-            "scheme": {"name": scheme.name, "theta": scheme.theta,
-                       "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                       "options": scheme.options},
+            "scheme": scheme.record,
             "continuation": bool(continuation),
             "engine": stats, "provenance": provenance(engine.code_version()),
             "settings": settings}
-    json_path = stem.with_name(stem.name + ".json")
-    json_path.write_text(json.dumps(meta, indent=1, default=str))
-    log(f"wrote {csv_path} ({len(table)} points: {stats['computed']} computed, "
-        f"{stats['cached']} from the cache) and {json_path.name}")
+    write_points_sidecar(stem, meta, csv_path, len(table), stats, log)
     if netcdf:
         write_netcdf_beside(stem, table, [swept], log)
     if plot:
@@ -480,6 +475,17 @@ def rows_to_netcdf(rows, dims, path, attrs=None):
         if tmp.exists():
             tmp.unlink()
     return path
+
+
+def write_points_sidecar(stem, meta, csv_path, points, stats, log=print):
+    """Write ``meta`` as ``STEM.json``, the sidecar of the table at ``csv_path`` (a sweep's, an
+    atlas's), and log both with the table's ``points`` and the engine's ``stats`` (computed,
+    from the cache). Returns the sidecar's path."""
+    json_path = pathlib.Path(stem).with_name(pathlib.Path(stem).name + ".json")
+    json_path.write_text(json.dumps(meta, indent=1, default=str))
+    log(f"wrote {csv_path} ({points} points: {stats['computed']} computed, "
+        f"{stats['cached']} from the cache) and {json_path.name}")
+    return json_path
 
 
 def write_netcdf_beside(stem, rows, dims, log=print):

@@ -266,7 +266,7 @@ def loop_template(name, namespace):
 _SPLICED = set()
 
 
-def spliced(fn):
+def spliced(fn=None, *, step_returns=False):
     """Decorator: a piece of step rule that :func:`loop_template` splices in at each call.
 
     The helper is written like a numba function; it is also compiled as one
@@ -276,8 +276,12 @@ def spliced(fn):
     and its parameters replaced by the arguments: no call, no arguments
     passed, so the arrays' reference counts cost nothing per step and the
     arithmetic is the caller's own, to the bit. Its parameters are never
-    assigned, and its only ``return`` is its last statement.
+    assigned, and its only ``return`` is its last statement, unless
+    ``step_returns``: then its other ``return X`` return ``X`` from the step
+    rule it is spliced into (a status; such a helper serves step rules only).
     """
+    if fn is None:
+        return functools.partial(spliced, step_returns=step_returns)
     fdef = _function_def(fn)
     params = {a.arg for a in fdef.args.args}
     stored = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
@@ -287,7 +291,8 @@ def spliced(fn):
                         f"{sorted(stored & params)}")
     returns = [n for n in ast.walk(fdef) if isinstance(n, ast.Return)]
     body = _strip_docstring(fdef.body)
-    if returns and not (len(returns) == 1 and body and body[-1] is returns[0]):
+    if returns and not step_returns and not (len(returns) == 1 and body
+                                             and body[-1] is returns[0]):
         raise TypeError(f"spliced helper {fn.__name__} returns before its last statement")
     _SPLICED.add(fn)
     return njit(inline="always", error_model="numpy")(fn)

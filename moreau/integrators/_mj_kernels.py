@@ -60,10 +60,11 @@ from ._contact_step import (  # noqa: F401
     _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
     new_stats, prev_regimes, set_painleve_stop)
 from . import _contact_step, _driver, _step_parts
-from ._driver import grid_step, loop_template, record_sample  # noqa: F401
+from ._driver import grid_step, loop_template, record_sample, spliced  # noqa: F401
 from ._step_parts import (COND_MAX, _invert_gj, _invert_small, add_impulse, all_finite,  # noqa: F401
                           contact_block, gap_block, gaps_at, gather_rows, index_set, invert,
-                          record_contacts, slip_rows)
+                          lemke_solve, move_by, record_contacts, restitution_shift, slip_rows,
+                          sparse_delassus, start_contacts)
 
 __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "STAT_NAMES", "OK", "PAINLEVE", "NUMERICAL",
            "SINGULAR", "LCP_HANDBACK"]
@@ -103,38 +104,15 @@ def step_workspace(n, nc, opts, lcp_ctl):
             flags, lw)
 
 
-@njit(inline="always", error_model="numpy")
-def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
-              HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
-              hn, record_initial, q, v, out):
-    """One Moreau–Jean step from ``(q, v)`` at ``tk`` to ``(q1, v1)`` at ``t1`` (see :mod:`._driver`).
+@spliced(step_returns=True)
+def free_velocity(mass_fn, forces_fn, contacts_fn, par, q, v, tk, t1, hk, k, k0, th, n, nc,
+                  const_mass, has_jac, constant_W, M, D, D0, G0, rhs, Wh, Wi, wk, flags, vf, v1):
+    """Moreau–Jean's free velocity ``vf = v + W_hat^-1 (h [theta f1 + (1 - theta) f0]
+    + h^2 theta K v)`` (also into ``v1``); the contact rows at ``(q_k, t_k)`` into ``G0``.
 
-    ``opts`` is ``(theta, projection)``, ``memo`` ``(closed,)``: the contacts
-    that carried a normal impulse in the step before, updated after a step
-    taken. The free velocity solves ``W_hat dv = h [theta f1 + (1 - theta)
-    f0] + h^2 theta K v``; a contact is active where its gap, extrapolated
-    half a step, closes (or where it was closed); one active contact is
-    solved in closed form, several by the friction LCP (:mod:`._contact_step`);
-    then the position update and, with ``projection``, the mass-weighted
-    projection of the closed gaps.
+    ``W_hat^-1`` of a constant mass matrix without force Jacobians is kept
+    (``flags[0]``); a singular ``W_hat`` stops the step (:data:`SINGULAR`).
     """
-    n = NDOF
-    nc = NCONTACTS
-    const_mass = CONST_MASS
-    has_jac = HAS_JAC
-    th, projection = opts
-    q1, v1, pN, pT, slip, reg, G0, Gq = out
-    closed = memo[0]
-    (M, Wh, Wi, wk, D, D0, rhs, vf, G1, vN0, active, cnew, ia, fa, H, hnz, hcnt, w, WiHT, Wd, Uf,
-     p, Mi, sel, X, S, rs, ident, dd, base, trow, rvel, flags, lw) = ws
-    # unpacked before the loop (the driver splices this): a tuple unpacked on every step
-    # costs a two-contact scene a third of its speed
-    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
-    force_lemke = lcp_ctl[CTL_FORCE] != 0
-    warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
-    constant_W = const_mass and not has_jac
-    ...  # the steps (moreau.integrators._driver.loop_template)
-    # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
     # the gaps at (q_k, t_k) were computed at the end of the step before
     if not (const_mass and k > k0):
         mass_fn(par, q, M)
@@ -178,133 +156,110 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         vf[i] = v[i] + acc
         v1[i] = vf[i]
 
-    # -- contacts
-    for i in range(nc):
-        pN[i] = 0.0
-        pT[i] = 0.0
-        slip[i] = 0.0
-        acc = G0[i, 1]
-        for j in range(n):
-            acc += G0[i, 3 + j] * v[j]
-        vN0[i] = acc
-        active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
-    na, nfa = index_set(active, mu, nc, ia, fa)
-    if na > 0:
-        contacts_fn(par, q, t1, G1, False, True)
-    if na == 1 and not force_lemke:
-        # one contact: the closed-form case analysis on the 2x2 (1x1) Delassus
-        # matrix, built from the contact's two rows only; loops over n alone, so
-        # that with the sizes known at compile time it is straight-line code
-        i = ia[0]
-        fr = nfa == 1
-        Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Wi, WiHT, vf, n, fr)
-        stats[S_LCP] += 1.0
-        stats[S_DIRECT] += 1.0
-        if fr:
-            pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
-            # a tangential impact is taken by the generic step, which records it (or
-            # stops there with painleve="stop"); it is rare, the test is not
-            if not ok or (reg[i] != 0 and reg[i] != 3
-                          and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
-                    or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
-                return PAINLEVE
-            rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
-                                              vN0[i], pn, pt)
-            slip[i] = uT + Wtn * pn + Wtt * pt
-        else:
-            pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i])
-            if not ok:
-                return PAINLEVE
-            rnum, rscale = _residual_parts(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i],
-                                           pn, 0.0)
-        pN[i] = pn
-        pT[i] = pt
-        # stats[S_RES] = max(stats[S_RES], rnum / rscale), dividing only where the
-        # quotient can exceed it: fl(rnum / rscale) > r implies rnum > r rscale exactly,
-        # hence rnum >= fl(r rscale) for the double rnum, so the test skips no update.
-        # On most steps the largest residual stands and the division is skipped
-        # (2 % of a friction-drive step)
-        if rnum >= stats[S_RES] * rscale:
-            res = rnum / rscale
-            if res > stats[S_RES]:
-                stats[S_RES] = res
-        for j in range(n):
-            v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
-    elif na > 0:
-        m = na + nfa
-        gather_rows(G1, ia, fa, na, nfa, n, H, w)
-        for c in range(m):
-            cnt = 0
-            for j in range(n):
-                if H[c, j] != 0.0:
-                    hnz[c, cnt] = j
-                    cnt += 1
-            hcnt[c] = cnt
-        for c in range(m):
-            for i in range(n):
-                acc = 0.0
-                for t in range(hcnt[c]):
-                    j = hnz[c, t]
-                    acc += Wi[i, j] * H[c, j]
-                WiHT[i, c] = acc
-        for r in range(m):
-            acc = w[r]
-            for t in range(hcnt[r]):
-                j = hnz[r, t]
-                acc += H[r, j] * vf[j]
-            Uf[r] = acc
-            for c in range(m):
-                acc = 0.0
-                for t in range(hcnt[r]):
-                    j = hnz[r, t]
-                    acc += H[r, j] * WiHT[j, c]
-                Wd[r, c] = acc
-        # Newton's restitution: the normal rows aim at -e times the approach speed
-        for r in range(na):
-            i = ia[r]
-            if e[i] > 0.0:
-                Uf[r] += e[i] * min(vN0[i], 0.0)
-        L = _lcp_size(na, ia, mu, base, trow)
-        res = np.inf
-        # the regimes of the step before (known from the second step of a call on)
-        regimes = warm_on and k > k0
-        if regimes:
-            res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel,
-                                pcol)
-        if 0.0 <= res <= DEFAULT_TOL:
-            stats[S_LCP] += 1.0
-            stats[S_WARM] += 1.0
-        else:
-            # refused: a regime changes in this step (or lies within the
-            # margin of changing) and Lemke decides, from scratch, since the
-            # remembered support is that of the old regimes. On the first
-            # step of a call the regimes are unknown: the support may serve
-            lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
-                                           Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                           lcp_ctl, Ab, xb, idx, pcol, not regimes)
-            if lst != 0:
-                return LCP_HANDBACK
-            if na == 1 and nfa == 1 and (
-                    (reg[ia[0]] != 0 and reg[ia[0]] != 3
-                     and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
-                              _slip_sign(reg[ia[0]])))
-                    or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
-                                e[ia[0]], vN0[ia[0]])):
-                # one contact by Lemke (lcp_method="lemke"): a tangential impact, as above
-                return PAINLEVE
-            stats[S_PIVOTS] += piv
-            stats[S_LCP] += 1.0
-            if warm:
-                stats[S_WARM] += 1.0
+
+@spliced(step_returns=True)
+def one_contact(G1, ia, nfa, Wi, WiHT, vf, v1, n, mu, e, vN0, reg, lcp_ctl, stats, pN, pT, slip):
+    """One active contact (``ia[0]``) in closed form, into ``pN``, ``pT``, ``slip`` and ``v1``.
+
+    The case analysis on the 2x2 (1x1) Delassus matrix, built from the
+    contact's two rows only; loops over ``n`` alone, so that with the sizes
+    known at compile time it is straight-line code. A tangential impact or no
+    solution hands the step to the generic path (:data:`PAINLEVE`).
+    """
+    i = ia[0]
+    fr = nfa == 1
+    Wnn, Wnt, Wtn, Wtt, uN, uT = contact_block(G1, i, Wi, WiHT, vf, n, fr)
+    stats[S_LCP] += 1.0
+    stats[S_DIRECT] += 1.0
+    if fr:
+        pn, pt, ok = _one_contact_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i], vN0[i])
+        # a tangential impact is taken by the generic step, which records it (or
+        # stops there with painleve="stop"); it is rare, the test is not
+        if not ok or (reg[i] != 0 and reg[i] != 3
+                      and _jam(Wnn, Wnt, mu[i], uN, e[i], vN0[i], _slip_sign(reg[i]))) \
+                or _stop_at(lcp_ctl, Wnn, Wnt, mu[i], uN, uT, e[i], vN0[i]):
+            return PAINLEVE
+        rnum, rscale = _residual_parts_fr(Wnn, Wnt, Wtn, Wtt, uN, uT, mu[i], e[i],
+                                          vN0[i], pn, pt)
+        slip[i] = uT + Wtn * pn + Wtt * pt
+    else:
+        pn, pt, ok = _one_contact(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i])
+        if not ok:
+            return PAINLEVE
+        rnum, rscale = _residual_parts(Wnn, 0.0, 0.0, 0.0, uN, 0.0, 0.0, e[i], vN0[i],
+                                       pn, 0.0)
+    pN[i] = pn
+    pT[i] = pt
+    # stats[S_RES] = max(stats[S_RES], rnum / rscale), dividing only where the
+    # quotient can exceed it: fl(rnum / rscale) > r implies rnum > r rscale exactly,
+    # hence rnum >= fl(r rscale) for the double rnum, so the test skips no update.
+    # On most steps the largest residual stands and the division is skipped
+    # (2 % of a friction-drive step)
+    if rnum >= stats[S_RES] * rscale:
+        res = rnum / rscale
         if res > stats[S_RES]:
             stats[S_RES] = res
-        add_impulse(WiHT, p, vf, v1, m, n)
-        slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
+    for j in range(n):
+        v1[j] = vf[j] + WiHT[j, 0] * pn + WiHT[j, 1] * pt
 
-    for i in range(n):
-        q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
-    for i in range(nc):
-        cnew[i] = pN[i] > 0.0
+
+@spliced(step_returns=True)
+def several_contacts(lcp_step, na, nfa, ia, mu, e, vN0, reg, Wd, Uf, p, pN, pT, base, trow, rvel,
+                     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb, idx, pcol,
+                     warm_on, k, k0, stats):
+    """The friction LCP of several active contacts (``Wd``, ``Uf`` assembled): impulses into ``p``,
+    ``pN``, ``pT``.
+
+    From the second step of a call on, the regimes of the step before are
+    tried first (:func:`_regime_solve`); refused, Lemke decides (from the
+    remembered support on a call's first step). Where Lemke fails the step
+    is handed back (:data:`LCP_HANDBACK`); a tangential impact of one
+    contact solved by Lemke goes to the generic path (:data:`PAINLEVE`).
+    """
+    L = _lcp_size(na, ia, mu, base, trow)
+    res = np.inf
+    # the regimes of the step before (known from the second step of a call on)
+    regimes = warm_on and k > k0
+    if regimes:
+        res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel,
+                            pcol)
+    if 0.0 <= res <= DEFAULT_TOL:
+        stats[S_LCP] += 1.0
+        stats[S_WARM] += 1.0
+    else:
+        # refused: a regime changes in this step (or lies within the
+        # margin of changing) and Lemke decides, from scratch, since the
+        # remembered support is that of the old regimes. On the first
+        # step of a call the regimes are unknown: the support may serve
+        piv, res, warm = lemke_solve(lcp_step, Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+                                     Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb,
+                                     idx, pcol, not regimes)
+        if na == 1 and nfa == 1 and (
+                (reg[ia[0]] != 0 and reg[ia[0]] != 3
+                 and _jam(Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], e[ia[0]], vN0[ia[0]],
+                          _slip_sign(reg[ia[0]])))
+                or _stop_at(lcp_ctl, Wd[0, 0], Wd[0, 1], mu[ia[0]], Uf[0], Uf[1],
+                            e[ia[0]], vN0[ia[0]])):
+            # one contact by Lemke (lcp_method="lemke"): a tangential impact, as in one_contact
+            return PAINLEVE
+        stats[S_PIVOTS] += piv
+        stats[S_LCP] += 1.0
+        if warm:
+            stats[S_WARM] += 1.0
+    if res > stats[S_RES]:
+        stats[S_RES] = res
+
+
+@spliced(step_returns=True)
+def project_positions(projection, nc, n, mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, par,
+                      t1, q1, M, Mi, wk, sel, cnew, Gq, ia, X, S, rs, pcol, dd, ident, flags,
+                      stats):
+    """With ``projection``: Gauss–Newton steps of ``q1`` onto ``g = 0`` for the contacts that
+    carried an impulse or whose gap is negative, in the metric of ``M``.
+
+    Returns whether ``Gq`` holds the gaps at ``q1``; a singular ``M`` or
+    selected gaps that are not independent stop the step (:data:`NUMERICAL`).
+    """
     gaps_current = False
     if projection and nc > 0:
         if not const_mass:
@@ -352,13 +307,71 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 # exactly singular one is a numerical failure, as before
                 if eliminate(S, rs, s, 0.0, 0.0, pcol, dd, ident) < s:
                     return NUMERICAL
-                for i in range(n):
-                    acc = 0.0
-                    for c in range(s):
-                        acc += X[i, c] * dd[c]
-                    q1[i] += acc
+                move_by(X, dd, q1, s, n)
             gaps_current = False
             stats[S_PROJ] += 1.0
+    return gaps_current
+
+
+@njit(inline="always", error_model="numpy")
+def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
+              HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
+              hn, record_initial, q, v, out):
+    """One Moreau–Jean step from ``(q, v)`` at ``tk`` to ``(q1, v1)`` at ``t1`` (see :mod:`._driver`).
+
+    ``opts`` is ``(theta, projection)``, ``memo`` ``(closed,)``: the contacts
+    that carried a normal impulse in the step before, updated after a step
+    taken. The free velocity solves ``W_hat dv = h [theta f1 + (1 - theta)
+    f0] + h^2 theta K v``; a contact is active where its gap, extrapolated
+    half a step, closes (or where it was closed); one active contact is
+    solved in closed form, several by the friction LCP (:mod:`._contact_step`);
+    then the position update and, with ``projection``, the mass-weighted
+    projection of the closed gaps.
+    """
+    n = NDOF
+    nc = NCONTACTS
+    const_mass = CONST_MASS
+    has_jac = HAS_JAC
+    th, projection = opts
+    q1, v1, pN, pT, slip, reg, G0, Gq = out
+    closed = memo[0]
+    (M, Wh, Wi, wk, D, D0, rhs, vf, G1, vN0, active, cnew, ia, fa, H, hnz, hcnt, w, WiHT, Wd, Uf,
+     p, Mi, sel, X, S, rs, ident, dd, base, trow, rvel, flags, lw) = ws
+    # unpacked before the loop (the driver splices this): a tuple unpacked on every step
+    # costs a two-contact scene a third of its speed
+    Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
+    force_lemke = lcp_ctl[CTL_FORCE] != 0
+    warm_on = lcp_ctl[CTL_WARM] != 0 and not force_lemke
+    constant_W = const_mass and not has_jac
+    ...  # the steps (moreau.integrators._driver.loop_template)
+    # -- free velocity: W_hat dv = h [theta f1 + (1 - theta) f0] + h^2 theta K v
+    free_velocity(mass_fn, forces_fn, contacts_fn, par, q, v, tk, t1, hk, k, k0, th, n, nc,
+                  const_mass, has_jac, constant_W, M, D, D0, G0, rhs, Wh, Wi, wk, flags, vf, v1)
+    # -- contacts: the active set at (q_k, v_k), the rows at (q_k, t_k+1)
+    start_contacts(G0, v, closed, hk, nc, n, vN0, active, pN, pT, slip)
+    na, nfa = index_set(active, mu, nc, ia, fa)
+    if na > 0:
+        contacts_fn(par, q, t1, G1, False, True)
+    if na == 1 and not force_lemke:
+        one_contact(G1, ia, nfa, Wi, WiHT, vf, v1, n, mu, e, vN0, reg, lcp_ctl, stats, pN, pT,
+                    slip)
+    elif na > 0:
+        m = na + nfa
+        sparse_delassus(G1, ia, fa, na, nfa, n, Wi, vf, H, hnz, hcnt, w, WiHT, Uf, Wd)
+        restitution_shift(Uf, na, ia, e, vN0)
+        several_contacts(lcp_step, na, nfa, ia, mu, e, vN0, reg, Wd, Uf, p, pN, pT, base, trow,
+                         rvel, Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb, idx,
+                         pcol, warm_on, k, k0, stats)
+        add_impulse(WiHT, p, vf, v1, m, n)
+        slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
+    # -- update: positions, then the projection
+    for i in range(n):
+        q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
+    for i in range(nc):
+        cnew[i] = pN[i] > 0.0
+    gaps_current = project_positions(projection, nc, n, mass_fn, gaps_fn, contacts_fn, HAS_GAPS,
+                                     const_mass, par, t1, q1, M, Mi, wk, sel, cnew, Gq, ia, X, S,
+                                     rs, pcol, dd, ident, flags, stats)
     if not all_finite(q1, v1, n):
         return NUMERICAL
     if nc > 0 and not gaps_current:

@@ -7,6 +7,14 @@ run written out, in the same order, to the bit. The contact rows a model
 writes are ``G[i] = (g, wN, wT, WN[0:n], WT[0:n])`` (:mod:`moreau.compiled`);
 ``ia`` lists the active contacts and ``fa`` the frictional ones among them,
 the normal rows first, then the tangential ones.
+
+The sequences several schemes share are here: the step's start and active
+set (:func:`start_contacts`), the contact problem's assembly
+(:func:`dense_delassus`, :func:`sparse_delassus`, :func:`restitution_shift`),
+its solution (:func:`solve_one`, :func:`one_row_impulse`,
+:func:`lemke_solve`) and the update (:func:`add_impulse`, :func:`slip_rows`,
+:func:`record_contacts`). A part written with ``spliced(step_returns=True)``
+may end the step with a status, as the step rule itself would.
 """
 
 import math
@@ -14,12 +22,15 @@ import math
 import numpy as np
 from numba import njit
 
-from ._contact_step import S_DIRECT, S_LCP, S_PEN, _classify, _one_contact, _residual, _stop_at
+from ._contact_step import (LCP_HANDBACK, PAINLEVE, S_DIRECT, S_LCP, S_PEN, _classify, _one_contact, _residual,
+                            _stop_at)
 from ._driver import spliced
 
 __all__ = ["invert", "gaps_at", "index_set", "gather_rows", "affine_rows", "times_ht",
            "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows", "all_finite",
-           "record_contacts", "gap_block", "COND_MAX"]
+           "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
+           "restitution_shift", "lemke_solve", "move_by", "dense_delassus", "one_row_impulse",
+           "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
 COND_MAX = 1e14
@@ -317,6 +328,16 @@ def slip_rows(W, U, p, fa, na, nfa, m, slip):
 
 
 @spliced
+def move_by(X, d, q, m, n):
+    """``q += X d`` over ``m`` columns (a position projection's step along ``X = A^-1 WN^T``)."""
+    for i in range(n):
+        acc = 0.0
+        for c in range(m):
+            acc += X[i, c] * d[c]
+        q[i] += acc
+
+
+@spliced
 def all_finite(a, b, n):
     """Whether the ``n`` first entries of ``a`` and ``b`` are finite (a step's state)."""
     finite = True
@@ -351,3 +372,107 @@ def gap_block(G, sel, s, Ai, X, S, n):
             for j in range(n):
                 acc += G[sel[r], 3 + j] * X[j, c]
             S[r, c] = acc
+
+
+@spliced
+def start_contacts(G0, v, closed, hk, nc, n, vN0, active, pN, pT, slip):
+    """The step's start: impulses and slips zeroed, the normal velocities ``vN0`` at ``v`` and the
+    active set (a gap that closes within half a step at ``vN0``, or a contact closed before)."""
+    for i in range(nc):
+        pN[i] = 0.0
+        pT[i] = 0.0
+        slip[i] = 0.0
+        acc = G0[i, 1]
+        for j in range(n):
+            acc += G0[i, 3 + j] * v[j]
+        vN0[i] = acc
+        active[i] = (G0[i, 0] + 0.5 * hk * acc <= 0.0) or closed[i]
+
+
+@spliced
+def sparse_delassus(G, ia, fa, na, nfa, n, Ai, u, H, hnz, hcnt, w, AiHT, U, W):
+    """The contact problem of the active rows: ``H``, ``AiHT = A^-1 H^T``, ``U = w + H u`` and
+    ``W = H AiHT``, summed over each row's nonzero columns only.
+
+    Contact rows touch few coordinates (two balls of a chain): over them alone
+    the assembly costs ``m nnz`` instead of ``m n^2`` (100 balls: 10x fewer
+    operations a step). The skipped terms are exact zeros, so the sums are the same.
+    """
+    m = na + nfa
+    gather_rows(G, ia, fa, na, nfa, n, H, w)
+    for c in range(m):
+        cnt = 0
+        for j in range(n):
+            if H[c, j] != 0.0:
+                hnz[c, cnt] = j
+                cnt += 1
+        hcnt[c] = cnt
+    for c in range(m):
+        for i in range(n):
+            acc = 0.0
+            for t in range(hcnt[c]):
+                j = hnz[c, t]
+                acc += Ai[i, j] * H[c, j]
+            AiHT[i, c] = acc
+    for r in range(m):
+        acc = w[r]
+        for t in range(hcnt[r]):
+            j = hnz[r, t]
+            acc += H[r, j] * u[j]
+        U[r] = acc
+        for c in range(m):
+            acc = 0.0
+            for t in range(hcnt[r]):
+                j = hnz[r, t]
+                acc += H[r, j] * AiHT[j, c]
+            W[r, c] = acc
+
+
+@spliced
+def restitution_shift(U, na, ia, e, vN0):
+    """Newton's restitution on the normal rows ``U[:na]``: each aims at ``-e`` times its
+    approach speed ``vN0`` (Signorini's law on the shifted velocity)."""
+    for r in range(na):
+        i = ia[r]
+        if e[i] > 0.0:
+            U[r] += e[i] * min(vN0[i], 0.0)
+
+
+@spliced(step_returns=True)
+def lemke_solve(lcp_step, W, U, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, rayl,
+                work, iwork, lay, lcp_ctl, Ab, xb, idx, pcol, warm_ok):
+    """The friction LCP of the active rows by ``lcp_step`` (:func:`._contact_step._lcp_step`):
+    ``(pivots, residual, warm)``; where Lemke fails the step is handed back (:data:`LCP_HANDBACK`)."""
+    lst, piv, res, warm = lcp_step(W, U, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl,
+                                   rayl, work, iwork, lay, lcp_ctl, Ab, xb, idx, pcol, warm_ok)
+    if lst != 0:
+        return LCP_HANDBACK
+    return piv, res, warm
+
+
+@spliced
+def dense_delassus(G, ia, fa, na, nfa, n, Ai, u, H, w, AiHT, U, W):
+    """The contact problem of the active rows, dense: ``H``, ``AiHT = A^-1 H^T``, ``U = w + H u``
+    and ``W = H AiHT``."""
+    m = na + nfa
+    gather_rows(G, ia, fa, na, nfa, n, H, w)
+    times_ht(Ai, H, AiHT, m, n)
+    affine_rows(H, w, u, U, m, n)
+    rows_times(H, AiHT, W, m, n)
+
+
+@spliced(step_returns=True)
+def one_row_impulse(W, U, i, fr, mu, ei, vpre, p, pN, pT, lcp_ctl, stats):
+    """Contact ``i``, the only active one, in closed form (:func:`solve_one`) on the Delassus
+    block ``W`` and velocities ``U``: impulses into ``p`` (stacked) and ``pN``, ``pT``; returns
+    the residual. No solution stops the step (:data:`PAINLEVE`)."""
+    pn, pt, ok, res = solve_one(W[0, 0], W[0, 1], W[1, 0], W[1, 1], U[0], U[1], fr, mu[i], ei,
+                                vpre, lcp_ctl, stats, True)
+    if not ok:
+        return PAINLEVE
+    p[0] = pn
+    if fr:
+        p[1] = pt
+    pN[i] = pn
+    pT[i] = pt
+    return res

@@ -17,9 +17,9 @@ from numba import njit
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
                           _residual, _stop_at, grid_step, lcp_buffers, record_sample)
-from ._driver import loop_template
+from ._driver import loop_template, spliced
 from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, index_set, invert,
-                          record_contacts, times_ht)
+                          record_contacts, start_contacts, times_ht)
 
 __all__ = ["tdg_loop"]
 
@@ -156,6 +156,93 @@ def step_workspace(n, nc, opts, lcp_ctl):
             np.zeros(ncm, dtype=np.bool_), lcp_buffers(ncm))
 
 
+@spliced(step_returns=True)
+def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, Dirs, v0, p, Ptot,
+                     force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats):
+    """The impulsive part at ``t_n+``: Newton's law on the pre-step velocities, into ``v0`` and
+    ``Ptot``; ``Dirs[0] = M^-1 H^T`` at the step's start."""
+    gather_rows(G0, ia, fa, na, nfa, n, H, w)
+    for r in range(na):
+        ea[r] = e[ia[r]]
+        ez[r] = vN0[ia[r]]
+    times_ht(Mi0, H, Dirs[0], m, n)
+    st = _stage_problem(H, w, Dirs[0], v0, ea, ez, n, na, nfa, ia, mu, force_lemke, p,
+                        sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+    if st != OK:
+        return st
+    for c in range(m):
+        Ptot[c] = p[c]
+        for i in range(n):
+            v0[i] += Dirs[0, i, c] * p[c]
+    for r in range(na):
+        ea[r] = 0.0
+        ez[r] = 0.0
+
+
+@spliced
+def total_impulses(na, nfa, m, s, hk, ia, fa, b_st, Lam, Ptot, pN, pT, held):
+    """The step's impulses: the one at its start plus the stages' forces by their weights, into
+    ``pN``, ``pT``; returns how many contacts the last stage holds (listed in ``held``)."""
+    nh = 0
+    if na > 0:
+        for c in range(m):
+            acc = Ptot[c]
+            for l in range(s):
+                acc += hk * b_st[l] * Lam[l, c]
+            Ptot[c] = acc
+        for r in range(na):
+            pN[ia[r]] = Ptot[r]
+            if Lam[s - 1, r] > 0.0:
+                held[nh] = ia[r]
+                nh += 1
+        for r in range(nfa):
+            pT[fa[r]] = Ptot[na + r]
+    return nh
+
+
+@spliced(step_returns=True)
+def project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, par, t1, n, nh, held, qi, M,
+                 Mi, Mi0, wk, Gi, gx, MW, S, stats):
+    """Newton steps of ``qi`` onto ``g = 0`` for the ``nh`` contacts in ``held``, in the metric of
+    ``M(q_{n+1})`` (at most four, down to rounding); a singular ``M`` stops the step."""
+    # Newton steps onto g = 0 for the held contacts, in the metric of M(q_{n+1})
+    # (a constant mass matrix is inverted once, in Mi0)
+    if const_mass:
+        for i in range(n):
+            for j in range(n):
+                Mi[i, j] = Mi0[i, j]
+    else:
+        mass_fn(par, qi, M)  # noqa: F821
+        ok = invert(M, Mi, wk, n)
+        if not ok:
+            return SINGULAR
+    qmax = 1.0
+    for j in range(n):
+        qmax = max(qmax, abs(qi[j]))
+    for it in range(4):
+        contacts_fn(par, qi, t1, Gi, False, True)  # noqa: F821
+        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qi, t1, Gi)
+        gm = 0.0
+        for r in range(nh):
+            gx[r] = Gi[held[r], 0]
+            gm = max(gm, abs(gx[r]))
+        if gm == 0.0:
+            break
+        gap_block(Gi, held, nh, Mi, MW, S, n)
+        if not _solve_small(S, gx, nh):
+            break
+        dmax = 0.0
+        for j in range(n):
+            acc = 0.0
+            for c in range(nh):
+                acc += MW[j, c] * gx[c]
+            qi[j] -= acc
+            dmax = max(dmax, abs(acc))
+        stats[S_PROJ] += 1.0
+        if dmax <= 4e-16 * qmax:
+            break
+
+
 @njit(inline="always", error_model="numpy")
 def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_MASS, HAS_JAC,
               HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo, lcp_ctl, stats, k, k0, tk, t1, hk,
@@ -190,39 +277,15 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         flags[0] = 1
     for j in range(n):
         v0[j] = v[j]
-    for i in range(nc):
-        pN[i] = 0.0
-        pT[i] = 0.0
-        slip[i] = 0.0
     if nc > 0:
         contacts_fn(par, q, tk, G0, False, True)  # noqa: F821
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, tk, G0)
-        for i in range(nc):
-            acc = G0[i, 1]
-            for j in range(n):
-                acc += G0[i, 3 + j] * v[j]
-            vN0[i] = acc
-            act[i] = G0[i, 0] + 0.5 * hk * acc <= 0.0 or closed[i]
+    start_contacts(G0, v, closed, hk, nc, n, vN0, act, pN, pT, slip)
     na, nfa = index_set(act, mu, nc, ia, fa)
     m = na + nfa
     if na > 0:
-        # the impulsive part at t_n+: Newton's law on the pre-step velocities
-        gather_rows(G0, ia, fa, na, nfa, n, H, w)
-        for r in range(na):
-            ea[r] = e[ia[r]]
-            ez[r] = vN0[ia[r]]
-        times_ht(Mi0, H, Dirs[0], m, n)
-        st = _stage_problem(H, w, Dirs[0], v0, ea, ez, n, na, nfa, ia, mu, force_lemke, p,
-                            sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
-        if st != OK:
-            return st
-        for c in range(m):
-            Ptot[c] = p[c]
-            for i in range(n):
-                v0[i] += Dirs[0, i, c] * p[c]
-        for r in range(na):
-            ea[r] = 0.0
-            ez[r] = 0.0
+        impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, Dirs, v0, p,
+                         Ptot, force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
     # the non-impulsive part: half-explicit Runge-Kutta on the Lobatto nodes
     forces_fn(par, q, v0, tk, D, False)  # noqa: F821
     for i in range(n):
@@ -287,57 +350,10 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             times_ht(Mi, H, Dirs[st_i], m, n)
     if not all_finite(qi, vi, n):
         return NUMERICAL
-    nh = 0
-    if na > 0:
-        for c in range(m):
-            acc = Ptot[c]
-            for l in range(s):
-                acc += hk * b_st[l] * Lam[l, c]
-            Ptot[c] = acc
-        for r in range(na):
-            pN[ia[r]] = Ptot[r]
-            if Lam[s - 1, r] > 0.0:
-                held[nh] = ia[r]
-                nh += 1
-        for r in range(nfa):
-            pT[fa[r]] = Ptot[na + r]
+    nh = total_impulses(na, nfa, m, s, hk, ia, fa, b_st, Lam, Ptot, pN, pT, held)
     if projection and nh > 0:
-        # Newton steps onto g = 0 for the held contacts, in the metric of M(q_{n+1})
-        # (a constant mass matrix is inverted once, in Mi0)
-        if const_mass:
-            for i in range(n):
-                for j in range(n):
-                    Mi[i, j] = Mi0[i, j]
-        else:
-            mass_fn(par, qi, M)  # noqa: F821
-            ok = invert(M, Mi, wk, n)
-            if not ok:
-                return SINGULAR
-        qmax = 1.0
-        for j in range(n):
-            qmax = max(qmax, abs(qi[j]))
-        for it in range(4):
-            contacts_fn(par, qi, t1, Gi, False, True)  # noqa: F821
-            gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qi, t1, Gi)
-            gm = 0.0
-            for r in range(nh):
-                gx[r] = Gi[held[r], 0]
-                gm = max(gm, abs(gx[r]))
-            if gm == 0.0:
-                break
-            gap_block(Gi, held, nh, Mi, MW, S, n)
-            if not _solve_small(S, gx, nh):
-                break
-            dmax = 0.0
-            for j in range(n):
-                acc = 0.0
-                for c in range(nh):
-                    acc += MW[j, c] * gx[c]
-                qi[j] -= acc
-                dmax = max(dmax, abs(acc))
-            stats[S_PROJ] += 1.0
-            if dmax <= 4e-16 * qmax:
-                break
+        project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, par, t1, n, nh, held,
+                     qi, M, Mi, Mi0, wk, Gi, gx, MW, S, stats)
     if not const_mass:
         flags[0] = 0
     if nc > 0:

@@ -52,7 +52,7 @@ from ._contact_step import (LCP_HANDBACK, NUMERICAL, OK, S_PEN, S_PROJ,  # noqa:
                             SHARED_INDIRECT, _lcp_size, _lcp_step, _lcp_step_unused,
                             lcp_buffers)
 from ._driver import loop_template
-from ._step_parts import gap_block, gaps_at, invert
+from ._step_parts import gap_block, gaps_at, invert, move_by
 from ._mj_kernels import step_rule as _mj_step
 from ._mj_kernels import step_workspace as _mj_workspace
 from .moreau_jean import MoreauJean, ThetaOptions
@@ -151,11 +151,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                     closed[i] = cl0[i]
                     reg[i] = reg0[i]
                 return LCP_HANDBACK
-        for i in range(n):
-            acc = 0.0
-            for c in range(s):
-                acc += X[i, c] * tau[c]
-            q1[i] += acc
+        move_by(X, tau, q1, s, n)
         stats[S_PROJ] += 1.0
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, Gq)
     for i in range(n):

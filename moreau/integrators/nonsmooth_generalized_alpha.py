@@ -167,15 +167,7 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.model.scene import Scene
-    >>> class Spring(Scene):
-    ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
-    ...     def mass(self, q): return np.eye(1)
-    ...     def forces(self, q, v, t): return -np.asarray(q, float)
-    ...     def force_jacobians(self, q, v, t): return -np.eye(1), np.zeros((1, 1))
-    ...     def gaps(self, q, t): return np.array([q[0] + 10.0])
-    ...     def contact_jacobians(self, q, t):
-    ...         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+    >>> from moreau.model.examples import Spring
     >>> err = [abs(simulate(Spring(), (0.0, 2.0), [1.0], [0.0], "nonsmooth-generalized-alpha",
     ...                     h=h).q[-1, 0] - np.cos(2.0)) for h in (0.02, 0.01)]
     >>> round(float(np.log2(err[0] / err[1])))
@@ -346,10 +338,7 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")
             return
-        gap = np.asarray(sc.gaps(q1, t1), float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         # the step's whole percussion: smooth force over the step plus the impulse
         PN, PT = h * lamN + pN, h * lamT + pT
         regime = np.array([int(classify_impulse(PN[i], PT[i], self.mu_c[i]))

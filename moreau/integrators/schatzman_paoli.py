@@ -148,14 +148,7 @@ class SchatzmanPaoli(TimeStepping):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.model.scene import Scene
-    >>> class Drop(Scene):
-    ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([1.0])
-    ...     def mass(self, q): return np.eye(1)
-    ...     def forces(self, q, v, t): return np.array([-1.0])
-    ...     def gaps(self, q, t): return np.array([q[0]])
-    ...     def contact_jacobians(self, q, t):
-    ...         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+    >>> from moreau.model.examples import Drop
     >>> res = simulate(Drop(), (0.0, 2 * np.sqrt(2)), [1.0], [0.0], "schatzman-paoli", h=1e-3)
     >>> bool(abs(res.q[-1, 0] - 1.0) < 2e-3)
     True
@@ -265,10 +258,7 @@ class SchatzmanPaoli(TimeStepping):
             self.counters["steps"] -= 1     # the base class counts this failed step
             self._fail(-5, EXPLICIT_BLOWUP.format(t=t0, h=h))
             return
-        gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
         self._prev_reg = regime
         fN, fT = pN / h, pT / h

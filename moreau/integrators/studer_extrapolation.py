@@ -184,14 +184,7 @@ class StuderExtrapolation(TimeStepping):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.model.scene import Scene
-    >>> class Drop(Scene):
-    ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([1.0])
-    ...     def mass(self, q): return np.eye(1)
-    ...     def forces(self, q, v, t): return np.array([-1.0])
-    ...     def gaps(self, q, t): return np.array([q[0]])
-    ...     def contact_jacobians(self, q, t):
-    ...         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+    >>> from moreau.model.examples import Drop
     >>> res = simulate(Drop(), (0.0, 2 * np.sqrt(2)), [1.0], [0.0], "studer-extrapolation",
     ...                tol=1e-8)
     >>> bool(abs(res.q[-1, 0] - 1.0) < 1e-6)

@@ -154,14 +154,7 @@ class TimeDiscontinuousGalerkin(TimeStepping):
 
     >>> import numpy as np
     >>> from moreau.integrators import simulate
-    >>> from moreau.model.scene import Scene
-    >>> class Spring(Scene):
-    ...     ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
-    ...     def mass(self, q): return np.eye(1)
-    ...     def forces(self, q, v, t): return -q
-    ...     def gaps(self, q, t): return q + 10.0
-    ...     def contact_jacobians(self, q, t):
-    ...         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+    >>> from moreau.model.examples import Spring
     >>> res = simulate(Spring(), (0.0, np.pi / 2), [1.0], [0.0], "time-discontinuous-galerkin",
     ...                h=np.pi / 200, degree=2)
     >>> bool(abs(res.q[-1, 0]) < 1e-6)
@@ -300,10 +293,7 @@ class TimeDiscontinuousGalerkin(TimeStepping):
             held = ia[lam[-1][:na] > 0.0]
             if self.projection and held.size:
                 q1 = project_positions(sc, t1, q1, held)
-        gap = np.asarray(sc.gaps(q1, t1), dtype=float) if nc else np.zeros(0)
-        if nc:
-            self.counters["max_penetration"] = max(self.counters["max_penetration"],
-                                                   float(np.max(-gap, initial=0.0)))
+        gap = self._end_gaps(q1, t1, nc)
         regime = np.array([int(classify_impulse(pN[i], pT[i], self.mu_c[i])) for i in range(nc)])
         self._prev_reg = regime
         self._closed = pN > 0.0

@@ -363,3 +363,12 @@ class TimeStepping(CompiledRecording, Integrator):
     def _warm_start(self):
         """Whether the compiled path warm-starts its contact problems."""
         return False
+
+    def _end_gaps(self, q1, t1, nc):
+        """The ``nc`` gaps at the step's end ``(q1, t1)``, the deepest penetration counted."""
+        if not nc:
+            return np.zeros(0)
+        gap = np.asarray(self.scene.gaps(q1, t1), dtype=float)
+        self.counters["max_penetration"] = max(self.counters["max_penetration"],
+                                               float(np.max(-gap, initial=0.0)))
+        return gap

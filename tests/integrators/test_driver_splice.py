@@ -51,3 +51,32 @@ def test_a_global_of_a_helper_that_the_namespace_binds_otherwise_is_renamed():
     assert ns["S_PEN___step_parts"] == _contact_step.S_PEN and ns["S_PEN"] == -1
     # the helper's locals are renamed apart, its parameters replaced by the arguments
     assert "for _record_contacts1_i in range(nc)" in out
+
+
+def test_a_part_with_step_returns_ends_the_step_with_its_status():
+    def part(x, out):
+        if x < 0.0:
+            return 7
+        out[0] = x
+    helper = spliced(part, step_returns=True)
+    stmts = _driver._Splicer({"part": helper}).stmts(ast.parse("part(y, buf)").body)
+    out = ast.unparse(ast.fix_missing_locations(
+        ast.Module(_driver._returns_to_breaks(stmts), [])))
+    assert "part(" not in out and "buf[0] = y" in out
+    assert "if y < 0.0:\n    status = 7\n    break" in out
+
+
+def test_the_schemes_parts_are_spliced_into_their_loops():
+    from moreau.integrators import _mj_kernels, _nsga_kernels, _tdg_kernels
+    parts = {_mj_kernels.mj_loop: {"free_velocity", "start_contacts", "one_contact",
+                                   "sparse_delassus", "several_contacts", "lemke_solve",
+                                   "project_positions"},
+             _nsga_kernels.nsga_loop: {"smooth_stage", "impulse_stage", "correct_positions",
+                                       "dense_delassus", "one_row_impulse", "lemke_solve"},
+             _tdg_kernels.tdg_loop: {"start_contacts", "impulse_at_start", "total_impulses",
+                                     "project_held"}}
+    for loop, names in parts.items():
+        src = loop.__moreau_source__
+        assert not _calls(src) & names
+        # each part's locals, renamed apart, are in the loop's source
+        assert all(f"_{name}" in src for name in names)

@@ -23,7 +23,6 @@ from ..._validate import positive
 # the module, not its function: a test (or a user) that replaces
 # engine.run_points reaches these sweeps too
 from ...analysis import engine
-from ...analysis.energy import ENERGY_COLUMNS
 from ...analysis.engine import check_output_dir, code_version
 from ...analysis.sweep import require_xarray, write_netcdf_beside
 from ...errors import InputError
@@ -33,7 +32,7 @@ from ...provenance import provenance
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
 from ..paper.figures import sweep_figure
 from ..paper.sweeps import make_scheme, scheme_tag, sweep_values
-from ..paper.tables import write_table
+from ..paper.tables import run_columns, write_table
 from ..paper.valid_range import lift_off_margin, range_marks
 from .direction_control import bidirectional_params
 
@@ -114,11 +113,7 @@ def tidy_rows(parameter, values, frequency, params, rows):
         r["lift_off_margin"] = _lift_off_margin(p, f)
         for c in _VALUE_COLUMNS:
             r[c] = row.get(c, math.nan if c != "mode" else "")
-        for c in ENERGY_COLUMNS:
-            if c in row:
-                r[c] = row[c]
-        r["compute_time_s"] = row.get("compute_time_s", math.nan)
-        out.append(r)
+        out.append(run_columns(r, row))
     return out
 
 
@@ -216,10 +211,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         "range": [float(values[0]), float(values[-1])],
         "frequency_Hz": frequency,
         "parameters_SI": asdict(params),
-        "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
-                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                             "projection": True if scheme.name == "moreau-jean" else None,
-                             "options": scheme.options},
+        "reference_scheme": {**scheme.record,
+                             "projection": True if scheme.name == "moreau-jean" else None},
         "valid_range": marks,
         "package_version": __version__,
         "code_version": code_version(),

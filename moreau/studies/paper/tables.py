@@ -19,7 +19,7 @@ from ...provenance import provenance
 from .valid_range import lift_off_margin
 
 __all__ = ["SWEPT_COLUMN", "PARAM_COLUMNS", "VALUE_COLUMNS", "sweep_point", "tidy_rows",
-           "write_table", "read_table", "write_sidecar"]
+           "write_table", "read_table", "write_sidecar", "run_columns"]
 
 SWEPT_COLUMN = {"frequency": "frequency_Hz", "mu": "mu", "phi0": "phi0_rad"}
 PARAM_COLUMNS = {"frequency": "frequency_Hz", "m": "m_kg", "m2": "m2_kg", "k": "k_N_per_m",
@@ -69,13 +69,24 @@ def tidy_rows(parameter, values, frequency, params, rows, checks, steps=None):
             for chk in checks:
                 for c in mj_check_columns(chk):
                     r[c] = row.get(c, math.nan)
-        # the energy audit, where the rows were computed with it (moreau sweep)
-        for c in ENERGY_COLUMNS:
-            if c in row:
-                r[c] = row[c]
-        r["compute_time_s"] = row.get("compute_time_s", math.nan)
-        out.append(r)
+        out.append(run_columns(r, row))
     return out
+
+
+def run_columns(r, row):
+    """``r`` with the energy audit's columns of ``row``, where it was computed with the audit
+    (moreau sweep), and its compute time (NaN where it has none).
+
+    Examples
+    --------
+    >>> run_columns({"mu": 0.2}, {"compute_time_s": 1.5})
+    {'mu': 0.2, 'compute_time_s': 1.5}
+    """
+    for c in ENERGY_COLUMNS:
+        if c in row:
+            r[c] = row[c]
+    r["compute_time_s"] = row.get("compute_time_s", math.nan)
+    return r
 
 
 def write_table(rows, path):
@@ -115,9 +126,7 @@ def write_sidecar(path, params, name, parameter, values, frequency, extra, check
         "range": [float(values[0]), float(values[-1])],
         "frequency_Hz": frequency,
         "parameters_SI": asdict(params),
-        "reference_scheme": {"name": scheme.name, "theta": scheme.theta,
-                             "steps_per_period": scheme.steps_per_period, "rtol": scheme.rtol,
-                             "options": scheme.options},
+        "reference_scheme": scheme.record,
         "cross_checks": [{"name": c.name, "theta": c.theta, "steps_per_period": c.steps_per_period}
                          for c in checks],
         "valid_range": {k: v for k, v in extra.items()},
