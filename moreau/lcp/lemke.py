@@ -1246,16 +1246,23 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
     # the rounding of M z + q counted (_residual): the scaled problem is the
     # means, the caller's is the one answered. Powers of two make every map exact.
     n = q.shape[0]
-    Ms = np.empty((n, n))
-    qs = np.empty(n)
-    ds = np.empty(n)
+    unit = ka == 0 and kb == 0
     for i in range(n):
-        qs[i] = _times_pow2(q[i], rexp[i] + kb)
-        # the covering vector of the scaled problem: all ones by default
-        # (the caller's d = 1 is a choice, not data), else the caller's mapped
-        ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
-        for j in range(n):
-            Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
+        unit = unit and rexp[i] == 0 and cexp[i] == 0
+    if unit:
+        # no scaling (a hand-over from the plain stage): the data as they are
+        Ms, qs, ds = M, q, d
+    else:
+        Ms = np.empty((n, n))
+        qs = np.empty(n)
+        ds = np.empty(n)
+        for i in range(n):
+            qs[i] = _times_pow2(q[i], rexp[i] + kb)
+            # the covering vector of the scaled problem: all ones by default
+            # (the caller's d = 1 is a choice, not data), else the caller's mapped
+            ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
+            for j in range(n):
+                Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
     if start.shape[0] == 0:
         status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
                                          tol, exact_ok)
@@ -1650,6 +1657,8 @@ _RUN_REPEAT = 1
 _RUN_LIMIT = 2
 _RUN_PYTHON = 3
 _RUN_MAX_ITER = 4
+# _RUN_DONE on a solution whose exact point is in z already
+_RUN_EXACT_POINT = 5
 
 
 @njit(cache=True)
@@ -1670,6 +1679,10 @@ def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_s
     qs = np.empty(n)
     ds = np.empty(n)
     residual = np.inf
+    info = out[3 * n + 1:]
+    unit = True
+    for t in range(2 * n + 3):
+        unit = unit and info[t] == 0.0
     while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         hb = 0
         for i in range(n):
@@ -1683,16 +1696,19 @@ def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_s
         if steps >= max_steps:
             return _RUN_LIMIT, status, pivots, residual, steps
         keys[steps] = key
-        info = out[3 * n + 1:]
-        ka = np.int64(info[2 * n])
-        kb = np.int64(info[2 * n + 1])
-        for i in range(n):
-            ri = np.int64(info[i])
-            qs[i] = _times_pow2(q[i], ri + kb)
-            ds[i] = _times_pow2(d[i], ri) if info[2 * n + 2] != 0.0 else d[i]
-            for j in range(n):
-                Ms[i, j] = _times_pow2(M[i, j], ri + np.int64(info[n + j]) + ka)
-        outcome, leaving = _modular.modular_step(Ms, qs, ds, basis, entering, primes, flags)
+        if unit:
+            # the plain stage's hand-over: the data as given
+            outcome, leaving = _modular.modular_step(M, q, d, basis, entering, primes, flags)
+        else:
+            ka = np.int64(info[2 * n])
+            kb = np.int64(info[2 * n + 1])
+            for i in range(n):
+                ri = np.int64(info[i])
+                qs[i] = _times_pow2(q[i], ri + kb)
+                ds[i] = _times_pow2(d[i], ri) if info[2 * n + 2] != 0.0 else d[i]
+                for j in range(n):
+                    Ms[i, j] = _times_pow2(M[i, j], ri + np.int64(info[n + j]) + ka)
+            outcome, leaving = _modular.modular_step(Ms, qs, ds, basis, entering, primes, flags)
         if outcome < 0:
             return _RUN_PYTHON, status, pivots, residual, steps
         steps += 1
@@ -1716,6 +1732,17 @@ def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_s
         if pivots >= max_iter and outcome != _modular.STEP_RAY and leaving != z0:
             return _RUN_MAX_ITER, status, pivots, residual, steps
         status, pivots, residual = _resume_packed(M, q, d, out, start, max_iter, tol)
+    if status == SOLVED and steps > 0:
+        # the exact point of the terminal basis (info: its variables), correctly
+        # rounded, as _exact.basis_point gives it; w and the check follow in Python
+        m = 0
+        for i in range(n):
+            v = np.int64(info[i])
+            if n <= v < 2 * n:
+                basis[m] = v - n
+                m += 1
+        if _modular.exact_point(M, q, basis[:m], primes, out[:n]):
+            return _RUN_EXACT_POINT, status, pivots, residual, steps
     return _RUN_DONE, status, pivots, residual, steps
 
 
@@ -2067,7 +2094,8 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
     run, status, pivots, residual, steps = _exact_run(
         M, q, d, out, start, _modular.primes(), handoff, pivots, max_iter, tol,
         DEFER_STEPS if defer else 2 * n + 17)
-    compiled_end = run == _RUN_DONE
+    # the compiled run put the exact point of the solution's basis in z already
+    exact_point = run == _RUN_EXACT_POINT
     if run == _RUN_MAX_ITER:
         status, residual = MAX_ITER, float(lcp_violation(M, q, np.zeros(n)))
         out[:n] = 0.0
@@ -2078,7 +2106,6 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
         return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
                              out[2 * n:3 * n].astype(np.int64).tolist(), int(out[3 * n]))
     while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
-        compiled_end = False
         basis = out[2 * n:3 * n].astype(np.int64)
         entering = int(out[3 * n])
         key = (frozenset(basis.tolist()), entering)
@@ -2150,13 +2177,14 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             return _exact_finish(M, q, covering, out, first, int(start[n + 2]), max_iter, tol,
                                  start[:n].astype(np.int64).tolist(), int(start[n]))
         return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol)
-    if status == SOLVED and not compiled_end:
+    if status == SOLVED:
         # the point of the terminal basis in exact arithmetic, correctly rounded
-        # (M_JJ z_J = -q_J, J its z variables): the answer the exact path gives.
-        # After compiled steps the resumed path's point stands (checked on the
-        # data like any other): the exact point costs more than the steps
-        J = [int(v) - n for v in out[3 * n + 1:4 * n + 1] if n <= v < 2 * n]
-        z = _exact.basis_point(M, q, J)
+        # (M_JJ z_J = -q_J, J its z variables): the answer the exact path gives
+        if exact_point:
+            z = out[:n]
+        else:
+            J = [int(v) - n for v in out[3 * n + 1:4 * n + 1] if n <= v < 2 * n]
+            z = _exact.basis_point(M, q, J)
         if z is not None:
             out[:n] = z
             out[n:2 * n] = M @ out[:n] + q
@@ -2262,9 +2290,10 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=Non
     return res
 
 
-# the compiled functions freeze FARKAS_TOL from certify.py and link _certified.py:
-# their on-disk cache must follow those files too (numba only checks this one)
+# the compiled functions freeze FARKAS_TOL from certify.py and link _certified.py
+# and _modular.py: their on-disk cache must follow those files too (numba only
+# checks this one)
 _jit_cache.bind_cache_to_sources(
     [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
      and getattr(f.py_func, "__module__", None) == __name__],
-    (__file__, certify.__file__, _certified.__file__))
+    (__file__, certify.__file__, _certified.__file__, _modular.__file__))
