@@ -861,7 +861,7 @@ _MAX_WALK = 64
 
 
 @njit(cache=True)
-def exact_point(M, q, J, P_all, z):
+def exact_point(M, q, J, P_all, z, use_filter=True):
     """The point of a complementary basis, exactly, correctly rounded (compiled).
 
     The result of :func:`moreau.lcp._exact.basis_point` (``M_JJ z_J = -q_J``,
@@ -882,6 +882,10 @@ def exact_point(M, q, J, P_all, z):
     z : float64[:], shape (n,)
         A guess of the point on entry (within a few ulps: the floating-point
         path's); the exact point, correctly rounded, on success.
+    use_filter : bool
+        First try the float filter (one refinement step with a rigorous error
+        bound, decisive unless a component is zero or near a midpoint); the
+        residues are computed only where it cannot decide.
 
     Returns
     -------
@@ -905,6 +909,8 @@ def exact_point(M, q, J, P_all, z):
     if k == 0:
         for j in range(n):
             z[j] = 0.0
+        return True
+    if use_filter and _point_filter(M, q, J, z):
         return True
     # integer data: the columns of M_JJ, then -q_J, times one 2^K
     mant = np.empty((k + 1, k), dtype=np.int64)
@@ -1173,3 +1179,145 @@ def _cmp_mid(N, dm, a, sn, sd, T, F, m, P, Pinv, W, half, res, capneg, cappos, p
             tu = _mulmod(tu, pw[u], p, pinv)
         res[u] = _submod(nu, tu, p)
     return _sign(res, m, P, Pinv, W, half)
+
+
+@njit(cache=True, inline="always")
+def _two_prod(a, b):
+    # a b = p + e exactly (Dekker's product by splitting; no overflow or underflow)
+    p = a * b
+    c = 134217729.0 * a
+    ah = c - (c - a)
+    al = a - ah
+    c = 134217729.0 * b
+    bh = c - (c - b)
+    bl = b - bh
+    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
+    return p, e
+
+
+@njit(cache=True)
+def _point_filter(M, q, J, z):
+    # The float filter of exact_point: one step of refinement of the guess,
+    # x~ + X r with the residual r = c - A x~ (A = M_JJ, c = -q_J) summed in
+    # double-double from exact products, and a rigorous bound e of the error
+    # (|A^-1 r - X r~| <= einv |r| + ||X|| |r - r~| + rounding, einv bounding
+    # ||A^-1 - X|| as in _float_filter). Where every component's interval lies
+    # strictly between the midpoints around one float, that float is the exact
+    # point correctly rounded: z takes it, True. Otherwise (a zero component, a
+    # value near a midpoint, data out of the safe range) False, z untouched.
+    n = q.shape[0]
+    k = J.shape[0]
+    u = 2.0**-53
+    gk = 1.01 * (k + 2) * u
+    A = np.empty((k, 2 * k))
+    for a in range(k):
+        for b in range(k):
+            v = M[J[a], J[b]]
+            if not abs(v) < 2.0**500 or (v != 0.0 and abs(v) < 2.0**-400):
+                return False
+            A[a, b] = v
+            A[a, k + b] = 1.0 if a == b else 0.0
+        x = z[J[a]]
+        if not abs(x) < 2.0**400 or abs(x) < 2.0**-400 or abs(q[J[a]]) > 2.0**900:
+            return False
+    # X ~ A^-1 (Gauss-Jordan with partial pivoting) and its bound
+    for col in range(k):
+        piv = col
+        big = 0.0
+        for a in range(col, k):
+            if abs(A[a, col]) > big:
+                big = abs(A[a, col])
+                piv = a
+        if not big > 0.0:
+            return False
+        if piv != col:
+            for b in range(2 * k):
+                tmp = A[col, b]
+                A[col, b] = A[piv, b]
+                A[piv, b] = tmp
+        inv = 1.0 / A[col, col]
+        for b in range(2 * k):
+            A[col, b] *= inv
+        for a in range(k):
+            f = A[a, col]
+            if a != col and f != 0.0:
+                for b in range(2 * k):
+                    A[a, b] -= f * A[col, b]
+    alpha = 0.0
+    nX = 0.0
+    for a in range(k):
+        row = 0.0
+        xrow = 0.0
+        for b in range(k):
+            acc = 1.0 if a == b else 0.0
+            mag = 0.0
+            for c in range(k):
+                g = M[J[c], J[b]]
+                acc -= A[a, k + c] * g
+                mag += abs(A[a, k + c] * g)
+            row += abs(acc) + gk * (mag + 1.0)
+            xrow += abs(A[a, k + b])
+        alpha = max(alpha, row)
+        nX = max(nX, xrow)
+    alpha *= _SAFE
+    nX *= _SAFE
+    if not alpha < 0.5 or not nX < 2.0**400:
+        return False
+    einv = alpha * nX / (1.0 - alpha) * _SAFE
+    # r = c - A x~ in double-double: exact products, compensated sums
+    r = np.empty(k)
+    rerr = 0.0
+    for a in range(k):
+        hi = -q[J[a]]
+        lo = 0.0
+        tot = abs(hi)
+        for b in range(k):
+            p, e = _two_prod(M[J[a], J[b]], z[J[b]])
+            if p != 0.0 and abs(p) < 2.0**-900:
+                return False
+            tot += abs(p)
+            # hi + lo -= p + e (TwoSum on the high parts)
+            s_ = hi - p
+            bb = s_ - hi
+            lo += (hi - (s_ - bb)) + (-p - bb) - e
+            hi = s_
+        ra = hi + lo
+        r[a] = ra
+        # the double-double sum's error (lo, of order k u tot, summed 2 k times
+        # with rounding) and the rounding of hi + lo
+        rerr = max(rerr, 2.0 * (2 * k + 2) ** 2 * u * u * tot + u * abs(ra))
+    rmax = 0.0
+    for a in range(k):
+        rmax = max(rmax, abs(r[a]))
+    # delta = X r~ and the bound of its error against A^-1 r
+    err = (einv * (rmax + rerr) + nX * rerr) * _SAFE
+    out = np.empty(k)
+    for a in range(k):
+        dl = 0.0
+        mag = 0.0
+        for b in range(k):
+            t = A[a, k + b] * r[b]
+            dl += t
+            mag += abs(t)
+        e = (err + gk * mag) * _SAFE
+        x0 = z[J[a]]
+        y = x0 + dl
+        if y == 0.0 or not abs(y - x0) <= 0.5 * abs(x0):
+            return False
+        # the exact value lies within e of x0 + dl = y + d
+        d = (x0 - y) + dl
+        ay = abs(y)
+        up = np.nextafter(ay, np.inf) - ay
+        down = ay - np.nextafter(ay, 0.0)
+        if y < 0.0:
+            up, down = down, up
+        # d's own rounding (x0 - y is exact: Sterbenz) and that of the sums below
+        slack = (e + 4.0 * u * abs(d)) * 1.01
+        if not (d + slack < 0.5 * up and d - slack > -0.5 * down):
+            return False
+        out[a] = y
+    for j in range(n):
+        z[j] = 0.0
+    for a in range(k):
+        z[J[a]] = out[a]
+    return True
