@@ -45,7 +45,27 @@ residue modulo ``prod p_t`` lies below half of it; that residue is compared
 in mixed radix (Garner's algorithm, Knuth, *TAOCP* vol. 2, Sec. 4.3.2), with
 no number above 2^51. A prime dividing ``det G`` is skipped; ``det G`` is
 zero (a singular basis) when more primes divide it than its bound allows
-(each of them exceeds 2^49).
+(each of them exceeds 2^49). Single numerators need fewer primes than
+products of two; the further primes are taken only when a product is not
+decided otherwise.
+
+The float filter
+----------------
+Most signs need no residues: ``X ~ G^-1`` in floating point with
+``alpha >= ||I - X G||_inf`` (its rounding counted) bounds ``||G^-1 - X||``
+by ``alpha ||X|| / (1 - alpha)`` (Neumann series), and ``x~ = X c_R`` is off
+``G^-1 c_R`` by at most ``||X|| ||c_R - G x~|| / (1 - alpha)``. A sign is read
+from floating point where the value stands above that bound; exact zeros and
+ties (rounding noise in floating point) always go to the residues.
+
+The exact point
+---------------
+:func:`exact_point` gives the point of a complementary basis correctly
+rounded, as :func:`moreau.lcp._exact.basis_point` does with Python's
+integers: ``z_J = N / det`` (Cramer) is compared, by the sign of an integer,
+with the midpoints between the floats around a guess. Before that, one step
+of refinement of the guess in double-double arithmetic with a rigorous error
+bound settles every component that is neither zero nor near a midpoint.
 """
 
 import math
@@ -53,7 +73,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["modular_step", "exact_point", "primes", "STEP_PIVOT", "STEP_RAY", "STEP_REFUSED", "STEP_TOO_BIG"]
+__all__ = ["modular_step", "exact_point", "primes", "STEP_PIVOT", "STEP_RAY", "STEP_REFUSED",
+           "STEP_TOO_BIG"]
 
 #: outcomes of :func:`modular_step`
 STEP_PIVOT = 0
@@ -897,7 +918,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
     Examples
     --------
     >>> import numpy as np
-    >>> z = np.array([0.3, 0.3])
+    >>> z = np.full(2, 1 / 3 - 2e-16)   # a guess a few ulps off
     >>> exact_point(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]),
     ...             np.array([0, 1]), primes(), z)
     True

@@ -37,13 +37,17 @@ within that bound of zero is no candidate, and if it could have changed the
 step (no other candidate, or a ratio that could undercut the minimum) the
 step is not taken in floating point either. Where floating point cannot
 decide, and where a basis repeats (the visited bases are hashed past ``2 n +
-16`` pivots), :func:`solve` decides that one step in exact integer arithmetic
-(:func:`moreau.lcp._exact.exact_step`: ``B^-1`` from the ``k x k`` block of
-the basic non-``w`` variables, ``O(k^3 + n k^2)``) and goes back to floating
-point from the basis reached, on a tableau made afresh from the data with the
-exact right-hand side; a solution reached that way is the exact point of its
-basis, correctly rounded. The whole path is finished in exact arithmetic
-only where a hand-over state repeats, where the basis is not
+16`` pivots), :func:`solve` decides that one step in exact arithmetic and goes
+back to floating point from the basis reached, on a tableau made afresh from
+the data with the right-hand side's exact zeros; a solution reached that way
+is the exact point of its basis, correctly rounded. Both are compiled
+(:mod:`moreau.lcp._modular`: ``B^-1`` from the ``k x k`` block of the basic
+non-``w`` variables, its entries as residues modulo primes below ``2^50``
+whose product exceeds Hadamard's bound, signs read after a float filter with a
+rigorous error bound); where the moduli cannot hold the numbers, Python's
+integers take the step (:func:`moreau.lcp._exact.exact_step`). The whole
+path is finished in exact arithmetic only where a hand-over state repeats,
+where the basis is not
 lexicographically positive for the caller's data (the path then starts
 afresh) or too close to singular for floating point to follow. The path is
 the exact lexicographic one and cannot cycle. One exception, for cost: where
