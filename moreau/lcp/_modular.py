@@ -138,7 +138,7 @@ def primes():
     return _PRIMES
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mulmod(a, b, p, pinv):
     # a b mod p for 0 <= a, b < p < 2^50: the quotient estimate (a b / p in
     # floating point, relative error below 2^-51) is off by at most one, so
@@ -153,13 +153,13 @@ def _mulmod(a, b, p, pinv):
     return r
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _addmod(a, b, p):
     r = a + b
     return r - p if r >= p else r
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _submod(a, b, p):
     r = a - b
     return r + p if r < 0 else r
@@ -239,7 +239,7 @@ def _sign(res, m, P, Pinv, W, half):
     return 1
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _reduce(x, p, pinv):
     # x mod p for |x| < 2^62
     r = x - np.int64(float(x) * pinv) * p
@@ -920,7 +920,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
     >>> import numpy as np
     >>> z = np.full(2, 1 / 3 - 2e-16)   # a guess a few ulps off
     >>> exact_point(np.array([[2.0, 1.0], [1.0, 2.0]]), np.array([-1.0, -1.0]),
-    ...             np.array([0, 1]), primes(), z)
+    ...             np.array([0, 1]), primes(), z, True)
     True
     >>> z.tolist()
     [0.3333333333333333, 0.3333333333333333]
@@ -1202,7 +1202,7 @@ def _cmp_mid(N, dm, a, sn, sd, T, F, m, P, Pinv, W, half, res, capneg, cappos, p
     return _sign(res, m, P, Pinv, W, half)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _two_prod(a, b):
     # a b = p + e exactly (Dekker's product by splitting; no overflow or underflow)
     p = a * b

@@ -1745,7 +1745,8 @@ def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_s
             if n <= v < 2 * n:
                 basis[m] = v - n
                 m += 1
-        if _modular.exact_point(M, q, basis[:m], primes, out[:n], True):
+        # np.bool_: the type of a Python caller's bool, one compile for both
+        if _modular.exact_point(M, q, basis[:m], primes, out[:n], np.bool_(True)):
             return _RUN_EXACT_POINT, status, pivots, residual, steps
     return _RUN_DONE, status, pivots, residual, steps
 
