@@ -37,13 +37,17 @@ within that bound of zero is no candidate, and if it could have changed the
 step (no other candidate, or a ratio that could undercut the minimum) the
 step is not taken in floating point either. Where floating point cannot
 decide, and where a basis repeats (the visited bases are hashed past ``2 n +
-16`` pivots), :func:`solve` decides that one step in exact integer arithmetic
-(:func:`moreau.lcp._exact.exact_step`: ``B^-1`` from the ``k x k`` block of
-the basic non-``w`` variables, ``O(k^3 + n k^2)``) and goes back to floating
-point from the basis reached, on a tableau made afresh from the data with the
-exact right-hand side; a solution reached that way is the exact point of its
-basis, correctly rounded. The whole path is finished in exact arithmetic
-only where a hand-over state repeats, where the basis is not
+16`` pivots), :func:`solve` decides that one step in exact arithmetic and goes
+back to floating point from the basis reached, on a tableau made afresh from
+the data with the right-hand side's exact zeros; a solution reached that way
+is the exact point of its basis, correctly rounded. Both are compiled
+(:mod:`moreau.lcp._modular`: ``B^-1`` from the ``k x k`` block of the basic
+non-``w`` variables, its entries as residues modulo primes below ``2^50``
+whose product exceeds Hadamard's bound, signs read after a float filter with a
+rigorous error bound); where the moduli cannot hold the numbers, Python's
+integers take the step (:func:`moreau.lcp._exact.exact_step`). The whole
+path is finished in exact arithmetic only where a hand-over state repeats,
+where the basis is not
 lexicographically positive for the caller's data (the path then starts
 afresh) or too close to singular for floating point to follow. The path is
 the exact lexicographic one and cannot cycle. One exception, for cost: where
@@ -112,7 +116,7 @@ from numba import njit
 from .. import _jit_cache
 from .._validate import finite_array, positive, positive_int
 from ..errors import InputError
-from . import _certified, _exact, certify
+from . import _certified, _exact, _modular, certify
 from ._certified import farkas_float
 from ._certified import residual as _residual
 from ._result import lcp_violation
@@ -983,9 +987,24 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
         ray_out[r] = 0.0
     for i in range(n + 1):
         ray_out[i] = 0.0
-    # the rows were filled in another order than start's: match them by variable
+    # the rows were filled in another order than start's: match them by variable.
+    # A NaN (the compiled exact step, _modular.modular_step) marks a right-hand
+    # side known to be positive but not given: it is (B^-1 q)_i from the
+    # tableau's columns of B^-1 (those of the w's), since the b pivoted along
+    # above was cut to zero wherever an intermediate basis made it negative
     for t in range(n):
-        b[pos[int(start[t])]] = start[n + 3 + t]
+        i = pos[int(start[t])]
+        if not np.isnan(start[n + 3 + t]):
+            b[i] = start[n + 3 + t]
+            continue
+        acc = 0.0
+        for j in range(n):
+            p = pos[j]
+            if p < 0:
+                acc += T[i, -p - 1] * q[j]
+            elif p == i:
+                acc += q[j]
+        b[i] = max(acc, 0.0)
     entering = int(start[n])
     mode = int(start[n + 1])
     status = MAX_ITER
@@ -1231,16 +1250,23 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
     # the rounding of M z + q counted (_residual): the scaled problem is the
     # means, the caller's is the one answered. Powers of two make every map exact.
     n = q.shape[0]
-    Ms = np.empty((n, n))
-    qs = np.empty(n)
-    ds = np.empty(n)
+    unit = ka == 0 and kb == 0
     for i in range(n):
-        qs[i] = _times_pow2(q[i], rexp[i] + kb)
-        # the covering vector of the scaled problem: all ones by default
-        # (the caller's d = 1 is a choice, not data), else the caller's mapped
-        ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
-        for j in range(n):
-            Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
+        unit = unit and rexp[i] == 0 and cexp[i] == 0
+    if unit:
+        # no scaling (a hand-over from the plain stage): the data as they are
+        Ms, qs, ds = M, q, d
+    else:
+        Ms = np.empty((n, n))
+        qs = np.empty(n)
+        ds = np.empty(n)
+        for i in range(n):
+            qs[i] = _times_pow2(q[i], rexp[i] + kb)
+            # the covering vector of the scaled problem: all ones by default
+            # (the caller's d = 1 is a choice, not data), else the caller's mapped
+            ds[i] = _times_pow2(d[i], rexp[i]) if scale_d else d[i]
+            for j in range(n):
+                Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
     if start.shape[0] == 0:
         status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
                                          tol, exact_ok)
@@ -1627,6 +1653,104 @@ def _resume_packed(M, q, d, out, start, max_iter, tol):
     return status, pivots, residual
 
 
+# outcomes of _exact_run: the path left the hand-over (its status is final for
+# the exact steps), a hand-over state repeated, the step limit was reached, the
+# step is left to the Python integers (_exact.exact_step), the pivot limit
+_RUN_DONE = 0
+_RUN_REPEAT = 1
+_RUN_LIMIT = 2
+_RUN_PYTHON = 3
+_RUN_MAX_ITER = 4
+# _RUN_DONE on a solution whose exact point is in z already
+_RUN_EXACT_POINT = 5
+
+
+@njit(cache=True)
+def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_steps):
+    # The loop of _exact_steps in compiled code: each hand-over's step decided
+    # exactly by _modular.modular_step on the data as scaled by the run that
+    # handed over (out[3 n + 1:], _handoff_info), the path resumed in floating
+    # point from the basis reached (_resume_packed), at most max_steps times.
+    # Returns (outcome, status, pivots, residual, steps); start holds the last
+    # resume's start, out the path's state as _resume_packed leaves it.
+    n = q.shape[0]
+    z0 = 2 * n
+    steps = 0
+    keys = np.empty(max_steps + 1, dtype=np.int64)
+    basis = np.empty(n, dtype=np.int64)
+    flags = np.empty(n)
+    Ms = np.empty((n, n))
+    qs = np.empty(n)
+    ds = np.empty(n)
+    residual = np.inf
+    info = out[3 * n + 1:]
+    unit = True
+    for t in range(2 * n + 3):
+        unit = unit and info[t] == 0.0
+    while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
+        hb = 0
+        for i in range(n):
+            basis[i] = np.int64(out[2 * n + i])
+            hb ^= _key(basis[i])
+        entering = np.int64(out[3 * n])
+        key = hb ^ _key(entering + 3 * n)
+        for t in range(steps):
+            if keys[t] == key:
+                return _RUN_REPEAT, status, pivots, residual, steps
+        if steps >= max_steps:
+            return _RUN_LIMIT, status, pivots, residual, steps
+        keys[steps] = key
+        if unit:
+            # the plain stage's hand-over: the data as given
+            outcome, leaving = _modular.modular_step(M, q, d, basis, entering, primes, flags)
+        else:
+            ka = np.int64(info[2 * n])
+            kb = np.int64(info[2 * n + 1])
+            for i in range(n):
+                ri = np.int64(info[i])
+                qs[i] = _times_pow2(q[i], ri + kb)
+                ds[i] = _times_pow2(d[i], ri) if info[2 * n + 2] != 0.0 else d[i]
+                for j in range(n):
+                    Ms[i, j] = _times_pow2(M[i, j], ri + np.int64(info[n + j]) + ka)
+            outcome, leaving = _modular.modular_step(Ms, qs, ds, basis, entering, primes, flags)
+        if outcome < 0:
+            return _RUN_PYTHON, status, pivots, residual, steps
+        steps += 1
+        for i in range(n):
+            start[i] = basis[i]
+            start[n + 3 + i] = flags[i]
+        start[n] = entering
+        if outcome == _modular.STEP_RAY:
+            start[n + 1] = _RESUME_RAY
+        else:
+            pivots += 1
+            for i in range(n):
+                if basis[i] == leaving:
+                    start[i] = entering
+            if leaving == z0:
+                start[n + 1] = _RESUME_SOLVED
+            else:
+                start[n] = leaving + n if leaving < n else leaving - n
+                start[n + 1] = _RESUME_PATH
+        start[n + 2] = pivots
+        if pivots >= max_iter and outcome != _modular.STEP_RAY and leaving != z0:
+            return _RUN_MAX_ITER, status, pivots, residual, steps
+        status, pivots, residual = _resume_packed(M, q, d, out, start, max_iter, tol)
+    if status == SOLVED and steps > 0:
+        # the exact point of the terminal basis (info: its variables), correctly
+        # rounded, as _exact.basis_point gives it; w and the check follow in Python
+        m = 0
+        for i in range(n):
+            v = np.int64(info[i])
+            if n <= v < 2 * n:
+                basis[m] = v - n
+                m += 1
+        # np.bool_: the type of a Python caller's bool, one compile for both
+        if _modular.exact_point(M, q, basis[:m], primes, out[:n], np.bool_(True)):
+            return _RUN_EXACT_POINT, status, pivots, residual, steps
+    return _RUN_DONE, status, pivots, residual, steps
+
+
 @njit(cache=True)
 def _violation(M, q, z):
     # lcp_violation of a finite z on finite data, without the Python checks
@@ -1968,10 +2092,24 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
     d = np.ones(n) if covering is None else covering
     first = handoff
     seen = set()
-    steps = 0
     start = np.empty(2 * n + 3)
-    status = handoff
-    residual = np.inf
+    # the steps in compiled code first (_exact_run); what it leaves (a step too
+    # large for its moduli, a refused basis, a repeat, the limit) goes on here
+    # as before, with the Python integers
+    run, status, pivots, residual, steps = _exact_run(
+        M, q, d, out, start, _modular.primes(), handoff, pivots, max_iter, tol,
+        DEFER_STEPS if defer else 2 * n + 17)
+    # the compiled run put the exact point of the solution's basis in z already
+    exact_point = run == _RUN_EXACT_POINT
+    if run == _RUN_MAX_ITER:
+        status, residual = MAX_ITER, float(lcp_violation(M, q, np.zeros(n)))
+        out[:n] = 0.0
+        out[n:2 * n] = q
+    elif run == _RUN_REPEAT:
+        if defer:
+            return None
+        return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
+                             out[2 * n:3 * n].astype(np.int64).tolist(), int(out[3 * n]))
     while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         basis = out[2 * n:3 * n].astype(np.int64)
         entering = int(out[3 * n])
@@ -2047,8 +2185,11 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
     if status == SOLVED:
         # the point of the terminal basis in exact arithmetic, correctly rounded
         # (M_JJ z_J = -q_J, J its z variables): the answer the exact path gives
-        J = [int(v) - n for v in out[3 * n + 1:4 * n + 1] if n <= v < 2 * n]
-        z = _exact.basis_point(M, q, J)
+        if exact_point:
+            z = out[:n]
+        else:
+            J = [int(v) - n for v in out[3 * n + 1:4 * n + 1] if n <= v < 2 * n]
+            z = _exact.basis_point(M, q, J)
         if z is not None:
             out[:n] = z
             out[n:2 * n] = M @ out[:n] + q
@@ -2154,9 +2295,10 @@ def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=Non
     return res
 
 
-# the compiled functions freeze FARKAS_TOL from certify.py and link _certified.py:
-# their on-disk cache must follow those files too (numba only checks this one)
+# the compiled functions freeze FARKAS_TOL from certify.py and link _certified.py
+# and _modular.py: their on-disk cache must follow those files too (numba only
+# checks this one)
 _jit_cache.bind_cache_to_sources(
     [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
      and getattr(f.py_func, "__module__", None) == __name__],
-    (__file__, certify.__file__, _certified.__file__))
+    (__file__, certify.__file__, _certified.__file__, _modular.__file__))
