@@ -257,27 +257,34 @@ def collapse(params=None, *, h=0.01, tol=1e-5, max_sweeps=500, max_time=200.0,
 def fit_runout(aspect, runout, a_split=2.0):
     """Fit ``runout = lambda a`` for ``a <= a_split`` and ``runout = c a^p`` above.
 
+    The small range is also fitted by a power ``c_small a^p_small`` (a line
+    in log-log), so that both ranges' exponents are reported side by side
+    (the experiments: ``p_small = 1``, ``p`` below one).
+
     Returns
     -------
     dict
         ``lambda`` (least squares through the origin), ``c``, ``p`` (a line
-        in log-log), each None without the points to fit it.
+        in log-log), ``c_small``, ``p_small``, each None without the points
+        to fit it (two at least, every runout > 0, for a power).
 
     Examples
     --------
     >>> f = fit_runout([0.5, 1.0, 4.0, 8.0], [1.0, 2.0, 2.0 * 4 ** (2 / 3), 2.0 * 8 ** (2 / 3)])
-    >>> round(f["lambda"], 6), round(f["c"], 6), round(f["p"], 6)
-    (2.0, 2.0, 0.666667)
+    >>> round(f["lambda"], 6), round(f["c"], 6), round(f["p"], 6), round(f["p_small"], 6)
+    (2.0, 2.0, 0.666667, 1.0)
     """
     a = np.asarray(aspect, dtype=float)
     r = np.asarray(runout, dtype=float)
     small, large = a <= a_split, a > a_split
-    out = {"lambda": None, "c": None, "p": None, "a_split": float(a_split)}
+    out = {"lambda": None, "c": None, "p": None, "c_small": None, "p_small": None,
+           "a_split": float(a_split)}
     if small.any():
         out["lambda"] = float(a[small] @ r[small] / (a[small] @ a[small]))
-    if np.count_nonzero(large) >= 2 and np.all(r[large] > 0):
-        p, logc = np.polyfit(np.log(a[large]), np.log(r[large]), 1)
-        out["c"], out["p"] = float(math.exp(logc)), float(p)
+    for part, c_key, p_key in ((large, "c", "p"), (small, "c_small", "p_small")):
+        if np.count_nonzero(part) >= 2 and np.all(r[part] > 0):
+            p, logc = np.polyfit(np.log(a[part]), np.log(r[part]), 1)
+            out[c_key], out[p_key] = float(math.exp(logc)), float(p)
     return out
 
 

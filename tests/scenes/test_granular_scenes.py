@@ -31,6 +31,10 @@ def test_the_runout_fit_recovers_a_known_law():
     r = np.where(a <= 1.5, 1.7 * a, 1.7 * 1.5 ** (1 / 3) * a ** (2 / 3))
     f = fit_runout(a, r, a_split=1.5)
     assert f["lambda"] == pytest.approx(1.7) and f["p"] == pytest.approx(2 / 3)
+    assert f["p_small"] == pytest.approx(1.0) and f["c_small"] == pytest.approx(1.7)
+    # a column that stood (runout <= 0) leaves the small range's power unfitted, not wrong
+    f = fit_runout([0.6, 1.2, 1.6, 4.0, 8.0], [3.1, -0.02, 2.5, 5.2, 10.7], a_split=2.0)
+    assert f["p_small"] is None and f["c_small"] is None and f["p"] is not None
 
 
 @pytest.mark.slow
