@@ -70,22 +70,21 @@ def test_the_silo_floor_load_saturates_as_janssen_predicts():
 
 
 @pytest.mark.slow
-def test_the_silo_floor_load_averaged_over_four_fills_follows_janssen_within_its_scatter():
+def test_the_silo_floor_load_averaged_over_four_fills_saturates_near_janssens_law():
     # four fills (seeds 0-3, 12 pours of 30 disks, W = 6 d, mu_wall = 0.5), the floor's load
     # averaged pour by pour. Measured: each fill's own fit K = 0.46, 0.37, 0.30, 0.18 (its
     # saturation mass 59 .. 150: the load of rigid grains is statically indeterminate, and
     # each fill's history mobilises the walls differently); the average's fit m_sat = 88.6,
-    # lam = 19.5 d, K = 0.31; its deviations from the fitted law -10 % .. +16 % (rms 9.4 %),
-    # within 1.9 standard errors of the four-fill mean at every pour (chi^2 / dof = 1.26):
-    # issue 38's 10 % at every depth is not reached, the scatter between fills (a standard
-    # error of 10-20 % of the load below the fourth pour) is as large as the deviation
+    # lam = 19.5 d, K = 0.31, deviations -10 % .. +16 % (rms 9.4 %). Issue 38's 10 % at every
+    # depth is not reached, and more fills do not reach it: eight (seeds 0-7, measured once,
+    # too dear for a test) fit K = 0.29 with deviations -12 % .. +22 % (rms 12.9 %), the
+    # averaged load rising faster than Janssen's exponential over the first pours and
+    # saturating more sharply (chi^2 / dof 2.9 against the standard error of the mean): a
+    # systematic difference, not scatter. This test holds the four-fill figures.
     r = fill_average(12, (0, 1, 2, 3), per_pour=30)
     f = fit_janssen(r["mass"], r["m_app"], rho=r["rho"], width=r["width"], mu_wall=0.5)
-    z = (r["m_app"] - janssen(r["mass"], f["m_sat"])) / r["m_app_sem"]
-    assert np.all(np.abs(z) <= 2.5) and np.mean(z ** 2) <= 2.0
     assert np.sqrt(np.mean(f["deviation"] ** 2)) <= 0.12 and f["max_deviation"] <= 0.20
     # saturated: the walls carry two thirds of the last pour's weight; K of the order
     # Rankine's active ratio (1 - sin phi) / (1 + sin phi) = 0.38 at tan phi = 0.5
     assert r["m_app"][-1] < 0.4 * r["mass"][-1] and 0.2 < f["K"] < 0.5
     assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
-
