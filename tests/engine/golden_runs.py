@@ -35,6 +35,13 @@ SPATIAL_EXACT = "puck-incline"
 #: registered Scene is a start with its contacts fixed, 50 contacts on the generic Python
 #: step of every scheme, while their physics runs on moreau.integrators.granular
 GRANULAR = {"granular-column", "silo"}
+#: scenes whose runs are too dear for the default run's budget: the masonry arch's contact
+#: problem is a degenerate friction LCP every step (2 (n + 1) contacts closed at once on
+#: 3 n coordinates), 400 steps of six voussoirs cost 0.1-6.6 s of CPU a scheme (20 s in all,
+#: measured; four, the default, about half) and Lemke forced on it minutes; its dynamics is
+#: held to the thrust-line LP by
+#: tests/scenes/test_masonry_arch.py
+UNSTORED = {"masonry-arch"}
 PATH = os.path.join(os.path.dirname(__file__), "..", "data", "golden_runs.npz")
 
 
@@ -88,7 +95,7 @@ def all_keys():
     from moreau.scenes import registry
     out = []
     for s in registry.scene_names():
-        if s in GRANULAR:
+        if s in GRANULAR or s in UNSTORED:
             continue
         scene = registry.make_scene(s)
         joints = joint_row_count(scene) > 0

@@ -28,6 +28,13 @@ NAMES = registry.scene_names()
 #: tests/scenes/test_granular_scenes.py and tests/model/test_granular.py
 GRANULAR = {"granular-column", "silo"}
 _NO_REFERENCE = pytest.mark.skip(reason="a granular scene: no comparison case (see GRANULAR)")
+#: scenes with a compiled model but no comparison case: the masonry arch, 2 (n + 1) frictional
+#: contacts closed at once, every one sticking while it stands and a four-hinge mechanism
+#: opening some when it collapses, beyond the event-driven reference (a mode per contact);
+#: its dynamics is held instead to an independent statics, the thrust-line LP of the safe
+#: theorem (tests/scenes/test_masonry_arch.py)
+NO_CASE = {"masonry-arch"}
+_NO_CASE_MARK = pytest.mark.skip(reason="no comparison case (see NO_CASE)")
 
 
 @pytest.mark.parametrize("name", NAMES)
@@ -57,7 +64,8 @@ HEAVY = {"flexible-rod-drive"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in HEAVY else
-                                  pytest.param(n, marks=_NO_REFERENCE) if n in GRANULAR else n
+                                  pytest.param(n, marks=_NO_REFERENCE) if n in GRANULAR else
+                                  pytest.param(n, marks=_NO_CASE_MARK) if n in NO_CASE else n
                                   for n in NAMES])
 def test_moreau_jean_agrees_with_the_reference_within_the_stated_tolerance(name):
     entry = registry.get_entry(name)
@@ -93,7 +101,9 @@ def test_moreau_jean_agrees_with_the_reference_within_the_stated_tolerance(name)
 # compliant schemes, without three of the five drives (the friction drive and the
 # stick-slip motor, with their own references, stay) and without the granular scenes (their
 # twentieth is free fall; 20 pairs, 7 s on the loaded machine, kept out of the default run's
-# budget); the full matrix runs with the long checks (-m slow), the compliant schemes over
+# budget), nor the masonry arch (NO_CASE: a degenerate friction LCP every step, 50 steps of
+# each scheme, with the long checks); the full matrix runs with the long checks (-m slow), the
+# compliant schemes over
 # one period of a drive (not ten).
 
 registry.discover()
@@ -196,7 +206,8 @@ def _pairs(slow_schemes=(), slow_scenes=()):
 
 @pytest.mark.parametrize("name, scheme", _pairs(
     slow_schemes=("compliant",),
-    slow_scenes=("bidirectional-drive", "flexible-rod-drive", "piezo-drive") + tuple(GRANULAR)))
+    slow_scenes=("bidirectional-drive", "flexible-rod-drive", "piezo-drive") + tuple(GRANULAR)
+    + tuple(NO_CASE)))
 def test_every_scheme_runs_every_scene_over_a_twentieth_of_its_window(name, scheme):
     _run_pair(name, scheme, 0.05)
 

@@ -18,8 +18,9 @@ def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
     assert NAMES == ["ball-chain", "bidirectional-drive", "billiard-backspin", "bouncing-ball",
                      "disk-incline", "double-pendulum-stop", "flexible-rod-drive",
-                     "friction-drive", "friction-drive-built", "granular-column", "painleve-rod", "piezo-drive",
-                     "puck-incline", "rocking-block", "rocking-block-built", "rolling-disk", "silo",
+                     "friction-drive", "friction-drive-built", "granular-column", "masonry-arch",
+                     "painleve-rod", "piezo-drive", "puck-incline", "rocking-block",
+                     "rocking-block-built", "rolling-disk", "silo",
                      "slider-crank", "slider-crank-clearance", "sliding-block", "sliding-box",
                      "sphere-incline", "stick-slip-motor", "tippe-top", "woodpecker-toy"]
 

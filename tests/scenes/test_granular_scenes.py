@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from moreau.scenes.granular_column import collapse, fit_runout, runout_study
-from moreau.scenes.silo import fill, fit_janssen, janssen
+from moreau.scenes.silo import fill, fill_average, fit_janssen, janssen
 
 
 def test_a_silo_at_rest_balances_its_weight_between_floor_and_walls():
@@ -31,6 +31,10 @@ def test_the_runout_fit_recovers_a_known_law():
     r = np.where(a <= 1.5, 1.7 * a, 1.7 * 1.5 ** (1 / 3) * a ** (2 / 3))
     f = fit_runout(a, r, a_split=1.5)
     assert f["lambda"] == pytest.approx(1.7) and f["p"] == pytest.approx(2 / 3)
+    assert f["p_small"] == pytest.approx(1.0) and f["c_small"] == pytest.approx(1.7)
+    # a column that stood (runout <= 0) leaves the small range's power unfitted, not wrong
+    f = fit_runout([0.6, 1.2, 1.6, 4.0, 8.0], [3.1, -0.02, 2.5, 5.2, 10.7], a_split=2.0)
+    assert f["p_small"] is None and f["c_small"] is None and f["p"] is not None
 
 
 @pytest.mark.slow
@@ -62,4 +66,25 @@ def test_the_silo_floor_load_saturates_as_janssen_predicts():
     assert np.sqrt(np.mean(f["deviation"] ** 2)) <= 0.10 and f["max_deviation"] <= 0.15
     # saturated: the last pours add (almost) nothing to the floor's load, the walls carry it
     assert r["m_app"][-1] < 0.35 * r["mass"][-1] and r["mass"][-1] > 3.0 * f["m_sat"]
+    assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
+
+
+@pytest.mark.slow
+def test_the_silo_floor_load_averaged_over_four_fills_saturates_near_janssens_law():
+    # four fills (seeds 0-3, 12 pours of 30 disks, W = 6 d, mu_wall = 0.5), the floor's load
+    # averaged pour by pour. Measured: each fill's own fit K = 0.46, 0.37, 0.30, 0.18 (its
+    # saturation mass 59 .. 150: the load of rigid grains is statically indeterminate, and
+    # each fill's history mobilises the walls differently); the average's fit m_sat = 88.6,
+    # lam = 19.5 d, K = 0.31, deviations -10 % .. +16 % (rms 9.4 %). Issue 38's 10 % at every
+    # depth is not reached, and more fills do not reach it: eight (seeds 0-7, measured once,
+    # too dear for a test) fit K = 0.29 with deviations -12 % .. +22 % (rms 12.9 %), the
+    # averaged load rising faster than Janssen's exponential over the first pours and
+    # saturating more sharply (chi^2 / dof 2.9 against the standard error of the mean): a
+    # systematic difference, not scatter. This test holds the four-fill figures.
+    r = fill_average(12, (0, 1, 2, 3), per_pour=30)
+    f = fit_janssen(r["mass"], r["m_app"], rho=r["rho"], width=r["width"], mu_wall=0.5)
+    assert np.sqrt(np.mean(f["deviation"] ** 2)) <= 0.12 and f["max_deviation"] <= 0.20
+    # saturated: the walls carry two thirds of the last pour's weight; K of the order
+    # Rankine's active ratio (1 - sin phi) / (1 + sin phi) = 0.38 at tan phi = 0.5
+    assert r["m_app"][-1] < 0.4 * r["mass"][-1] and 0.2 < f["K"] < 0.5
     assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)

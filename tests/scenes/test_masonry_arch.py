@@ -54,6 +54,18 @@ def test_a_thick_arch_stands_and_a_thin_one_collapses():
     assert not ok and moved > 1e-2
 
 
+def test_the_registered_arch_stands_above_its_limit_and_collapses_below_it():
+    # the registered default, four voussoirs (its model compiled once for the conformance
+    # suite too), on either side of its thrust-line limit 0.10086: the default run's check of
+    # the stand criterion; the bisection to Milankovitch's 0.1075 (ten voussoirs) is slow
+    assert abs(limit_thickness(4, tol=1e-5) - 0.10086) < 2e-5
+    ok, moved = stands(window=0.5, voussoirs=4, thickness=0.12)
+    assert ok and moved < 1e-12
+    ok, moved = stands(window=0.5, voussoirs=4, thickness=0.09)
+    # (a mechanism accelerates from rest: a t^2 / 2, far above the bound within 0.5)
+    assert not ok and moved > 1e-4
+
+
 def test_bad_parameters_are_refused():
     with pytest.raises(InputError, match="`voussoirs`"):
         masonry_arch(voussoirs=1)

@@ -13,7 +13,14 @@ from moreau.model.scene import Scene, velocity_count
 from moreau.suite.animate import animate_run
 
 
-@pytest.mark.parametrize("name", registry.scene_names())
+#: with the long checks: the masonry arch, whose first drawing compiles its generated poses and
+#: frames for four bodies (11 s on the loaded shared machine, about 2 s quiet), beyond the
+#: default run's budget for a new scene; its model is checked there by check_scene
+DRAWN_SLOWLY = {"masonry-arch"}
+
+
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow)
+                                  if n in DRAWN_SLOWLY else n for n in registry.scene_names()])
 def test_every_scene_draws_itself(name):
     scene = registry.make_scene(name)
     q, _ = scene.initial_state()
