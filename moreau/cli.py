@@ -974,6 +974,23 @@ def _stop_on_sigterm():
         # Ctrl-C as before, but recorded: an error it causes where an interrupt cannot pass
         # (inside numba's compiler) is still the interruption (an ignored SIGINT stays so)
         previous[signal.SIGINT] = signal.signal(signal.SIGINT, stop)
+    default_hook = sys.unraisablehook
+
+    def swallowed(unraisable):
+        # an interrupt raised inside a ctypes callback (numba's LLVM object cache, while it
+        # compiles) is printed and dropped by CPython, and the command would run on: send
+        # the signal again, for the main thread to take once it is out of the callback
+        if seen["signal"] is not None and isinstance(unraisable.exc_value, KeyboardInterrupt):
+            if seen["resend"] is None:
+                seen["resend"] = threading.Timer(0.05, os.kill, (os.getpid(), seen["signal"]))
+                seen["resend"].daemon = True
+                seen["resend"].start()
+            return
+        default_hook(unraisable)
+
+    seen["resend"] = None
+    sys.unraisablehook = swallowed
+    previous["unraisablehook"] = default_hook
     return previous, seen
 
 
@@ -1014,8 +1031,14 @@ def main(argv=None):
             print(f"\nmoreau: {how}", file=sys.stderr)
         return status
     finally:
+        if seen.get("resend") is not None:
+            # the command has stopped: a signal sent again now would land in the shutdown
+            seen["resend"].cancel()
         for signum, handler in previous.items():
-            signal.signal(signum, handler)
+            if signum == "unraisablehook":
+                sys.unraisablehook = handler
+            else:
+                signal.signal(signum, handler)
     return 0
 
 

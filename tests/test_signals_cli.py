@@ -96,3 +96,26 @@ def test_sigterm_on_a_run_keeps_the_history_under_partial_names(tmp_path):
     # the kept samples end where the run stopped, before the requested end
     last = float(rows[-1].split(",")[0])
     assert 0.0 < last < 1e5 / 185.0
+
+
+def test_an_interrupt_dropped_inside_a_ctypes_callback_is_sent_again():
+    # CPython prints and drops an exception raised in a ctypes callback (numba's compiler
+    # calls back into Python while it compiles): the command must still stop
+    from types import SimpleNamespace
+
+    from moreau.cli import _stop_on_sigterm
+
+    previous, seen = _stop_on_sigterm()
+    try:
+        seen["signal"] = signal.SIGINT
+        with pytest.raises(KeyboardInterrupt):
+            sys.unraisablehook(SimpleNamespace(exc_value=KeyboardInterrupt(), exc_type=KeyboardInterrupt,
+                                               exc_traceback=None, err_msg=None, object=None))
+            time.sleep(5.0)   # the signal sent again ends this wait
+        assert seen["resend"] is not None
+    finally:
+        for signum, handler in previous.items():
+            if signum == "unraisablehook":
+                sys.unraisablehook = handler
+            else:
+                signal.signal(signum, handler)
