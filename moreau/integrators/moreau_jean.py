@@ -265,6 +265,7 @@ from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
 from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
 from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
+from ._sparse_mj import sparse_contacts_of, sparse_step
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
                             FixedStepOptions, TimeStepping, bool_option, check_lcp_options,
@@ -555,6 +556,13 @@ class MoreauJean(TimeStepping):
 
     # -- one step -------------------------------------------------------------
     def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
+        # a long frictionless chain's own sparse step (moreau.integrators._sparse_mj)
+        self._sparse = None
+        if not self._space and fast is not False and lcp_method == "auto" \
+                and not self.projection and not self._n_eq:
+            self._sparse = sparse_contacts_of(self.scene)
+        if self._sparse is not None:
+            return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
         if not self._space:
             return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
         # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
@@ -573,6 +581,8 @@ class MoreauJean(TimeStepping):
         return super()._runner(template)
 
     def _step_impl(self):
+        if self._sparse is not None:
+            return sparse_step(self, self._sparse)
         if self._fast:
             return self._space_block() if self._space else self._fast_block()
         return self._generic_step()
