@@ -4,14 +4,19 @@ Solves ``0 <= w = A z + q  _|_  z >= 0`` for a sparse ``A`` (scipy) by the
 primal-dual active-set method, a semismooth Newton method on ``min(z, A z +
 q) = 0`` (M. Hintermüller, K. Ito, K. Kunisch, *The primal-dual active set
 strategy as a semismooth Newton method*, SIAM J. Optim. 13 (2003) 865-888):
-guess the pressed set ``P``, solve ``A_PP z_P = -q_P`` by a sparse LU with
+guess the pressed set ``P`` (every row at first), solve ``A_PP z_P = -q_P`` by a sparse LU with
 ``z = 0`` off ``P``, take ``P = {z - (A z + q) > 0}``, repeat until ``P``
 repeats. For a nonsingular M-matrix ``A`` (positive diagonal, off-diagonal
 entries ``<= 0``, ``A^-1 >= 0``; a chain of bodies' Delassus matrix on a
-line is one) the iterates are monotone and the method ends, with the exact
-solution to rounding, within ``n + 1`` solves; each costs a sparse LU, for a
-banded ``A`` linear in ``n``. Any other matrix may cycle: a solve that has
-not ended within ``n + 1`` steps raises.
+line is one) the iterates are monotone from the second on, whatever the
+first guess, and the method ends, with the exact solution to rounding,
+within ``n + 2`` solves (Hintermüller, Ito and Kunisch's theorem 3.2); each
+costs a sparse LU, for a banded ``A`` linear in ``n``. The first guess,
+every row pressed, is the answer of a chain struck at once (every contact
+presses), which then takes two solves; starting from the rows with
+``q < 0`` instead, the pressed set grows by one contact a solve along the
+chain. Any other matrix may cycle: a solve that has not ended within
+``n + 2`` steps raises.
 
 The residual returned is the natural map on the caller's data,
 ``||min(z, A z + q)||_2 / (1 + ||q||_2)``, recomputed on the ``z`` returned.
@@ -49,7 +54,7 @@ def solve_active_set(A, q):
     InputError
         Bad shapes or values.
     LCPError
-        No end within ``n + 1`` steps (``A`` is not an M-matrix).
+        No end within ``n + 2`` steps (``A`` is not an M-matrix).
 
     Examples
     --------
@@ -65,12 +70,12 @@ def solve_active_set(A, q):
     if not np.all(np.isfinite(A.data)):
         raise InputError("`A` must be finite")
     z = np.zeros(n)
-    pressed = q < 0.0
+    pressed = np.ones(n, dtype=bool)
     seen = None
     solves = 0
     while seen is None or not np.array_equal(pressed, seen):
-        if solves > n + 1:
-            raise LCPError(f"the active-set method did not end within {n + 1} steps (`A` is "
+        if solves > n + 2:
+            raise LCPError(f"the active-set method did not end within {n + 2} steps (`A` is "
                            "not an M-matrix)")
         seen = pressed
         z = np.zeros(n)

@@ -64,8 +64,10 @@ __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impact
 #: the chain lengths the scene takes
 MIN_BALLS, MAX_BALLS = 2, 10_000
 #: balls from which Moreau–Jean runs the chain on its sparse step (:meth:`BallChain.sparse_contacts`)
-#: and :func:`simultaneous_impact` solves by the sparse active-set method, not by dense Lemke
-SPARSE_FROM = 100
+#: and :func:`simultaneous_impact` solves by the sparse active-set method, not by dense Lemke:
+#: the measured crossover (the default window at h = 0.01, 310 steps, best of 3, shared
+#: machine): dense 111, 292, 221 us a step at 100, 130, 150 balls, sparse 177, 325, 178
+SPARSE_FROM = 150
 
 
 @dataclass(frozen=True)
