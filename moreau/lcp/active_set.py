@@ -13,7 +13,7 @@ first guess, and the method ends, with the exact solution to rounding,
 within ``n + 2`` solves (Hintermüller, Ito and Kunisch's theorem 3.2); each
 costs a sparse LU, for a banded ``A`` linear in ``n``. The first guess,
 every row pressed, is the answer of a chain struck at once (every contact
-presses), which then takes two solves; starting from the rows with
+presses), which then takes one solve; starting from the rows with
 ``q < 0`` instead, the pressed set grows by one contact a solve along the
 chain. Any other matrix may cycle: a solve that has not ended within
 ``n + 2`` steps raises.
@@ -54,7 +54,8 @@ def solve_active_set(A, q):
     InputError
         Bad shapes or values.
     LCPError
-        No end within ``n + 2`` steps (``A`` is not an M-matrix).
+        No end within ``n + 2`` steps, or a singular block (``A`` is not a
+        nonsingular M-matrix).
 
     Examples
     --------
@@ -81,7 +82,11 @@ def solve_active_set(A, q):
         z = np.zeros(n)
         idx = np.flatnonzero(pressed)
         if idx.size:
-            z[idx] = splu(sps.csc_array(A[idx][:, idx])).solve(-q[idx])
+            try:
+                z[idx] = splu(sps.csc_array(A[idx][:, idx])).solve(-q[idx])
+            except RuntimeError as exc:         # superlu: a singular principal block
+                raise LCPError(f"the active-set method met a singular block of `A` ({exc}); "
+                               "`A` is not a nonsingular M-matrix") from None
         pressed = z - (A @ z + q) > 0.0
         solves += 1
     z = np.maximum(z, 0.0)
