@@ -265,7 +265,7 @@ from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
 from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
 from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
-from ._sparse_mj import sparse_contacts_of, sparse_step
+from ._sparse_mj import SPARSE_TOL, sparse_contacts_of, sparse_step  # noqa: F401
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
                             FixedStepOptions, TimeStepping, bool_option, check_lcp_options,
