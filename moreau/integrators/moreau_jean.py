@@ -414,6 +414,14 @@ class MoreauJean(TimeStepping):
         Python step through the :class:`Scene` interface. In the compiled mode
         one call of :meth:`step` advances a block of up to 65536 time steps
         (``stats["steps"]`` still counts time steps).
+        A frictionless scene that offers a sparse contact model
+        (``sparse_contacts()``: the ball chain from 150 balls) takes its
+        sparse step instead, with ``fast`` ``"auto"`` or True,
+        ``lcp_method="auto"`` and no projection: the same scheme with ``W``
+        in CSR and each step's LCP solved exactly by
+        :func:`moreau.lcp.active_set.solve_active_set` (``stats["max_residual"]``
+        its natural-map residual; above ``SPARSE_TOL`` = 1e-10 the run fails,
+        status -3).
     closed0 : bool or array_like of bool, optional
         Contacts to treat as closed in the step before ``t0`` (the index-set
         memory; see the module docstring). Default: none. Lets a run continue

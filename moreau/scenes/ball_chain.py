@@ -26,6 +26,13 @@ the impact law:
   ``v1+ = (1 + e) m0 V / (m0 + m1)``, from momentum conservation and
   ``v1+ - v0+ = e V``.
 
+Long chains
+-----------
+``N`` runs from 2 to 10 000. From :data:`SPARSE_FROM` (150) balls on,
+Moreau–Jean steps the chain on its sparse form (:meth:`BallChain.sparse_contacts`,
+:mod:`moreau.integrators.moreau_jean`): no dense matrix, each step's LCP
+solved exactly by the active-set method of :mod:`moreau.lcp.active_set`.
+
 Scales
 ------
 Lengths in the radius ``r``, time in ``r / V`` (``V`` the striker speed),
