@@ -265,6 +265,7 @@ from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
 from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
 from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
+from ._sparse_mj import SPARSE_TOL, sparse_contacts_of, sparse_step  # noqa: F401
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
                             FixedStepOptions, TimeStepping, bool_option, check_lcp_options,
@@ -413,6 +414,14 @@ class MoreauJean(TimeStepping):
         Python step through the :class:`Scene` interface. In the compiled mode
         one call of :meth:`step` advances a block of up to 65536 time steps
         (``stats["steps"]`` still counts time steps).
+        A frictionless scene that offers a sparse contact model
+        (``sparse_contacts()``: the ball chain from 150 balls) takes its
+        sparse step instead, with ``fast`` ``"auto"`` or True,
+        ``lcp_method="auto"`` and no projection: the same scheme with ``W``
+        in CSR and each step's LCP solved exactly by
+        :func:`moreau.lcp.active_set.solve_active_set` (``stats["max_residual"]``
+        its natural-map residual; above ``SPARSE_TOL`` = 1e-10 the run fails,
+        status -3).
     closed0 : bool or array_like of bool, optional
         Contacts to treat as closed in the step before ``t0`` (the index-set
         memory; see the module docstring). Default: none. Lets a run continue
@@ -555,6 +564,13 @@ class MoreauJean(TimeStepping):
 
     # -- one step -------------------------------------------------------------
     def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
+        # a long frictionless chain's own sparse step (moreau.integrators._sparse_mj)
+        self._sparse = None
+        if not self._space and fast is not False and lcp_method == "auto" \
+                and not self.projection and not self._n_eq:
+            self._sparse = sparse_contacts_of(self.scene)
+        if self._sparse is not None:
+            return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
         if not self._space:
             return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
         # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
@@ -573,6 +589,8 @@ class MoreauJean(TimeStepping):
         return super()._runner(template)
 
     def _step_impl(self):
+        if self._sparse is not None:
+            return sparse_step(self, self._sparse)
         if self._fast:
             return self._space_block() if self._space else self._fast_block()
         return self._generic_step()

@@ -28,7 +28,9 @@ from moreau.compiled import check_compiled_model
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.scenes import registry
-from moreau.scenes.ball_chain import (BallChain, BallChainCase, sequential_impacts,
+from moreau.integrators.moreau_jean import SPARSE_TOL, MoreauJean
+from moreau.scenes import ball_chain
+from moreau.scenes.ball_chain import (SPARSE_FROM, BallChain, BallChainCase, sequential_impacts,
                                       simultaneous_impact, two_ball_impact)
 
 EPS = np.finfo(float).eps
@@ -251,7 +253,7 @@ def test_a_compliant_contact_carries_a_wave_down_the_chain():
 # -- input --------------------------------------------------------------------------------------
 
 BAD = [
-    ({"n_balls": 1}, "n_balls"), ({"n_balls": 101}, "n_balls"), ({"n_balls": 2.5}, "n_balls"),
+    ({"n_balls": 1}, "n_balls"), ({"n_balls": 10_001}, "n_balls"), ({"n_balls": 2.5}, "n_balls"),
     ({"n_balls": True}, "n_balls"), ({"n_balls": math.nan}, "n_balls"),
     ({"n_balls": "3"}, "n_balls"), ({"mass": -1.0}, "mass"), ({"mass": math.nan}, "mass"),
     ({"striker_mass": 0.0}, "striker_mass"), ({"radius": math.inf}, "radius"),
@@ -305,3 +307,78 @@ def test_si_units_come_back():
     assert cols["t"][0] == "s" and cols["v_1"][0] == "m/s" and cols["q_0"][0] == "m"
     assert cols["v_1"][1][-1] == pytest.approx(2.0, rel=1e-14)      # the last ball leaves at V
     assert cols["v_0"][1][-1] == pytest.approx(0.0, abs=1e-14)
+
+
+# -- long chains: the sparse step ---------------------------------------------------------------
+
+def test_the_sparse_model_is_the_compiled_one_from_sparse_from_balls():
+    assert BallChain(n_balls=SPARSE_FROM - 1).sparse_contacts() is None
+    chain = BallChain(n_balls=SPARSE_FROM, striker_mass=0.23)
+    inv_m, f, jacobian, gaps = chain.sparse_contacts()
+    rng = np.random.default_rng(3)
+    q = chain.initial_state()[0] + 0.1 * rng.standard_normal(SPARSE_FROM)
+    WN = np.asarray(chain.contact_jacobians(q, 0.0)[0])
+    assert np.array_equal(jacobian(q).toarray(), WN)
+    assert np.array_equal(gaps(q), np.asarray(chain.gaps(q, 0.0)))
+    assert np.array_equal(1.0 / inv_m, np.diag(chain.mass(q))) and not f.any()
+
+
+def test_the_sparse_step_runs_like_the_generic_step(monkeypatch):
+    # a short chain put on the sparse step (the generic step's dense Lemke at SPARSE_FROM
+    # balls takes seconds), e = 0.5, striker twice as heavy, the default window
+    monkeypatch.setattr(ball_chain, "SPARSE_FROM", 2)
+    chain = BallChain(n_balls=30, restitution=0.5, striker_mass=0.2)
+    q0, v0 = chain.initial_state()
+    sparse = simulate(chain, (0.0, chain.default_window), q0, v0, "moreau-jean", h=0.01)
+    dense = _run(chain, "moreau-jean", h=0.01)
+    assert sparse.success and sparse.stats["lcp_solves"] >= 1
+    for name in ("t", "q", "v", "force_N", "gap"):
+        assert np.max(np.abs(getattr(sparse, name) - getattr(dense, name))) < 1e-11, name
+    # after the impact the block's closed contacts meet approach velocities of rounding size,
+    # which one solver may answer with impulses of 1e-15 and the other with none: the
+    # regimes agree wherever a force is above rounding
+    loaded = np.maximum(sparse.force_N, dense.force_N) > 1e-9
+    assert loaded.any() and np.array_equal(sparse.regime[loaded], dense.regime[loaded])
+
+
+def test_moreau_jean_takes_the_sparse_step_from_sparse_from_balls():
+    for n, sparse in [(SPARSE_FROM - 1, False), (SPARSE_FROM, True)]:
+        chain = BallChain(n_balls=n)
+        mj = MoreauJean(chain, 0.0, *chain.initial_state(), 1.0, h=0.01)
+        assert (mj._sparse is not None) == sparse
+        # a named dense solver, or the generic step, keeps the dense path
+        mj = MoreauJean(chain, 0.0, *chain.initial_state(), 1.0, h=0.01, lcp_method="lemke")
+        assert mj._sparse is None
+
+
+@pytest.mark.parametrize("ratio, e", [(1.0, 1.0), (2.5, 0.5)])
+def test_a_thousand_balls_move_as_the_block(ratio, e):
+    # the registered scene by name, the default options: the sparse step
+    n = 1000
+    chain = registry.make_scene("ball-chain", n_balls=n, restitution=e, striker_mass=0.1 * ratio)
+    q0, v0 = chain.initial_state()
+    r = simulate(chain, (0.0, chain.default_window), q0, v0, "moreau-jean", h=0.01)
+    assert r.success and r.stats["lcp_solves"] >= 1
+    assert r.stats["max_residual"] <= SPARSE_TOL
+    block = _block(n, ratio, e)
+    # the solver's tolerance on the residual bounds the velocities' error far above what
+    # the exact active set leaves (2.6e-14 measured)
+    assert r.v[-1] == pytest.approx(block, abs=1e-12)
+    assert r.v[-1] == pytest.approx(simultaneous_impact(chain.masses, v0, e), abs=1e-12)
+    momentum = r.v @ chain.masses
+    assert momentum == pytest.approx(np.full(len(r.t), ratio), abs=1e-12)
+    if ratio == 1.0:
+        assert r.v[-1] == pytest.approx([2 / n - 1] + [2 / n] * (n - 1), abs=1e-12)
+
+
+@pytest.mark.slow
+def test_ten_thousand_balls_move_as_the_block():
+    n = 10_000
+    chain = registry.make_scene("ball-chain", n_balls=n, restitution=0.7, striker_mass=0.2)
+    q0, v0 = chain.initial_state()
+    r = simulate(chain, (0.0, chain.default_window), q0, v0, "moreau-jean", h=0.01)
+    assert r.success and r.stats["max_residual"] <= SPARSE_TOL
+    block = _block(n, 2.0, 0.7)
+    assert simultaneous_impact(chain.masses, v0, 0.7) == pytest.approx(block, abs=1e-12)
+    # 2.5e-13 measured at e = 1
+    assert r.v[-1] == pytest.approx(block, abs=1e-11)
