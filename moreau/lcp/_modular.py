@@ -744,27 +744,16 @@ def _entry_sign(Zc, adj, P, Pinv, W, half, m, k, zi, v, t, res, C, X, einv, sd):
 
 
 @njit(cache=True)
-def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
-    # The entering column a = B^-1 A_e and b = B^-1 q in floating point (fa,
-    # fb), each entry with a rigorous bound on its error (ea, eb; inf where
-    # none holds), and X ~ G^-1 with the bound of its entries' error (returned;
-    # inf where none holds). X by Gauss-Jordan; with E = I - X G and
-    # alpha >= ||E||_inf counting the rounding of X G, ||G^-1||_inf <=
-    # ||X||_inf / (1 - alpha) and ||G^-1 - X||_inf <= alpha ||X||_inf / (1 - alpha)
-    # (Neumann series). For x~ ~ G^-1 c_R, x - x~ = G^-1 r with r = c_R - G x~,
-    # computed with its own rounding bound. A w row's entry c_j - B[j, Z] x
-    # adds its own rounding. u = 2^-53; gamma_j = j u / (1 - j u) < 1.01 j u.
-    u = 2.0**-53
-    gk = 1.01 * (k + 2) * u
-    for i in range(n):
-        ea[i] = np.inf
-        eb[i] = np.inf
-        fa[i] = 0.0
-        fb[i] = 0.0
+def _approx_inverse(G, X, k, gk):
+    # X ~ G^-1 by Gauss-Jordan with partial pivoting, and (alpha, ||X||_inf),
+    # each times _SAFE: alpha >= ||I - X G||_inf counting the rounding of X G
+    # (gk = gamma_(k+2)), so that ||G^-1 - X||_inf <= alpha ||X||_inf / (1 -
+    # alpha) where alpha < 1 (Neumann series). alpha is inf where a pivot is
+    # zero or X is not finite.
     A = np.empty((k, 2 * k))
     for a in range(k):
         for b in range(k):
-            A[a, b] = C[b, R[a]]
+            A[a, b] = G[a, b]
             A[a, k + b] = 1.0 if a == b else 0.0
     for col in range(k):
         piv = col
@@ -774,7 +763,7 @@ def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
                 big = abs(A[a, col])
                 piv = a
         if not big > 0.0:
-            return np.inf
+            return np.inf, np.inf
         if piv != col:
             for b in range(2 * k):
                 tmp = A[col, b]
@@ -792,8 +781,7 @@ def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
         for b in range(k):
             X[a, b] = A[a, k + b]
             if not abs(X[a, b]) < np.inf:
-                return np.inf
-    # alpha: rows of |I - X G| plus the rounding of the product
+                return np.inf, np.inf
     alpha = 0.0
     nX = 0.0
     for a in range(k):
@@ -803,7 +791,7 @@ def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
             acc = 1.0 if a == b else 0.0
             mag = 0.0
             for c in range(k):
-                g = C[b, R[c]]
+                g = G[c, b]
                 acc -= X[a, c] * g
                 mag += abs(X[a, c] * g)
             row += abs(acc) + gk * (mag + 1.0)
@@ -812,8 +800,32 @@ def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
         nX = max(nX, xrow)
     # every bound is a sum of non-negative terms, computed with a relative
     # error below gamma_n: _SAFE covers that for any n below 10^5
-    alpha *= _SAFE
-    nX *= _SAFE
+    return alpha * _SAFE, nX * _SAFE
+
+
+@njit(cache=True)
+def _float_filter(C, R, zrow, basis, entering, e_w, k, n, fa, ea, fb, eb, X):
+    # The entering column a = B^-1 A_e and b = B^-1 q in floating point (fa,
+    # fb), each entry with a rigorous bound on its error (ea, eb; inf where
+    # none holds), and X ~ G^-1 with the bound of its entries' error (returned;
+    # inf where none holds). X by Gauss-Jordan; with E = I - X G and
+    # alpha >= ||E||_inf counting the rounding of X G, ||G^-1||_inf <=
+    # ||X||_inf / (1 - alpha) and ||G^-1 - X||_inf <= alpha ||X||_inf / (1 - alpha)
+    # (Neumann series). For x~ ~ G^-1 c_R, x - x~ = G^-1 r with r = c_R - G x~,
+    # computed with its own rounding bound. A w row's entry c_j - B[j, Z] x
+    # adds its own rounding. u = 2^-53; gamma_j = j u / (1 - j u) < 1.01 j u.
+    u = 2.0**-53
+    gk = 1.01 * (k + 2) * u
+    for i in range(n):
+        ea[i] = np.inf
+        eb[i] = np.inf
+        fa[i] = 0.0
+        fb[i] = 0.0
+    G = np.empty((k, k))
+    for a in range(k):
+        for b in range(k):
+            G[a, b] = C[b, R[a]]
+    alpha, nX = _approx_inverse(G, X, k, gk)
     if not alpha < 0.5:
         return np.inf
     einv = alpha * nX / (1.0 - alpha) * _SAFE
@@ -1230,58 +1242,19 @@ def _point_filter(M, q, J, z):
     k = J.shape[0]
     u = 2.0**-53
     gk = 1.01 * (k + 2) * u
-    A = np.empty((k, 2 * k))
+    G = np.empty((k, k))
     for a in range(k):
         for b in range(k):
             v = M[J[a], J[b]]
             if not abs(v) < 2.0**500 or (v != 0.0 and abs(v) < 2.0**-400):
                 return False
-            A[a, b] = v
-            A[a, k + b] = 1.0 if a == b else 0.0
+            G[a, b] = v
         x = z[J[a]]
         if not abs(x) < 2.0**400 or abs(x) < 2.0**-400 or abs(q[J[a]]) > 2.0**900:
             return False
-    # X ~ A^-1 (Gauss-Jordan with partial pivoting) and its bound
-    for col in range(k):
-        piv = col
-        big = 0.0
-        for a in range(col, k):
-            if abs(A[a, col]) > big:
-                big = abs(A[a, col])
-                piv = a
-        if not big > 0.0:
-            return False
-        if piv != col:
-            for b in range(2 * k):
-                tmp = A[col, b]
-                A[col, b] = A[piv, b]
-                A[piv, b] = tmp
-        inv = 1.0 / A[col, col]
-        for b in range(2 * k):
-            A[col, b] *= inv
-        for a in range(k):
-            f = A[a, col]
-            if a != col and f != 0.0:
-                for b in range(2 * k):
-                    A[a, b] -= f * A[col, b]
-    alpha = 0.0
-    nX = 0.0
-    for a in range(k):
-        row = 0.0
-        xrow = 0.0
-        for b in range(k):
-            acc = 1.0 if a == b else 0.0
-            mag = 0.0
-            for c in range(k):
-                g = M[J[c], J[b]]
-                acc -= A[a, k + c] * g
-                mag += abs(A[a, k + c] * g)
-            row += abs(acc) + gk * (mag + 1.0)
-            xrow += abs(A[a, k + b])
-        alpha = max(alpha, row)
-        nX = max(nX, xrow)
-    alpha *= _SAFE
-    nX *= _SAFE
+    # X ~ A^-1 and its bound
+    X = np.empty((k, k))
+    alpha, nX = _approx_inverse(G, X, k, gk)
     if not alpha < 0.5 or not nX < 2.0**400:
         return False
     einv = alpha * nX / (1.0 - alpha) * _SAFE
@@ -1317,7 +1290,7 @@ def _point_filter(M, q, J, z):
         dl = 0.0
         mag = 0.0
         for b in range(k):
-            t = A[a, k + b] * r[b]
+            t = X[a, b] * r[b]
             dl += t
             mag += abs(t)
         e = (err + gk * mag) * _SAFE
