@@ -40,7 +40,7 @@ leave the structural zeros alone):
 ``par`` belongs to the model: its functions may also keep values there from
 one call to the next, as long as each output depends on the arguments alone
 (the friction drive keeps the sines and cosines of its last angle and phase,
-:func:`moreau.scenes.friction_drive.rod.memo_sincos`).
+:func:`memo_sincos`).
 
 :func:`check_compiled_model` (and :func:`moreau.check_scene`) hold every
 function to the scene's Python methods.
@@ -72,14 +72,17 @@ A ball of radius ``par[0]`` above the floor, under gravity:
 """
 
 import dataclasses
+import math
 from typing import Any, Optional
 
 import numpy as np
+from numba import njit
 
 from . import _jit_cache
 from .errors import InputError
 
-__all__ = ["CompiledModel", "evaluate_compiled", "check_compiled_model", "MODEL_FUNCTIONS"]
+__all__ = ["CompiledModel", "evaluate_compiled", "check_compiled_model", "MODEL_FUNCTIONS",
+           "memo_sincos"]
 
 #: the function fields of a :class:`CompiledModel`, required ones first
 MODEL_FUNCTIONS = ("mass", "forces", "contacts", "drift", "gaps")
@@ -261,3 +264,35 @@ def check_compiled_model(scene, q, v, t):
         if b.size:
             worst = max(worst, float(np.max(np.abs(a - b) / np.maximum(1.0, np.abs(b)))))
     return worst
+
+
+@njit(cache=True)
+def memo_sincos(par, j, x):
+    """``(sin x, cos x)``, from ``par[j + 1], par[j + 2]`` when ``par[j]`` is ``x``, else computed and kept there.
+
+    A scheme's step evaluates a model's functions several times at one time
+    and one state (a Moreau–Jean step of a drive: three times at the angle it
+    starts from, once at the one it ends at; the next step starts from that
+    angle): a driven angle and a harmonic's phase are then the same from call
+    to call, and their sines and cosines are computed once (LLVM fuses the two
+    into one ``sincos``). The kept values are those the library returns for
+    that argument, so every result is the same to the last bit; a zero hits
+    only a zero of its own sign (``sin(-0.0)`` is ``-0.0``). The three slots
+    start at ``(0, 0, 1)``, consistent.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> par = np.array([0.0, 0.0, 1.0])
+    >>> memo_sincos(par, 0, 0.5) == (np.sin(0.5), np.cos(0.5)), float(par[0])
+    (True, 0.5)
+    """
+    key = par[j]
+    if x == key and (x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, key)):
+        return par[j + 1], par[j + 2]
+    s = math.sin(x)
+    c = math.cos(x)
+    par[j] = x
+    par[j + 1] = s
+    par[j + 2] = c
+    return s, c

@@ -59,6 +59,9 @@ import math
 
 from numba import njit
 
+# a driven angle's or a harmonic's sine and cosine, kept in ``par`` (the drives' kernel)
+from ...compiled import memo_sincos as kept_sincos
+
 HEADER = 11
 JREC = 10
 BREC = 10
@@ -93,28 +96,6 @@ def harmonic_part(f, d1, d2, A, w, ph, t):
 #: the phase that makes a harmonic a cosine, evaluated as one (``sin(w t + pi/2)`` would
 #: round ``pi/2``: its rate at ``t = 0`` would be ``A w 6e-17``, not 0)
 QUARTER = 0.5 * math.pi
-
-
-@njit
-def kept_sincos(par, j, x):
-    """``(sin x, cos x)``, from ``par[j + 1], par[j + 2]`` when ``par[j]`` is ``x``, else computed and kept there.
-
-    A scheme's step evaluates a model's functions several times at one time
-    and one state: a driven body's angle and a harmonic's phase are then the
-    same from call to call, and their sines and cosines are computed once.
-    The kept values are those the library returns for that argument, so
-    every result is the same to the last bit (a zero hits only a zero of its
-    own sign). The slots start at ``(0, 0, 1)``, consistent.
-    """
-    key = par[j]
-    if x == key and (x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, key)):
-        return par[j + 1], par[j + 2]
-    s = math.sin(x)
-    c = math.cos(x)
-    par[j] = x
-    par[j + 1] = s
-    par[j + 2] = c
-    return s, c
 
 
 @njit

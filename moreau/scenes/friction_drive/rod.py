@@ -17,7 +17,7 @@ Rod ``j`` at angle ``phi`` (``s = sin phi``, ``c = cos phi``), base motion
 
 A model evaluates the same sines and cosines in several of its functions,
 and the Moreau–Jean step calls them at the same angle and phase several
-times (:func:`memo_sincos`).
+times (:func:`moreau.compiled.memo_sincos`).
 """
 
 import math
@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from ... import _validate as V
+from ...compiled import memo_sincos
 from ..._validate import positive
 
 __all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS", "RodParams", "OneRod"]
@@ -36,31 +37,6 @@ __all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS", "Ro
 #: start at: an argument with its sine and cosine, exact ones, so that ``par`` is
 #: consistent from the start
 MEMO_SLOTS = (0.0, 0.0, 1.0)
-
-
-@njit(cache=True)
-def memo_sincos(par, j, x):
-    """``(sin x, cos x)``, from ``par[j + 1], par[j + 2]`` when ``par[j]`` is ``x``.
-
-    A Moreau–Jean step of a drive evaluates its model three times at the
-    angle it starts from and once at the one it ends at, and at the phase of
-    its end three times; the next step starts from that angle and phase.
-    With the values of the last call kept, each step computes one sine and
-    cosine of the angle and one of the phase (which LLVM fuses into one
-    ``sincos`` each), against eleven library calls before, half of a step's
-    time on the friction drive. The kept values are those the library
-    returns for that argument, so every result is the same to the last bit;
-    a zero hits only a zero of its own sign (``sin(-0.0)`` is ``-0.0``).
-    """
-    key = par[j]
-    if x == key and (x != 0.0 or math.copysign(1.0, x) == math.copysign(1.0, key)):
-        return par[j + 1], par[j + 2]
-    s = math.sin(x)
-    c = math.cos(x)
-    par[j] = x
-    par[j + 1] = s
-    par[j + 2] = c
-    return s, c
 
 
 @njit(cache=True)
