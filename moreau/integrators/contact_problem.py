@@ -202,7 +202,14 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     problem = ContactProblem.trusted(W, U_free, mu, e, vN_pre)
     if mu.size == 1 and lcp_method == "auto":
         # what "auto" does with one contact, without the registry's dispatch (4 us of 15)
-        sol = closed_form_solve(problem)
+        try:
+            sol = closed_form_solve(problem)
+        except PainleveError:
+            sol = None
+        if sol is None or not sol.success:
+            # singular W, or digits lost to it: "auto" hands it to Lemke (or raises the
+            # Painlevé case where the problem has no solution)
+            sol = solve(problem, "auto", max_iter=lemke_max_iter)
     else:
         sol = solve(problem, lcp_method, max_iter=lemke_max_iter)
     r = sol.lcp

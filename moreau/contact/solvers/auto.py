@@ -30,6 +30,7 @@ cost 123 ms with 10 000 plain sweeps before Lemke (0.5 ms), 40 ms with
 this budget (199 contacts: 524 ms, 236 ms; shared machine, one run).
 """
 
+from ...errors import PainleveError
 from .._sparse import DENSE_CROSSOVER
 from ..problem import SOLVED
 from ..registry import register_solver
@@ -78,7 +79,22 @@ def solve(problem, *, max_iter=None, tol=None):
     if problem.n_eq:
         return mlcp.solve(problem, max_iter=max_iter, tol=tol)
     if problem.mu.size == 1:
-        return closed_form.solve(problem)
+        try:
+            sol = closed_form.solve(problem, tol=tol)
+        except PainleveError as exc:
+            # a singular Delassus matrix (normal and tangential rates tied: a one-dof
+            # mechanism): the case formulas cannot pick among the impulses that give its
+            # unique velocities; the LCP can, and where it finds none the problem has none
+            dense = solve_friction_lcp(problem, "auto", max_iter, tol)
+            if dense.status != SOLVED:
+                raise exc
+            return dense._replace(path=("closed-form",) + tuple(dense.path))
+        if sol.status == SOLVED:
+            return sol
+        # a Delassus matrix singular to rounding: the case formulas lost their digits, and
+        # Lemke with the QP fallback decides on the same data
+        dense = solve_friction_lcp(problem, "auto", max_iter, tol)
+        return dense._replace(path=tuple(sol.path) + tuple(dense.path))
     if problem.mu.size > DENSE_CROSSOVER:
         budget = auto_budget(problem.mu.size) if max_iter is None else max_iter
         sol = _staged_nsgs(problem, budget, tol)

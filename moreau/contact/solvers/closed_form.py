@@ -3,8 +3,9 @@
 
 import numpy as np
 
+from ...lcp.lemke import DEFAULT_TOL
 from ..closed_form import one_contact_impulse, one_contact_residual
-from ..problem import SOLVED, ContactSolution
+from ..problem import FAILED, SOLVED, ContactSolution
 from ..registry import register_solver
 
 __all__ = ["solve"]
@@ -16,7 +17,12 @@ def solve(problem, *, max_iter=None, tol=None):
     """Impulse of a one-contact problem: open, stick, positive or negative slip.
 
     Exact where ``W`` is positive definite (a unique answer, the tangential
-    impact included); ``max_iter`` and ``tol`` do not apply.
+    impact included). The answer's residual on the caller's data is checked
+    against ``tol`` (Lemke's :data:`~moreau.lcp.lemke.DEFAULT_TOL` by
+    default): where ``W`` is singular to rounding (a contact whose normal and
+    tangential rates the system ties together) the case formulas can lose
+    every digit, and the status is then ``"failed"`` with the residual, for
+    ``"auto"`` to hand the problem to Lemke. ``max_iter`` does not apply.
 
     Raises
     ------
@@ -42,6 +48,12 @@ def solve(problem, *, max_iter=None, tol=None):
         pn, pt = one_contact_impulse(W[:1, :1], U[:1], 0.0, e[0], vN[0])
         res = one_contact_residual(W[0, 0], 0.0, 0.0, 0.0, U[0], 0.0, 0.0, e[0], vN[0], pn, 0.0)
         p = np.array([pn])
+    tol = DEFAULT_TOL if tol is None else tol
+    if not res <= tol:
+        return ContactSolution(p, _NO_EQ, np.array([pn]), np.array([pt]), FAILED, float(res),
+                               "closed-form", 0,
+                               f"the closed form's residual {res:.3g} exceeds tol = {tol:.3g} "
+                               f"(a Delassus matrix singular to rounding)", ("closed-form",))
     return ContactSolution(p, _NO_EQ, np.array([pn]), np.array([pt]), SOLVED, float(res),
                            "closed-form", 0, "Solved in closed form.", ("closed-form",))
 
