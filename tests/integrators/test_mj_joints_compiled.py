@@ -57,6 +57,10 @@ def test_joint_scenes_run_compiled():
     (lambda: double_pendulum_stop(mu=0.3, restitution=0.5), 3.0,
      {"theta": 0.5, "joint_rows": "theta"}),
     (slider_crank_clearance, 0.75, {}),
+    # the Baumgarte term on both rows (module docstring of moreau_jean, *Baumgarte*)
+    (slider_crank, 1.5, {"theta": 0.5, "joint_baumgarte": 0.5}),
+    (lambda: double_pendulum_stop(mu=0.3, restitution=0.5), 3.0,
+     {"theta": 0.5, "joint_rows": "theta", "joint_baumgarte": 1.0}),
 ])
 def test_compiled_joint_loop_equals_the_generic_step(make, t_end, opts):
     a, b = _pair(make(), t_end, 120, **opts)
