@@ -40,6 +40,12 @@ FIG4 = pathlib.Path(__file__).parents[1] / "data" / "leine2001_woodpecker_fig4.n
 FIG4_DROPS = (0.01888, 0.01953)
 #: Fig. 4's line width in y [m] and phi_S [rad]
 FIG4_LINE = (0.21e-3, 3.9e-3)
+#: Fig. 5 (p. 4, phi_M' against phi_M, read from its vector paths as Fig. 4): after the lower
+#: edge's impact the sleeve lifts off the pole and strikes it again 2.7 ms later, a loop of
+#: largest phi_M -0.1028 rad, largest phi_M' 0.532 rad/s and phi_M' -1.537 rad/s before the
+#: second strike; the line is 0.26 pt wide: 0.092 rad/s and 5e-4 rad
+FIG5_BOUNCE = (-0.1028, 0.532, -1.537)
+FIG5_LINE = (5e-4, 0.092)
 
 
 def _fit_to_fig4(toy, res):
@@ -81,6 +87,16 @@ def _least_bird_angle(toy, res):
     return float(res.q[t > t[-1] - LEINE_2001["period"], 2].min())
 
 
+def _bounce(toy, res):
+    """Largest phi_M, largest and least phi_M' in the 4 ms after the last lower-edge impact."""
+    t, pm, w = res.t * toy.time, res.q[:, 1], res.v[:, 1] / toy.time
+    last = np.flatnonzero(t > t[-1] - LEINE_2001["period"])
+    # the impact: phi_M' jumps from about -11 rad/s to about 0, the sleeve on its lower edge
+    i0 = [i for i in last[1:] if w[i - 1] < -5.0 and w[i] > -2.0 and pm[i] < -0.1][-1]
+    k = (t > t[i0]) & (t < t[i0] + 0.004)
+    return float(pm[k].max()), float(w[k].max()), float(w[k].min())
+
+
 def _check_against_leine_2001(toy, res, lc):
     """The run's limit cycle against the paper's text and Fig. 4; returns the figures."""
     fits = _fit_to_fig4(toy, res)
@@ -91,6 +107,11 @@ def _check_against_leine_2001(toy, res, lc):
     assert abs(least - LEINE_2001["min_bird_angle"]) <= 5e-3
     # the drop per period between the figure's two cycles, widened by its line
     assert FIG4_DROPS[0] - FIG4_LINE[0] <= lc["descent"] <= FIG4_DROPS[1] + FIG4_LINE[0]
+    # the sleeve's bounce on its lower edge, Fig. 5
+    top, w_top, w_low = _bounce(toy, res)
+    assert abs(top - FIG5_BOUNCE[0]) <= FIG5_LINE[0]
+    assert abs(w_top - FIG5_BOUNCE[1]) <= FIG5_LINE[1]
+    assert abs(w_low - FIG5_BOUNCE[2]) <= FIG5_LINE[1]
     return fits, least
 
 
@@ -181,7 +202,8 @@ def test_the_limit_cycle_passes_through_glockers_published_state():
     assert 0.14 < lc["period"] < 0.15 and 0.018 < lc["descent"] < 0.021
     # Leine et al. (2001): T = 0.1452 s; measured 0.146142 s, 0.65 % longer (the reference
     # 0.53 %); Fig. 4 cycle by cycle: phi_S within 0.40 and 1.9 mrad rms, y within 0.017
-    # and 0.15 mm, the figure's cycle 0.14517 s; drop 19.56 mm; least phi_S -0.5296
+    # and 0.15 mm, the figure's cycle 0.14517 s; drop 19.56 mm; least phi_S -0.5296; the
+    # bounce (Fig. 5): phi_M up to -0.10285, phi_M' from 0.521 to -1.469 rad/s
     assert abs(lc["period"] / LEINE_2001["period"] - 1.0) <= 1e-2
     fits, _ = _check_against_leine_2001(toy, res, lc)
     assert abs(_fig4_period(fits, lc) - LEINE_2001["period"]) <= 2e-4
@@ -227,7 +249,8 @@ def test_the_reference_limit_cycle_against_leine_glocker_van_campen_2001():
     # measured: T 0.145974 s, 0.53 % longer than the published 0.1452 s; drop 19.44 mm
     # (Fig. 4: 18.88 jam to jam, 19.53 over its first period); least phi_S -0.5296;
     # Fig. 4 cycle by cycle: phi_S within 0.45 and 1.5 mrad rms, y within 0.03 and 0.12 mm,
-    # the figure's cycle 0.14522 s
+    # the figure's cycle 0.14522 s; the bounce (Fig. 5): phi_M up to -0.10280, phi_M' from
+    # 0.535 to -1.549 rad/s
     assert abs(lc["period"] / LEINE_2001["period"] - 1.0) <= 6e-3
     fits, _ = _check_against_leine_2001(toy, res, lc)
     assert abs(_fig4_period(fits, lc) - LEINE_2001["period"]) <= 2e-4
