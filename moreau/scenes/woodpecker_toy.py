@@ -70,10 +70,13 @@ parameters; :data:`LEINE_2001`): the limit cycle's period ``T = 0.1452 s``
 the free toy's eigenfrequency ``72.91 Hz`` (p. 5), the jammed equilibrium
 ``(phi_M, phi_S) = (-0.1034, -0.2216)``, possible only for ``mu >= 0.285``
 (p. 4), and two periods of the motion plotted (Fig. 4, p. 4; its sleeve drops
-18.88 mm from one jam to the next). The event-driven reference has the
+18.88 mm from one jam to the next) with their phase portraits (Fig. 5: the
+sleeve lifts off its lower edge after striking it and strikes again, a loop
+up to ``phi_M' = 0.532 rad/s``). The event-driven reference has the
 eigenfrequency, the equilibrium, the threshold and the least angle to the
-published digits, the plotted curves within their line width, and a period
-0.53 % and a drop 3.0 % longer (``tests/scenes/test_woodpecker_toy.py``).
+published digits, the plotted curves and the loop within their line width,
+and a period 0.53 % and a drop 3.0 % longer
+(``tests/scenes/test_woodpecker_toy.py``).
 
 Units: lengths in ``l_M``, time in ``sqrt(l_M / g)``, mass in ``m_S``
 (forces in ``m_S g``); the angles stay in rad. Valid region: the model is
