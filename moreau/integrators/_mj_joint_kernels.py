@@ -11,7 +11,9 @@ call over a block of steps. Per step:
   the generic path;
 * the rows ``H = [WE; WN; WT]``: the joints' Jacobian at the predicted
   θ-point or end point, the active contact's rows at ``(q_k, t_k+1)``, the
-  Delassus matrix ``W = H W_hat^-1 H^T`` and ``U_free = H v_free + w``;
+  Delassus matrix ``W = H W_hat^-1 H^T`` and ``U_free = H v_free + w``; the
+  joint rows' target with the Baumgarte term ``-(alpha / h) gE(q_k, t_k)``
+  where ``alpha > 0``;
 * the equality rows eliminated as :mod:`moreau.contact.solvers.mlcp` does:
   the block ``A`` checked by its singular values (:data:`RANK_RTOL`), the
   Schur complement ``W_S = B - D A^-1 C``, ``u_S = b - D A^-1 a``, the
@@ -197,7 +199,8 @@ def _refined(A, rhs):
 
 @njit(cache=True, error_model="numpy")
 def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac,
-                  par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, theta_rows, closed, reg,
+                  par, mu, e, t0, h, t_bound, k0, nmax, q, v, theta, theta_rows, alpha, closed,
+                  reg,
                   save_every, record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT,
                   rec_slip, rec_gap, stats):
     """Up to ``nmax`` Moreau–Jean steps of a scene with joints (module docstring).
@@ -217,6 +220,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
     Gq = np.zeros((ncm, w2))
     GE = np.zeros((max(nj, 1), w2))
     GEq = np.zeros((max(nj, 1), w2))
+    GEk = np.zeros((max(nj, 1), w2))
     pN = np.zeros(ncm)
     pT = np.zeros(ncm)
     slip = np.zeros(ncm)
@@ -310,6 +314,12 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
                 for j in range(n):
                     acc += H[r, j] * v[j]
                 target[r] = ((theta - 1.0) / theta) * acc
+        if alpha > 0.0:
+            # Baumgarte: less (alpha / h) gE(q_k, t_k), over theta on the theta-weighted rows
+            joints_fn(par, q, tk, GEk, True)
+            div = theta if (theta_rows and theta != 1.0) else 1.0
+            for r in range(nj):
+                target[r] = target[r] - ((alpha / hk) * GEk[r, 0]) / div
         if na == 1:
             contacts_fn(par, q, t1, G1, True, True)
             for j in range(n):

@@ -63,6 +63,21 @@ start, a state on the limit cycle with the sleeve jammed on its lower edge
 and the bird swinging out, is ``q = (0, -0.1036, -0.2788)``,
 ``q' = (-0.3411 m/s, 0, -7.4583 rad/s)``: the scene's initial state.
 
+Published values (Leine, Glocker and van Campen, "Nonlinear dynamics of the
+woodpecker toy", ASME DETC2001/VIB-21608, Pittsburgh 2001, with these
+parameters; :data:`LEINE_2001`): the limit cycle's period ``T = 0.1452 s``
+(p. 4), the bird's least angle during the jam ``phi_S = -0.53 rad`` (p. 6),
+the free toy's eigenfrequency ``72.91 Hz`` (p. 5), the jammed equilibrium
+``(phi_M, phi_S) = (-0.1034, -0.2216)``, possible only for ``mu >= 0.285``
+(p. 4), and two periods of the motion plotted (Fig. 4, p. 4; its sleeve drops
+18.88 mm from one jam to the next) with their phase portraits (Fig. 5: the
+sleeve lifts off its lower edge after striking it and strikes again, a loop
+up to ``phi_M' = 0.532 rad/s``). The event-driven reference has the
+eigenfrequency, the equilibrium, the threshold and the least angle to the
+published digits, the plotted curves and the loop within their line width,
+and a period 0.53 % and a drop 3.0 % longer
+(``tests/scenes/test_woodpecker_toy.py``).
+
 Units: lengths in ``l_M``, time in ``sqrt(l_M / g)``, mass in ``m_S``
 (forces in ``m_S g``); the angles stay in rad. Valid region: the model is
 linear in the angles; a run stops where ``|phi_M|`` or ``|phi_S|`` reaches 1 rad.
@@ -85,12 +100,20 @@ from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.units import SIUnits
 
-__all__ = ["WoodpeckerToyParams", "WoodpeckerToy", "GLOCKER_STATE", "section_crossings",
-           "section_event", "limit_cycle"]
+__all__ = ["WoodpeckerToyParams", "WoodpeckerToy", "GLOCKER_STATE", "LEINE_2001",
+           "section_crossings", "section_event", "limit_cycle"]
 
 #: Glocker's published state on the limit cycle: ``(y [m], phi_M [rad], phi_S [rad])``
 #: and ``(y' [m/s], phi_M' [rad/s], phi_S' [rad/s])``, four significant digits
 GLOCKER_STATE = ((0.0, -0.1036, -0.2788), (-0.3411, 0.0, -7.4583))
+
+#: Leine, Glocker and van Campen (2001, DETC2001/VIB-21608), Glocker's parameters, as
+#: printed: the limit cycle's ``period`` [s] (p. 4), the bird's least angle during the
+#: jam ``min_bird_angle`` [rad] (p. 6), the free toy's ``eigenfrequency`` [Hz] (p. 5),
+#: the jammed ``equilibrium`` ``(phi_M, phi_S)`` [rad] and the least ``jamming_mu``
+#: that holds it (p. 4)
+LEINE_2001 = {"period": 0.1452, "min_bird_angle": -0.53, "eigenfrequency": 72.91,
+              "equilibrium": (-0.1034, -0.2216), "jamming_mu": 0.285}
 
 
 @dataclass(frozen=True)
