@@ -38,13 +38,17 @@ natural-map tolerance ``lcp_tol`` (default :data:`ITERATIVE_TOL`) within
 NSGS over-relaxed by ``lcp_omega``. The solve starts from the impulses of the
 step before on the contacts active in both (zero elsewhere), unless no
 impulse at all has the smaller residual (after an impact the next step's
-answer is about zero, and the impact's impulses would be a start far off).
+answer is about zero, and the impact's impulses would be a start far off);
+where no impulse at all meets the tolerance (its residual is exact: ``u =
+q``) it is the answer, without a solve.
 The certified residual of the answer enters ``stats["max_residual"]`` and
 the sweeps ``stats["iterations"]``; a solve that stops above its tolerance
 fails the step with status -3 and the solver's message (the residual, the
 tolerance, the iterations), as a failed Lemke or active-set solve does:
 never taken silently.
 """
+
+import math
 
 import numpy as np
 import scipy.sparse as sps
@@ -166,27 +170,44 @@ def _interleaved(W):
     return sps.csr_array((data, indices, indptr), shape=(2 * n, 2 * n))
 
 
+def _start_residual(W, q, mu, r):
+    """``||F(r)|| / (1 + ||q||)`` in plain float sums, to choose a start (the solver certifies
+    what it returns); frictionless contacts in numpy: ``F_N = min(r_N, u_N)``, ``F_T = r_T``."""
+    if np.any(mu):
+        return problem_residual(W, q, mu, r)[0]
+    u = W @ r + q
+    fn = np.minimum(r[0::2], u[0::2])
+    return math.sqrt(float(fn @ fn + r[1::2] @ r[1::2])) / (1.0 + float(np.linalg.norm(q)))
+
+
 def _solve_iterative(integ, W, q, mu, ia, nc):
     """FCLib-layout impulses of the step's problem ``(W, q, mu)`` on the active contacts ``ia``
     (of ``nc``) by ``integ.lcp_method``, warm-started; the books kept, a miss raised."""
     method = integ.lcp_method
+    tol = ITERATIVE_TOL if integ.lcp_tol is None else integ.lcp_tol
+    c = integ.counters
+    c["lcp_solves"] += 1
+    c.setdefault("iterations", 0)
+    zero = np.zeros_like(q)
+    # F(0) is exact (u = q): where no impulse meets the tolerance, it is the answer (after
+    # an inexact impact the next steps' problems are of the size of its residual)
+    res_zero = _start_residual(W, q, mu, zero)
+    if res_zero <= tol:
+        c["max_residual"] = max(c["max_residual"], res_zero)
+        return zero
     last = getattr(integ, "_iterative_last", None)
     r0 = None
     if last is not None and last[0] == integ._k - 1:
         r0 = last[1][ia].ravel()
-        if not np.any(r0) or (problem_residual(W, q, mu, np.zeros_like(q))[0]
-                              <= problem_residual(W, q, mu, r0)[0]):
+        if not np.any(r0) or res_zero <= _start_residual(W, q, mu, r0):
             r0 = None
-    tol = ITERATIVE_TOL if integ.lcp_tol is None else integ.lcp_tol
     budget = ITERATIVE_BUDGET[method] if integ.lcp_max_iter is None else integ.lcp_max_iter
     if method == "nsgs":
         omega = 1.0 if integ.lcp_omega is None else integ.lcp_omega
         res = solve_nsgs(W, q, mu, r0=r0, tol=tol, max_sweeps=budget, omega=omega)
     else:
         res = solve_apgd(W, q, mu, r0=r0, tol=tol, max_iter=budget)
-    c = integ.counters
-    c["lcp_solves"] += 1
-    c["iterations"] = c.get("iterations", 0) + res.iterations
+    c["iterations"] += res.iterations
     c["max_residual"] = max(c["max_residual"], res.residual)
     if not res.converged:
         raise LCPError(f"the contact problem at t = {integ.t!r} was not solved: {res.message}")
