@@ -44,6 +44,13 @@ the sparse active set from there), ``"nsgs"`` (``lcp_omega`` at
   in ``tests/scenes/test_ball_chain_iterative.py``.
 
 ``python benchmarks/bench_chain_sparse_mj.py --scaling [--sizes ...] [--repeats 3]``.
+
+``--orders`` counts the sweeps of projected Gauss–Seidel on the struck
+chain's frictionless LCP (``W = tridiag(-1, 2, -1)``, ``q = (-2, 0, ...)``)
+to the natural map ``--tol`` in three orders along the chain (from the
+striker, towards it, and symmetric: one each way, two sweeps), plain and at
+:func:`moreau.scenes.ball_chain.sor_omega`: a sweep is one pass over the
+contacts, what NSGS's sweep costs.
 """
 
 import os
@@ -59,6 +66,7 @@ import subprocess  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
+from numba import njit  # noqa: E402
 
 from moreau.contact._sparse import delassus, disk_jacobian  # noqa: E402
 from moreau.contact.solvers.apgd import solve_apgd  # noqa: E402
@@ -143,6 +151,46 @@ def siconos_mj(N):
     return json.loads(out.stdout)
 
 
+@njit(cache=False)
+def _projected_sor(n, omega, order, tol, max_sweeps):
+    # order 0: from the striker, 1: towards it, 2: one each way; returns sweeps or -1
+    p = np.zeros(n)
+    q = np.zeros(n)
+    q[0] = -2.0
+    sweeps = 0
+    while sweeps < max_sweeps:
+        for k in range(2 if order == 2 else 1):
+            forward = order == 0 or (order == 2 and k == 0)
+            for j in range(n):
+                i = j if forward else n - 1 - j
+                b = q[i] - (p[i - 1] if i > 0 else 0.0) - (p[i + 1] if i < n - 1 else 0.0)
+                p[i] = max(0.0, p[i] + omega * (max(0.0, -0.5 * b) - p[i]))
+            sweeps += 1
+        s = 0.0
+        for i in range(n):
+            u = q[i] + 2.0 * p[i] - (p[i - 1] if i > 0 else 0.0) - (p[i + 1] if i < n - 1 else 0.0)
+            f = min(p[i], u)
+            s += f * f
+        if math.sqrt(s) / 3.0 <= tol:
+            return sweeps
+    return -1
+
+
+def sweep_orders(sizes, tol):
+    """Sweeps to ``tol`` of projected (S)SOR on the struck chain in each order (module docstring)."""
+    rows = []
+    for N in sizes:
+        om = sor_omega(np.ones(N))
+        for omega in (1.0, om):
+            budget = 4 * N * N if omega == 1.0 else 100 * N
+            row = {"N": N, "omega": omega}
+            for order, name in enumerate(("from the striker", "towards it", "symmetric")):
+                row[name] = int(_projected_sor(N - 1, omega, order, tol, budget))
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    return rows
+
+
 def _mj_run(N, method, **options):
     """One Moreau–Jean run of the chain stepped by hand: ``(CPU seconds of each step, the
     integrator, the velocities after the impact step)``."""
@@ -224,9 +272,14 @@ def main():
                     help="the scaling table of moreau's Moreau-Jean (module docstring)")
     ap.add_argument("--sweeps", type=int, default=100)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--orders", action="store_true",
+                    help="sweeps of projected SOR on the struck chain by sweep order")
     ap.add_argument("--no-siconos", action="store_true")
     ap.add_argument("--no-lemke", action="store_true", help="skip the dense Lemke runs")
     args = ap.parse_args()
+    if args.orders:
+        sweep_orders([N for N in args.sizes if N <= 1000], args.tol)
+        return
     if args.scaling:
         for method in ("auto", "nsgs", "apgd"):       # load the compiled solvers once
             _mj_run(200, method)

@@ -244,7 +244,9 @@ path only); ``pivots`` (Lemke pivots);
 ``fallbacks`` (solves where ``"auto"`` fell back to QP); ``max_residual``
 (largest scaled complementarity residual, :func:`moreau.lcp.lcp_residual`
 of the friction LCP; on the compiled path Lemke's measure,
-:func:`moreau.lcp.lcp_violation`); ``max_penetration`` (largest ``-g``
+:func:`moreau.lcp.lcp_violation`; with ``lcp_method`` ``"nsgs"`` or
+``"apgd"`` the certified natural-map residual, and ``iterations`` their
+sweeps or gradient steps); ``max_penetration`` (largest ``-g``
 after a step, 0 if none); ``projection_iterations``.
 """
 
@@ -409,13 +411,29 @@ class MoreauJean(TimeStepping):
         each step's problem: ``"exact"`` or the number ``d >= 3`` of the
         polyhedral cone's directions (default 8); see "Spatial scenes" in the
         module docstring. Planar scenes ignore it.
-    lcp_method : {"auto", "lemke", "qp"}
+    lcp_method : {"auto", "lemke", "qp", "nsgs", "apgd"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
         contacts go to Lemke with the QP fallback;
         ``"lemke"`` or ``"qp"`` forces that solver on the assembled LCP of
         every contact step, one contact included, so that solvers can be
-        compared (``moreau compare``).
+        compared (``moreau compare``). ``"nsgs"`` and ``"apgd"`` (the
+        iterative contact solvers of :mod:`moreau.contact`, by their
+        registered names; planar scenes without joints) solve every contact
+        step to ``lcp_tol``, warm-started from the last step's impulses, on
+        the generic step or a scene's sparse step
+        (:mod:`moreau.integrators._sparse_mj`, "Iterative solvers"); a step
+        whose solver stops above ``lcp_tol`` fails the run (status -3, the
+        residual in the message and in ``stats["max_residual"]``).
+    lcp_tol : float, optional
+        With ``"nsgs"``/``"apgd"``: the tolerance on the certified natural-map
+        residual ``||F(r)|| / (1 + ||q||)``, in ``[1e-15, 1)``; 1e-8 by default.
+    lcp_max_iter : int, optional
+        With ``"nsgs"``/``"apgd"``: the budget of sweeps or gradient steps of
+        each step's solve; 10 000 (NSGS) or 100 000 (APGD) by default.
+    lcp_omega : float, optional
+        With ``"nsgs"``: the over-relaxation in ``(0, 2)``, 1 by default (on
+        a struck chain, :func:`moreau.scenes.ball_chain.sor_omega`).
     lemke_max_iter : int, optional
         Pivot limit of Lemke's method on each step's contact problem (default:
         Lemke's own, at least 1000). A step on which Lemke stops at the limit
@@ -445,7 +463,8 @@ class MoreauJean(TimeStepping):
         in CSR and each step's LCP solved exactly by
         :func:`moreau.lcp.active_set.solve_active_set` (``stats["max_residual"]``
         its natural-map residual; above ``SPARSE_TOL`` = 1e-10 the run fails,
-        status -3).
+        status -3), or by ``lcp_method`` ``"nsgs"``/``"apgd"``. Elsewhere
+        these two take the generic step (``fast=True`` is then refused).
     closed0 : bool or array_like of bool, optional
         Contacts to treat as closed in the step before ``t0`` (the index-set
         memory; see the module docstring). Default: none. Lets a run continue
