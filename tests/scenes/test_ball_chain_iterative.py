@@ -50,9 +50,9 @@ from moreau.scenes.ball_chain import SPARSE_FROM, BallChain, simultaneous_impact
 
 H = 0.01
 TOL = 1e-8
-#: the striker 0.012 radii from the chain: the impact in the second step (t* = 0.012), a run
-#: of four steps (the generic step inverts a 100 x 100 mass matrix each step)
-GAP = 0.00012
+#: the striker 0.004 radii from the chain: the impact in the first step (t* = 0.004), a run
+#: of two steps (the generic step inverts a 100 x 100 mass matrix each step)
+GAP = 0.00004
 
 
 def _chain(n):
@@ -69,7 +69,7 @@ def _bound(n, tol):
 def _impact_run(n, method, **options):
     chain = _chain(n)
     q0, v0 = chain.initial_state()
-    res = simulate(chain, (0.0, chain.impact_time + 2 * H), q0, v0, "moreau-jean", h=H,
+    res = simulate(chain, (0.0, chain.impact_time + H), q0, v0, "moreau-jean", h=H,
                    lcp_method=method, **options)
     exact = simultaneous_impact(chain.masses, v0, 1.0)
     return res, exact
@@ -91,6 +91,9 @@ def test_the_impact_step_is_the_block_result_within_the_tolerance_bound(n, metho
     assert err <= _bound(n, TOL)
     # and the bound says something: speeds are of order 1
     assert _bound(n, TOL) < 1e-4
+    if method == "nsgs":
+        # over-relaxed at Young's optimum, a few N sweeps (test below: plain, more than N^2)
+        assert res.stats["iterations"] < 4 * n
 
 
 def test_the_dense_and_the_sparse_path_take_the_solver():
@@ -100,13 +103,11 @@ def test_the_dense_and_the_sparse_path_take_the_solver():
         assert (integ._sparse is not None) is sparse
 
 
-def test_sweeps_grow_as_n_squared_plain_and_as_n_over_relaxed():
+def test_plain_sweeps_grow_as_n_squared():
     # the struck chain's impact problem, every contact pressing: Gauss-Seidel on
     # tridiag(-1, 2, -1) contracts the slowest mode by cos^2(pi / N) a sweep, so plain
     # sweeps to 1e-8 exceed N^2 at N = 100; at Young's optimum the rate is omega - 1 and
     # the sweeps a few N
-    res, _ = _impact_run(100, "nsgs", lcp_omega=sor_omega(np.ones(100)))
-    assert res.success and res.stats["iterations"] < 4 * 100
     plain = solve_nsgs(*_impact_problem(100), tol=TOL, max_sweeps=20_000)
     assert plain.converged and plain.iterations > 100 ** 2
 
@@ -130,8 +131,8 @@ def test_a_budget_too_small_fails_the_step_with_the_true_residual():
     res, _ = _impact_run(100, "nsgs")
     assert not res.success and res.status == -3
     assert "nsgs: not converged" in res.message and "after 10000 iterations" in res.message
-    # the state is the last one before the impact step, which was not taken
-    assert np.all(res.v[-1, 1:] == 0.0)
+    # the impact step, the first, was not taken
+    assert res.stats["steps"] == 0
     W, q, mu = _impact_problem(100)
     r = solve_nsgs(W, q, mu, tol=TOL, max_sweeps=10_000).r
     F = np.minimum(r, W @ r + q)
@@ -219,15 +220,16 @@ def test_ten_thousand_balls(method):
 
 # -- the generic step with friction (any planar scene without joints) ---------------------
 
-@pytest.mark.parametrize("method", ["nsgs", "apgd"])
-def test_a_frictional_scene_takes_the_solver_on_the_generic_step(method):
+def test_a_frictional_scene_takes_the_solver_on_the_generic_step():
     # the sliding box: two frictional corner contacts, a well-conditioned 4 x 4 Delassus
     # matrix; Lemke's answer ("auto", exact to rounding) is the reference, and at 1e-12 a
-    # step's error is of that order, 200 steps of it far below 1e-8
+    # step's error is of that order, 50 steps of it far below 1e-8 (APGD's frictional path
+    # is the same code, met below where it stalls)
+    method = "nsgs"
     sc = registry.get_entry("sliding-box").factory()
     q0, v0 = sc.initial_state()
-    ref = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=H, fast=False)
-    res = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=H, lcp_method=method,
+    ref = simulate(sc, (0.0, 0.5), q0, v0, "moreau-jean", h=H, fast=False)
+    res = simulate(sc, (0.0, 0.5), q0, v0, "moreau-jean", h=H, lcp_method=method,
                    lcp_tol=1e-12, lcp_max_iter=100_000)
     assert res.success, res.message
     assert 0.0 < res.stats["max_residual"] <= 1e-12 and res.stats["iterations"] > 0
