@@ -296,7 +296,9 @@ path only); ``pivots`` (Lemke pivots);
 ``fallbacks`` (solves where ``"auto"`` fell back to QP); ``max_residual``
 (largest scaled complementarity residual, :func:`moreau.lcp.lcp_residual`
 of the friction LCP; on the compiled path Lemke's measure,
-:func:`moreau.lcp.lcp_violation`); ``max_penetration`` (largest ``-g``
+:func:`moreau.lcp.lcp_violation`; with ``lcp_method`` ``"nsgs"`` or
+``"apgd"`` the certified natural-map residual, and ``iterations`` their
+sweeps or gradient steps); ``max_penetration`` (largest ``-g``
 after a step, 0 if none); ``projection_iterations``.
 """
 
@@ -306,7 +308,7 @@ from typing import ClassVar
 import numpy as np
 
 from ..contact import ContactProblem, solve as solve_problem
-from .._validate import in_closed_interval
+from .._validate import in_closed_interval, positive_int
 from ..errors import InputError, LCPError
 from ..lcp.mlcp import RankDeficientError, equality_block
 from ..model.scene import is_spatial, joint_row_count
@@ -318,11 +320,12 @@ from ._mj_joint_kernels import J_STAT_NAMES, run_joint_block
 from ._mj_kernels import LCP_HANDBACK, mj_loop, prev_regimes
 from ._space_kernels import run_space_loop, space_solver, space_tables
 from ._space_step import check_cone, space_step
-from ._sparse_mj import SPARSE_TOL, sparse_contacts_of, sparse_step  # noqa: F401
+from ._sparse_mj import (ITERATIVE_METHODS, SPARSE_TOL, iterative_contact_step,  # noqa: F401
+                         sparse_contacts_of, sparse_step)
 # the time-stepping checks lived here; their names stay importable from this module
 from .time_stepping import (LCP_METHODS, MAX_RECORD_BYTES, MAX_STEPS,  # noqa: F401
                             FixedStepOptions, TimeStepping, bool_option, check_lcp_options,
-                            check_scene_contacts,
+                            check_scene_contacts, optional,
                             check_step, check_step_fits, check_work, compiled_model_of,
                             next_time)
 
@@ -404,6 +407,28 @@ def _baumgarte_option(value):
     return in_closed_interval("joint_baumgarte", value, 0.0, 1.0)
 
 
+def _mj_lcp_method_option(value):
+    # Moreau–Jean's steps also run the iterative contact solvers by their registered names
+    if value not in LCP_METHODS + ITERATIVE_METHODS:
+        raise InputError(f"`lcp_method` must be one of {list(LCP_METHODS + ITERATIVE_METHODS)}, "
+                         f"got {value!r}")
+    return value
+
+
+def _lcp_omega_option(value):
+    value = float(value)
+    if not 0.0 < value < 2.0:
+        raise InputError(f"`lcp_omega` must lie in (0, 2), got {value!r}")
+    return value
+
+
+def _lcp_tol_option(value):
+    value = float(value)
+    if not 1e-15 <= value < 1.0:
+        raise InputError(f"`lcp_tol` must lie in [1e-15, 1), got {value!r}")
+    return value
+
+
 def _joint_rows_option(value):
     if value not in ("end", "theta", "theta-projected"):
         raise InputError(f"`joint_rows` must be 'end', 'theta' or 'theta-projected', "
@@ -451,13 +476,29 @@ class MoreauJean(TimeStepping):
         each step's problem: ``"exact"`` or the number ``d >= 3`` of the
         polyhedral cone's directions (default 8); see "Spatial scenes" in the
         module docstring. Planar scenes ignore it.
-    lcp_method : {"auto", "lemke", "qp"}
+    lcp_method : {"auto", "lemke", "qp", "nsgs", "apgd"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
         contacts go to Lemke with the QP fallback;
         ``"lemke"`` or ``"qp"`` forces that solver on the assembled LCP of
         every contact step, one contact included, so that solvers can be
-        compared (``moreau compare``).
+        compared (``moreau compare``). ``"nsgs"`` and ``"apgd"`` (the
+        iterative contact solvers of :mod:`moreau.contact`, by their
+        registered names; planar scenes without joints) solve every contact
+        step to ``lcp_tol``, warm-started from the last step's impulses, on
+        the generic step or a scene's sparse step
+        (:mod:`moreau.integrators._sparse_mj`, "Iterative solvers"); a step
+        whose solver stops above ``lcp_tol`` fails the run (status -3, the
+        residual in the message and in ``stats["max_residual"]``).
+    lcp_tol : float, optional
+        With ``"nsgs"``/``"apgd"``: the tolerance on the certified natural-map
+        residual ``||F(r)|| / (1 + ||q||)``, in ``[1e-15, 1)``; 1e-8 by default.
+    lcp_max_iter : int, optional
+        With ``"nsgs"``/``"apgd"``: the budget of sweeps or gradient steps of
+        each step's solve; 10 000 (NSGS) or 100 000 (APGD) by default.
+    lcp_omega : float, optional
+        With ``"nsgs"``: the over-relaxation in ``(0, 2)``, 1 by default (on
+        a struck chain, :func:`moreau.scenes.ball_chain.sor_omega`).
     lemke_max_iter : int, optional
         Pivot limit of Lemke's method on each step's contact problem (default:
         Lemke's own, at least 1000). A step on which Lemke stops at the limit
@@ -487,7 +528,8 @@ class MoreauJean(TimeStepping):
         in CSR and each step's LCP solved exactly by
         :func:`moreau.lcp.active_set.solve_active_set` (``stats["max_residual"]``
         its natural-map residual; above ``SPARSE_TOL`` = 1e-10 the run fails,
-        status -3).
+        status -3), or by ``lcp_method`` ``"nsgs"``/``"apgd"``. Elsewhere
+        these two take the generic step (``fast=True`` is then refused).
     closed0 : bool or array_like of bool, optional
         Contacts to treat as closed in the step before ``t0`` (the index-set
         memory; see the module docstring). Default: none. Lets a run continue
@@ -544,10 +586,33 @@ class MoreauJean(TimeStepping):
         joint_rows: str = "end"
         joint_baumgarte: float = 0.0
         cone: str | int = 8
+        lcp_tol: float | None = None
+        lcp_max_iter: int | None = None
+        lcp_omega: float | None = None
         _rules: ClassVar[dict] = {"joint_projection": bool_option("joint_projection"),
                                   "joint_rows": _joint_rows_option,
                                   "joint_baumgarte": _baumgarte_option,
-                                  "cone": check_cone}
+                                  "cone": check_cone,
+                                  "lcp_method": _mj_lcp_method_option,
+                                  "lcp_tol": optional(_lcp_tol_option),
+                                  "lcp_max_iter": optional(lambda v: positive_int("lcp_max_iter",
+                                                                                  v)),
+                                  "lcp_omega": optional(_lcp_omega_option)}
+
+        def _check(self):
+            super()._check()
+            iterative = self.lcp_method in ITERATIVE_METHODS
+            for name in ("lcp_tol", "lcp_max_iter", "lcp_omega"):
+                if getattr(self, name) is not None and not iterative:
+                    raise InputError(f"`{name}` is an option of the iterative contact solvers "
+                                     f"(`lcp_method` in {list(ITERATIVE_METHODS)}), got "
+                                     f"`lcp_method={self.lcp_method!r}`")
+            if self.lcp_omega is not None and self.lcp_method != "nsgs":
+                raise InputError("`lcp_omega` over-relaxes NSGS; `lcp_method='apgd'` has none")
+            if iterative and self.lemke_max_iter is not None:
+                raise InputError(f"`lemke_max_iter` limits Lemke's pivots; "
+                                 f"`lcp_method={self.lcp_method!r}` runs no Lemke (its budget "
+                                 f"is `lcp_max_iter`)")
 
     def __init__(self, scene, t0, q0, v0, t_bound, options=None, **keywords):
         super().__init__(scene, t0, q0, v0, t_bound, options, **keywords)
@@ -582,6 +647,11 @@ class MoreauJean(TimeStepping):
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
         self._end_gap = None
+        if self.lcp_method in ITERATIVE_METHODS and (self._space or self._n_eq):
+            raise InputError(f"`lcp_method={self.lcp_method!r}` solves the contacts of a planar "
+                             f"scene without joints; scene {self.scene.name!r} is "
+                             + ("spatial" if self._space else "jointed")
+                             + ": use lcp_method='auto'")
         if getattr(self, "joint_projection", False) and not self._n_eq:
             raise InputError(f"`joint_projection` projects the positions onto the joints; scene "
                              f"{self.scene.name!r} has no joint rows: use joint_projection=False")
@@ -637,10 +707,19 @@ class MoreauJean(TimeStepping):
     def _choose_compiled(self, fast, model, lcp_method, lemke_max_iter=None, warm_start=False):
         # a long frictionless chain's own sparse step (moreau.integrators._sparse_mj)
         self._sparse = None
-        if not self._space and fast is not False and lcp_method == "auto" \
+        iterative = lcp_method in ITERATIVE_METHODS
+        if not self._space and fast is not False and (lcp_method == "auto" or iterative) \
                 and not self.projection and not self._n_eq:
             self._sparse = sparse_contacts_of(self.scene)
         if self._sparse is not None:
+            return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
+        if iterative:
+            # the compiled loop solves by closed form and Lemke: these solvers take the
+            # generic step
+            if fast is True:
+                raise InputError(f"`fast=True` solves contacts in closed form or by Lemke; "
+                                 f"`lcp_method={lcp_method!r}` needs fast='auto' or False on "
+                                 f"scene {self.scene.name!r}")
             return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
         if not self._space:
             return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
@@ -976,6 +1055,8 @@ class MoreauJean(TimeStepping):
 
     def _solve_lcp(self, W, U_free, mu, e, vN_pre, ia, pN, pT):
         # the assembled LCP of several contacts (or of one, with a forced solver)
+        if self.lcp_method in ITERATIVE_METHODS:
+            return iterative_contact_step(self, W, U_free, mu, e, vN_pre, ia, pN, pT)
         p, pN[ia], pT[ia] = solve_contact_problem(
             W, U_free, mu, e, vN_pre, lcp_method=self.lcp_method, counters=self.counters,
             lemke_max_iter=self.lemke_max_iter, t=self.t, slip_before=self._slip_before(ia),

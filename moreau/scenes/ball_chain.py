@@ -32,6 +32,12 @@ Long chains
 Moreau–Jean steps the chain on its sparse form (:meth:`BallChain.sparse_contacts`,
 :mod:`moreau.integrators.moreau_jean`): no dense matrix, each step's LCP
 solved exactly by the active-set method of :mod:`moreau.lcp.active_set`.
+Moreau–Jean's ``lcp_method="nsgs"`` or ``"apgd"`` solves it by that iterative
+solver instead (to ``lcp_tol``, on this sparse path and on the dense one
+below 150 balls). The chain's Delassus matrix is tridiagonal, so Gauss–Seidel
+needs of the order of ``N^2`` sweeps on the struck chain (the impulses fall
+linearly along it, the slowest mode) in any sweep order, and over-relaxed
+at Young's optimum (:func:`sor_omega`, ``lcp_omega``) of the order of ``N``.
 
 Scales
 ------
@@ -44,11 +50,13 @@ Coordinates: ``q_i`` the centre of ball ``i``, ball 1 at 0; the gap of
 contact ``i`` (balls ``i`` and ``i + 1``) is ``q_{i+1} - q_i - 2``.
 """
 
+import math
 import numbers
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sps
+from scipy.linalg import eigvalsh_tridiagonal
 
 from numba import njit
 
@@ -66,7 +74,7 @@ from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
-           "simultaneous_impact"]
+           "simultaneous_impact", "sor_omega"]
 
 #: the chain lengths the scene takes
 MIN_BALLS, MAX_BALLS = 2, 10_000
@@ -363,6 +371,43 @@ def simultaneous_impact(masses, v, e):
     if not r.success:
         raise LCPError(f"the simultaneous impact problem was not solved: {r.message}")
     return u + (WN.T @ r.z) / m
+
+
+def sor_omega(masses):
+    """Young's optimal over-relaxation of Gauss–Seidel on a pressed chain of ``masses``.
+
+    The chain's Delassus matrix ``W = WN M^-1 WN^T`` is tridiagonal
+    (``W_ii = 1/m_i + 1/m_{i+1}``, ``W_i,i+1 = -1/m_{i+1}``), hence
+    consistently ordered, and positive definite, so SOR's best factor is
+    ``2 / (1 + sqrt(1 - rho^2))`` with ``rho`` the spectral radius of the
+    Jacobi matrix ``I - D^-1 W`` (Young 1954; Varga, *Matrix Iterative
+    Analysis*, 2000, thm. 4.4), here the largest eigenvalue of the symmetric
+    tridiagonal ``I - D^-1/2 W D^-1/2``. Equal masses give ``rho = cos(pi /
+    N)`` and ``2 / (1 + sin(pi / N))``. It is Moreau–Jean's ``lcp_omega``
+    for ``lcp_method="nsgs"`` on a struck chain, where every contact ends
+    pressed and the LCP is this linear system.
+
+    Parameters
+    ----------
+    masses : array_like, shape (N,)
+        The balls' masses, > 0, ``N >= 3`` (two contacts at least).
+
+    Examples
+    --------
+    >>> import math
+    >>> round(sor_omega(np.ones(100)), 9), round(2.0 / (1.0 + math.sin(math.pi / 100)), 9)
+    (1.939091659, 1.939091659)
+    """
+    m = finite_array("masses", masses, ndim=1)
+    if m.size < 3 or not np.all(m > 0.0):
+        raise InputError(f"`masses` must hold 3 or more masses > 0, got {m.size} with the "
+                         f"smallest {m.min() if m.size else None!r}")
+    inv = 1.0 / m
+    diag = inv[:-1] + inv[1:]
+    off = inv[1:-1] / np.sqrt(diag[:-1] * diag[1:])
+    n = diag.size
+    rho = float(eigvalsh_tridiagonal(np.zeros(n), off, select="i", select_range=(n - 1, n - 1))[0])
+    return 2.0 / (1.0 + math.sqrt(max(1.0 - rho * rho, 0.0)))
 
 
 # -- comparison case -----------------------------------------------------------------------------
