@@ -513,6 +513,10 @@ class MoreauJean(TimeStepping):
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
+        if self._space and getattr(self.scene, "drilling", False) and self.cone != "exact":
+            raise InputError(f"`cone` must be \"exact\" on scene {self.scene.name!r}: its "
+                             f"Coulomb–Contensou friction (a contact with `contact_radius` > 0) "
+                             f"has no polyhedral form here, got cone={self.cone!r}")
         self._end_gap = None
         if getattr(self, "joint_projection", False) and not self._n_eq:
             raise InputError(f"`joint_projection` projects the positions onto the joints; scene "
@@ -579,8 +583,9 @@ class MoreauJean(TimeStepping):
             tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
         if fast is True and tables is None:
             raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
-                             f"points against half-spaces; scene {self.scene.name!r} has other "
-                             "contacts: use fast='auto' or False (the generic step)")
+                             f"points against half-spaces, without a `contact_radius`; scene "
+                             f"{self.scene.name!r} has other contacts: use fast='auto' or False "
+                             "(the generic step)")
         super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
 
     def _runner(self, template):

@@ -77,7 +77,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import in_open_interval, positive
+from .._validate import in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -110,6 +110,11 @@ class TippeTopParams:
         ``n0`` [rad/s] about the symmetry axis, > 0.
     tilt : float
         ``theta0`` [rad], the axis from the upward vertical, in (0, pi/2).
+    contact_radius : float
+        ``r`` [m], ``>= 0``: the contact patch's radius, whose drilling
+        friction couples with the sliding force (Coulomb–Contensou friction,
+        :mod:`moreau.model.space`); ``0`` is the point contact. Leine and
+        Glocker's top has ``r = 0.5 mm``.
     """
 
     mass: float = 6e-3
@@ -121,6 +126,7 @@ class TippeTopParams:
     gravity: float = 9.81
     spin: float = 180.0
     tilt: float = 0.1
+    contact_radius: float = 0.0
 
     def __post_init__(self):
         for name in ("mass", "radius", "inertia_transverse", "inertia_axial", "mu", "gravity",
@@ -128,6 +134,8 @@ class TippeTopParams:
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "offset", in_open_interval("offset", self.offset, 0.0, 1.0))
         object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
+        object.__setattr__(self, "contact_radius", nonnegative("contact_radius",
+                                                               self.contact_radius))
         if self.inertia_axial > 2.0 * self.inertia_transverse:
             raise InputError(f"`inertia_axial` must be <= 2 inertia_transverse (the triangle "
                              f"inequality), got {self.inertia_axial!r}")
@@ -228,7 +236,8 @@ def tippe_top(params=None, **overrides):
     top = m.add_body(p.mass, [p.inertia_transverse, p.inertia_transverse, p.inertia_axial],
                      position=np.array([0.0, 0.0, R]) - Rm @ np.array([0.0, 0.0, a]),
                      orientation=orient, angular_velocity=(0.0, 0.0, p.spin), name="top")
-    m.add_contact(top, Sphere(R, centre=(0.0, 0.0, a)), table, mu=p.mu)
+    m.add_contact(top, Sphere(R, centre=(0.0, 0.0, a)), table, mu=p.mu,
+                  contact_radius=p.contact_radius)
     sc = m.build("tippe-top", default_window=100.0)
     sc.params = p
     return sc
@@ -267,7 +276,7 @@ register_scene(SceneEntry(
                                               "inertia_transverse": "kg m^2",
                                               "inertia_axial": "kg m^2", "mu": "",
                                               "gravity": "m/s^2", "spin": "rad/s",
-                                              "tilt": "rad"}),
+                                              "tilt": "rad", "contact_radius": "m"}),
     description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
                  "threshold set by Jellett's integral, it turns its axis from up to down"),
     case=TippeTopCase,
