@@ -49,8 +49,12 @@ Two solvers
     natural map above, with status ``"not converged"`` and the true
     residual when the budget ran out.
 
-Rolling and torsional friction are left out: each contact carries three
-rows only.
+Rolling friction is left out. Torsional (drilling) friction coupled with
+sliding, Coulomb–Contensou's law, has its own solver for contacts of four
+rows, :func:`solve_exact_contensou` (the ellipsoid of
+:mod:`moreau.model.space` as a round cone with three tangential rows,
+:func:`project_contensou` its projection); the other solvers take three
+rows a contact.
 
 Examples
 --------
@@ -71,6 +75,7 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.optimize import brentq
 
 from .._validate import finite_array
 from ..errors import InputError
@@ -1036,14 +1041,12 @@ def local_solve_contensou(A, b, mu):
     >>> (np.round(local_solve_contensou(A, [-1.0, 3.0, 0.0, 4.0], 0.5), 14) + 0.0).tolist()
     [1.0, -0.3, 0.0, -0.4]
     """
-    from scipy.optimize import brentq
-
     A = finite_array("A", A, ndim=2)
     b = finite_array("b", b, shape=(A.shape[0],))
-    return _local_nd(A, b, float(mu), brentq)
+    return _local_nd(A, b, float(mu))
 
 
-def _local_nd(A, b, mu, brentq):
+def _local_nd(A, b, mu):
     m = b.shape[0]
     r = np.zeros(m)
     if b[0] >= 0.0:
@@ -1176,8 +1179,6 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
     >>> sol.status, (np.round(sol.r, 12) + 0.0).tolist()
     ('converged', [1.0, -0.3, 0.0, -0.4])
     """
-    from scipy.optimize import brentq
-
     if check:
         W, q, mu, starts = check_block_problem(W, q, mu, sizes)
     else:
@@ -1198,7 +1199,7 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
         for i in range(nc):
             a, b = starts[i], starts[i + 1]
             A = W[a:b, a:b]
-            ri = _local_nd(A, u[a:b] - A @ r[a:b], mu[i], brentq)
+            ri = _local_nd(A, u[a:b] - A @ r[a:b], mu[i])
             u += W[:, a:b] @ (ri - r[a:b])
             r[a:b] = ri
         u = W @ r + q

@@ -169,7 +169,12 @@ symmetric ``W = H M^-1 H^T``, which the gyroscopic Jacobian would break; its
 error is ``O(h)`` only where contacts act on a body spinning about a
 non-principal axis). A contact's recorded tangential force and slip
 are magnitudes, its regime ``P`` for slip in any direction. ``projection``
-is refused. The step runs in the compiled loop of
+is refused. A contact with a patch (``contact_radius > 0``: Coulomb–Contensou
+friction, :mod:`moreau.model.space`) adds its drilling row to the three,
+and the step solves the round cone with three tangential rows
+(:func:`moreau.contact.cone3d.solve_exact_contensou`); it takes
+``cone="exact"`` only (another ``cone`` is refused by name) and the Python
+step. The step runs in the compiled loop of
 :mod:`moreau.integrators._space_kernels` for scenes whose contacts are
 spheres and material points (pucks) against half-spaces (all shipped
 ones), the same step to rounding; a contact problem the loop does not

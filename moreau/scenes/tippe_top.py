@@ -9,11 +9,16 @@ Glocker's tippe top (R. I. Leine, Ch. Glocker, "A set-valued force law for
 spatial Coulomb–Contensou friction", Eur. J. Mech. A/Solids 22 (2003)
 193–216, as used by Siconos's tippe-top example): ``m = 6 g``, ``R = 15
 mm``, ``a = 3 mm``, ``A = 8e-7``, ``C = 7e-7 kg m^2``, ``mu = 0.3``, ``n0 =
-180 rad/s``, ``theta0 = 0.1 rad``; their stem is left out (the eccentric
-sphere of Or, SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden
-and Romero, SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and
-Watanabe, SIAM J. Appl. Dyn. Syst. 4 (2005) 1159), and so is the drilling
-(Contensou) friction.
+180 rad/s``, ``theta0 = 0.1 rad``, and a contact patch of radius ``r =
+0.5 mm`` (the same values in Capobianco, Harsch, Eugster and Leine's
+tippe-top example, Int. J. Numer. Methods Eng. 2021, Sect. 10.6, citing
+Leine and Glocker). Their stem is left out (the eccentric sphere of Or,
+SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden and Romero,
+SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and Watanabe, SIAM
+J. Appl. Dyn. Syst. 4 (2005) 1159). The patch is the option
+``contact_radius``, ``0`` by default (the point contact, the stored runs'
+scene); ``contact_radius=5e-4`` is Leine and Glocker's top with its
+Coulomb–Contensou friction (:mod:`moreau.model.space`).
 
 Jellett's integral and the spin thresholds
 ------------------------------------------
@@ -64,7 +69,22 @@ it through the step's own dissipation: the axis passes horizontal at 1.15,
 steps over the window (``h`` = 0.003) the top stays upright like the
 reference. The thresholds above say where a dissipating top can end, not
 that this model's top dissipates; the inversion Leine and Glocker publish
-comes with their Coulomb–Contensou (drilling) friction, not modelled here.
+comes with their Coulomb–Contensou (drilling) friction.
+
+With the patch (``contact_radius=5e-4``) the contact spins about the normal
+and so slides in the ellipsoid's generalized sense all the time: friction
+keeps dissipating and the top turns over. Its drilling torque ``M_d n``
+has the moment ``M_d n . d = M_d (R - a cos theta)`` about ``d``, so
+Jellett's integral is no longer kept: it falls slowly, and the thresholds
+above, taken at the initial ``J``, bound from above where the top can end.
+The event-driven reference (which slides with the drilling row) has the
+axis horizontal at ``t = 0.975323 s``; Moreau–Jean (exact cone) reaches
+it 0.0181, 0.0081, 0.0039, 0.0019 s later at ``h`` = 0.05, 0.025, 0.0125,
+0.00625 units (order one), and the top is inverted (``cos theta <
+-0.99``) from 2.7 s on (at h = 0.05 units). Spun at 108 rad/s (0.9 of the inversion
+threshold) it rises and hangs above the tilt of least energy; at 15 rad/s
+it stays upright. No inversion time was recovered from Leine and
+Glocker's text for comparison.
 
 The model: the symmetry axis is the body's ``z``, the sphere's centre at
 ``(0, 0, a)`` from the centre of mass (:class:`moreau.model.space.Sphere`

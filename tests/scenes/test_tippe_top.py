@@ -142,7 +142,7 @@ def test_with_its_patch_the_top_inverts_above_the_threshold_and_not_below(spin, 
     assert res.status == 0
     c = axis_height(res.q)
     if inverts:
-        # measured: cos(theta) -0.9979 at 3.9 s, below -0.99 from 2.3 s
+        # measured: cos(theta) -0.9979 at 3.9 s, below -0.99 from 2.34 s, for good from 2.70 s
         assert spin > n_inv and c[-1] < -0.99
     elif spin > n_up:
         # 0.9 of the threshold: it rises and hangs, never past the tilt of least energy at
