@@ -992,25 +992,32 @@ def _natural_sq_blocks(r, u, mu, starts):
 def _secular(c, d):
     # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0:
     # 1/|s(alpha)| - 1 is concave and increasing, so Newton from the left end of the bracket
-    # [|c| - max d, |c| - min d] climbs monotonically to the root (bisection guards rounding)
-    cn = float(np.linalg.norm(c))
+    # [|c| - max d, |c| - min d] climbs monotonically to the root (bisection guards rounding).
+    # c, d: lists of floats (two or three tangential rows: plain floats beat array calls)
+    cn = math.sqrt(sum(x * x for x in c))
     if cn == 0.0:
         return 0.0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        at0 = float(np.sum(np.where(c != 0.0, (c / d) ** 2, 0.0)))
+    at0 = 0.0
+    for x, y in zip(c, d):
+        if x != 0.0:
+            at0 = math.inf if y == 0.0 else at0 + (x / y) ** 2
     if at0 <= 1.0:
         return 0.0
-    lo, hi = max(cn - float(np.max(d)), 0.0), max(cn - float(np.min(d)), 0.0)
+    lo, hi = max(cn - max(d), 0.0), max(cn - min(d), 0.0)
     a = lo if lo > 0.0 else min(hi, 1e-300 + 1e-16 * cn)
     for _ in range(100):
-        e = c / (d + a)
-        s2 = float(e @ e)
-        phi = 1.0 / math.sqrt(s2) - 1.0
+        s2 = s3 = 0.0
+        for x, y in zip(c, d):
+            e = x / (y + a)
+            s2 += e * e
+            s3 += e * e / (y + a)
+        norm = math.sqrt(s2)
+        phi = 1.0 / norm - 1.0
         if phi > 0.0:
             hi = min(hi, a)
         else:
             lo = max(lo, a)
-        dphi = float(e @ (e / (d + a))) / (s2 * math.sqrt(s2))
+        dphi = s3 / (s2 * norm)
         new = a - phi / dphi if dphi > 0.0 else 0.5 * (lo + hi)
         if not lo <= new <= hi:
             new = 0.5 * (lo + hi)
@@ -1062,12 +1069,10 @@ def _local_nd(A, b, mu):
     aTN, aNT, bT = A[1:, 0], A[0, 1:], b[1:]
 
     def direction(rho):
-        c = Q.T @ (rho * aTN + bT)
-        d = (mu * rho) * lam
+        c = (Q.T @ (rho * aTN + bT)).tolist()
+        d = [(mu * rho) * x for x in lam.tolist()]
         alpha = _secular(c, d)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            e = np.where(c != 0.0, c / (d + alpha), 0.0)
-        return Q @ e
+        return Q @ np.array([x / (y + alpha) if x != 0.0 else 0.0 for x, y in zip(c, d)])
 
     def g(rho):
         return A[0, 0] * rho - mu * rho * float(aNT @ direction(rho)) + b[0]
