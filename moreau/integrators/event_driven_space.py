@@ -190,6 +190,8 @@ class SpaceEventDriven(Integrator):
 
     def _update_vscale(self, q, v):
         rows = self.scene.contact_rows(q)[0]
+        if self.lever > 0.0:
+            rows = np.vstack([rows, self.scene.drilling_rows(q)[:1]])
         self._vscale = max(self._vscale, float(np.max(np.abs(rows) @ np.abs(v))))
 
     def _tangent_rows(self, q, rows):

@@ -193,3 +193,18 @@ def test_a_bad_contact_radius_is_refused_by_name():
     with pytest.raises(InputError, match="`contact_radius`"):
         simulate(sc, (0.0, 0.1), *sc.initial_state(), "moreau-jean", h=0.01, cone="exact",
                  fast=True)
+
+
+def test_the_event_driven_reference_spins_the_disk_down_and_stops_at_rest_by_name():
+    mu, a, m, g, w0 = 0.4, 0.05, 0.2, 9.81, 30.0
+    sc, C = _spinning_disk(w0, mu=mu, a=a, m=m)
+    t_stop = C * w0 / (mu * m * g * DRILLING_LEVER * a)
+    res = simulate(sc, (0.0, 2.0 * t_stop / sc.time), *sc.initial_state(),
+                   "event-driven-space", sample_dt=0.1 * t_stop / sc.time)
+    # the drilling torque's line to rounding while it spins; at rest it would roll (stick
+    # under the patch), which this reference refuses by name
+    t, w = res.t * sc.time, res.v[:, 5] / sc.time
+    assert np.max(np.abs(w - (w0 - w0 * t / t_stop))) < 1e-9 * w0
+    assert res.status == -5 and "`contact_radius`" in res.message
+    t_end = float(res.message.split("reaches zero at t = ")[1].split(":")[0]) * sc.time
+    assert t_end == pytest.approx(t_stop, rel=1e-9)
