@@ -49,8 +49,12 @@ Two solvers
     natural map above, with status ``"not converged"`` and the true
     residual when the budget ran out.
 
-Rolling and torsional friction are left out: each contact carries three
-rows only.
+Rolling friction is left out. Torsional (drilling) friction coupled with
+sliding, Coulomb–Contensou's law, has its own solver for contacts of four
+rows, :func:`solve_exact_contensou` (the ellipsoid of
+:mod:`moreau.model.space` as a round cone with three tangential rows,
+:func:`project_contensou` its projection); the other solvers take three
+rows a contact.
 
 Examples
 --------
@@ -71,6 +75,7 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.optimize import brentq
 
 from .._validate import finite_array
 from ..errors import InputError
@@ -90,6 +95,10 @@ __all__ = [
     "solve_cone",
     "exact_gauss_seidel",
     "natural_map_sq",
+    "project_contensou",
+    "local_solve_contensou",
+    "check_block_problem",
+    "solve_exact_contensou",
     "CONVERGED",
     "NOT_CONVERGED",
 ]
@@ -919,3 +928,294 @@ def solve_cone(W, q, mu, cone="exact", **options):
         raise InputError(f'`cone` must be "exact" or an integer number of directions >= 3, '
                          f'got {cone!r}')
     return solve_polyhedral(W, q, mu, int(cone), **options)
+
+
+# --------------------------------------------------------------------------- Coulomb–Contensou
+
+def _proj_nd(x, mu):
+    # projection on K = {|t| <= mu n}, t of any dimension (a contact's rows after the normal)
+    n = x[0]
+    nt = float(np.linalg.norm(x[1:]))
+    if nt <= mu * n:
+        return x.copy()
+    if mu * nt <= -n:
+        return np.zeros_like(x)
+    nn = (n + mu * nt) / (1.0 + mu * mu)
+    out = np.empty_like(x)
+    out[0] = nn
+    out[1:] = (mu * nn / nt) * x[1:]
+    return out
+
+
+def project_contensou(x, mu, lever):
+    r"""Project ``x = [N, F1, F2, M]`` on Coulomb–Contensou's ellipsoidal cone, in its metric.
+
+    The cone is ``{(N, F, M) : |F|^2 + (M / r*)^2 <= (mu N)^2}``
+    (:mod:`moreau.model.space`, "Coulomb–Contensou friction", ``r* =
+    lever``), and the projection is the nearest point in the metric ``G =
+    diag(1, 1, 1, 1 / r*^2)``: with ``S = G^(1/2)``, ``(x - z)^T G (x - z) =
+    |S x - S z|^2`` and ``S z`` ranges over the round cone ``|t| <= mu n`` of
+    three tangential rows, so the answer is ``S^-1 proj(S x)``.
+
+    Examples
+    --------
+    >>> project_contensou([1.0, 3.0, 4.0, 0.0], 0.5, 0.1).round(12).tolist()   # the force alone
+    [2.8, 0.84, 1.12, 0.0]
+    >>> project_contensou([1.0, 0.0, 0.0, 0.2], 0.5, 0.1).round(12).tolist()   # the torque alone
+    [1.6, 0.0, 0.0, 0.08]
+    """
+    x = finite_array("x", x, shape=(4,))
+    mu = float(mu)
+    if not math.isfinite(mu) or mu < 0.0:
+        raise InputError(f"`mu` must be a finite number >= 0, got {mu!r}")
+    lever = float(lever)
+    if not math.isfinite(lever) or lever <= 0.0:
+        raise InputError(f"`lever` must be a finite number > 0 (r* = 2 r / 3), got {lever!r}")
+    y = x.copy()
+    y[3] /= lever
+    p = _proj_nd(y, mu)
+    p[3] *= lever
+    return p
+
+
+def _natural_sq_blocks(r, u, mu, starts):
+    total = 0.0
+    for i in range(mu.shape[0]):
+        a, b = starts[i], starts[i + 1]
+        ut = u[a + 1:b]
+        x = r[a:b] - u[a:b]
+        x[0] = r[a] - (u[a] + mu[i] * float(np.linalg.norm(ut)))
+        total += float(np.sum((r[a:b] - _proj_nd(x, mu[i])) ** 2))
+    return total
+
+
+def _secular(c, d):
+    # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0:
+    # 1/|s(alpha)| - 1 is concave and increasing, so Newton from the left end of the bracket
+    # [|c| - max d, |c| - min d] climbs monotonically to the root (bisection guards rounding).
+    # c, d: lists of floats (two or three tangential rows: plain floats beat array calls)
+    cn = math.sqrt(sum(x * x for x in c))
+    if cn == 0.0:
+        return 0.0
+    at0 = 0.0
+    for x, y in zip(c, d):
+        if x != 0.0:
+            at0 = math.inf if y == 0.0 else at0 + (x / y) ** 2
+    if at0 <= 1.0:
+        return 0.0
+    lo, hi = max(cn - max(d), 0.0), max(cn - min(d), 0.0)
+    a = lo if lo > 0.0 else min(hi, 1e-300 + 1e-16 * cn)
+    for _ in range(100):
+        s2 = s3 = 0.0
+        for x, y in zip(c, d):
+            e = x / (y + a)
+            s2 += e * e
+            s3 += e * e / (y + a)
+        norm = math.sqrt(s2)
+        phi = 1.0 / norm - 1.0
+        if phi > 0.0:
+            hi = min(hi, a)
+        else:
+            lo = max(lo, a)
+        dphi = s3 / (s2 * norm)
+        new = a - phi / dphi if dphi > 0.0 else 0.5 * (lo + hi)
+        if not lo <= new <= hi:
+            new = 0.5 * (lo + hi)
+        if abs(new - a) <= 4e-16 * (a + cn):
+            return new
+        a = new
+    return a
+
+
+def local_solve_contensou(A, b, mu):
+    """Solve one contact's problem ``u = A r + b`` on the round cone of any tangential dimension.
+
+    ``A`` is ``m x m`` (``m = 3`` for a point contact, ``4`` with the
+    drilling row of Coulomb–Contensou friction), symmetric positive definite.
+    Take-off when ``b_N >= 0``; stick when ``r = -A^-1 b`` lies in the cone;
+    otherwise slip, ``r = rho (1, -mu s)`` with ``|s| = 1``, ``u_N = 0`` and
+    ``u_T = alpha s``, ``alpha >= 0``. For a given ``rho`` the tangential
+    rows read ``(mu rho A_TT + alpha I) s = rho A_TN + b_T``: with ``A_TT =
+    Q diag(l) Q^T`` the norm of ``s`` falls monotonically with ``alpha``, so
+    ``s(rho)`` is unique (a secular equation, solved by safeguarded Newton to
+    rounding). The normal row leaves the scalar equation ``g(rho) = A_NN rho
+    - mu rho A_NT . s(rho) + b_N = 0``, with ``g(0) = b_N < 0``, bracketed
+    by doubling and solved by Brent's method to rounding.
+
+    Examples
+    --------
+    >>> A = np.diag([1.0, 3.5, 3.5, 3.5])
+    >>> (np.round(local_solve_contensou(A, [-1.0, 3.0, 0.0, 4.0], 0.5), 14) + 0.0).tolist()
+    [1.0, -0.3, 0.0, -0.4]
+    """
+    A = finite_array("A", A, ndim=2)
+    b = finite_array("b", b, shape=(A.shape[0],))
+    return _local_nd(A, b, float(mu))
+
+
+def _local_nd(A, b, mu):
+    m = b.shape[0]
+    r = np.zeros(m)
+    if b[0] >= 0.0:
+        return r
+    if mu == 0.0:
+        r[0] = -b[0] / A[0, 0]
+        return r
+    rs = np.linalg.solve(A, -b)
+    if rs[0] >= 0.0 and float(np.linalg.norm(rs[1:])) <= mu * rs[0]:
+        return rs
+    lam, Q = np.linalg.eigh(A[1:, 1:])
+    lam = np.maximum(lam, 0.0)
+    aTN, aNT, bT = A[1:, 0], A[0, 1:], b[1:]
+
+    def direction(rho):
+        c = (Q.T @ (rho * aTN + bT)).tolist()
+        d = [(mu * rho) * x for x in lam.tolist()]
+        alpha = _secular(c, d)
+        return Q @ np.array([x / (y + alpha) if x != 0.0 else 0.0 for x, y in zip(c, d)])
+
+    def g(rho):
+        return A[0, 0] * rho - mu * rho * float(aNT @ direction(rho)) + b[0]
+
+    hi = -b[0] / A[0, 0]
+    for _ in range(200):
+        if g(hi) > 0.0:
+            break
+        hi *= 2.0
+    else:
+        return rs if rs[0] >= 0.0 else r      # no slip root (a Painlevé-like block)
+    rho = brentq(g, 0.0, hi, xtol=1e-300, rtol=8.9e-16, maxiter=400)
+    s = direction(rho)
+    r[0] = rho
+    r[1:] = -mu * rho * s
+    return r
+
+
+def check_block_problem(W, q, mu, sizes):
+    """Validate a problem whose contacts own ``sizes`` rows each (3, or 4 with drilling).
+
+    As :func:`check_cone_problem`, the rows of contact ``i`` following those
+    of the contacts before it: ``[N, T1, T2]`` or ``[N, T1, T2, D]`` with
+    ``D`` the scaled drilling row (:func:`solve_exact_contensou`).
+
+    Returns
+    -------
+    W, q, mu : ndarray
+    starts : ndarray of int, shape (nc + 1,)
+        Each contact's first row, and the total.
+
+    Examples
+    --------
+    >>> check_block_problem(np.eye(7), np.zeros(7), 0.3, [3, 3])
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `sizes` must add up to W's size 7, got 6
+    """
+    sizes = np.asarray(sizes)
+    if sizes.ndim != 1 or sizes.size == 0 or not np.all(np.isin(sizes, (3, 4))):
+        raise InputError(f"`sizes` must list 3 or 4 rows for each contact, got {sizes!r}")
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    W = finite_array("W", W, ndim=2)
+    if W.shape[0] != W.shape[1]:
+        raise InputError(f"`W` must be square, got shape {W.shape}")
+    if starts[-1] != W.shape[0]:
+        raise InputError(f"`sizes` must add up to W's size {W.shape[0]}, got {int(starts[-1])}")
+    nc = sizes.size
+    q = finite_array("q", q, shape=(W.shape[0],))
+    mu_arr = np.asarray(mu, dtype=float) if not isinstance(mu, str) else None
+    if mu_arr is None or mu_arr.ndim > 1:
+        raise InputError(f"`mu` must be a number or an array of shape ({nc},), got {mu!r}")
+    mu_arr = finite_array("mu", np.broadcast_to(mu_arr, (nc,)) if mu_arr.ndim == 0 else mu_arr,
+                          shape=(nc,))
+    if np.any(mu_arr < 0.0):
+        raise InputError(f"`mu` must be >= 0 for every contact, got {mu_arr.tolist()!r}")
+    if float(np.max(np.abs(W - W.T))) > _SYM_RTOL * float(np.max(np.abs(W))):
+        raise InputError("`W` must be symmetric (a Delassus matrix H M^-1 H^T)")
+    for i in range(nc):
+        a, b = starts[i], starts[i + 1]
+        try:
+            np.linalg.cholesky(W[a:b, a:b])
+        except np.linalg.LinAlgError:
+            raise InputError(f"`W`'s diagonal block of contact {i} must be positive definite "
+                             f"(the contact must move under its own impulse)") from None
+    return (np.ascontiguousarray(W), np.ascontiguousarray(q), np.ascontiguousarray(mu_arr),
+            starts)
+
+
+def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None, check=True):
+    r"""Solve a friction problem whose contacts may carry a drilling row (Coulomb–Contensou).
+
+    Contact ``i`` owns ``sizes[i]`` rows: ``[N, T1, T2]`` (Coulomb's cone)
+    or ``[N, T1, T2, D]`` with ``D`` the drilling row scaled by the contact's
+    lever ``r*`` (its impulse is the drilling torque's over ``r*``, its
+    velocity ``r*`` times the spin about the normal). In those variables Leine
+    and Glocker's ellipsoid is the round cone ``|r_T| <= mu r_N`` with three
+    tangential rows (:mod:`moreau.model.space`, "Coulomb–Contensou friction"),
+    and the law is the one of the module docstring with ``u_T`` and ``r_T``
+    of dimension 3: De Saxcé's ``û = u + mu |u_T| e_N`` and the natural map
+    ``r - proj_K(r - û)``, whose norm on the caller's data is the residual.
+
+    Projected Gauss–Seidel over contacts, each contact's problem solved
+    exactly by :func:`local_solve_contensou`; one contact is solved in one
+    sweep. There is no Newton polish here: with several coupled contacts
+    the sweeps stop at ``tol`` or after ``max_sweeps`` (status ``"not
+    converged"``, the true residual reported).
+
+    Parameters
+    ----------
+    W, q, mu, sizes :
+        The problem (:func:`check_block_problem`).
+    tol : float
+        Stop when the residual is ``<= tol ||q||``.
+    max_sweeps : int
+    r0 : array_like, optional
+        Starting impulse.
+    check : bool
+        False skips the checks (a scheme's step, its data checked already).
+
+    Returns
+    -------
+    ConeSolution
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5, 3.5]); q = np.array([-1.0, 3.0, 0.0, 4.0])
+    >>> sol = solve_exact_contensou(W, q, 0.5, [4])
+    >>> sol.status, (np.round(sol.r, 12) + 0.0).tolist()
+    ('converged', [1.0, -0.3, 0.0, -0.4])
+    """
+    if check:
+        W, q, mu, starts = check_block_problem(W, q, mu, sizes)
+    else:
+        W, q, mu = _trusted(W, q, mu)
+        starts = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+    if isinstance(max_sweeps, bool) or not isinstance(max_sweeps, (int, np.integer)) \
+            or max_sweeps < 1:
+        raise InputError(f"`max_sweeps` must be an integer >= 1, got {max_sweeps!r}")
+    nc = mu.shape[0]
+    r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
+    u = W @ r + q
+    qn = float(np.linalg.norm(q))
+    scale = qn if qn > 0.0 else 1.0
+    bound_sq = (tol * scale) ** 2
+    res = _natural_sq_blocks(r, u, mu, starts)
+    sweeps = 0
+    while res > bound_sq and sweeps < max_sweeps:
+        for i in range(nc):
+            a, b = starts[i], starts[i + 1]
+            A = W[a:b, a:b]
+            ri = _local_nd(A, u[a:b] - A @ r[a:b], mu[i])
+            u += W[:, a:b] @ (ri - r[a:b])
+            r[a:b] = ri
+        u = W @ r + q
+        sweeps += 1
+        res = _natural_sq_blocks(r, u, mu, starts)
+        if nc == 1:
+            break
+    res = math.sqrt(res)
+    status = CONVERGED if res <= tol * scale else NOT_CONVERGED
+    detail = (f"{sweeps} Gauss–Seidel sweep(s) with the exact local solve over "
+              f"{int(np.sum(np.diff(starts) == 4))} contact(s) with a drilling row; residual "
+              f"{res:.3g} against the bound {tol * scale:.3g} (tol {tol:g} x ||q||).")
+    return ConeSolution(r, u, status, res, res / qn if qn > 0 else res, {"sweeps": int(sweeps)},
+                        "exact", detail)

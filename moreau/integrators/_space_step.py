@@ -5,7 +5,7 @@ See :mod:`moreau.integrators.moreau_jean` ("Spatial scenes") for the scheme.
 
 import numpy as np
 
-from ..contact.cone3d import solve_cone
+from ..contact.cone3d import solve_cone, solve_exact_contensou
 from ..errors import InputError, LCPError
 from ..model.space import advance_coordinates
 from ..regimes import Regime
@@ -70,7 +70,10 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
         vN0 = rows[:, 0, :] @ v
         g0 = scene.gaps(q, t0)
         active = np.flatnonzero((g0 + 0.5 * h * vN0 <= 0.0) | closed)
-        if active.size:
+        if active.size and getattr(scene, "drilling", False):
+            v1 = _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e,
+                                     counters, pN, pT, slip, regime)
+        elif active.size:
             H = rows[active].reshape(3 * active.size, -1)
             MinvHT = Minv @ H.T
             W = H @ MinvHT
@@ -100,3 +103,52 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
                                     else Regime.STICK)
     q1 = advance_coordinates(scene, q, theta * v1 + (1.0 - theta) * v, h)
     return q1, v1, pN, pT, slip, regime
+
+
+def _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e, counters,
+                        pN, pT, slip, regime):
+    """The active contacts' impulses with Coulomb–Contensou friction; returns ``v1``.
+
+    A frictional contact with a patch (``scene.drilling_levers > 0``) adds
+    its drilling row to ``[n, t1, t2]`` (:meth:`SpaceScene.drilling_rows`),
+    and the problem is solved on the round cone with three tangential rows
+    (:func:`moreau.contact.cone3d.solve_exact_contensou`). The recorded
+    tangential force and slip are those of the two sliding rows; a contact
+    slips (``P``) where its generalized slip ``(u_T, r* omega_n)`` does.
+    """
+    drill = scene.drilling_rows(q)
+    lever = scene.drilling_levers
+    blocks, sizes = [], []
+    for i in active:
+        if lever[i] > 0.0 and mu[i] > 0.0:
+            blocks.append(np.vstack([rows[i], drill[i][None, :]]))
+            sizes.append(4)
+        else:
+            blocks.append(rows[i])
+            sizes.append(3)
+    H = np.vstack(blocks)
+    MinvHT = Minv @ H.T
+    W = H @ MinvHT
+    W = 0.5 * (W + W.T)
+    U_free = H @ v_free
+    starts = np.concatenate([[0], np.cumsum(sizes)])
+    U_free[starts[:-1]] += e[active] * np.minimum(vN0[active], 0.0)
+    sol = solve_exact_contensou(W, U_free, mu[active], sizes, check=False)
+    counters["lcp_solves"] += 1
+    counters["max_residual"] = max(counters["max_residual"], sol.relative_residual)
+    if not sol.success:
+        raise LCPError(f"the step's Coulomb–Contensou friction problem at t = {t0!r} "
+                       f"({active.size} contacts) was not solved: {sol.status}, residual "
+                       f"{sol.residual:.3g}; {sol.detail}")
+    v1 = v_free + MinvHT @ sol.r
+    U = H @ v1
+    scale = max(float(np.max(np.abs(U_free))), 1e-300)
+    for k, i in enumerate(active):
+        a, b = starts[k], starts[k + 1]
+        pN[i] = sol.r[a]
+        pT[i] = np.hypot(sol.r[a + 1], sol.r[a + 2])
+        slip[i] = np.hypot(U[a + 1], U[a + 2])
+        if pN[i] > 0.0:
+            moving = float(np.linalg.norm(U[a + 1:b])) > SLIP_RTOL * scale
+            regime[i] = int(Regime.POSITIVE if mu[i] > 0.0 and moving else Regime.STICK)
+    return v1

@@ -48,9 +48,23 @@ same); the largest drift met is the counter ``quaternion_norm_drift``. At
 each event the centre is also moved along the normal onto the gap's zero
 and the velocity projected onto the closed rows.
 
+Coulomb–Contensou friction
+    A contact with a patch (``contact_radius > 0``, :mod:`moreau.model.space`)
+    slides in three generalized rows, the two slip rates and the drilling row
+    ``r* n . (R omega)`` (:meth:`~moreau.model.space.SpaceScene.drilling_rows`):
+    its slip ``u`` and direction ``s`` above have three components, and the
+    force ``-mu lamN s`` is Leine and Glocker's ellipsoidal law, smooth while
+    the generalized slip is not zero (the Contensou regularity: a spinning
+    contact slides in every direction with bounded forces). Sliding with the
+    drilling row is the same mode, ``G = WN - mu s^T [WT; D]``; the drilling
+    row's drift is zero (``d(R omega)/dt = R omega'``). Where the generalized
+    slip vanishes (rolling without spin about the normal) the run stops with
+    a :class:`~moreau.errors.MoreauError` naming it: rolling under
+    Coulomb–Contensou friction is left to ``moreau-jean``.
+
 Known limits: one contact (scenes with several, the puck on three rim
 points or a capsule, are refused by name); no impacts, no flight, no
-rolling or drilling friction.
+rolling friction; no rolling with a contact patch (above).
 """
 
 import dataclasses
@@ -142,6 +156,9 @@ class SpaceEventDriven(Integrator):
                           else (self.t_bound - self.t0) / 256.0)
         self._next_sample = self.t0 + self.sample_dt
         self.mu = float(scene.mu[0])
+        # the drilling row's lever r* (0: a point contact, two tangential rows)
+        self.lever = (float(getattr(scene, "drilling_levers", np.zeros(1))[0])
+                      if self.mu > 0.0 else 0.0)
         self.nb = scene.nbodies
         self.normal = np.asarray(scene.contact_bases()[0][0], dtype=float)
         self.Minv = scene.mass_inverse(self.q)
@@ -173,10 +190,25 @@ class SpaceEventDriven(Integrator):
 
     def _update_vscale(self, q, v):
         rows = self.scene.contact_rows(q)[0]
+        if self.lever > 0.0:
+            rows = np.vstack([rows, self.scene.drilling_rows(q)[:1]])
         self._vscale = max(self._vscale, float(np.max(np.abs(rows) @ np.abs(v))))
 
-    def _slip(self, rows, v):
-        return rows[1:] @ v if self.mu > 0.0 else np.zeros(2)
+    def _tangent_rows(self, q, rows):
+        # the slip's rows: [t1, t2], and the drilling row with a contact patch
+        if self.lever > 0.0:
+            return np.vstack([rows[1:], self.scene.drilling_rows(q)[:1]])
+        return rows[1:]
+
+    def _slip(self, rows, v, T=None):
+        if self.mu == 0.0:
+            return np.zeros(2)
+        return (rows[1:] if T is None else T) @ v
+
+    def _no_rolling(self, t):
+        raise MoreauError(f"the contact's generalized slip (sliding and drilling) reaches zero "
+                          f"at t = {t:.12g}: scheme 'event-driven-space' models no rolling "
+                          f"with a contact patch (`contact_radius` > 0); use 'moreau-jean'")
 
     def solve(self, t, q, v, mode, direction):
         """``(a, lamN, lamT, slip, coefficient)`` of ``mode`` at ``(t, q, v)``.
@@ -188,17 +220,20 @@ class SpaceEventDriven(Integrator):
         f = sc.forces(q, v, t)
         rows = sc.contact_rows(q)[0]
         wN, wT = sc.contact_drift(q, v, t)
-        u = self._slip(rows, v)
+        T = self._tangent_rows(q, rows)
+        u = self._slip(rows, v, T)
         Mf = self.Minv @ f
+        if mode == _STICK and self.lever > 0.0:
+            self._no_rolling(t)
         if mode == _STICK:
             H = rows
             wbar = np.array([wN[0], wT[0], wT[1]])
             MH = self.Minv @ H.T
             lam = np.linalg.solve(H @ MH, -(H @ Mf + wbar))
             return Mf + MH @ lam, lam[0], lam[1:], u, 1.0
-        speed = math.hypot(u[0], u[1])
+        speed = float(np.linalg.norm(u))
         s = u / speed if speed > self._vtol() else direction
-        G = rows[0] - self.mu * (s @ rows[1:]) if self.mu > 0.0 else rows[0]
+        G = rows[0] - self.mu * (s @ T) if self.mu > 0.0 else rows[0]
         if self.mu == 0.0:
             s = np.zeros(2)
         MG = self.Minv @ G
@@ -247,13 +282,15 @@ class SpaceEventDriven(Integrator):
         self.q, self.v = q, v
         self._update_vscale(q, v)
         rows = self.scene.contact_rows(q)[0]
-        u = self._slip(rows, v)
-        speed = math.hypot(u[0], u[1])
+        u = self._slip(rows, v, self._tangent_rows(q, rows))
+        speed = float(np.linalg.norm(u))
         if self.mu == 0.0:
             # frictionless: the normal row alone, whatever the slip
             mode, d = _SLIDE, None
         elif speed > self._vtol():
             mode, d = _SLIDE, u / speed
+        elif self.lever > 0.0:
+            self._no_rolling(t)
         else:
             self.q, self.v = q, v = self._restart(q, v, _STICK)
             _, lamN, lamT, _, _ = self.solve(t, q, v, _STICK, None)

@@ -221,7 +221,12 @@ symmetric ``W = H M^-1 H^T``, which the gyroscopic Jacobian would break; its
 error is ``O(h)`` only where contacts act on a body spinning about a
 non-principal axis). A contact's recorded tangential force and slip
 are magnitudes, its regime ``P`` for slip in any direction. ``projection``
-is refused. The step runs in the compiled loop of
+is refused. A contact with a patch (``contact_radius > 0``: Coulomb–Contensou
+friction, :mod:`moreau.model.space`) adds its drilling row to the three,
+and the step solves the round cone with three tangential rows
+(:func:`moreau.contact.cone3d.solve_exact_contensou`); it takes
+``cone="exact"`` only (another ``cone`` is refused by name) and the Python
+step. The step runs in the compiled loop of
 :mod:`moreau.integrators._space_kernels` for scenes whose contacts are
 spheres and material points (pucks) against half-spaces (all shipped
 ones), the same step to rounding; a contact problem the loop does not
@@ -646,6 +651,10 @@ class MoreauJean(TimeStepping):
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
+        if self._space and getattr(self.scene, "drilling", False) and self.cone != "exact":
+            raise InputError(f"`cone` must be \"exact\" on scene {self.scene.name!r}: its "
+                             f"Coulomb–Contensou friction (a contact with `contact_radius` > 0) "
+                             f"has no polyhedral form here, got cone={self.cone!r}")
         self._end_gap = None
         if self.lcp_method in ITERATIVE_METHODS and (self._space or self._n_eq):
             raise InputError(f"`lcp_method={self.lcp_method!r}` solves the contacts of a planar "
@@ -729,8 +738,9 @@ class MoreauJean(TimeStepping):
             tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
         if fast is True and tables is None:
             raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
-                             f"points against half-spaces; scene {self.scene.name!r} has other "
-                             "contacts: use fast='auto' or False (the generic step)")
+                             f"points against half-spaces, without a `contact_radius`; scene "
+                             f"{self.scene.name!r} has other contacts: use fast='auto' or False "
+                             "(the generic step)")
         super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
 
     def _runner(self, template):

@@ -9,11 +9,16 @@ Glocker's tippe top (R. I. Leine, Ch. Glocker, "A set-valued force law for
 spatial Coulomb–Contensou friction", Eur. J. Mech. A/Solids 22 (2003)
 193–216, as used by Siconos's tippe-top example): ``m = 6 g``, ``R = 15
 mm``, ``a = 3 mm``, ``A = 8e-7``, ``C = 7e-7 kg m^2``, ``mu = 0.3``, ``n0 =
-180 rad/s``, ``theta0 = 0.1 rad``; their stem is left out (the eccentric
-sphere of Or, SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden
-and Romero, SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and
-Watanabe, SIAM J. Appl. Dyn. Syst. 4 (2005) 1159), and so is the drilling
-(Contensou) friction.
+180 rad/s``, ``theta0 = 0.1 rad``, and a contact patch of radius ``r =
+0.5 mm`` (the same values in Capobianco, Harsch, Eugster and Leine's
+tippe-top example, Int. J. Numer. Methods Eng. 2021, Sect. 10.6, citing
+Leine and Glocker). Their stem is left out (the eccentric sphere of Or,
+SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden and Romero,
+SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and Watanabe, SIAM
+J. Appl. Dyn. Syst. 4 (2005) 1159). The patch is the option
+``contact_radius``, ``0`` by default (the point contact, the stored runs'
+scene); ``contact_radius=5e-4`` is Leine and Glocker's top with its
+Coulomb–Contensou friction (:mod:`moreau.model.space`).
 
 Jellett's integral and the spin thresholds
 ------------------------------------------
@@ -64,7 +69,24 @@ it through the step's own dissipation: the axis passes horizontal at 1.15,
 steps over the window (``h`` = 0.003) the top stays upright like the
 reference. The thresholds above say where a dissipating top can end, not
 that this model's top dissipates; the inversion Leine and Glocker publish
-comes with their Coulomb–Contensou (drilling) friction, not modelled here.
+comes with their Coulomb–Contensou (drilling) friction.
+
+With the patch (``contact_radius=5e-4``) the contact spins about the normal
+and so slides in the ellipsoid's generalized sense all the time: friction
+keeps dissipating and the top turns over. Its drilling torque ``M_d n``
+has the moment ``M_d n . d = M_d (R - a cos theta)`` about ``d``, so
+Jellett's integral is no longer kept: it falls slowly (by 4 % when the
+axis passes horizontal, 24 % at 3.9 s, still 1.14 times the inversion
+threshold's), and the thresholds above, taken at the initial ``J``, bound
+from above where the top can end.
+The event-driven reference (which slides with the drilling row) has the
+axis horizontal at ``t = 0.975323 s``; Moreau–Jean (exact cone) reaches
+it 0.0181, 0.0081, 0.0039, 0.0019 s later at ``h`` = 0.05, 0.025, 0.0125,
+0.00625 units (order one), and the top is inverted (``cos theta <
+-0.99``) from 2.7 s on (at h = 0.05 units). Spun at 108 rad/s (0.9 of the inversion
+threshold) it rises and hangs above the tilt of least energy; at 15 rad/s
+it stays upright. No inversion time was recovered from Leine and
+Glocker's text for comparison.
 
 The model: the symmetry axis is the body's ``z``, the sphere's centre at
 ``(0, 0, a)`` from the centre of mass (:class:`moreau.model.space.Sphere`
@@ -77,7 +99,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import in_open_interval, positive
+from .._validate import in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -110,6 +132,11 @@ class TippeTopParams:
         ``n0`` [rad/s] about the symmetry axis, > 0.
     tilt : float
         ``theta0`` [rad], the axis from the upward vertical, in (0, pi/2).
+    contact_radius : float
+        ``r`` [m], ``>= 0``: the contact patch's radius, whose drilling
+        friction couples with the sliding force (Coulomb–Contensou friction,
+        :mod:`moreau.model.space`); ``0`` is the point contact. Leine and
+        Glocker's top has ``r = 0.5 mm``.
     """
 
     mass: float = 6e-3
@@ -121,6 +148,7 @@ class TippeTopParams:
     gravity: float = 9.81
     spin: float = 180.0
     tilt: float = 0.1
+    contact_radius: float = 0.0
 
     def __post_init__(self):
         for name in ("mass", "radius", "inertia_transverse", "inertia_axial", "mu", "gravity",
@@ -128,6 +156,8 @@ class TippeTopParams:
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "offset", in_open_interval("offset", self.offset, 0.0, 1.0))
         object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
+        object.__setattr__(self, "contact_radius", nonnegative("contact_radius",
+                                                               self.contact_radius))
         if self.inertia_axial > 2.0 * self.inertia_transverse:
             raise InputError(f"`inertia_axial` must be <= 2 inertia_transverse (the triangle "
                              f"inequality), got {self.inertia_axial!r}")
@@ -228,7 +258,8 @@ def tippe_top(params=None, **overrides):
     top = m.add_body(p.mass, [p.inertia_transverse, p.inertia_transverse, p.inertia_axial],
                      position=np.array([0.0, 0.0, R]) - Rm @ np.array([0.0, 0.0, a]),
                      orientation=orient, angular_velocity=(0.0, 0.0, p.spin), name="top")
-    m.add_contact(top, Sphere(R, centre=(0.0, 0.0, a)), table, mu=p.mu)
+    m.add_contact(top, Sphere(R, centre=(0.0, 0.0, a)), table, mu=p.mu,
+                  contact_radius=p.contact_radius)
     sc = m.build("tippe-top", default_window=100.0)
     sc.params = p
     return sc
@@ -267,7 +298,7 @@ register_scene(SceneEntry(
                                               "inertia_transverse": "kg m^2",
                                               "inertia_axial": "kg m^2", "mu": "",
                                               "gravity": "m/s^2", "spin": "rad/s",
-                                              "tilt": "rad"}),
+                                              "tilt": "rad", "contact_radius": "m"}),
     description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
                  "threshold set by Jellett's integral, it turns its axis from up to down"),
     case=TippeTopCase,

@@ -98,6 +98,39 @@ is the material point's normal velocity (the rate of ``r sigma`` is ``-r u .
 Every row is held to central differences of the gap and of the material
 point's position along the exponential-map motion in ``tests/model``.
 
+Coulomb–Contensou friction
+--------------------------
+A contact added with ``contact_radius = r > 0`` touches through a flat
+patch of radius ``r`` about the contact point, with the uniform pressure
+``N / (pi r^2)``. Spinning about the normal at ``omega_n`` without sliding,
+every patch element at the distance ``rho`` slides at ``omega_n rho``, and
+Coulomb's law there gives the drilling torque
+
+.. math::
+
+    M_{max} = \int_0^r \mu \frac{N}{\pi r^2}\, \rho \; 2\pi\rho\, d\rho
+            = \mu N \frac{2 r}{3} = \mu N r^*, \qquad r^* = \tfrac{2}{3} r
+
+(:data:`DRILLING_LEVER`); sliding without spin, the force is ``mu N``. The
+set of the patch's admissible (force, torque) pairs is convex; Leine and
+Glocker ("A set-valued force law for spatial Coulomb–Contensou friction",
+Eur. J. Mech. A/Solids 22 (2003) 193) replace it by the ellipsoid through
+these two extremes,
+
+.. math::
+
+    \frac{|F_T|^2}{(\mu N)^2} + \frac{M_d^2}{(\mu N r^*)^2} \le 1 .
+
+With the scaled torque ``M_d / r*`` and the scaled spin ``r* omega_n`` the
+power ``F_T . v_T + M_d omega_n`` keeps its form and the ellipsoid is the
+round ball ``|(F_T, M_d / r*)| <= mu N``: maximal dissipation puts the
+generalized force opposite the generalized slip ``(v_T, r* omega_n)``, and
+the contact is the Coulomb cone of :mod:`moreau.contact.cone3d` with three
+tangential rows, ``[n, t1, t2, d]``, the drilling row ``d = r* n . (R
+omega)`` (:meth:`SpaceScene.drilling_rows`). A Hertzian pressure would give
+``r* = 3 pi r / 16`` instead; ``r`` is the patch the user names, its
+pressure uniform.
+
 Examples
 --------
 A ball of radius 0.1 m on the floor, sliding at 1 m/s without spin:
@@ -129,7 +162,11 @@ from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "Box", "Capsule", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
-           "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN"]
+           "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN", "DRILLING_LEVER"]
+
+#: ``r* / r``: a uniform pressure on a patch of radius ``r`` resists pure spin with the torque
+#: ``mu N r*`` (the module docstring's "Coulomb–Contensou friction")
+DRILLING_LEVER = 2.0 / 3.0
 
 #: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
 #: has no single lowest point (the rim point's direction is rounding over this sine)
@@ -425,13 +462,20 @@ class SpaceModel:
         self.planes.append(HalfSpace(point, normal, tangent))
         return len(self.planes) - 1
 
-    def add_contact(self, body, shape, plane, mu=0.0, restitution=0.0):
+    def add_contact(self, body, shape, plane, mu=0.0, restitution=0.0, contact_radius=0.0):
         """Contacts of ``body``'s ``shape`` with the half-space ``plane``; returns their indices.
 
         A :class:`Sphere` gives one contact, a :class:`Puck` one per rim point, a
         :class:`Box` one per named corner, a :class:`Capsule` two (its end spheres),
         a :class:`Disk` one (its rim's lowest point; refused, naming
         ``orientation``, where the body lies flat on the half-space).
+
+        ``contact_radius`` [m], ``>= 0``: the radius ``r`` of a flat contact
+        patch of uniform pressure about each contact point, which adds the
+        drilling (Contensou) friction torque about the normal, coupled with
+        the sliding force in Leine and Glocker's ellipsoid (the module
+        docstring's "Coulomb–Contensou friction"); ``0``, the default, is the
+        point contact. Refused, naming it, on a :class:`Disk`'s rim.
         """
         if isinstance(body, bool) or not isinstance(body, (int, np.integer)) \
                 or not 0 <= body < len(self.bodies):
@@ -450,6 +494,10 @@ class SpaceModel:
         e = finite_scalar("restitution", restitution)
         if not 0.0 <= e <= 1.0:
             raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        r_patch = nonnegative("contact_radius", contact_radius)
+        if r_patch > 0.0 and isinstance(shape, Disk):
+            raise InputError("`contact_radius` must be 0 on a Disk: its rim touches along a "
+                             "line, with no flat patch about the contact point")
         if isinstance(shape, Disk):
             R = rotation_matrix(self.bodies[body]["orientation"], check=False)
             n = self.planes[plane].normal
@@ -470,6 +518,9 @@ class SpaceModel:
                                   "point": None if pts is None else pts[k],
                                   "centre": (shape.centre / self.length if pts is None
                                              and np.any(shape.centre != 0.0) else None)})
+            if r_patch > 0.0:
+                # the key only where there is a patch: a point contact's data stay as they were
+                self.contacts[-1]["contact_radius"] = r_patch / self.length
             out.append(len(self.contacts) - 1)
         return out
 
@@ -525,6 +576,12 @@ class SpaceScene(Scene):
         self.contact_bodies = [c["body"] for c in model.contacts]
         self.mu = np.array([c["mu"] for c in model.contacts])
         self.restitution = np.array([c["e"] for c in model.contacts])
+        #: each contact's patch radius ``r`` (scene units; 0: a point contact)
+        self.contact_radii = np.array([c.get("contact_radius", 0.0) for c in model.contacts])
+        #: ``r* = 2 r / 3``: the drilling torque's lever in the friction ellipsoid
+        self.drilling_levers = DRILLING_LEVER * self.contact_radii
+        #: True where a frictional contact has a patch (Coulomb–Contensou friction)
+        self.drilling = bool(np.any((self.drilling_levers > 0.0) & (self.mu > 0.0)))
 
     def initial_state(self):
         return self._q0.copy(), self._v0.copy()
@@ -620,6 +677,30 @@ class SpaceScene(Scene):
         for i in range(self.ncontacts):
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i, Rs)
             out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
+        return out
+
+    def drilling_rows(self, q):
+        """Every contact's drilling row ``r* n . (R omega)`` against the velocities, (nc, nvel).
+
+        The spin about the half-space's normal, scaled by the contact's lever
+        ``r*`` (:attr:`drilling_levers`; zero rows for point contacts): with
+        it the friction ellipsoid is the round cone of the module docstring.
+
+        Examples
+        --------
+        >>> m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.1)
+        >>> b = m.add_body(1.0, [0.004] * 3, position=(0.0, 0.0, 0.1))
+        >>> _ = m.add_contact(b, Sphere(0.1), m.add_half_space((0, 0, 0), (0, 0, 1)), mu=0.2,
+        ...                   contact_radius=0.03)
+        >>> m.build("ball").drilling_rows(np.array([0, 0, 1.0, 1, 0, 0, 0])).round(12).tolist()
+        [[0.0, 0.0, 0.0, 0.0, 0.0, 0.2]]
+        """
+        q = np.asarray(q, dtype=float)
+        out = np.zeros((self.ncontacts, self.nvel))
+        Rs = self._rotations(q)
+        for i in np.flatnonzero(self.drilling_levers > 0.0):
+            b, _, R, _, _, n, _, _ = self._contact_geometry(q, i, Rs)
+            out[i, 6 * b + 3:6 * b + 6] = self.drilling_levers[i] * (n @ R)
         return out
 
     def contact_jacobians(self, q, t):
@@ -736,7 +817,8 @@ class SpaceScene(Scene):
         of mass (``s = -radius n``), 1 for an eccentric sphere (``s = R c -
         radius n``, ``c`` its centre) and 2 for a material point (``s = R
         c``, ``c`` the point), as in the module docstring. None where a
-        contact is of none of these kinds.
+        contact is of none of these kinds, or has a contact patch
+        (``contact_radius > 0``: Coulomb–Contensou friction, the Python step's).
 
         Examples
         --------
