@@ -20,7 +20,7 @@ import numpy as np
 
 from ._mj_kernels import (OK, S_PEN, SINGULAR, _classify, _invert_gj, _invert_small, lcp_buffers,
                           record_sample)
-from ._step_parts import affine_rows, gap_block, gaps_at, held_gaps, move_back, times_ht
+from ._step_parts import gap_block, held_gaps, move_back
 from ._tdg_kernels import _solve_small, _stage_problem
 
 __all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY", "DENSE_IMPACT",
@@ -187,7 +187,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                         sl[c] = 0.0
                         act[c] = False
                     if nc > 0:
-                        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qm, tm, Gm)  # noqa: F821
+                        if HAS_GAPS:  # noqa: F821
+                            gaps_fn(par, qm, tm, Gm)  # noqa: F821
+                        else:
+                            contacts_fn(par, qm, tm, Gm, True, False)  # noqa: F821
                         for c in range(nc):
                             # a contact that carried a force stays in the index set
                             # while it does, whatever its midpoint gap
@@ -220,15 +223,23 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                                 Hm[na + r, k] = Gm[c, 3 + n + k]
                                 He[na + r, k] = Ge[c, 3 + n + k]
                             we[na + r] = Ge[c, 2]
-                        times_ht(Mi, Hm, Dir, m, n)
+                        for cc in range(m):
+                            for k in range(n):
+                                a = 0.0
+                                for l in range(n):
+                                    a += Mi[k, l] * Hm[cc, l]
+                                Dir[k, cc] = a
                         st = _stage_problem(He, we, Dir, vf, ea, vpre, n, na, nfa, ia, mu,
                                             force_lemke, p, pN, pT, U, Wd, Uf, base, trow, lw,
                                             lcp_ctl, stats)
                         if st != OK:
                             status = st
                             break
-                        # v1 = vf + Dir p
-                        affine_rows(Dir, vf, p, v1, n, m)
+                        for k in range(n):
+                            a = vf[k]
+                            for cc in range(m):
+                                a += Dir[k, cc] * p[cc]
+                            v1[k] = a
                         for r in range(nfa):
                             sl[fa[r]] = U[na + r]
                     # the mean accelerations of the first and the last base step: at
@@ -248,7 +259,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     miss = False
                     if na < nc:
                         # only a contact open at the midpoint can be crossed unseen
-                        gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qs, tb + hb, G1)  # noqa: F821
+                        if HAS_GAPS:  # noqa: F821
+                            gaps_fn(par, qs, tb + hb, G1)  # noqa: F821
+                        else:
+                            contacts_fn(par, qs, tb + hb, G1, True, False)  # noqa: F821
                         for c in range(nc):
                             if G1[c, 0] < 0.0 and not act[c]:
                                 miss = True
@@ -406,7 +420,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     status = SINGULAR
                     break
             for it in range(4):
-                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, G1)  # noqa: F821
+                if HAS_GAPS:  # noqa: F821
+                    gaps_fn(par, q1, t1, G1)  # noqa: F821
+                else:
+                    contacts_fn(par, q1, t1, G1, True, False)  # noqa: F821
                 gm = held_gaps(G1, held, nh, gx)
                 if gm == 0.0:
                     break
@@ -436,7 +453,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
             if _solve_small(S, gx, nh):
                 move_back(MW, gx, v1, nh, n)
         if nc > 0:
-            gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, G1)  # noqa: F821
+            if HAS_GAPS:  # noqa: F821
+                gaps_fn(par, q1, t1, G1)  # noqa: F821
+            else:
+                contacts_fn(par, q1, t1, G1, True, False)  # noqa: F821
             for c in range(nc):
                 if -G1[c, 0] > stats[S_PEN]:
                     stats[S_PEN] = -G1[c, 0]
@@ -449,7 +469,10 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
             reg[c] = sq_reg[ir, c]
         if record_initial:
             if nc > 0:
-                gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q, t, Gm)  # noqa: F821
+                if HAS_GAPS:  # noqa: F821
+                    gaps_fn(par, q, t, Gm)  # noqa: F821
+                else:
+                    contacts_fn(par, q, t, Gm, True, False)  # noqa: F821
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
                           t, q, v, reg, pN, pT, H, sl, Gm, n, nc)
             rec_kind[nrec] = -1

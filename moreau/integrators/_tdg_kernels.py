@@ -18,9 +18,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
                           _residual, _stop_at, grid_step, lcp_buffers, record_sample)
 from ._driver import loop_template, spliced
-from ._step_parts import (affine_rows, all_finite, gap_block, gaps_at, gather_rows, held_gaps,
-                          index_set, invert, move_back, record_contacts, rows_times,
-                          start_contacts, times_ht)
+from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, held_gaps, index_set,
+                          invert, move_back, record_contacts, start_contacts, times_ht)
 
 __all__ = ["tdg_loop"]
 
@@ -44,8 +43,11 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
     """
     m = na + nfa
     need = False
-    affine_rows(Hm, wm, vfree, U, m, n)
     for r in range(m):
+        acc = wm[r]
+        for j in range(n):
+            acc += Hm[r, j] * vfree[j]
+        U[r] = acc
         p[r] = 0.0
     for r in range(na):
         i = ia[r]
@@ -56,7 +58,12 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
     if not need:
         # no contact needs to push: a zero normal impulse bounds the friction to zero
         return OK
-    rows_times(Hm, Dir, Wd, m, n)
+    for r in range(m):
+        for c in range(m):
+            acc = 0.0
+            for j in range(n):
+                acc += Hm[r, j] * Dir[j, c]
+            Wd[r, c] = acc
     stats[S_LCP] += 1.0
     if na == 1 and not force_lemke:
         stats[S_DIRECT] += 1.0
