@@ -202,6 +202,13 @@ def shorthands():
     return ("frequency",) + tuple(sorted(set(scene_parameter_flags()) - {"frequency"}))
 
 
+def _scene_command(p, func, with_set=True):
+    # the options every command on one scene ends with, and its function
+    _add_params(p, scheme_defaults=False)
+    add_scene_options(p, with_set=with_set)
+    p.set_defaults(func=func)
+
+
 def add_scene_options(p, with_set=True):
     """The ``--scene`` switch (and ``--set``); the scene parameters' flags where not yet there."""
     default = default_scene()
@@ -577,9 +584,7 @@ def _add_atlas(sub):
                    help="budget of the plain run that names the motion of a point without a "
                         "periodic orbit (period-k, non-periodic with its mean, runaway); "
                         "0: none (default %d)" % CLASSIFY_PERIODS)
-    _add_params(p, scheme_defaults=False)
-    add_scene_options(p, with_set=False)
-    p.set_defaults(func=_cmd_atlas)
+    _scene_command(p, _cmd_atlas, with_set=False)
 
 
 #: options of a scene's own atlas that the generic one (--x, --y) does not take
@@ -839,9 +844,7 @@ def build_parser():
     _add_points_options(s, "run", "the figure",
                         "also write the table as NetCDF (.nc next to the CSV: the swept parameter "
                         "as coordinate, units as attributes; needs pip install -e \".[data]\")")
-    _add_params(s, scheme_defaults=False)
-    add_scene_options(s, with_set=False)
-    s.set_defaults(func=_cmd_sweep)
+    _scene_command(s, _cmd_sweep, with_set=False)
     r = sub.add_parser("run", help="time history of any scene under any scheme, from its initial "
                                     "state (CSV with units, JSON sidecar, figure)")
     r.add_argument("--frequency", type=float, default=None, help="drive frequency [Hz]")
@@ -854,9 +857,7 @@ def build_parser():
     r.add_argument("--samples", type=int, default=2000,
                    help="samples written, evenly spaced in time (default 2000)")
     _add_output_options(r, "run")
-    _add_params(r, scheme_defaults=False)
-    add_scene_options(r)
-    r.set_defaults(func=_cmd_run)
+    _scene_command(r, _cmd_run)
     b = sub.add_parser("bifurcation", help="stroboscopic section of the long-run motion against "
                                           "one parameter, period, Lyapunov exponent and "
                                           "bifurcation marks (CSV, JSON sidecar, figure)")
@@ -882,9 +883,7 @@ def build_parser():
                    help="do not start from a shot periodic orbit (only the transient)")
     b.add_argument("--json", action="store_true", help="print one JSON object")
     _add_output_options(b, "run")
-    _add_params(b, scheme_defaults=False)
-    add_scene_options(b)
-    b.set_defaults(func=_cmd_bifurcation)
+    _scene_command(b, _cmd_bifurcation)
     ch = sub.add_parser("characteristic", help="the motor's load characteristic: no-load "
                                                "velocity, stall force, maximum output power "
                                                "(CSV, JSON sidecar, figure)")
@@ -900,9 +899,7 @@ def build_parser():
     ch.add_argument("--json", action="store_true", help="print the summary as one JSON object")
     ch.add_argument("--out", default="out", help="output folder (default ./out)")
     ch.add_argument("--no-plot", action="store_true", help="skip the figure")
-    _add_params(ch, scheme_defaults=False)
-    add_scene_options(ch)
-    ch.set_defaults(func=_cmd_characteristic)
+    _scene_command(ch, _cmd_characteristic)
     _add_reproduce(sub)
     _add_atlas(sub)
     sc = sub.add_parser("scenes", help="the registered scenes, their parameters and units")

@@ -73,6 +73,7 @@ from ..provenance import provenance
 from ..regimes import Regime
 from ..model import registry
 from . import engine
+from ._illinois import false_position, illinois_update
 from ..integrators.event_driven_generic import project_positions
 from .classify import MAX_PERIOD_K, sequence_period
 from .engine import check_output_dir
@@ -627,25 +628,14 @@ def _brent(fun, a, b, fa, fb, xtol, evals):
     # Illinois regula falsi on a sign change of fun over [a, b]
     n, side = 0, 0
     while abs(b - a) > xtol and n < evals:
-        c = (a * fb - b * fa) / (fb - fa)
-        if not min(a, b) < c < max(a, b):
-            c = 0.5 * (a + b)
+        c = false_position(a, b, fa, fb)
         fc = fun(c)
         n += 1
         if not math.isfinite(fc):
             return a, b, n, False
         if fc == 0.0:
             return c, c, n, True
-        if (fc > 0) == (fb > 0):
-            b, fb = c, fc
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:
-            a, fa = c, fc
-            if side == 1:
-                fb *= 0.5
-            side = 1
+        a, fa, b, fb, side = illinois_update(a, fa, b, fb, c, fc, side, (fc > 0) == (fb > 0))
     return a, b, n, True
 
 

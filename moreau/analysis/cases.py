@@ -41,7 +41,7 @@ from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
-__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "GRID", "switching_error", "flatten",
+__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "ClosedFormPath", "GRID", "switching_error", "flatten",
            "contact_switches", "regime_switches", "switches", "drop_reversal_sticks"]
 
 TWO_PI = 2.0 * math.pi
@@ -281,6 +281,36 @@ class SpatialCase(FactoryCase):
         q0, v0 = self.start()
         return simulate(self.scene, (0.0, self.window), q0, v0, "moreau-jean",
                         h=self.window / n, theta=theta, cone=cone)
+
+
+class ClosedFormPath:
+    """A mixin for a case whose reference is a closed form of its coordinate in time.
+
+    The subclass gives :meth:`path`; the reference is that path at the end
+    of the window and on the comparison grid, the headline the coordinate at
+    the run's last sample, and no switch is compared (the regime holds over
+    the window, :meth:`first_regime`).
+    """
+
+    def path(self, tau):
+        """The coordinate (scene units) at the scene times ``tau`` (an array)."""
+        raise NotImplementedError
+
+    def first_regime(self):
+        """The regime letter that holds over the window."""
+        return "S"
+
+    def reference(self, rtol):
+        return float(self.path(np.array([self.window]))[0]), [(0.0, self.first_regime())]
+
+    def reference_grid(self):
+        return self.path(np.linspace(0.0, self.window, GRID + 1))
+
+    def headline_of_run(self, res):
+        return float(self.coordinate(res.q[-1:])[0])
+
+    def _run_switches(self, res, h):
+        return []
 
 
 class DriveCase(CompareCase):

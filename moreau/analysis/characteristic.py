@@ -361,20 +361,25 @@ def motor_characteristic(scene, frequency=None, fixed=None, scheme=ED_REFERENCE,
         summary["note"] = (f"{summary['failed_points']} of the {points} grid loads have no "
                            "steady state (their `status` in the table); the others are kept")
     if out is not None:
-        stem = out / characteristic_tag(entry.name, frequency or 0.0, scheme)
-        csv_path = stem.with_name(stem.name + ".csv")
-        write_csv(csv_path, rows, COLUMNS)
-        side = dict(summary, csv=csv_path.name)
-        json_path = stem.with_name(stem.name + ".json")
-        json_path.write_text(json.dumps(side, indent=1, default=str))
-        log(f"wrote {csv_path} and {json_path.name}")
-        if plot:
-            fig = stem.with_name(stem.name + ".png")
-            if _figure(rows, summary, fig):
-                log(f"wrote {fig}")
-            else:
-                log("matplotlib is not installed: no figure (pip install matplotlib)")
+        _write_table(out / characteristic_tag(entry.name, frequency or 0.0, scheme), rows,
+                     COLUMNS, summary, _load_panels if plot else None, log)
     return {"summary": summary, "rows": rows}
+
+
+def _write_table(stem, rows, columns, summary, draw, log):
+    # STEM.csv, its sidecar STEM.json (the summary) and, with `draw` (see _plot), STEM.png
+    csv_path = stem.with_name(stem.name + ".csv")
+    write_csv(csv_path, rows, columns)
+    side = dict(summary, csv=csv_path.name)
+    json_path = stem.with_name(stem.name + ".json")
+    json_path.write_text(json.dumps(side, indent=1, default=str))
+    log(f"wrote {csv_path} and {json_path.name}")
+    if draw is not None:
+        fig = stem.with_name(stem.name + ".png")
+        if _plot(draw, rows, summary, fig):
+            log(f"wrote {fig}")
+        else:
+            log("matplotlib is not installed: no figure (pip install matplotlib)")
 
 
 def _or_none(x):
@@ -508,17 +513,8 @@ def efficiency_vs_frequency(scene, frequencies, fixed=None, scheme=ED_REFERENCE,
     }
     if out is not None:
         stem = out / f"efficiency_{entry.name}_{min(freqs):g}-{max(freqs):g}Hz_{scheme.full_label}"
-        csv_path = stem.with_name(stem.name + ".csv")
-        write_csv(csv_path, rows, EFFICIENCY_COLUMNS)
-        side = dict(summary, csv=csv_path.name)
-        stem.with_name(stem.name + ".json").write_text(json.dumps(side, indent=1, default=str))
-        log(f"wrote {csv_path} and {stem.name}.json")
-        if plot:
-            fig = stem.with_name(stem.name + ".png")
-            if _efficiency_figure(rows, summary, fig):
-                log(f"wrote {fig}")
-            else:
-                log("matplotlib is not installed: no figure (pip install matplotlib)")
+        _write_table(stem, rows, EFFICIENCY_COLUMNS, summary, _efficiency_panels if plot else None,
+                     log)
     return {"summary": summary, "rows": rows}
 
 
@@ -563,20 +559,28 @@ def _row(curve, load, v0, scheme):
     return row
 
 
-def _figure(rows, summary, path):
+def _plot(draw, rows, summary, path):
+    # two panels sharing x, drawn by `draw(ok_rows, summary, a1, a2)` and saved at `path`;
+    # False without matplotlib
     try:
         import matplotlib  # noqa: PLC0415  (optional: figures only)
     except ImportError:
         return False
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt  # noqa: PLC0415
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
+    draw([r for r in rows if r["status"] == "ok"], summary, a1, a2)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return True
 
-    ok = [r for r in rows if r["status"] == "ok"]
+
+def _load_panels(ok, summary, a1, a2):
     f = np.array([r["load_N"] for r in ok]) * 1e3
     v = np.array([r["average_velocity_m_per_s"] for r in ok]) * 1e3
     p = np.array([r["output_power_W"] for r in ok]) * 1e6
     eff = np.array([r["efficiency"] for r in ok])
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     a1.plot(f, v, "k.-", lw=0.8)
     a1.axhline(0.0, color="0.7", lw=0.5)
     a1.axvline(summary["stall_force_N"] * 1e3, color="C3", lw=0.8, ls="--",
@@ -596,23 +600,10 @@ def _figure(rows, summary, path):
         ax.plot(f, eff * 100, "C2--", lw=0.8, label="efficiency")
         ax.set_ylabel("efficiency [%]", color="C2")
     a2.legend(fontsize=8, loc="lower left")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return True
 
 
-def _efficiency_figure(rows, summary, path):
-    try:
-        import matplotlib  # noqa: PLC0415  (optional: figures only)
-    except ImportError:
-        return False
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt  # noqa: PLC0415
-
-    ok = [r for r in rows if r["status"] == "ok"]
+def _efficiency_panels(ok, summary, a1, a2):
     f = np.array([r["frequency_Hz"] for r in ok])
-    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 6), sharex=True)
     a1.plot(f, [100 * r["efficiency"] for r in ok], "C2o-", lw=0.8)
     a1.set_ylabel("efficiency at max. power [%]")
     eff = np.array([r["efficiency"] for r in ok])
@@ -630,7 +621,3 @@ def _efficiency_figure(rows, summary, path):
     for ax in (a1, a2):
         ax.set_xscale("log")
         ax.grid(True, which="both", lw=0.3, color="0.85")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return True

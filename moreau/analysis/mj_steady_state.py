@@ -51,6 +51,7 @@ from ..modes import impacts_after_flight, mode_name, step_letters
 from ..integrators.contact_problem import check_painleve
 from ..integrators.moreau_jean import LCP_METHODS, MoreauJean
 from ..integrators.result import SteadyState
+from ._illinois import false_position, illinois_update
 from .floquet import period_map_jacobian, sorted_multipliers
 from .periodic_shooting import free_bases
 from .steady_solvers import register_steady_solver
@@ -685,22 +686,12 @@ def _bracket_u(pm, x, closed, scale, tol, max_iter):
             raise ConvergenceError(
                 f"Moreau–Jean shooting did not converge in `max_iter` iterations "
                 f"(bracket [{ua:.17g}, {ub:.17g}])")
-        uc = (ua * Fb - ub * Fa) / (Fb - Fa)
-        if not (min(ua, ub) < uc < max(ua, ub)):
-            uc = 0.5 * (ua + ub)
+        uc = false_position(ua, ub, Fa, Fb)
         Fc, xc, yc, cc = ev(uc)
         if done(Fc, xc, yc) or uc in (ua, ub):
             return xc, float(np.max(np.abs(yc - xc) / scale)), yc, cc, it
-        if np.sign(Fc) == np.sign(Fb):
-            ub, Fb = uc, Fc
-            if side == -1:
-                Fa *= 0.5
-            side = -1
-        else:
-            ua, Fa = uc, Fc
-            if side == 1:
-                Fb *= 0.5
-            side = 1
+        ua, Fa, ub, Fb, side = illinois_update(ua, Fa, ub, Fb, uc, Fc, side,
+                                               np.sign(Fc) == np.sign(Fb))
 
 
 def _jacobian(pm, x, closed, scale, rel, y1=None, central=False):

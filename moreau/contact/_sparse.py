@@ -42,6 +42,8 @@ from numba import njit
 from moreau import _jit_cache
 from moreau._validate import finite_array
 from moreau.errors import InputError
+from moreau.lcp import _certified
+from moreau.lcp._certified import two_prod
 
 #: numba's cache pickles the module's name with the machine code; a copy of this file imported
 #: under another name (pytest's doctest collection imports a module outside a regular package
@@ -267,19 +269,6 @@ def _two_sum(a, b):
     return s, (a - (s - bb)) + (b - bb)
 
 
-@njit(cache=_CACHE, inline="always")
-def _two_prod(a, b):
-    # Dekker's splitting (no fused multiply-add in numba's portable code)
-    p = a * b
-    c = 134217729.0 * a
-    ah = c - (c - a)
-    al = a - ah
-    c = 134217729.0 * b
-    bh = c - (c - b)
-    bl = b - bh
-    return p, ((ah * bh - p) + ah * bl + al * bh) + al * bl
-
-
 @njit(cache=_CACHE)
 def velocities_compensated(indptr, indices, data, q, r, u):
     """``u = W r + q`` row by row with compensated sums (Ogita, Rump, Oishi 2005, Dot2)."""
@@ -288,7 +277,7 @@ def velocities_compensated(indptr, indices, data, q, r, u):
         s = q[i]
         c = 0.0
         for k in range(indptr[i], indptr[i + 1]):
-            p, ep = _two_prod(data[k], r[indices[k]])
+            p, ep = two_prod(data[k], r[indices[k]])
             s, es = _two_sum(s, p)
             c += ep + es
         u[i] = s + c
@@ -339,8 +328,8 @@ def record_check(indptr, indices, data, q, r, u, mu, it, hist_it, hist_res, nh, 
 
 
 _jit_cache.bind_cache_to_sources(
-    [project_cone, _local_residual_sq, local_solve, _two_sum, _two_prod, velocities_compensated,
-     velocities, natural_map, record_check], [__file__])
+    [project_cone, _local_residual_sq, local_solve, _two_sum, velocities_compensated,
+     velocities, natural_map, record_check], [__file__, _certified.__file__])
 
 
 def problem_residual(W, q, mu, r):

@@ -75,11 +75,7 @@ class CompiledRecording:
         state in ``before``/``after``, stores them back after the call, then
         hands the status to :meth:`_after_block`.
         """
-        n, nc = self.scene.ndof, self.scene.ncontacts
-        ns = FAST_BLOCK // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, velocity_count(self.scene))),
-               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
-               np.empty((ns, nc)), np.empty((ns, nc)))
+        buf = self._block_buffers(velocity_count(self.scene))
         st = self._stats
         st[:] = 0.0
         m = self._model
@@ -87,6 +83,23 @@ class CompiledRecording:
             m.par, self.mu_c, self.e_c, self.t0, self.h, self.t_bound, self._k,
             getattr(self, "_block_limit", FAST_BLOCK),
             *before, self.save_every, self._pending_initial, *after, *buf, st)
+        self._keep_block(k, nrec, buf)
+        c = self.counters
+        for name, x in zip(STAT_NAMES, st):
+            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
+        return status
+
+    def _block_buffers(self, nv):
+        """A block's recording buffers: times, ``q``, ``v`` (``nv`` columns), the
+        regimes, normal and tangential forces, slips and gaps of the contacts."""
+        n, nc = self.scene.ndof, self.scene.ncontacts
+        ns = FAST_BLOCK // self.save_every + 2
+        return (np.empty(ns), np.empty((ns, n)), np.empty((ns, nv)),
+                np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
+                np.empty((ns, nc)), np.empty((ns, nc)))
+
+    def _keep_block(self, k, nrec, buf):
+        """The books after a block that reached step ``k`` and recorded ``nrec`` rows of ``buf``."""
         ndone = k - self._k
         if nrec:
             self._blocks.append(tuple(b[:nrec].copy() for b in buf))
@@ -95,11 +108,7 @@ class CompiledRecording:
         self._k = k
         t = self.t0 + k * self.h
         self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
-        c = self.counters
-        for name, x in zip(STAT_NAMES, st):
-            c[name] = max(c[name], float(x)) if name.startswith("max_") else c[name] + int(x)
-        c["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
-        return status
+        self.counters["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
 
     def _runner(self, template):
         """The compiled loop of ``template`` on the run's model (:func:`runner_for`)."""

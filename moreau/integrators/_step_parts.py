@@ -29,7 +29,7 @@ from ._driver import spliced
 __all__ = ["invert", "gaps_at", "index_set", "gather_rows", "affine_rows", "times_ht",
            "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows", "all_finite",
            "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
-           "restitution_shift", "lemke_solve", "move_by", "dense_delassus", "one_row_impulse",
+           "restitution_shift", "lemke_solve", "move_by", "move_back", "held_gaps", "dense_delassus", "one_row_impulse",
            "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
@@ -335,6 +335,31 @@ def move_by(X, d, q, m, n):
         for c in range(m):
             acc += X[i, c] * d[c]
         q[i] += acc
+
+
+@spliced
+def held_gaps(G, held, nh, gx):
+    """``gx`` = the gaps (``G[:, 0]``) of the ``nh`` contacts listed in ``held``; returns the
+    largest in magnitude (a position projection's residual)."""
+    gm = 0.0
+    for r in range(nh):
+        gx[r] = G[held[r], 0]
+        gm = max(gm, abs(gx[r]))
+    return gm
+
+
+@spliced
+def move_back(X, d, q, m, n):
+    """``q -= X d`` over ``m`` columns; returns the largest ``|X d|`` (a Newton step onto the
+    gaps or the velocities along ``X = A^-1 WN^T``, and its size)."""
+    dmax = 0.0
+    for i in range(n):
+        acc = 0.0
+        for c in range(m):
+            acc += X[i, c] * d[c]
+        q[i] -= acc
+        dmax = max(dmax, abs(acc))
+    return dmax
 
 
 @spliced

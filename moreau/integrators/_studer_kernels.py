@@ -20,6 +20,7 @@ import numpy as np
 
 from ._mj_kernels import (OK, S_PEN, SINGULAR, _classify, _invert_gj, _invert_small, lcp_buffers,
                           record_sample)
+from ._step_parts import gap_block, held_gaps, move_back
 from ._tdg_kernels import _solve_small, _stage_problem
 
 __all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY", "DENSE_IMPACT",
@@ -423,35 +424,15 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     gaps_fn(par, q1, t1, G1)  # noqa: F821
                 else:
                     contacts_fn(par, q1, t1, G1, True, False)  # noqa: F821
-                gm = 0.0
-                for r in range(nh):
-                    gx[r] = G1[held[r], 0]
-                    gm = max(gm, abs(gx[r]))
+                gm = held_gaps(G1, held, nh, gx)
                 if gm == 0.0:
                     break
                 contacts_fn(par, q1, t1, G1, False, True)  # noqa: F821
-                for cc in range(nh):
-                    for k in range(n):
-                        a = 0.0
-                        for l in range(n):
-                            a += Mp[k, l] * G1[held[cc], 3 + l]
-                        MW[k, cc] = a
-                for r in range(nh):
-                    for cc in range(nh):
-                        a = 0.0
-                        for k in range(n):
-                            a += G1[held[r], 3 + k] * MW[k, cc]
-                        S[r, cc] = a
+                gap_block(G1, held, nh, Mp, MW, S, n)
                 if not _solve_small(S, gx, nh):
                     break
-                dmax = 0.0
+                dmax = move_back(MW, gx, q1, nh, n)
                 qmax = 1.0
-                for k in range(n):
-                    a = 0.0
-                    for cc in range(nh):
-                        a += MW[k, cc] * gx[cc]
-                    q1[k] -= a
-                    dmax = max(dmax, abs(a))
                 for k in range(n):
                     qmax = max(qmax, abs(q1[k]))
                 if dmax <= 4e-16 * qmax:
@@ -463,28 +444,14 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                     status = SINGULAR
                     break
             contacts_fn(par, q1, t1, G1, False, True)  # noqa: F821
-            for cc in range(nh):
-                for k in range(n):
-                    a = 0.0
-                    for l in range(n):
-                        a += Mp[k, l] * G1[held[cc], 3 + l]
-                    MW[k, cc] = a
+            gap_block(G1, held, nh, Mp, MW, S, n)
             for r in range(nh):
                 a = G1[held[r], 1]
                 for k in range(n):
                     a += G1[held[r], 3 + k] * v1[k]
                 gx[r] = a
-                for cc in range(nh):
-                    a = 0.0
-                    for k in range(n):
-                        a += G1[held[r], 3 + k] * MW[k, cc]
-                    S[r, cc] = a
             if _solve_small(S, gx, nh):
-                for k in range(n):
-                    a = 0.0
-                    for cc in range(nh):
-                        a += MW[k, cc] * gx[cc]
-                    v1[k] -= a
+                move_back(MW, gx, v1, nh, n)
         if nc > 0:
             if HAS_GAPS:  # noqa: F821
                 gaps_fn(par, q1, t1, G1)  # noqa: F821
@@ -493,19 +460,19 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
             for c in range(nc):
                 if -G1[c, 0] > stats[S_PEN]:
                     stats[S_PEN] = -G1[c, 0]
+        # the step's regime and forces, recorded at its end and, as every time-stepping
+        # scheme records its start (no step has ended there), at the start of the first
+        for c in range(nc):
+            pN[c] = sq_pN[ir, c]
+            pT[c] = sq_pT[ir, c]
+            sl[c] = sq_slip[ir, c]
+            reg[c] = sq_reg[ir, c]
         if record_initial:
             if nc > 0:
                 if HAS_GAPS:  # noqa: F821
                     gaps_fn(par, q, t, Gm)  # noqa: F821
                 else:
                     contacts_fn(par, q, t, Gm, True, False)  # noqa: F821
-            # the first step's regime and forces, as every time-stepping scheme records its
-            # start (no step has ended there)
-            for c in range(nc):
-                pN[c] = sq_pN[ir, c]
-                pT[c] = sq_pT[ir, c]
-                sl[c] = sq_slip[ir, c]
-                reg[c] = sq_reg[ir, c]
             record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
                           t, q, v, reg, pN, pT, H, sl, Gm, n, nc)
             rec_kind[nrec] = -1
@@ -514,11 +481,6 @@ def studer_loop(par, mu, e, t_bound, tol, K, h_min, budget, nmax, th, q, v, clos
                 rec_a1[nrec, k] = 0.0
             nrec += 1
             record_initial = False
-        for c in range(nc):
-            pN[c] = sq_pN[ir, c]
-            pT[c] = sq_pT[ir, c]
-            sl[c] = sq_slip[ir, c]
-            reg[c] = sq_reg[ir, c]
         record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
                       t1, q1, v1, reg, pN, pT, H, sl, G1, n, nc)
         rec_kind[nrec] = kind

@@ -18,8 +18,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
                           _residual, _stop_at, grid_step, lcp_buffers, record_sample)
 from ._driver import loop_template, spliced
-from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, index_set, invert,
-                          record_contacts, start_contacts, times_ht)
+from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, held_gaps, index_set,
+                          invert, move_back, record_contacts, start_contacts, times_ht)
 
 __all__ = ["tdg_loop"]
 
@@ -222,22 +222,13 @@ def project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, par, t1, n
     for it in range(4):
         contacts_fn(par, qi, t1, Gi, False, True)  # noqa: F821
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qi, t1, Gi)
-        gm = 0.0
-        for r in range(nh):
-            gx[r] = Gi[held[r], 0]
-            gm = max(gm, abs(gx[r]))
+        gm = held_gaps(Gi, held, nh, gx)
         if gm == 0.0:
             break
         gap_block(Gi, held, nh, Mi, MW, S, n)
         if not _solve_small(S, gx, nh):
             break
-        dmax = 0.0
-        for j in range(n):
-            acc = 0.0
-            for c in range(nh):
-                acc += MW[j, c] * gx[c]
-            qi[j] -= acc
-            dmax = max(dmax, abs(acc))
+        dmax = move_back(MW, gx, qi, nh, n)
         stats[S_PROJ] += 1.0
         if dmax <= 4e-16 * qmax:
             break

@@ -340,6 +340,13 @@ __all__ = ["MoreauJean", "one_contact_impulse", "one_contact_residual", "classif
 #: most Python steps taken in a row on a spatial scene after hand-backs of the compiled loop
 _MAX_PYTHON_RUN = 64
 
+#: the failure messages of Moreau–Jean's compiled blocks (:meth:`_after_block`'s)
+_MJ_FAILURES = dict(
+    singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
+              "t = {t!r}; reduce `h` or use a smaller `theta`"),
+    numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
+               "too large for an explicit part of the forces)"))
+
 # |p_T| within this relative distance of mu p_N counts as slip: the LCP and
 # the enumeration reach the friction-cone boundary only up to rounding
 SLIP_RTOL = 1e-10
@@ -870,10 +877,7 @@ class MoreauJean(TimeStepping):
         q, v = self.q.copy(), self.v.copy()
         closed = np.ascontiguousarray(self._closed, dtype=bool).copy()
         reg = np.ascontiguousarray(self._regimes_before(), dtype=np.int64).copy()
-        ns = FAST_BLOCK // self.save_every + 2
-        buf = (np.empty(ns), np.empty((ns, n)), np.empty((ns, n)),
-               np.empty((ns, nc), dtype=np.int64), np.empty((ns, nc)), np.empty((ns, nc)),
-               np.empty((ns, nc)), np.empty((ns, nc)))
+        buf = self._block_buffers(n)
         st = np.zeros(len(J_STAT_NAMES))
         status, k, nrec = run_joint_block(
             m.mass, m.forces, m.contacts, sc.compiled_joints(), n, nc, self._n_eq,
@@ -883,30 +887,17 @@ class MoreauJean(TimeStepping):
             float(self.theta), self.joint_rows != "end", float(self.joint_baumgarte), closed,
             reg, self.save_every,
             self._pending_initial, *buf, st)
-        ndone = k - self._k
-        if nrec:
-            self._blocks.append(tuple(b[:nrec].copy() for b in buf))
-        if ndone:
-            self._pending_initial = False
-        self._k = k
-        t = self.t0 + k * self.h
-        self.t = self.t_bound if t >= self.t_bound - 1e-9 * self.h else t
+        self._keep_block(k, nrec, buf)
         self.q, self.v, self._closed = q, v, closed
         self._regimes_before()[:] = reg
         c = self.counters
-        c["steps"] += ndone - 1     # the base class counts one step per call of _step_impl
         c["lcp_solves"] += int(st[0])
         c["max_residual"] = max(c["max_residual"], float(st[1]))
         c["max_penetration"] = max(c["max_penetration"], float(st[2]))
         self._max_drift = max(self._max_drift, float(st[3]))
         # a step the loop leaves (several contacts, a rank-deficient joint block, a case the
         # closed form does not decide) is the generic step's, which solves it or says why not
-        self._after_block(
-            status,
-            singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
-                      "t = {t!r}; reduce `h` or use a smaller `theta`"),
-            numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
-                       "too large for an explicit part of the forces)"))
+        self._after_block(status, **_MJ_FAILURES)
 
     def _space_block(self):
         if self._python_steps_left and not hasattr(self, "_block_limit"):
@@ -943,12 +934,7 @@ class MoreauJean(TimeStepping):
         # A tangential impact (or a Painlevé case on a singular Delassus matrix): the
         # generic step takes it and records it, or raises with the full diagnosis (the
         # state is the start of that step).
-        self._after_block(
-            status,
-            singular=("the iteration matrix W_hat = M - h theta C - h^2 theta^2 K is singular at "
-                      "t = {t!r}; reduce `h` or use a smaller `theta`"),
-            numerical=("non-finite state after the step at t = {t!r} (the step `h` is probably "
-                       "too large for an explicit part of the forces)"))
+        self._after_block(status, **_MJ_FAILURES)
 
     def _regimes_before(self):
         # the regimes of the last step taken, generic or compiled (a view, written in place)

@@ -54,7 +54,7 @@ import inspect
 
 import numpy as np
 
-from . import decide, lemke, qp
+from . import _result, decide, lemke, qp
 from ._result import (
     BREAKDOWN,
     INFEASIBLE,
@@ -83,19 +83,7 @@ from .lemke import lemke_core, lemke_kernel, lemke_workspace
 __all__ = [
     "solve_lcp",
     "METHODS",
-    "LCPResult",
-    "lcp_residual",
-    "lcp_violation",
-    "STATUS_MESSAGES",
-    "SOLVED",
-    "SECONDARY_RAY",
-    "MAX_ITER",
-    "BREAKDOWN",
-    "INVALID_INPUT",
-    "SOLVER_FAILED",
-    "NOT_APPLICABLE",
-    "INFEASIBLE",
-    "NO_SOLUTION",
+    *_result.__all__,
     "lemke_kernel",
     "lemke_core",
     "lemke_workspace",

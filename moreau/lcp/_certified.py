@@ -10,7 +10,7 @@ Python :func:`lcp_violation` all call it, so that "solved" means one thing.
 import numpy as np
 from numba import njit
 
-__all__ = ["residual", "lcp_violation", "farkas_float"]
+__all__ = ["residual", "lcp_violation", "farkas_float", "two_prod"]
 
 _EPS = float(np.finfo(float).eps)
 # a row's violation below 1e-9 times this (in units of max|q|) needs no
@@ -19,8 +19,20 @@ _CERT_SLACK = 1e-3
 
 
 @njit(cache=True, inline="always")
-def _two_prod(a, b):
-    # a b = p + e exactly (Dekker's split; Ogita, Rump & Oishi 2005, TwoProduct)
+def two_prod(a, b):
+    """``(p, e)`` with ``a b = p + e`` exactly, ``p = fl(a b)`` (compiled; no overflow or
+    underflow in the products).
+
+    Dekker's split (no fused multiply-add in numba's portable code); Ogita,
+    Rump & Oishi 2005, TwoProduct. Every operation of the error term is
+    exact, so it equals the rounding error of ``p``.
+
+    Examples
+    --------
+    >>> p, e = two_prod(1.0 + 2.0**-30, 1.0 + 2.0**-30)
+    >>> p == 1.0 + 2.0**-29, e == 2.0**-60
+    (True, True)
+    """
     p = a * b
     c = 134217729.0 * a
     ah = c - (c - a)
@@ -41,7 +53,7 @@ def _dot2_row(M, q, z, i, n):
     for j in range(n):
         zj = z[j]
         if zj != 0.0:
-            p, ep = _two_prod(M[i, j], zj)
+            p, ep = two_prod(M[i, j], zj)
             t = s + p
             bb = t - s
             es = (s - (t - bb)) + (p - bb)
@@ -137,7 +149,7 @@ def _dot_sign(M, q, y, j):
         a = abs(p)
         if not (a < 2.0**1000 and a > 2.0**-960):
             return 2
-        p, err = _two_prod(c, y[i])
+        p, err = two_prod(c, y[i])
         m = _grow(e, m, err)
         m = _grow(e, m, p)
     if m == 0:

@@ -73,6 +73,10 @@ import math
 import numpy as np
 from numba import njit
 
+from .. import _jit_cache
+from . import _certified
+from ._certified import two_prod
+
 __all__ = ["modular_step", "exact_point", "primes", "STEP_PIVOT", "STEP_RAY", "STEP_REFUSED",
            "STEP_TOO_BIG"]
 
@@ -254,6 +258,45 @@ def _reduce(x, p, pinv):
 def _to_residue(mant, sh, p, pinv, pow2):
     # (mant 2^sh) mod p, mant an integer below 2^53 in magnitude
     return _mulmod(_reduce(mant, p, pinv), pow2[sh], p, pinv)
+
+
+@njit(cache=True)
+def _prime_powers(P_all, pi, pow2, smax):
+    # the prime P_all[pi] and its reciprocal; pow2[s] = 2^s mod it for s <= smax
+    p = P_all[pi]
+    pinv = 1.0 / p
+    pow2[0] = 1
+    for s in range(1, smax + 1):
+        pow2[s] = _addmod(pow2[s - 1], pow2[s - 1], p)
+    return p, pinv
+
+
+@njit(cache=True)
+def _first_nonzero(A, col, k):
+    # the first row from col to k - 1 whose entry in column col is nonzero, -1 if none
+    for a in range(col, k):
+        if A[a, col] != 0:
+            return a
+    return -1
+
+
+@njit(cache=True)
+def _swap_rows(A, i, j):
+    for b in range(A.shape[1]):
+        tmp = A[i, b]
+        A[i, b] = A[j, b]
+        A[j, b] = tmp
+
+
+@njit(cache=True)
+def _radix_row(W, P, used, p, pinv):
+    # row `used` of the mixed-radix table: the earlier primes mod p, and in the
+    # diagonal the inverse of their product mod p
+    acc = np.int64(1)
+    for j in range(used):
+        W[used, j] = _reduce(P[j], p, pinv)
+        acc = _mulmod(acc, W[used, j], p, pinv)
+    W[used, used] = _invmod(acc, p)
 
 
 @njit(cache=True)
@@ -605,12 +648,8 @@ def _add_primes(target, maxbad, state, P_all, P, Pinv, dm, adj, Zc, Na, Nb, W, w
     while used < target:
         if pi >= NP:
             return False
-        p = P_all[pi]
+        p, pinv = _prime_powers(P_all, pi, pow2, smax)
         pi += 1
-        pinv = 1.0 / p
-        pow2[0] = 1
-        for s in range(1, smax + 1):
-            pow2[s] = _addmod(pow2[s - 1], pow2[s - 1], p)
         Zu = Zc[used]
         for c in range(k + 2):
             for a in range(n):
@@ -625,19 +664,12 @@ def _add_primes(target, maxbad, state, P_all, P, Pinv, dm, adj, Zc, Na, Nb, W, w
         det = np.int64(1)
         ok = True
         for col in range(k):
-            piv = -1
-            for a in range(col, k):
-                if G[a, col] != 0:
-                    piv = a
-                    break
+            piv = _first_nonzero(G, col, k)
             if piv < 0:
                 ok = False
                 break
             if piv != col:
-                for b in range(2 * k):
-                    tmp = G[col, b]
-                    G[col, b] = G[piv, b]
-                    G[piv, b] = tmp
+                _swap_rows(G, col, piv)
                 det = _submod(0, det, p)
             det = _mulmod(det, G[col, col], p, pinv)
             inv = _invmod(G[col, col], p)
@@ -685,11 +717,7 @@ def _add_primes(target, maxbad, state, P_all, P, Pinv, dm, adj, Zc, Na, Nb, W, w
                 Na[used, i] = acc_a
                 Nb[used, i] = acc_b
         # mixed radix: p_j mod p, the inverse of the product of the earlier primes
-        acc = np.int64(1)
-        for j in range(used):
-            W[used, j] = _reduce(P[j], p, pinv)
-            acc = _mulmod(acc, W[used, j], p, pinv)
-        W[used, used] = _invmod(acc, p)
+        _radix_row(W, P, used, p, pinv)
         used += 1
     state[0] = used
     state[1] = pi
@@ -765,10 +793,7 @@ def _approx_inverse(G, X, k, gk):
         if not big > 0.0:
             return np.inf, np.inf
         if piv != col:
-            for b in range(2 * k):
-                tmp = A[col, b]
-                A[col, b] = A[piv, b]
-                A[piv, b] = tmp
+            _swap_rows(A, col, piv)
         inv = 1.0 / A[col, col]
         for b in range(2 * k):
             A[col, b] *= inv
@@ -1023,12 +1048,8 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
     while used < m:
         if pi >= P_all.shape[0]:
             return False
-        p = P_all[pi]
+        p, pinv = _prime_powers(P_all, pi, pow2, smax)
         pi += 1
-        pinv = 1.0 / p
-        pow2[0] = 1
-        for s in range(1, smax + 1):
-            pow2[s] = _addmod(pow2[s - 1], pow2[s - 1], p)
         for c in range(k + 1):
             for a in range(k):
                 A[a, c] = _to_residue(mant[c, a], ex[c, a], p, pinv, pow2)
@@ -1041,11 +1062,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
         mult = np.int64(1)
         ok = True
         for col in range(k):
-            piv = -1
-            for a in range(col, k):
-                if A[a, col] != 0:
-                    piv = a
-                    break
+            piv = _first_nonzero(A, col, k)
             if piv < 0:
                 ok = False
                 break
@@ -1054,10 +1071,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
             elif seq[col] != piv:
                 return False
             if piv != col:
-                for b in range(k + 1):
-                    tmp = A[col, b]
-                    A[col, b] = A[piv, b]
-                    A[piv, b] = tmp
+                _swap_rows(A, col, piv)
                 det = _submod(0, det, p)
                 nsw += 1
             pv = A[col, col]
@@ -1102,11 +1116,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
         dm[used] = det
         for a in range(k):
             N[used, a] = _mulmod(det, A[a, k], p, pinv)
-        acc = np.int64(1)
-        for j in range(used):
-            W[used, j] = _reduce(P[j], p, pinv)
-            acc = _mulmod(acc, W[used, j], p, pinv)
-        W[used, used] = _invmod(acc, p)
+        _radix_row(W, P, used, p, pinv)
         used += 1
     half = W[m]
     _half(P, m, half)
@@ -1215,20 +1225,6 @@ def _cmp_mid(N, dm, a, sn, sd, T, F, m, P, Pinv, W, half, res, capneg, cappos, p
 
 
 @njit(cache=True)
-def _two_prod(a, b):
-    # a b = p + e exactly (Dekker's product by splitting; no overflow or underflow)
-    p = a * b
-    c = 134217729.0 * a
-    ah = c - (c - a)
-    al = a - ah
-    c = 134217729.0 * b
-    bh = c - (c - b)
-    bl = b - bh
-    e = ((ah * bh - p) + ah * bl + al * bh) + al * bl
-    return p, e
-
-
-@njit(cache=True)
 def _point_filter(M, q, J, z):
     # The float filter of exact_point: one step of refinement of the guess,
     # x~ + X r with the residual r = c - A x~ (A = M_JJ, c = -q_J) summed in
@@ -1266,7 +1262,7 @@ def _point_filter(M, q, J, z):
         lo = 0.0
         tot = abs(hi)
         for b in range(k):
-            p, e = _two_prod(M[J[a], J[b]], z[J[b]])
+            p, e = two_prod(M[J[a], J[b]], z[J[b]])
             if p != 0.0 and abs(p) < 2.0**-900:
                 return False
             tot += abs(p)
@@ -1315,3 +1311,10 @@ def _point_filter(M, q, J, z):
     for a in range(k):
         z[J[a]] = out[a]
     return True
+
+
+# _point_filter inlines _certified.two_prod: the on-disk cache follows that file too
+_jit_cache.bind_cache_to_sources(
+    [f for f in list(globals().values()) if hasattr(f, "py_func") and hasattr(f, "_cache")
+     and getattr(f.py_func, "__module__", None) == __name__],
+    (__file__, _certified.__file__))

@@ -355,6 +355,57 @@ def _pivot(T, b, col, n, r, s):
     b[r] = b_r
 
 
+@njit(cache=True, inline="always")
+def _write_ray(col, pos, n, entering, ray_out):
+    # the secondary ray along the entering column col: the entering variable +1,
+    # each basic z_j and z0 (ray_out[n]) moving by minus its row's entry
+    for j in range(n):
+        p = pos[n + j]
+        if p >= 0:
+            ray_out[j] = -col[p]
+        elif n + j == entering:
+            ray_out[j] = 1.0
+    ray_out[n] = -col[pos[2 * n]]
+
+
+@njit(cache=True, inline="always")
+def _views(work, iwork, n):
+    # the path's arrays in the workspace: the tableau T, the right-hand side b,
+    # the entering column col, the basis and pos (see _core)
+    return work, work[n + 1], work[n + 2], iwork[:n], iwork[n:]
+
+
+@njit(cache=True, inline="always")
+def _scales(M, q, n):
+    # max|M_ij|, max|q_i| and sum |q_i|
+    mmax = 0.0
+    qmax = 0.0
+    qsum = 0.0
+    for i in range(n):
+        for j in range(n):
+            mmax = max(mmax, abs(M[i, j]))
+        qmax = max(qmax, abs(q[i]))
+        qsum += abs(q[i])
+    return mmax, qmax, qsum
+
+
+@njit(cache=True, inline="always")
+def _start_tableau(M, q, d, T, b, basis, pos, n, ncol):
+    # the tableau [-M | -d | 0] with right-hand side q and every w basic: w_j in row j,
+    # z_j and z0 in the slots 1 .. n + 1 of the nonbasic (see _core's `pos`)
+    for i in range(n):
+        for j in range(n):
+            T[i, j] = -M[i, j]
+        T[i, n] = -d[i]
+        for j in range(n + 1, ncol):
+            T[i, j] = 0.0
+        b[i] = q[i]
+        basis[i] = i
+        pos[i] = i
+        pos[n + i] = -(i + 1)
+    pos[2 * n] = -(n + 1)
+
+
 @njit(cache=True, _nrt=False)
 def _copy_into(dst, src):
     # an explicit loop: a slice assignment (dst[:] = src) makes numba compile its
@@ -593,31 +644,18 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
             w_out[k] = q[k]
         return SOLVED, 0, 0.0
 
-    T = work
-    b = work[n + 1]
-    col = work[n + 2]
-    basis = iwork[:n]
     # pos[var] = row if basic, else -(slot + 1); variables: w_j -> j,
     # z_j -> n + j, z0 -> 2n
-    pos = iwork[n:]
+    T, b, col, basis, pos = _views(work, iwork, n)
     ncol = T.shape[1]
     if ncol < n + 1 or T.shape[0] < n + 3 or iwork.shape[0] < 3 * n + 1:
         for k in range(n):
             z_out[k] = 0.0
             w_out[k] = 0.0
         return INVALID_INPUT, 0, np.inf
+    _start_tableau(M, q, d, T, b, basis, pos, n, ncol)
     for i in range(n):
-        for j in range(n):
-            T[i, j] = -M[i, j]
-        T[i, n] = -d[i]
-        for j in range(n + 1, ncol):
-            T[i, j] = 0.0
-        b[i] = q[i]
         col[i] = -d[i]
-        basis[i] = i
-        pos[i] = i
-        pos[n + i] = -(i + 1)
-    pos[2 * n] = -(n + 1)
     z0 = 2 * n
 
     # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i.
@@ -743,13 +781,7 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
                 break
         if theta == np.inf:
             # secondary ray: entering variable +1, basic ones move by -a_i
-            for j in range(n):
-                p = pos[n + j]
-                if p >= 0:
-                    ray_out[j] = -col[p]
-                elif n + j == entering:
-                    ray_out[j] = 1.0
-            ray_out[n] = -col[pos[z0]]
+            _write_ray(col, pos, n, entering, ray_out)
             status = SECONDARY_RAY
             break
         lim = theta + TIE_TOL * abs(theta)
@@ -851,20 +883,8 @@ def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_
     # solution's basis is re-solved from the data), with the tableau, basis
     # and outputs where they left them
     n = q.shape[0]
-    mmax = 0.0
-    qmax = 0.0
-    qsum = 0.0
-    for i in range(n):
-        for j in range(n):
-            mmax = max(mmax, abs(M[i, j]))
-    for i in range(n):
-        qmax = max(qmax, abs(q[i]))
-        qsum += abs(q[i])
-    T = work
-    b = work[n + 1]
-    col = work[n + 2]
-    basis = iwork[:n]
-    pos = iwork[n:]
+    mmax, qmax, qsum = _scales(M, q, n)
+    T, b, col, basis, pos = _views(work, iwork, n)
     if status == _NEED_SEEN:
         seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
         entering = np.int64(ray_out[n])
@@ -919,33 +939,12 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
     # column) is handed back at once (_HANDOFF_TIE): the exact path decides
     # its step too. The data are finite (the hand-over came from _core).
     n = q.shape[0]
-    mmax = 0.0
-    qmax = 0.0
-    qsum = 0.0
-    for i in range(n):
-        for j in range(n):
-            mmax = max(mmax, abs(M[i, j]))
-        qmax = max(qmax, abs(q[i]))
-        qsum += abs(q[i])
+    mmax, qmax, qsum = _scales(M, q, n)
     for k in range(n + 1):
         ray_out[k] = 0.0
-    T = work
-    b = work[n + 1]
-    col = work[n + 2]
-    basis = iwork[:n]
-    pos = iwork[n:]
+    T, b, col, basis, pos = _views(work, iwork, n)
     ncol = T.shape[1]
-    for i in range(n):
-        for j in range(n):
-            T[i, j] = -M[i, j]
-        T[i, n] = -d[i]
-        for j in range(n + 1, ncol):
-            T[i, j] = 0.0
-        b[i] = q[i]
-        basis[i] = i
-        pos[i] = i
-        pos[n + i] = -(i + 1)
-    pos[2 * n] = -(n + 1)
+    _start_tableau(M, q, d, T, b, basis, pos, n, ncol)
     # the w of row i leaves (its row takes a non-w variable) when w_i is not in the target
     # basis; ray_out[:n] marks those rows while the tableau is built
     for i in range(n):
@@ -1014,13 +1013,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
         s = -pos[entering] - 1
         for i in range(n):
             col[i] = T[i, s]
-        for j in range(n):
-            p = pos[n + j]
-            if p >= 0:
-                ray_out[j] = -col[p]
-            elif n + j == entering:
-                ray_out[j] = 1.0
-        ray_out[n] = -col[pos[2 * n]]
+        _write_ray(col, pos, n, entering, ray_out)
         status = SECONDARY_RAY
     return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(start[n + 2]),
                  np.int64(entering), max_iter, tol, np.bool_(True), mmax, qmax, qsum,
@@ -1498,12 +1491,7 @@ def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_i
             status = INFEASIBLE
         if status != BREAKDOWN:
             return status, pivots, residual
-    mmax = 0.0
-    qmax = 0.0
-    for i in range(n):
-        qmax = max(qmax, abs(q[i]))
-        for j in range(n):
-            mmax = max(mmax, abs(M[i, j]))
+    mmax, qmax, _ = _scales(M, q, n)
     if plain:
         status, pivots, residual = BREAKDOWN, pivots, residual
     else:
@@ -1630,12 +1618,7 @@ def _resume_packed(M, q, d, out, start, max_iter, tol):
     ka = np.int64(info[2 * n])
     kb = np.int64(info[2 * n + 1])
     scale_d = info[2 * n + 2] != 0.0
-    mmax = 0.0
-    qmax = 0.0
-    for i in range(n):
-        qmax = max(qmax, abs(q[i]))
-        for j in range(n):
-            mmax = max(mmax, abs(M[i, j]))
+    mmax, qmax, _ = _scales(M, q, n)
     work = np.empty((n + 3, _padded(n)))
     iwork = np.empty(3 * n + 1, dtype=np.int64)
     z_out = out[:n]
@@ -1755,12 +1738,7 @@ def _exact_run(M, q, d, out, start, primes, status, pivots, max_iter, tol, max_s
 def _violation(M, q, z):
     # lcp_violation of a finite z on finite data, without the Python checks
     n = q.shape[0]
-    mmax = 0.0
-    qmax = 0.0
-    for i in range(n):
-        qmax = max(qmax, abs(q[i]))
-        for j in range(n):
-            mmax = max(mmax, abs(M[i, j]))
+    mmax, qmax, _ = _scales(M, q, n)
     return _residual(M, q, z, np.empty(n), mmax, qmax)
 
 

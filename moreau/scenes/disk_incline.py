@@ -36,19 +36,19 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import check_fields, finite_array, in_open_interval, nonnegative, positive
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import ClosedFormPath, FactoryCase
 from ..errors import InputError
 from ..model.planar import Circle, HalfPlane, Model
 from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
-__all__ = ["DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact",
+__all__ = ["InclineParams", "DiskInclineParams", "INCLINE_UNITS", "disk_incline_model", "disk_incline", "disk_incline_exact",
            "incline_motion", "rolls_down"]
 
 
 @dataclass(frozen=True)
-class DiskInclineParams:
-    """SI parameters of the disk on an incline.
+class InclineParams:
+    """SI parameters of a round body on an incline (the disk's and the sphere's).
 
     Attributes
     ----------
@@ -78,6 +78,16 @@ class DiskInclineParams:
         check_fields(self, nonnegative, "mu", "speed")
         object.__setattr__(self, "slope",
                            in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+
+
+@dataclass(frozen=True)
+class DiskInclineParams(InclineParams):
+    """SI parameters of the disk on an incline (those of :class:`InclineParams`)."""
+
+
+#: the units of the parameters of a round body on an incline
+INCLINE_UNITS = {"mass": "kg", "radius": "m", "slope": "rad", "mu": "", "gravity": "m/s^2",
+                 "speed": "m/s"}
 
 
 def disk_incline_model(params=None, **overrides):
@@ -155,39 +165,36 @@ def disk_incline_exact(params, t):
     return incline_motion(p, t, 0.5)
 
 
-class DiskInclineCase(FactoryCase):
-    """The disk over the window: distance down the slope against the closed form."""
+class InclineCase(ClosedFormPath):
+    """A round body of inertia ``inertia m r^2`` over the window: distance down the slope
+    against :func:`incline_motion` (a mixin for the disk's and the sphere's cases)."""
 
     headline_name = "distance down the slope"
     window = 10.0
+    inertia = None
 
+    def path(self, tau):
+        return incline_motion(self.p, tau * self.scene.time, self.inertia)[0] / self.scene.length
+
+    def first_regime(self):
+        return "S" if rolls_down(self.p, self.inertia) else "P"
+
+
+class DiskInclineCase(InclineCase, FactoryCase):
+    """The disk over the window: distance down the slope against the closed form."""
+
+    inertia = 0.5
     scene_factory = staticmethod(disk_incline)
 
     def coordinate(self, q):
         a = self.p.slope
         return -(q[:, 0] * math.cos(a) + q[:, 1] * math.sin(a))
 
-    def reference(self, rtol):
-        s, _, _ = disk_incline_exact(self.p, [self.window * self.scene.time])
-        return float(s[0]) / self.scene.length, [(0.0, "S" if rolls_down(self.p, 0.5) else "P")]
-
-    def reference_grid(self):
-        s, _, _ = disk_incline_exact(self.p, np.linspace(0.0, self.window, GRID + 1)
-                                     * self.scene.time)
-        return s / self.scene.length
-
-    def headline_of_run(self, res):
-        return float(self.coordinate(res.q[-1:])[0])
-
-    def _run_switches(self, res, h):
-        return []
-
 
 register_scene(SceneEntry(
     name="disk-incline",
     factory=disk_incline,
-    parameters=parameters_of(DiskInclineParams, {"mass": "kg", "radius": "m", "slope": "rad",
-                                                 "mu": "", "gravity": "m/s^2", "speed": "m/s"}),
+    parameters=parameters_of(DiskInclineParams, INCLINE_UNITS),
     description=("disk rolling down a rough incline at (2/3) g sin(alpha), built with the "
                  "planar builder (closed form)"),
     case=DiskInclineCase,

@@ -53,7 +53,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 from .._validate import finite_array, in_open_interval, nonnegative, positive, finite_scalar
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
@@ -210,7 +210,7 @@ def puck_incline_path(params, t):
     return _integrated(p, tt)
 
 
-class PuckInclineCase(SpatialCase):
+class PuckInclineCase(ClosedFormPath, SpatialCase):
     """The puck over the window: its drift across the slope against the reference path."""
 
     headline_name = "distance across the slope"
@@ -221,19 +221,11 @@ class PuckInclineCase(SpatialCase):
     def coordinate(self, q):
         return q[:, 1]
 
-    def reference(self, rtol):
-        z = puck_incline_path(self.p, [self.window * self.scene.time])
-        return float(z[0, 1]) / self.scene.length, [(0.0, "P")]
+    def path(self, tau):
+        return puck_incline_path(self.p, tau * self.scene.time)[:, 1] / self.scene.length
 
-    def reference_grid(self):
-        z = puck_incline_path(self.p, np.linspace(0.0, self.window, GRID + 1) * self.scene.time)
-        return z[:, 1] / self.scene.length
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 1])
-
-    def _run_switches(self, res, h):
-        return []
+    def first_regime(self):
+        return "P"
 
 
 register_scene(SceneEntry(

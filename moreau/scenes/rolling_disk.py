@@ -70,7 +70,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import in_open_interval, positive
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
@@ -235,7 +235,7 @@ def rolling_disk(params=None, **overrides):
     return sc
 
 
-class RollingDiskCase(SpatialCase):
+class RollingDiskCase(ClosedFormPath, SpatialCase):
     """The disk over a quarter precession period: its axis' precession angle against ``Omega t``."""
 
     headline_name = "precession angle"
@@ -249,20 +249,12 @@ class RollingDiskCase(SpatialCase):
     def coordinate(self, q):
         return tilt_and_heading(q)[1]
 
-    def _rate(self):
-        return steady_motion(self.p)["precession"] * self.scene.time
-
-    def reference(self, rtol):
-        return self._rate() * self.window, [(0.0, "S")]
-
-    def reference_grid(self):
-        return self._rate() * np.linspace(0.0, self.window, GRID + 1)
+    def path(self, tau):
+        return steady_motion(self.p)["precession"] * self.scene.time * tau
 
     def headline_of_run(self, res):
+        # the heading is unwrapped along the whole run
         return float(tilt_and_heading(res.q)[1][-1])
-
-    def _run_switches(self, res, h):
-        return []
 
 
 register_scene(SceneEntry(

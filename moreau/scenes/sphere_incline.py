@@ -30,52 +30,21 @@ angular velocity (3).
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from .._validate import in_open_interval, nonnegative, positive
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import SpatialCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
-from .disk_incline import incline_motion, rolls_down
+from .disk_incline import INCLINE_UNITS, InclineCase, InclineParams, incline_motion, rolls_down
 
 __all__ = ["SphereInclineParams", "sphere_incline", "sphere_incline_exact", "rolls"]
 
 
 @dataclass(frozen=True)
-class SphereInclineParams:
-    """SI parameters of the sphere on an incline.
+class SphereInclineParams(InclineParams):
+    """SI parameters of the sphere on an incline: those of :class:`InclineParams`, radius
+    5 cm by default."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    radius : float
-        [m], > 0.
-    slope : float
-        Inclination ``alpha`` [rad], in (0, pi/2).
-    mu : float
-        Coulomb friction, >= 0.
-    gravity : float
-        [m/s^2], > 0.
-    speed : float
-        Initial speed down the slope [m/s], rolling, >= 0.
-    """
-
-    mass: float = 1.0
     radius: float = 0.05
-    slope: float = 0.3
-    mu: float = 0.5
-    gravity: float = 9.81
-    speed: float = 0.2
-
-    def __post_init__(self):
-        for name in ("mass", "radius", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
-        object.__setattr__(self, "speed", nonnegative("speed", self.speed))
-        object.__setattr__(self, "slope",
-                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
 
 
 def rolls(p):
@@ -125,39 +94,20 @@ def sphere_incline_exact(params, t):
     return incline_motion(p, t, 0.4)
 
 
-class SphereInclineCase(SpatialCase):
+class SphereInclineCase(InclineCase, SpatialCase):
     """The sphere over the window: distance down the slope against the closed form."""
 
-    headline_name = "distance down the slope"
-    window = 10.0
-
+    inertia = 0.4
     scene_factory = staticmethod(sphere_incline)
 
     def coordinate(self, q):
         return q[:, 0]
 
-    def reference(self, rtol):
-        s, _, _ = sphere_incline_exact(self.p, [self.window * self.scene.time])
-        return float(s[0]) / self.scene.length, [(0.0, "S" if rolls(self.p) else "P")]
-
-    def reference_grid(self):
-        s, _, _ = sphere_incline_exact(self.p, np.linspace(0.0, self.window, GRID + 1)
-                                       * self.scene.time)
-        return s / self.scene.length
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-    def _run_switches(self, res, h):
-        return []
-
 
 register_scene(SceneEntry(
     name="sphere-incline",
     factory=sphere_incline,
-    parameters=parameters_of(SphereInclineParams, {"mass": "kg", "radius": "m", "slope": "rad",
-                                                   "mu": "", "gravity": "m/s^2",
-                                                   "speed": "m/s"}),
+    parameters=parameters_of(SphereInclineParams, INCLINE_UNITS),
     description=("sphere rolling down a rough incline in space at (5/7) g sin(alpha), slipping "
                  "below mu = (2/7) tan(alpha) (closed form)"),
     case=SphereInclineCase,

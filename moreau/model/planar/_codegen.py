@@ -101,6 +101,13 @@ def _constant(st, off):
     return st.par[off + 1] == 0.0 and st.par[off + 2] == 0.0 and _i(st.par[off + 3]) == 0
 
 
+def _function(st, signature, used, with_v):
+    # a generated function's first lines: its header and the state of the bodies in `used`
+    lines = ["@njit(cache=True)", f"def {signature}:"]
+    _bodies(lines, st, used, with_v=with_v)
+    return lines
+
+
 def _bodies(lines, st, used, with_v, indent="    "):
     """Scalars ``x{k}, y{k}, c{k}, s{k}, th{k}, vx{k}, vy{k}, w{k}, ax{k}, ay{k}, al{k}`` of the bodies ``used``."""
     for k in sorted(used):
@@ -271,8 +278,7 @@ def _mass(st):
 
 def _contacts(st):
     n = st.n
-    lines = ["@njit(cache=True)", "def contacts(par, q, t, G, need_gap, need_T):"]
-    _bodies(lines, st, _contact_bodies(st), with_v=False)
+    lines = _function(st, "contacts(par, q, t, G, need_gap, need_T)", _contact_bodies(st), False)
     for i in range(st.nc):
         kind, A, B = _frame(lines, st, i)
         lines.append("    if need_gap:")
@@ -287,8 +293,7 @@ def _contacts(st):
 
 def _gaps(st):
     # the gaps alone (the engine's call at each step's end), without the rows
-    lines = ["@njit(cache=True)", "def gaps(par, q, t, G):"]
-    _bodies(lines, st, _contact_bodies(st), with_v=False)
+    lines = _function(st, "gaps(par, q, t, G)", _contact_bodies(st), False)
     for i in range(st.nc):
         _frame(lines, st, i)
         lines.append(f"    G[{i}, 0] = g")
@@ -297,8 +302,7 @@ def _gaps(st):
 
 
 def _drift(st):
-    lines = ["@njit(cache=True)", "def drift(par, q, v, t, Dr):"]
-    _bodies(lines, st, _contact_bodies(st), with_v=True)
+    lines = _function(st, "drift(par, q, v, t, Dr)", _contact_bodies(st), True)
     for i in range(st.nc):
         kind, A, B = _frame(lines, st, i)
         dv = f"w{A}, w{B}, vx{A} - vx{B}, vy{A} - vy{B}"
@@ -451,16 +455,14 @@ def _turning(lines, st, k):
 
 
 def _poses(st):
-    lines = ["@njit(cache=True)", "def poses(par, q, v, t, P):"]
-    _bodies(lines, st, range(st.nb), with_v=False)
+    lines = _function(st, "poses(par, q, v, t, P)", range(st.nb), False)
     for k in range(st.nb):
         lines.append(f"    P[{k}, 0] = x{k}; P[{k}, 1] = y{k}; P[{k}, 2] = th{k}")
     return lines
 
 
 def _frames(st):
-    lines = ["@njit(cache=True)", "def frames(par, q, v, t, F):"]
-    _bodies(lines, st, _contact_bodies(st), with_v=False)
+    lines = _function(st, "frames(par, q, v, t, F)", _contact_bodies(st), False)
     for i in range(st.nc):
         kind, A, B = _frame(lines, st, i)
         lines.append(f"    F[{i}, 0] = x{A} + sAx; F[{i}, 1] = y{A} + sAy; F[{i}, 2] = nx; "
@@ -503,14 +505,19 @@ def _joint_bodies(st):
     return used
 
 
-def _joints(st):
-    lines = ["@njit(cache=True)", "def joints(par, q, t, G, need_gap):"]
-    _bodies(lines, st, _joint_bodies(st), with_v=False)
+def _each_joint_row(lines, st):
+    # the rows of _joint_rows, each joint's frame written into lines before its first row
     last = None
-    for r, kind, i, j, o, row, e in _joint_rows(st):
-        if r != last:
-            _joint_frame(lines, st, r)
-            last = r
+    for rec in _joint_rows(st):
+        if rec[0] != last:
+            _joint_frame(lines, st, rec[0])
+            last = rec[0]
+        yield rec
+
+
+def _joints(st):
+    lines = _function(st, "joints(par, q, t, G, need_gap)", _joint_bodies(st), False)
+    for r, kind, i, j, o, row, e in _each_joint_row(lines, st):
         if kind == K.JANGLE:
             lines.append("    if need_gap:")
             lines.append(f"        G[{row}, 0] = th{i} - th{j} - par[{o + 9}]")
@@ -537,13 +544,8 @@ def _joints(st):
 
 
 def _joint_drift(st):
-    lines = ["@njit(cache=True)", "def joint_drift(par, q, v, t, Dr):"]
-    _bodies(lines, st, _joint_bodies(st), with_v=True)
-    last = None
-    for r, kind, i, j, o, row, e in _joint_rows(st):
-        if r != last:
-            _joint_frame(lines, st, r)
-            last = r
+    lines = _function(st, "joint_drift(par, q, v, t, Dr)", _joint_bodies(st), True)
+    for r, kind, i, j, o, row, e in _each_joint_row(lines, st):
         if kind == K.JANGLE:
             lines.append(f"    Dr[{row}, 0] = al{i} - al{j}")
             continue
