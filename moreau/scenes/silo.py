@@ -67,7 +67,8 @@ from ..model.granular import DiskScene, DiskSystem, HalfPlane, random_fill
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
-__all__ = ["SiloParams", "silo", "silo_system", "fill", "fill_average", "fit_janssen", "janssen"]
+__all__ = ["SiloParams", "silo", "silo_system", "fill", "fill_average", "fit_janssen", "janssen",
+           "wall_profile", "janssen_k_bounds"]
 
 
 @dataclass(frozen=True)
@@ -174,8 +175,9 @@ def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measu
         ``density d^2``; ``height`` (the top of the pile, in ``d``),
         ``wall_friction`` (the walls' upward force over ``g``),
         ``wall_normal``, ``unconverged`` (steps above tolerance in the
-        weighing), ``max_residual``; and ``rho``, the packing's mass per
-        unit area at the last pour (its mass over ``W`` times its height).
+        weighing), ``max_residual``; ``rho``, the packing's mass per
+        unit area at the last pour (its mass over ``W`` times its height);
+        ``profile``, :func:`wall_profile` of the last pour's last step.
     """
     p = params_with(SiloParams, params, overrides)
     W = p.width / p.diameter
@@ -222,7 +224,121 @@ def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measu
     res = {k: np.array(val) for k, val in out.items()}
     res["rho"] = float(res["mass"][-1] / (W * res["height"][-1]))
     res["width"] = W
+    res["profile"] = wall_profile(fixed, x, meas.impulses, h)
     return res
+
+
+def wall_profile(system, x, impulses, h, *, dz=2.0):
+    """The load a silo's packing carries across horizontal cuts, and how its walls hold it.
+
+    The disks whose centres lie above a cut at height ``z`` weigh ``M(z)``
+    (over ``g``); at rest the vertical force the disks below the cut exert
+    on them is their weight less the walls' upward friction on them, so the
+    cut carries ``m_app(z) = M(z) - F_w(z)`` (over ``g``): Janssen's
+    apparent mass of the column above ``z`` (module docstring). ``F_w``
+    comes from the wall impulses of one step (walls 1 and 2 of
+    :func:`silo_system`), divided by ``h``.
+
+    Parameters
+    ----------
+    system : DiskSystem
+        A silo's (:func:`silo_system`): the floor is wall 0, the sides walls 1 and 2.
+    x : array_like, shape (N, 2)
+        The centres at the end of the step.
+    impulses : (ContactSet, ndarray)
+        That step's contacts and impulses (:attr:`GranularResult.impulses
+        <moreau.integrators.granular.GranularResult.impulses>`).
+    h : float
+        The step.
+    dz : float
+        The spacing of the cuts, down from the top of the packing; the last
+        cut lies below every centre (it carries the floor's load).
+
+    Returns
+    -------
+    dict of ndarray
+        Per cut, top down: ``depth`` (below the top of the packing),
+        ``mass`` (``M``), ``m_app``, ``wall_normal`` and ``wall_friction``
+        (the walls' normal and upward friction forces on the disks above),
+        ``mobilised`` (``wall_friction / (mu_wall wall_normal)``: 1 where
+        every wall contact above slides down, Janssen's premise). Per band
+        between successive cuts, ``K_band``: the walls' mean normal stress
+        in it over the vertical stress ``m_app / W`` at its middle.
+
+    Examples
+    --------
+    Two disks in a channel at rest on the floor, side by side (no wall friction):
+
+    >>> from moreau.integrators.granular import simulate_disks
+    >>> sysm = silo_system([0.5, 0.5])
+    >>> run = simulate_disks(sysm, [[1.5, 0.5], [4.5, 0.5]], np.zeros((2, 3)), 3, 0.01, theta=1.0)
+    >>> prof = wall_profile(sysm, run.x[-1], run.impulses, 0.01)
+    >>> np.round(prof["m_app"], 6).tolist(), np.round(prof["mass"], 6).tolist()
+    ([1.570796], [1.570796])
+    """
+    if not isinstance(system, DiskSystem) or system.n_walls != 3:
+        raise InputError("`system` must be a silo's DiskSystem (silo_system): floor and two walls")
+    x = np.asarray(x, dtype=float)
+    if x.shape != (system.n_disks, 2):
+        raise InputError(f"`x` must have shape ({system.n_disks}, 2), got {x.shape}")
+    h = positive("h", h)
+    dz = positive("dz", dz)
+    cs, r = impulses
+    f = np.asarray(r, dtype=float).reshape(-1, 2) / h
+    side = (cs.a == -2) | (cs.a == -3)
+    # (left wall: t = (0, 1) points up; right wall: t = (0, -1))
+    up = np.where(cs.a[side] == -2, f[side, 1], -f[side, 1])
+    normal = f[side, 0]
+    y_wall = x[cs.b[side], 1]
+    top = float(np.max(x[:, 1] + system.radii))
+    lowest = float(np.min(x[:, 1]))
+    cuts = np.append(np.arange(top - dz, lowest, -dz), lowest - 1.0)
+    mass = np.array([system.masses[x[:, 1] > z].sum() for z in cuts])
+    friction = np.array([up[y_wall > z].sum() for z in cuts])
+    wall_n = np.array([normal[y_wall > z].sum() for z in cuts])
+    mu_wall = float(system._wall_mu[1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        mobilised = np.where(wall_n > 0.0, friction / (mu_wall * np.where(wall_n > 0.0, wall_n,
+                                                                                 1.0)), np.nan)
+    m_app = mass - friction
+    width = float(system._p0[2, 0] - system._p0[1, 0])
+    heights = cuts[:-1] - cuts[1:]
+    sigma_mid = 0.5 * (m_app[:-1] + m_app[1:]) / width
+    band_n = np.diff(wall_n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k_band = np.where(sigma_mid > 0.0, band_n / (2.0 * heights) / np.where(
+            sigma_mid > 0.0, sigma_mid, 1.0), np.nan)
+    return {"depth": top - cuts, "mass": mass, "m_app": m_app, "wall_normal": wall_n,
+            "wall_friction": friction, "mobilised": mobilised, "K_band": k_band}
+
+
+def janssen_k_bounds(phi, mu_wall):
+    """The range of Janssen's ``K`` a Mohr-Coulomb packing of friction angle ``phi`` allows.
+
+    Returns ``(K_a, K_w, K_p)``: Rankine's active and passive ratios
+    ``(1 -+ sin phi) / (1 +- sin phi)``, the bounds on the ratio of two
+    perpendicular normal stresses in any state at or below yield, and
+    ``K_w``, the ratio at a wall whose friction ``mu_wall`` is fully
+    mobilised in the active state (module docstring; ``nan`` when
+    ``mu_wall > tan phi``: such a wall cannot slide, the packing yields
+    inside).
+
+    Examples
+    --------
+    >>> [round(k, 4) for k in janssen_k_bounds(math.atan(0.5), 0.5)]
+    [0.382, 0.6667, 2.618]
+    """
+    phi = in_closed_interval("phi", phi, 0.0, 0.5 * math.pi - 1e-9)
+    mu_wall = nonnegative("mu_wall", mu_wall)
+    s = math.sin(phi)
+    c2 = math.cos(phi) ** 2
+    disc = s * s - mu_wall * mu_wall * c2
+    if disc < -1e-15:
+        k_w = float("nan")
+    else:
+        root = math.sqrt(max(disc, 0.0))
+        k_w = (1.0 - root) / (1.0 + 2.0 * mu_wall ** 2 + root)
+    return (1.0 - s) / (1.0 + s), k_w, (1.0 + s) / (1.0 - s)
 
 
 def fill_average(pours, seeds, params=None, **options):
