@@ -101,6 +101,15 @@ def test_the_silo_floor_load_saturates_as_janssen_predicts():
     # saturated: the last pours add (almost) nothing to the floor's load, the walls carry it
     assert r["m_app"][-1] < 0.35 * r["mass"][-1] and r["mass"][-1] > 3.0 * f["m_sat"]
     assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
+    # why the fit is not closer (issue 38's 10 %; the silo module): inside this packing, at rest,
+    # Janssen's premises fail. Measured: the walls' friction mobilised to 43 % of mu_w over the
+    # column, the load across cuts every 2 d non-monotonic (87 at depth 30 d, 59 on the floor),
+    # Janssen's law fitted to it off by 42 % at worst (rms 17 %)
+    prof = r["profile"]
+    assert prof["m_app"][-1] == pytest.approx(r["m_app"][-1], rel=2e-2)
+    assert prof["mobilised"][-1] < 0.6
+    fp = fit_janssen(prof["mass"], prof["m_app"], rho=r["rho"], width=r["width"], mu_wall=0.5)
+    assert fp["max_deviation"] > 0.2 and np.max(prof["m_app"]) > 1.2 * prof["m_app"][-1]
 
 
 @pytest.mark.slow
