@@ -108,7 +108,8 @@ packing, measured with :func:`wall_profile` (cuts every ``2 d``):
 - More polydispersity (``spread = 0.5`` against 0.8) does not help: seeds
   0 and 1 fit ``K = 0.26`` and 0.10, worst deviations 21 % and 29 %.
 
-Issue 38's 10 % at every depth is therefore not reached: a packing of rigid
+``benchmarks/silo_janssen_probe.py`` reruns these measurements (``rest``,
+``slide``, ``roll``). Issue 38's 10 % at every depth is therefore not reached: a packing of rigid
 round disks has no way to hold its wall friction fully mobilised (no
 rolling resistance, no elastic creep to keep the contacts slipping), which
 is Janssen's premise and what the experiments achieve with real grains.
@@ -318,8 +319,8 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     h : float
         The step.
     dz : float
-        The spacing of the cuts, down from the top of the packing; the last
-        cut lies below every centre (it carries the floor's load).
+        The spacing of the cuts, down from the top of the packing to the
+        lowest centre; the last cut is the floor (it carries the floor's load).
 
     Returns
     -------
@@ -340,8 +341,10 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     >>> sysm = silo_system([0.5, 0.5])
     >>> run = simulate_disks(sysm, [[1.5, 0.5], [4.5, 0.5]], np.zeros((2, 3)), 3, 0.01, theta=1.0)
     >>> prof = wall_profile(sysm, run.x[-1], run.impulses, 0.01)
-    >>> np.round(prof["m_app"], 6).tolist(), np.round(prof["mass"], 6).tolist()
-    ([1.570796], [1.570796])
+    >>> prof["depth"].tolist(), np.round(prof["m_app"], 6).tolist()
+    ([1.0], [1.570796])
+    >>> np.round(prof["mass"], 6).tolist(), prof["wall_friction"].tolist()
+    ([1.570796], [0.0])
     """
     if not isinstance(system, DiskSystem) or system.n_walls != 3:
         raise InputError("`system` must be a silo's DiskSystem (silo_system): floor and two walls")
@@ -359,7 +362,8 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     y_wall = x[cs.b[side], 1]
     top = float(np.max(x[:, 1] + system.radii))
     lowest = float(np.min(x[:, 1]))
-    cuts = np.append(np.arange(top - dz, lowest, -dz), lowest - 1.0)
+    # (every centre lies above the floor, y = 0: the last cut holds every disk)
+    cuts = np.append(np.arange(top - dz, lowest, -dz), 0.0)
     mass = np.array([system.masses[x[:, 1] > z].sum() for z in cuts])
     friction = np.array([up[y_wall > z].sum() for z in cuts])
     wall_n = np.array([normal[y_wall > z].sum() for z in cuts])
