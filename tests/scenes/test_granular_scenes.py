@@ -4,7 +4,13 @@ import numpy as np
 import pytest
 
 from moreau.scenes.granular_column import collapse, fit_runout, runout_study
-from moreau.scenes.silo import fill, fill_average, fit_janssen, janssen
+import math
+
+from scipy.optimize import brentq
+
+from moreau.errors import InputError
+from moreau.scenes.silo import (fill, fill_average, fit_janssen, janssen, janssen_k_bounds,
+                                wall_profile)
 
 
 def test_a_silo_at_rest_balances_its_weight_between_floor_and_walls():
@@ -15,6 +21,34 @@ def test_a_silo_at_rest_balances_its_weight_between_floor_and_walls():
     # indeterminate: the pours' history picks it; Janssen's saturation is the slow test's)
     assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
     assert np.all(r["m_app"] > 0.5 * r["mass"])
+    # the profile's deepest cut holds every disk and carries the floor's load (the last step's
+    # against the mean over the weighing: at rest they agree), its shallowest little
+    prof = r["profile"]
+    assert prof["mass"][-1] == pytest.approx(r["mass"][-1], rel=1e-12)
+    assert prof["m_app"][-1] == pytest.approx(r["m_app"][-1], rel=2e-2)
+    assert np.all(np.diff(prof["mass"]) > 0.0) and prof["mass"][0] < 0.5 * r["mass"][-1]
+    assert np.allclose(prof["m_app"] + prof["wall_friction"], prof["mass"], rtol=1e-12)
+    assert np.all(np.abs(prof["wall_friction"]) <= 0.5 * prof["wall_normal"] * (1 + 1e-9))
+    assert prof["K_band"].shape == (prof["depth"].size - 1,)
+
+
+def test_janssens_k_bounds_match_the_mohr_circle():
+    # an independent construction: a circle of centre 1, radius sin(phi), the point at the
+    # wall where tau = mu_w sigma on its lower (active) side, between the point where the
+    # circle's tangent passes through the origin (cos = -sin(phi)) and sigma's minimum, the
+    # vertical stress opposite
+    for phi, mu_w in ((math.radians(30.0), 0.3), (math.radians(40.0), 0.7), (0.4, 0.1)):
+        s = math.sin(phi)
+        ang = brentq(lambda a: s * math.sin(a) - mu_w * (1 + s * math.cos(a)), math.acos(-s),
+                     math.pi)
+        sig_w = 1 + s * math.cos(ang)
+        k_a, k_w, k_p = janssen_k_bounds(phi, mu_w)
+        assert k_w == pytest.approx(sig_w / (2 - sig_w), rel=1e-10)
+        assert k_a == pytest.approx((1 - s) / (1 + s)) and k_p == pytest.approx(1 / k_a)
+        assert k_a < k_w < 1.0
+    assert math.isnan(janssen_k_bounds(math.radians(20.0), 0.5)[1])
+    with pytest.raises(InputError, match="`phi`"):
+        janssen_k_bounds(2.0, 0.5)
 
 
 def test_a_column_collapses_and_spreads_and_says_how_well_each_step_was_solved():
@@ -67,6 +101,15 @@ def test_the_silo_floor_load_saturates_as_janssen_predicts():
     # saturated: the last pours add (almost) nothing to the floor's load, the walls carry it
     assert r["m_app"][-1] < 0.35 * r["mass"][-1] and r["mass"][-1] > 3.0 * f["m_sat"]
     assert np.allclose(r["m_app"] + r["wall_friction"], r["mass"], rtol=2e-2)
+    # why the fit is not closer (issue 38's 10 %; the silo module): inside this packing, at rest,
+    # Janssen's premises fail. Measured: the walls' friction mobilised to 43 % of mu_w over the
+    # column, the load across cuts every 2 d non-monotonic (87 at depth 30 d, 59 on the floor),
+    # Janssen's law fitted to it off by 42 % at worst (rms 17 %)
+    prof = r["profile"]
+    assert prof["m_app"][-1] == pytest.approx(r["m_app"][-1], rel=2e-2)
+    assert prof["mobilised"][-1] < 0.6
+    fp = fit_janssen(prof["mass"], prof["m_app"], rho=r["rho"], width=r["width"], mu_wall=0.5)
+    assert fp["max_deviation"] > 0.2 and np.max(prof["m_app"]) > 1.2 * prof["m_app"][-1]
 
 
 @pytest.mark.slow
