@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 import moreau.integrators.moreau_jean as mj_module
-from moreau.contact.cone3d import exact_gauss_seidel, solve_exact
+from moreau.contact import cone3d
+from moreau.contact.cone3d import exact_gauss_seidel, exact_newton_polish, solve_exact
 from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.integrators.moreau_jean import MoreauJean
@@ -127,16 +128,56 @@ def test_a_statically_indeterminate_stick_keeps_the_motion():
     assert np.array_equal(ref.regime, res.regime)
 
 
-def test_the_exact_cone_hands_gauss_seidel_s_misses_to_the_python_solver(monkeypatch):
-    # three contacts on one body: Gauss–Seidel alone stalls above the tolerance, and the
-    # Python step (with its Newton polish) takes the step; the run is the Python one
+def test_the_exact_cone_s_newton_polish_runs_in_the_loop(monkeypatch):
+    # three contacts on one body: Gauss–Seidel alone stalls above the tolerance and Newton's
+    # polish, compiled, ends the step as the Python step's solver does
     sc = _puck_and_ball(0.3)
     q0, v0 = sc.initial_state()
+    polished = []
+    solve = cone3d.solve_exact
+
+    def counting(*args, **kwargs):
+        sol = solve(*args, **kwargs)
+        polished.append(sol.iterations["newton"])
+        return sol
+    monkeypatch.setattr(cone3d, "solve_exact", counting)
     ref = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.01, fast=False, cone="exact")
+    assert sum(n > 0 for n in polished) >= 10
     calls = _python_steps(monkeypatch)
     res = simulate(sc, (0.0, 0.2), q0, v0, "moreau-jean", h=0.01, cone="exact")
-    assert 0 < calls[0] <= 20
+    assert calls[0] == 0
     _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+    assert res.stats["max_residual"] <= 1e-10
+
+
+def test_exact_newton_polish_is_solve_exact_s_newton():
+    # from Gauss–Seidel's point the compiled polish takes solve_exact's Newton steps and
+    # ends at its answer; where solve_exact restarts, the polish says it did not converge
+    rng = np.random.default_rng(11)
+    polished = 0
+    for _ in range(40):
+        nc = int(rng.integers(2, 5))
+        A = rng.normal(size=(3 * nc, 3 * nc))
+        W = A @ A.T + 0.1 * np.eye(3 * nc)
+        W = 0.5 * (W + W.T)
+        q = rng.normal(size=3 * nc)
+        mu = rng.uniform(0.0, 1.5, nc)
+        r, u = np.zeros(3 * nc), q.copy()
+        ok, _, _ = exact_gauss_seidel(W, q, mu, r, u, 1e-10, 1e-6, 500)
+        if ok:
+            continue
+        ref = solve_exact(W, q, mu)
+        ok, res, qn, steps = exact_newton_polish(W, q, mu, r, u, 1e-10, 15)
+        assert ok == ("restarted" not in ref.detail)
+        if ok:
+            polished += 1
+            assert steps == ref.iterations["newton"]
+            # both at the rounding of the data, or both the same residual above it
+            assert res <= 1e-10 * qn and abs(res - ref.residual) <= 1e-3 * res + 1e-13 * qn
+            assert np.max(np.abs(r - ref.r)) <= 1e-12 * np.max(np.abs(ref.r))
+            assert np.max(np.abs(u - (W @ r + q))) <= 1e-13 * qn
+    assert polished >= 10
 
 
 def test_exact_gauss_seidel_is_solve_exact_where_it_converges():
