@@ -947,16 +947,16 @@ def _alart_curnier_into(W, q, mu, rho, r, u, phi, J):
 
 
 @njit(cache=True)
-def _lu_solve(A, b, x):
+def _lu_solve(A, b, x, floor):
     # A x = b by Gaussian elimination with partial pivoting (A, b overwritten); False on a
-    # zero pivot, where the Python Newton's LAPACK solve raises and it falls back on lstsq
+    # pivot at or below `floor`: A singular to rounding (a box's corners at rest)
     n = b.shape[0]
     for c in range(n):
         p = c
         for i in range(c + 1, n):
             if abs(A[i, c]) > abs(A[p, c]):
                 p = i
-        if A[p, c] == 0.0:
+        if abs(A[p, c]) <= floor:
             return False
         if p != c:
             for j in range(n):
@@ -974,6 +974,10 @@ def _lu_solve(A, b, x):
             acc -= A[c, j] * x[j]
         x[c] = acc / A[c, c]
     return True
+
+
+#: a Newton Jacobian whose pivot falls to this fraction of its largest entry is singular
+_SINGULAR = 1e-13
 
 
 @njit(cache=True)
@@ -1034,6 +1038,8 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
         rho[i] = 1.0 / W[3 * i, 3 * i]
     phi = np.empty(n)
     J = np.empty((n, n))
+    Jc = np.empty((n, n))
+    rhs = np.empty(n)
     step = np.empty(n)
     trial = np.empty(n)
     best_r = r.copy()
@@ -1048,11 +1054,18 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     while it < max_newton and best > tol_sq:
         _alart_curnier_into(W, q, mu, rho, r, ut, phi, J)
         merit = 0.0
+        big = 0.0
         for j in range(n):
             merit += phi[j] * phi[j]
             phi[j] = -phi[j]
-        if not _lu_solve(J, phi, step):
-            return False, math.sqrt(best), qn, it
+            for l in range(n):
+                big = max(big, abs(J[j, l]))
+        Jc[:, :] = J
+        rhs[:] = phi
+        if not _lu_solve(J, phi, step, _SINGULAR * big):
+            # a Jacobian singular to rounding (stick on statically indeterminate contacts,
+            # where LAPACK's solve returns a step of size 1/rounding): the least-norm step
+            step[:] = np.linalg.lstsq(Jc, rhs)[0]
         finite = True
         for j in range(n):
             finite = finite and math.isfinite(step[j])

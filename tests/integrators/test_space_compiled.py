@@ -18,6 +18,10 @@ _SPATIAL = {s: sc for s in registry.scene_names()
             if is_spatial(sc := registry.make_scene(s))}
 #: the spatial scenes whose every contact the compiled loop knows (spheres and material points)
 COMPILED = [s for s, sc in _SPATIAL.items() if sc.contact_table() is not None]
+#: scenes whose contact forces are statically indeterminate (a box's four corners on a
+#: plane): two solvers' rounding picks different admissible splits, so the loop is held to the
+#: Python step on their motion and determinate resultants instead (test below)
+INDETERMINATE = {"box-incline"}
 FIELDS = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap")
 
 
@@ -47,7 +51,7 @@ def _python_steps(monkeypatch):
 
 @pytest.mark.parametrize("options", [{"cone": "exact"}, {"cone": 8, "theta": 0.5}],
                          ids=["exact", "d8-theta-half"])
-@pytest.mark.parametrize("name", COMPILED)
+@pytest.mark.parametrize("name", [s for s in COMPILED if s not in INDETERMINATE])
 def test_the_compiled_loop_is_the_python_step_on_every_spatial_scene(name, options, monkeypatch):
     sc = registry.make_scene(name)
     q0, v0 = sc.initial_state()
@@ -216,7 +220,8 @@ def test_integer_times_run_the_same_compiled_loop():
 
 def test_a_contact_the_loop_does_not_know_takes_the_python_step():
     # a contact of another kind than a sphere or a material point has no compiled row
-    assert {"sphere-incline", "billiard-backspin", "puck-incline", "tippe-top"} <= set(COMPILED)
+    assert {"sphere-incline", "billiard-backspin", "puck-incline", "tippe-top",
+            "box-incline"} <= set(COMPILED)
     sc = _two_balls()
     sc._contacts[2] = dict(sc._contacts[2], kind="rim")
     q0, v0 = sc.initial_state()
@@ -233,3 +238,19 @@ def test_fast_false_keeps_the_python_step_and_fast_true_is_accepted():
     assert MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True)._fast
     with pytest.raises(InputError, match="`fast=True` solves contacts"):
         MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True, lcp_method="qp")
+
+
+def test_a_box_s_four_corners_run_in_the_loop_with_the_exact_cone(monkeypatch):
+    # four corners on a plane: the normal forces are statically indeterminate (their split
+    # between diagonal corners is free), so the two steps agree on the motion and on the
+    # determinate resultants, to the cone solver's tolerance (1e-10 of the step's velocity)
+    sc = registry.make_scene("box-incline")
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 1.0), q0, v0, "moreau-jean", h=0.04, fast=False, cone="exact")
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 1.0), q0, v0, "moreau-jean", h=0.04, cone="exact")
+    assert calls[0] == 0 and res.stats["max_residual"] <= 1e-10
+    _assert_same(ref, res, fields=("t", "q", "v", "gap"), rtol=1e-9)
+    for pair in ([1, 3], [0, 2]):
+        assert np.max(np.abs(ref.force_N[:, pair].sum(axis=1)
+                             - res.force_N[:, pair].sum(axis=1))) <= 1e-9
