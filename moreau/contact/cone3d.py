@@ -473,8 +473,12 @@ def _local_res_sq(A, b, mu, rn, r1, r2):
 def _slip_fn(A, b, mu, phi):
     # with s = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
     # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
-    c = math.cos(phi)
-    s = math.sin(phi)
+    return _slip_cs(A, b, mu, math.cos(phi), math.sin(phi))
+
+
+@njit(cache=True, inline="always")
+def _slip_cs(A, b, mu, c, s):
+    # _slip_fn at the angle whose cosine and sine are c and s
     g = A[0, 0] - mu * (A[0, 1] * c + A[0, 2] * s)
     h1 = -b[0] * (A[1, 0] - mu * (A[1, 1] * c + A[1, 2] * s)) + g * b[1]
     h2 = -b[0] * (A[2, 0] - mu * (A[2, 1] * c + A[2, 2] * s)) + g * b[2]
@@ -482,6 +486,11 @@ def _slip_fn(A, b, mu, phi):
 
 
 _N_SAMPLES = 64
+# the samples' upper ends as _local's loop computes them (k step + step) and their cosines and
+# sines, computed once: the loop's trigonometry is then its bisections' only
+_SAMPLE_STEP = 2.0 * math.pi / _N_SAMPLES
+_SAMPLE_COS = np.array([math.cos(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
+_SAMPLE_SIN = np.array([math.sin(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
 #: Gauss–Seidel sweeps without a new least residual before Newton takes over
 _STALL = 50
 #: directions of the polyhedral cone whose solution restarts Newton
@@ -502,19 +511,16 @@ def _local(A, b, mu):
     c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
     det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
     if det > 0.0:
-        inv = np.empty((3, 3))
-        inv[0, 0] = c00
-        inv[1, 0] = c01
-        inv[2, 0] = c02
-        inv[0, 1] = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
-        inv[1, 1] = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
-        inv[2, 1] = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
-        inv[0, 2] = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
-        inv[1, 2] = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
-        inv[2, 2] = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        rn = -(inv[0, 0] * b[0] + inv[0, 1] * b[1] + inv[0, 2] * b[2]) / det
-        r1 = -(inv[1, 0] * b[0] + inv[1, 1] * b[1] + inv[1, 2] * b[2]) / det
-        r2 = -(inv[2, 0] * b[0] + inv[2, 1] * b[1] + inv[2, 2] * b[2]) / det
+        # the adjugate's entries as scalars (no array allocated in this hot branch)
+        i01 = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
+        i11 = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
+        i21 = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
+        i02 = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
+        i12 = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
+        i22 = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+        rn = -(c00 * b[0] + i01 * b[1] + i02 * b[2]) / det
+        r1 = -(c01 * b[0] + i11 * b[1] + i12 * b[2]) / det
+        r2 = -(c02 * b[0] + i21 * b[1] + i22 * b[2]) / det
         if rn >= 0.0 and math.hypot(r1, r2) <= mu * rn:
             return rn, r1, r2
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
@@ -525,7 +531,7 @@ def _local(A, b, mu):
     for k in range(_N_SAMPLES):
         lo = k * step
         hi = lo + step
-        fb, _, _ = _slip_fn(A, b, mu, hi)
+        fb, _, _ = _slip_cs(A, b, mu, _SAMPLE_COS[k], _SAMPLE_SIN[k])
         if fa == 0.0 or fa * fb < 0.0:
             flo = fa
             if fa != 0.0:
