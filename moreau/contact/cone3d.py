@@ -497,6 +497,42 @@ _STALL = 50
 _RESTART_D = 16
 
 
+#: the sliding angle's bracket is refined to this width [rad] (a few rounding units of 2 pi)
+_ANGLE_TOL = 4e-15
+
+
+@njit(cache=True, inline="always")
+def _refine_angle(A, b, mu, lo, hi, flo, fhi):
+    # a root of the slip function in [lo, hi] (flo, fhi of opposite signs) by the Illinois
+    # variant of regula falsi (superlinear, the bracket kept): a dozen evaluations where
+    # bisection takes fifty; a step that rounding puts outside the bracket bisects instead.
+    # Returns the end of least |F| once the bracket is _ANGLE_TOL wide
+    wlo, whi = flo, fhi           # the weights Illinois halves; flo, fhi stay the values
+    side = 0
+    for _ in range(100):
+        if hi - lo <= _ANGLE_TOL:
+            break
+        x = hi - whi * (hi - lo) / (whi - wlo)
+        if not lo < x < hi:
+            x = 0.5 * (lo + hi)
+            if not lo < x < hi:
+                break
+        fx, _, _ = _slip_fn(A, b, mu, x)
+        if fx == 0.0:
+            return x
+        if (fx < 0.0) == (flo < 0.0):
+            lo, flo, wlo = x, fx, fx
+            if side < 0:
+                whi *= 0.5
+            side = -1
+        else:
+            hi, fhi, whi = x, fx, fx
+            if side > 0:
+                wlo *= 0.5
+            side = 1
+    return lo if abs(flo) <= abs(fhi) else hi
+
+
 @njit(cache=True)
 def _local(A, b, mu):
     # The one-contact problem u = A r + b, exactly: the three cases of the
@@ -533,31 +569,15 @@ def _local(A, b, mu):
         hi = lo + step
         fb, _, _ = _slip_cs(A, b, mu, _SAMPLE_COS[k], _SAMPLE_SIN[k])
         if fa == 0.0 or fa * fb < 0.0:
-            flo = fa
-            if fa != 0.0:
-                for _ in range(200):
-                    mid = 0.5 * (lo + hi)
-                    if mid <= lo or mid >= hi:
-                        break
-                    fm, _, _ = _slip_fn(A, b, mu, mid)
-                    if fm == 0.0:
-                        lo = mid
-                        hi = mid
-                        break
-                    if (fm < 0.0) == (flo < 0.0):
-                        lo = mid
-                        flo = fm
-                    else:
-                        hi = mid
-                phi = lo if abs(flo) <= abs(fm) else hi
-            else:
-                phi = lo
-            _, along, g = _slip_fn(A, b, mu, phi)
+            phi = lo if fa == 0.0 else _refine_angle(A, b, mu, lo, hi, fa, fb)
+            c = math.cos(phi)
+            sn = math.sin(phi)
+            _, along, g = _slip_cs(A, b, mu, c, sn)
             if g > 0.0 and along >= 0.0:
                 rho = -b[0] / g
                 rn = rho
-                r1 = -mu * rho * math.cos(phi)
-                r2 = -mu * rho * math.sin(phi)
+                r1 = -mu * rho * c
+                r2 = -mu * rho * sn
                 res = _local_res_sq(A, b, mu, rn, r1, r2)
                 if res < best:
                     best, best_n, best_1, best_2 = res, rn, r1, r2
@@ -572,9 +592,9 @@ def local_solve(A, b, mu):
     in the cone; otherwise slip: ``r = rho (1, -mu cos phi, -mu sin phi)``
     with ``u_N = 0`` giving ``rho = -b_N / g(phi)``, ``g = A_NN - mu A_NT s``,
     and the sliding angle a root of ``s_perp . u_T(phi) = 0`` with ``s .
-    u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and bisected to the
-    last bit. Of several admissible roots the one with the least residual
-    is kept.
+    u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and refined by
+    the Illinois variant of regula falsi to a bracket ``4e-15`` rad wide. Of
+    several admissible roots the one with the least residual is kept.
 
     Examples
     --------
@@ -987,6 +1007,32 @@ _SINGULAR = 1e-13
 
 
 @njit(cache=True)
+def _all_finite(x):
+    for j in range(x.shape[0]):
+        if not math.isfinite(x[j]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _armijo(W, q, mu, rho, r, step, merit, trial, ut, phi, J):
+    # _newton's search: the step halved until the merit |phi|^2 falls by 1e-4 t, down to 1e-10;
+    # trial holds the last point tried
+    n = r.shape[0]
+    t = 1.0
+    while True:
+        for j in range(n):
+            trial[j] = r[j] + t * step[j]
+        _alart_curnier_into(W, q, mu, rho, trial, ut, phi, J)
+        mt = 0.0
+        for j in range(n):
+            mt += phi[j] * phi[j]
+        if mt <= (1.0 - 1e-4 * t) * merit or t < 1e-10:
+            return t
+        t *= 0.5
+
+
+@njit(cache=True)
 def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     """:func:`solve_exact`'s Newton polish after its Gauss–Seidel phase, compiled.
 
@@ -999,10 +1045,14 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     bound. ``r`` and ``u = W r + q`` are updated in place, on contiguous
     float arrays checked by the caller. The linear solves are Gaussian
     elimination with partial pivoting (LAPACK's in :func:`solve_exact`: the
-    two agree to rounding). Where Newton does not reach ``tol ||q||``, or
-    meets an exactly singular Jacobian, :func:`solve_exact` would go on
-    (least squares, a restart from the polyhedral solution, relaxed
-    sweeps): the caller hands the problem to it.
+    two agree to rounding), the least-norm solution where a pivot shows the
+    Jacobian singular to rounding. Where that Newton does not reach ``tol
+    ||q||``, :func:`solve_exact` restarts from the polyhedral solution; here
+    Newton runs again from the same start with least-norm steps throughout
+    (a Jacobian with a null space: contacts whose forces are statically
+    indeterminate, a box's corners, where elimination does not always see
+    the singularity). Where that misses too the caller hands the problem
+    to :func:`solve_exact`.
 
     Returns
     -------
@@ -1013,7 +1063,7 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     qnorm : float
         ``||q||``.
     steps : int
-        Newton steps taken.
+        Newton steps taken (both runs).
 
     Examples
     --------
@@ -1042,13 +1092,54 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     rho = np.empty(nc)
     for i in range(nc):
         rho[i] = 1.0 / W[3 * i, 3 * i]
+    start = r.copy()
+    best_r = r.copy()
+    best, it = _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, False)
+    if best > tol_sq:
+        # solve_exact's Newton missed (it would restart from the polyhedral solution): the
+        # Jacobian is singular to rounding where it has a null space (a box's corners, their
+        # forces statically indeterminate), which Gaussian elimination does not always see;
+        # Newton again from the same point with the least-norm steps
+        best2_r = start.copy()
+        best2, more = _newton_run(W, q, mu, rho, start, best2_r, tol_sq, max_newton, True)
+        it += more
+        if best2 < best:
+            best = best2
+            best_r[:] = best2_r
+    if best > tol_sq:
+        return False, math.sqrt(best), qn, it
+    r[:] = best_r
+    r_in = _project_all(r, mu)
+    ut = np.empty(n)
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r_in[l]
+        ut[j] = acc
+    if _natural_sq(r_in, ut, mu) <= max(best, tol_sq):
+        r[:] = r_in
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r[l]
+        u[j] = acc
+    res = math.sqrt(_natural_sq(r, u, mu))
+    return res <= tol * scale, res, qn, it
+
+
+@njit(cache=True)
+def _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, least_norm):
+    # _newton from r (moved): at most max_newton steps, best_r the iterate of least natural
+    # residual (r's own to begin with); returns that residual squared and the steps taken.
+    # Steps by Gaussian elimination as LAPACK's solve in _newton, the least-norm solution
+    # where a pivot shows J singular to rounding, or throughout with `least_norm`
+    n = r.shape[0]
     phi = np.empty(n)
     J = np.empty((n, n))
     Jc = np.empty((n, n))
     rhs = np.empty(n)
     step = np.empty(n)
     trial = np.empty(n)
-    best_r = r.copy()
     ut = np.empty(n)
     for j in range(n):
         acc = q[j]
@@ -1068,26 +1159,11 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
                 big = max(big, abs(J[j, l]))
         Jc[:, :] = J
         rhs[:] = phi
-        if not _lu_solve(J, phi, step, _SINGULAR * big):
-            # a Jacobian singular to rounding (stick on statically indeterminate contacts,
-            # where LAPACK's solve returns a step of size 1/rounding): the least-norm step
+        if least_norm or not _lu_solve(J, phi, step, _SINGULAR * big):
             step[:] = np.linalg.lstsq(Jc, rhs)[0]
-        finite = True
-        for j in range(n):
-            finite = finite and math.isfinite(step[j])
-        if not finite:
+        if not _all_finite(step):
             break
-        t = 1.0
-        while True:
-            for j in range(n):
-                trial[j] = r[j] + t * step[j]
-            _alart_curnier_into(W, q, mu, rho, trial, ut, phi, J)
-            mt = 0.0
-            for j in range(n):
-                mt += phi[j] * phi[j]
-            if mt <= (1.0 - 1e-4 * t) * merit or t < 1e-10:
-                break
-            t *= 0.5
+        t = _armijo(W, q, mu, rho, r, step, merit, trial, ut, phi, J)
         it += 1
         if t < 1e-10:
             break
@@ -1101,24 +1177,7 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
         if res < best:
             best = res
             best_r[:] = r
-    if best > tol_sq:
-        return False, math.sqrt(best), qn, it
-    r[:] = best_r
-    r_in = _project_all(r, mu)
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r_in[l]
-        ut[j] = acc
-    if _natural_sq(r_in, ut, mu) <= max(best, tol_sq):
-        r[:] = r_in
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r[l]
-        u[j] = acc
-    res = math.sqrt(_natural_sq(r, u, mu))
-    return res <= tol * scale, res, qn, it
+    return best, it
 
 
 def solve_cone(W, q, mu, cone="exact", **options):

@@ -254,3 +254,10 @@ def test_a_box_s_four_corners_run_in_the_loop_with_the_exact_cone(monkeypatch):
     for pair in ([1, 3], [0, 2]):
         assert np.max(np.abs(ref.force_N[:, pair].sum(axis=1)
                              - res.force_N[:, pair].sum(axis=1))) <= 1e-9
+    # at rest every corner sticks and Newton's Jacobian is singular (W has a null space):
+    # the least-norm steps end every step in the loop, where solve_exact restarts
+    rest = registry.make_scene("box-incline", mu=0.5, speed=0.0)
+    q0, v0 = rest.initial_state()
+    res = simulate(rest, (0.0, 1.0), q0, v0, "moreau-jean", h=0.04, cone="exact")
+    assert calls[0] == 0 and res.stats["max_residual"] <= 1e-10
+    assert np.max(np.abs(res.v)) <= 1e-10
