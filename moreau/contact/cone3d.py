@@ -1007,6 +1007,32 @@ _SINGULAR = 1e-13
 
 
 @njit(cache=True)
+def _least_norm_step(J, rhs, step, A, b):
+    # the least-norm solution of J step = rhs where J is singular to rounding, by the normal
+    # equations regularised at 1e-14 of their scale, (J^T J + eps I) step = J^T rhs (the
+    # null-space part damped to zero, the rest exact to the conditioning of J on its range;
+    # LAPACK's least squares would cost the compile of its bindings); A and b are scratch
+    n = rhs.shape[0]
+    scale = 0.0
+    for a in range(n):
+        for c in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += J[k, a] * J[k, c]
+            A[a, c] = acc
+        scale = max(scale, A[a, a])
+        acc = 0.0
+        for k in range(n):
+            acc += J[k, a] * rhs[k]
+        b[a] = acc
+    for a in range(n):
+        A[a, a] += 1e-14 * scale
+    if not _lu_solve(A, b, step, 0.0):
+        for a in range(n):
+            step[a] = 0.0
+
+
+@njit(cache=True)
 def _all_finite(x):
     for j in range(x.shape[0]):
         if not math.isfinite(x[j]):
@@ -1160,7 +1186,7 @@ def _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, least_norm):
         Jc[:, :] = J
         rhs[:] = phi
         if least_norm or not _lu_solve(J, phi, step, _SINGULAR * big):
-            step[:] = np.linalg.lstsq(Jc, rhs)[0]
+            _least_norm_step(Jc, rhs, step, J, phi)
         if not _all_finite(step):
             break
         t = _armijo(W, q, mu, rho, r, step, merit, trial, ut, phi, J)

@@ -17,9 +17,9 @@ the scene's shapes against its half-spaces
 * ``"exact"``: :func:`moreau.contact.cone3d.exact_gauss_seidel`, the exact
   solver's Gauss–Seidel phase with its exact local solve, then where it
   stops short its Newton polish (:func:`moreau.contact.cone3d.exact_newton_polish`:
-  several contacts on one body, a box's corners); where the exact solver would
-  go further (its restart from the polyhedral solution) the step is handed
-  back (:data:`LCP_HANDBACK`) to the Python step, which runs the whole solver;
+  several contacts on one body, a box's corners; compiled and linked only for
+  scenes with such a body); where that misses too the step is handed back
+  (:data:`LCP_HANDBACK`) to the Python step, which runs the whole solver;
 * ``d`` directions: the polyhedral LCP of
   :func:`moreau.contact.cone3d.build_polyhedral_lcp`, assembled here and
   solved by :func:`moreau.lcp.lemke.lemke_core`; where Lemke fails the
@@ -68,11 +68,14 @@ class SpaceTables:
     """A spatial scene as the compiled loop takes it: ``tables`` (:func:`space_tables`) and an
     unused ``par`` (the block runner passes a compiled model's parameters first)."""
 
-    __slots__ = ("tables", "par")
+    __slots__ = ("tables", "par", "several")
 
     def __init__(self, tables):
         self.tables = tables
         self.par = np.zeros(1)
+        #: some body has several contacts: the exact cone may need Newton's polish
+        bodies = tables[5][:, 0]
+        self.several = bool(bodies.size > np.unique(bodies).size)
 
 
 def space_tables(scene, cone, mu, e):
@@ -272,8 +275,19 @@ def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, ma
 
 @njit(cache=True)
 def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r, u):
-    # the exact cone by Gauss–Seidel, then Newton's polish where it stops short; status 1
-    # where solve_exact would go on (a singular Jacobian, its restart, relaxed sweeps)
+    # the exact cone by Gauss–Seidel; status 1 where Newton's polish is needed (never with
+    # one contact a body, whose local solve is exact: the solver of such scenes)
+    u[:] = Uf
+    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                     EXACT_SWEEPS)
+    return np.int64(0 if ok else 1), np.int64(0), res, qn
+
+
+@njit(cache=True)
+def _exact_polish_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter,
+                        r, u):
+    # the exact cone by Gauss–Seidel, then Newton's polish where it stops short (several
+    # contacts on one body); status 1 where solve_exact would go on (its restart)
     u[:] = Uf
     ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
                                      EXACT_SWEEPS)
@@ -310,9 +324,17 @@ SOLVE_SIGNATURE = nbtypes.Tuple((_INT, _INT, nbtypes.float64, nbtypes.float64))(
     _A1, _A1)
 
 
-def space_solver(cone):
-    """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`."""
-    fn = _exact_solve if cone == "exact" else _polyhedral_solve
+def space_solver(cone, several=False):
+    """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`.
+
+    With ``several`` (some body has several contacts,
+    :attr:`SpaceTables.several`) the exact cone's solver ends with Newton's
+    polish; without, it is compiled without it (a third of the exact path's
+    compile: with one contact a body Gauss–Seidel's exact local solve converges
+    in a sweep).
+    """
+    fn = (_polyhedral_solve if cone != "exact" else
+          _exact_polish_solve if several else _exact_solve)
     if not fn.signatures:
         fn.compile(SOLVE_SIGNATURE)
     return fn

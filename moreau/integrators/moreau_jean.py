@@ -757,7 +757,7 @@ class MoreauJean(TimeStepping):
         k0 = self._k
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
-                                         space_solver(self.cone)), ())
+                                         space_solver(self.cone, self._model.several)), ())
         self.q, self.v, self._closed = q, v, closed
         if status == LCP_HANDBACK:
             if self._k == k0:
