@@ -514,6 +514,12 @@ def _refine_angle(A, b, mu, lo, hi, flo, fhi):
             break
         x = hi - whi * (hi - lo) / (whi - wlo)
         if not lo < x < hi:
+            # the secant lands on an end: a root there to rounding (a launch along a
+            # sample's direction) when that end's F is rounding beside the other's
+            if x <= lo and abs(flo) <= 1e-14 * abs(fhi):
+                return lo
+            if x >= hi and abs(fhi) <= 1e-14 * abs(flo):
+                return hi
             x = 0.5 * (lo + hi)
             if not lo < x < hi:
                 break
