@@ -94,6 +94,7 @@ __all__ = [
     "solve_exact",
     "solve_cone",
     "exact_gauss_seidel",
+    "exact_newton_polish",
     "natural_map_sq",
     "project_contensou",
     "local_solve_contensou",
@@ -481,8 +482,12 @@ def _local_res_sq(A, b, mu, rn, r1, r2):
 def _slip_fn(A, b, mu, phi):
     # with s = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
     # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
-    c = math.cos(phi)
-    s = math.sin(phi)
+    return _slip_cs(A, b, mu, math.cos(phi), math.sin(phi))
+
+
+@njit(cache=True, inline="always")
+def _slip_cs(A, b, mu, c, s):
+    # _slip_fn at the angle whose cosine and sine are c and s
     g = A[0, 0] - mu * (A[0, 1] * c + A[0, 2] * s)
     h1 = -b[0] * (A[1, 0] - mu * (A[1, 1] * c + A[1, 2] * s)) + g * b[1]
     h2 = -b[0] * (A[2, 0] - mu * (A[2, 1] * c + A[2, 2] * s)) + g * b[2]
@@ -490,10 +495,57 @@ def _slip_fn(A, b, mu, phi):
 
 
 _N_SAMPLES = 64
+# the samples' upper ends as _local's loop computes them (k step + step) and their cosines and
+# sines, computed once: the loop's trigonometry is then its bisections' only
+_SAMPLE_STEP = 2.0 * math.pi / _N_SAMPLES
+_SAMPLE_COS = np.array([math.cos(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
+_SAMPLE_SIN = np.array([math.sin(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
 #: Gauss–Seidel sweeps without a new least residual before Newton takes over
 _STALL = 50
 #: directions of the polyhedral cone whose solution restarts Newton
 _RESTART_D = 16
+
+
+#: the sliding angle's bracket is refined to this width [rad] (a few rounding units of 2 pi)
+_ANGLE_TOL = 4e-15
+
+
+@njit(cache=True, inline="always")
+def _refine_angle(A, b, mu, lo, hi, flo, fhi):
+    # a root of the slip function in [lo, hi] (flo, fhi of opposite signs) by the Illinois
+    # variant of regula falsi (superlinear, the bracket kept): a dozen evaluations where
+    # bisection takes fifty; a step that rounding puts outside the bracket bisects instead.
+    # Returns the end of least |F| once the bracket is _ANGLE_TOL wide
+    wlo, whi = flo, fhi           # the weights Illinois halves; flo, fhi stay the values
+    side = 0
+    for _ in range(100):
+        if hi - lo <= _ANGLE_TOL:
+            break
+        x = hi - whi * (hi - lo) / (whi - wlo)
+        if not lo < x < hi:
+            # the secant lands on an end: a root there to rounding (a launch along a
+            # sample's direction) when that end's F is rounding beside the other's
+            if x <= lo and abs(flo) <= 1e-14 * abs(fhi):
+                return lo
+            if x >= hi and abs(fhi) <= 1e-14 * abs(flo):
+                return hi
+            x = 0.5 * (lo + hi)
+            if not lo < x < hi:
+                break
+        fx, _, _ = _slip_fn(A, b, mu, x)
+        if fx == 0.0:
+            return x
+        if (fx < 0.0) == (flo < 0.0):
+            lo, flo, wlo = x, fx, fx
+            if side < 0:
+                whi *= 0.5
+            side = -1
+        else:
+            hi, fhi, whi = x, fx, fx
+            if side > 0:
+                wlo *= 0.5
+            side = 1
+    return lo if abs(flo) <= abs(fhi) else hi
 
 
 @njit(cache=True)
@@ -510,19 +562,16 @@ def _local(A, b, mu):
     c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
     det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
     if det > 0.0:
-        inv = np.empty((3, 3))
-        inv[0, 0] = c00
-        inv[1, 0] = c01
-        inv[2, 0] = c02
-        inv[0, 1] = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
-        inv[1, 1] = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
-        inv[2, 1] = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
-        inv[0, 2] = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
-        inv[1, 2] = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
-        inv[2, 2] = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        rn = -(inv[0, 0] * b[0] + inv[0, 1] * b[1] + inv[0, 2] * b[2]) / det
-        r1 = -(inv[1, 0] * b[0] + inv[1, 1] * b[1] + inv[1, 2] * b[2]) / det
-        r2 = -(inv[2, 0] * b[0] + inv[2, 1] * b[1] + inv[2, 2] * b[2]) / det
+        # the adjugate's entries as scalars (no array allocated in this hot branch)
+        i01 = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
+        i11 = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
+        i21 = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
+        i02 = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
+        i12 = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
+        i22 = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+        rn = -(c00 * b[0] + i01 * b[1] + i02 * b[2]) / det
+        r1 = -(c01 * b[0] + i11 * b[1] + i12 * b[2]) / det
+        r2 = -(c02 * b[0] + i21 * b[1] + i22 * b[2]) / det
         if rn >= 0.0 and math.hypot(r1, r2) <= mu * rn:
             return rn, r1, r2
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
@@ -533,33 +582,17 @@ def _local(A, b, mu):
     for k in range(_N_SAMPLES):
         lo = k * step
         hi = lo + step
-        fb, _, _ = _slip_fn(A, b, mu, hi)
+        fb, _, _ = _slip_cs(A, b, mu, _SAMPLE_COS[k], _SAMPLE_SIN[k])
         if fa == 0.0 or fa * fb < 0.0:
-            flo = fa
-            if fa != 0.0:
-                for _ in range(200):
-                    mid = 0.5 * (lo + hi)
-                    if mid <= lo or mid >= hi:
-                        break
-                    fm, _, _ = _slip_fn(A, b, mu, mid)
-                    if fm == 0.0:
-                        lo = mid
-                        hi = mid
-                        break
-                    if (fm < 0.0) == (flo < 0.0):
-                        lo = mid
-                        flo = fm
-                    else:
-                        hi = mid
-                phi = lo if abs(flo) <= abs(fm) else hi
-            else:
-                phi = lo
-            _, along, g = _slip_fn(A, b, mu, phi)
+            phi = lo if fa == 0.0 else _refine_angle(A, b, mu, lo, hi, fa, fb)
+            c = math.cos(phi)
+            sn = math.sin(phi)
+            _, along, g = _slip_cs(A, b, mu, c, sn)
             if g > 0.0 and along >= 0.0:
                 rho = -b[0] / g
                 rn = rho
-                r1 = -mu * rho * math.cos(phi)
-                r2 = -mu * rho * math.sin(phi)
+                r1 = -mu * rho * c
+                r2 = -mu * rho * sn
                 res = _local_res_sq(A, b, mu, rn, r1, r2)
                 if res < best:
                     best, best_n, best_1, best_2 = res, rn, r1, r2
@@ -574,9 +607,9 @@ def local_solve(A, b, mu):
     in the cone; otherwise slip: ``r = rho (1, -mu cos phi, -mu sin phi)``
     with ``u_N = 0`` giving ``rho = -b_N / g(phi)``, ``g = A_NN - mu A_NT s``,
     and the sliding angle a root of ``s_perp . u_T(phi) = 0`` with ``s .
-    u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and bisected to the
-    last bit. Of several admissible roots the one with the least residual
-    is kept.
+    u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and refined by
+    the Illinois variant of regula falsi to a bracket ``4e-15`` rad wide. Of
+    several admissible roots the one with the least residual is kept.
 
     Examples
     --------
@@ -893,6 +926,299 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
         u[:] = u_in
     res = math.sqrt(_natural_sq(r, u, mu))
     return res <= tol * scale, res, qn
+
+
+@njit(cache=True)
+def _alart_curnier_into(W, q, mu, rho, r, u, phi, J):
+    # _alart_curnier's function and Jacobian written into phi and J, in its order of operations
+    n = r.shape[0]
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r[l]
+        u[j] = acc
+    for i in range(mu.shape[0]):
+        k = 3 * i
+        p = rho[i]
+        tau = r[k] - p * u[k]
+        active = tau > 0.0
+        phi[k] = r[k] - max(tau, 0.0)
+        for j in range(n):
+            # the row of dtau = e_k - p W[k]
+            dt = -p * W[k, j]
+            if j == k:
+                dt += 1.0
+            J[k, j] = ((1.0 if j == k else 0.0) - dt) if active else (1.0 if j == k else 0.0)
+        x0 = r[k + 1] - p * u[k + 1]
+        x1 = r[k + 2] - p * u[k + 2]
+        radius = mu[i] * max(tau, 0.0)
+        nx = math.hypot(x0, x1)
+        if nx <= radius:
+            phi[k + 1] = p * u[k + 1]
+            phi[k + 2] = p * u[k + 2]
+            for j in range(n):
+                J[k + 1, j] = p * W[k + 1, j]
+                J[k + 2, j] = p * W[k + 2, j]
+        else:
+            h0 = x0 / nx
+            h1 = x1 / nx
+            phi[k + 1] = r[k + 1] - radius * h0
+            phi[k + 2] = r[k + 2] - radius * h1
+            f = radius / nx
+            p00 = f * (1.0 - h0 * h0)
+            p01 = f * (0.0 - h0 * h1)
+            p11 = f * (1.0 - h1 * h1)
+            for j in range(n):
+                d0 = -p * W[k + 1, j]
+                d1 = -p * W[k + 2, j]
+                if j == k + 1:
+                    d0 += 1.0
+                if j == k + 2:
+                    d1 += 1.0
+                dp0 = p00 * d0 + p01 * d1
+                dp1 = p01 * d0 + p11 * d1
+                if active:
+                    dt = -p * W[k, j]
+                    if j == k:
+                        dt += 1.0
+                    dp0 += mu[i] * h0 * dt
+                    dp1 += mu[i] * h1 * dt
+                J[k + 1, j] = (1.0 if j == k + 1 else 0.0) - dp0
+                J[k + 2, j] = (1.0 if j == k + 2 else 0.0) - dp1
+
+
+@njit(cache=True)
+def _lu_solve(A, b, x, floor):
+    # A x = b by Gaussian elimination with partial pivoting (A, b overwritten); False on a
+    # pivot at or below `floor`: A singular to rounding (a box's corners at rest)
+    n = b.shape[0]
+    for c in range(n):
+        p = c
+        for i in range(c + 1, n):
+            if abs(A[i, c]) > abs(A[p, c]):
+                p = i
+        if abs(A[p, c]) <= floor:
+            return False
+        if p != c:
+            for j in range(n):
+                A[c, j], A[p, j] = A[p, j], A[c, j]
+            b[c], b[p] = b[p], b[c]
+        for i in range(c + 1, n):
+            f = A[i, c] / A[c, c]
+            if f != 0.0:
+                for j in range(c + 1, n):
+                    A[i, j] -= f * A[c, j]
+                b[i] -= f * b[c]
+    for c in range(n - 1, -1, -1):
+        acc = b[c]
+        for j in range(c + 1, n):
+            acc -= A[c, j] * x[j]
+        x[c] = acc / A[c, c]
+    return True
+
+
+#: a Newton Jacobian whose pivot falls to this fraction of its largest entry is singular
+_SINGULAR = 1e-13
+
+
+@njit(cache=True)
+def _least_norm_step(J, rhs, step, A, b):
+    # the least-norm solution of J step = rhs where J is singular to rounding, by the normal
+    # equations regularised at 1e-14 of their scale, (J^T J + eps I) step = J^T rhs (the
+    # null-space part damped to zero, the rest exact to the conditioning of J on its range;
+    # LAPACK's least squares would cost the compile of its bindings); A and b are scratch
+    n = rhs.shape[0]
+    scale = 0.0
+    for a in range(n):
+        for c in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += J[k, a] * J[k, c]
+            A[a, c] = acc
+        scale = max(scale, A[a, a])
+        acc = 0.0
+        for k in range(n):
+            acc += J[k, a] * rhs[k]
+        b[a] = acc
+    for a in range(n):
+        A[a, a] += 1e-14 * scale
+    if not _lu_solve(A, b, step, 0.0):
+        for a in range(n):
+            step[a] = 0.0
+
+
+@njit(cache=True)
+def _all_finite(x):
+    for j in range(x.shape[0]):
+        if not math.isfinite(x[j]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _armijo(W, q, mu, rho, r, step, merit, trial, ut, phi, J):
+    # _newton's search: the step halved until the merit |phi|^2 falls by 1e-4 t, down to 1e-10;
+    # trial holds the last point tried
+    n = r.shape[0]
+    t = 1.0
+    while True:
+        for j in range(n):
+            trial[j] = r[j] + t * step[j]
+        _alart_curnier_into(W, q, mu, rho, trial, ut, phi, J)
+        mt = 0.0
+        for j in range(n):
+            mt += phi[j] * phi[j]
+        if mt <= (1.0 - 1e-4 * t) * merit or t < 1e-10:
+            return t
+        t *= 0.5
+
+
+@njit(cache=True)
+def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
+    """:func:`solve_exact`'s Newton polish after its Gauss–Seidel phase, compiled.
+
+    From ``r`` (Gauss–Seidel's last iterate, :func:`exact_gauss_seidel`) the
+    nonsmooth Newton method of :func:`solve_exact` on the Alart–Curnier
+    function (``rho_i = 1 / W_NN,i``, Armijo's search halving the step down
+    to ``1e-10``), ``max_newton`` steps at most, keeping the iterate of
+    least natural-map residual; then, as :func:`solve_exact` ends, the
+    projection of ``r`` on the cone where that costs nothing against the
+    bound. ``r`` and ``u = W r + q`` are updated in place, on contiguous
+    float arrays checked by the caller. The linear solves are Gaussian
+    elimination with partial pivoting (LAPACK's in :func:`solve_exact`: the
+    two agree to rounding), the least-norm solution where a pivot shows the
+    Jacobian singular to rounding. Where that Newton does not reach ``tol
+    ||q||``, :func:`solve_exact` restarts from the polyhedral solution; here
+    Newton runs again from the same start with least-norm steps throughout
+    (a Jacobian with a null space: contacts whose forces are statically
+    indeterminate, a box's corners, where elimination does not always see
+    the singularity). Where that misses too the caller hands the problem
+    to :func:`solve_exact`.
+
+    Returns
+    -------
+    converged : bool
+        ``residual <= tol ||q||``.
+    residual : float
+        The natural-map residual of ``r`` on the data (:func:`cone_residual`).
+    qnorm : float
+        ``||q||``.
+    steps : int
+        Newton steps taken (both runs).
+
+    Examples
+    --------
+    Two contacts of one body, where Gauss–Seidel alone stops at ``1e-6``:
+
+    >>> W = np.array([[2.0, 0.5, 0.0, 1.0, 0.0, 0.0], [0.5, 3.0, 0.0, 0.0, 0.0, 0.0],
+    ...               [0.0, 0.0, 3.0, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 2.0, 0.0, 0.5],
+    ...               [0.0, 0.0, 0.0, 0.0, 3.0, 0.0], [0.0, 0.0, 0.0, 0.5, 0.0, 3.0]])
+    >>> q = np.array([-1.0, 2.0, 0.0, -1.0, 0.0, -2.0]); mu = np.array([0.3, 0.3])
+    >>> r = np.zeros(6); u = q.copy()
+    >>> ok, res, qn = exact_gauss_seidel(W, q, mu, r, u, 1e-10, 1e-6, 500)
+    >>> bool(ok), res > 1e-10 * qn
+    (False, True)
+    >>> ok, res, qn, steps = exact_newton_polish(W, q, mu, r, u, 1e-10, 15)
+    >>> bool(ok), res <= 1e-10 * qn, bool(np.abs(r - solve_exact(W, q, mu).r).max() < 1e-14)
+    (True, True, True)
+    """
+    n = q.shape[0]
+    nc = mu.shape[0]
+    qn = 0.0
+    for j in range(n):
+        qn += q[j] * q[j]
+    qn = math.sqrt(qn)
+    scale = qn if qn > 0.0 else 1.0
+    tol_sq = (tol * scale) ** 2
+    rho = np.empty(nc)
+    for i in range(nc):
+        rho[i] = 1.0 / W[3 * i, 3 * i]
+    start = r.copy()
+    best_r = r.copy()
+    best, it = _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, False)
+    if best > tol_sq:
+        # solve_exact's Newton missed (it would restart from the polyhedral solution): the
+        # Jacobian is singular to rounding where it has a null space (a box's corners, their
+        # forces statically indeterminate), which Gaussian elimination does not always see;
+        # Newton again from the same point with the least-norm steps
+        best2_r = start.copy()
+        best2, more = _newton_run(W, q, mu, rho, start, best2_r, tol_sq, max_newton, True)
+        it += more
+        if best2 < best:
+            best = best2
+            best_r[:] = best2_r
+    if best > tol_sq:
+        return False, math.sqrt(best), qn, it
+    r[:] = best_r
+    r_in = _project_all(r, mu)
+    ut = np.empty(n)
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r_in[l]
+        ut[j] = acc
+    if _natural_sq(r_in, ut, mu) <= max(best, tol_sq):
+        r[:] = r_in
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r[l]
+        u[j] = acc
+    res = math.sqrt(_natural_sq(r, u, mu))
+    return res <= tol * scale, res, qn, it
+
+
+@njit(cache=True)
+def _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, least_norm):
+    # _newton from r (moved): at most max_newton steps, best_r the iterate of least natural
+    # residual (r's own to begin with); returns that residual squared and the steps taken.
+    # Steps by Gaussian elimination as LAPACK's solve in _newton, the least-norm solution
+    # where a pivot shows J singular to rounding, or throughout with `least_norm`
+    n = r.shape[0]
+    phi = np.empty(n)
+    J = np.empty((n, n))
+    Jc = np.empty((n, n))
+    rhs = np.empty(n)
+    step = np.empty(n)
+    trial = np.empty(n)
+    ut = np.empty(n)
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r[l]
+        ut[j] = acc
+    best = _natural_sq(r, ut, mu)
+    it = 0
+    while it < max_newton and best > tol_sq:
+        _alart_curnier_into(W, q, mu, rho, r, ut, phi, J)
+        merit = 0.0
+        big = 0.0
+        for j in range(n):
+            merit += phi[j] * phi[j]
+            phi[j] = -phi[j]
+            for l in range(n):
+                big = max(big, abs(J[j, l]))
+        Jc[:, :] = J
+        rhs[:] = phi
+        if least_norm or not _lu_solve(J, phi, step, _SINGULAR * big):
+            _least_norm_step(Jc, rhs, step, J, phi)
+        if not _all_finite(step):
+            break
+        t = _armijo(W, q, mu, rho, r, step, merit, trial, ut, phi, J)
+        it += 1
+        if t < 1e-10:
+            break
+        r[:] = trial
+        for j in range(n):
+            acc = q[j]
+            for l in range(n):
+                acc += W[j, l] * r[l]
+            ut[j] = acc
+        res = _natural_sq(r, ut, mu)
+        if res < best:
+            best = res
+            best_r[:] = r
+    return best, it
 
 
 def solve_cone(W, q, mu, cone="exact", **options):

@@ -15,9 +15,11 @@ the scene's shapes against its half-spaces
 :func:`space_solver`, so that a run compiles and links only its own):
 
 * ``"exact"``: :func:`moreau.contact.cone3d.exact_gauss_seidel`, the exact
-  solver's Gauss–Seidel phase with its exact local solve; where it would
-  need the Newton polish the step is handed back (:data:`LCP_HANDBACK`) to
-  the Python step, which runs the whole solver;
+  solver's Gauss–Seidel phase with its exact local solve, then where it
+  stops short its Newton polish (:func:`moreau.contact.cone3d.exact_newton_polish`:
+  several contacts on one body, a box's corners; compiled and linked only for
+  scenes with such a body); where that misses too the step is handed back
+  (:data:`LCP_HANDBACK`) to the Python step, which runs the whole solver;
 * ``d`` directions: the polyhedral LCP of
   :func:`moreau.contact.cone3d.build_polyhedral_lcp`, assembled here and
   solved by :func:`moreau.lcp.lemke.lemke_core`; where Lemke fails the
@@ -40,7 +42,8 @@ from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from ..contact import cone3d as _cone3d
-from ..contact.cone3d import exact_gauss_seidel, facet_directions, natural_map_sq
+from ..contact.cone3d import (exact_gauss_seidel, exact_newton_polish, facet_directions,
+                              natural_map_sq)
 from ..lcp.lemke import DEFAULT_TOL, default_max_iter, lemke_core, lemke_workspace
 from ..model import spatial as _spatial
 from ..model.spatial import rotate_into
@@ -49,10 +52,12 @@ from ._contact_step import LCP_HANDBACK, NUMERICAL, OK, S_LCP, S_PEN, S_PIVOTS, 
 from ._driver import grid_step
 
 __all__ = ["SpaceTables", "space_tables", "space_loop", "space_solver", "run_space_loop",
-           "SOLVE_SIGNATURE", "EXACT_TOL", "EXACT_POLISH_FROM", "EXACT_SWEEPS"]
+           "SOLVE_SIGNATURE", "EXACT_TOL", "EXACT_POLISH_FROM", "EXACT_SWEEPS", "EXACT_NEWTON"]
 
 #: :func:`moreau.contact.cone3d.solve_exact`'s defaults, which the Python step uses
 EXACT_TOL, EXACT_POLISH_FROM, EXACT_SWEEPS = 1e-10, 1e-6, 500
+#: its first Newton run's budget, half of its 30 steps (the rest is for its restart)
+EXACT_NEWTON = 15
 
 # the regimes (moreau.regimes.Regime) and the Python step's stick threshold
 _POSITIVE, _STICK = 1, 3
@@ -63,11 +68,14 @@ class SpaceTables:
     """A spatial scene as the compiled loop takes it: ``tables`` (:func:`space_tables`) and an
     unused ``par`` (the block runner passes a compiled model's parameters first)."""
 
-    __slots__ = ("tables", "par")
+    __slots__ = ("tables", "par", "several")
 
     def __init__(self, tables):
         self.tables = tables
         self.par = np.zeros(1)
+        #: some body has several contacts: the exact cone may need Newton's polish
+        bodies = tables[5][:, 0]
+        self.several = bool(bodies.size > np.unique(bodies).size)
 
 
 def space_tables(scene, cone, mu, e):
@@ -267,10 +275,24 @@ def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, ma
 
 @njit(cache=True)
 def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r, u):
-    # the exact cone where Gauss–Seidel converges; status 1 where Newton's polish is needed
+    # the exact cone by Gauss–Seidel; status 1 where Newton's polish is needed (never with
+    # one contact a body, whose local solve is exact: the solver of such scenes)
     u[:] = Uf
     ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
                                      EXACT_SWEEPS)
+    return np.int64(0 if ok else 1), np.int64(0), res, qn
+
+
+@njit(cache=True)
+def _exact_polish_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter,
+                        r, u):
+    # the exact cone by Gauss–Seidel, then Newton's polish where it stops short (several
+    # contacts on one body); status 1 where solve_exact would go on (its restart)
+    u[:] = Uf
+    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                     EXACT_SWEEPS)
+    if not ok:
+        ok, res, qn, _ = exact_newton_polish(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_NEWTON)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
@@ -302,9 +324,17 @@ SOLVE_SIGNATURE = nbtypes.Tuple((_INT, _INT, nbtypes.float64, nbtypes.float64))(
     _A1, _A1)
 
 
-def space_solver(cone):
-    """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`."""
-    fn = _exact_solve if cone == "exact" else _polyhedral_solve
+def space_solver(cone, several=False):
+    """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`.
+
+    With ``several`` (some body has several contacts,
+    :attr:`SpaceTables.several`) the exact cone's solver ends with Newton's
+    polish; without, it is compiled without it (a third of the exact path's
+    compile: with one contact a body Gauss–Seidel's exact local solve converges
+    in a sweep).
+    """
+    fn = (_polyhedral_solve if cone != "exact" else
+          _exact_polish_solve if several else _exact_solve)
     if not fn.signatures:
         fn.compile(SOLVE_SIGNATURE)
     return fn

@@ -229,10 +229,11 @@ and the step solves the round cone with three tangential rows
 step. The step runs in the compiled loop of
 :mod:`moreau.integrators._space_kernels` for scenes whose contacts are
 spheres and material points (pucks) against half-spaces (all shipped
-ones), the same step to rounding; a contact problem the loop does not
-finish (the exact cone where Gauss–Seidel alone misses the tolerance and
-the Newton polish is needed, which happens with several contacts on one
-body; a Lemke failure) is handed to the Python step, which stays the
+ones), the same step to rounding, the exact cone's Newton polish included
+(several contacts on one body: a puck's rim points, a box's corners); a
+contact problem the loop does not finish (the exact cone where that Newton
+misses the tolerance and the exact solver restarts from the polyhedral
+solution; a Lemke failure) is handed to the Python step, which stays the
 reference (``fast=False``).
 
 *Compiled path.* Scenes with a ``compiled_model()`` (all shipped ones) run
@@ -910,7 +911,7 @@ class MoreauJean(TimeStepping):
         k0 = self._k
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
-                                         space_solver(self.cone)), ())
+                                         space_solver(self.cone, self._model.several)), ())
         self.q, self.v, self._closed = q, v, closed
         if status == LCP_HANDBACK:
             if self._k == k0:
@@ -918,7 +919,7 @@ class MoreauJean(TimeStepping):
                 self._python_steps_left = self._python_run
             else:
                 self._python_run = 1
-        # a contact problem the loop does not finish (the exact cone's Newton polish, a Lemke
+        # a contact problem the loop does not finish (the exact cone's restart, a Lemke
         # failure) is the generic step's, which solves it or raises with its diagnosis
         self._after_block(status)
 
