@@ -377,3 +377,19 @@ def test_an_answer_beyond_the_range_of_doubles_is_a_breakdown_not_a_nan():
     res = solve_lcp(M, np.array([-1.0, 1.0]))  # z1 = 5e309
     assert res.status == BREAKDOWN
     assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w)) and np.isfinite(res.residual)
+
+
+def test_fortran_ordered_and_strided_data_reuse_the_c_ordered_compile():
+    # a transposed or fancy-indexed matrix (Fortran order) and a strided q are copied to C
+    # order at the entry: numba would otherwise compile the whole solver again for their
+    # layout (23 CPU s on a cold cache); the same arithmetic, so the same bits
+    from moreau.lcp import lemke
+    rng = np.random.default_rng(3)
+    M = random_p_matrix(6, rng)
+    q = rng.standard_normal(12)
+    ref = solve_lcp(M, q[::2].copy())
+    res = solve_lcp(np.asfortranarray(M), q[::2])
+    assert res.success and ref.success
+    np.testing.assert_array_equal(res.z, ref.z)
+    layouts = {(sig[0].layout, sig[1].layout) for sig in lemke._solve_packed_ones.signatures}
+    assert layouts == {("C", "C")}, layouts
