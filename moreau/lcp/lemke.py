@@ -1891,7 +1891,7 @@ def coerce_lcp(M, q):
     # cheap when the caller already passes float64 arrays, the common case
     if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2 or not M.flags.c_contiguous:
         M = _as_matrix(M)
-    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1 or not q.flags.c_contiguous:
+    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
     m0, m1 = M.shape
     if m0 != m1:
@@ -2011,7 +2011,7 @@ def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     # inline fast path of coerce_lcp costs a handful of attribute reads
     if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2 or not M.flags.c_contiguous:
         M = _as_matrix(M)
-    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1 or not q.flags.c_contiguous:
+    if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
     # shapes are checked in compiled code before any read (_solve_packed:
     # INVALID_INPUT, then _raise_nonfinite names the argument)
