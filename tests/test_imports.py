@@ -8,6 +8,7 @@
 """
 
 import ast
+import functools
 import json
 import math
 import os
@@ -80,16 +81,19 @@ def _imports(node, in_function):
             child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
 
 
-FILES = {f.module: f for f in map(_File, sorted(PACKAGE.rglob("*.py")))}
+@functools.cache
+def _files():
+    # parsed when a test asks, not at collection: each xdist worker collects every module
+    return {f.module: f for f in map(_File, sorted(PACKAGE.rglob("*.py")))}
 
 
 def _is_private_module(module):
-    return module in FILES and FILES[module].path.name.startswith("_") and \
-        not FILES[module].is_package
+    return module in _files() and _files()[module].path.name.startswith("_") and \
+        not _files()[module].is_package
 
 
 def _package_of(module):
-    f = FILES[module]
+    f = _files()[module]
     return module if f.is_package else module.rpartition(".")[0]
 
 
@@ -107,7 +111,7 @@ def _private_imports(f):
             name = alias.name
             if not name.startswith("_") or name.startswith("__"):
                 continue
-            if f"{src}.{name}" in FILES:
+            if f"{src}.{name}" in _files():
                 # a private module itself (``from . import _certified``): a package-internal helper
                 continue
             if _is_private_module(src) and f.module.startswith(_package_of(src) + "."):
@@ -118,7 +122,7 @@ def _private_imports(f):
 
 
 def test_no_private_name_is_imported_from_a_public_module():
-    bad = [b for f in FILES.values() for b in _private_imports(f)]
+    bad = [b for f in _files().values() for b in _private_imports(f)]
     assert not bad, "private names imported across modules:\n" + "\n".join(bad)
 
 
@@ -139,7 +143,7 @@ def _function_imports(f):
 
 
 def test_imports_are_at_the_top_except_optional_dependencies():
-    bad = [b for f in FILES.values() for b in _function_imports(f)]
+    bad = [b for f in _files().values() for b in _function_imports(f)]
     assert not bad, "imports inside functions (move them to the top):\n" + "\n".join(bad)
 
 
@@ -162,7 +166,7 @@ def _dependencies(f):
 
     def add(module, explicit):
         for m in _ancestors(module) | {module}:
-            if m in FILES and m != f.module and (m == module and explicit or m not in mine):
+            if m in _files() and m != f.module and (m == module and explicit or m not in mine):
                 deps.add(m)
 
     for node, in_function in f.imports:
@@ -175,7 +179,7 @@ def _dependencies(f):
         src = f.source(node)
         for alias in node.names:
             sub = f"{src}.{alias.name}"
-            if sub in FILES:
+            if sub in _files():
                 add(src, False)
                 add(sub, True)
             else:
@@ -184,7 +188,7 @@ def _dependencies(f):
 
 
 def test_module_graph_has_no_cycle():
-    graph = {m: _dependencies(f) for m, f in FILES.items()}
+    graph = {m: _dependencies(f) for m, f in _files().items()}
     cycle = find_cycle(graph)
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
 

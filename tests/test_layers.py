@@ -10,6 +10,7 @@ discovery only.
 """
 
 import ast
+import functools
 import pathlib
 import re
 
@@ -93,7 +94,10 @@ class Module:
         return ".".join(base + ([node.module] if node.module else []))
 
 
-MODULES = {m.name: m for m in map(Module, sorted(PACKAGE.rglob("*.py")))}
+@functools.cache
+def _modules():
+    # parsed when a test asks, not at collection: each xdist worker collects every module
+    return {m.name: m for m in map(Module, sorted(PACKAGE.rglob("*.py")))}
 
 
 def upward_imports(modules):
@@ -154,18 +158,18 @@ def find_cycle(graph):
 
 
 def test_every_module_has_a_floor():
-    missing = [m.rel for m in MODULES.values() if m.floor is None]
+    missing = [m.rel for m in _modules().values() if m.floor is None]
     assert not missing, "modules on no floor (add them to FLOORS and moreau's docstring): " \
         + ", ".join(missing)
 
 
 def test_no_import_runs_up_a_floor():
-    bad = upward_imports(MODULES)
+    bad = upward_imports(_modules())
     assert not bad, "imports from a lower floor into a higher one:\n" + "\n".join(bad)
 
 
 def test_the_import_graph_has_no_cycle():
-    cycle = find_cycle(import_graph(MODULES))
+    cycle = find_cycle(import_graph(_modules()))
     assert cycle is None, "import cycle: " + " -> ".join(cycle)
 
 

@@ -10,7 +10,10 @@ processes the tests start (README commands, notebooks) are all logged. One JSON
 line per compile (a disk-cache load is not a compile), written at once into
 ``<pid>.jsonl``: the function, its argument types, wall and CPU seconds, the
 nesting depth and the test running (``PYTEST_CURRENT_TEST``, which child
-processes inherit).
+processes inherit). A wait of more than 50 ms for an exclusive ``fcntl.flock``
+(the compile lock of :mod:`moreau.integrators._loops`: another worker compiles
+the same kernel) is logged as a line with ``"lock_wait"`` seconds: wall time
+that worker spent idle.
 """
 
 import json
@@ -44,3 +47,23 @@ if LOG_DIR:
                 fh.write(json.dumps(rec) + "\n")
 
     event.register("numba:compile", CompileLog())
+
+    import fcntl
+
+    _flock = fcntl.flock
+
+    def _timed_flock(fd, op):
+        if not op & fcntl.LOCK_EX or op & fcntl.LOCK_NB:
+            return _flock(fd, op)
+        t0 = time.perf_counter()
+        out = _flock(fd, op)
+        wait = time.perf_counter() - t0
+        if wait > 0.05:
+            rec = {"pid": os.getpid(), "test": os.environ.get("PYTEST_CURRENT_TEST", ""),
+                   "lock": getattr(fd, "name", str(fd))[-120:], "lock_wait": wait,
+                   "t": time.time()}
+            with open(os.path.join(LOG_DIR, f"{os.getpid()}.jsonl"), "a") as fh:
+                fh.write(json.dumps(rec) + "\n")
+        return out
+
+    fcntl.flock = _timed_flock

@@ -18,6 +18,11 @@ import sys
 def main(folder, show_all=False):
     recs = [json.loads(line) for path in glob.glob(os.path.join(folder, "*.jsonl"))
             for line in open(path)]
+    waits = [r for r in recs if "lock_wait" in r]
+    recs = [r for r in recs if "lock_wait" not in r]
+    if waits:
+        print(f"compile-lock waits: {len(waits)}, {sum(r['lock_wait'] for r in waits):.1f} s "
+              f"of idle wall time (longest {max(r['lock_wait'] for r in waits):.1f} s)")
     top = [r for r in recs if r["depth"] == 0]
     print(f"compiles: {len(recs)} in all, {len(top)} outermost, "
           f"{sum(r['cpu'] for r in top):.0f} CPU s, {len({r['pid'] for r in recs})} processes")

@@ -1867,7 +1867,7 @@ _NDARRAY = np.ndarray
 def coerce_lcp(M, q):
     """``(M, q)`` as float64 arrays of matching square shapes; refusals name the argument."""
     # cheap when the caller already passes float64 arrays, the common case
-    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
+    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2 or not M.flags.c_contiguous:
         M = _as_matrix(M)
     if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)
@@ -1893,7 +1893,9 @@ def _as_matrix(M):
         raise InputError("`M` must be an array of real numbers") from None
     if a.ndim != 2:
         raise InputError(f"`M` must be a square 2-D array, got shape {a.shape}")
-    return a
+    # C order: a Fortran-ordered or strided array would compile the whole solver
+    # again for its layout (23 CPU s on a cold cache), for the same arithmetic
+    return np.ascontiguousarray(a)
 
 
 def _as_vector(q, name="q"):
@@ -1904,7 +1906,7 @@ def _as_vector(q, name="q"):
         raise InputError(f"`{name}` must be an array of real numbers") from None
     if a.ndim != 1:
         raise InputError(f"`{name}` must be a 1-D array, got shape {a.shape}")
-    return a
+    return np.ascontiguousarray(a)
 
 
 def _raise_nonfinite(M, q, d):
@@ -1985,7 +1987,7 @@ def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     # types and shapes are checked on every path (an unchecked call must not
     # reach compiled code with arrays it would read out of bounds); the
     # inline fast path of coerce_lcp costs a handful of attribute reads
-    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2:
+    if type(M) is not _NDARRAY or M.dtype is not _F8 or M.ndim != 2 or not M.flags.c_contiguous:
         M = _as_matrix(M)
     if type(q) is not _NDARRAY or q.dtype is not _F8 or q.ndim != 1:
         q = _as_vector(q)

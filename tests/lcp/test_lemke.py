@@ -377,3 +377,21 @@ def test_an_answer_beyond_the_range_of_doubles_is_a_breakdown_not_a_nan():
     res = solve_lcp(M, np.array([-1.0, 1.0]))  # z1 = 5e309
     assert res.status == BREAKDOWN
     assert np.all(np.isfinite(res.z)) and np.all(np.isfinite(res.w)) and np.isfinite(res.residual)
+
+
+def test_fortran_ordered_and_strided_matrices_reuse_the_c_ordered_compile():
+    # a transposed or fancy-indexed matrix (Fortran order) or a strided one is copied to C
+    # order at the entry: numba would otherwise compile the whole solver again for its
+    # layout (23 CPU s on a cold cache); the same arithmetic, so the same bits
+    from moreau.lcp import lemke
+    rng = np.random.default_rng(3)
+    M = random_p_matrix(6, rng)
+    q = rng.standard_normal(6)
+    ref = solve_lcp(M, q)
+    for other in (np.asfortranarray(M), np.repeat(M, 2, axis=1)[:, ::2]):
+        assert not other.flags.c_contiguous
+        res = solve_lcp(other, q)
+        assert res.success and ref.success
+        np.testing.assert_array_equal(res.z, ref.z)
+    layouts = {sig[0].layout for sig in lemke._solve_packed_ones.signatures}
+    assert layouts == {"C"}, layouts
