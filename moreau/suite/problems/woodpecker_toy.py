@@ -36,6 +36,9 @@ class WoodpeckerToyProblem(Problem):
     # Moreau-Jean at 40000 steps (h = 32 us): 0.67 % and 0.41 % off; at 4000, several %
     steps = (4000, 40000, 400000)
     quick_steps = (4000, 40000)
+    # the compliant contacts take 10 to 17 s of CPU a quick cell over the eight cycles (and
+    # miss the cycle by 9 % and more): the quick suite runs their softest setting only
+    quick_settings = {"compliant-radau": (1e3,), "compliant-rk45": (1e3,)}
 
     def reference(self):
         (_, _, _), (ydot, _, phidot) = GLOCKER_STATE
