@@ -62,10 +62,10 @@ def test_granular_column_table_against_the_event_driven_reference():
     scene = prob.make_scene()
     start = prob.measure(scene, type("Run", (), {"q": prob.start(scene)[0][None]})())
     ref = prob.reference()
-    # the column settles: its centres sink, its top falls, its front leans out by less than
-    # a tenth of a grain in the window
+    # the column settles: its centres sink, its top falls, its front moves by less than a
+    # tenth of a grain in the window
     assert ref["mean_height"] < start["mean_height"] and ref["top"] < start["top"]
-    assert start["front"] <= ref["front"] < start["front"] + 0.1
+    assert abs(ref["front"] - start["front"]) < 0.1
     rep = run_suite(problems=["granular-column"], schemes=["moreau-jean", "compliant-rk45"],
                     quick=True, progress=False)
     rows = {(r["scheme"], r["setting"]): r for r in rep["rows"]}
