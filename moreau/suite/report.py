@@ -23,6 +23,9 @@ import json
 import math
 import os
 
+import joblib
+
+from ..analysis.engine import end_worker_pool, worker_pool_config
 from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
 from ..provenance import provenance
@@ -207,10 +210,6 @@ def _animate_all(jobs, n_jobs):
     # each animation reruns a scheme over its problem's window: on the worker pool, side by side
     if n_jobs == 1 or len(jobs) < 4:
         return [animate_problem(*j) for j in jobs]
-    import joblib
-
-    from ..analysis.engine import end_worker_pool, worker_pool_config
-
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, batch_size=1)
     ok = False
