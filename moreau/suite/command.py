@@ -40,9 +40,10 @@ def _cmd_suite(args):
                                              "schemes": schemes,
                                              "peers": not args.no_peers}, args.force)
     t0 = time.perf_counter()
+    n_jobs = None if args.jobs is None and args.quick else check_jobs(_jobs(args), 2)
     report = run_suite(problems=problems, schemes=schemes, quick=args.quick,
                        cache_dir=os.path.join(out, "cells"), progress=not args.quiet,
-                       n_jobs=check_jobs(args.jobs, 2), scheduler=args.scheduler,
+                       n_jobs=n_jobs, scheduler=args.scheduler,
                        peers=not args.no_peers)
     report["wall_time_s"] = time.perf_counter() - t0
     if hist is not None:
@@ -53,7 +54,8 @@ def _cmd_suite(args):
             rerun=lambda r: cell_task(r["problem"], r["scheme"], r["setting"],
                                       _options(r, args.quick)))
         record_run(args.compare_to, hist, report["rows"], calibration, args.quick)
-    paths = write_report(report, out, settings=settings, plot=not args.no_plot)
+    paths = write_report(report, out, settings=settings, plot=not args.no_plot,
+                         n_jobs=report["jobs"] if args.scheduler is None else 1)
     cells = report["cells"]
     if hist is not None:
         flags = report["flags"]
@@ -64,6 +66,12 @@ def _cmd_suite(args):
     print(f"({cells['total']} cells: {cells['computed']} computed, {cells['cached']} from "
           f"{os.path.join(out, 'cells')}; {report['wall_time_s']:.1f} s)")
     print(f"wrote {len(paths)} files; start with {paths['page']}")
+
+
+def _jobs(args):
+    # the full suite keeps its cells' CPU times clean, one at a time, unless told otherwise;
+    # the quick one (None) takes every core when it has cells enough (run_suite)
+    return 1 if args.jobs is None else args.jobs
 
 
 def _options(row, quick):
@@ -102,9 +110,10 @@ def add_commands(sub):
     s.add_argument("--no-peers", action="store_true",
                    help="leave out Siconos's OSIs (columns by default where Siconos is "
                         "installed, /usr/bin/python3)")
-    s.add_argument("--jobs", type=int, default=1,
+    s.add_argument("--jobs", type=int, default=None,
                    help="local worker processes, as for `moreau sweep` (-1: one per core; "
-                        "default 1: the cells' CPU times are cleanest one at a time)")
+                        "default: one per core with --quick, else 1: the cells' CPU times "
+                        "are cleanest one at a time)")
     s.add_argument("--scheduler", default=None, metavar="ADDRESS",
                    help="run the cells on this Dask scheduler (e.g. tcp://host:8786)")
     s.add_argument("--quiet", action="store_true", help="no progress bar")

@@ -21,7 +21,15 @@ edit. A problem states:
     accurate when every error is at most ``tolerance``;
 ``steps`` / ``quick_steps``
     the step counts over the window of the time-stepping schemes (the
-    work-precision points), finest last.
+    work-precision points), finest last;
+``quick_settings``
+    ``{scheme: values}``: where a scheme's usual quick settings cost the
+    quick suite too much on this problem, the values it runs at instead
+    (step counts for a scheme that takes ``h``, else values of its own
+    comparison setting or ``rtol``); the full suite keeps its settings;
+``declines`` / ``quick_declines``
+    ``{scheme: reason}``: schemes the problem refuses by name, in every
+    suite or in the quick one only; their row is *refused* with the reason.
 
 Examples
 --------
@@ -61,6 +69,11 @@ class Problem:
     tolerance = 1e-2
     steps = (200, 1000, 5000)
     quick_steps = (200, 2000)
+    #: ``{scheme: values}`` replacing the scheme's quick settings on this problem
+    quick_settings = {}
+    #: ``{scheme: reason}`` refused by name in every suite / in the quick suite
+    declines = {}
+    quick_declines = {}
     #: a problem built on a scene's comparison case (``moreau.analysis.cases``): its class
     case_class = None
     _case = None
@@ -101,6 +114,13 @@ class Problem:
 
     def reference(self):
         raise NotImplementedError
+
+    def declined(self, scheme, quick=False):
+        """The reason the problem refuses ``scheme`` by name (in the quick suite if ``quick``), or None."""
+        reason = self.declines.get(scheme)
+        if reason is None and quick:
+            reason = self.quick_declines.get(scheme)
+        return reason
 
     def scales(self):
         """``{quantity: scale}``: what an error is relative to."""

@@ -23,6 +23,9 @@ import json
 import math
 import os
 
+import joblib
+
+from ..analysis.engine import end_worker_pool, worker_pool_config
 from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
 from ..provenance import provenance
@@ -166,7 +169,8 @@ def animate_problem(name, path, frames=30):
     """A short animation of problem ``name``: its event-driven run over the window, drawn.
 
     Where the event-driven run stops (the Painlevé rod's jam, which it does
-    not take) or refuses the scene (a spatial one), Moreau–Jean's run at its
+    not take), refuses the scene (a spatial one) or the problem declines it
+    in the quick suite, Moreau–Jean's run at its
     finest quick step is drawn instead.
     Returns ``(path, None)``, or ``(None, cause)`` where both runs stop or
     the scene cannot draw itself.
@@ -177,6 +181,10 @@ def animate_problem(name, path, frames=30):
     causes = []
     try:
         for scheme in ("event-driven", "moreau-jean"):
+            reason = prob.declined(scheme, quick=True)
+            if reason is not None:
+                causes.append(f"the problem declines {scheme}: {reason}")
+                continue
             label, opts = settings_of(scheme, prob, scene, quick=True)[-1]
             try:
                 res = simulate(scene, (0.0, prob.window), q0, v0, scheme, **opts)
@@ -198,11 +206,27 @@ def animate_problem(name, path, frames=30):
     return path, None
 
 
-def write_report(report, out, settings=None, plot=True, animation_frames=30):
+def _animate_all(jobs, n_jobs):
+    # each animation reruns a scheme over its problem's window: on the worker pool, side by side
+    if n_jobs == 1 or len(jobs) < 4:
+        return [animate_problem(*j) for j in jobs]
+    with worker_pool_config():
+        par = joblib.Parallel(n_jobs=n_jobs, batch_size=1)
+    ok = False
+    try:
+        out = par(joblib.delayed(animate_problem)(*j) for j in jobs)
+        ok = True
+    finally:
+        end_worker_pool(kill=not ok)
+    return out
+
+
+def write_report(report, out, settings=None, plot=True, animation_frames=30, n_jobs=1):
     """Write the table, figures and ``index.md`` of a suite run to ``out``; return the paths.
 
     With ``plot``, each problem also gets a short animation (``anim_<name>.gif``,
-    at most ``animation_frames`` frames; 0: none) of its event-driven run.
+    at most ``animation_frames`` frames; 0: none) of its event-driven run,
+    drawn by ``n_jobs`` local worker processes.
     """
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
     paths = {}
@@ -217,6 +241,11 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30):
     with open(paths["json"], "w") as fh:
         json.dump(doc, fh, indent=1, default=lambda x: None if x != x else str(x))
     figures, animations = {}, {}
+    if plot and animation_frames:
+        jobs = [(p["name"], os.path.join(out, f"anim_{p['name']}.gif"), animation_frames)
+                for p in probs]
+        for (name, _, _), (done, cause) in zip(jobs, _animate_all(jobs, n_jobs)):
+            animations[name] = f"anim_{name}.gif" if done else cause
     for p in probs:
         prow = [r for r in rows if r["problem"] == p["name"]]
         pcsv = os.path.join(out, f"problem_{p['name']}.csv")
@@ -226,10 +255,6 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30):
             fig = f"wp_{p['name']}.png"
             plot_work_precision(p, prow, os.path.join(out, fig))
             figures[p["name"]] = fig
-        if plot and animation_frames:
-            gif = f"anim_{p['name']}.gif"
-            done, cause = animate_problem(p["name"], os.path.join(out, gif), animation_frames)
-            animations[p["name"]] = gif if done else cause
     if plot:
         plot_overview(rows, [p["name"] for p in probs], schemes, os.path.join(out, "overview.png"))
         figures["overview"] = "overview.png"

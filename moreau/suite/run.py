@@ -43,7 +43,8 @@ from ..model.registry import discover as discover_scenes
 from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
 from .problem import get_problem, problem_names
 
-__all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS"]
+__all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS",
+           "DECLINED"]
 
 #: the outcomes, best first
 OUTCOMES = ("ok", "inaccurate", "failed", "refused")
@@ -53,6 +54,10 @@ REFUSED_STATUS = (-6,)
 SAMPLES = 2000
 #: tolerances of the schemes with an ``rtol`` (event-driven): quick, full
 RTOLS = ((1e-6, 1e-10), (1e-4, 1e-7, 1e-10))
+#: cells to compute from which ``n_jobs=None`` takes every core (fewer: one process, no pool)
+AUTO_POOL_CELLS = 40
+#: the one setting of a scheme its problem declines by name (``Problem.declines``)
+DECLINED = "declined"
 
 
 def scheme_names():
@@ -76,7 +81,10 @@ def settings_of(name, problem, scene, quick=False):
     (``Integrator.compare_settings``: a tolerance, a contact stiffness) at
     those; an event-driven scheme at :data:`RTOLS`; any other once with its
     defaults. Those that choose their own steps are asked for
-    :data:`SAMPLES` samples over the window.
+    :data:`SAMPLES` samples over the window. In the quick suite a problem's
+    ``quick_settings`` replace a scheme's quick values; a scheme the problem
+    declines (``declines``, ``quick_declines``) has one setting,
+    :data:`DECLINED`, whose cell is refused with the problem's reason.
 
     Examples
     --------
@@ -85,8 +93,11 @@ def settings_of(name, problem, scene, quick=False):
     >>> [label for label, _ in settings_of("moreau-jean", p, p.make_scene(), quick=True)]
     ['N=400', 'N=4000']
     """
+    if problem.declined(name, quick) is not None:
+        return [(DECLINED, {})]
     if is_peer(name):
         return [(PEER_SETTING, {})]
+    own = problem.quick_settings.get(name) if quick else None
     cls, takes = _options_of(name, scene)
     extra = {}
     if "sample_dt" in takes:
@@ -95,14 +106,15 @@ def settings_of(name, problem, scene, quick=False):
         extra["samples_per_period"] = SAMPLES
     if "h" in takes:
         return [(f"N={n}", dict(extra, h=problem.window / n))
-                for n in (problem.quick_steps if quick else problem.steps)]
+                for n in (own or (problem.quick_steps if quick else problem.steps))]
     cs = getattr(cls, "compare_settings", None)
     if cs is not None and cs[0] in takes:
         key, values, quick_values, fixed = cs
         return [(f"{key}={v:g}", dict(extra, **dict(fixed), **{key: v}))
-                for v in (quick_values if quick else values)]
+                for v in (own or (quick_values if quick else values))]
     if "rtol" in takes:
-        return [(f"rtol={r:g}", dict(extra, rtol=r)) for r in RTOLS[0 if quick else 1]]
+        return [(f"rtol={r:g}", dict(extra, rtol=r))
+                for r in (own or RTOLS[0 if quick else 1])]
     return [("default", extra)]
 
 
@@ -121,6 +133,10 @@ def run_cell(problem, scheme, label, options, scene=None, reference=None):
     row = {"problem": problem.name, "scheme": scheme, "setting": label, "outcome": None,
            "cause": "", "status": None, "values": {}, "errors": {}, "max_error": None,
            "tolerance": problem.tolerance, "cpu_s": None, "wall_s": None, "steps": None}
+    if label == DECLINED:
+        reason = problem.declines.get(scheme) or problem.quick_declines.get(scheme)
+        row.update(outcome="refused", cause=f"the problem declines {scheme}: {reason}")
+        return row
     try:
         scene = problem.make_scene() if scene is None else scene
         reference = problem.reference() if reference is None else reference
@@ -169,12 +185,22 @@ def cell_path(cache_dir, problem, scheme, label):
     return os.path.join(cache_dir, _safe(problem), _safe(scheme), _safe(label) + ".json")
 
 
+#: steps over the whole window of a time-stepping scheme's warm-up run
+WARM_UP_STEPS = 100
+
+
 def _warm_up(problem, scheme, options, scene):
-    # numba compiles a scheme's loop for a scene on its first run: do it outside the timings
+    # numba compiles a scheme's loop for a scene on its first run: do it outside the timings.
+    # A kernel called first at an impact (Moreau-Jean projected's) compiles there: a scheme
+    # that takes a step runs the whole window at a coarse one; the others a twentieth of it
     q0, v0 = problem.start(scene)
+    window = 0.05 * problem.window
+    if "h" in options:
+        window = problem.window
+        options = dict(options, h=max(options["h"], problem.window / WARM_UP_STEPS))
     try:
         with np.errstate(all="ignore"):
-            simulate(scene, (0.0, 0.05 * problem.window), q0, v0, scheme, **options)
+            simulate(scene, (0.0, window), q0, v0, scheme, **options)
     except Exception:   # noqa: BLE001  (the timed run reports whatever this one met)
         pass
 
@@ -185,26 +211,33 @@ _INSTANCES = {}
 _WARMED = set()
 
 
-def instance(pname):
+def instance(pname, reference=None):
+    """``(problem, scene, reference)`` of ``pname``, built once per process.
+
+    ``reference``: the problem's reference computed elsewhere (the parent
+    of a worker), so that a worker does not compute it again.
+    """
     if pname not in _INSTANCES:
         prob = get_problem(pname)
-        _INSTANCES[pname] = (prob, prob.make_scene(), prob.reference())
+        _INSTANCES[pname] = (prob, prob.make_scene(),
+                             prob.reference() if reference is None else dict(reference))
     return _INSTANCES[pname]
 
 
-def cell_task(pname, scheme, label, options):
+def cell_task(pname, scheme, label, options, reference=None):
     """One cell, computed in this process (a worker's task): its row.
 
     The first cell of a (problem, scheme) pair in a process runs the scheme
-    once over a twentieth of the window first, untimed, so that numba's
+    once first, untimed (over the window at :data:`WARM_UP_STEPS` steps, or
+    over a twentieth of it for a scheme that takes no step), so that numba's
     compilation (or loading) is not counted in the cell's time.
     """
-    prob, scene, ref = instance(pname)
+    prob, scene, ref = instance(pname, reference)
     if is_peer(scheme):
         row = run_peer_cell(prob, scheme, scene, ref)
         row["cached"] = False
         return row
-    if (pname, scheme) not in _WARMED:
+    if label != DECLINED and (pname, scheme) not in _WARMED:
         _WARMED.add((pname, scheme))
         _warm_up(prob, scheme, options, scene)
     row = run_cell(prob, scheme, label, options, scene, ref)
@@ -286,12 +319,18 @@ def _results(plan, todo, n_jobs, scheduler):
         for i in todo:
             yield i, cell_task(*plan[i])
         return
+    refs = {pname: instance(pname)[2] for pname in {plan[i][0] for i in todo}}
+    tasks = [joblib.delayed(warm_task)(*plan[i], refs[plan[i][0]])
+             for i in _first_of_each_scheme(plan, todo)]
+    tasks += [joblib.delayed(_indexed_cell)(i, *plan[i], refs[plan[i][0]]) for i in todo]
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
-    gen = par(joblib.delayed(_indexed_cell)(i, *plan[i]) for i in todo)
+    gen = par(tasks)
     ok = False
     try:
-        yield from gen
+        for i, row in gen:
+            if i is not None:
+                yield i, row
         ok = True
     finally:
         if not ok:
@@ -304,6 +343,33 @@ def _results(plan, todo, n_jobs, scheduler):
 
 def _indexed_cell(i, *cell):
     return i, cell_task(*cell)
+
+
+def _first_of_each_scheme(plan, todo):
+    """Indices of the first cell of each scheme in ``todo`` that runs in this process (no peer, no
+    declined one): the warm-up tasks a pool takes before the cells."""
+    seen, first = set(), []
+    for i in todo:
+        pname, scheme, label, _ = plan[i]
+        if scheme not in seen and label != DECLINED and not is_peer(scheme):
+            seen.add(scheme)
+            first.append(i)
+    return first
+
+
+def warm_task(pname, scheme, label, options, reference=None):
+    """A pool's first tasks, one per scheme: its first cell's untimed warm-up, no row.
+
+    On a cold cache numba compiles each scheme here once, in one worker, the
+    workers compiling different schemes side by side; the cells that follow
+    load it from numba's cache instead of compiling it again in every worker
+    at once. Returns ``(None, scheme)``.
+    """
+    prob, scene, _ = instance(pname, reference)
+    if (pname, scheme) not in _WARMED:
+        _WARMED.add((pname, scheme))
+        _warm_up(prob, scheme, options, scene)
+    return None, scheme
 
 
 def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
@@ -323,8 +389,10 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     peers : bool
         Without ``schemes``, add Siconos's OSIs as columns where Siconos is
         installed (:mod:`moreau.suite.peers`).
-    n_jobs : int
-        Local worker processes (the pool of ``moreau sweep``; 1: in this process).
+    n_jobs : int or None
+        Local worker processes (the pool of ``moreau sweep``; 1: in this process;
+        None: one per core where :data:`AUTO_POOL_CELLS` cells or more are
+        to be computed, else 1). The report's ``jobs`` says how many ran.
     scheduler : str, optional
         A Dask scheduler's address: the cells run there instead.
 
@@ -344,6 +412,8 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
         else:
             rows[i] = row
     done = len(plan) - len(todo)
+    if n_jobs is None:
+        n_jobs = (os.cpu_count() or 1) if len(todo) >= AUTO_POOL_CELLS else 1
     bar = None
     if progress:
         bar = tqdm(total=len(plan), initial=done, desc="suite", unit="cell", disable=None)
@@ -362,7 +432,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
         if bar is not None:
             bar.close()
     return {"rows": rows, "problems": [instance(p)[0].describe() for p in problems],
-            "schemes": schemes, "cells": {"total": len(plan),
+            "schemes": schemes, "jobs": n_jobs, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
                                           "computed": sum(1 for r in rows if not r.get("cached"))}}
 
