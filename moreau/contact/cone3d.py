@@ -624,6 +624,17 @@ def local_solve(A, b, mu):
 
 
 @njit(cache=True)
+def _affine_into(W, q, r, out):
+    # out = q + W r, row by row in the order every caller used (the same bits)
+    n = q.shape[0]
+    for j in range(n):
+        acc = q[j]
+        for l in range(n):
+            acc += W[j, l] * r[l]
+        out[j] = acc
+
+
+@njit(cache=True)
 def _pgs(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall):
     # projected Gauss–Seidel over contacts; u = W r + q kept in step and
     # recomputed each sweep so that the residual is the one of the data.
@@ -661,11 +672,7 @@ def _pgs(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall):
                     r[k] += d0
                     r[k + 1] += d1
                     r[k + 2] += d2
-        for j in range(n):
-            acc = q[j]
-            for l in range(n):
-                acc += W[j, l] * r[l]
-            u[j] = acc
+        _affine_into(W, q, r, u)
         sweeps += 1
         res = _natural_sq(r, u, mu)
         if res < 0.999 * best:
@@ -916,11 +923,7 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
         return False, math.sqrt(res), qn
     r_in = _project_all(r, mu)
     u_in = np.empty(n)
-    for j in range(n):
-        acc = q[j]
-        for k in range(n):
-            acc += W[j, k] * r_in[k]
-        u_in[j] = acc
+    _affine_into(W, q, r_in, u_in)
     if _natural_sq(r_in, u_in, mu) <= max(res, tol_sq):
         r[:] = r_in
         u[:] = u_in
@@ -932,11 +935,7 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
 def _alart_curnier_into(W, q, mu, rho, r, u, phi, J):
     # _alart_curnier's function and Jacobian written into phi and J, in its order of operations
     n = r.shape[0]
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r[l]
-        u[j] = acc
+    _affine_into(W, q, r, u)
     for i in range(mu.shape[0]):
         k = 3 * i
         p = rho[i]
@@ -1152,18 +1151,10 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     r[:] = best_r
     r_in = _project_all(r, mu)
     ut = np.empty(n)
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r_in[l]
-        ut[j] = acc
+    _affine_into(W, q, r_in, ut)
     if _natural_sq(r_in, ut, mu) <= max(best, tol_sq):
         r[:] = r_in
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r[l]
-        u[j] = acc
+    _affine_into(W, q, r, u)
     res = math.sqrt(_natural_sq(r, u, mu))
     return res <= tol * scale, res, qn, it
 
@@ -1182,11 +1173,7 @@ def _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, least_norm):
     step = np.empty(n)
     trial = np.empty(n)
     ut = np.empty(n)
-    for j in range(n):
-        acc = q[j]
-        for l in range(n):
-            acc += W[j, l] * r[l]
-        ut[j] = acc
+    _affine_into(W, q, r, ut)
     best = _natural_sq(r, ut, mu)
     it = 0
     while it < max_newton and best > tol_sq:
@@ -1209,11 +1196,7 @@ def _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, least_norm):
         if t < 1e-10:
             break
         r[:] = trial
-        for j in range(n):
-            acc = q[j]
-            for l in range(n):
-                acc += W[j, l] * r[l]
-            ut[j] = acc
+        _affine_into(W, q, r, ut)
         res = _natural_sq(r, ut, mu)
         if res < best:
             best = res
