@@ -149,7 +149,7 @@ def _run_pair(name, scheme, fraction):
     scene = registry.make_scene(name)
     q0, v0 = scene.initial_state()
     span = fraction * scene.default_span()
-    joints = "scheme '[a-z-]+' solves no joints"
+    joints = "scheme '[a-z0-9-]+' solves no joints"
     space = "scheme '[a-z0-9-]+' steps no spatial scene"
     if scheme == "event-driven-space" and (not is_spatial(scene) or scene.ncontacts != 1):
         # the spatial reference keeps one persistent contact of a spatial scene
