@@ -85,3 +85,6 @@ class Spring(Scene):
 
     def contact_jacobians(self, q, t):
         return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
+
+    def contact_drift(self, q, v, t):
+        return np.zeros(1), np.zeros(0)

@@ -23,6 +23,7 @@ from moreau.errors import InputError
 from moreau.integrators import simulate
 from moreau.integrators.base import INTEGRATORS, SchemeOptions, check_options, get_integrator
 from moreau.scenes import registry
+from moreau.model.examples import Spring  # unit mass on a unit spring, its contact never active
 from moreau.model.scene import Scene
 
 registry.discover()
@@ -34,29 +35,6 @@ GENERAL = [k for k in SCHEMES if k not in ("friction-drive-walker", "stick-slip-
                                            "event-driven-space")]
 #: the time-stepping schemes with a fixed step h (and a stated order)
 STEPPING = [k for k in GENERAL if "h" in INTEGRATORS[k].Options.names()]
-
-
-class Spring(Scene):
-    """Unit mass on a unit spring; its one contact stays 10 away (never active)."""
-    ndof, mu, restitution = 1, np.array([0.0]), np.array([0.0])
-
-    def mass(self, q):
-        return np.eye(1)
-
-    def forces(self, q, v, t):
-        return -np.asarray(q, float)
-
-    def force_jacobians(self, q, v, t):
-        return -np.eye(1), np.zeros((1, 1))
-
-    def gaps(self, q, t):
-        return np.array([q[0] + 10.0])
-
-    def contact_jacobians(self, q, t):
-        return np.array([[1.0]]), np.zeros(1), np.zeros((0, 1)), np.zeros(0)
-
-    def contact_drift(self, q, v, t):
-        return np.zeros(1), np.zeros(0)
 
 
 class Ball(Scene):
