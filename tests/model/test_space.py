@@ -102,6 +102,25 @@ def test_a_bad_shape_or_contact_is_refused_by_name():
         m.add_contact(b, Sphere(1.0), 3)
 
 
+def _rows_and_drift_against_differences(sc, q, v):
+    # the gap's rate, the contact point's slip and the rows' time derivative by central
+    # differences along the motion; returns the drift (wNb, wTb)
+    eps = 1e-6
+    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
+    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
+    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
+    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
+    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
+    (_, t1, t2), = sc.contact_bases()
+    slip = np.array([t1 @ pdot[0], t2 @ pdot[0]])
+    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
+    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
+    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
+    wNb, wTb = sc.contact_drift(q, v, 0.0)
+    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    return wNb, wTb
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_an_eccentric_sphere_rows_and_drift_against_differences(seed):
     # a sphere whose centre is off the centre of mass (the tippe top): its support point is
@@ -123,19 +142,7 @@ def test_an_eccentric_sphere_rows_and_drift_against_differences(seed):
     n = np.array([0.1, 0.2, 1.0]) / np.linalg.norm([0.1, 0.2, 1.0])
     pts = q[:3] * 0.02 + R @ c + 0.015 * u
     assert abs(sc.gaps(q, 0.0)[0] * 0.02 - np.min((pts - (0.0, 0.0, -0.01)) @ n)) < 1e-6
-    eps = 1e-6
-    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
-    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
-    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
-    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
-    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
-    (_, t1, t2), = sc.contact_bases()
-    slip = np.array([t1 @ pdot[0], t2 @ pdot[0]])
-    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
-    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
-    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
-    wNb, wTb = sc.contact_drift(q, v, 0.0)
-    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    wNb, wTb = _rows_and_drift_against_differences(sc, q, v)
     assert abs(wNb[0]) > 1e-3 and np.max(np.abs(wTb)) > 1e-3    # the offset does turn
 
 
@@ -166,19 +173,7 @@ def test_a_disks_rim_point_gap_rows_and_drift_against_sampling_and_differences(s
     (R0, s0), = sc.contact_frames(q, 0.0)
     k = int(np.argmin((rim - (0.0, 0.0, -0.01)) @ n))
     assert np.linalg.norm((q[:3] + s0) * 0.05 - rim[k]) < 1e-5
-    eps = 1e-6
-    qp, qm = _motion(sc, q, v, eps), _motion(sc, q, v, -eps)
-    WN, wN, WT, wT = sc.contact_jacobians(q, 0.0)
-    gdot = (sc.gaps(qp, 0.0) - sc.gaps(qm, 0.0)) / (2 * eps)
-    assert np.max(np.abs(WN @ v + wN - gdot)) < 1e-8 * max(1.0, np.max(np.abs(gdot)))
-    pdot = (_material_points(sc, qp, q) - _material_points(sc, qm, q)) / (2 * eps)
-    (_, t1, t2), = sc.contact_bases()
-    slip = np.array([t1 @ pdot[0], t2 @ pdot[0]])
-    assert np.max(np.abs(WT @ v + wT - slip)) < 1e-8 * max(1.0, np.max(np.abs(slip)))
-    dN = (sc.contact_jacobians(qp, 0.0)[0] @ v - sc.contact_jacobians(qm, 0.0)[0] @ v) / (2 * eps)
-    dT = (sc.contact_jacobians(qp, 0.0)[2] @ v - sc.contact_jacobians(qm, 0.0)[2] @ v) / (2 * eps)
-    wNb, wTb = sc.contact_drift(q, v, 0.0)
-    assert np.max(np.abs(wNb - dN)) < 1e-7 and np.max(np.abs(wTb - dT)) < 1e-7
+    wNb, wTb = _rows_and_drift_against_differences(sc, q, v)
     # the rim point slides round the rim: its drift is not a material point's
     s = s0
     w = R @ v[3:6]
