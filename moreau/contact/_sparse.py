@@ -40,7 +40,7 @@ import scipy.sparse as sps
 from numba import njit
 
 from moreau import _jit_cache
-from moreau._validate import finite_array
+from moreau._validate import finite_array, finite_scalar
 from moreau.errors import InputError
 from moreau.lcp import _certified
 from moreau.lcp._certified import two_prod
@@ -366,6 +366,36 @@ def _residual_checked(W, q, mu, r):
     velocities_compensated(W.indptr, W.indices, W.data, q, r, u)
     res_abs = math.sqrt(natural_map(r, u, mu))
     return res_abs / (1.0 + float(np.linalg.norm(q))), res_abs, u
+
+
+def checked_tolerance(tol):
+    """``tol`` of an iterative solver, a finite number in ``[1e-15, 1)``."""
+    tol = finite_scalar("tol", tol)
+    if not 1e-15 <= tol < 1.0:
+        raise InputError(f"`tol` must lie in [1e-15, 1), got {tol!r}")
+    return tol
+
+
+class CheckRecord:
+    """The history buffers an iterative solver's :func:`record_check` fills, and its result.
+
+    One entry per check, every ``check_every`` of ``budget`` iterations, and
+    two more (the start and the last iteration). The residuals are recorded
+    absolute and returned relative to ``scale = 1 + ||q||``, the units of ``tol``.
+    """
+
+    def __init__(self, q, budget, check_every):
+        self.scale = 1.0 + float(np.linalg.norm(q))
+        n = budget // check_every + 2
+        self.iterations = np.zeros(n, dtype=np.int64)
+        self.residuals = np.zeros(n)
+
+    def result(self, W, q, mu, best_r, iterations, n_checks, tol, solver):
+        """The :class:`IterativeResult` of ``best_r``, its residual recomputed (compensated sums)."""
+        res, res_abs, u = _residual_checked(W, q, mu, best_r)
+        history = np.column_stack([self.iterations[:n_checks],
+                                   self.residuals[:n_checks] / self.scale])
+        return IterativeResult(best_r, u, res, res_abs, iterations, tol, solver, history)
 
 
 # -- building W = H M^-1 H^T ---------------------------------------------------------------------

@@ -22,7 +22,7 @@ import numpy as np
 from ..fclib_layout import from_fclib, to_fclib
 from ..problem import FAILED, MAX_ITER, SOLVED, ContactSolution
 
-__all__ = ["DEFAULT_TOL", "local_problem", "solution_of"]
+__all__ = ["DEFAULT_TOL", "local_problem", "solution_of", "solve_local"]
 
 #: the tolerance on the natural-map residual when the caller gives none (the FCLib solvers' own)
 DEFAULT_TOL = 1e-8
@@ -54,3 +54,14 @@ def solution_of(problem, result, budget):
         status = FAILED
     return ContactSolution(p, _NO_EQ, pN, pT, status, result.residual, result.solver,
                            result.iterations, result.message, (result.solver,), None)
+
+
+def solve_local(problem, budget, tol, solver, **options):
+    """``problem`` solved by ``solver(W, q, mu, tol=..., **options)`` in FCLib's layout.
+
+    ``budget`` is the iteration limit that ``options`` give the solver (see
+    :func:`solution_of`); ``tol`` ``None`` is :data:`DEFAULT_TOL`.
+    """
+    W, q, mu = local_problem(problem)
+    res = solver(W, q, mu, tol=DEFAULT_TOL if tol is None else tol, **options)
+    return solution_of(problem, res, budget)

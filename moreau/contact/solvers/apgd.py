@@ -32,8 +32,7 @@ from numba import njit
 from moreau import _jit_cache
 from moreau._validate import finite_array, finite_scalar, positive_int
 from moreau.contact import _sparse
-from moreau.contact._sparse import (IterativeResult, check_problem, natural_map, project_cone,
-                                    record_check, velocities)
+from moreau.contact._sparse import check_problem, project_cone, record_check, velocities
 from moreau.errors import InputError
 
 from ..registry import register_solver
@@ -90,14 +89,11 @@ def _apgd(indptr, indices, data, q, mu, x, L, max_iter, check_every, tol_abs, hi
     x_new = np.empty_like(x)
     g = np.empty_like(x)
     u = np.empty_like(x)
-    velocities(indptr, indices, data, q, x, u)
-    best = math.sqrt(natural_map(x, u, mu))
     best_r[:] = x
-    hist_it[0] = 0
-    hist_res[0] = best
-    nh = 1
+    nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, 0, hist_it, hist_res, 0,
+                                  math.inf, best_r, tol_abs)
     it = 0
-    if best <= tol_abs:
+    if stop:
         return it, nh
     theta = 1.0
     step = 1.0 / L
@@ -168,9 +164,7 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     ('converged', True)
     """
     W, q, mu = check_problem(W, q, mu)
-    tol = finite_scalar("tol", tol)
-    if not 1e-15 <= tol < 1.0:
-        raise InputError(f"`tol` must lie in [1e-15, 1), got {tol!r}")
+    tol = _sparse.checked_tolerance(tol)
     max_iter = positive_int("max_iter", max_iter)
     check_every = positive_int("check_every", check_every)
     if L is None:
@@ -185,16 +179,11 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     x = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
     for i in range(mu.shape[0]):
         x[2 * i], x[2 * i + 1] = project_cone(mu[i], x[2 * i], x[2 * i + 1])
-    scale = 1.0 + float(np.linalg.norm(q))
-    nh_max = max_iter // check_every + 2
-    hist_it = np.zeros(nh_max, dtype=np.int64)
-    hist_res = np.zeros(nh_max)
+    checks = _sparse.CheckRecord(q, max_iter, check_every)
     best_r = np.empty_like(x)
     it, nh = _apgd(W.indptr, W.indices, W.data, q, mu, x, float(L), max_iter, check_every,
-                   tol * scale, hist_it, hist_res, best_r)
-    res, res_abs, u = _sparse._residual_checked(W, q, mu, best_r)
-    history = np.column_stack([hist_it[:nh], hist_res[:nh] / scale])
-    return IterativeResult(best_r, u, res, res_abs, it, tol, "apgd", history)
+                   tol * checks.scale, checks.iterations, checks.residuals, best_r)
+    return checks.result(W, q, mu, best_r, it, nh, tol, "apgd")
 
 
 def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
@@ -224,10 +213,8 @@ def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
     ('solved', 'apgd', [1.0, -0.5])
     """
     budget = 100_000 if max_iter is None else max_iter
-    W, q, mu = _iterative.local_problem(problem)
-    res = solve_apgd(W, q, mu, tol=_iterative.DEFAULT_TOL if tol is None else tol,
-                     max_iter=budget, check_every=check_every, L=L)
-    return _iterative.solution_of(problem, res, budget)
+    return _iterative.solve_local(problem, budget, tol, solve_apgd, max_iter=budget,
+                                  check_every=check_every, L=L)
 
 
 register_solver("apgd", solve,

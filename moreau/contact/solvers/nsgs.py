@@ -24,8 +24,7 @@ from numba import njit
 from moreau import _jit_cache
 from moreau._validate import finite_array, finite_scalar, positive_int
 from moreau.contact import _sparse
-from moreau.contact._sparse import (IterativeResult, check_problem, local_solve,
-                                    natural_map, project_cone, record_check, velocities)
+from moreau.contact._sparse import check_problem, local_solve, project_cone, record_check
 from moreau.errors import InputError
 
 from ..registry import register_solver
@@ -45,14 +44,11 @@ def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_
           hist_it, hist_res, best_r):
     nc = mu.shape[0]
     u = np.empty_like(q)
-    velocities(indptr, indices, data, q, r, u)
-    best = math.sqrt(natural_map(r, u, mu))
     best_r[:] = r
-    hist_it[0] = 0
-    hist_res[0] = best
-    nh = 1
+    nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, 0, hist_it, hist_res, 0,
+                                  math.inf, best_r, tol_abs)
     sweeps = 0
-    if best <= tol_abs:
+    if stop:
         return sweeps, nh
     while sweeps < max_sweeps:
         for i in range(nc):
@@ -161,9 +157,7 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     'not converged'
     """
     W, q, mu = check_problem(W, q, mu)
-    tol = finite_scalar("tol", tol)
-    if not 1e-15 <= tol < 1.0:
-        raise InputError(f"`tol` must lie in [1e-15, 1), got {tol!r}")
+    tol = _sparse.checked_tolerance(tol)
     max_sweeps = positive_int("max_sweeps", max_sweeps)
     check_every = positive_int("check_every", check_every)
     omega = finite_scalar("omega", omega)
@@ -171,17 +165,12 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
         raise InputError(f"`omega` must lie in (0, 2), got {omega!r}")
     r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
     _project_start(r, mu)
-    scale = 1.0 + float(np.linalg.norm(q))
-    nh_max = max_sweeps // check_every + 2
-    hist_it = np.zeros(nh_max, dtype=np.int64)
-    hist_res = np.zeros(nh_max)
+    checks = _sparse.CheckRecord(q, max_sweeps, check_every)
     best_r = np.empty_like(r)
     blocks = _blocks(W.indptr, W.indices, W.data, mu.shape[0])
     sweeps, nh = _nsgs(W.indptr, W.indices, W.data, blocks, q, mu, r, max_sweeps, check_every,
-                       tol * scale, omega, hist_it, hist_res, best_r)
-    res, res_abs, u = _sparse._residual_checked(W, q, mu, best_r)
-    history = np.column_stack([hist_it[:nh], hist_res[:nh] / scale])
-    return IterativeResult(best_r, u, res, res_abs, sweeps, tol, "nsgs", history)
+                       tol * checks.scale, omega, checks.iterations, checks.residuals, best_r)
+    return checks.result(W, q, mu, best_r, sweeps, nh, tol, "nsgs")
 
 
 def solve(problem, *, max_iter=None, tol=None, omega=1.0, check_every=4):
@@ -213,10 +202,8 @@ def solve(problem, *, max_iter=None, tol=None, omega=1.0, check_every=4):
     ('solved', 'nsgs', [1.0, -0.5])
     """
     budget = 10_000 if max_iter is None else max_iter
-    W, q, mu = _iterative.local_problem(problem)
-    res = solve_nsgs(W, q, mu, tol=_iterative.DEFAULT_TOL if tol is None else tol,
-                     max_sweeps=budget, omega=omega, check_every=check_every)
-    return _iterative.solution_of(problem, res, budget)
+    return _iterative.solve_local(problem, budget, tol, solve_nsgs, max_sweeps=budget,
+                                  omega=omega, check_every=check_every)
 
 
 register_solver("nsgs", solve,
