@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with", "joint_row_count", "velocity_count", "is_spatial"]
+__all__ = ["Scene", "params_with", "FromParams", "joint_row_count", "velocity_count", "is_spatial"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
@@ -328,3 +328,55 @@ def params_with(cls, params, overrides):
             raise InputError(f"`{key}` is not a parameter of {cls.__name__}; "
                              f"known parameters: {sorted(known)}")
     return replace(params, **overrides)
+
+
+class FromParams:
+    """A scene made from one frozen dataclass of SI parameters, its class attribute ``Params``.
+
+    ``SceneClass(params=None, **overrides)`` takes ``params`` (a ``Params``;
+    the defaults if omitted) with the overrides applied by :func:`params_with`,
+    keeps it as ``self.params`` and hands it to the scene's ``_setup(p)``,
+    which sets the scene's own quantities. The line ``{params}`` in a
+    subclass's docstring (its Parameters section) is replaced by the entries
+    of these two arguments, so that each scene does not write them again.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class DropParams:
+    ...     height: float = 1.0
+    >>> class Drop(FromParams):
+    ...     '''A point dropped from ``height``.
+    ...
+    ...     Parameters
+    ...     ----------
+    ...     {params}
+    ...     '''
+    ...     Params = DropParams
+    ...     def _setup(self, p):
+    ...         self.q0 = p.height
+    >>> Drop(height=2.0).q0
+    2.0
+    >>> Drop.__doc__.splitlines()[4].strip()
+    'params : DropParams, optional'
+    """
+
+    #: the scene's parameter dataclass
+    Params = None
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        doc = cls.__dict__.get("__doc__")
+        if doc and "{params}" in doc:
+            head, _, tail = doc.partition("{params}")
+            indent = head[head.rfind("\n") + 1:]
+            entries = (f"params : {cls.Params.__name__}, optional",
+                       "    SI parameters; the defaults if omitted.",
+                       "**overrides",
+                       "    Individual parameters replacing those of ``params``, by name.")
+            cls.__doc__ = head + ("\n" + indent).join(entries) + tail
+
+    def __init__(self, params=None, **overrides):
+        self.params = params_with(self.Params, params, overrides)
+        self._setup(self.params)

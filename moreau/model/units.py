@@ -1,5 +1,6 @@
 """Unit conversions shared by the scenes: the paper's drive scaling and the validation scenes' SI scales."""
 
+import math
 from collections import namedtuple
 
 import numpy as np
@@ -135,6 +136,12 @@ class SIUnits:
 
     #: coordinates that are angles (their SI unit is rad, not m)
     angle_coordinates = ()
+
+    def _scale_by_weight(self, length, mass, gravity):
+        # a scene under gravity: lengths over L, time over sqrt(L / g), forces over the weight m g
+        self.length = length
+        self.time = math.sqrt(length / gravity)
+        self.force = mass * gravity
 
     def _qscale(self):
         # one scale for all coordinates, so that scalars convert to scalars

@@ -70,7 +70,7 @@ from ..lcp.active_set import solve_active_set
 from ..model.drawing import circle, contact
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
@@ -134,14 +134,12 @@ class BallChainParams:
         check_fields(self, nonnegative, "striker_gap")
 
 
-class BallChain(SIUnits, CompiledScene):
+class BallChain(FromParams, SIUnits, CompiledScene):
     """``N`` balls on a line, the striker approaching the resting chain.
 
     Parameters
     ----------
-    params : BallChainParams, optional
-    **overrides
-        Individual parameters replacing those of ``params`` (e.g. ``n_balls=5``).
+    {params}
 
     Examples
     --------
@@ -161,9 +159,9 @@ class BallChain(SIUnits, CompiledScene):
         """The striker's impact and two time units after it."""
         return self.impact_time + 2.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(BallChainParams, params, overrides)
-        self.params = p
+    Params = BallChainParams
+
+    def _setup(self, p):
         n = p.n_balls
         self.ndof = n
         self.mu = np.zeros(n - 1)

@@ -30,7 +30,7 @@ from ..errors import InputError
 from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
 from ..model.compiled_scene import CompiledScene
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from ..analysis.cases import GRID, CompareCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
@@ -71,16 +71,12 @@ class BouncingBallParams:
         check_fields(self, restitution, "restitution")
 
 
-class BouncingBall(SIUnits, CompiledScene):
+class BouncingBall(FromParams, SIUnits, CompiledScene):
     """A ball of radius ``r`` falling on the floor ``y = 0``, restitution ``e``.
 
     Parameters
     ----------
-    params : BouncingBallParams, optional
-        SI parameters; defaults if omitted.
-    **overrides
-        Individual parameters replacing those of ``params``
-        (e.g. ``restitution=0.8``).
+    {params}
 
     Attributes
     ----------
@@ -108,14 +104,12 @@ class BouncingBall(SIUnits, CompiledScene):
     #: from the default start: the first impacts and, for e = 0.5, the ball at rest (t_inf = 4.24)
     default_window = 4.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(BouncingBallParams, params, overrides)
-        self.params = p
+    Params = BouncingBallParams
+
+    def _setup(self, p):
         self.e = p.restitution
         self.r = p.radius / p.length
-        self.length = p.length
-        self.time = math.sqrt(p.length / p.gravity)
-        self.force = p.mass * p.gravity
+        self._scale_by_weight(p.length, p.mass, p.gravity)
         self.mu = np.zeros(1)
         self.restitution = np.array([self.e])
 

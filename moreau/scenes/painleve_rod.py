@@ -48,7 +48,7 @@ from ..errors import InputError, PainleveError
 from ..model.drawing import contact, line
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from scipy.integrate import solve_ivp
 
 from ..analysis.cases import GRID, CompareCase
@@ -111,15 +111,12 @@ class PainleveRodParams:
         check_fields(self, restitution, "restitution")
 
 
-class PainleveRod(SIUnits, CompiledScene):
+class PainleveRod(FromParams, SIUnits, CompiledScene):
     """Uniform rod with its lower tip on a rough floor.
 
     Parameters
     ----------
-    params : PainleveRodParams, optional
-        SI parameters; defaults if omitted.
-    **overrides
-        Individual parameters replacing those of ``params`` (e.g. ``mu=0.5``).
+    {params}
 
     Attributes
     ----------
@@ -147,14 +144,12 @@ class PainleveRod(SIUnits, CompiledScene):
     #: from the default start the rod slides, falls flat (phi -> 0) within it
     default_window = 2.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(PainleveRodParams, params, overrides)
-        self.params = p
+    Params = PainleveRodParams
+
+    def _setup(self, p):
         self.mu = np.array([p.mu])
         self.restitution = np.array([p.restitution])
-        self.length = 0.5 * p.length
-        self.time = math.sqrt(self.length / p.gravity)
-        self.force = p.mass * p.gravity
+        self._scale_by_weight(0.5 * p.length, p.mass, p.gravity)
         self._M = np.diag([1.0, 1.0, 1.0 / 3.0])
 
     # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --

@@ -75,7 +75,7 @@ from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from .sliding_box import SlidingBox
 
@@ -136,14 +136,12 @@ class RockingBlockParams:
                              f"for the block to fall back onto both corners, got {tilt!r}")
 
 
-class RockingBlock(SIUnits, CompiledScene):
+class RockingBlock(FromParams, SIUnits, CompiledScene):
     """Rectangular block on a level floor, its two bottom corners frictional contacts.
 
     Parameters
     ----------
-    params : RockingBlockParams, optional
-    **overrides
-        Individual parameters replacing those of ``params``.
+    {params}
 
     Examples
     --------
@@ -157,13 +155,11 @@ class RockingBlock(SIUnits, CompiledScene):
     name = "rocking-block"
     angle_coordinates = (2,)
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(RockingBlockParams, params, overrides)
-        self.params = p
+    Params = RockingBlockParams
+
+    def _setup(self, p):
         R = 0.5 * math.hypot(p.width, p.height)
-        self.length = R
-        self.time = math.sqrt(R / p.gravity)
-        self.force = p.mass * p.gravity
+        self._scale_by_weight(R, p.mass, p.gravity)
         self.alpha = math.atan(p.width / p.height)
         # the model of the sliding box, in units of R
         self._box = SlidingBox(mass=p.mass, half_width=0.5 * p.width, half_height=0.5 * p.height,

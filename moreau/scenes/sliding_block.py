@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -81,15 +81,12 @@ class SlidingBlockParams:
         check_fields(self, restitution, "restitution")
 
 
-class SlidingBlock(SIUnits, CompiledScene):
+class SlidingBlock(FromParams, SIUnits, CompiledScene):
     """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
 
     Parameters
     ----------
-    params : SlidingBlockParams, optional
-        SI parameters; defaults if omitted.
-    **overrides
-        Individual parameters replacing those of ``params`` (e.g. ``mu=0.5``).
+    {params}
 
     Attributes
     ----------
@@ -112,15 +109,13 @@ class SlidingBlock(SIUnits, CompiledScene):
     #: the default launch stops at t* = 1 / mu = 3.33
     default_window = 5.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(SlidingBlockParams, params, overrides)
-        self.params = p
+    Params = SlidingBlockParams
+
+    def _setup(self, p):
         self.alpha = p.incline
         self.mu = np.array([p.mu])
         self.restitution = np.array([p.restitution])
-        self.length = p.length
-        self.time = math.sqrt(p.length / p.gravity)
-        self.force = p.mass * p.gravity
+        self._scale_by_weight(p.length, p.mass, p.gravity)
 
     # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def initial_state(self):

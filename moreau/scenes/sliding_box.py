@@ -47,7 +47,7 @@ from ..errors import InputError
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase, flatten
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -90,14 +90,12 @@ class SlidingBoxParams:
         check_fields(self, restitution, "restitution")
 
 
-class SlidingBox(SIUnits, CompiledScene):
+class SlidingBox(FromParams, SIUnits, CompiledScene):
     """Rigid box on a level floor, two frictional corner contacts.
 
     Parameters
     ----------
-    params : SlidingBoxParams, optional
-    **overrides
-        Individual parameters replacing those of ``params``.
+    {params}
 
     Examples
     --------
@@ -116,17 +114,15 @@ class SlidingBox(SIUnits, CompiledScene):
     #: the default launch stops at t* = 1 / mu = 2.5
     default_window = 4.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(SlidingBoxParams, params, overrides)
-        self.params = p
+    Params = SlidingBoxParams
+
+    def _setup(self, p):
         self.a = p.half_width / p.length
         self.b = p.half_height / p.length
         self.inertia = (self.a ** 2 + self.b ** 2) / 3.0
         self.mu = np.array([p.mu, p.mu])
         self.restitution = np.array([p.restitution, p.restitution])
-        self.length = p.length
-        self.time = math.sqrt(p.length / p.gravity)
-        self.force = p.mass * p.gravity
+        self._scale_by_weight(p.length, p.mass, p.gravity)
 
     # -- Scene interface (mass, forces, gaps, ...: the compiled model's, CompiledScene) --
     def inside_valid_region(self, t, q, v):

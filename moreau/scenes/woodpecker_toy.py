@@ -97,7 +97,7 @@ from ..integrators import simulate
 from ..model.compiled_scene import CompiledScene
 from ..model.drawing import circle, contact, line, polygon
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import FromParams
 from ..model.units import SIUnits
 
 __all__ = ["WoodpeckerToyParams", "WoodpeckerToy", "GLOCKER_STATE", "LEINE_2001",
@@ -178,14 +178,12 @@ class WoodpeckerToyParams:
                              "`pole_radius`: at zero angles the beak lies off the pole")
 
 
-class WoodpeckerToy(SIUnits, CompiledScene):
+class WoodpeckerToy(FromParams, SIUnits, CompiledScene):
     """Glocker's woodpecker toy: sleeve on a pole, bird on a torsion spring (module docstring).
 
     Parameters
     ----------
-    params : WoodpeckerToyParams, optional
-    **overrides
-        Individual parameters replacing those of ``params``.
+    {params}
 
     Examples
     --------
@@ -202,13 +200,11 @@ class WoodpeckerToy(SIUnits, CompiledScene):
     #: about two and a half cycles of the limit cycle
     default_window = 8.0
 
-    def __init__(self, params=None, **overrides):
-        p = params_with(WoodpeckerToyParams, params, overrides)
-        self.params = p
+    Params = WoodpeckerToyParams
+
+    def _setup(self, p):
         L = p.spring_offset
-        self.length = L
-        self.time = math.sqrt(L / p.gravity)
-        self.force = p.bird_mass * p.gravity
+        self._scale_by_weight(L, p.bird_mass, p.gravity)
         m = p.bird_mass
         self.mu = np.full(3, p.mu)
         self.restitution = np.array([p.sleeve_restitution, p.sleeve_restitution,
