@@ -19,7 +19,6 @@ import sys
 from dataclasses import asdict
 
 from ... import __version__
-from ..._validate import positive
 # the module, not its function: a test (or a user) that replaces
 # engine.run_points reaches these sweeps too
 from ...analysis import engine
@@ -31,7 +30,8 @@ from ...outputs import claim_outputs
 from ...provenance import provenance
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
 from ..paper.figures import sweep_figure
-from ..paper.sweeps import make_scheme, scheme_tag, sweep_values
+from ..paper.sweeps import (fixed_frequency, log_modes, make_scheme, scheme_tag, sweep_settings,
+                           sweep_values)
 from ..paper.tables import run_columns, write_table
 from ..paper.valid_range import lift_off_margin, range_marks
 from .direction_control import bidirectional_params
@@ -139,12 +139,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         The swept values (``points`` from ``start`` to ``stop``, linear or log).
     scheme : Scheme, optional
         From :func:`moreau.studies.paper.sweeps.make_scheme` (event-driven by default).
-    out : path-like
-        Output folder, checked writable before any work.
-    netcdf : bool
-        Also write the table as NetCDF next to its CSV
-        (:func:`moreau.analysis.sweep.write_netcdf_beside`; needs xarray, the
-        ``[data]`` extra, checked before any work).
+    out, netcdf
+        As for :func:`moreau.studies.paper.sweeps.run_sweep`.
 
     Returns
     -------
@@ -161,16 +157,9 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
         raise InputError(f"`START` and `STOP` are required for a bidirectional sweep of "
                          f"{parameter!r}")
     values = sweep_values("frequency", start, stop, 50 if points is None else points, scale)
-    if parameter == "frequency":
-        if frequency is not None:
-            raise InputError("`--frequency` is the swept parameter here; leave it out")
-        if values.min() <= 0:
-            raise InputError("`START` and `STOP` must be > 0 for a frequency sweep")
-    elif frequency is None:
-        raise InputError(f"`--frequency` is required for a sweep of {parameter!r} "
-                         "(drive frequency in Hz)")
-    else:
-        frequency = positive("frequency", frequency)
+    frequency = fixed_frequency(parameter, frequency)
+    if parameter == "frequency" and values.min() <= 0:
+        raise InputError("`START` and `STOP` must be > 0 for a frequency sweep")
     # every value must make a valid parameter set before any work starts
     for x in (values.min(), values.max()):
         point_params(params, parameter, x)
@@ -181,11 +170,8 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
     tag = "bidirectional_" + (parameter if parameter == "frequency"
                               else f"{parameter}_{frequency:g}Hz") + scheme_tag(scheme)
     stem = out / f"sweep_{tag}"
-    settings = claim_outputs(stem, {
-        "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
-        "frequency_Hz": frequency, "parameters_SI": asdict(params),
-        "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                   scheme.options], "continuation": bool(continuation)}, force)
+    settings = claim_outputs(stem, sweep_settings(parameter, values, scale, frequency, params,
+                                                  scheme, continuation), force)
 
     pts = [(asdict(point_params(params, parameter, x)),
             float(x) if parameter == "frequency" else frequency) for x in values]
@@ -236,13 +222,7 @@ def run_bidirectional_sweep(parameter, params=None, frequency=None, start=None, 
             log(f"wrote {paths[0]}")
         except ImportError:  # matplotlib is optional for the data
             pass
-    prev = None
-    col = BIDIRECTIONAL_COLUMNS[parameter]
-    for r in table:
-        label = r["mode"] if r["status"] == "ok" else "failed: " + r["status"].split(":")[0]
-        if label != prev:
-            log(f"  from {r[col]:.6g}: {label}")
-            prev = label
+    log_modes(table, BIDIRECTIONAL_COLUMNS[parameter], log)
     return table
 
 

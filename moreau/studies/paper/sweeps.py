@@ -28,6 +28,7 @@ from .tables import sweep_point, tidy_rows, write_sidecar, write_table
 from .valid_range import range_marks
 
 __all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE",
+           "fixed_frequency", "sweep_settings", "log_modes",
            "command", "params_from_args"]
 
 #: parameter -> (start, stop, num, log)
@@ -185,6 +186,41 @@ def sweep_values(parameter, start, stop, points, scale="linear"):
     return values
 
 
+def fixed_frequency(parameter, frequency):
+    """The drive frequency [Hz] of a sweep of ``parameter``: ``None`` when it is the swept one.
+
+    Examples
+    --------
+    >>> fixed_frequency("mu", 185), fixed_frequency("frequency", None)
+    (185.0, None)
+    """
+    if parameter == "frequency":
+        if frequency is not None:
+            raise InputError("`--frequency` is the swept parameter here; leave it out")
+        return None
+    if frequency is None:
+        raise InputError(f"`--frequency` is required for a sweep of {parameter!r} (drive frequency in Hz)")
+    return positive("frequency", frequency)
+
+
+def sweep_settings(parameter, values, scale, frequency, params, scheme, continuation):
+    """The settings of a sweep that :func:`moreau.outputs.claim_outputs` records with its outputs."""
+    return {"parameter": parameter, "values": [values[0], values[-1], len(values), scale],
+            "frequency_Hz": frequency, "parameters_SI": asdict(params),
+            "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
+                       scheme.options], "continuation": bool(continuation)}
+
+
+def log_modes(table, column, log):
+    """One line to ``log`` where the steady state's mode changes along a sweep's ``table``."""
+    prev = None
+    for r in table:
+        label = r["mode"] if r["status"] == "ok" else "failed: " + r["status"].split(":")[0]
+        if label != prev:
+            log(f"  from {r[column]:.6g}: {label}")
+            prev = label
+
+
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
               progress=True, plot=True, log=print, force=False, continuation=True, netcdf=False):
@@ -235,13 +271,7 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     stop = d1 if stop is None else stop
     scale = ("log" if dlog else "linear") if scale is None else scale
     values = sweep_values(parameter, start, stop, dn if points is None else points, scale)
-    if parameter == "frequency":
-        if frequency is not None:
-            raise InputError("`--frequency` is the swept parameter here; leave it out")
-    elif frequency is None:
-        raise InputError(f"`--frequency` is required for a sweep of {parameter!r} (drive frequency in Hz)")
-    else:
-        frequency = positive("frequency", frequency)
+    frequency = fixed_frequency(parameter, frequency)
     # every value must make a valid parameter set before any work starts
     for x in (values[0], values[-1]):
         sweep_point(params, parameter, x, frequency if frequency is not None else float(x))
@@ -253,11 +283,8 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
     # that sweeps of one parameter by different schemes do not overwrite each other
     tag += scheme_tag(scheme)
     stem = out / f"sweep_{tag}"
-    settings = claim_outputs(stem, {
-        "parameter": parameter, "values": [values[0], values[-1], len(values), scale],
-        "frequency_Hz": frequency, "parameters_SI": asdict(params),
-        "scheme": [scheme.name, scheme.theta, scheme.steps_per_period, scheme.rtol,
-                   scheme.options], "continuation": bool(continuation)}, force)
+    settings = claim_outputs(stem, sweep_settings(parameter, values, scale, frequency, params,
+                                                  scheme, continuation), force)
 
     points_ = [sweep_point(params, parameter, x, frequency) for x in values]
     # neighbours in segments, each point shot from the previous one's orbit
@@ -284,13 +311,7 @@ def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, poi
         paths = sweep_figure(table, parameter, frequency, marks, stem, log=scale == "log",
                              scheme_label=label)
         log(f"wrote {paths[0]}")
-    prev = None
-    col = list(table[0])[0] if table else None
-    for r in table:
-        label = r["mode"] if r["status"] == "ok" else "failed: " + r["status"].split(":")[0]
-        if label != prev:
-            log(f"  from {r[col]:.6g}: {label}")
-            prev = label
+    log_modes(table, list(table[0])[0] if table else None, log)
     return table
 
 
