@@ -132,6 +132,20 @@ def finite_array(name, value, shape=None, ndim=None):
     return a
 
 
+def times(name, value):
+    """Return ``value`` as a 1-D float array of times, each finite and ``>= 0`` (a scalar: one).
+
+    Examples
+    --------
+    >>> times("t", 2).tolist()
+    [2.0]
+    """
+    t = np.atleast_1d(finite_array(name, value)).astype(float)
+    if np.any(t < 0.0):
+        raise InputError(f"`{name}` must be >= 0")
+    return t
+
+
 #: the tightest relative tolerance float64 arithmetic can certify: a hundred units of
 #: rounding (eps = 2.2e-16), the floor scipy's solve_ivp sets for its own rtol
 TOL_MIN = 100.0 * float(np.finfo(float).eps)

@@ -65,27 +65,15 @@ class CompiledScene(Scene):
 
     Examples
     --------
+    A ball of radius 0.1 above the floor, its model the one of
+    :mod:`moreau.compiled`'s example (:func:`moreau.model.examples.drop_model`):
+
     >>> import numpy as np
-    >>> from numba import njit
-    >>> from moreau.compiled import CompiledModel
-    >>> @njit
-    ... def mass(par, q, M):
-    ...     M[0, 0] = 1.0
-    >>> @njit
-    ... def forces(par, q, v, t, D, need_jac):
-    ...     D[0, 0] = -1.0
-    >>> @njit
-    ... def contacts(par, q, t, G, need_gap, need_T):
-    ...     if need_gap:
-    ...         G[0, 0] = q[0] - par[0]
-    ...     G[0, 3] = 1.0
-    >>> @njit
-    ... def drift(par, q, v, t, Dr):
-    ...     Dr[0, 0] = 0.0
+    >>> from moreau.model.examples import drop_model
     >>> class Ball(CompiledScene):
     ...     ndof, mu, restitution = 1, np.zeros(1), np.array([0.5])
     ...     def compiled_model(self):
-    ...         return CompiledModel(mass, forces, contacts, drift, [0.1], 1, 1, True, False)
+    ...         return drop_model(0.1)
     >>> ball = Ball()
     >>> ball.gaps([1.0], 0.0), ball.forces([1.0], [0.0], 0.0)
     (array([0.9]), array([-1.]))

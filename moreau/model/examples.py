@@ -4,13 +4,16 @@ Each is the smallest :class:`~moreau.model.scene.Scene` that shows a scheme's
 behaviour in a line or two (:class:`Drop`: an impact; :class:`Spring`: the
 order of a scheme where no contact acts). How such a scene is written is
 shown by their source, and by :class:`moreau.integrators.moreau_jean.MoreauJean`'s example.
+:func:`drop_model` is the drop's compiled model (:mod:`moreau.compiled`).
 """
 
 import numpy as np
+from numba import njit
 
+from ..compiled import CompiledModel
 from .scene import Scene
 
-__all__ = ["Drop", "Spring"]
+__all__ = ["Drop", "Spring", "drop_model"]
 
 
 class Drop(Scene):
@@ -88,3 +91,42 @@ class Spring(Scene):
 
     def contact_drift(self, q, v, t):
         return np.zeros(1), np.zeros(0)
+
+
+# the functions of moreau.compiled's example, where they are explained
+@njit
+def _drop_mass(par, q, M):
+    M[0, 0] = 1.0
+
+
+@njit
+def _drop_forces(par, q, v, t, D, need_jac):
+    D[0, 0] = -1.0
+
+
+@njit
+def _drop_contacts(par, q, t, G, need_gap, need_T):
+    if need_gap:
+        G[0, 0] = q[0] - par[0]
+    G[0, 3] = 1.0
+
+
+@njit
+def _drop_drift(par, q, v, t, Dr):
+    Dr[0, 0] = 0.0
+
+
+def drop_model(radius=0.0):
+    """:class:`Drop`'s equations as a :class:`~moreau.compiled.CompiledModel`, for a ball of ``radius``.
+
+    Unit mass under gravity 1, one frictionless contact of gap ``q - radius``
+    (``radius = 0``: the point of :class:`Drop`).
+
+    Examples
+    --------
+    >>> model = drop_model(0.1)
+    >>> model.ndof, model.ncontacts, float(model.par[0])
+    (1, 1, 0.1)
+    """
+    return CompiledModel(_drop_mass, _drop_forces, _drop_contacts, _drop_drift, par=[radius],
+                         ndof=1, ncontacts=1, const_mass=True, has_jacobians=False)

@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with", "FromParams", "joint_row_count", "velocity_count", "is_spatial"]
+__all__ = ["Scene", "params_with", "as_params", "FromParams", "joint_row_count", "velocity_count", "is_spatial"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
@@ -328,6 +328,11 @@ def params_with(cls, params, overrides):
             raise InputError(f"`{key}` is not a parameter of {cls.__name__}; "
                              f"known parameters: {sorted(known)}")
     return replace(params, **overrides)
+
+
+def as_params(cls, params):
+    """``params`` as a ``cls``: itself if it is one, else ``cls(**params)`` from a mapping."""
+    return params if isinstance(params, cls) else cls(**params)
 
 
 class FromParams:

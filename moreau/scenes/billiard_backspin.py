@@ -29,11 +29,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, finite_scalar, positive
+from .._validate import finite_scalar, positive, times
 from ..analysis.cases import GRID, SpatialCase
-from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.space import SpaceModel, Sphere
 
 __all__ = ["BilliardParams", "billiard_backspin", "billiard_exact", "rolling_onset"]
@@ -121,10 +120,8 @@ def billiard_exact(params, t):
     >>> bool(abs(vx[1] - v) < 1e-15 and abs(w[1] * p.radius - v) < 1e-12)
     True
     """
-    p = params if isinstance(params, BilliardParams) else BilliardParams(**params)
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
+    p = as_params(BilliardParams, params)
+    tt = times("t", t)
     t_star, v_star = rolling_onset(p)
     sign = 1.0 if p.speed - p.radius * p.spin >= 0.0 else -1.0
     a = -sign * p.mu * p.gravity

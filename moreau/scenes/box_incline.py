@@ -52,11 +52,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_array, in_open_interval, nonnegative, positive
+from .._validate import in_open_interval, nonnegative, positive, times
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.space import Box, SpaceModel
 
 __all__ = ["BoxInclineParams", "box_incline", "box_incline_motion", "slides", "stop_time"]
@@ -162,10 +162,8 @@ def box_incline_motion(params, t):
     >>> round(float((nf[0] - nb[0]) / (nf[0] + nb[0])), 12)     # mu c / a
     0.1
     """
-    p = params if isinstance(params, BoxInclineParams) else BoxInclineParams(**params)
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
+    p = as_params(BoxInclineParams, params)
+    tt = times("t", t)
     g, al, v0 = p.gravity, p.slope, p.speed
     acc = g * (math.sin(al) - p.mu * math.cos(al))
     N = p.mass * g * math.cos(al)

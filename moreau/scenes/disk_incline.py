@@ -35,11 +35,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, finite_array, in_open_interval, nonnegative, positive
+from .._validate import check_fields, in_open_interval, nonnegative, positive, times
 from ..analysis.cases import ClosedFormPath, FactoryCase
-from ..errors import InputError
 from ..model.planar import Circle, HalfPlane, Model
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["InclineParams", "DiskInclineParams", "INCLINE_UNITS", "disk_incline_model", "disk_incline", "disk_incline_exact",
@@ -139,9 +138,7 @@ def incline_motion(p, t, k):
     sin(alpha) / (1 + k)`` with ``F = k m a <= mu m g cos(alpha)`` (:func:`rolls_down`);
     slipping, ``a = g (sin(alpha) - mu cos(alpha))`` and ``w' = mu g cos(alpha) / (k r)``.
     """
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
+    tt = times("t", t)
     g, a, r = p.gravity, p.slope, p.radius
     if rolls_down(p, k):
         acc = g * math.sin(a) / (1.0 + k)
@@ -161,7 +158,7 @@ def disk_incline_exact(params, t):
     >>> round(float(sd[0]) / (9.81 * math.sin(0.3)), 12)     # rolling: 2/3 g sin(alpha)
     0.666666666667
     """
-    p = params if isinstance(params, DiskInclineParams) else DiskInclineParams(**params)
+    p = as_params(DiskInclineParams, params)
     return incline_motion(p, t, 0.5)
 
 

@@ -52,11 +52,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import finite_array, in_open_interval, nonnegative, positive, finite_scalar
+from .._validate import in_open_interval, nonnegative, positive, finite_scalar, times
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.space import Puck, SpaceModel
 
 __all__ = ["PuckInclineParams", "puck_incline", "puck_incline_path"]
@@ -201,10 +201,8 @@ def puck_incline_path(params, t):
     >>> round(float(z[1, 1] / (2 * v0 ** 2 / (3 * gs))), 12), round(float(z[1, 2] / v0), 12)
     (1.0, 0.5)
     """
-    p = params if isinstance(params, PuckInclineParams) else PuckInclineParams(**params)
-    tt = np.atleast_1d(finite_array("t", t)).astype(float)
-    if np.any(tt < 0.0):
-        raise InputError("`t` must be >= 0")
+    p = as_params(PuckInclineParams, params)
+    tt = times("t", t)
     if abs(p.mu - math.tan(p.slope)) <= 1e-12 * math.tan(p.slope):
         return _closed_form(p, tt)
     return _integrated(p, tt)

@@ -73,7 +73,7 @@ from .._validate import in_open_interval, positive
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.space import Disk, SpaceModel
 from ..model.spatial import quat_exp, quat_multiply, rotation_matrix
 
@@ -175,7 +175,7 @@ def rolling_disk_exact(params, t):
     ...     np.hstack([x, quat]))[0][1]), 12)
     (True, 1.2)
     """
-    p = params if isinstance(params, RollingDiskParams) else RollingDiskParams(**params)
+    p = as_params(RollingDiskParams, params)
     tt = np.atleast_1d(np.asarray(t, dtype=float))
     W, b, w3 = _rates(p)
     _, orient, _, _ = _start(p)

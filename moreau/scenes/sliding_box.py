@@ -42,7 +42,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import check_fields, finite_array, nonnegative, positive, restitution
+from .._validate import check_fields, finite_array, nonnegative, positive, restitution, times
 from ..errors import InputError
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
@@ -200,9 +200,7 @@ class SlidingBox(FromParams, SIUnits, CompiledScene):
         if q0[2] != 0.0 or q0[1] != self.b:
             raise InputError("`q0` must be flat on the floor: q0[1] == half_height, q0[2] == 0")
         u = self._speed(v0)
-        tt = np.atleast_1d(finite_array("t", t)).astype(float)
-        if np.any(tt < 0.0):
-            raise InputError("`t` must be >= 0")
+        tt = times("t", t)
         mu = float(self.mu[0])
         ts = np.minimum(tt, u / mu)
         q = np.zeros((len(tt), 3))

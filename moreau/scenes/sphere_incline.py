@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 from ..analysis.cases import SpatialCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
-from ..model.scene import params_with
+from ..model.scene import as_params, params_with
 from ..model.space import SpaceModel, Sphere
 from .disk_incline import INCLINE_UNITS, InclineCase, InclineParams, incline_motion, rolls_down
 
@@ -90,7 +90,7 @@ def sphere_incline_exact(params, t):
     >>> round(float(sd[0]) / (9.81 * math.sin(0.3)), 12)     # rolling: 5/7 g sin(alpha)
     0.714285714286
     """
-    p = params if isinstance(params, SphereInclineParams) else SphereInclineParams(**params)
+    p = as_params(SphereInclineParams, params)
     return incline_motion(p, t, 0.4)
 
 

@@ -857,7 +857,24 @@ class Model:
         return PlanarScene(self, name, valid_region, inside, default_window)
 
 
-class PlanarScene(SIUnits, Scene):
+class _GeneratedFunctions:
+    """Holds ``_fn``, the functions of the module generated for ``par``, and pickles without it.
+
+    The generated module is found again from ``par``: a worker process
+    imports it, or compiles it, where the object is unpickled.
+    """
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        del state["_fn"]
+        return state
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        self._fn = _codegen.compiled_functions(self.par)
+
+
+class PlanarScene(_GeneratedFunctions, SIUnits, Scene):
     """A scene built by :class:`Model`: its Python methods run its compiled model's functions.
 
     Built by :meth:`Model.build`, not directly.
@@ -881,17 +898,6 @@ class PlanarScene(SIUnits, Scene):
         self._fn = _codegen.compiled_functions(self.par)
         self._joints = JointRows(model) if model.joints else None
         self.n_joint_rows = 0 if self._joints is None else self._joints.nrows
-
-    def __getstate__(self):
-        # the generated module is found again from par (a worker process imports or
-        # compiles it there)
-        state = dict(self.__dict__)
-        del state["_fn"]
-        return state
-
-    def __setstate__(self, state):
-        self.__dict__.update(state)
-        self._fn = _codegen.compiled_functions(self.par)
 
     def _qscale(self):
         s = np.full(self.ndof, self.length)
@@ -1036,7 +1042,7 @@ class PlanarScene(SIUnits, Scene):
         return out
 
 
-class JointRows:
+class JointRows(_GeneratedFunctions):
     """The bilateral rows of a model's joints: ``g(q, t) = 0``, their Jacobian and drift terms.
 
     Rows in the order the joints were added (a revolute joint two, a
@@ -1052,15 +1058,6 @@ class JointRows:
     def __init__(self, model):
         self.par, self.ndof = model.pack()
         self.nrows = sum(2 if j["kind"] == K.JPOINT else 1 for j in model.joints)
-        self._fn = _codegen.compiled_functions(self.par)
-
-    def __getstate__(self):
-        state = dict(self.__dict__)
-        del state["_fn"]
-        return state
-
-    def __setstate__(self, state):
-        self.__dict__.update(state)
         self._fn = _codegen.compiled_functions(self.par)
 
     def _G(self, q, t):
