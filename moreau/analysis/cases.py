@@ -322,8 +322,10 @@ class DriveCase(CompareCase):
     :attr:`ref_rtols`; Moreau–Jean rows are the discrete steady states
     (the fixed point of the compiled period map). ``_tight()`` gives the
     reference's periodic state at ``tau = 0`` and its trajectory on the
-    comparison grid. A subclass sets :attr:`scene` (and may override the
-    reference where the scene has its own walker).
+    comparison grid. A subclass names its :attr:`scene_class` (and may
+    override the reference where the scene has its own walker);
+    ``Case(frequency=None, **params)`` builds the scene and keeps the
+    parameters for :meth:`parameters`.
     """
 
     ref_scheme = "event-driven"
@@ -332,6 +334,29 @@ class DriveCase(CompareCase):
     headline_name = "displacement per period"
     projection = True
     _ref = None
+    #: the scene, built as ``scene_class(frequency=..., **params)``
+    scene_class = None
+    #: its drive frequency [Hz] when the caller gives none
+    default_frequency = 185.0
+    #: parameters given to the scene where the caller does not give them
+    default_params = {}
+
+    def __init__(self, frequency=None, **params):
+        for key, value in self.default_params.items():
+            params[key] = params.pop(key, value)
+        f = self.default_frequency if frequency is None else frequency
+        self.scene = self.scene_class(frequency=f, **params)
+        self.frequency = self.scene.frequency
+        self._params = params
+        self.trajectory_scale = self.scale_of(self.scene)
+
+    @staticmethod
+    def scale_of(scene):
+        """The size of the cyclic coordinate's motion, the unit of the trajectory errors."""
+        return scene.u10
+
+    def parameters(self):
+        return dict(frequency=self.frequency, **self._params)
 
     @property
     def cyclic(self):

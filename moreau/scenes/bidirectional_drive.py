@@ -349,14 +349,12 @@ class BidirectionalDriveCase(DriveCase):
     ``NSP|NP`` at 185 Hz).
     """
 
-    def __init__(self, frequency=185.0, x10_b=1.0e-6, **params):
-        self.scene = BidirectionalDrive(frequency=frequency, x10_b=x10_b, **params)
-        self.frequency = self.scene.frequency
-        self._params = dict(params, x10_b=x10_b)
-        self.trajectory_scale = float(np.max(self.scene.u10))
+    scene_class = BidirectionalDrive
+    default_params = {"x10_b": 1.0e-6}
 
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
+    @staticmethod
+    def scale_of(scene):
+        return float(np.max(scene.u10))
 
 
 #: SI units of the parameters of :class:`BidirectionalDriveParams`

@@ -488,14 +488,7 @@ class FlexibleRodDriveCase(DriveCase):
     tight_rtol = 1e-9
     ref_rtols = (1e-4, 1e-6, 1e-8, 1e-9)
 
-    def __init__(self, frequency=185.0, **params):
-        self.scene = FlexibleRodDrive(frequency=frequency, **params)
-        self.frequency = self.scene.frequency
-        self._params = dict(params)
-        self.trajectory_scale = self.scene.u10
-
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
+    scene_class = FlexibleRodDrive
 
 
 def _rigid_reference(**params):

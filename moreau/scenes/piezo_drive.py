@@ -666,14 +666,12 @@ class PiezoDriveCase(DriveCase):
     1.28e-3 l per period; near 1000 Hz its displacement crosses zero.
     """
 
-    def __init__(self, frequency=1400.0, **params):
-        self.scene = PiezoDrive(frequency=frequency, **params)
-        self.frequency = self.scene.frequency
-        self._params = dict(params)
-        self.trajectory_scale = self.scene.velocity_scale
+    scene_class = PiezoDrive
+    default_frequency = 1400.0
 
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
+    @staticmethod
+    def scale_of(scene):
+        return scene.velocity_scale
 
 
 #: SI units of the parameters of :class:`PiezoDriveParams`

@@ -388,15 +388,7 @@ class FrictionDriveCase(DriveCase):
     headline_name = "displacement per period"
     projection = True
 
-    def __init__(self, frequency=185.0, **params):
-        self.scene = FrictionDrive(frequency=frequency, **params)
-        self.frequency = self.scene.frequency
-        self._params = dict(params)
-        self.trajectory_scale = self.scene.u10
-        self._ref = None
-
-    def parameters(self):
-        return dict(frequency=self.frequency, **self._params)
+    scene_class = FrictionDrive
 
     def reference(self, rtol):
         ss = find_steady_state(self.scene, rtol=rtol, statistical=False)
