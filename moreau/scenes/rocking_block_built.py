@@ -58,7 +58,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import finite_scalar, positive
-from ..analysis.cases import GRID
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Polygon, TimeFunction
 from ..model.scene import params_with
@@ -173,14 +172,8 @@ class RockingBlockBuiltCase(RockingBlockCase):
         self.exact = self.scene
         self.scene = rocking_block_built(**params)
 
-    def reference(self, rtol):
-        th, _ = self.exact.exact_solution([self.window])
-        t1 = float(self.exact.impact_times(1)[0])
-        return float(th[0]), [(t1, "0:F"), (t1, "1:S")]
-
-    def reference_grid(self):
-        th, _ = self.exact.exact_solution(np.linspace(0.0, self.window, GRID + 1))
-        return th
+    def _exact(self):
+        return self.exact
 
 
 register_scene(SceneEntry(
