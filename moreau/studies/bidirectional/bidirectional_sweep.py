@@ -30,8 +30,8 @@ from ...outputs import claim_outputs
 from ...provenance import provenance
 from ...scenes.bidirectional_drive import BidirectionalDriveParams, params_from_kwargs
 from ..paper.figures import sweep_figure
-from ..paper.sweeps import (fixed_frequency, log_modes, make_scheme, scheme_tag, sweep_settings,
-                           sweep_values)
+from ..paper.sweeps import (apply_settings, fixed_frequency, log_modes, make_scheme, scheme_tag,
+                           settings_of, sweep_options, sweep_settings, sweep_values)
 from ..paper.tables import run_columns, write_table
 from ..paper.valid_range import lift_off_margin, range_marks
 from .direction_control import bidirectional_params
@@ -246,16 +246,7 @@ def command(args):
                          f"`--scene bidirectional`, got {param!r} (`x10` sets both rods: "
                          "sweep `x10_a`, `x10_b` or `balance`)")
     settable = [p for p in BIDIRECTIONAL_SWEEPABLE if p != "balance"] + ["x10"]
-    settings = {}
-    for item in args.set or []:
-        key, sep, val = item.partition("=")
-        key = key.strip()
-        if not sep or key not in settable:
-            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {settable}, got {item!r}")
-        try:
-            settings[key] = float(val)
-        except ValueError:
-            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    settings = settings_of(args.set, settable)
     # the stator amplitudes a balance point sets, and the parameter swept, cannot also be fixed
     fixed_by_sweep = {"balance": ("x10_a", "x10_b")}.get(param, (param,))
     for key in fixed_by_sweep:
@@ -267,23 +258,11 @@ def command(args):
     frequency = settings.pop("frequency", args.frequency)
     if "frequency" in fixed_by_sweep and args.frequency is not None:
         raise InputError("`--frequency` is the swept parameter here; leave it out")
-    for key, val in settings.items():
-        if getattr(args, key, None) is not None:
-            raise InputError(f"`{key}` is given twice (`--{key.replace('_', '-')}` and "
-                             f"`--set {key}=...`)")
-        setattr(args, key, val)
+    apply_settings(args, settings)
     params = params_from_args(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
-                         getattr(args, "scheme_options", None))
-    if args.num is not None and args.points is not None:
-        raise InputError("`--num` is the old name of `--points`; give one of them")
-    scale = args.scale or "linear"
-    if args.log:
-        if args.scale == "linear":
-            raise InputError("`--log` contradicts `--scale linear`")
-        scale = "log"
+    scheme, points, scale = sweep_options(args, args.scale or "linear")
     run_bidirectional_sweep(param, params, frequency=frequency, start=args.start, stop=args.stop,
-                            points=args.points if args.points is not None else args.num,
+                            points=points,
                             scale=scale, scheme=scheme, out=args.out, cache_dir=args.cache,
                             n_jobs=args.jobs, scheduler=args.scheduler, progress=not args.quiet,
                             plot=not args.no_plot, force=args.force,

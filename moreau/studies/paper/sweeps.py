@@ -28,7 +28,8 @@ from .tables import sweep_point, tidy_rows, write_sidecar, write_table
 from .valid_range import range_marks
 
 __all__ = ["sweep", "run_sweep", "make_scheme", "sweep_values", "SWEEP_DEFAULTS", "SWEEPABLE",
-           "fixed_frequency", "sweep_settings", "log_modes",
+           "fixed_frequency", "sweep_settings", "log_modes", "settings_of", "apply_settings",
+           "sweep_options",
            "command", "params_from_args"]
 
 #: parameter -> (start, stop, num, log)
@@ -221,6 +222,52 @@ def log_modes(table, column, log):
             prev = label
 
 
+def settings_of(items, names):
+    """A sweep command's ``--set NAME=VALUE`` options as ``{NAME: float}``, each ``NAME`` in ``names``.
+
+    Examples
+    --------
+    >>> settings_of(["mu=0.2", " k = 30"], ["mu", "k"])
+    {'mu': 0.2, 'k': 30.0}
+    """
+    settings = {}
+    for item in items or []:
+        key, sep, val = item.partition("=")
+        key = key.strip()
+        if not sep or key not in names:
+            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {names}, got {item!r}")
+        try:
+            settings[key] = float(val)
+        except ValueError:
+            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    return settings
+
+
+def apply_settings(args, settings):
+    """Each of ``settings`` onto the parsed options ``args``, refused where its own option is given too."""
+    for key, val in settings.items():
+        if getattr(args, key, None) is not None:
+            raise InputError(f"`{key}` is given twice (`--{key.replace('_', '-')}` and "
+                             f"`--set {key}=...`)")
+        setattr(args, key, val)
+
+
+def sweep_options(args, scale):
+    """``(scheme, points, scale)`` of a sweep command's options, ``scale`` the default scale.
+
+    ``--num`` is the old name of ``--points``; ``--log`` is ``--scale log``.
+    """
+    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
+                         getattr(args, "scheme_options", None))
+    if args.num is not None and args.points is not None:
+        raise InputError("`--num` is the old name of `--points`; give one of them")
+    if args.log:
+        if args.scale == "linear":
+            raise InputError("`--log` contradicts `--scale linear`")
+        scale = "log"
+    return scheme, args.points if args.points is not None else args.num, scale
+
+
 def run_sweep(parameter, params=None, frequency=None, start=None, stop=None, points=None,
               scale=None, scheme=None, out="out", cache_dir=None, n_jobs=-1, scheduler=None,
               progress=True, plot=True, log=print, force=False, continuation=True, netcdf=False):
@@ -335,38 +382,17 @@ def command(args):
     for opt in ("x10_a", "x10_b", "phase"):
         if getattr(args, opt) is not None:
             raise InputError(f"`--{opt.replace('_', '-')}` is not a parameter of the friction drive")
-    settings = {}
-    for item in args.set or []:
-        key, sep, val = item.partition("=")
-        key = key.strip()
-        if not sep or key not in SWEEPABLE:
-            raise InputError(f"`--set` takes NAME=VALUE with NAME one of {list(SWEEPABLE)}, "
-                             f"got {item!r}")
-        if key == args.parameter:
-            raise InputError(f"`--set {key}` fixes the swept parameter; leave it out")
-        try:
-            settings[key] = float(val)
-        except ValueError:
-            raise InputError(f"`--set {key}` must be a number, got {val.strip()!r}") from None
+    settings = settings_of(args.set, list(SWEEPABLE))
+    if args.parameter in settings:
+        raise InputError(f"`--set {args.parameter}` fixes the swept parameter; leave it out")
     if args.parameter != "frequency" and getattr(args, args.parameter, None) is not None:
         raise InputError(f"`--{args.parameter}` fixes the swept parameter; leave it out")
     frequency = settings.pop("frequency", args.frequency)
-    for key, val in settings.items():
-        if getattr(args, key, None) is not None:
-            raise InputError(f"`{key}` is given twice (`--{key}` and `--set {key}=...`)")
-        setattr(args, key, val)
+    apply_settings(args, settings)
     params = params_from_args(args)
-    scheme = make_scheme(args.scheme, args.theta, args.steps_per_period, args.rtol,
-                         getattr(args, "scheme_options", None))
-    if args.num is not None and args.points is not None:
-        raise InputError("`--num` is the old name of `--points`; give one of them")
-    scale = args.scale
-    if args.log:
-        if scale == "linear":
-            raise InputError("`--log` contradicts `--scale linear`")
-        scale = "log"
+    scheme, points, scale = sweep_options(args, args.scale)
     run_sweep(args.parameter, params, frequency=frequency, start=args.start, stop=args.stop,
-              points=args.points if args.points is not None else args.num, scale=scale,
+              points=points, scale=scale,
               scheme=scheme, out=args.out, cache_dir=args.cache, n_jobs=args.jobs,
               scheduler=args.scheduler, progress=not args.quiet, plot=not args.no_plot,
               force=args.force, continuation=not args.cold,
