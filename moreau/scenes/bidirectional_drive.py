@@ -121,11 +121,7 @@ class BidirectionalDriveParams(RodParams):
         V.check_fields(self, V.restitution, "restitution")
         for name in ("x10_a", "x10_b"):
             x = V.nonnegative(name, getattr(self, name))
-            if not 2.0 * x < self.length * math.sin(self.phi0):
-                raise InputError(
-                    f"`{name}` must be < length*sin(phi0)/2 = "
-                    f"{self.length * math.sin(self.phi0) / 2!r} m so that the rod stays above "
-                    f"the horizontal in contact, got {x!r}")
+            self._check_amplitude(name, x)
             object.__setattr__(self, name, x)
 
     def rod(self, which):

@@ -30,6 +30,7 @@ from numba import njit
 from ... import _validate as V
 from ...compiled import memo_sincos
 from ..._validate import positive
+from ...errors import InputError
 
 __all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS", "RodParams", "OneRod"]
 
@@ -96,6 +97,13 @@ class RodParams:
         object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
                                                             "in the open interval (0, pi/2)"))
         V.check_fields(self, V.nonnegative, "mu")
+
+    def _check_amplitude(self, name, x):
+        # the rod must stay above the horizontal while in contact
+        if not 2.0 * x < self.length * math.sin(self.phi0):
+            raise InputError(
+                f"`{name}` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
+                f"so that the rod stays above the horizontal in contact, got {x!r}")
 
     def with_(self, **changes):
         """Copy with some parameters changed (validated again)."""

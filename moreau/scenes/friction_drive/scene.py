@@ -146,10 +146,7 @@ class FrictionDriveParams(RodParams):
         V.check_fields(self, V.finite_scalar, "load")
         V.check_fields(self, V.restitution, "restitution")
         V.check_fields(self, V.nonnegative, "preload")
-        if not 2.0 * self.x10 < self.length * math.sin(self.phi0):
-            raise InputError(
-                f"`x10` must be < length*sin(phi0)/2 = {self.length * math.sin(self.phi0) / 2!r} m "
-                f"so that the rod stays above the horizontal in contact, got {self.x10!r}")
+        self._check_amplitude("x10", self.x10)
 
 
 PAPER_DEFAULTS = FrictionDriveParams()
