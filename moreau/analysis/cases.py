@@ -156,7 +156,8 @@ class CompareCase:
         return q[:, 0]
 
     def headline_of_run(self, res):
-        raise NotImplementedError
+        """The headline of a run: by default its :meth:`coordinate` at the last sample."""
+        return float(self.coordinate(res.q[-1:])[0])
 
     def run_mj(self, n, theta, lcp):
         q0, v0 = self.start()
@@ -305,9 +306,6 @@ class ClosedFormPath:
 
     def reference_grid(self):
         return self.path(np.linspace(0.0, self.window, GRID + 1))
-
-    def headline_of_run(self, res):
-        return float(self.coordinate(res.q[-1:])[0])
 
     def _run_switches(self, res, h):
         return []

@@ -445,9 +445,6 @@ class BallChainCase(FactoryCase):
     def coordinate(self, q):
         return q[:, -1]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, -1])
-
 
 # -- compiled model (moreau.compiled); par = (striker mass / ball mass,) -------------------
 

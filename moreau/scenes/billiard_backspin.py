@@ -140,9 +140,6 @@ class BilliardCase(SpatialCase):
 
     scene_factory = staticmethod(billiard_backspin)
 
-    def coordinate(self, q):
-        return q[:, 0]
-
     def reference(self, rtol):
         x, _, _ = billiard_exact(self.p, [self.window * self.scene.time])
         t_star, _ = rolling_onset(self.p)
@@ -151,9 +148,6 @@ class BilliardCase(SpatialCase):
     def reference_grid(self):
         x, _, _ = billiard_exact(self.p, np.linspace(0.0, self.window, GRID + 1) * self.scene.time)
         return x / self.scene.length
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
 
 
 register_scene(SceneEntry(

@@ -41,7 +41,6 @@ __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 BallImpacts = namedtuple("BallImpacts", ["t", "v_before", "v_after"])
 
 
-
 @dataclass(frozen=True)
 class BouncingBallParams:
     """SI parameters of the bouncing ball.
@@ -296,16 +295,12 @@ class BouncingBallCase(CompareCase):
         q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), q0, v0)
         return q[:, 0]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
     def _run_switches(self, res, h):
         # impacts: a contact step that follows a flight step
         letters = res.regime_letters()
         t = res.t - h
         return [(float(t[i]), "!") for i in range(1, len(letters))
                 if letters[i] != "F" and letters[i - 1] == "F"]
-
 
 
 # -- compiled model (moreau.compiled); par: r ---------------------------------------------

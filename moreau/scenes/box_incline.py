@@ -193,9 +193,6 @@ class BoxInclineCase(SpatialCase):
 
     scene_factory = staticmethod(box_incline)
 
-    def coordinate(self, q):
-        return q[:, 0]
-
     def reference(self, rtol):
         s, _, _, _ = box_incline_motion(self.p, [self.window * self.scene.time])
         ts = stop_time(self.p) / self.scene.time
@@ -208,9 +205,6 @@ class BoxInclineCase(SpatialCase):
         s, _, _, _ = box_incline_motion(self.p, np.linspace(0.0, self.window, GRID + 1)
                                         * self.scene.time)
         return s / self.scene.length
-
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
 
     def _run_switches(self, res, h):
         return []

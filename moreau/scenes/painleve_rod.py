@@ -403,10 +403,6 @@ class PainleveRodCase(CompareCase):
             self._sol = self._ode(self.tight_rtol)
         return self._sol.sol(np.linspace(0.0, self.window, GRID + 1))[0]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-
 
 # -- compiled model (moreau.compiled); no parameters ------------------------------------
 

@@ -359,9 +359,6 @@ class RockingBlockCase(FactoryCase):
 
     trajectory_scale = 0.05
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 2])
-
 
 register_scene(SceneEntry(
     name="rocking-block",

@@ -171,9 +171,6 @@ class SliderCrankCase(FactoryCase):
     def reference_grid(self):
         return slider_kinematics(np.linspace(0.0, self.window, GRID + 1), self._r, self._l)[0]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 3])
-
     def _run_switches(self, res, h):
         # no contact: no regime, no switch
         return []

@@ -276,10 +276,6 @@ class SlidingBlockCase(CompareCase):
         q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
         return q[:, 0]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
-
 
 # -- compiled model (moreau.compiled); par: sin(alpha), cos(alpha) -------------------------
 

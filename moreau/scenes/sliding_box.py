@@ -240,13 +240,9 @@ class SlidingBoxCase(CompareCase):
         q, _ = self.scene.exact_solution(np.linspace(0.0, self.window, GRID + 1), *self.start())
         return q[:, 0]
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
     def _run_switches(self, res, h):
         # each corner's stop is measured: Moreau–Jean may stop them a step apart
         return flatten([self._run_switches_of(res, h, c) for c in (0, 1)])
-
 
 
 # -- compiled model (moreau.compiled); par: a, b, inertia -----------------------------

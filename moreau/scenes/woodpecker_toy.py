@@ -387,9 +387,6 @@ class WoodpeckerToyCase(FactoryCase):
             self._grid = self._reference_run(self.tight_rtol).q[:, 0]
         return self._grid
 
-    def headline_of_run(self, res):
-        return float(res.q[-1, 0])
-
     def _run_switches(self, res, h):
         # the comparison is on the trajectory; the switching times are not matched
         return []
