@@ -102,7 +102,7 @@ from .. import _validate as V
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
-from .friction_drive.rod import OneRod, RodParams
+from .friction_drive.rod import OneRod, RodParams, one_rod_mass
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ..model.drawing import rod_drive_shapes
@@ -269,12 +269,6 @@ def _drift_dyn(par, q, v, t, Dr):
 
 
 # -- compiled model, rigid stator u1 = w(tau): q = (phi, u2) ----------------------------
-
-@njit(cache=True)
-def _mass_rig(par, q, M):
-    M[0, 0] = 1.0 / 3.0
-    M[1, 1] = par[0]
-
 
 @njit(cache=True)
 def _forces_rig(par, q, v, t, D, need_jac):
@@ -514,7 +508,7 @@ class PiezoDrive(OneRod, DriveUnits, CompiledScene):
         if self.ndof == 3:
             return CompiledModel(_mass_dyn, _forces_dyn, _contacts_dyn, _drift_dyn, self._par, 3,
                                  1, False, True, gaps=_gaps_dyn)
-        return CompiledModel(_mass_rig, _forces_rig, _contacts_rig, _drift_rig, self._par, 2, 1,
+        return CompiledModel(one_rod_mass, _forces_rig, _contacts_rig, _drift_rig, self._par, 2, 1,
                              True, True, gaps=_gaps_rig)
 
     def to_si(self, result):

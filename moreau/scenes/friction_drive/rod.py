@@ -32,12 +32,20 @@ from ...compiled import memo_sincos
 from ..._validate import positive
 from ...errors import InputError
 
-__all__ = ["rod_gap", "rod_forces", "rod_rows", "memo_sincos", "MEMO_SLOTS", "RodParams", "OneRod"]
+__all__ = ["rod_gap", "rod_forces", "rod_rows", "one_rod_mass", "memo_sincos", "MEMO_SLOTS",
+           "RodParams", "OneRod"]
 
 #: entries of ``par`` that :func:`memo_sincos` keeps for one argument, and what they
 #: start at: an argument with its sine and cosine, exact ones, so that ``par`` is
 #: consistent from the start
 MEMO_SLOTS = (0.0, 0.0, 1.0)
+
+
+@njit(cache=True)
+def one_rod_mass(par, q, M):
+    # one rod on the rotor, q = (phi, rotor): diag(1/3, J), J = par[0] in every one-rod model
+    M[0, 0] = 1.0 / 3.0
+    M[1, 1] = par[0]
 
 
 @njit(cache=True)

@@ -86,8 +86,8 @@ from ...model.units import DriveUnits
 from numba import njit
 
 from ...compiled import CompiledModel
-from .rod import (MEMO_SLOTS, OneRod, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
-                  rod_rows)
+from .rod import (MEMO_SLOTS, OneRod, RodParams, StatorMotion, memo_sincos, one_rod_mass,
+                  rod_forces, rod_gap, rod_rows)
 from ...model.compiled_scene import CompiledScene
 from ...model.scene import params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
@@ -286,7 +286,7 @@ class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
         # cosines (PHI_MEMO, PHASE_MEMO)
         par = np.array([self.J, self.P, self.u10, self.fL, self.sin_phi0, self.fp,
                         *MEMO_SLOTS, *MEMO_SLOTS], dtype=np.float64)
-        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
+        return CompiledModel(one_rod_mass, _forces, _contacts, _drift, par, 2, 1, True, True, gaps=_gaps)
 
     # -- units ------------------------------------------------------------------
     #: ``q = (phi, u2)``: the rod angle is in rad
@@ -322,12 +322,6 @@ class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
 # memo_sincos: angle phi, sin, cos; phase tau, sin, cos -----------------------------------
 PHI_MEMO = 6
 PHASE_MEMO = 9
-
-
-@njit(cache=True)
-def _mass(par, q, M):
-    M[0, 0] = 1.0 / 3.0
-    M[1, 1] = par[0]
 
 
 @njit(cache=True)
