@@ -53,16 +53,10 @@ def register_solver(name, fn, *, equality_rows=False, max_contacts=None, summary
 
     Parameters
     ----------
-    name : str
-    fn : callable
-        ``fn(problem, *, max_iter=None, tol=None, **options) -> ContactSolution``.
-    equality_rows : bool
-        True when it solves problems with equality rows; :func:`solve`
-        refuses such problems for the others.
-    max_contacts : int, optional
-        The most contacts it solves; :func:`solve` refuses larger problems.
-    summary : str
-        One line for listings.
+    name, fn, equality_rows, max_contacts, summary
+        The fields of :class:`SolverEntry`; :func:`solve` refuses a problem
+        with equality rows, or with more than ``max_contacts`` contacts, to a
+        solver that does not take it.
     replace : bool
         Allow replacing a registered solver of the same name.
 
