@@ -38,7 +38,8 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with", "as_params", "FromParams", "joint_row_count", "velocity_count", "is_spatial"]
+__all__ = ["Scene", "params_with", "as_params", "FromParams", "joint_row_count", "velocity_count",
+           "is_spatial"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
 _FD_STEP = float(np.finfo(float).eps) ** (1.0 / 3.0)
