@@ -343,7 +343,7 @@ class FromParams:
     the defaults if omitted) with the overrides applied by :func:`params_with`,
     keeps it as ``self.params`` and hands it to the scene's ``_setup(p)``,
     which sets the scene's own quantities. The line ``{params}`` in a
-    subclass's docstring (its Parameters section) is replaced by the entries
+    subclass's docstring is replaced by its Parameters section, the entries
     of these two arguments, so that each scene does not write them again.
 
     Examples
@@ -355,8 +355,6 @@ class FromParams:
     >>> class Drop(FromParams):
     ...     '''A point dropped from ``height``.
     ...
-    ...     Parameters
-    ...     ----------
     ...     {params}
     ...     '''
     ...     Params = DropParams
@@ -377,7 +375,7 @@ class FromParams:
         if doc and "{params}" in doc:
             head, _, tail = doc.partition("{params}")
             indent = head[head.rfind("\n") + 1:]
-            entries = (f"params : {cls.Params.__name__}, optional",
+            entries = ("Parameters", "----------", f"params : {cls.Params.__name__}, optional",
                        "    SI parameters; the defaults if omitted.",
                        "**overrides",
                        "    Individual parameters replacing those of ``params``, by name.")

@@ -137,8 +137,6 @@ class BallChainParams:
 class BallChain(FromParams, SIUnits, CompiledScene):
     """``N`` balls on a line, the striker approaching the resting chain.
 
-    Parameters
-    ----------
     {params}
 
     Examples

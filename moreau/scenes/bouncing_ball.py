@@ -73,8 +73,6 @@ class BouncingBallParams:
 class BouncingBall(FromParams, SIUnits, CompiledScene):
     """A ball of radius ``r`` falling on the floor ``y = 0``, restitution ``e``.
 
-    Parameters
-    ----------
     {params}
 
     Attributes

@@ -114,8 +114,6 @@ class PainleveRodParams:
 class PainleveRod(FromParams, SIUnits, CompiledScene):
     """Uniform rod with its lower tip on a rough floor.
 
-    Parameters
-    ----------
     {params}
 
     Attributes

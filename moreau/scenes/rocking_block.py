@@ -139,8 +139,6 @@ class RockingBlockParams:
 class RockingBlock(FromParams, SIUnits, CompiledScene):
     """Rectangular block on a level floor, its two bottom corners frictional contacts.
 
-    Parameters
-    ----------
     {params}
 
     Examples

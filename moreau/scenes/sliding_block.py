@@ -84,8 +84,6 @@ class SlidingBlockParams:
 class SlidingBlock(FromParams, SIUnits, CompiledScene):
     """A block on a plane inclined by ``alpha``, Coulomb friction ``mu``.
 
-    Parameters
-    ----------
     {params}
 
     Attributes

@@ -93,8 +93,6 @@ class SlidingBoxParams:
 class SlidingBox(FromParams, SIUnits, CompiledScene):
     """Rigid box on a level floor, two frictional corner contacts.
 
-    Parameters
-    ----------
     {params}
 
     Examples

@@ -181,8 +181,6 @@ class WoodpeckerToyParams:
 class WoodpeckerToy(FromParams, SIUnits, CompiledScene):
     """Glocker's woodpecker toy: sleeve on a pole, bird on a torsion spring (module docstring).
 
-    Parameters
-    ----------
     {params}
 
     Examples
