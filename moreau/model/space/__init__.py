@@ -779,9 +779,8 @@ class SpaceScene(Scene):
         Rs = Rs or self._rotations(q)
         Ra, Rb = Rs[a], Rs[b]
         ca, cb = Ra @ c["centre"], Rb @ c["centre_b"]
-        pa, pb = q[7 * a:7 * a + 3] + ca, q[7 * b:7 * b + 3] + cb
-        d = pb - pa
-        L = math.sqrt(d @ d)
+        d = (q[7 * b:7 * b + 3] + cb) - (q[7 * a:7 * a + 3] + ca)
+        L = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
         if L <= CONCENTRIC_TOL * (c["radius"] + c["radius_b"]):
             raise IllPosedError(f"the spheres of contact {i} (bodies {a} and {b}) are "
                                 f"concentric (centres {L:.3g} apart): the contact has no normal")
@@ -844,9 +843,11 @@ class SpaceScene(Scene):
         for i in range(self.ncontacts):
             if self._contacts[i]["kind"] == "pair":
                 a, b, Ra, Rb, _, _, n, _, sa, sb = self._pair_geometry(q, i, Rs)
-                E = np.array([n, *tangent_basis(n)])
-                out[i, :, 6 * b:6 * b + 6] = point_rows(Rb, sb, E)
-                out[i, :, 6 * a:6 * a + 6] = -point_rows(Ra, sa, E)
+                E = _frame(n)
+                out[i, :, 6 * b:6 * b + 3] = E
+                out[i, :, 6 * b + 3:6 * b + 6] = _cross_rows(sb, E) @ Rb
+                out[i, :, 6 * a:6 * a + 3] = -E
+                out[i, :, 6 * a + 3:6 * a + 6] = -(_cross_rows(sa, E) @ Ra)
                 continue
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i, Rs)
             out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
@@ -927,8 +928,8 @@ class SpaceScene(Scene):
         sad = np.cross(wa, ca) + c["radius"] * nd
         sbd = np.cross(wb, cb) - c["radius_b"] * nd
         acc = np.cross(wb, sbd) - np.cross(wa, sad)
-        t1, t2 = tangent_basis(n)
-        k = int(np.argmin(np.abs(n)))        # tangent_basis's axis e_k
+        _, t1, t2 = _frame(n)
+        k = _least_axis(n)        # tangent_basis's axis e_k
         m = -n[k] * n
         m[k] += 1.0
         md = -nd[k] * n - n[k] * nd
@@ -1031,8 +1032,7 @@ class SpaceScene(Scene):
         out = []
         for i, c in enumerate(self._contacts):
             if c["kind"] == "pair":
-                n = self._pair_geometry(np.asarray(q, dtype=float), i)[6]
-                out.append((n, *tangent_basis(n)))
+                out.append(tuple(_frame(self._pair_geometry(np.asarray(q, dtype=float), i)[6])))
             else:
                 out.append(self._planes[c["plane"]][1:])
         return out
@@ -1075,6 +1075,32 @@ class SpaceScene(Scene):
 
 #: the keys of a contact that :meth:`SpaceScene.contact_table` knows
 _TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre"}
+
+
+def _least_axis(n):
+    # np.argmin(np.abs(n)), ties to the first, without the array calls
+    a0, a1, a2 = abs(n[0]), abs(n[1]), abs(n[2])
+    return (0 if a0 <= a2 else 2) if a0 <= a1 else (1 if a1 <= a2 else 2)
+
+
+def _frame(n):
+    # [n, t1, t2] of tangent_basis(n) in one (3, 3) array, written out (a pair contact's
+    # frame, evaluated every step)
+    k = _least_axis(n)
+    n0, n1, n2 = float(n[0]), float(n[1]), float(n[2])
+    nk = (n0, n1, n2)[k]
+    t = [-nk * n0, -nk * n1, -nk * n2]
+    t[k] += 1.0
+    f = 1.0 / math.sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2])
+    a, b, c = t[0] * f, t[1] * f, t[2] * f
+    return np.array([[n0, n1, n2], [a, b, c],
+                     [n1 * c - n2 * b, n2 * a - n0 * c, n0 * b - n1 * a]])
+
+
+def _cross_rows(s, E):
+    # s x E[k] for each row k
+    return np.column_stack([s[1] * E[:, 2] - s[2] * E[:, 1], s[2] * E[:, 0] - s[0] * E[:, 2],
+                            s[0] * E[:, 1] - s[1] * E[:, 0]])
 
 
 def _rim_point_rate(R, n, radius, w):
