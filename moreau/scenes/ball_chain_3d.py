@@ -43,8 +43,51 @@ Scales: lengths in ``r``, time in ``r / V``, masses in ``m`` (the striker
 speed is 1 inside). Coordinates: each sphere's centre (3) and unit
 quaternion (4); velocities: the centre's (3) and the body-frame angular
 velocity (3) (:class:`moreau.model.space.SpaceScene`).
+
+A resting pyramid (:func:`sphere_pyramid`, not registered: it stays at rest)
+-----------------------------------------------------------------------------
+Three equal spheres (mass ``m``, radius ``r``) lie on a rough floor at the
+corners of an equilateral triangle, their centres ``a`` from its centre and
+apart from each other by ``spread`` times ``2r`` (``spread > 1``: they do
+not touch each other); a fourth equal sphere rests on them. Let ``e_i`` be
+the horizontal unit vector from the triangle's centre to bottom sphere
+``i``; the line from its centre to the top one's makes the angle ``beta``
+with the vertical, ``sin(beta) = a / (2r) = spread / sqrt(3)``, its unit
+vector ``n_i = -sin(beta) e_i + cos(beta) e_z`` and the tangent in the
+same vertical plane ``t_i = cos(beta) e_i + sin(beta) e_z``. By the
+symmetry the top sphere takes ``N1 n_i + F1 t_i`` from bottom sphere ``i``
+and bottom sphere ``i`` takes ``N0 e_z + f0 e_i`` from the floor. Then,
+with ``k_i = e_z x e_i = n_i x t_i``:
+
+* the top sphere, vertically: ``3 (N1 cos(beta) + F1 sin(beta)) = m g``;
+  its friction torques ``-r F1 k_i`` add to zero over the three;
+* bottom sphere ``i``, vertically: ``N0 = m g + N1 cos(beta) + F1
+  sin(beta)``; along ``e_i``: ``N1 sin(beta) - F1 cos(beta) + f0 = 0``;
+  about its centre (the torques of ``-F1 t_i`` at ``r n_i`` and of ``f0
+  e_i`` at ``-r e_z``): ``-r (F1 + f0) k_i = 0``.
+
+So ``f0 = -F1`` (the floor holds the bottom spheres inwards),
+``N1 sin(beta) = F1 (1 + cos(beta))``, ``F1 = N1 tan(beta / 2)``, and as
+``cos(beta) + sin(beta) tan(beta / 2) = 1``,
+
+.. math::
+
+    N_1 = \frac{m g}{3}, \quad F_1 = \frac{m g}{3} \tan\frac{\beta}{2}, \quad
+    N_0 = \frac{4 m g}{3}, \quad |f_0| = \frac{m g}{3} \tan\frac{\beta}{2} :
+
+the pyramid holds where ``mu >= tan(beta / 2)`` between the spheres and
+``mu >= tan(beta / 2) / 4`` on the floor (derived here from the equations
+of equilibrium of the four rigid spheres alone). The forces are determinate: the
+18 rows of the six sticking contacts have rank 18 on the 24 velocities (the
+free motions, each bottom sphere turning about the line through its two
+contact points, are the gravity-free ones), so Moreau–Jean's step from rest
+gives these impulses over ``h`` to rounding on the exact cone, and on a
+polyhedral cone of ``d`` directions where ``mu cos(pi / d)`` still covers
+``tan(beta / 2)`` (there Lemke's pivots on the degenerate resting problem
+are dear: seconds a step).
 """
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -57,7 +100,8 @@ from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
 from .ball_chain import simultaneous_impact
 
-__all__ = ["BallChain3DParams", "ball_chain_3d", "block_result", "MAX_BALLS_3D"]
+__all__ = ["BallChain3DParams", "ball_chain_3d", "block_result", "MAX_BALLS_3D",
+           "PyramidParams", "sphere_pyramid", "pyramid_forces"]
 
 #: the longest chain the scene takes (its step is the Python one, a dense cone problem)
 MAX_BALLS_3D = 50
@@ -158,6 +202,97 @@ def block_result(n_balls, speed=1.0):
     out = np.full(n, 2.0 * speed / n)
     out[0] = (2.0 - n) * speed / n
     return out
+
+
+@dataclass(frozen=True)
+class PyramidParams:
+    """SI parameters of the resting pyramid of four spheres (the module docstring).
+
+    Attributes
+    ----------
+    mass, radius : float
+        Each sphere's [kg], [m], > 0.
+    spread : float
+        The bottom spheres' distance between centres over ``2 radius``, in
+        ``(1, sqrt(3))``: above 1 they do not touch, below ``sqrt(3)`` the top
+        sphere rests above them.
+    mu : float
+        Coulomb friction at every contact, >= 0 (it holds for ``mu >= tan(beta / 2)``).
+    gravity : float
+        [m/s^2], > 0.
+    """
+
+    mass: float = 0.2
+    radius: float = 0.05
+    spread: float = 1.2
+    mu: float = 0.5
+    gravity: float = 9.81
+
+    def __post_init__(self):
+        check_fields(self, positive, "mass", "radius", "gravity")
+        check_fields(self, nonnegative, "mu")
+        if not 1.0 < self.spread < math.sqrt(3.0):
+            raise InputError(f"`spread` must be in (1, sqrt(3)) (the bottom spheres apart, the "
+                             f"top one above them), got {self.spread!r}")
+
+
+def pyramid_forces(params=None, **overrides):
+    """The closed-form contact forces [N] of the pyramid at rest, and the least ``mu`` holding it.
+
+    Returns ``{"beta", "normal_top", "friction_top", "normal_floor",
+    "friction_floor", "mu_min"}``: each top contact's ``N1``, ``F1``, each
+    floor contact's ``N0``, ``|f0|`` (the module docstring) and ``tan(beta / 2)``.
+
+    Examples
+    --------
+    >>> f = pyramid_forces(mass=0.3, gravity=10.0)
+    >>> round(f["normal_top"], 12), round(f["normal_floor"], 12)
+    (1.0, 4.0)
+    """
+    p = params_with(PyramidParams, params, overrides)
+    beta = math.asin(p.spread / math.sqrt(3.0))
+    w = p.mass * p.gravity
+    tb = math.tan(0.5 * beta)
+    return {"beta": beta, "normal_top": w / 3.0, "friction_top": w / 3.0 * tb,
+            "normal_floor": 4.0 * w / 3.0, "friction_floor": w / 3.0 * tb, "mu_min": tb}
+
+
+#: the top sphere starts this fraction of the radius into its three supports, so that rounding
+#: leaves every contact closed at the first step (the closed form's geometry moves by as much)
+PYRAMID_SQUEEZE = 1e-13
+
+
+def sphere_pyramid(params=None, **overrides):
+    """The scene of the pyramid: contacts ``0..2`` the bottom spheres on the floor, ``3..5``
+    the top sphere on bottom spheres ``0..2`` (normals from the bottom sphere to the top).
+
+    Lengths in ``r``, time in ``sqrt(r / g)``, masses in ``m``.
+
+    Examples
+    --------
+    >>> sc = sphere_pyramid()
+    >>> sc.ncontacts, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) > -1e-12))
+    (6, True)
+    """
+    p = params_with(PyramidParams, params, overrides)
+    r, M = p.radius, p.mass
+    beta = math.asin(p.spread / math.sqrt(3.0))
+    a = 2.0 * r * math.sin(beta)
+    m = SpaceModel(gravity=(0.0, 0.0, -p.gravity), length=r, mass=M)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0))
+    J = [0.4 * M * r * r] * 3
+    bottom = [m.add_body(M, J, position=(a * math.cos(2.0 * math.pi * i / 3.0),
+                                         a * math.sin(2.0 * math.pi * i / 3.0), r),
+                         name=f"bottom {i}") for i in range(3)]
+    top = m.add_body(M, J, position=(0.0, 0.0, r + 2.0 * r * math.cos(beta)
+                                     - PYRAMID_SQUEEZE * r), name="top")
+    for b in bottom:
+        m.add_contact(b, Sphere(r), floor, mu=p.mu)
+    for b in bottom:
+        m.add_pair_contact(b, Sphere(r), top, Sphere(r), mu=p.mu)
+    sc = m.build("sphere-pyramid", default_window=10.0)
+    sc.params = p
+    return sc
 
 
 class BallChain3DCase(SpatialCase):

@@ -5,8 +5,9 @@ import pytest
 
 from moreau.integrators import simulate
 from moreau.model.space import SpaceModel, Sphere
+from moreau.regimes import Regime
 from moreau.scenes.ball_chain import simultaneous_impact
-from moreau.scenes.ball_chain_3d import ball_chain_3d, block_result
+from moreau.scenes.ball_chain_3d import ball_chain_3d, block_result, pyramid_forces, sphere_pyramid
 
 
 def test_the_block_result_is_the_simultaneous_impacts_lcp():
@@ -54,3 +55,41 @@ def test_an_oblique_rough_chain_gives_the_block_result_along_its_line():
     along = V[:, :3] @ u
     assert np.max(np.abs(along - block_result(n))) <= 1e-12
     assert np.max(np.abs(V[:, :3] - np.outer(along, u))) <= 1e-12 and np.max(np.abs(V[:, 3:])) <= 1e-12
+
+
+# -- the resting pyramid ------------------------------------------------------------------------
+
+# the polyhedral cone: Lemke on the resting pyramid's degenerate LCP (six sticking contacts,
+# 60 unknowns at d = 8) took 27 s a step on the loaded machine (100 steps: 2712 s; d = 4: 232
+# s), with the forces to 7e-15: one step, with the long checks
+@pytest.mark.parametrize("cone, span", [("exact", 2.0), pytest.param(8, 0.1, marks=pytest.mark.slow)])
+def test_the_pyramids_contact_forces_are_the_closed_form(cone, span):
+    sc = sphere_pyramid()                  # mu = 0.5 >= tan(beta/2) = 0.4025 / cos(pi/8)
+    f = pyramid_forces(sc.params)
+    q0, v0 = sc.initial_state()
+    res = simulate(sc, (0.0, span), q0, v0, "moreau-jean", h=0.1, cone=cone)
+    assert res.status == 0, res.message
+    assert np.all(res.regime == int(Regime.STICK))
+    fN, fT = res.force_N[1:] * sc.force, res.force_T[1:] * sc.force
+    for got, want in ((fN[:, :3], f["normal_floor"]), (fN[:, 3:], f["normal_top"]),
+                      (fT[:, :3], f["friction_floor"]), (fT[:, 3:], f["friction_top"])):
+        assert np.max(np.abs(got - want)) <= 1e-10 * want
+    # at rest throughout
+    assert np.max(np.abs(res.v)) <= 1e-14 and np.max(np.abs(res.q - q0)) <= 1e-14
+
+
+def test_the_pyramid_holds_from_mu_tan_half_beta_and_collapses_below():
+    mu_min = pyramid_forces()["mu_min"]
+    for factor, holds in ((1.01, True), (0.99, False)):
+        sc = sphere_pyramid(mu=factor * mu_min)
+        q0, v0 = sc.initial_state()
+        res = simulate(sc, (0.0, 0.5), q0, v0, "moreau-jean", h=0.1, cone="exact")
+        assert res.status == 0, res.message
+        if holds:
+            assert np.max(np.abs(res.v)) <= 1e-14 and np.all(res.regime == int(Regime.STICK))
+        else:
+            # the top sphere sinks (measured: 1.6e-4 sqrt(g r) after the first step), sliding
+            # on its three supports; the bottom ones stick on the floor (mu > tan(beta/2) / 4)
+            assert np.all(np.diff(res.v[:, 6 * 3 + 2]) < -1e-4)
+            assert np.all(res.regime[:, 3:] == int(Regime.POSITIVE))
+            assert np.all(res.regime[:, :3] == int(Regime.STICK))
