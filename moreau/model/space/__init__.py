@@ -601,7 +601,8 @@ class SpaceModel:
         >>> b = m.add_body(1.0, [0.004] * 3, position=(0.25, 0.0, 0.0))
         >>> m.add_pair_contact(a, Sphere(0.1), b, Sphere(0.1), mu=0.3)
         [0]
-        >>> float(m.build("pair").gaps(np.array([0, 0, 0, 1, 0, 0, 0, 0.25, 0, 0, 1, 0, 0, 0]), 0.0)[0])
+        >>> q = np.array([0, 0, 0, 1, 0, 0, 0, 0.25, 0, 0, 1, 0, 0, 0])
+        >>> round(float(m.build("pair").gaps(q, 0.0)[0]), 12)      # 0.25 - 0.1 - 0.1
         0.05
         """
         for name, value in (("body_a", body_a), ("body_b", body_b)):
