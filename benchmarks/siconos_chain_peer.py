@@ -4,7 +4,7 @@ Run from the project's venv::
 
     python benchmarks/siconos_chain_peer.py [--steps 1000] [--repeat 3]
 
-The registered chain at its defaults (four spheres of 0.1 kg and 1 cm, the
+The registered chain at its defaults (three spheres of 0.1 kg and 1 cm, the
 striker at 1 m/s, ``e = 1``, ``mu = 0``) over its default window, at the
 same ``h`` and ``theta = 1`` on both sides. Siconos runs under the system
 interpreter (``/usr/bin/python3``, Debian's ``python3-siconos``; this file's

@@ -133,7 +133,7 @@ class BallChain3DParams:
         radii, puts the impact at ``t* = 1.1 r / V``, off the usual grids.
     """
 
-    n_balls: int = 4
+    n_balls: int = 3
     mass: float = 0.1
     striker_mass: float = 0.1
     radius: float = 0.01

@@ -19,7 +19,7 @@ def test_the_block_result_is_the_simultaneous_impacts_lcp():
 
 @pytest.mark.parametrize("cone", ["exact", 8])
 def test_moreau_jean_gives_the_block_result_on_the_default_chain(cone):
-    sc = ball_chain_3d()                 # four spheres, e = 1, the impact at t* = 1.1
+    sc = ball_chain_3d(n_balls=4)        # e = 1, the impact at t* = 1.1
     q0, v0 = sc.initial_state()
     res = simulate(sc, (0.0, 1.3), q0, v0, "moreau-jean", h=0.01, cone=cone)
     assert res.status == 0, res.message
