@@ -61,7 +61,7 @@ from .compiled import evaluate_compiled
 from .integrators import simulate
 from .model.scene import Scene, is_spatial, joint_row_count
 from .model.space import advance_coordinates
-from .model.spatial import quat_exp, quat_multiply, rotation_matrix
+from .model.spatial import quat_exp, quat_multiply
 
 __all__ = ["check_scene", "SceneReport"]
 
@@ -139,11 +139,8 @@ def _check_spatial(scene, states, t, fd_tol, seed):
              "tangential drift (wTbar)": 0.0, "force Jacobians": 0.0}
 
     def material(qq, q_at):
-        out = []
-        for i, (R0, s0) in enumerate(scene.contact_frames(q_at, t)):
-            b = scene.contact_bodies[i]
-            out.append(qq[7 * b:7 * b + 3] + rotation_matrix(qq[7 * b + 3:7 * b + 7]) @ (R0.T @ s0))
-        return np.array(out).reshape(nc, 3)
+        # (a contact between two bodies: the difference of its two material points)
+        return np.asarray(scene.material_points(qq, q_at), dtype=float).reshape(nc, 3)
 
     for q, v in states:
         M = np.asarray(scene.mass(q), dtype=float)
@@ -166,7 +163,7 @@ def _check_spatial(scene, states, t, fd_tol, seed):
         gdot = (scene.gaps(qp, t) - scene.gaps(qm, t)) / (2 * eps)
         worst["gap rates (WN, wN)"] = max(worst["gap rates (WN, wN)"], _rel(WN @ v + wN, gdot))
         pdot = (material(qp, q) - material(qm, q)) / (2 * eps)
-        bases = scene.contact_bases()
+        bases = scene.contact_bases(q)
         slip = np.array([[bases[i][1] @ pdot[i], bases[i][2] @ pdot[i]]
                          for i in scene.frictional_index]).reshape(-1)
         worst["slip rates (WT, wT)"] = max(worst["slip rates (WT, wT)"], _rel(WT @ v + wT, slip))

@@ -231,7 +231,8 @@ def _proj(n, t1, t2, mu):
     # projection on K = {|t| <= mu n}; its polar cone is {mu |t| <= -n}
     # hypot, not sqrt(t1^2 + t2^2): the squares underflow for |t| below 1e-154
     nt = math.hypot(t1, t2)
-    if nt <= mu * n:
+    # (n >= 0: with mu = 0, nt = 0 <= mu n = -0.0 holds for n < 0 too, off the cone)
+    if nt <= mu * n and n >= 0.0:
         return n, t1, t2
     if mu * nt <= -n:
         return 0.0, 0.0, 0.0

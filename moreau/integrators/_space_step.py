@@ -32,6 +32,9 @@ def _free_rotation(J, w0, impulse, h, theta):
     to rounding; at ``theta = 1/2`` the implicit midpoint rule, which keeps the
     free body's energy ``1/2 w.J w`` and ``|J w|`` (quadratic invariants).
     """
+    if not (w0.any() or impulse.any()):
+        # at rest and unloaded: Newton's answer is zero (+0.0) at its first step
+        return np.zeros(3)
     w = w0 + np.linalg.solve(J, impulse)
     for _ in range(20):
         wt = theta * w + (1.0 - theta) * w0

@@ -152,6 +152,10 @@ class SpaceEventDriven(Integrator):
         if scene.ncontacts != 1:
             raise InputError(f"scheme 'event-driven-space' keeps one persistent contact: `scene` "
                              f"{name!r} has {scene.ncontacts} contacts; use 'moreau-jean'")
+        if getattr(scene, "pair_index", ()):
+            raise InputError(f"scheme 'event-driven-space' keeps one persistent contact with a "
+                             f"half-space: `scene` {name!r}'s contact joins two bodies; use "
+                             f"'moreau-jean'")
         self.sample_dt = (o.sample_dt if o.sample_dt is not None
                           else (self.t_bound - self.t0) / 256.0)
         self._next_sample = self.t0 + self.sample_dt

@@ -98,6 +98,52 @@ is the material point's normal velocity (the rate of ``r sigma`` is ``-r u .
 Every row is held to central differences of the gap and of the material
 point's position along the exponential-map motion in ``tests/model``.
 
+Contacts between two spheres
+----------------------------
+:meth:`SpaceModel.add_pair_contact` joins a sphere of body ``a`` (radius
+``r_a``, centre ``p_a = x_a + R_a c_a``) and one of body ``b``. With ``d =
+p_b - p_a`` and ``L = |d|``, the normal ``n = d / L`` points from ``a`` to
+``b`` and
+
+.. math::
+
+    g = L - r_a - r_b, \qquad s_a = R_a c_a + r_a n, \qquad s_b = R_b c_b - r_b n,
+
+``s_a``, ``s_b`` the offsets of the two surface points facing each other
+from the centres of mass; the tangents ``t1, t2`` are :func:`tangent_basis`
+of ``n``, so the frame turns with the line of centres. The contact's
+velocity is that of ``b``'s material point at ``x_b + s_b`` less that of
+``a``'s at ``x_a + s_a``, and a row is the difference of the two point rows,
+
+.. math::
+
+    e . \Delta = (e^T, (R_b^T (s_b \times e))^T)\, v_b
+              - (e^T, (R_a^T (s_a \times e))^T)\, v_a ,
+    \qquad e \in \{n, t1, t2\}.
+
+The gap's rate is ``n . (p_b' - p_a')`` (``L' = n . d'``) and equals ``n .
+Delta``, because the parts ``r_a w_a x n`` and ``-r_b w_b x n`` that the
+surface points add to the centres' velocities are normal to ``n``: one row
+serves the gap and the slip, as on a half-space. Differentiating ``e .
+Delta`` at zero accelerations (``w = R omega`` constant in the world, the
+centres' velocities too) gives the drift
+
+.. math::
+
+    \dot e . \Delta + e . (w_b \times \dot s_b - w_a \times \dot s_a), \quad
+    \dot n = \frac{(I - n n^T)(p_b' - p_a')}{L}, \quad
+    \dot s_a = w_a \times R_a c_a + r_a \dot n, \quad
+    \dot s_b = w_b \times R_b c_b - r_b \dot n,
+
+with ``p' = x' + w x R c``. The tangents' rates follow from their
+definition: ``t1 = m / |m|``, ``m = e_k - n_k n`` for the fixed axis
+``e_k``, so ``t1' = (m' - (t1 . m') t1) / |m|`` with ``m' = -n_k' n - n_k
+n'``, and ``t2' = n' x t1 + n x t1'``. Two spheres whose centres meet
+(``L <= CONCENTRIC_TOL (r_a + r_b)``) have no normal: refused when the
+contact is added and raised (:class:`~moreau.errors.IllPosedError`) during
+a run. These rows are held to central differences of the gap and of the two
+material points' relative position in ``tests/model``.
+
 Coulomb–Contensou friction
 --------------------------
 A contact added with ``contact_radius = r > 0`` touches through a flat
@@ -162,7 +208,8 @@ from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
 
 __all__ = ["Sphere", "Puck", "Box", "Capsule", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
-           "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN", "DRILLING_LEVER"]
+           "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN", "DRILLING_LEVER",
+           "CONCENTRIC_TOL"]
 
 #: ``r* / r``: a uniform pressure on a patch of radius ``r`` resists pure spin with the torque
 #: ``mu N r*`` (the module docstring's "Coulomb–Contensou friction")
@@ -171,6 +218,10 @@ DRILLING_LEVER = 2.0 / 3.0
 #: a disk whose axis makes a sine below this with the half-space's normal lies flat: its rim
 #: has no single lowest point (the rim point's direction is rounding over this sine)
 FLAT_SIN = 1e-8
+
+#: two spheres whose centres are closer than this fraction of their radii's sum have no
+#: normal (the line of centres is rounding): refused when added and during a run
+CONCENTRIC_TOL = 1e-8
 
 
 def tangent_basis(normal):
@@ -426,14 +477,22 @@ class SpaceModel:
         The scene's units of length [m] and mass [kg]; its time unit is
         ``sqrt(length / |gravity|)`` (1 s without gravity), so that gravity
         is of size 1 inside.
+    time : float, optional
+        The time unit [s] of a scene without gravity (e.g. a length over a
+        speed), > 0; refused with gravity, whose time unit is the one above.
     """
 
-    def __init__(self, gravity=(0.0, 0.0, 0.0), length=1.0, mass=1.0):
+    def __init__(self, gravity=(0.0, 0.0, 0.0), length=1.0, mass=1.0, time=None):
         self.gravity = finite_array("gravity", gravity, shape=(3,))
         self.length = positive("length", length)
         self.mass_unit = positive("mass", mass)
         g = float(np.linalg.norm(self.gravity))
         self.time = math.sqrt(self.length / g) if g > 0.0 else 1.0
+        if time is not None:
+            if g > 0.0:
+                raise InputError("`time` must be None with gravity: the time unit is then "
+                                 "sqrt(length / |gravity|)")
+            self.time = positive("time", time)
         self.bodies = []
         self.planes = []
         self.contacts = []
@@ -524,6 +583,60 @@ class SpaceModel:
             out.append(len(self.contacts) - 1)
         return out
 
+    def add_pair_contact(self, body_a, sphere_a, body_b, sphere_b, mu=0.0, restitution=0.0):
+        """A contact between a sphere of ``body_a`` and a sphere of ``body_b``; returns ``[index]``.
+
+        The module docstring's "Contacts between two spheres": the normal
+        points from ``a``'s sphere centre to ``b``'s, the gap is the centres'
+        distance less the radii. Both shapes are :class:`Sphere` (eccentric
+        ones too); the bodies are two different added bodies; spheres whose
+        centres meet at the bodies' initial positions have no normal and are
+        refused, naming ``body_b``. ``mu`` >= 0, ``restitution`` in [0, 1]
+        as in :meth:`add_contact` (point contacts: no ``contact_radius``).
+
+        Examples
+        --------
+        >>> m = SpaceModel()
+        >>> a = m.add_body(1.0, [0.004] * 3)
+        >>> b = m.add_body(1.0, [0.004] * 3, position=(0.25, 0.0, 0.0))
+        >>> m.add_pair_contact(a, Sphere(0.1), b, Sphere(0.1), mu=0.3)
+        [0]
+        >>> q = np.array([0, 0, 0, 1, 0, 0, 0, 0.25, 0, 0, 1, 0, 0, 0])
+        >>> round(float(m.build("pair").gaps(q, 0.0)[0]), 12)      # 0.25 - 0.1 - 0.1
+        0.05
+        """
+        for name, value in (("body_a", body_a), ("body_b", body_b)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
+                    or not 0 <= value < len(self.bodies):
+                raise InputError(f"`{name}` must be the index of an added body "
+                                 f"(0..{len(self.bodies) - 1}), got {value!r}")
+        if body_a == body_b:
+            raise InputError(f"`body_b` must be another body than `body_a`, got {body_b!r} twice")
+        for name, shape in (("sphere_a", sphere_a), ("sphere_b", sphere_b)):
+            if not isinstance(shape, Sphere):
+                raise InputError(f"`{name}` must be a Sphere (contacts between two bodies are "
+                                 f"sphere against sphere), got {type(shape).__name__}")
+        mu = nonnegative("mu", mu)
+        e = finite_scalar("restitution", restitution)
+        if not 0.0 <= e <= 1.0:
+            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        centres = []
+        for b, shape in ((body_a, sphere_a), (body_b, sphere_b)):
+            body = self.bodies[b]
+            centres.append(body["position"]
+                           + rotation_matrix(body["orientation"], check=False) @ shape.centre)
+        if float(np.linalg.norm(centres[1] - centres[0])) <= CONCENTRIC_TOL * (
+                sphere_a.radius + sphere_b.radius):
+            raise InputError("`body_b`'s sphere must not be concentric with `body_a`'s at the "
+                             "initial positions: the line of centres, the contact's normal, "
+                             "is undefined")
+        L = self.length
+        self.contacts.append({"kind": "pair", "body": int(body_a), "body_b": int(body_b),
+                              "plane": None, "mu": mu, "e": e, "radius": sphere_a.radius / L,
+                              "radius_b": sphere_b.radius / L, "point": None,
+                              "centre": sphere_a.centre / L, "centre_b": sphere_b.centre / L})
+        return [len(self.contacts) - 1]
+
     def build(self, name, default_window=None):
         """The :class:`SpaceScene` of the model, in the scene's units."""
         if not self.bodies:
@@ -572,8 +685,12 @@ class SpaceScene(Scene):
         self._rot_cache = []
         self._planes = [(p.point / L, p.normal, p.t1, p.t2) for p in model.planes]
         self._contacts = model.contacts
-        #: the body of each contact
+        #: the body of each contact (a contact between two bodies: its first, ``a``)
         self.contact_bodies = [c["body"] for c in model.contacts]
+        #: ``(a, b)`` of each contact: its bodies, ``b = -1`` for a half-space
+        self.contact_pairs = [(c["body"], c.get("body_b", -1)) for c in model.contacts]
+        #: the contacts between two bodies' spheres (:meth:`SpaceModel.add_pair_contact`)
+        self.pair_index = [i for i, c in enumerate(model.contacts) if c["kind"] == "pair"]
         self.mu = np.array([c["mu"] for c in model.contacts])
         self.restitution = np.array([c["e"] for c in model.contacts])
         #: each contact's patch radius ``r`` (scene units; 0: a point contact)
@@ -655,19 +772,69 @@ class SpaceScene(Scene):
             s = R @ c["point"]
         return b, x, R, s, y0, n, t1, t2
 
+    def _pair_geometry(self, q, i, Rs=None):
+        # the module docstring's "Contacts between two spheres": (a, b, Ra, Rb, the centres'
+        # offsets R c (world), the centres p, n, L, s_a, s_b)
+        c = self._contacts[i]
+        a, b = c["body"], c["body_b"]
+        Rs = Rs or self._rotations(q)
+        Ra, Rb = Rs[a], Rs[b]
+        ca, cb = Ra @ c["centre"], Rb @ c["centre_b"]
+        d = (q[7 * b:7 * b + 3] + cb) - (q[7 * a:7 * a + 3] + ca)
+        L = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        if L <= CONCENTRIC_TOL * (c["radius"] + c["radius_b"]):
+            raise IllPosedError(f"the spheres of contact {i} (bodies {a} and {b}) are "
+                                f"concentric (centres {L:.3g} apart): the contact has no normal")
+        n = d / L
+        return a, b, Ra, Rb, ca, cb, n, L, ca + c["radius"] * n, cb - c["radius_b"] * n
+
     def gaps(self, q, t):
         q = np.asarray(q, dtype=float)
         out = np.empty(self.ncontacts)
         Rs = self._rotations(q)
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] == "pair":
+                c = self._contacts[i]
+                out[i] = self._pair_geometry(q, i, Rs)[7] - c["radius"] - c["radius_b"]
+                continue
             _, x, _, s, y0, n, _, _ = self._contact_geometry(q, i, Rs)
             out[i] = n @ (x + s - y0)
         return out
 
     def contact_frames(self, q, t):
-        """``(R, s)`` per contact: the body's rotation and the contact point's offset (world)."""
+        """``(R, s)`` per contact: the body's rotation and the contact point's offset (world)
+        (a contact between two bodies: its body ``a``'s, :meth:`material_points` has both)."""
         q = np.asarray(q, dtype=float)
-        return [self._contact_geometry(q, i)[2:4] for i in range(self.ncontacts)]
+        out = []
+        for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] == "pair":
+                g = self._pair_geometry(q, i)
+                out.append((g[2], g[8]))
+            else:
+                out.append(self._contact_geometry(q, i)[2:4])
+        return out
+
+    def material_points(self, q, q_at):
+        """Each contact point as material points fixed in their bodies at ``q_at``, moved to ``q``.
+
+        Row ``i`` is the contact point of ``q_at`` carried with its body to
+        the configuration ``q`` (world, scene units); for a contact between
+        two bodies, ``b``'s point less ``a``'s: the rates of these along a
+        motion are the contacts' relative velocities, which the rows give
+        (:func:`moreau.check.check_scene` differentiates them). Shape (nc, 3).
+        """
+        q, q_at = np.asarray(q, dtype=float), np.asarray(q_at, dtype=float)
+        Rs, R0s = self._rotations(q), self._rotations(q_at)
+        out = np.empty((self.ncontacts, 3))
+        for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] == "pair":
+                a, b, _, _, _, _, _, _, sa, sb = self._pair_geometry(q_at, i, R0s)
+                out[i] = (q[7 * b:7 * b + 3] + Rs[b] @ (R0s[b].T @ sb)
+                          - q[7 * a:7 * a + 3] - Rs[a] @ (R0s[a].T @ sa))
+            else:
+                b, _, R0, s0, _, _, _, _ = self._contact_geometry(q_at, i, R0s)
+                out[i] = q[7 * b:7 * b + 3] + Rs[b] @ (R0.T @ s0)
+        return out
 
     def contact_rows(self, q):
         """Every contact's three rows ``[n, t1, t2]`` against the velocities, shape (nc, 3, nvel)."""
@@ -675,6 +842,14 @@ class SpaceScene(Scene):
         out = np.zeros((self.ncontacts, 3, self.nvel))
         Rs = self._rotations(q)
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] == "pair":
+                a, b, Ra, Rb, _, _, n, _, sa, sb = self._pair_geometry(q, i, Rs)
+                E = _frame(n)
+                out[i, :, 6 * b:6 * b + 3] = E
+                out[i, :, 6 * b + 3:6 * b + 6] = _cross_rows(sb, E) @ Rb
+                out[i, :, 6 * a:6 * a + 3] = -E
+                out[i, :, 6 * a + 3:6 * a + 6] = -(_cross_rows(sa, E) @ Ra)
+                continue
             b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i, Rs)
             out[i, :, 6 * b:6 * b + 6] = point_rows(R, s, np.array([n, t1, t2]))
         return out
@@ -717,8 +892,15 @@ class SpaceScene(Scene):
         wN = np.zeros(self.ncontacts)
         wT = np.zeros(2 * len(fi))
         for i in range(self.ncontacts):
-            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
             c = self._contacts[i]
+            if c["kind"] == "pair":
+                dN, dT = self._pair_drift(q, v, i)
+                wN[i] = dN
+                if i in fi:
+                    j = fi.index(i)
+                    wT[2 * j], wT[2 * j + 1] = dT
+                continue
+            b, _, R, s, _, n, t1, t2 = self._contact_geometry(q, i)
             w = R @ v[6 * b + 3:6 * b + 6]
             if c["kind"] == "rim":
                 a = np.cross(w, _rim_point_rate(R, n, c["radius"], w))
@@ -733,6 +915,29 @@ class SpaceScene(Scene):
                 j = fi.index(i)
                 wT[2 * j], wT[2 * j + 1] = t1 @ a, t2 @ a
         return wN, wT
+
+    def _pair_drift(self, q, v, i):
+        # d/dt (e . Delta) at zero accelerations, e = n, t1, t2 (the module docstring's
+        # "Contacts between two spheres"); returns (normal, (t1, t2))
+        c = self._contacts[i]
+        a, b, Ra, Rb, ca, cb, n, L, sa, sb = self._pair_geometry(q, i)
+        wa, wb = Ra @ v[6 * a + 3:6 * a + 6], Rb @ v[6 * b + 3:6 * b + 6]
+        xa, xb = v[6 * a:6 * a + 3], v[6 * b:6 * b + 3]
+        delta = xb + np.cross(wb, sb) - xa - np.cross(wa, sa)
+        dd = xb + np.cross(wb, cb) - xa - np.cross(wa, ca)        # p_b' - p_a'
+        nd = (dd - (n @ dd) * n) / L
+        sad = np.cross(wa, ca) + c["radius"] * nd
+        sbd = np.cross(wb, cb) - c["radius_b"] * nd
+        acc = np.cross(wb, sbd) - np.cross(wa, sad)
+        _, t1, t2 = _frame(n)
+        k = _least_axis(n)        # tangent_basis's axis e_k
+        m = -n[k] * n
+        m[k] += 1.0
+        md = -nd[k] * n - n[k] * nd
+        t1d = (md - (t1 @ md) * t1) / math.sqrt(m @ m)
+        t2d = np.cross(nd, t1) + np.cross(n, t1d)
+        return (nd @ delta + n @ acc,
+                (t1d @ delta + t1 @ acc, t2d @ delta + t2 @ acc))
 
     # -- SI units and drawing ------------------------------------------------------------
     @property
@@ -779,10 +984,16 @@ class SpaceScene(Scene):
             d = np.array([n[2], -n[0]])
             d = d / (np.hypot(*d) or 1.0) * 20.0 * L
             out.append(line([p0 - d, p0 + d], "ground"))
+        Rs = self._rotations(qs)
         for i, c in enumerate(self._contacts):
             b = c["body"]
             x = qs[7 * b:7 * b + 3] * L
-            if c["kind"] == "rim":
+            if c["kind"] == "pair":
+                for bb, cc, rr in ((b, c["centre"], c["radius"]),
+                                   (c["body_b"], c["centre_b"], c["radius_b"])):
+                    y = (qs[7 * bb:7 * bb + 3] + Rs[bb] @ cc) * L
+                    out.append(circle((y[0], y[2]), rr * L))
+            elif c["kind"] == "rim":
                 # the rim seen from the side: its points' (x, z), an ellipse's outline
                 R = self._rotations(qs)[b]
                 phi = np.linspace(0.0, 2.0 * np.pi, 49)
@@ -794,20 +1005,38 @@ class SpaceScene(Scene):
                     x = x + self._rotations(qs)[b] @ c["centre"] * L
                 out.append(circle((x[0], x[2]), c["radius"] * L))
         for b in range(self.nbodies):
-            if not any(c["body"] == b and c["point"] is None for c in self._contacts):
+            if not any((c["body"] == b or c.get("body_b") == b) and c["point"] is None
+                       for c in self._contacts):
                 x = qs[7 * b:7 * b + 3] * L
                 out.append(circle((x[0], x[2]), 0.05 * L))
-        Rs = self._rotations(qs)
         for i in range(self.ncontacts):
-            _, x, _, s, _, n, _, _ = self._contact_geometry(qs, i, Rs)
+            if self._contacts[i]["kind"] == "pair":
+                a, _, _, _, _, _, n, _, s, _ = self._pair_geometry(qs, i, Rs)
+                x = qs[7 * a:7 * a + 3]
+            else:
+                _, x, _, s, _, n, _, _ = self._contact_geometry(qs, i, Rs)
             p = (x + s) * L
             nn = np.array([n[0], n[2]])
             out.append(contact(i, (p[0], p[2]), nn / (np.hypot(*nn) or 1.0)))
         return out
 
-    def contact_bases(self):
-        """``(n, t1, t2)`` of every contact's half-space (world), one row each."""
-        return [self._planes[c["plane"]][1:] for c in self._contacts]
+    def contact_bases(self, q=None):
+        """``(n, t1, t2)`` of every contact (world), one row each.
+
+        A half-space's frame is fixed; a contact between two spheres has the
+        frame of their line of centres at ``q``, which it then needs (an
+        :class:`~moreau.errors.InputError` naming ``q`` without it).
+        """
+        if q is None and self.pair_index:
+            raise InputError(f"`q` must be given: scene {self.name!r} has contacts between "
+                             f"two bodies, whose frames turn with them")
+        out = []
+        for i, c in enumerate(self._contacts):
+            if c["kind"] == "pair":
+                out.append(tuple(_frame(self._pair_geometry(np.asarray(q, dtype=float), i)[6])))
+            else:
+                out.append(self._planes[c["plane"]][1:])
+        return out
 
     def contact_table(self):
         """Every contact's data in one float array for a compiled step, or None.
@@ -818,7 +1047,8 @@ class SpaceScene(Scene):
         radius n``, ``c`` its centre) and 2 for a material point (``s = R
         c``, ``c`` the point), as in the module docstring. None where a
         contact is of none of these kinds, or has a contact patch
-        (``contact_radius > 0``: Coulomb–Contensou friction, the Python step's).
+        (``contact_radius > 0``: Coulomb–Contensou friction, the Python step's),
+        or joins two bodies (:meth:`SpaceModel.add_pair_contact`).
 
         Examples
         --------
@@ -846,6 +1076,32 @@ class SpaceScene(Scene):
 
 #: the keys of a contact that :meth:`SpaceScene.contact_table` knows
 _TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre"}
+
+
+def _least_axis(n):
+    # np.argmin(np.abs(n)), ties to the first, without the array calls
+    a0, a1, a2 = abs(n[0]), abs(n[1]), abs(n[2])
+    return (0 if a0 <= a2 else 2) if a0 <= a1 else (1 if a1 <= a2 else 2)
+
+
+def _frame(n):
+    # [n, t1, t2] of tangent_basis(n) in one (3, 3) array, written out (a pair contact's
+    # frame, evaluated every step)
+    k = _least_axis(n)
+    n0, n1, n2 = float(n[0]), float(n[1]), float(n[2])
+    nk = (n0, n1, n2)[k]
+    t = [-nk * n0, -nk * n1, -nk * n2]
+    t[k] += 1.0
+    f = 1.0 / math.sqrt(t[0] * t[0] + t[1] * t[1] + t[2] * t[2])
+    a, b, c = t[0] * f, t[1] * f, t[2] * f
+    return np.array([[n0, n1, n2], [a, b, c],
+                     [n1 * c - n2 * b, n2 * a - n0 * c, n0 * b - n1 * a]])
+
+
+def _cross_rows(s, E):
+    # s x E[k] for each row k
+    return np.column_stack([s[1] * E[:, 2] - s[2] * E[:, 1], s[2] * E[:, 0] - s[0] * E[:, 2],
+                            s[0] * E[:, 1] - s[1] * E[:, 0]])
 
 
 def _rim_point_rate(R, n, radius, w):
