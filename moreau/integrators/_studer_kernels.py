@@ -120,6 +120,96 @@ def midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
     return na
 
 
+@spliced(step_returns=True)
+def sequence(mass_fn, forces_fn, contacts_fn, gaps_fn, HAS_GAPS, const_mass, have_Mi, par, mu, e,
+             q, v, closed, last_reg, t, H, j, n, nc, M, Mi, wk, D, qm, qe, qs, vs, vf, v1, pN, pT,
+             sl, reg, reg0, cl, act, ia, fa, Gm, Ge, G1, Hm, He, wm, we, ea, vpre, Dir, force_lemke,
+             p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, cnt, Y, sq_smooth, sq_missed,
+             sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg):
+    """Sequence ``j``: ``j`` Moreau midpoint steps of ``H / j`` from ``(q, v)`` at ``t``, into
+    row ``j - 1`` of the table ``Y`` (state, the first and the last step's mean accelerations)
+    and of the ``sq_*`` arrays. Returns ``(same_last, have_Mi)``: whether it ends in the regimes
+    the step before ended in, and whether ``Mi`` holds the constant mass matrix's inverse."""
+    fresh = have_Mi
+    hb = H / j
+    for i in range(n):
+        qs[i] = q[i]
+        vs[i] = v[i]
+    for c in range(nc):
+        cl[c] = closed[c]
+        sq_pN[j - 1, c] = 0.0
+        sq_pT[j - 1, c] = 0.0
+    s_smooth = True
+    s_missed = False
+    s_closing = False
+    for ib in range(j):
+        cnt[1] += 1
+        tb = t + ib * hb
+        tm = tb + 0.5 * hb
+        for i in range(n):
+            qm[i] = qs[i] + 0.5 * hb * vs[i]
+        if not (const_mass and fresh):
+            mass_fn(par, qm, M)
+            ok = invert(M, Mi, wk, n)
+            if not ok:
+                return SINGULAR
+            fresh = True
+        na = midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
+                               vs, qm, tb, tm, hb, n, nc, cl, Mi, D, qe, vf, v1, pN, pT,
+                               sl, act, ia, fa, Gm, Ge, Hm, He, wm, we, ea, vpre, Dir,
+                               force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+        # the mean accelerations of the first and the last base step: at the ends of
+        # the macro step to O(hb), and extrapolated with the state
+        if ib == 0:
+            for i in range(n):
+                Y[j - 1, 2 * n + i] = (v1[i] - vs[i]) / hb
+        if ib == j - 1:
+            for i in range(n):
+                Y[j - 1, 3 * n + i] = (v1[i] - vs[i]) / hb
+        for i in range(n):
+            qs[i] = qm[i] + 0.5 * hb * v1[i]
+            vs[i] = v1[i]
+        if not const_mass:
+            fresh = False
+        switch = False
+        miss = False
+        if na < nc:
+            # only a contact open at the midpoint can be crossed unseen
+            gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qs, tb + hb, G1)
+            for c in range(nc):
+                if G1[c, 0] < 0.0 and not act[c]:
+                    miss = True
+        same = True
+        for c in range(nc):
+            if pN[c] > 0.0 and not cl[c]:
+                switch = True
+            reg[c] = _classify(pN[c], pT[c], mu[c])
+            cl[c] = pN[c] > 0.0
+            sq_pN[j - 1, c] += pN[c]
+            sq_pT[j - 1, c] += pT[c]
+            if ib == 0:
+                reg0[c] = reg[c]
+            if reg[c] != reg0[c]:
+                same = False
+        s_missed = s_missed or miss
+        s_closing = s_closing or switch
+        s_smooth = s_smooth and not switch and not miss and same
+    for i in range(n):
+        Y[j - 1, i] = qs[i]
+        Y[j - 1, n + i] = vs[i]
+    sq_smooth[j - 1] = s_smooth
+    sq_missed[j - 1] = s_missed
+    sq_closing[j - 1] = s_closing
+    same_last = True
+    for c in range(nc):
+        sq_closed[j - 1, c] = cl[c]
+        sq_slip[j - 1, c] = sl[c]
+        sq_reg[j - 1, c] = reg[c]
+        if reg[c] != last_reg[c]:
+            same_last = False
+    return same_last, fresh
+
+
 @spliced
 def extrapolated(Y, R, Rn, y, a0, a1, K, n, tol):
     """The Aitken–Neville table of the ``K`` sequences (``n_j = j``, an error expansion in every
@@ -278,92 +368,21 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         reject_missed = False
         jdone = 0
         for j in range(1, K + 1):
-            # -- sequence j: j base steps of H / j ---------------------------------------
-            hb = H / j
-            for i in range(n):
-                qs[i] = q[i]
-                vs[i] = v[i]
-            for c in range(nc):
-                cl[c] = closed[c]
-                sq_pN[j - 1, c] = 0.0
-                sq_pT[j - 1, c] = 0.0
-            s_smooth = True
-            s_missed = False
-            s_closing = False
-            for ib in range(j):
-                cnt[1] += 1
-                tb = t + ib * hb
-                tm = tb + 0.5 * hb
-                for i in range(n):
-                    qm[i] = qs[i] + 0.5 * hb * vs[i]
-                if not (const_mass and have_Mi):
-                    mass_fn(par, qm, M)
-                    ok = invert(M, Mi, wk, n)
-                    if not ok:
-                        return SINGULAR
-                    have_Mi = True
-                na = midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
-                                       vs, qm, tb, tm, hb, n, nc, cl, Mi, D, qe, vf, v1, pN, pT,
-                                       sl, act, ia, fa, Gm, Ge, Hm, He, wm, we, ea, vpre, Dir,
-                                       force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
-                # the mean accelerations of the first and the last base step: at the ends of
-                # the macro step to O(hb), and extrapolated with the state
-                if ib == 0:
-                    for i in range(n):
-                        Y[j - 1, 2 * n + i] = (v1[i] - vs[i]) / hb
-                if ib == j - 1:
-                    for i in range(n):
-                        Y[j - 1, 3 * n + i] = (v1[i] - vs[i]) / hb
-                for i in range(n):
-                    qs[i] = qm[i] + 0.5 * hb * v1[i]
-                    vs[i] = v1[i]
-                if not const_mass:
-                    have_Mi = False
-                switch = False
-                miss = False
-                if na < nc:
-                    # only a contact open at the midpoint can be crossed unseen
-                    gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, qs, tb + hb, G1)
-                    for c in range(nc):
-                        if G1[c, 0] < 0.0 and not act[c]:
-                            miss = True
-                same = True
-                for c in range(nc):
-                    if pN[c] > 0.0 and not cl[c]:
-                        switch = True
-                    reg[c] = _classify(pN[c], pT[c], mu[c])
-                    cl[c] = pN[c] > 0.0
-                    sq_pN[j - 1, c] += pN[c]
-                    sq_pT[j - 1, c] += pT[c]
-                    if ib == 0:
-                        reg0[c] = reg[c]
-                    if reg[c] != reg0[c]:
-                        same = False
-                s_missed = s_missed or miss
-                s_closing = s_closing or switch
-                s_smooth = s_smooth and not switch and not miss and same
-            for i in range(n):
-                Y[j - 1, i] = qs[i]
-                Y[j - 1, n + i] = vs[i]
-            sq_smooth[j - 1] = s_smooth
-            sq_missed[j - 1] = s_missed
-            sq_closing[j - 1] = s_closing
-            same_last = True
-            for c in range(nc):
-                sq_closed[j - 1, c] = cl[c]
-                sq_slip[j - 1, c] = sl[c]
-                sq_reg[j - 1, c] = reg[c]
-                if reg[c] != last_reg[c]:
-                    same_last = False
+            same_last, have_Mi = sequence(
+                mass_fn, forces_fn, contacts_fn, gaps_fn, HAS_GAPS, const_mass, have_Mi, par, mu,
+                e, q, v, closed, last_reg, t, H, j, n, nc, M, Mi, wk, D, qm, qe, qs, vs, vf, v1,
+                pN, pT, sl, reg, reg0, cl, act, ia, fa, Gm, Ge, G1, Hm, He, wm, we, ea, vpre, Dir,
+                force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, cnt, Y, sq_smooth,
+                sq_missed, sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg)
             jdone = j
-            # -- after the sequence: go on, or decide -----------------------------------
+            # after sequence j: go on, or decide
             if j == 1:
-                smooth = s_smooth and same_last
+                smooth = sq_smooth[0] and same_last
                 continue
             if j == 2 and (sq_missed[0] or sq_missed[1]) and H > h_min:
                 reject_missed = True
                 break
-            smooth = smooth and s_smooth and same_last
+            smooth = smooth and sq_smooth[j - 1] and same_last
             if not smooth:
                 break
         if reject_missed:
