@@ -1,4 +1,4 @@
-"""The compiled loop of Studer's step-size adjustment and extrapolation: a template per model.
+"""Studer's step-size adjustment and extrapolation as a step rule of the compiled driver.
 
 The same macro step as
 :meth:`moreau.integrators.studer_extrapolation.StuderExtrapolation._generic_step`
@@ -9,15 +9,17 @@ phases, step halving and the switch location elsewhere, the projection of
 the accepted state onto the closed contacts. Every contact problem goes
 through :func:`moreau.integrators._tdg_kernels._stage_problem` (the rows
 that measure the velocity are those of the step's end, the impulse acts
-along the midpoint's). Like the other loops it is a template:
-:func:`moreau.integrators._loops.runner_for` compiles it in a namespace that
-holds the model's functions and sizes as frozen globals.
+along the midpoint's). :func:`step_rule` takes one accepted macro step; the
+driver (:mod:`moreau.integrators._driver`, without its grid:
+``ADAPTIVE_STEPS``) owns the loop, the buffers and the recording, and
+:func:`moreau.integrators._loops.runner_for` compiles ``studer_loop`` as
+every driver's template. Its helpers are :func:`moreau.integrators._driver.spliced`
+into it as source, as the step parts it uses are.
 """
 
 import math
 
 import numpy as np
-
 from numba import njit
 
 from ._driver import loop_template, spliced
