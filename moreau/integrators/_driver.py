@@ -26,6 +26,13 @@ loop template with :func:`loop_template`:
   tuple of the scheme's options and ``memo`` a tuple of the arrays it
   carries from one call to the next (Moreau–Jean's closed contacts).
 
+A scheme that chooses its own step sizes (Studer's extrapolation) sets
+``ADAPTIVE_STEPS = True`` in its module: the driver then has no grid, ``tk``
+is where the step before ended (``t0`` for the first; ``h`` is not read),
+and the step rule sets ``t1``, ``hk`` and ``last`` (the step's end, its
+length and whether it is the call's last) instead of reading them; ``hn``
+is not given.
+
 The model comes first in the step rule's arguments, as the driver has it:
 frozen globals in a model's own (specialised) loop, run-time arguments in the
 scheme's shared loop (:mod:`moreau.integrators._loops` compiles the one
@@ -225,6 +232,8 @@ def loop_template(name, namespace):
     tree = ast.parse(textwrap.dedent(inspect.getsource(drive)))
     fdef = tree.body[0]
     fdef.name = name
+    if namespace.get("ADAPTIVE_STEPS", False):
+        _adaptive(fdef)
     step = namespace["step_rule"].py_func
     sdef = _function_def(step)
     setup, per_step = _split_at_marker(sdef.body)
@@ -296,6 +305,21 @@ def spliced(fn=None, *, step_returns=False):
         raise TypeError(f"spliced helper {fn.__name__} returns before its last statement")
     _SPLICED.add(fn)
     return njit(inline="always", error_model="numpy")(fn)
+
+
+def _adaptive(fdef):
+    """The driver's loop without its grid: each step starts where the one before ended (``t1``),
+    the step rule sets ``t1``, ``hk`` and ``last`` (see the module docstring)."""
+    loop_at = next(i for i, st in enumerate(fdef.body) if isinstance(st, ast.While))
+    loop = fdef.body[loop_at]
+
+    def assigns(st, nm):
+        return isinstance(st, ast.Assign) and any(
+            isinstance(n, ast.Name) and n.id == nm for tg in st.targets for n in ast.walk(tg))
+    grid = next(i for i, st in enumerate(loop.body) if assigns(st, "tk"))
+    loop.body[grid] = ast.parse("tk = t1").body[0]
+    loop.body = [st for st in loop.body if not assigns(st, "hn")]
+    fdef.body[loop_at:loop_at] = ast.parse("t1 = t0\nhk = h\nlast = False").body
 
 
 def _function_def(fn):

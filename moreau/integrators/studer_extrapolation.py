@@ -409,10 +409,12 @@ class StuderExtrapolation(TimeStepping):
         st[:] = 0.0
         cnt = np.zeros(len(STUDER_COUNTERS), dtype=np.int64)
         m = self._model
+        opts = (float(self.tol), int(self.columns), float(self.h_min),
+                int(self.max_steps - self._macro))
+        memo = (th, closed, reg, acc, cnt) + buf[8:]
         status, nacc, nrec = runner_for(m, studer_loop, self.scene)(
-            m.par, self.mu_c, self.e_c, bound, self.tol, self.columns, self.h_min,
-            self.max_steps - self._macro, nmax, th, q, v, closed, reg, acc,
-            self._pending_initial, self._lcp_ctl, *buf, st, cnt)
+            m.par, self.mu_c, self.e_c, float(th[0]), float(th[1]), bound, 0, nmax, q, v, opts,
+            memo, 1, self._pending_initial, self._lcp_ctl, *buf[:8], st)
         if nrec:
             self._add_rows(tuple(b[:nrec].copy() for b in buf))
             self._pending_initial = False

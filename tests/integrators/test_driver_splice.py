@@ -67,16 +67,30 @@ def test_a_part_with_step_returns_ends_the_step_with_its_status():
 
 
 def test_the_schemes_parts_are_spliced_into_their_loops():
-    from moreau.integrators import _mj_kernels, _nsga_kernels, _tdg_kernels
+    from moreau.integrators import _mj_kernels, _nsga_kernels, _studer_kernels, _tdg_kernels
     parts = {_mj_kernels.mj_loop: {"free_velocity", "start_contacts", "one_contact",
                                    "sparse_delassus", "several_contacts", "lemke_solve",
                                    "project_positions"},
              _nsga_kernels.nsga_loop: {"smooth_stage", "impulse_stage", "correct_positions",
                                        "dense_delassus", "one_row_impulse", "lemke_solve"},
              _tdg_kernels.tdg_loop: {"start_contacts", "impulse_at_start", "total_impulses",
-                                     "project_held"}}
+                                     "project_held"},
+             _studer_kernels.studer_loop: {"sequence", "midpoint_velocity", "extrapolated",
+                                           "switch_error", "project_held", "times_ht",
+                                           "add_impulse", "gather_rows"}}
     for loop, names in parts.items():
         src = loop.__moreau_source__
         assert not _calls(src) & names
         # each part's locals, renamed apart, are in the loop's source
         assert all(f"_{name}" in src for name in names)
+
+
+def test_a_scheme_that_sizes_its_steps_runs_the_driver_without_its_grid():
+    # Studer's macro steps (ADAPTIVE_STEPS): each starts where the one before ended, the step
+    # rule sets its end; a fixed-step scheme's loop keeps the grid
+    from moreau.integrators import _studer_kernels, _tdg_kernels
+    src = _studer_kernels.studer_loop.__moreau_source__
+    names = {n.id for n in ast.walk(ast.parse(src)) if isinstance(n, ast.Name)}
+    assert "grid_step" not in _calls(src) and "hn" not in names
+    assert "t1 = t0" in src and "tk = t1" in src
+    assert "grid_step" in _calls(_tdg_kernels.tdg_loop.__moreau_source__)
