@@ -165,64 +165,69 @@ def _rows(ct, i, R, s, rows):
 
 
 @njit(cache=True)
-def _solve3(A, F, out):
-    # A out = F by Gaussian elimination with partial pivoting (a 3x3 system)
-    M = A.copy()
-    x = F.copy()
+def _solve3(S, ia, jf, jo):
+    # S[jo] = x with S[ia:ia+3] x = S[jf] by Gaussian elimination with partial pivoting (a 3x3
+    # system), on the rows of the scratch S (rows 7-10 its working copy): no array allocated
+    for i in range(3):
+        for j in range(3):
+            S[7 + i, j] = S[ia + i, j]
+        S[10, i] = S[jf, i]
     for c in range(3):
         p = c
         for r in range(c + 1, 3):
-            if abs(M[r, c]) > abs(M[p, c]):
+            if abs(S[7 + r, c]) > abs(S[7 + p, c]):
                 p = r
         if p != c:
             for j in range(3):
-                M[c, j], M[p, j] = M[p, j], M[c, j]
-            x[c], x[p] = x[p], x[c]
+                S[7 + c, j], S[7 + p, j] = S[7 + p, j], S[7 + c, j]
+            S[10, c], S[10, p] = S[10, p], S[10, c]
         for r in range(c + 1, 3):
-            f = M[r, c] / M[c, c]
+            f = S[7 + r, c] / S[7 + c, c]
             for j in range(c, 3):
-                M[r, j] -= f * M[c, j]
-            x[r] -= f * x[c]
+                S[7 + r, j] -= f * S[7 + c, j]
+            S[10, r] -= f * S[10, c]
     for c in range(2, -1, -1):
-        acc = x[c]
+        acc = S[10, c]
         for j in range(c + 1, 3):
-            acc -= M[c, j] * out[j]
-        out[c] = acc / M[c, c]
+            acc -= S[7 + c, j] * S[jo, j]
+        S[jo, c] = acc / S[7 + c, c]
 
 
 @njit(cache=True)
-def _free_rotation(J, w0, impulse, h, theta, w):
-    # the Python step's _free_rotation: J (w - w0) + h wt x J wt = impulse, Newton on 3x3
-    dw = np.empty(3)
-    wt = np.empty(3)
-    Jw = np.empty(3)
-    F = np.empty(3)
-    A = np.empty((3, 3))
-    _solve3(J, impulse, dw)
+def _free_rotation(J, v, o, h, theta, S):
+    # the Python step's _free_rotation: J (w - w0) + h wt x J wt = impulse, Newton on 3x3,
+    # w0 = v[o:o+3], in the rows of the loop's scratch S (12 x 3; nothing allocated a step):
+    # 0 w, 1 F then dw (the solve copies F first), 2 wt, 3 J wt, 4-6 J then the Jacobian,
+    # 7-10 _solve3's working copy, 11 the impulse
     for a in range(3):
-        w[a] = w0[a] + dw[a]
+        for j in range(3):
+            S[4 + a, j] = J[a, j]
+    _solve3(S, 4, 11, 1)
+    for a in range(3):
+        S[0, a] = v[o + a] + S[1, a]
     for _ in range(20):
         for a in range(3):
-            wt[a] = theta * w[a] + (1.0 - theta) * w0[a]
+            S[2, a] = theta * S[0, a] + (1.0 - theta) * v[o + a]
         for a in range(3):
-            Jw[a] = J[a, 0] * wt[0] + J[a, 1] * wt[1] + J[a, 2] * wt[2]
+            S[3, a] = J[a, 0] * S[2, 0] + J[a, 1] * S[2, 1] + J[a, 2] * S[2, 2]
         for a in range(3):
             a1 = (a + 1) % 3
             a2 = (a + 2) % 3
-            F[a] = (J[a, 0] * (w[0] - w0[0]) + J[a, 1] * (w[1] - w0[1]) + J[a, 2] * (w[2] - w0[2])
-                    + h * (wt[a1] * Jw[a2] - wt[a2] * Jw[a1]) - impulse[a])
+            S[1, a] = (J[a, 0] * (S[0, 0] - v[o]) + J[a, 1] * (S[0, 1] - v[o + 1])
+                       + J[a, 2] * (S[0, 2] - v[o + 2])
+                       + h * (S[2, a1] * S[3, a2] - S[2, a2] * S[3, a1]) - S[11, a])
             # h theta ([wt]x J - [J wt]x), row a
             for j in range(3):
-                A[a, j] = J[a, j] + h * theta * (wt[a1] * J[a2, j] - wt[a2] * J[a1, j])
-            A[a, a2] -= h * theta * Jw[a1]
-            A[a, a1] += h * theta * Jw[a2]
-        _solve3(A, F, dw)
+                S[4 + a, j] = J[a, j] + h * theta * (S[2, a1] * J[a2, j] - S[2, a2] * J[a1, j])
+            S[4 + a, a2] -= h * theta * S[3, a1]
+            S[4 + a, a1] += h * theta * S[3, a2]
+        _solve3(S, 4, 1, 1)
         big = 0.0
         wmax = 0.0
         for a in range(3):
-            w[a] -= dw[a]
-            big = max(big, abs(dw[a]))
-            wmax = max(wmax, abs(w[a]))
+            S[0, a] -= S[1, a]
+            big = max(big, abs(S[1, a]))
+            wmax = max(wmax, abs(S[0, a]))
         if big <= 1e-15 * max(1.0, wmax):
             break
 
@@ -397,8 +402,7 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     vfree = np.empty(nv)
     v1 = np.empty(nv)
     q1 = np.empty(nq)
-    wb = np.empty(3)
-    imp = np.empty(3)
+    fr = np.empty((12, 3))
     pN = np.zeros(ncm)
     pT = np.zeros(ncm)
     slip = np.zeros(ncm)
@@ -461,10 +465,10 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                 vfree[o + a] = v[o + a] + hk * acc
             if bgyro[b]:
                 for a in range(3):
-                    imp[a] = hk * f[o + 3 + a]
-                _free_rotation(bJ[b], v[o + 3:o + 6], imp, hk, theta, wb)
+                    fr[11, a] = hk * f[o + 3 + a]
+                _free_rotation(bJ[b], v, o + 3, hk, theta, fr)
                 for a in range(3):
-                    vfree[o + 3 + a] = wb[a]
+                    vfree[o + 3 + a] = fr[0, a]
         for j in range(nv):
             v1[j] = vfree[j]
         na = 0
