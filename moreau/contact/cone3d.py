@@ -479,15 +479,9 @@ def _local_res_sq(A, b, mu, rn, r1, r2):
 
 
 @njit(cache=True, inline="always")
-def _slip_fn(A, b, mu, phi):
-    # with s = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
-    # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
-    return _slip_cs(A, b, mu, math.cos(phi), math.sin(phi))
-
-
-@njit(cache=True, inline="always")
 def _slip_cs(A, b, mu, c, s):
-    # _slip_fn at the angle whose cosine and sine are c and s
+    # with s = (c, s) = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
+    # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
     g = A[0, 0] - mu * (A[0, 1] * c + A[0, 2] * s)
     h1 = -b[0] * (A[1, 0] - mu * (A[1, 1] * c + A[1, 2] * s)) + g * b[1]
     h2 = -b[0] * (A[2, 0] - mu * (A[2, 1] * c + A[2, 2] * s)) + g * b[2]
@@ -495,8 +489,8 @@ def _slip_cs(A, b, mu, c, s):
 
 
 _N_SAMPLES = 64
-# the samples' upper ends as _local's loop computes them (k step + step) and their cosines and
-# sines, computed once: the loop's trigonometry is then its bisections' only
+# the samples' upper ends (k step + step) and their cosines and sines, computed once: the
+# slip's solve has no trigonometry (_refine_angle turns rationally from a sample's start)
 _SAMPLE_STEP = 2.0 * math.pi / _N_SAMPLES
 _SAMPLE_COS = np.array([math.cos(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
 _SAMPLE_SIN = np.array([math.sin(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
@@ -508,33 +502,51 @@ _RESTART_D = 16
 
 #: the sliding angle's bracket is refined to this width [rad] (a few rounding units of 2 pi)
 _ANGLE_TOL = 4e-15
+#: the tangent of half a sample's width: a bracket's parameter t runs over [0, _SAMPLE_T]
+_SAMPLE_T = math.tan(0.5 * _SAMPLE_STEP)
 
 
 @njit(cache=True, inline="always")
-def _refine_angle(A, b, mu, lo, hi, flo, fhi):
-    # a root of the slip function in [lo, hi] (flo, fhi of opposite signs) by the Illinois
-    # variant of regula falsi (superlinear, the bracket kept): a dozen evaluations where
-    # bisection takes fifty; a step that rounding puts outside the bracket bisects instead.
-    # Returns the end of least |F| once the bracket is _ANGLE_TOL wide
+def _turn(c0, s0, t):
+    # (cos, sin) of the angle phi0 + 2 atan(t), rational in t: no trigonometry, and of unit
+    # norm to rounding since (1 - t^2)^2 + (2 t)^2 = (1 + t^2)^2
+    den = 1.0 + t * t
+    a = (1.0 - t * t) / den
+    bb = 2.0 * t / den
+    return a * c0 - bb * s0, a * s0 + bb * c0
+
+
+@njit(cache=True, inline="always")
+def _refine_angle(A, b, mu, c0, s0, flo, fhi):
+    # a root of the slip function in the sample [phi0, phi0 + step] (cos phi0 = c0, sin phi0 =
+    # s0; flo, fhi its ends' values, of opposite signs) as (cos, sin), by the Illinois variant
+    # of regula falsi (superlinear, the bracket kept) on t = tan((phi - phi0) / 2) in [0,
+    # _SAMPLE_T]: each evaluation rational, without the cosine and sine an angle would cost
+    # (they were two thirds of a slip's solve); a step that rounding puts outside the bracket
+    # bisects instead. Stops once the bracket is _ANGLE_TOL wide in the angle (dphi = 2 dt /
+    # (1 + t^2) <= 2 dt) and returns the end of least |F|; t = _SAMPLE_T returns the sample's
+    # end (hi) itself, as (nan, nan), for the caller's table
+    lo, hi = 0.0, _SAMPLE_T
     wlo, whi = flo, fhi           # the weights Illinois halves; flo, fhi stay the values
     side = 0
     for _ in range(100):
-        if hi - lo <= _ANGLE_TOL:
+        if hi - lo <= 0.5 * _ANGLE_TOL:
             break
         x = hi - whi * (hi - lo) / (whi - wlo)
         if not lo < x < hi:
             # the secant lands on an end: a root there to rounding (a launch along a
             # sample's direction) when that end's F is rounding beside the other's
             if x <= lo and abs(flo) <= 1e-14 * abs(fhi):
-                return lo
+                return _end(c0, s0, lo)
             if x >= hi and abs(fhi) <= 1e-14 * abs(flo):
-                return hi
+                return _end(c0, s0, hi)
             x = 0.5 * (lo + hi)
             if not lo < x < hi:
                 break
-        fx, _, _ = _slip_fn(A, b, mu, x)
+        cx, sx = _turn(c0, s0, x)
+        fx, _, _ = _slip_cs(A, b, mu, cx, sx)
         if fx == 0.0:
-            return x
+            return cx, sx
         if (fx < 0.0) == (flo < 0.0):
             lo, flo, wlo = x, fx, fx
             if side < 0:
@@ -545,7 +557,15 @@ def _refine_angle(A, b, mu, lo, hi, flo, fhi):
             if side > 0:
                 wlo *= 0.5
             side = 1
-    return lo if abs(flo) <= abs(fhi) else hi
+    return _end(c0, s0, lo if abs(flo) <= abs(fhi) else hi)
+
+
+@njit(cache=True, inline="always")
+def _end(c0, s0, t):
+    # the bracket's answer t; its upper end _SAMPLE_T as (nan, nan): the caller's table has it
+    if t == _SAMPLE_T:
+        return math.nan, math.nan
+    return _turn(c0, s0, t)
 
 
 @njit(cache=True)
@@ -577,16 +597,17 @@ def _local(A, b, mu):
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
     best_n, best_1, best_2 = -b[0] / A[0, 0], 0.0, 0.0
     best = _local_res_sq(A, b, mu, best_n, best_1, best_2)
-    step = 2.0 * math.pi / _N_SAMPLES
-    fa, _, _ = _slip_fn(A, b, mu, 0.0)
+    c0, s0 = 1.0, 0.0
+    fa, _, _ = _slip_cs(A, b, mu, c0, s0)
     for k in range(_N_SAMPLES):
-        lo = k * step
-        hi = lo + step
-        fb, _, _ = _slip_cs(A, b, mu, _SAMPLE_COS[k], _SAMPLE_SIN[k])
+        c1, s1 = _SAMPLE_COS[k], _SAMPLE_SIN[k]
+        fb, _, _ = _slip_cs(A, b, mu, c1, s1)
         if fa == 0.0 or fa * fb < 0.0:
-            phi = lo if fa == 0.0 else _refine_angle(A, b, mu, lo, hi, fa, fb)
-            c = math.cos(phi)
-            sn = math.sin(phi)
+            c, sn = c0, s0
+            if fa != 0.0:
+                c, sn = _refine_angle(A, b, mu, c0, s0, fa, fb)
+                if math.isnan(c):
+                    c, sn = c1, s1
             _, along, g = _slip_cs(A, b, mu, c, sn)
             if g > 0.0 and along >= 0.0:
                 rho = -b[0] / g
@@ -597,6 +618,7 @@ def _local(A, b, mu):
                 if res < best:
                     best, best_n, best_1, best_2 = res, rn, r1, r2
         fa = fb
+        c0, s0 = c1, s1
     return best_n, best_1, best_2
 
 
@@ -608,7 +630,9 @@ def local_solve(A, b, mu):
     with ``u_N = 0`` giving ``rho = -b_N / g(phi)``, ``g = A_NN - mu A_NT s``,
     and the sliding angle a root of ``s_perp . u_T(phi) = 0`` with ``s .
     u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and refined by
-    the Illinois variant of regula falsi to a bracket ``4e-15`` rad wide. Of
+    the Illinois variant of regula falsi on ``tan`` of the half angle from
+    the sample's start (the cosine and sine rational in it: no
+    trigonometry) to a bracket ``4e-15`` rad wide. Of
     several admissible roots the one with the least residual is kept.
 
     Examples
