@@ -90,10 +90,13 @@ __all__ = [
     "PolyhedralLCP",
     "build_polyhedral_lcp",
     "solve_polyhedral",
+    "polyhedral_one_contact",
+    "ONE_CONTACT_TOL",
     "local_solve",
     "solve_exact",
     "solve_cone",
     "exact_gauss_seidel",
+    "exact_gauss_seidel_into",
     "exact_newton_polish",
     "natural_map_sq",
     "project_contensou",
@@ -466,6 +469,198 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
                         {"pivots": int(res.pivots)}, f"polyhedral-{lcp.d}", detail, lcp=res)
 
 
+#: the violation (in :func:`moreau.lcp.lcp_violation`'s units) below which
+#: :func:`polyhedral_one_contact`'s answer is certified (Lemke's own bound is 1e-9)
+ONE_CONTACT_TOL = 1e-12
+
+
+@njit(cache=True)
+def polyhedral_one_contact(W, q, mu, D, r):
+    """One contact's polyhedral problem (:func:`build_polyhedral_lcp`) in closed form, certified.
+
+    The LCP of one contact, ``z = (r_N, beta, lambda)``, has three kinds of
+    answer, tried in turn: take-off (``r = 0``, ``lambda = max_k -D_k.u_T``:
+    an answer whenever ``q_N >= 0``), stick (``r = -W^-1 q`` inside the
+    pyramid, ``lambda = 0``) and slip, ``r_T = mu r_N t`` with ``t`` on the
+    polygon's boundary: at a vertex ``D_k`` (``beta_k = mu r_N``) or on the
+    facet from ``D_k`` to ``D_k+1`` (two betas; a 2 x 2 system for ``r_N``
+    and the split), with ``u_N = 0`` and ``-lambda = D_k.u_T`` the least of
+    the ``D_j.u_T``. The facet the stick impulse points through is tried,
+    then its vertices and the facets beside them. A candidate counts where it
+    meets the LCP's conditions to :data:`ONE_CONTACT_TOL` in the units of
+    :func:`moreau.lcp.lcp_violation` (with a bound on ``max|M|``: stricter than
+    Lemke's 1e-9). It is tried only far from Painlevé's coupling, ``2 mu
+    |W_NT| < W_NN``, where an impulse along any ``t`` pushes the normal
+    velocity up; nearer, the LCP may have several answers (a jam beside a
+    take-off) and the caller's Lemke picks one (the test suite holds this
+    function to Lemke's answer on random problems).
+
+    Parameters
+    ----------
+    W : ndarray, shape (3, 3)
+        The contact's Delassus block, symmetric positive definite.
+    q : ndarray, shape (3,)
+        Its free velocity ``[N, T1, T2]``.
+    mu : float
+    D : ndarray, shape (2, d)
+        The directions (:func:`facet_directions`).
+    r : ndarray, shape (3,)
+        Receives the impulse where the answer is certified.
+
+    Returns
+    -------
+    bool
+        False where no candidate passed (``r`` untouched): the caller solves
+        the LCP (Lemke).
+
+    Examples
+    --------
+    >>> r = np.zeros(3)
+    >>> W = np.diag([1.0, 3.5, 3.5]); D = facet_directions(4)
+    >>> bool(polyhedral_one_contact(W, np.array([-1.0, 0.5, 0.0]), 0.5, D, r))   # sticks
+    True
+    >>> (np.round(r, 12) + 0.0).tolist()
+    [1.0, -0.142857142857, 0.0]
+    >>> bool(polyhedral_one_contact(W, np.array([-1.0, 3.0, 0.0]), 0.5, D, r))   # slips
+    True
+    >>> (np.round(r, 12) + 0.0).tolist()
+    [1.0, -0.5, 0.0]
+    """
+    # As j -> D_j.u_T samples |u_T| cos(angle), a least value against both neighbours is the
+    # least of all: a slip candidate is checked against every direction all the same
+    d = D.shape[1]
+    n0, f1, f2 = q[0], q[1], q[2]
+    if 2.0 * mu * math.hypot(W[0, 1], W[0, 2]) >= W[0, 0]:
+        # far from Painlevé's coupling only (an impulse along any t of the polygon pushes
+        # the normal velocity up: W_NN - mu |W_NT| > W_NN / 2), where the answer is unique;
+        # nearer, the LCP may have several (a jam beside a take-off) and Lemke's path picks one
+        return False
+    if n0 >= 0.0:
+        r[0] = 0.0
+        r[1] = 0.0
+        r[2] = 0.0
+        return True
+    if mu <= 0.0:
+        return False
+    # the LCP's scales: s = max|q| (q_lcp = (q_N, D^T q_T, 0)) and a bound on max|M| (its
+    # entries are W_NN, W_N.D_k, D_j.W_TT D_k, 1 and mu), so the bounds are tighter than Lemke's
+    sc = abs(n0)
+    for k in range(d):
+        sc = max(sc, abs(D[0, k] * f1 + D[1, k] * f2))
+    mm = max(1.0, mu, abs(W[0, 0]), abs(W[0, 1]) + abs(W[0, 2]),
+             abs(W[1, 1]) + abs(W[1, 2]) + abs(W[2, 1]) + abs(W[2, 2]))
+    tol_w = ONE_CONTACT_TOL * sc
+    tol_z = tol_w / mm
+    # stick: W r = -q by Cramer's rule
+    c00 = W[1, 1] * W[2, 2] - W[1, 2] * W[2, 1]
+    c01 = W[1, 2] * W[2, 0] - W[1, 0] * W[2, 2]
+    c02 = W[1, 0] * W[2, 1] - W[1, 1] * W[2, 0]
+    det = W[0, 0] * c00 + W[0, 1] * c01 + W[0, 2] * c02
+    a1, a2 = -f1, -f2                      # the sliding impulse's direction, failing stick
+    if det > 0.0:
+        i01 = W[0, 2] * W[2, 1] - W[0, 1] * W[2, 2]
+        i11 = W[0, 0] * W[2, 2] - W[0, 2] * W[2, 0]
+        i21 = W[0, 1] * W[2, 0] - W[0, 0] * W[2, 1]
+        i02 = W[0, 1] * W[1, 2] - W[0, 2] * W[1, 1]
+        i12 = W[0, 2] * W[1, 0] - W[0, 0] * W[1, 2]
+        i22 = W[0, 0] * W[1, 1] - W[0, 1] * W[1, 0]
+        rn = -(c00 * n0 + i01 * f1 + i02 * f2) / det
+        r1 = -(c01 * n0 + i11 * f1 + i12 * f2) / det
+        r2 = -(c02 * n0 + i21 * f1 + i22 * f2) / det
+        if rn >= 0.0:
+            # inside the polygon of vertices mu r_N D_k: below every facet's line, whose
+            # outward normal is D_k + D_k+1 and whose offset is mu r_N (1 + D_k.D_k+1)
+            inside = True
+            for k in range(d):
+                k1 = (k + 1) % d
+                e1 = D[0, k] + D[0, k1]
+                e2 = D[1, k] + D[1, k1]
+                if e1 * r1 + e2 * r2 > mu * rn * (1.0 + D[0, k] * D[0, k1] + D[1, k] * D[1, k1]):
+                    inside = False
+                    break
+            if inside:
+                r[0] = rn
+                r[1] = r1
+                r[2] = r2
+                return True
+            a1, a2 = r1, r2
+    # slip: the facet that the stick impulse (or -q_T) points through, then its two
+    # vertices, then the facets beside them
+    step = 2.0 * math.pi / d
+    k0 = int(math.floor(math.atan2(a2, a1) / step)) % d
+    for trial in range(5):
+        if trial == 0:
+            k, facet = k0, True
+        elif trial < 3:
+            k, facet = (k0 + trial - 1) % d, False
+        else:
+            k, facet = (k0 - 1 if trial == 3 else k0 + 1) % d, True
+        if _slip_candidate(W, n0, f1, f2, mu, D, d, k, facet, tol_w, tol_z, r):
+            return True
+    return False
+
+
+@njit(cache=True)
+def _slip_candidate(W, n0, f1, f2, mu, D, d, k, facet, tol_w, tol_z, r):
+    # slip at vertex k (facet False) or on the facet k -> k+1; writes r where certified
+    k1 = (k + 1) % d
+    dk0, dk1 = D[0, k], D[1, k]
+    wn_k = W[0, 1] * dk0 + W[0, 2] * dk1
+    if facet:
+        e0, e1 = D[0, k1] - dk0, D[1, k1] - dk1
+        wn_e = W[0, 1] * e0 + W[0, 2] * e1
+        # e.W_TT d_k, e.W_TT e and e.W_TN
+        te0 = W[1, 1] * dk0 + W[1, 2] * dk1
+        te1 = W[2, 1] * dk0 + W[2, 2] * dk1
+        ee0 = W[1, 1] * e0 + W[1, 2] * e1
+        ee1 = W[2, 1] * e0 + W[2, 2] * e1
+        a11 = W[0, 0] + mu * wn_k
+        a12 = mu * wn_e
+        a21 = e0 * W[1, 0] + e1 * W[2, 0] + mu * (e0 * te0 + e1 * te1)
+        a22 = mu * (e0 * ee0 + e1 * ee1)
+        b2 = -(e0 * f1 + e1 * f2)
+        det = a11 * a22 - a12 * a21
+        if det == 0.0:
+            return False
+        x = (-n0 * a22 - a12 * b2) / det       # r_N
+        y = (a11 * b2 + a21 * n0) / det        # r_N alpha
+        if not (x > 0.0 and y >= 0.0 and y <= x):
+            return False
+        t1 = x * dk0 + y * e0
+        t2 = x * dk1 + y * e1
+        rn = x
+        r1 = mu * t1
+        r2 = mu * t2
+        bk, bk1 = mu * (x - y), mu * y
+    else:
+        g = W[0, 0] + mu * wn_k
+        if not g > 0.0:
+            return False
+        rn = -n0 / g
+        r1 = mu * rn * dk0
+        r2 = mu * rn * dk1
+        bk, bk1 = mu * rn, 0.0
+    # the LCP's w at this z: u_N, D_j.u_T + lambda, mu r_N - sum beta
+    un = W[0, 0] * rn + W[0, 1] * r1 + W[0, 2] * r2 + n0
+    u1 = W[1, 0] * rn + W[1, 1] * r1 + W[1, 2] * r2 + f1
+    u2 = W[2, 0] * rn + W[2, 1] * r1 + W[2, 2] * r2 + f2
+    lam = -(dk0 * u1 + dk1 * u2)
+    if lam < -tol_z or abs(un) > tol_w or abs(mu * rn - bk - bk1) > tol_w:
+        return False
+    # every D_j.u_T + lambda >= 0, = 0 (to the bound) where beta_j > 0
+    for j in range(d):
+        wj = D[0, j] * u1 + D[1, j] * u2 + lam
+        if wj < -tol_w:
+            return False
+        bj = bk if j == k else bk1 if j == k1 else 0.0
+        if bj > tol_z and wj > tol_w:
+            return False
+    r[0] = rn
+    r[1] = r1
+    r[2] = r2
+    return True
+
+
 # --------------------------------------------------------------------------- exact cone
 
 @njit(cache=True)
@@ -665,10 +860,16 @@ def _pgs(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall):
     # relax < 1 moves each contact part way to its local solution (a convex
     # combination, so r stays in K); the sweeps stop after `stall` of them
     # without a new least residual (Gauss–Seidel can cycle when mu is large)
+    return _pgs_into(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall, np.empty((3, 3)),
+                     np.empty(3))
+
+
+@njit(cache=True)
+def _pgs_into(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall, A, b):
+    # _pgs with its local block A (at least 3 x 3) and right-hand side b given: a
+    # time-stepping loop passes its own scratch (nothing allocated a step)
     nc = mu.shape[0]
     n = 3 * nc
-    A = np.empty((3, 3))
-    b = np.empty(3)
     res = _natural_sq(r, u, mu)
     best = res
     since = 0
@@ -935,6 +1136,28 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
     (True, [1.0, -0.3, -0.4], 5.0990195135927845)
     """
     n = q.shape[0]
+    return exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps,
+                                   np.empty((3, 3)), np.empty(3), np.empty(n), np.empty(n))
+
+
+@njit(cache=True)
+def exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps, A, b, r_in, u_in):
+    """:func:`exact_gauss_seidel` on the caller's scratch: ``A`` (at least 3 x 3), ``b`` (at
+    least 3), ``r_in`` and ``u_in`` (at least ``q``'s length); the same operations.
+
+    For a time-stepping loop that allocates nothing a step.
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5]); q = np.array([-1.0, 3.0, 4.0])
+    >>> r = np.zeros(3); u = q.copy()
+    >>> ok, res, qn = exact_gauss_seidel_into(W, q, np.array([0.5]), r, u, 1e-10, 1e-6, 500,
+    ...                                       np.empty((3, 3)), np.empty(3), np.empty(3),
+    ...                                       np.empty(3))
+    >>> bool(ok), np.round(r, 12).tolist()
+    (True, [1.0, -0.3, -0.4])
+    """
+    n = q.shape[0]
     qn = 0.0
     for j in range(n):
         qn += q[j] * q[j]
@@ -942,15 +1165,17 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
     scale = qn if qn > 0.0 else 1.0
     tol_sq = (tol * scale) ** 2
     switch_sq = (max(tol, polish_from) * scale) ** 2
-    _, res = _pgs(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL)
+    _, res = _pgs_into(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL, A, b)
     if res > tol_sq:
         return False, math.sqrt(res), qn
-    r_in = _project_all(r, mu)
-    u_in = np.empty(n)
+    for i in range(mu.shape[0]):
+        k = 3 * i
+        r_in[k], r_in[k + 1], r_in[k + 2] = _proj(r[k], r[k + 1], r[k + 2], mu[i])
     _affine_into(W, q, r_in, u_in)
     if _natural_sq(r_in, u_in, mu) <= max(res, tol_sq):
-        r[:] = r_in
-        u[:] = u_in
+        for j in range(n):
+            r[j] = r_in[j]
+            u[j] = u_in[j]
     res = math.sqrt(_natural_sq(r, u, mu))
     return res <= tol * scale, res, qn
 

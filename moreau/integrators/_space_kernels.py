@@ -42,8 +42,8 @@ from numba.core import types as nbtypes
 
 from .. import _jit_cache
 from ..contact import cone3d as _cone3d
-from ..contact.cone3d import (exact_gauss_seidel, exact_newton_polish, facet_directions,
-                              natural_map_sq)
+from ..contact.cone3d import (exact_gauss_seidel_into, exact_newton_polish, facet_directions,
+                              natural_map_sq, polyhedral_one_contact)
 from ..lcp.lemke import DEFAULT_TOL, default_max_iter, lemke_core, lemke_workspace
 from ..model import spatial as _spatial
 from ..model.spatial import rotate_into
@@ -235,6 +235,8 @@ def _free_rotation(J, v, o, h, theta, S):
 @njit(cache=True)
 def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
     # build_polyhedral_lcp's M = B^T W B + E, q = B^T Uf on the active contacts, Lemke, r = B z
+    if na == 1 and polyhedral_one_contact(W, Uf, mu_a[0], D, r):
+        return np.int64(0), np.int64(0)
     m = d + 2
     L = na * m
     for a in range(L):
@@ -283,8 +285,9 @@ def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, m
     # the exact cone by Gauss–Seidel; status 1 where Newton's polish is needed (never with
     # one contact a body, whose local solve is exact: the solver of such scenes)
     u[:] = Uf
-    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                     EXACT_SWEEPS)
+    # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
+    ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                          EXACT_SWEEPS, Ml, ql, zl, wl)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
@@ -294,8 +297,9 @@ def _exact_polish_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, i
     # the exact cone by Gauss–Seidel, then Newton's polish where it stops short (several
     # contacts on one body); status 1 where solve_exact would go on (its restart)
     u[:] = Uf
-    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                     EXACT_SWEEPS)
+    # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
+    ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                          EXACT_SWEEPS, Ml, ql, zl, wl)
     if not ok:
         ok, res, qn, _ = exact_newton_polish(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_NEWTON)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
@@ -415,7 +419,8 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     u_all = np.empty(3 * ncm)
     U = np.empty(3)
     mu_all = np.empty(ncm)
-    Lmax = ncm * (d + 2)
+    # (the exact cone's Gauss–Seidel takes its scratch from Lemke's: 3 rows a contact)
+    Lmax = ncm * max(d + 2, 3)
     Ml = np.zeros((Lmax, Lmax))
     ql = np.zeros(Lmax)
     dl = np.ones(Lmax)
