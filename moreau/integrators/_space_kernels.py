@@ -39,6 +39,7 @@ import numba
 import numpy as np
 from numba import njit
 from numba.core import types as nbtypes
+from numba.experimental.function_type import _get_wrapper_address as _wrapper_address
 
 from .. import _jit_cache
 from ..contact import cone3d as _cone3d
@@ -342,11 +343,37 @@ def space_solver(cone, several=False):
     compile: with one contact a body Gauss–Seidel's exact local solve converges
     in a sweep).
     """
-    fn = (_polyhedral_solve if cone != "exact" else
-          _exact_polish_solve if several else _exact_solve)
-    if not fn.signatures:
-        fn.compile(SOLVE_SIGNATURE)
-    return fn
+    key = (cone != "exact", bool(several))
+    got = _SOLVERS.get(key)
+    if got is None:
+        fn = (_polyhedral_solve if cone != "exact" else
+              _exact_polish_solve if several else _exact_solve)
+        if not fn.signatures:
+            fn.compile(SOLVE_SIGNATURE)
+        got = _SOLVERS[key] = _Solver(fn)
+    return got
+
+
+class _Solver:
+    """A compiled solver as the loop's function-pointer argument, its address looked up once.
+
+    numba unboxes a dispatcher passed for a first-class function by looking
+    its compiled entry up on every call (60 us, a seventh of a short run's
+    setup); an object with the ``__wrapper_address__`` protocol hands over the
+    address it holds. The loop then calls the solver's C wrapper.
+    """
+
+    __slots__ = ("fn", "address")
+
+    def __init__(self, fn):
+        self.fn = fn
+        self.address = _wrapper_address(fn, SOLVE_SIGNATURE)
+
+    def __wrapper_address__(self):
+        return self.address
+
+
+_SOLVERS = {}
 
 
 def run_space_loop(*args):
@@ -363,12 +390,15 @@ def run_space_loop(*args):
         args[i] = int(args[i])
     args[15] = bool(args[15])
     if not _LOOP:
-        types = [numba.typeof(a) for a in args]
-        types[13] = nbtypes.FunctionType(SOLVE_SIGNATURE)
+        types = [nbtypes.FunctionType(SOLVE_SIGNATURE) if i == 13 else numba.typeof(a)
+                 for i, a in enumerate(args)]
         space_loop.compile(tuple(types))
         space_loop.disable_compile()
-        _LOOP.append(True)
-    return space_loop(*args)
+        # its one compiled entry, called directly: the dispatcher would type the solver
+        # (a _Solver) as a Python object; the other arguments have the types compiled for
+        # (the conversions above)
+        _LOOP.append(next(iter(space_loop.overloads.values())).entry_point)
+    return _LOOP[0](*args)
 
 
 _LOOP = []
