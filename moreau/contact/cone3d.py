@@ -75,7 +75,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.optimize import brentq
 
 from .._validate import finite_array
 from ..errors import InputError
@@ -1536,39 +1535,66 @@ def project_contensou(x, mu, lever):
     return p
 
 
+@njit(cache=True)
 def _natural_sq_blocks(r, u, mu, starts):
+    # sum over contacts of |r - proj_K(r - û)|^2, a contact's rows starts[i]:starts[i+1]
     total = 0.0
     for i in range(mu.shape[0]):
         a, b = starts[i], starts[i + 1]
-        ut = u[a + 1:b]
-        x = r[a:b] - u[a:b]
-        x[0] = r[a] - (u[a] + mu[i] * float(np.linalg.norm(ut)))
-        total += float(np.sum((r[a:b] - _proj_nd(x, mu[i])) ** 2))
+        m = mu[i]
+        ut = 0.0
+        for j in range(a + 1, b):
+            ut += u[j] * u[j]
+        xn = r[a] - (u[a] + m * math.sqrt(ut))
+        xt = 0.0
+        for j in range(a + 1, b):
+            xt += (r[j] - u[j]) ** 2
+        xt = math.sqrt(xt)
+        # the projection of x = (xn, x_T) on {|t| <= m n}: x, the apex, or scaled onto the cone
+        if xt <= m * xn:
+            pn, f = xn, 1.0
+        elif m * xt <= -xn:
+            pn, f = 0.0, 0.0
+        else:
+            pn = (xn + m * xt) / (1.0 + m * m)
+            f = m * pn / xt
+        total += (r[a] - pn) ** 2
+        for j in range(a + 1, b):
+            total += (r[j] - f * (r[j] - u[j])) ** 2
     return total
 
 
-def _secular(c, d):
-    # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0:
-    # 1/|s(alpha)| - 1 is concave and increasing, so Newton from the left end of the bracket
-    # [|c| - max d, |c| - min d] climbs monotonically to the root (bisection guards rounding).
-    # c, d: lists of floats (two or three tangential rows: plain floats beat array calls)
-    cn = math.sqrt(sum(x * x for x in c))
+@njit(cache=True)
+def _secular(c, d, m):
+    # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0,
+    # over the first m entries: 1/|s(alpha)| - 1 is concave and increasing, so Newton from
+    # the left end of the bracket [|c| - max d, |c| - min d] climbs monotonically to the root
+    # (bisection guards rounding)
+    cn = 0.0
+    for k in range(m):
+        cn += c[k] * c[k]
+    cn = math.sqrt(cn)
     if cn == 0.0:
         return 0.0
     at0 = 0.0
-    for x, y in zip(c, d):
-        if x != 0.0:
-            at0 = math.inf if y == 0.0 else at0 + (x / y) ** 2
+    for k in range(m):
+        if c[k] != 0.0:
+            at0 = math.inf if d[k] == 0.0 else at0 + (c[k] / d[k]) ** 2
     if at0 <= 1.0:
         return 0.0
-    lo, hi = max(cn - max(d), 0.0), max(cn - min(d), 0.0)
+    dmax, dmin = d[0], d[0]
+    for k in range(1, m):
+        dmax = max(dmax, d[k])
+        dmin = min(dmin, d[k])
+    lo, hi = max(cn - dmax, 0.0), max(cn - dmin, 0.0)
     a = lo if lo > 0.0 else min(hi, 1e-300 + 1e-16 * cn)
     for _ in range(100):
-        s2 = s3 = 0.0
-        for x, y in zip(c, d):
-            e = x / (y + a)
+        s2 = 0.0
+        s3 = 0.0
+        for k in range(m):
+            e = c[k] / (d[k] + a)
             s2 += e * e
-            s3 += e * e / (y + a)
+            s3 += e * e / (d[k] + a)
         norm = math.sqrt(s2)
         phi = 1.0 / norm - 1.0
         if phi > 0.0:
@@ -1606,47 +1632,220 @@ def local_solve_contensou(A, b, mu):
     >>> (np.round(local_solve_contensou(A, [-1.0, 3.0, 0.0, 4.0], 0.5), 14) + 0.0).tolist()
     [1.0, -0.3, 0.0, -0.4]
     """
-    A = finite_array("A", A, ndim=2)
-    b = finite_array("b", b, shape=(A.shape[0],))
-    return _local_nd(A, b, float(mu))
+    A = np.ascontiguousarray(finite_array("A", A, ndim=2))
+    b = np.ascontiguousarray(finite_array("b", b, shape=(A.shape[0],)))
+    r = np.empty(b.shape[0])
+    _local_nd(A, b, float(mu), r)
+    return r
 
 
-def _local_nd(A, b, mu):
+@njit(cache=True)
+def _solve_small(A, b, x, M):
+    # A x = b for an m x m block (m <= 4) by Gaussian elimination with partial pivoting on
+    # the scratch M (m x (m + 1)); False where a pivot vanishes
     m = b.shape[0]
-    r = np.zeros(m)
+    for i in range(m):
+        for j in range(m):
+            M[i, j] = A[i, j]
+        M[i, m] = b[i]
+    for c in range(m):
+        p = c
+        for i in range(c + 1, m):
+            if abs(M[i, c]) > abs(M[p, c]):
+                p = i
+        if M[p, c] == 0.0:
+            return False
+        if p != c:
+            for j in range(m + 1):
+                M[c, j], M[p, j] = M[p, j], M[c, j]
+        for i in range(c + 1, m):
+            f = M[i, c] / M[c, c]
+            for j in range(c, m + 1):
+                M[i, j] -= f * M[c, j]
+    for c in range(m - 1, -1, -1):
+        acc = M[c, m]
+        for j in range(c + 1, m):
+            acc -= M[c, j] * x[j]
+        x[c] = acc / M[c, c]
+    return True
+
+
+@njit(cache=True)
+def _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s):
+    # s(rho): (mu rho A_TT + alpha I) s = rho A_TN + b_T with |s| = 1, in A_TT's eigenbasis
+    m = b.shape[0] - 1
+    for k in range(m):
+        acc = 0.0
+        for j in range(m):
+            acc += Q[j, k] * (rho * A[j + 1, 0] + b[j + 1])
+        cc[k] = acc
+        dd[k] = (mu * rho) * lam[k]
+    alpha = _secular(cc, dd, m)
+    for j in range(m):
+        acc = 0.0
+        for k in range(m):
+            if cc[k] != 0.0:
+                acc += Q[j, k] * (cc[k] / (dd[k] + alpha))
+        s[j] = acc
+
+
+@njit(cache=True)
+def _slip_g(A, b, mu, rho, lam, Q, cc, dd, s):
+    # the normal row's g(rho) = A_NN rho - mu rho A_NT . s(rho) + b_N
+    _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s)
+    acc = 0.0
+    for j in range(b.shape[0] - 1):
+        acc += A[0, j + 1] * s[j]
+    return A[0, 0] * rho - mu * rho * acc + b[0]
+
+
+@njit(cache=True)
+def _local_nd(A, b, mu, r):
+    # local_solve_contensou's solve into r (any m >= 2 rows): take-off, stick, or slip with
+    # g(rho) = 0 found by Brent's method (bisection, secant and inverse quadratic
+    # interpolation, the bracket kept; Brent 1973, "Algorithms for minimization without
+    # derivatives", ch. 4) to rounding
+    m = b.shape[0]
+    for k in range(m):
+        r[k] = 0.0
     if b[0] >= 0.0:
-        return r
+        return
     if mu == 0.0:
         r[0] = -b[0] / A[0, 0]
-        return r
-    rs = np.linalg.solve(A, -b)
-    if rs[0] >= 0.0 and float(np.linalg.norm(rs[1:])) <= mu * rs[0]:
-        return rs
-    lam, Q = np.linalg.eigh(A[1:, 1:])
-    lam = np.maximum(lam, 0.0)
-    aTN, aNT, bT = A[1:, 0], A[0, 1:], b[1:]
-
-    def direction(rho):
-        c = (Q.T @ (rho * aTN + bT)).tolist()
-        d = [(mu * rho) * x for x in lam.tolist()]
-        alpha = _secular(c, d)
-        return Q @ np.array([x / (y + alpha) if x != 0.0 else 0.0 for x, y in zip(c, d)])
-
-    def g(rho):
-        return A[0, 0] * rho - mu * rho * float(aNT @ direction(rho)) + b[0]
-
+        return
+    M = np.empty((m, m + 1))
+    rs = np.empty(m)
+    nb = np.empty(m)
+    for k in range(m):
+        nb[k] = -b[k]
+    solved = _solve_small(A, nb, rs, M)
+    if solved:
+        nt = 0.0
+        for k in range(1, m):
+            nt += rs[k] * rs[k]
+        if rs[0] >= 0.0 and math.sqrt(nt) <= mu * rs[0]:
+            for k in range(m):
+                r[k] = rs[k]
+            return
+    lam, Q = np.linalg.eigh(np.ascontiguousarray(A[1:, 1:]))
+    for k in range(m - 1):
+        lam[k] = max(lam[k], 0.0)
+    cc = np.empty(m - 1)
+    dd = np.empty(m - 1)
+    s = np.empty(m - 1)
     hi = -b[0] / A[0, 0]
+    ghi = 0.0
+    found = False
     for _ in range(200):
-        if g(hi) > 0.0:
+        ghi = _slip_g(A, b, mu, hi, lam, Q, cc, dd, s)
+        if ghi > 0.0:
+            found = True
             break
         hi *= 2.0
-    else:
-        return rs if rs[0] >= 0.0 else r      # no slip root (a Painlevé-like block)
-    rho = brentq(g, 0.0, hi, xtol=1e-300, rtol=8.9e-16, maxiter=400)
-    s = direction(rho)
+    if not found:
+        # no slip root (a Painlevé-like block)
+        if solved and rs[0] >= 0.0:
+            for k in range(m):
+                r[k] = rs[k]
+        return
+    rho = _brent(A, b, mu, 0.0, hi, b[0], ghi, lam, Q, cc, dd, s)
+    _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s)
     r[0] = rho
-    r[1:] = -mu * rho * s
-    return r
+    for k in range(m - 1):
+        r[k + 1] = -mu * rho * s[k]
+
+
+@njit(cache=True)
+def _brent(A, b, mu, xa, xb, fa, fb, lam, Q, cc, dd, s):
+    # a root of g in [xa, xb] (fa, fb of opposite signs) to |dx| <= 4e-16 |x| (8.9e-16 rtol
+    # over two), keeping a bracket [b, c] with |g(b)| <= |g(c)| and the step before last
+    if fa == 0.0:
+        return xa
+    if fb == 0.0:
+        return xb
+    xc, fc = xa, fa
+    e = xb - xa
+    dstep = e
+    for _ in range(400):
+        if (fb > 0.0) == (fc > 0.0):
+            xc, fc = xa, fa
+            e = xb - xa
+            dstep = e
+        if abs(fc) < abs(fb):
+            xa, fa = xb, fb
+            xb, fb = xc, fc
+            xc, fc = xa, fa
+        tol = 2.0 * 4.45e-16 * abs(xb) + 0.5e-300
+        half = 0.5 * (xc - xb)
+        if abs(half) <= tol or fb == 0.0:
+            return xb
+        if abs(e) >= tol and abs(fa) > abs(fb):
+            # interpolation: secant when two points coincide, else inverse quadratic
+            sb = fb / fa
+            if xa == xc:
+                pp = 2.0 * half * sb
+                qq = 1.0 - sb
+            else:
+                qa = fa / fc
+                rb = fb / fc
+                pp = sb * (2.0 * half * qa * (qa - rb) - (xb - xa) * (rb - 1.0))
+                qq = (qa - 1.0) * (rb - 1.0) * (sb - 1.0)
+            if pp > 0.0:
+                qq = -qq
+            else:
+                pp = -pp
+            if 2.0 * pp < min(3.0 * half * qq - abs(tol * qq), abs(e * qq)):
+                e = dstep
+                dstep = pp / qq
+            else:
+                dstep = half
+                e = dstep
+        else:
+            dstep = half
+            e = dstep
+        xa, fa = xb, fb
+        if abs(dstep) > tol:
+            xb += dstep
+        else:
+            xb += tol if half > 0.0 else -tol
+        fb = _slip_g(A, b, mu, xb, lam, Q, cc, dd, s)
+    return xb
+
+
+@njit(cache=True)
+def _contensou_gs(W, q, mu, starts, r, u, bound_sq, max_sweeps):
+    # solve_exact_contensou's Gauss–Seidel sweeps from r with u = W r + q (both updated);
+    # returns (sweeps, squared residual)
+    nc = mu.shape[0]
+    n = q.shape[0]
+    res = _natural_sq_blocks(r, u, mu, starts)
+    sweeps = 0
+    while res > bound_sq and sweeps < max_sweeps:
+        for i in range(nc):
+            a, b = starts[i], starts[i + 1]
+            m = b - a
+            A = np.ascontiguousarray(W[a:b, a:b])
+            bl = np.empty(m)
+            for j in range(m):
+                acc = 0.0
+                for k in range(m):
+                    acc += A[j, k] * r[a + k]
+                bl[j] = u[a + j] - acc
+            ri = np.empty(m)
+            _local_nd(A, bl, mu[i], ri)
+            for j in range(n):
+                acc = 0.0
+                for k in range(m):
+                    acc += W[j, a + k] * (ri[k] - r[a + k])
+                u[j] += acc
+            for k in range(m):
+                r[a + k] = ri[k]
+        _affine_into(W, q, r, u)
+        sweeps += 1
+        res = _natural_sq_blocks(r, u, mu, starts)
+        if nc == 1:
+            break
+    return sweeps, res
 
 
 def check_block_problem(W, q, mu, sizes):
@@ -1752,24 +1951,11 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
         raise InputError(f"`max_sweeps` must be an integer >= 1, got {max_sweeps!r}")
     nc = mu.shape[0]
     r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
-    u = W @ r + q
+    u = np.empty_like(q)
+    _affine_into(W, q, r, u)
     qn = float(np.linalg.norm(q))
     scale = qn if qn > 0.0 else 1.0
-    bound_sq = (tol * scale) ** 2
-    res = _natural_sq_blocks(r, u, mu, starts)
-    sweeps = 0
-    while res > bound_sq and sweeps < max_sweeps:
-        for i in range(nc):
-            a, b = starts[i], starts[i + 1]
-            A = W[a:b, a:b]
-            ri = _local_nd(A, u[a:b] - A @ r[a:b], mu[i])
-            u += W[:, a:b] @ (ri - r[a:b])
-            r[a:b] = ri
-        u = W @ r + q
-        sweeps += 1
-        res = _natural_sq_blocks(r, u, mu, starts)
-        if nc == 1:
-            break
+    sweeps, res = _contensou_gs(W, q, mu, starts, r, u, (tol * scale) ** 2, int(max_sweeps))
     res = math.sqrt(res)
     status = CONVERGED if res <= tol * scale else NOT_CONVERGED
     detail = (f"{sweeps} Gauss–Seidel sweep(s) with the exact local solve over "
