@@ -102,6 +102,7 @@ __all__ = [
     "local_solve_contensou",
     "check_block_problem",
     "solve_exact_contensou",
+    "contensou_gauss_seidel",
     "CONVERGED",
     "NOT_CONVERGED",
 ]
@@ -1813,9 +1814,30 @@ def _brent(A, b, mu, xa, xb, fa, fb, lam, Q, cc, dd, s):
 
 
 @njit(cache=True)
-def _contensou_gs(W, q, mu, starts, r, u, bound_sq, max_sweeps):
-    # solve_exact_contensou's Gauss–Seidel sweeps from r with u = W r + q (both updated);
-    # returns (sweeps, squared residual)
+def contensou_gauss_seidel(W, q, mu, starts, r, u, bound_sq, max_sweeps):
+    """:func:`solve_exact_contensou`'s Gauss–Seidel sweeps, compiled and unchecked.
+
+    From ``r`` with ``u = W r + q`` (both updated in place), contact ``i``
+    owning the rows ``starts[i]:starts[i + 1]``, sweeps until the squared
+    natural-map residual is ``<= bound_sq`` or ``max_sweeps`` ran (one sweep
+    for one contact). For compiled callers (a time-stepping loop) on
+    contiguous float arrays and an int64 ``starts``.
+
+    Returns
+    -------
+    sweeps : int
+    residual_sq : float
+        The squared residual on the data after the sweeps.
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5, 3.5]); q = np.array([-1.0, 3.0, 0.0, 4.0])
+    >>> r = np.zeros(4); u = q.copy()
+    >>> sweeps, res = contensou_gauss_seidel(W, q, np.array([0.5]), np.array([0, 4]), r, u,
+    ...                                      1e-20, 500)
+    >>> sweeps, (np.round(r, 12) + 0.0).tolist()
+    (1, [1.0, -0.3, 0.0, -0.4])
+    """
     nc = mu.shape[0]
     n = q.shape[0]
     res = _natural_sq_blocks(r, u, mu, starts)
@@ -1955,7 +1977,7 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
     _affine_into(W, q, r, u)
     qn = float(np.linalg.norm(q))
     scale = qn if qn > 0.0 else 1.0
-    sweeps, res = _contensou_gs(W, q, mu, starts, r, u, (tol * scale) ** 2, int(max_sweeps))
+    sweeps, res = contensou_gauss_seidel(W, q, mu, starts, r, u, (tol * scale) ** 2, int(max_sweeps))
     res = math.sqrt(res)
     status = CONVERGED if res <= tol * scale else NOT_CONVERGED
     detail = (f"{sweeps} Gauss–Seidel sweep(s) with the exact local solve over "
