@@ -790,6 +790,15 @@ def _local(A, b, mu):
         if rn >= 0.0 and math.hypot(r1, r2) <= mu * rn:
             return rn, r1, r2
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
+    if (A[0, 1] == 0.0 and A[1, 0] == 0.0 and A[0, 2] == 0.0 and A[2, 0] == 0.0
+            and A[1, 2] == 0.0 and A[2, 1] == 0.0 and A[1, 1] == A[2, 2]):
+        # an isotropic block (a sphere or a point under its centre of mass): F = A_NN (c b_2
+        # - s b_1), whose one admissible root slides against b_T (the other has s . u_T < 0
+        # where stick failed): r = rho (1, -mu b_T / |b_T|), rho = -b_N / A_NN
+        bt = math.hypot(b[1], b[2])
+        if bt > 0.0:
+            rho = -b[0] / A[0, 0]
+            return rho, -mu * rho * (b[1] / bt), -mu * rho * (b[2] / bt)
     best_n, best_1, best_2 = -b[0] / A[0, 0], 0.0, 0.0
     best = _local_res_sq(A, b, mu, best_n, best_1, best_2)
     c0, s0 = 1.0, 0.0

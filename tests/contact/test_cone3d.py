@@ -386,3 +386,22 @@ def test_one_contact_s_closed_form_is_lemke_s_answer_on_random_problems():
             # refused (r untouched, for the caller's Lemke): never without coupling
             assert r.tolist() == [0.0, 0.0, 0.0] and W[0, 1] != 0.0
     assert certified >= 125
+
+
+def test_an_isotropic_block_s_slip_in_closed_form_is_the_sampled_root():
+    # a sphere's or a point's block diag(a, b, b) slides against b_T in closed form; the same
+    # block with a negligible coupling (1e-300) takes the sampled and refined sliding angle
+    rng = np.random.default_rng(37)
+    for _ in range(20):
+        A = np.diag([rng.uniform(0.5, 2.0), *[rng.uniform(0.5, 4.0)] * 2])
+        mu = rng.uniform(0.05, 0.5)
+        # |b_T| beyond the stick bound mu A_TT (-b_N) / A_NN, in a random direction
+        phi = rng.uniform(0.0, 2.0 * math.pi)
+        bn = -rng.uniform(0.1, 1.0)
+        size = rng.uniform(1.5, 5.0) * mu * A[1, 1] * -bn / A[0, 0]
+        b = np.array([bn, size * math.cos(phi), size * math.sin(phi)])
+        nudged = A.copy()
+        nudged[0, 1] = nudged[1, 0] = 1e-300
+        r, ref = local_solve(A, b, mu), local_solve(nudged, b, mu)
+        assert math.hypot(r[1], r[2]) == pytest.approx(mu * r[0], rel=1e-15)   # it slips
+        np.testing.assert_allclose(r, ref, rtol=0, atol=2e-15 * np.max(np.abs(ref)))
