@@ -1986,7 +1986,8 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
     _affine_into(W, q, r, u)
     qn = float(np.linalg.norm(q))
     scale = qn if qn > 0.0 else 1.0
-    sweeps, res = contensou_gauss_seidel(W, q, mu, starts, r, u, (tol * scale) ** 2, int(max_sweeps))
+    sweeps, res = contensou_gauss_seidel(W, q, mu, starts, r, u, (tol * scale) ** 2,
+                                         int(max_sweeps))
     res = math.sqrt(res)
     status = CONVERGED if res <= tol * scale else NOT_CONVERGED
     detail = (f"{sweeps} Gauss–Seidel sweep(s) with the exact local solve over "
