@@ -39,7 +39,10 @@ with ``c = 0`` it gives Siconos's ``SphereNEDSPlanR`` run bit for bit (a row
 under the sphere's). Its ``computeh`` is a Python callback each step, so the
 tippe top's Siconos time includes that; the same row measures it (about 25
 us a step, more than Siconos's whole step on the sphere). All three scenes
-are stated in Siconos's Python API; none is left out.
+are stated in Siconos's Python API; none is left out. A row under the tippe
+top's gives our time a step on Leine and Glocker's top with its contact
+patch (``contact_radius=5e-4``: Coulomb–Contensou friction, the exact cone),
+which Siconos's frictional contact does not model.
 
 The table gives, per scene, the largest difference over the window between
 the two codes (position and velocity [SI], every step; for the tippe top also
@@ -293,6 +296,16 @@ def main(argv=None):
                      f"{d['position']:12.2e} {d['velocity']:14.2e} {d['angular']:14.2e} {axis} "
                      f"{us[0]:15.1f} {us[1]:13.1f} {us[2]:12.1f} {us[2] / us[0]:7.1f} "
                      f"{us[2] / us[1]:6.1f}{note}")
+        if name == "tippe-top":
+            # Leine and Glocker's top with its contact patch (Coulomb–Contensou friction, the
+            # exact cone only; Siconos has no drilling friction): ours alone, same window
+            from moreau.scenes.tippe_top import LEINE_GLOCKER_PATCH
+            patched = make_scene(name, contact_radius=LEINE_GLOCKER_PATCH)
+            run = ours(patched, window, args.steps, args.theta, "exact", args.repeat,
+                       record=False)
+            lines.append(f"  (tippe-top with its patch, contact_radius {LEINE_GLOCKER_PATCH:g} m, "
+                         f"exact cone: ours {1e6 * run['cpu_seconds'] / run['steps']:.1f} us a "
+                         f"step)")
         if name == "sphere-incline":
             # the tippe top's Python relation on the sphere (centre offset 0): the same run
             # as SphereNEDSPlanR's, and the cost of its Python callback

@@ -75,7 +75,6 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy.optimize import brentq
 
 from .._validate import finite_array
 from ..errors import InputError
@@ -90,16 +89,20 @@ __all__ = [
     "PolyhedralLCP",
     "build_polyhedral_lcp",
     "solve_polyhedral",
+    "polyhedral_one_contact",
+    "ONE_CONTACT_TOL",
     "local_solve",
     "solve_exact",
     "solve_cone",
     "exact_gauss_seidel",
+    "exact_gauss_seidel_into",
     "exact_newton_polish",
     "natural_map_sq",
     "project_contensou",
     "local_solve_contensou",
     "check_block_problem",
     "solve_exact_contensou",
+    "contensou_gauss_seidel",
     "CONVERGED",
     "NOT_CONVERGED",
 ]
@@ -467,6 +470,198 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
                         {"pivots": int(res.pivots)}, f"polyhedral-{lcp.d}", detail, lcp=res)
 
 
+#: the violation (in :func:`moreau.lcp.lcp_violation`'s units) below which
+#: :func:`polyhedral_one_contact`'s answer is certified (Lemke's own bound is 1e-9)
+ONE_CONTACT_TOL = 1e-12
+
+
+@njit(cache=True)
+def polyhedral_one_contact(W, q, mu, D, r):
+    """One contact's polyhedral problem (:func:`build_polyhedral_lcp`) in closed form, certified.
+
+    The LCP of one contact, ``z = (r_N, beta, lambda)``, has three kinds of
+    answer, tried in turn: take-off (``r = 0``, ``lambda = max_k -D_k.u_T``:
+    an answer whenever ``q_N >= 0``), stick (``r = -W^-1 q`` inside the
+    pyramid, ``lambda = 0``) and slip, ``r_T = mu r_N t`` with ``t`` on the
+    polygon's boundary: at a vertex ``D_k`` (``beta_k = mu r_N``) or on the
+    facet from ``D_k`` to ``D_k+1`` (two betas; a 2 x 2 system for ``r_N``
+    and the split), with ``u_N = 0`` and ``-lambda = D_k.u_T`` the least of
+    the ``D_j.u_T``. The facet the stick impulse points through is tried,
+    then its vertices and the facets beside them. A candidate counts where it
+    meets the LCP's conditions to :data:`ONE_CONTACT_TOL` in the units of
+    :func:`moreau.lcp.lcp_violation` (with a bound on ``max|M|``: stricter than
+    Lemke's 1e-9). It is tried only far from Painlevé's coupling, ``2 mu
+    |W_NT| < W_NN``, where an impulse along any ``t`` pushes the normal
+    velocity up; nearer, the LCP may have several answers (a jam beside a
+    take-off) and the caller's Lemke picks one (the test suite holds this
+    function to Lemke's answer on random problems).
+
+    Parameters
+    ----------
+    W : ndarray, shape (3, 3)
+        The contact's Delassus block, symmetric positive definite.
+    q : ndarray, shape (3,)
+        Its free velocity ``[N, T1, T2]``.
+    mu : float
+    D : ndarray, shape (2, d)
+        The directions (:func:`facet_directions`).
+    r : ndarray, shape (3,)
+        Receives the impulse where the answer is certified.
+
+    Returns
+    -------
+    bool
+        False where no candidate passed (``r`` untouched): the caller solves
+        the LCP (Lemke).
+
+    Examples
+    --------
+    >>> r = np.zeros(3)
+    >>> W = np.diag([1.0, 3.5, 3.5]); D = facet_directions(4)
+    >>> bool(polyhedral_one_contact(W, np.array([-1.0, 0.5, 0.0]), 0.5, D, r))   # sticks
+    True
+    >>> (np.round(r, 12) + 0.0).tolist()
+    [1.0, -0.142857142857, 0.0]
+    >>> bool(polyhedral_one_contact(W, np.array([-1.0, 3.0, 0.0]), 0.5, D, r))   # slips
+    True
+    >>> (np.round(r, 12) + 0.0).tolist()
+    [1.0, -0.5, 0.0]
+    """
+    # As j -> D_j.u_T samples |u_T| cos(angle), a least value against both neighbours is the
+    # least of all: a slip candidate is checked against every direction all the same
+    d = D.shape[1]
+    n0, f1, f2 = q[0], q[1], q[2]
+    if 2.0 * mu * math.hypot(W[0, 1], W[0, 2]) >= W[0, 0]:
+        # far from Painlevé's coupling only (an impulse along any t of the polygon pushes
+        # the normal velocity up: W_NN - mu |W_NT| > W_NN / 2), where the answer is unique;
+        # nearer, the LCP may have several (a jam beside a take-off) and Lemke's path picks one
+        return False
+    if n0 >= 0.0:
+        r[0] = 0.0
+        r[1] = 0.0
+        r[2] = 0.0
+        return True
+    if mu <= 0.0:
+        return False
+    # the LCP's scales: s = max|q| (q_lcp = (q_N, D^T q_T, 0)) and a bound on max|M| (its
+    # entries are W_NN, W_N.D_k, D_j.W_TT D_k, 1 and mu), so the bounds are tighter than Lemke's
+    sc = abs(n0)
+    for k in range(d):
+        sc = max(sc, abs(D[0, k] * f1 + D[1, k] * f2))
+    mm = max(1.0, mu, abs(W[0, 0]), abs(W[0, 1]) + abs(W[0, 2]),
+             abs(W[1, 1]) + abs(W[1, 2]) + abs(W[2, 1]) + abs(W[2, 2]))
+    tol_w = ONE_CONTACT_TOL * sc
+    tol_z = tol_w / mm
+    # stick: W r = -q by Cramer's rule
+    c00 = W[1, 1] * W[2, 2] - W[1, 2] * W[2, 1]
+    c01 = W[1, 2] * W[2, 0] - W[1, 0] * W[2, 2]
+    c02 = W[1, 0] * W[2, 1] - W[1, 1] * W[2, 0]
+    det = W[0, 0] * c00 + W[0, 1] * c01 + W[0, 2] * c02
+    a1, a2 = -f1, -f2                      # the sliding impulse's direction, failing stick
+    if det > 0.0:
+        i01 = W[0, 2] * W[2, 1] - W[0, 1] * W[2, 2]
+        i11 = W[0, 0] * W[2, 2] - W[0, 2] * W[2, 0]
+        i21 = W[0, 1] * W[2, 0] - W[0, 0] * W[2, 1]
+        i02 = W[0, 1] * W[1, 2] - W[0, 2] * W[1, 1]
+        i12 = W[0, 2] * W[1, 0] - W[0, 0] * W[1, 2]
+        i22 = W[0, 0] * W[1, 1] - W[0, 1] * W[1, 0]
+        rn = -(c00 * n0 + i01 * f1 + i02 * f2) / det
+        r1 = -(c01 * n0 + i11 * f1 + i12 * f2) / det
+        r2 = -(c02 * n0 + i21 * f1 + i22 * f2) / det
+        if rn >= 0.0:
+            # inside the polygon of vertices mu r_N D_k: below every facet's line, whose
+            # outward normal is D_k + D_k+1 and whose offset is mu r_N (1 + D_k.D_k+1)
+            inside = True
+            for k in range(d):
+                k1 = (k + 1) % d
+                e1 = D[0, k] + D[0, k1]
+                e2 = D[1, k] + D[1, k1]
+                if e1 * r1 + e2 * r2 > mu * rn * (1.0 + D[0, k] * D[0, k1] + D[1, k] * D[1, k1]):
+                    inside = False
+                    break
+            if inside:
+                r[0] = rn
+                r[1] = r1
+                r[2] = r2
+                return True
+            a1, a2 = r1, r2
+    # slip: the facet that the stick impulse (or -q_T) points through, then its two
+    # vertices, then the facets beside them
+    step = 2.0 * math.pi / d
+    k0 = int(math.floor(math.atan2(a2, a1) / step)) % d
+    for trial in range(5):
+        if trial == 0:
+            k, facet = k0, True
+        elif trial < 3:
+            k, facet = (k0 + trial - 1) % d, False
+        else:
+            k, facet = (k0 - 1 if trial == 3 else k0 + 1) % d, True
+        if _slip_candidate(W, n0, f1, f2, mu, D, d, k, facet, tol_w, tol_z, r):
+            return True
+    return False
+
+
+@njit(cache=True)
+def _slip_candidate(W, n0, f1, f2, mu, D, d, k, facet, tol_w, tol_z, r):
+    # slip at vertex k (facet False) or on the facet k -> k+1; writes r where certified
+    k1 = (k + 1) % d
+    dk0, dk1 = D[0, k], D[1, k]
+    wn_k = W[0, 1] * dk0 + W[0, 2] * dk1
+    if facet:
+        e0, e1 = D[0, k1] - dk0, D[1, k1] - dk1
+        wn_e = W[0, 1] * e0 + W[0, 2] * e1
+        # e.W_TT d_k, e.W_TT e and e.W_TN
+        te0 = W[1, 1] * dk0 + W[1, 2] * dk1
+        te1 = W[2, 1] * dk0 + W[2, 2] * dk1
+        ee0 = W[1, 1] * e0 + W[1, 2] * e1
+        ee1 = W[2, 1] * e0 + W[2, 2] * e1
+        a11 = W[0, 0] + mu * wn_k
+        a12 = mu * wn_e
+        a21 = e0 * W[1, 0] + e1 * W[2, 0] + mu * (e0 * te0 + e1 * te1)
+        a22 = mu * (e0 * ee0 + e1 * ee1)
+        b2 = -(e0 * f1 + e1 * f2)
+        det = a11 * a22 - a12 * a21
+        if det == 0.0:
+            return False
+        x = (-n0 * a22 - a12 * b2) / det       # r_N
+        y = (a11 * b2 + a21 * n0) / det        # r_N alpha
+        if not (x > 0.0 and y >= 0.0 and y <= x):
+            return False
+        t1 = x * dk0 + y * e0
+        t2 = x * dk1 + y * e1
+        rn = x
+        r1 = mu * t1
+        r2 = mu * t2
+        bk, bk1 = mu * (x - y), mu * y
+    else:
+        g = W[0, 0] + mu * wn_k
+        if not g > 0.0:
+            return False
+        rn = -n0 / g
+        r1 = mu * rn * dk0
+        r2 = mu * rn * dk1
+        bk, bk1 = mu * rn, 0.0
+    # the LCP's w at this z: u_N, D_j.u_T + lambda, mu r_N - sum beta
+    un = W[0, 0] * rn + W[0, 1] * r1 + W[0, 2] * r2 + n0
+    u1 = W[1, 0] * rn + W[1, 1] * r1 + W[1, 2] * r2 + f1
+    u2 = W[2, 0] * rn + W[2, 1] * r1 + W[2, 2] * r2 + f2
+    lam = -(dk0 * u1 + dk1 * u2)
+    if lam < -tol_z or abs(un) > tol_w or abs(mu * rn - bk - bk1) > tol_w:
+        return False
+    # every D_j.u_T + lambda >= 0, = 0 (to the bound) where beta_j > 0
+    for j in range(d):
+        wj = D[0, j] * u1 + D[1, j] * u2 + lam
+        if wj < -tol_w:
+            return False
+        bj = bk if j == k else bk1 if j == k1 else 0.0
+        if bj > tol_z and wj > tol_w:
+            return False
+    r[0] = rn
+    r[1] = r1
+    r[2] = r2
+    return True
+
+
 # --------------------------------------------------------------------------- exact cone
 
 @njit(cache=True)
@@ -480,15 +675,9 @@ def _local_res_sq(A, b, mu, rn, r1, r2):
 
 
 @njit(cache=True, inline="always")
-def _slip_fn(A, b, mu, phi):
-    # with s = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
-    # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
-    return _slip_cs(A, b, mu, math.cos(phi), math.sin(phi))
-
-
-@njit(cache=True, inline="always")
 def _slip_cs(A, b, mu, c, s):
-    # _slip_fn at the angle whose cosine and sine are c and s
+    # with s = (c, s) = (cos phi, sin phi), r = rho (1, -mu s) and u_N = 0:
+    # rho = -b_N / g, g u_T = h; returns (s_perp . h, s . h, g)
     g = A[0, 0] - mu * (A[0, 1] * c + A[0, 2] * s)
     h1 = -b[0] * (A[1, 0] - mu * (A[1, 1] * c + A[1, 2] * s)) + g * b[1]
     h2 = -b[0] * (A[2, 0] - mu * (A[2, 1] * c + A[2, 2] * s)) + g * b[2]
@@ -496,8 +685,8 @@ def _slip_cs(A, b, mu, c, s):
 
 
 _N_SAMPLES = 64
-# the samples' upper ends as _local's loop computes them (k step + step) and their cosines and
-# sines, computed once: the loop's trigonometry is then its bisections' only
+# the samples' upper ends (k step + step) and their cosines and sines, computed once: the
+# slip's solve has no trigonometry (_refine_angle turns rationally from a sample's start)
 _SAMPLE_STEP = 2.0 * math.pi / _N_SAMPLES
 _SAMPLE_COS = np.array([math.cos(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
 _SAMPLE_SIN = np.array([math.sin(k * _SAMPLE_STEP + _SAMPLE_STEP) for k in range(_N_SAMPLES)])
@@ -509,33 +698,51 @@ _RESTART_D = 16
 
 #: the sliding angle's bracket is refined to this width [rad] (a few rounding units of 2 pi)
 _ANGLE_TOL = 4e-15
+#: the tangent of half a sample's width: a bracket's parameter t runs over [0, _SAMPLE_T]
+_SAMPLE_T = math.tan(0.5 * _SAMPLE_STEP)
 
 
 @njit(cache=True, inline="always")
-def _refine_angle(A, b, mu, lo, hi, flo, fhi):
-    # a root of the slip function in [lo, hi] (flo, fhi of opposite signs) by the Illinois
-    # variant of regula falsi (superlinear, the bracket kept): a dozen evaluations where
-    # bisection takes fifty; a step that rounding puts outside the bracket bisects instead.
-    # Returns the end of least |F| once the bracket is _ANGLE_TOL wide
+def _turn(c0, s0, t):
+    # (cos, sin) of the angle phi0 + 2 atan(t), rational in t: no trigonometry, and of unit
+    # norm to rounding since (1 - t^2)^2 + (2 t)^2 = (1 + t^2)^2
+    den = 1.0 + t * t
+    a = (1.0 - t * t) / den
+    bb = 2.0 * t / den
+    return a * c0 - bb * s0, a * s0 + bb * c0
+
+
+@njit(cache=True, inline="always")
+def _refine_angle(A, b, mu, c0, s0, flo, fhi):
+    # a root of the slip function in the sample [phi0, phi0 + step] (cos phi0 = c0, sin phi0 =
+    # s0; flo, fhi its ends' values, of opposite signs) as (cos, sin), by the Illinois variant
+    # of regula falsi (superlinear, the bracket kept) on t = tan((phi - phi0) / 2) in [0,
+    # _SAMPLE_T]: each evaluation rational, without the cosine and sine an angle would cost
+    # (they were two thirds of a slip's solve); a step that rounding puts outside the bracket
+    # bisects instead. Stops once the bracket is _ANGLE_TOL wide in the angle (dphi = 2 dt /
+    # (1 + t^2) <= 2 dt) and returns the end of least |F|; t = _SAMPLE_T returns the sample's
+    # end (hi) itself, as (nan, nan), for the caller's table
+    lo, hi = 0.0, _SAMPLE_T
     wlo, whi = flo, fhi           # the weights Illinois halves; flo, fhi stay the values
     side = 0
     for _ in range(100):
-        if hi - lo <= _ANGLE_TOL:
+        if hi - lo <= 0.5 * _ANGLE_TOL:
             break
         x = hi - whi * (hi - lo) / (whi - wlo)
         if not lo < x < hi:
             # the secant lands on an end: a root there to rounding (a launch along a
             # sample's direction) when that end's F is rounding beside the other's
             if x <= lo and abs(flo) <= 1e-14 * abs(fhi):
-                return lo
+                return _end(c0, s0, lo)
             if x >= hi and abs(fhi) <= 1e-14 * abs(flo):
-                return hi
+                return _end(c0, s0, hi)
             x = 0.5 * (lo + hi)
             if not lo < x < hi:
                 break
-        fx, _, _ = _slip_fn(A, b, mu, x)
+        cx, sx = _turn(c0, s0, x)
+        fx, _, _ = _slip_cs(A, b, mu, cx, sx)
         if fx == 0.0:
-            return x
+            return cx, sx
         if (fx < 0.0) == (flo < 0.0):
             lo, flo, wlo = x, fx, fx
             if side < 0:
@@ -546,7 +753,15 @@ def _refine_angle(A, b, mu, lo, hi, flo, fhi):
             if side > 0:
                 wlo *= 0.5
             side = 1
-    return lo if abs(flo) <= abs(fhi) else hi
+    return _end(c0, s0, lo if abs(flo) <= abs(fhi) else hi)
+
+
+@njit(cache=True, inline="always")
+def _end(c0, s0, t):
+    # the bracket's answer t; its upper end _SAMPLE_T as (nan, nan): the caller's table has it
+    if t == _SAMPLE_T:
+        return math.nan, math.nan
+    return _turn(c0, s0, t)
 
 
 @njit(cache=True)
@@ -576,18 +791,28 @@ def _local(A, b, mu):
         if rn >= 0.0 and math.hypot(r1, r2) <= mu * rn:
             return rn, r1, r2
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
+    if (A[0, 1] == 0.0 and A[1, 0] == 0.0 and A[0, 2] == 0.0 and A[2, 0] == 0.0
+            and A[1, 2] == 0.0 and A[2, 1] == 0.0 and A[1, 1] == A[2, 2]):
+        # an isotropic block (a sphere or a point under its centre of mass): F = A_NN (c b_2
+        # - s b_1), whose one admissible root slides against b_T (the other has s . u_T < 0
+        # where stick failed): r = rho (1, -mu b_T / |b_T|), rho = -b_N / A_NN
+        bt = math.hypot(b[1], b[2])
+        if bt > 0.0:
+            rho = -b[0] / A[0, 0]
+            return rho, -mu * rho * (b[1] / bt), -mu * rho * (b[2] / bt)
     best_n, best_1, best_2 = -b[0] / A[0, 0], 0.0, 0.0
     best = _local_res_sq(A, b, mu, best_n, best_1, best_2)
-    step = 2.0 * math.pi / _N_SAMPLES
-    fa, _, _ = _slip_fn(A, b, mu, 0.0)
+    c0, s0 = 1.0, 0.0
+    fa, _, _ = _slip_cs(A, b, mu, c0, s0)
     for k in range(_N_SAMPLES):
-        lo = k * step
-        hi = lo + step
-        fb, _, _ = _slip_cs(A, b, mu, _SAMPLE_COS[k], _SAMPLE_SIN[k])
+        c1, s1 = _SAMPLE_COS[k], _SAMPLE_SIN[k]
+        fb, _, _ = _slip_cs(A, b, mu, c1, s1)
         if fa == 0.0 or fa * fb < 0.0:
-            phi = lo if fa == 0.0 else _refine_angle(A, b, mu, lo, hi, fa, fb)
-            c = math.cos(phi)
-            sn = math.sin(phi)
+            c, sn = c0, s0
+            if fa != 0.0:
+                c, sn = _refine_angle(A, b, mu, c0, s0, fa, fb)
+                if math.isnan(c):
+                    c, sn = c1, s1
             _, along, g = _slip_cs(A, b, mu, c, sn)
             if g > 0.0 and along >= 0.0:
                 rho = -b[0] / g
@@ -598,6 +823,7 @@ def _local(A, b, mu):
                 if res < best:
                     best, best_n, best_1, best_2 = res, rn, r1, r2
         fa = fb
+        c0, s0 = c1, s1
     return best_n, best_1, best_2
 
 
@@ -609,7 +835,9 @@ def local_solve(A, b, mu):
     with ``u_N = 0`` giving ``rho = -b_N / g(phi)``, ``g = A_NN - mu A_NT s``,
     and the sliding angle a root of ``s_perp . u_T(phi) = 0`` with ``s .
     u_T >= 0``, bracketed on 64 samples of ``[0, 2 pi)`` and refined by
-    the Illinois variant of regula falsi to a bracket ``4e-15`` rad wide. Of
+    the Illinois variant of regula falsi on ``tan`` of the half angle from
+    the sample's start (the cosine and sine rational in it: no
+    trigonometry) to a bracket ``4e-15`` rad wide. Of
     several admissible roots the one with the least residual is kept.
 
     Examples
@@ -642,10 +870,16 @@ def _pgs(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall):
     # relax < 1 moves each contact part way to its local solution (a convex
     # combination, so r stays in K); the sweeps stop after `stall` of them
     # without a new least residual (Gauss–Seidel can cycle when mu is large)
+    return _pgs_into(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall, np.empty((3, 3)),
+                     np.empty(3))
+
+
+@njit(cache=True)
+def _pgs_into(W, q, mu, r, u, max_sweeps, tol_sq, relax, stall, A, b):
+    # _pgs with its local block A (at least 3 x 3) and right-hand side b given: a
+    # time-stepping loop passes its own scratch (nothing allocated a step)
     nc = mu.shape[0]
     n = 3 * nc
-    A = np.empty((3, 3))
-    b = np.empty(3)
     res = _natural_sq(r, u, mu)
     best = res
     since = 0
@@ -912,6 +1146,28 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
     (True, [1.0, -0.3, -0.4], 5.0990195135927845)
     """
     n = q.shape[0]
+    return exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps,
+                                   np.empty((3, 3)), np.empty(3), np.empty(n), np.empty(n))
+
+
+@njit(cache=True)
+def exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps, A, b, r_in, u_in):
+    """:func:`exact_gauss_seidel` on the caller's scratch: ``A`` (at least 3 x 3), ``b`` (at
+    least 3), ``r_in`` and ``u_in`` (at least ``q``'s length); the same operations.
+
+    For a time-stepping loop that allocates nothing a step.
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5]); q = np.array([-1.0, 3.0, 4.0])
+    >>> r = np.zeros(3); u = q.copy()
+    >>> ok, res, qn = exact_gauss_seidel_into(W, q, np.array([0.5]), r, u, 1e-10, 1e-6, 500,
+    ...                                       np.empty((3, 3)), np.empty(3), np.empty(3),
+    ...                                       np.empty(3))
+    >>> bool(ok), np.round(r, 12).tolist()
+    (True, [1.0, -0.3, -0.4])
+    """
+    n = q.shape[0]
     qn = 0.0
     for j in range(n):
         qn += q[j] * q[j]
@@ -919,15 +1175,17 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
     scale = qn if qn > 0.0 else 1.0
     tol_sq = (tol * scale) ** 2
     switch_sq = (max(tol, polish_from) * scale) ** 2
-    _, res = _pgs(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL)
+    _, res = _pgs_into(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL, A, b)
     if res > tol_sq:
         return False, math.sqrt(res), qn
-    r_in = _project_all(r, mu)
-    u_in = np.empty(n)
+    for i in range(mu.shape[0]):
+        k = 3 * i
+        r_in[k], r_in[k + 1], r_in[k + 2] = _proj(r[k], r[k + 1], r[k + 2], mu[i])
     _affine_into(W, q, r_in, u_in)
     if _natural_sq(r_in, u_in, mu) <= max(res, tol_sq):
-        r[:] = r_in
-        u[:] = u_in
+        for j in range(n):
+            r[j] = r_in[j]
+            u[j] = u_in[j]
     res = math.sqrt(_natural_sq(r, u, mu))
     return res <= tol * scale, res, qn
 
@@ -1288,39 +1546,66 @@ def project_contensou(x, mu, lever):
     return p
 
 
+@njit(cache=True)
 def _natural_sq_blocks(r, u, mu, starts):
+    # sum over contacts of |r - proj_K(r - û)|^2, a contact's rows starts[i]:starts[i+1]
     total = 0.0
     for i in range(mu.shape[0]):
         a, b = starts[i], starts[i + 1]
-        ut = u[a + 1:b]
-        x = r[a:b] - u[a:b]
-        x[0] = r[a] - (u[a] + mu[i] * float(np.linalg.norm(ut)))
-        total += float(np.sum((r[a:b] - _proj_nd(x, mu[i])) ** 2))
+        m = mu[i]
+        ut = 0.0
+        for j in range(a + 1, b):
+            ut += u[j] * u[j]
+        xn = r[a] - (u[a] + m * math.sqrt(ut))
+        xt = 0.0
+        for j in range(a + 1, b):
+            xt += (r[j] - u[j]) ** 2
+        xt = math.sqrt(xt)
+        # the projection of x = (xn, x_T) on {|t| <= m n}: x, the apex, or scaled onto the cone
+        if xt <= m * xn:
+            pn, f = xn, 1.0
+        elif m * xt <= -xn:
+            pn, f = 0.0, 0.0
+        else:
+            pn = (xn + m * xt) / (1.0 + m * m)
+            f = m * pn / xt
+        total += (r[a] - pn) ** 2
+        for j in range(a + 1, b):
+            total += (r[j] - f * (r[j] - u[j])) ** 2
     return total
 
 
-def _secular(c, d):
-    # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0:
-    # 1/|s(alpha)| - 1 is concave and increasing, so Newton from the left end of the bracket
-    # [|c| - max d, |c| - min d] climbs monotonically to the root (bisection guards rounding).
-    # c, d: lists of floats (two or three tangential rows: plain floats beat array calls)
-    cn = math.sqrt(sum(x * x for x in c))
+@njit(cache=True)
+def _secular(c, d, m):
+    # alpha >= 0 with |(diag(d) + alpha)^-1 c| = 1 (d >= 0), or 0 where that norm is <= 1 at 0,
+    # over the first m entries: 1/|s(alpha)| - 1 is concave and increasing, so Newton from
+    # the left end of the bracket [|c| - max d, |c| - min d] climbs monotonically to the root
+    # (bisection guards rounding)
+    cn = 0.0
+    for k in range(m):
+        cn += c[k] * c[k]
+    cn = math.sqrt(cn)
     if cn == 0.0:
         return 0.0
     at0 = 0.0
-    for x, y in zip(c, d):
-        if x != 0.0:
-            at0 = math.inf if y == 0.0 else at0 + (x / y) ** 2
+    for k in range(m):
+        if c[k] != 0.0:
+            at0 = math.inf if d[k] == 0.0 else at0 + (c[k] / d[k]) ** 2
     if at0 <= 1.0:
         return 0.0
-    lo, hi = max(cn - max(d), 0.0), max(cn - min(d), 0.0)
+    dmax, dmin = d[0], d[0]
+    for k in range(1, m):
+        dmax = max(dmax, d[k])
+        dmin = min(dmin, d[k])
+    lo, hi = max(cn - dmax, 0.0), max(cn - dmin, 0.0)
     a = lo if lo > 0.0 else min(hi, 1e-300 + 1e-16 * cn)
     for _ in range(100):
-        s2 = s3 = 0.0
-        for x, y in zip(c, d):
-            e = x / (y + a)
+        s2 = 0.0
+        s3 = 0.0
+        for k in range(m):
+            e = c[k] / (d[k] + a)
             s2 += e * e
-            s3 += e * e / (y + a)
+            s3 += e * e / (d[k] + a)
         norm = math.sqrt(s2)
         phi = 1.0 / norm - 1.0
         if phi > 0.0:
@@ -1358,47 +1643,241 @@ def local_solve_contensou(A, b, mu):
     >>> (np.round(local_solve_contensou(A, [-1.0, 3.0, 0.0, 4.0], 0.5), 14) + 0.0).tolist()
     [1.0, -0.3, 0.0, -0.4]
     """
-    A = finite_array("A", A, ndim=2)
-    b = finite_array("b", b, shape=(A.shape[0],))
-    return _local_nd(A, b, float(mu))
+    A = np.ascontiguousarray(finite_array("A", A, ndim=2))
+    b = np.ascontiguousarray(finite_array("b", b, shape=(A.shape[0],)))
+    r = np.empty(b.shape[0])
+    _local_nd(A, b, float(mu), r)
+    return r
 
 
-def _local_nd(A, b, mu):
+@njit(cache=True)
+def _solve_small(A, b, x, M):
+    # A x = b for an m x m block (m <= 4) by Gaussian elimination with partial pivoting on
+    # the scratch M (m x (m + 1)); False where a pivot vanishes
     m = b.shape[0]
-    r = np.zeros(m)
+    for i in range(m):
+        for j in range(m):
+            M[i, j] = A[i, j]
+        M[i, m] = b[i]
+    for c in range(m):
+        p = c
+        for i in range(c + 1, m):
+            if abs(M[i, c]) > abs(M[p, c]):
+                p = i
+        if M[p, c] == 0.0:
+            return False
+        if p != c:
+            for j in range(m + 1):
+                M[c, j], M[p, j] = M[p, j], M[c, j]
+        for i in range(c + 1, m):
+            f = M[i, c] / M[c, c]
+            for j in range(c, m + 1):
+                M[i, j] -= f * M[c, j]
+    for c in range(m - 1, -1, -1):
+        acc = M[c, m]
+        for j in range(c + 1, m):
+            acc -= M[c, j] * x[j]
+        x[c] = acc / M[c, c]
+    return True
+
+
+@njit(cache=True)
+def _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s):
+    # s(rho): (mu rho A_TT + alpha I) s = rho A_TN + b_T with |s| = 1, in A_TT's eigenbasis
+    m = b.shape[0] - 1
+    for k in range(m):
+        acc = 0.0
+        for j in range(m):
+            acc += Q[j, k] * (rho * A[j + 1, 0] + b[j + 1])
+        cc[k] = acc
+        dd[k] = (mu * rho) * lam[k]
+    alpha = _secular(cc, dd, m)
+    for j in range(m):
+        acc = 0.0
+        for k in range(m):
+            if cc[k] != 0.0:
+                acc += Q[j, k] * (cc[k] / (dd[k] + alpha))
+        s[j] = acc
+
+
+@njit(cache=True)
+def _slip_g(A, b, mu, rho, lam, Q, cc, dd, s):
+    # the normal row's g(rho) = A_NN rho - mu rho A_NT . s(rho) + b_N
+    _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s)
+    acc = 0.0
+    for j in range(b.shape[0] - 1):
+        acc += A[0, j + 1] * s[j]
+    return A[0, 0] * rho - mu * rho * acc + b[0]
+
+
+@njit(cache=True)
+def _local_nd(A, b, mu, r):
+    # local_solve_contensou's solve into r (any m >= 2 rows): take-off, stick, or slip with
+    # g(rho) = 0 found by Brent's method (bisection, secant and inverse quadratic
+    # interpolation, the bracket kept; Brent 1973, "Algorithms for minimization without
+    # derivatives", ch. 4) to rounding
+    m = b.shape[0]
+    for k in range(m):
+        r[k] = 0.0
     if b[0] >= 0.0:
-        return r
+        return
     if mu == 0.0:
         r[0] = -b[0] / A[0, 0]
-        return r
-    rs = np.linalg.solve(A, -b)
-    if rs[0] >= 0.0 and float(np.linalg.norm(rs[1:])) <= mu * rs[0]:
-        return rs
-    lam, Q = np.linalg.eigh(A[1:, 1:])
-    lam = np.maximum(lam, 0.0)
-    aTN, aNT, bT = A[1:, 0], A[0, 1:], b[1:]
-
-    def direction(rho):
-        c = (Q.T @ (rho * aTN + bT)).tolist()
-        d = [(mu * rho) * x for x in lam.tolist()]
-        alpha = _secular(c, d)
-        return Q @ np.array([x / (y + alpha) if x != 0.0 else 0.0 for x, y in zip(c, d)])
-
-    def g(rho):
-        return A[0, 0] * rho - mu * rho * float(aNT @ direction(rho)) + b[0]
-
+        return
+    M = np.empty((m, m + 1))
+    rs = np.empty(m)
+    nb = np.empty(m)
+    for k in range(m):
+        nb[k] = -b[k]
+    solved = _solve_small(A, nb, rs, M)
+    if solved:
+        nt = 0.0
+        for k in range(1, m):
+            nt += rs[k] * rs[k]
+        if rs[0] >= 0.0 and math.sqrt(nt) <= mu * rs[0]:
+            for k in range(m):
+                r[k] = rs[k]
+            return
+    lam, Q = np.linalg.eigh(np.ascontiguousarray(A[1:, 1:]))
+    for k in range(m - 1):
+        lam[k] = max(lam[k], 0.0)
+    cc = np.empty(m - 1)
+    dd = np.empty(m - 1)
+    s = np.empty(m - 1)
     hi = -b[0] / A[0, 0]
+    ghi = 0.0
+    found = False
     for _ in range(200):
-        if g(hi) > 0.0:
+        ghi = _slip_g(A, b, mu, hi, lam, Q, cc, dd, s)
+        if ghi > 0.0:
+            found = True
             break
         hi *= 2.0
-    else:
-        return rs if rs[0] >= 0.0 else r      # no slip root (a Painlevé-like block)
-    rho = brentq(g, 0.0, hi, xtol=1e-300, rtol=8.9e-16, maxiter=400)
-    s = direction(rho)
+    if not found:
+        # no slip root (a Painlevé-like block)
+        if solved and rs[0] >= 0.0:
+            for k in range(m):
+                r[k] = rs[k]
+        return
+    rho = _brent(A, b, mu, 0.0, hi, b[0], ghi, lam, Q, cc, dd, s)
+    _slip_direction(A, b, mu, rho, lam, Q, cc, dd, s)
     r[0] = rho
-    r[1:] = -mu * rho * s
-    return r
+    for k in range(m - 1):
+        r[k + 1] = -mu * rho * s[k]
+
+
+@njit(cache=True)
+def _brent(A, b, mu, xa, xb, fa, fb, lam, Q, cc, dd, s):
+    # a root of g in [xa, xb] (fa, fb of opposite signs) to |dx| <= 4e-16 |x| (8.9e-16 rtol
+    # over two), keeping a bracket [b, c] with |g(b)| <= |g(c)| and the step before last
+    if fa == 0.0:
+        return xa
+    if fb == 0.0:
+        return xb
+    xc, fc = xa, fa
+    e = xb - xa
+    dstep = e
+    for _ in range(400):
+        if (fb > 0.0) == (fc > 0.0):
+            xc, fc = xa, fa
+            e = xb - xa
+            dstep = e
+        if abs(fc) < abs(fb):
+            xa, fa = xb, fb
+            xb, fb = xc, fc
+            xc, fc = xa, fa
+        tol = 2.0 * 4.45e-16 * abs(xb) + 0.5e-300
+        half = 0.5 * (xc - xb)
+        if abs(half) <= tol or fb == 0.0:
+            return xb
+        if abs(e) >= tol and abs(fa) > abs(fb):
+            # interpolation: secant when two points coincide, else inverse quadratic
+            sb = fb / fa
+            if xa == xc:
+                pp = 2.0 * half * sb
+                qq = 1.0 - sb
+            else:
+                qa = fa / fc
+                rb = fb / fc
+                pp = sb * (2.0 * half * qa * (qa - rb) - (xb - xa) * (rb - 1.0))
+                qq = (qa - 1.0) * (rb - 1.0) * (sb - 1.0)
+            if pp > 0.0:
+                qq = -qq
+            else:
+                pp = -pp
+            if 2.0 * pp < min(3.0 * half * qq - abs(tol * qq), abs(e * qq)):
+                e = dstep
+                dstep = pp / qq
+            else:
+                dstep = half
+                e = dstep
+        else:
+            dstep = half
+            e = dstep
+        xa, fa = xb, fb
+        if abs(dstep) > tol:
+            xb += dstep
+        else:
+            xb += tol if half > 0.0 else -tol
+        fb = _slip_g(A, b, mu, xb, lam, Q, cc, dd, s)
+    return xb
+
+
+@njit(cache=True)
+def contensou_gauss_seidel(W, q, mu, starts, r, u, bound_sq, max_sweeps):
+    """:func:`solve_exact_contensou`'s Gauss–Seidel sweeps, compiled and unchecked.
+
+    From ``r`` with ``u = W r + q`` (both updated in place), contact ``i``
+    owning the rows ``starts[i]:starts[i + 1]``, sweeps until the squared
+    natural-map residual is ``<= bound_sq`` or ``max_sweeps`` ran (one sweep
+    for one contact). For compiled callers (a time-stepping loop) on
+    contiguous float arrays and an int64 ``starts``.
+
+    Returns
+    -------
+    sweeps : int
+    residual_sq : float
+        The squared residual on the data after the sweeps.
+
+    Examples
+    --------
+    >>> W = np.diag([1.0, 3.5, 3.5, 3.5]); q = np.array([-1.0, 3.0, 0.0, 4.0])
+    >>> r = np.zeros(4); u = q.copy()
+    >>> sweeps, res = contensou_gauss_seidel(W, q, np.array([0.5]), np.array([0, 4]), r, u,
+    ...                                      1e-20, 500)
+    >>> sweeps, (np.round(r, 12) + 0.0).tolist()
+    (1, [1.0, -0.3, 0.0, -0.4])
+    """
+    nc = mu.shape[0]
+    n = q.shape[0]
+    res = _natural_sq_blocks(r, u, mu, starts)
+    sweeps = 0
+    while res > bound_sq and sweeps < max_sweeps:
+        for i in range(nc):
+            a, b = starts[i], starts[i + 1]
+            m = b - a
+            A = np.ascontiguousarray(W[a:b, a:b])
+            bl = np.empty(m)
+            for j in range(m):
+                acc = 0.0
+                for k in range(m):
+                    acc += A[j, k] * r[a + k]
+                bl[j] = u[a + j] - acc
+            ri = np.empty(m)
+            _local_nd(A, bl, mu[i], ri)
+            for j in range(n):
+                acc = 0.0
+                for k in range(m):
+                    acc += W[j, a + k] * (ri[k] - r[a + k])
+                u[j] += acc
+            for k in range(m):
+                r[a + k] = ri[k]
+        _affine_into(W, q, r, u)
+        sweeps += 1
+        res = _natural_sq_blocks(r, u, mu, starts)
+        if nc == 1:
+            break
+    return sweeps, res
 
 
 def check_block_problem(W, q, mu, sizes):
@@ -1504,24 +1983,12 @@ def solve_exact_contensou(W, q, mu, sizes, *, tol=1e-10, max_sweeps=500, r0=None
         raise InputError(f"`max_sweeps` must be an integer >= 1, got {max_sweeps!r}")
     nc = mu.shape[0]
     r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
-    u = W @ r + q
+    u = np.empty_like(q)
+    _affine_into(W, q, r, u)
     qn = float(np.linalg.norm(q))
     scale = qn if qn > 0.0 else 1.0
-    bound_sq = (tol * scale) ** 2
-    res = _natural_sq_blocks(r, u, mu, starts)
-    sweeps = 0
-    while res > bound_sq and sweeps < max_sweeps:
-        for i in range(nc):
-            a, b = starts[i], starts[i + 1]
-            A = W[a:b, a:b]
-            ri = _local_nd(A, u[a:b] - A @ r[a:b], mu[i])
-            u += W[:, a:b] @ (ri - r[a:b])
-            r[a:b] = ri
-        u = W @ r + q
-        sweeps += 1
-        res = _natural_sq_blocks(r, u, mu, starts)
-        if nc == 1:
-            break
+    sweeps, res = contensou_gauss_seidel(W, q, mu, starts, r, u, (tol * scale) ** 2,
+                                         int(max_sweeps))
     res = math.sqrt(res)
     status = CONVERGED if res <= tol * scale else NOT_CONVERGED
     detail = (f"{sweeps} Gauss–Seidel sweep(s) with the exact local solve over "

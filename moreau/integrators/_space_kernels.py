@@ -39,11 +39,13 @@ import numba
 import numpy as np
 from numba import njit
 from numba.core import types as nbtypes
+from numba.experimental.function_type import _get_wrapper_address as _wrapper_address
 
 from .. import _jit_cache
 from ..contact import cone3d as _cone3d
-from ..contact.cone3d import (exact_gauss_seidel, exact_newton_polish, facet_directions,
-                              natural_map_sq)
+from ..contact.cone3d import (contensou_gauss_seidel, exact_gauss_seidel_into,
+                              exact_newton_polish, facet_directions, natural_map_sq,
+                              polyhedral_one_contact)
 from ..lcp.lemke import DEFAULT_TOL, default_max_iter, lemke_core, lemke_workspace
 from ..model import spatial as _spatial
 from ..model.spatial import rotate_into
@@ -68,7 +70,7 @@ class SpaceTables:
     """A spatial scene as the compiled loop takes it: ``tables`` (:func:`space_tables`) and an
     unused ``par`` (the block runner passes a compiled model's parameters first)."""
 
-    __slots__ = ("tables", "par", "several")
+    __slots__ = ("tables", "par", "several", "drilling")
 
     def __init__(self, tables):
         self.tables = tables
@@ -76,6 +78,8 @@ class SpaceTables:
         #: some body has several contacts: the exact cone may need Newton's polish
         bodies = tables[5][:, 0]
         self.several = bool(bodies.size > np.unique(bodies).size)
+        #: some frictional contact has a patch: Coulomb–Contensou's solver
+        self.drilling = bool(np.any(tables[11] > 0.0))
 
 
 def space_tables(scene, cone, mu, e):
@@ -83,8 +87,10 @@ def space_tables(scene, cone, mu, e):
 
     A :class:`SpaceTables` of the tuple ``(masses, inertias, Minv blocks (nb, 6, 6), gyroscopic flags,
     gravity, contact table, mu, e, facet directions (2, d), Lemke's pivot
-    limit per number of active contacts, d)`` (``d = 0``: the exact cone).
-    None where a contact is of a kind the loop does not know
+    limit per number of active contacts, d, drilling levers)`` (``d = 0``: the
+    exact cone; a contact's lever ``r* > 0`` where it has a patch and
+    friction: Coulomb–Contensou, its drilling row in the loop). None where a
+    contact is of a kind the loop does not know
     (:meth:`~moreau.model.space.SpaceScene.contact_table`).
     """
     table = scene.contact_table()
@@ -104,7 +110,14 @@ def space_tables(scene, cone, mu, e):
             np.ascontiguousarray(scene.inertias, dtype=float).reshape(nb, 3, 3), blocks, gyro,
             np.ascontiguousarray(scene.gravity, dtype=float), np.ascontiguousarray(table),
             np.ascontiguousarray(mu, dtype=float), np.ascontiguousarray(e, dtype=float),
-            np.ascontiguousarray(D), maxit, np.int64(d)))
+            np.ascontiguousarray(D), maxit, np.int64(d), _levers(scene, mu)))
+
+
+def _levers(scene, mu):
+    # each contact's drilling lever r*, zero without a patch or without friction (the Python
+    # step's Coulomb–Contensou rows: moreau.integrators._space_step._contensou_contacts)
+    lever = np.asarray(getattr(scene, "drilling_levers", np.zeros(scene.ncontacts)), dtype=float)
+    return np.ascontiguousarray(np.where(np.asarray(mu, dtype=float) > 0.0, lever, 0.0))
 
 
 @njit(cache=True)
@@ -165,64 +178,80 @@ def _rows(ct, i, R, s, rows):
 
 
 @njit(cache=True)
-def _solve3(A, F, out):
-    # A out = F by Gaussian elimination with partial pivoting (a 3x3 system)
-    M = A.copy()
-    x = F.copy()
-    for c in range(3):
-        p = c
-        for r in range(c + 1, 3):
-            if abs(M[r, c]) > abs(M[p, c]):
-                p = r
-        if p != c:
-            for j in range(3):
-                M[c, j], M[p, j] = M[p, j], M[c, j]
-            x[c], x[p] = x[p], x[c]
-        for r in range(c + 1, 3):
-            f = M[r, c] / M[c, c]
-            for j in range(c, 3):
-                M[r, j] -= f * M[c, j]
-            x[r] -= f * x[c]
-    for c in range(2, -1, -1):
-        acc = x[c]
-        for j in range(c + 1, 3):
-            acc -= M[c, j] * out[j]
-        out[c] = acc / M[c, c]
+def _drilling_row(ct, i, R, lever, rows):
+    # rows[i, 3] = (0, r* R^T n): the patch's spin about the normal, r* n . (R omega)
+    # (moreau.model.space.SpaceScene.drilling_rows)
+    b = int(ct[i, 0])
+    for j in range(3):
+        rows[i, 3, j] = 0.0
+        rows[i, 3, 3 + j] = lever * (ct[i, 9] * R[b, 0, j] + ct[i, 10] * R[b, 1, j]
+                                     + ct[i, 11] * R[b, 2, j])
 
 
 @njit(cache=True)
-def _free_rotation(J, w0, impulse, h, theta, w):
-    # the Python step's _free_rotation: J (w - w0) + h wt x J wt = impulse, Newton on 3x3
-    dw = np.empty(3)
-    wt = np.empty(3)
-    Jw = np.empty(3)
-    F = np.empty(3)
-    A = np.empty((3, 3))
-    _solve3(J, impulse, dw)
+def _solve3(S, ia, jf, jo):
+    # S[jo] = x with S[ia:ia+3] x = S[jf] by Gaussian elimination with partial pivoting (a 3x3
+    # system), on the rows of the scratch S (rows 7-10 its working copy): no array allocated
+    for i in range(3):
+        for j in range(3):
+            S[7 + i, j] = S[ia + i, j]
+        S[10, i] = S[jf, i]
+    for c in range(3):
+        p = c
+        for r in range(c + 1, 3):
+            if abs(S[7 + r, c]) > abs(S[7 + p, c]):
+                p = r
+        if p != c:
+            for j in range(3):
+                S[7 + c, j], S[7 + p, j] = S[7 + p, j], S[7 + c, j]
+            S[10, c], S[10, p] = S[10, p], S[10, c]
+        for r in range(c + 1, 3):
+            f = S[7 + r, c] / S[7 + c, c]
+            for j in range(c, 3):
+                S[7 + r, j] -= f * S[7 + c, j]
+            S[10, r] -= f * S[10, c]
+    for c in range(2, -1, -1):
+        acc = S[10, c]
+        for j in range(c + 1, 3):
+            acc -= S[7 + c, j] * S[jo, j]
+        S[jo, c] = acc / S[7 + c, c]
+
+
+@njit(cache=True)
+def _free_rotation(J, v, o, h, theta, S):
+    # the Python step's _free_rotation: J (w - w0) + h wt x J wt = impulse, Newton on 3x3,
+    # w0 = v[o:o+3], in the rows of the loop's scratch S (12 x 3; nothing allocated a step):
+    # 0 w, 1 F then dw (the solve copies F first), 2 wt, 3 J wt, 4-6 J then the Jacobian,
+    # 7-10 _solve3's working copy, 11 the impulse
     for a in range(3):
-        w[a] = w0[a] + dw[a]
+        for j in range(3):
+            S[4 + a, j] = J[a, j]
+    _solve3(S, 4, 11, 1)
+    for a in range(3):
+        S[0, a] = v[o + a] + S[1, a]
     for _ in range(20):
         for a in range(3):
-            wt[a] = theta * w[a] + (1.0 - theta) * w0[a]
+            S[2, a] = theta * S[0, a] + (1.0 - theta) * v[o + a]
         for a in range(3):
-            Jw[a] = J[a, 0] * wt[0] + J[a, 1] * wt[1] + J[a, 2] * wt[2]
+            S[3, a] = J[a, 0] * S[2, 0] + J[a, 1] * S[2, 1] + J[a, 2] * S[2, 2]
         for a in range(3):
             a1 = (a + 1) % 3
             a2 = (a + 2) % 3
-            F[a] = (J[a, 0] * (w[0] - w0[0]) + J[a, 1] * (w[1] - w0[1]) + J[a, 2] * (w[2] - w0[2])
-                    + h * (wt[a1] * Jw[a2] - wt[a2] * Jw[a1]) - impulse[a])
+            S[1, a] = (J[a, 0] * (S[0, 0] - v[o]) + J[a, 1] * (S[0, 1] - v[o + 1])
+                       + J[a, 2] * (S[0, 2] - v[o + 2])
+                       + h * (S[2, a1] * S[3, a2] - S[2, a2] * S[3, a1]) - S[11, a])
             # h theta ([wt]x J - [J wt]x), row a
             for j in range(3):
-                A[a, j] = J[a, j] + h * theta * (wt[a1] * J[a2, j] - wt[a2] * J[a1, j])
-            A[a, a2] -= h * theta * Jw[a1]
-            A[a, a1] += h * theta * Jw[a2]
-        _solve3(A, F, dw)
+                S[4 + a, j] = J[a, j] + h * theta * (S[2, a1] * J[a2, j] - S[2, a2] * J[a1, j])
+            S[4 + a, a2] -= h * theta * S[3, a1]
+            S[4 + a, a1] += h * theta * S[3, a2]
+        _solve3(S, 4, 1, 1)
         big = 0.0
         wmax = 0.0
         for a in range(3):
-            w[a] -= dw[a]
-            big = max(big, abs(dw[a]))
-            wmax = max(wmax, abs(w[a]))
+            S[0, a] -= S[1, a]
+            big = max(big, abs(S[1, a]))
+            wmax = max(wmax, abs(S[0, a]))
         if big <= 1e-15 * max(1.0, wmax):
             break
 
@@ -230,6 +259,8 @@ def _free_rotation(J, w0, impulse, h, theta, w):
 @njit(cache=True)
 def _polyhedral(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r):
     # build_polyhedral_lcp's M = B^T W B + E, q = B^T Uf on the active contacts, Lemke, r = B z
+    if na == 1 and polyhedral_one_contact(W, Uf, mu_a[0], D, r):
+        return np.int64(0), np.int64(0)
     m = d + 2
     L = na * m
     for a in range(L):
@@ -278,8 +309,9 @@ def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, m
     # the exact cone by Gauss–Seidel; status 1 where Newton's polish is needed (never with
     # one contact a body, whose local solve is exact: the solver of such scenes)
     u[:] = Uf
-    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                     EXACT_SWEEPS)
+    # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
+    ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                          EXACT_SWEEPS, Ml, ql, zl, wl)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
@@ -289,8 +321,9 @@ def _exact_polish_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, i
     # the exact cone by Gauss–Seidel, then Newton's polish where it stops short (several
     # contacts on one body); status 1 where solve_exact would go on (its restart)
     u[:] = Uf
-    ok, res, qn = exact_gauss_seidel(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                     EXACT_SWEEPS)
+    # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
+    ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
+                                          EXACT_SWEEPS, Ml, ql, zl, wl)
     if not ok:
         ok, res, qn, _ = exact_newton_polish(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_NEWTON)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
@@ -314,6 +347,25 @@ def _polyhedral_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwo
     return status, pivots, math.sqrt(natural_map_sq(r, u, mu_a)), math.sqrt(qn)
 
 
+@njit(cache=True)
+def _contensou_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, max_iter, r,
+                     u):
+    # Coulomb–Contensou's exact cone (solve_exact_contensou's sweeps from r = 0), a contact's
+    # rows from iwork[a] to iwork[a + 1] (3, or 4 with its drilling row); status 1 where the
+    # sweeps stop short (the Python step then says so)
+    n = Uf.shape[0]
+    qn = 0.0
+    for j in range(n):
+        u[j] = Uf[j]
+        qn += Uf[j] * Uf[j]
+    qn = math.sqrt(qn)
+    scale = qn if qn > 0.0 else 1.0
+    _, res = contensou_gauss_seidel(W, Uf, mu_a, iwork[:na + 1], r, u,
+                                    (EXACT_TOL * scale) ** 2, EXACT_SWEEPS)
+    res = math.sqrt(res)
+    return np.int64(0 if res <= EXACT_TOL * scale else 1), np.int64(0), res, qn
+
+
 _A1 = nbtypes.float64[::1]
 _A2 = nbtypes.float64[:, ::1]
 _INT = nbtypes.int64
@@ -324,20 +376,48 @@ SOLVE_SIGNATURE = nbtypes.Tuple((_INT, _INT, nbtypes.float64, nbtypes.float64))(
     _A1, _A1)
 
 
-def space_solver(cone, several=False):
+def space_solver(cone, several=False, drilling=False):
     """The loop's solver of the cone ``cone`` (``"exact"`` or ``d``), compiled for :data:`SOLVE_SIGNATURE`.
 
     With ``several`` (some body has several contacts,
     :attr:`SpaceTables.several`) the exact cone's solver ends with Newton's
     polish; without, it is compiled without it (a third of the exact path's
     compile: with one contact a body Gauss–Seidel's exact local solve converges
-    in a sweep).
+    in a sweep). With ``drilling`` (a contact with a patch,
+    :attr:`SpaceTables.drilling`) it is Coulomb–Contensou's
+    (:func:`moreau.contact.cone3d.contensou_gauss_seidel`).
     """
-    fn = (_polyhedral_solve if cone != "exact" else
-          _exact_polish_solve if several else _exact_solve)
-    if not fn.signatures:
-        fn.compile(SOLVE_SIGNATURE)
-    return fn
+    key = (cone != "exact", bool(several), bool(drilling))
+    got = _SOLVERS.get(key)
+    if got is None:
+        fn = (_polyhedral_solve if cone != "exact" else _contensou_solve if drilling else
+              _exact_polish_solve if several else _exact_solve)
+        if not fn.signatures:
+            fn.compile(SOLVE_SIGNATURE)
+        got = _SOLVERS[key] = _Solver(fn)
+    return got
+
+
+class _Solver:
+    """A compiled solver as the loop's function-pointer argument, its address looked up once.
+
+    numba unboxes a dispatcher passed for a first-class function by looking
+    its compiled entry up on every call (60 us, a seventh of a short run's
+    setup); an object with the ``__wrapper_address__`` protocol hands over the
+    address it holds. The loop then calls the solver's C wrapper.
+    """
+
+    __slots__ = ("fn", "address")
+
+    def __init__(self, fn):
+        self.fn = fn
+        self.address = _wrapper_address(fn, SOLVE_SIGNATURE)
+
+    def __wrapper_address__(self):
+        return self.address
+
+
+_SOLVERS = {}
 
 
 def run_space_loop(*args):
@@ -354,12 +434,15 @@ def run_space_loop(*args):
         args[i] = int(args[i])
     args[15] = bool(args[15])
     if not _LOOP:
-        types = [numba.typeof(a) for a in args]
-        types[13] = nbtypes.FunctionType(SOLVE_SIGNATURE)
+        types = [nbtypes.FunctionType(SOLVE_SIGNATURE) if i == 13 else numba.typeof(a)
+                 for i, a in enumerate(args)]
         space_loop.compile(tuple(types))
         space_loop.disable_compile()
-        _LOOP.append(True)
-    return space_loop(*args)
+        # its one compiled entry, called directly: the dispatcher would type the solver
+        # (a _Solver) as a Python object; the other arguments have the types compiled for
+        # (the conversions above)
+        _LOOP.append(next(iter(space_loop.overloads.values())).entry_point)
+    return _LOOP[0](*args)
 
 
 _LOOP = []
@@ -380,16 +463,22 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     is left to the Python step, the state is that step's start) or
     :data:`NUMERICAL` (a non-finite state; the last good one is kept).
     """
-    bm, bJ, bMinv, bgyro, grav, ct, _, _, D, maxit, d = tables
+    bm, bJ, bMinv, bgyro, grav, ct, _, _, D, maxit, d, lever = tables
     nb = bm.shape[0]
     nc = ct.shape[0]
     nv = 6 * nb
     nq = 7 * nb
     ncm = max(nc, 1)
+    drilling = False
+    for i in range(nc):
+        drilling = drilling or lever[i] > 0.0
     R = np.empty((nb, 3, 3))
     R1 = np.empty((nb, 3, 3))
     s = np.empty(3)
-    rows = np.zeros((ncm, 3, 6))
+    # a contact's rows [n, t1, t2] and, with a patch (lever > 0), its drilling row
+    rows = np.zeros((ncm, 4, 6))
+    sz = np.empty(ncm, dtype=np.int64)
+    st = np.zeros(ncm + 1, dtype=np.int64)
     g0 = np.empty(ncm)
     g1 = np.empty(ncm)
     vN0 = np.empty(ncm)
@@ -397,21 +486,19 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     vfree = np.empty(nv)
     v1 = np.empty(nv)
     q1 = np.empty(nq)
-    wb = np.empty(3)
-    imp = np.empty(3)
+    fr = np.empty((12, 3))
     pN = np.zeros(ncm)
     pT = np.zeros(ncm)
     slip = np.zeros(ncm)
     reg = np.zeros(ncm, dtype=np.int64)
     ia = np.empty(ncm, dtype=np.int64)
-    MHT = np.empty((3 * ncm, 6))
-    Wf = np.empty((3 * ncm, 3 * ncm))
-    Uf_all = np.empty(3 * ncm)
-    r_all = np.empty(3 * ncm)
-    u_all = np.empty(3 * ncm)
-    U = np.empty(3)
+    MHT = np.empty((4 * ncm, 6))
+    Wf = np.empty((4 * ncm, 4 * ncm))
+    Uf_all = np.empty(4 * ncm)
+    U = np.empty(4)
     mu_all = np.empty(ncm)
-    Lmax = ncm * (d + 2)
+    # (the exact cone's Gauss–Seidel takes its scratch from Lemke's: 3 rows a contact)
+    Lmax = ncm * max(d + 2, 3)
     Ml = np.zeros((Lmax, Lmax))
     ql = np.zeros(Lmax)
     dl = np.ones(Lmax)
@@ -461,10 +548,10 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                 vfree[o + a] = v[o + a] + hk * acc
             if bgyro[b]:
                 for a in range(3):
-                    imp[a] = hk * f[o + 3 + a]
-                _free_rotation(bJ[b], v[o + 3:o + 6], imp, hk, theta, wb)
+                    fr[11, a] = hk * f[o + 3 + a]
+                _free_rotation(bJ[b], v, o + 3, hk, theta, fr)
                 for a in range(3):
-                    vfree[o + 3 + a] = wb[a]
+                    vfree[o + 3 + a] = fr[0, a]
         for j in range(nv):
             v1[j] = vfree[j]
         na = 0
@@ -476,6 +563,10 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             g0[i] = _gap(ct, i, q, R, s)
             _rows(ct, i, R, s, rows)
             b = int(ct[i, 0])
+            sz[i] = 3
+            if lever[i] > 0.0:
+                _drilling_row(ct, i, R, lever[i], rows)
+                sz[i] = 4
             acc = 0.0
             for j in range(6):
                 acc += rows[i, 0, j] * v[6 * b + j]
@@ -484,13 +575,15 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                 ia[na] = i
                 na += 1
         if na:
-            n3 = 3 * na
+            for a in range(na):
+                st[a + 1] = st[a] + sz[ia[a]]
+            n3 = st[na]
             for a in range(na):
                 i = ia[a]
                 b = int(ct[i, 0])
                 mu_all[a] = mu[i]
-                for kk in range(3):
-                    row = 3 * a + kk
+                for kk in range(sz[i]):
+                    row = st[a] + kk
                     for j in range(6):
                         acc = 0.0
                         for l in range(6):
@@ -500,20 +593,20 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                     for j in range(6):
                         acc += rows[i, kk, j] * vfree[6 * b + j]
                     Uf_all[row] = acc
-                Uf_all[3 * a] += e[i] * min(vN0[i], 0.0)
+                Uf_all[st[a]] += e[i] * min(vN0[i], 0.0)
             # W = H M^-1 H^T by contact pairs: zero between two bodies' contacts
             for a in range(na):
                 i = ia[a]
                 ba = int(ct[i, 0])
                 for c in range(na):
                     same = ba == int(ct[ia[c], 0])
-                    for kk in range(3):
-                        for ll in range(3):
+                    for kk in range(sz[i]):
+                        for ll in range(sz[ia[c]]):
                             acc = 0.0
                             if same:
                                 for j in range(6):
-                                    acc += rows[i, kk, j] * MHT[3 * c + ll, j]
-                            Wf[3 * a + kk, 3 * c + ll] = acc
+                                    acc += rows[i, kk, j] * MHT[st[c] + ll, j]
+                            Wf[st[a] + kk, st[c] + ll] = acc
             if n3 != W.shape[0]:
                 # the solvers take contiguous arrays of the problem's size: new ones only
                 # when the number of active contacts changes
@@ -529,6 +622,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                 r[a] = 0.0
             for a in range(na):
                 mu_a[a] = mu_all[a]
+            if drilling:
+                # the Coulomb–Contensou solver's blocks: its rows' starts, in Lemke's int
+                # scratch (which that cone does not use)
+                for a in range(na + 1):
+                    iwork[a] = st[a]
             lst, piv, res, qn = solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work,
                                       iwork, maxit[na], r, u)
             if lst != 0:
@@ -539,25 +637,33 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             stats[S_RES] = max(stats[S_RES], res / qn if qn > 0.0 else res)
             for a in range(na):
                 b = int(ct[ia[a], 0])
+                o = st[a]
                 for j in range(6):
-                    v1[6 * b + j] += (MHT[3 * a, j] * r[3 * a] + MHT[3 * a + 1, j] * r[3 * a + 1]
-                                      + MHT[3 * a + 2, j] * r[3 * a + 2])
+                    dv = MHT[o, j] * r[o] + MHT[o + 1, j] * r[o + 1] + MHT[o + 2, j] * r[o + 2]
+                    if sz[ia[a]] == 4:
+                        dv += MHT[o + 3, j] * r[o + 3]
+                    v1[6 * b + j] += dv
             scale = 1e-300
             for a in range(n3):
                 scale = max(scale, abs(Uf[a]))
             for a in range(na):
                 i = ia[a]
                 b = int(ct[i, 0])
-                for kk in range(3):
+                for kk in range(sz[i]):
                     acc = 0.0
                     for j in range(6):
                         acc += rows[i, kk, j] * v1[6 * b + j]
                     U[kk] = acc
-                pN[i] = r[3 * a]
-                pT[i] = math.hypot(r[3 * a + 1], r[3 * a + 2])
+                o = st[a]
+                pN[i] = r[o]
+                pT[i] = math.hypot(r[o + 1], r[o + 2])
                 slip[i] = math.hypot(U[1], U[2])
+                # a contact slips where its generalized slip (u_T, r* omega_n) does
+                moving = slip[i]
+                if sz[i] == 4:
+                    moving = math.sqrt(U[1] * U[1] + U[2] * U[2] + U[3] * U[3])
                 if pN[i] > 0.0:
-                    reg[i] = (_POSITIVE if mu[i] > 0.0 and slip[i] > _SLIP_RTOL * scale
+                    reg[i] = (_POSITIVE if mu[i] > 0.0 and moving > _SLIP_RTOL * scale
                               else _STICK)
         # q moved at the theta-weighted velocity: centres, then orientations on SO(3)
         for b in range(nb):

@@ -5,7 +5,8 @@ See :mod:`moreau.integrators.moreau_jean` ("Spatial scenes") for the scheme.
 
 import numpy as np
 
-from ..contact.cone3d import solve_cone, solve_exact_contensou
+from ..contact.cone3d import (CONVERGED, ConeSolution, facet_directions, natural_map_sq,
+                              polyhedral_one_contact, solve_cone, solve_exact_contensou)
 from ..errors import InputError, LCPError
 from ..model.space import advance_coordinates
 from ..regimes import Regime
@@ -83,8 +84,11 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
             W = 0.5 * (W + W.T)
             U_free = H @ v_free
             U_free[0::3] += e[active] * np.minimum(vN0[active], 0.0)
-            # (built in the layout from the scene's checked data)
-            sol = solve_cone(W, U_free, mu[active], cone, check=False)
+            # (built in the layout from the scene's checked data); one contact's polyhedral
+            # problem in closed form where certified, as the compiled loop solves it
+            sol = _one_contact(W, U_free, mu[active], cone)
+            if sol is None:
+                sol = solve_cone(W, U_free, mu[active], cone, check=False)
             counters["lcp_solves"] += 1
             counters["max_residual"] = max(counters["max_residual"], sol.relative_residual)
             if "pivots" in sol.iterations:
@@ -106,6 +110,23 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
                                     else Regime.STICK)
     q1 = advance_coordinates(scene, q, theta * v1 + (1.0 - theta) * v, h)
     return q1, v1, pN, pT, slip, regime
+
+
+def _one_contact(W, U_free, mu, cone):
+    """One contact's polyhedral problem by :func:`moreau.contact.cone3d.polyhedral_one_contact`,
+    as a :class:`~moreau.contact.cone3d.ConeSolution`; None where it is not certified."""
+    if cone == "exact" or mu.size != 1:
+        return None
+    r = np.zeros(3)
+    W = np.ascontiguousarray(W)
+    U_free = np.ascontiguousarray(U_free)
+    if not polyhedral_one_contact(W, U_free, float(mu[0]), facet_directions(cone), r):
+        return None
+    u = W @ r + U_free
+    res = float(np.sqrt(natural_map_sq(r, u, mu)))
+    qn = float(np.linalg.norm(U_free))
+    return ConeSolution(r, u, CONVERGED, res, res / qn if qn > 0 else res, {"pivots": 0},
+                        f"polyhedral-{cone}", "one contact in closed form")
 
 
 def _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e, counters,

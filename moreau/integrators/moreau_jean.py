@@ -225,11 +225,11 @@ is refused. A contact with a patch (``contact_radius > 0``: Coulomb–Contensou
 friction, :mod:`moreau.model.space`) adds its drilling row to the three,
 and the step solves the round cone with three tangential rows
 (:func:`moreau.contact.cone3d.solve_exact_contensou`); it takes
-``cone="exact"`` only (another ``cone`` is refused by name) and the Python
-step. The step runs in the compiled loop of
-:mod:`moreau.integrators._space_kernels` for scenes whose contacts are
-spheres and material points (pucks) against half-spaces (all shipped
-ones), the same step to rounding, the exact cone's Newton polish included
+``cone="exact"`` only (another ``cone`` is refused by name). The step
+runs in the compiled loop of :mod:`moreau.integrators._space_kernels` for
+scenes whose contacts are spheres and material points (pucks) against
+half-spaces, with or without a patch, the same step to rounding, the exact
+cone's Newton polish included
 (several contacts on one body: a puck's rim points, a box's corners); a
 contact problem the loop does not finish (the exact cone where that Newton
 misses the tolerance and the exact solver restarts from the polyhedral
@@ -746,7 +746,7 @@ class MoreauJean(TimeStepping):
             tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
         if fast is True and tables is None:
             raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
-                             f"points against half-spaces, without a `contact_radius`; scene "
+                             f"points against half-spaces; scene "
                              f"{self.scene.name!r} has other contacts: use fast='auto' or False "
                              "(the generic step)")
         super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
@@ -911,7 +911,8 @@ class MoreauJean(TimeStepping):
         k0 = self._k
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
-                                         space_solver(self.cone, self._model.several)), ())
+                                         space_solver(self.cone, self._model.several,
+                                                      self._model.drilling)), ())
         self.q, self.v, self._closed = q, v, closed
         if status == LCP_HANDBACK:
             if self._k == k0:

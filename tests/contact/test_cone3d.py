@@ -360,3 +360,48 @@ def test_the_qp_method_says_it_has_no_formulation_for_the_polyhedral_lcp():
     assert not sol.success and sol.status.startswith("The method has no formulation")
     assert sol.residual == pytest.approx(cone_residual(W_SPHERE, q, 0.5, sol.r), abs=0)
     assert math.isfinite(sol.residual) and sol.residual > 0.5
+
+
+def test_one_contact_s_closed_form_is_lemke_s_answer_on_random_problems():
+    # the compiled spatial loop's (and the Python step's) closed form of one contact's
+    # polyhedral LCP against Lemke (solve_polyhedral), on random SPD blocks and free
+    # velocities: the same impulse where it certifies one, and it certifies most
+    from moreau.contact.cone3d import polyhedral_one_contact
+    rng = np.random.default_rng(20261128)
+    certified = 0
+    for k in range(300):
+        d = (4, 8, 16)[k % 3]
+        A = rng.normal(size=(3, 3))
+        W = A @ A.T + 0.1 * np.eye(3) if k % 4 else np.diag([1.0, 3.5, 3.5])
+        q = rng.normal(size=3)
+        mu = (0.1, 0.5, 1.0, 2.0)[k % 4]
+        r = np.zeros(3)
+        if polyhedral_one_contact(W, q, mu, facet_directions(d), r):
+            certified += 1
+            ref = solve_polyhedral(W, q, mu, d)
+            assert ref.success
+            scale = max(np.max(np.abs(ref.r)), np.max(np.abs(q)) / np.max(np.abs(W)))
+            assert np.max(np.abs(r - ref.r)) <= 1e-12 * scale, (k, r, ref.r)
+        else:
+            # refused (r untouched, for the caller's Lemke): never without coupling
+            assert r.tolist() == [0.0, 0.0, 0.0] and W[0, 1] != 0.0
+    assert certified >= 125
+
+
+def test_an_isotropic_block_s_slip_in_closed_form_is_the_sampled_root():
+    # a sphere's or a point's block diag(a, b, b) slides against b_T in closed form; the same
+    # block with a negligible coupling (1e-300) takes the sampled and refined sliding angle
+    rng = np.random.default_rng(37)
+    for _ in range(20):
+        A = np.diag([rng.uniform(0.5, 2.0), *[rng.uniform(0.5, 4.0)] * 2])
+        mu = rng.uniform(0.05, 0.5)
+        # |b_T| beyond the stick bound mu A_TT (-b_N) / A_NN, in a random direction
+        phi = rng.uniform(0.0, 2.0 * math.pi)
+        bn = -rng.uniform(0.1, 1.0)
+        size = rng.uniform(1.5, 5.0) * mu * A[1, 1] * -bn / A[0, 0]
+        b = np.array([bn, size * math.cos(phi), size * math.sin(phi)])
+        nudged = A.copy()
+        nudged[0, 1] = nudged[1, 0] = 1e-300
+        r, ref = local_solve(A, b, mu), local_solve(nudged, b, mu)
+        assert math.hypot(r[1], r[2]) == pytest.approx(mu * r[0], rel=1e-15)   # it slips
+        np.testing.assert_allclose(r, ref, rtol=0, atol=2e-15 * np.max(np.abs(ref)))

@@ -261,3 +261,23 @@ def test_a_box_s_four_corners_run_in_the_loop_with_the_exact_cone(monkeypatch):
     res = simulate(rest, (0.0, 1.0), q0, v0, "moreau-jean", h=0.04, cone="exact")
     assert calls[0] == 0 and res.stats["max_residual"] <= 1e-10
     assert np.max(np.abs(res.v)) <= 1e-10
+
+
+def test_a_contact_patch_runs_in_the_loop_as_the_python_step(monkeypatch):
+    # Leine and Glocker's top with its patch: Coulomb–Contensou's four rows (drilling) in the
+    # compiled loop, every step there, the Python step's run to rounding (300 steps of the
+    # turning, the patch spinning and sliding)
+    from moreau.scenes.tippe_top import LEINE_GLOCKER_PATCH
+    sc = registry.make_scene("tippe-top", contact_radius=LEINE_GLOCKER_PATCH)
+    assert sc.drilling
+    q0, v0 = sc.initial_state()
+    h = sc.default_window / 2000
+    ref = simulate(sc, (0.0, 300 * h), q0, v0, "moreau-jean", h=h, cone="exact", fast=False)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 300 * h), q0, v0, "moreau-jean", h=h, cone="exact")
+    assert calls[0] == 0 and res.status == 0
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+    assert {Regime.POSITIVE} <= set(res.regime[:, 0])
+    assert res.stats["max_residual"] == pytest.approx(ref.stats["max_residual"], rel=1e-9,
+                                                      abs=1e-15)

@@ -1046,9 +1046,10 @@ class SpaceScene(Scene):
         of mass (``s = -radius n``), 1 for an eccentric sphere (``s = R c -
         radius n``, ``c`` its centre) and 2 for a material point (``s = R
         c``, ``c`` the point), as in the module docstring. None where a
-        contact is of none of these kinds, or has a contact patch
-        (``contact_radius > 0``: Coulomb–Contensou friction, the Python step's),
-        or joins two bodies (:meth:`SpaceModel.add_pair_contact`).
+        contact is of none of these kinds, or joins two bodies
+        (:meth:`SpaceModel.add_pair_contact`). A contact patch
+        (``contact_radius > 0``) leaves its row as it is: its lever is
+        :attr:`drilling_levers`.
 
         Examples
         --------
@@ -1075,7 +1076,8 @@ class SpaceScene(Scene):
 
 
 #: the keys of a contact that :meth:`SpaceScene.contact_table` knows
-_TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre"}
+_TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre",
+               "contact_radius"}
 
 
 def _least_axis(n):
