@@ -402,7 +402,15 @@ mj_loop = loop_template("mj_loop", globals())
 
 
 def lean_enough(nc, lcp_ctl, opts):
-    """Whether a run can take the lean shared loop: no contact LCP (:func:`lcp_needed`), no projection."""
+    """Whether a run can take the lean shared loop: no contact LCP (:func:`lcp_needed`), no
+    projection.
+
+    Examples
+    --------
+    >>> lean_enough(1, new_lcp_control(1), (1.0, False)), lean_enough(2, new_lcp_control(2),
+    ...                                                                (1.0, False))
+    (True, False)
+    """
     return not lcp_needed(nc, lcp_ctl) and isinstance(opts, tuple) and len(opts) == 2 \
         and not opts[1]
 
