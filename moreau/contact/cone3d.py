@@ -1175,7 +1175,8 @@ def exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps, A, b, 
     scale = qn if qn > 0.0 else 1.0
     tol_sq = (tol * scale) ** 2
     switch_sq = (max(tol, polish_from) * scale) ** 2
-    _, res = _pgs_into(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, _STALL, A, b)
+    # np.int64: a literal (the global) would compile _pgs_into again
+    _, res = _pgs_into(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, np.int64(_STALL), A, b)
     if res > tol_sq:
         return False, math.sqrt(res), qn
     for i in range(mu.shape[0]):
@@ -1393,14 +1394,16 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
         rho[i] = 1.0 / W[3 * i, 3 * i]
     start = r.copy()
     best_r = r.copy()
-    best, it = _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, False)
+    # np.bool_ flags, not literals, which would compile _newton_run once for each value
+    best, it = _newton_run(W, q, mu, rho, r, best_r, tol_sq, max_newton, np.False_)
     if best > tol_sq:
         # solve_exact's Newton missed (it would restart from the polyhedral solution): the
         # Jacobian is singular to rounding where it has a null space (a box's corners, their
         # forces statically indeterminate), which Gaussian elimination does not always see;
         # Newton again from the same point with the least-norm steps
         best2_r = start.copy()
-        best2, more = _newton_run(W, q, mu, rho, start, best2_r, tol_sq, max_newton, True)
+        best2, more = _newton_run(W, q, mu, rho, start, best2_r, tol_sq, max_newton,
+                                  np.True_)
         it += more
         if best2 < best:
             best = best2

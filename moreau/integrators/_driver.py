@@ -163,7 +163,9 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
     roff = CTL_IA + 5 * ncm
     for i in range(nc):
         reg[i] = lcp_ctl[roff + i]
-    nrec = 0
+    # np.int64, not the literal: numba types the calls of record_sample once with the
+    # literal 0 before the loop's increment widens it, and compiles it twice
+    nrec = np.int64(0)
     k = k0
     status = OK
     # steps left until the next sample (k % save_every == 0 after the step): a

@@ -197,11 +197,47 @@ def _shared_function(template):
     code = compile(tree, template.__code__.co_filename, "exec")
     module = sys.modules[template.__module__]
     namespace = dict(vars(module))
+    # the lean variant's compile-time switches (_lean_template)
+    namespace.update(getattr(template, "__moreau_switches__", {}))
     exec(code, namespace)  # noqa: S102  (the package's own template, transformed above)
     fn = namespace[fdef.name]
     fn.__module__ = template.__module__
     fn.__qualname__ = fdef.name
     return fn
+
+
+_LEAN = {}
+
+
+def _lean_template(template):
+    """The lean variant of ``template``'s shared loop, or None where its module gives none.
+
+    A scheme module's ``SHARED_LEAN`` is ``(switches, test, names)``: global
+    names the step rule branches on, with the values that prune the branches a
+    run passing ``test(ncontacts, *the loop's arguments named)`` cannot reach
+    (Moreau–Jean: the several-contact LCP and the projection). The variant is
+    the same template under another name (its own disk-cache files), compiled
+    with those globals; it gives the same numbers to the last bit as the full
+    loop on every run it takes.
+    """
+    spec = getattr(sys.modules[template.__module__], "SHARED_LEAN", None)
+    if spec is None:
+        return None
+    with _LOCK:
+        lean = _LEAN.get(template)
+        if lean is None:
+            name = template.__name__ + "_lean"
+            lean = types.FunctionType(template.__code__, template.__globals__, name,
+                                      template.__defaults__)
+            lean.__qualname__ = name
+            lean.__module__ = template.__module__
+            lean.__doc__ = template.__doc__
+            lean.__moreau_source__ = getattr(template, "__moreau_source__", None) or \
+                textwrap.dedent(inspect.getsource(template))
+            lean.__moreau_sources__ = getattr(template, "__moreau_sources__", ())
+            lean.__moreau_switches__ = dict(spec[0])
+            _LEAN[template] = lean
+    return lean
 
 
 def shared_core(template, argtypes):
@@ -242,7 +278,9 @@ class SharedRunner:
     ``mode`` is ``"auto"``, ``"shared"`` or ``"specialised"``. Each call
     first picks its variant: with the stand-ins of the template's
     ``SHARED_INDIRECT`` kernels where the call cannot reach them (one
-    contact, Lemke not forced), with the kernels otherwise. Then:
+    contact, Lemke not forced), with the kernels otherwise; and the shared
+    loop's lean variant where the call cannot reach what it leaves out
+    (:func:`_lean_template`). Then:
 
     - ``"specialised"``: the model's own loop of that variant, compiled at
       its first call;
@@ -272,6 +310,11 @@ class SharedRunner:
         params = list(inspect.signature(template).parameters)
         self._deciders = tuple((spec[2], params.index(spec[3])) for spec in indirect.values())
         self._core = None
+        self._cores = {}        # lean or not -> the shared loop
+        self._lean = _lean_template(template)
+        lean_spec = getattr(module, "SHARED_LEAN", None)
+        self._lean_test = None if self._lean is None else (
+            lean_spec[1], tuple(params.index(name) for name in lean_spec[2]))
         self._specials = {}     # variant (stand-ins or not) -> the model's own loop
         self._looked = set()    # variants whose own loop has been considered
         self._kernels_ready = not self._deciders
@@ -282,9 +325,9 @@ class SharedRunner:
         """Whether a long run moves on to the model's own loop (``mode="auto"``)."""
         return self.mode == "auto"
 
-    def _bind(self, args):
+    def _bind(self, args, lean=False):
         argtypes = tuple(numba.typeof(a) for a in args)
-        core = shared_core(self.template, argtypes)
+        core = shared_core(self._lean if lean else self.template, argtypes)
         if not core.signatures:
             with _compile_lock(core):
                 if not _jit_cache.has_cached_code(core):
@@ -293,13 +336,21 @@ class SharedRunner:
             # one signature: a call with other argument types is an error, not a silent
             # compile of a loop specialised on the model's functions
             core.disable_compile()
-        self._core = core
+        self._cores[lean] = self._core = core
+        return core
 
     def _stub(self, args):
         """Whether this call cannot reach the kernels passed as arguments."""
         nc = self.model.ncontacts
         return bool(self._deciders) and not any(needed(nc, args[i])
                                                 for needed, i in self._deciders)
+
+    def _lean_for(self, args, stub):
+        """Whether this call takes the lean shared loop (:func:`_lean_template`)."""
+        if not stub or self._lean_test is None:
+            return False
+        test, at = self._lean_test
+        return bool(test(self.model.ncontacts, *(args[i] for i in at)))
 
     def _prefix_for(self, args):
         return self._stub_prefix if self._stub(args) else self._prefix
@@ -330,12 +381,14 @@ class SharedRunner:
                 own = self._specialise(stub, args)
         if own is not None:
             return own(*args)
-        if self._core is None:
-            self._bind(args)
+        lean = self._lean_for(args, stub)
+        core = self._cores.get(lean)
+        if core is None:
+            core = self._bind(args, lean)
         if not stub and not self._kernels_ready:
             self._compile_kernels()
         t0 = _SHARED_CLOCK()
-        out = self._core(*(self._stub_prefix if stub else self._prefix), *args)
+        out = core(*(self._stub_prefix if stub else self._prefix), *args)
         self.seconds[stub] += _SHARED_CLOCK() - t0
         if self.tier_up and self.seconds[stub] > TIER_UP_SECONDS:
             # the model's own loop, with the same stand-ins as this call (a single-contact

@@ -226,7 +226,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
     slip = np.zeros(ncm)
     vN0 = np.zeros(ncm)
     cnew = np.zeros(ncm, dtype=np.bool_)
-    nrec = 0
+    nrec = np.int64(0)  # not a literal: see _driver.drive
     k = k0
     status = OK
     while k - k0 < nmax:
@@ -376,7 +376,8 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
         if na == 1:
             viol, res = _mlcp_check(W, Uf, target, nj, pE, pn, pt, mu[ic], e[ic], vN0[ic], fr)
         else:
-            viol, res = _mlcp_check(W, Uf, target, nj, pE, -1.0, 0.0, 0.0, 0.0, 0.0, False)
+            # np.False_, not False: a literal argument compiles a second _mlcp_check
+            viol, res = _mlcp_check(W, Uf, target, nj, pE, -1.0, 0.0, 0.0, 0.0, 0.0, np.False_)
         if not viol <= DEFAULT_TOL:
             status = LCP_HANDBACK
             break

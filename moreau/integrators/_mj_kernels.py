@@ -73,6 +73,11 @@ __all__ = ["mj_loop", "grid_step", "no_gaps", "new_stats", "new_lcp_control", "S
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
 
+#: compile-time switches of the step rule, True in every loop but the lean shared one
+#: (SHARED_LEAN), where numba prunes the branches they guard
+LCP_REACHABLE = True
+PROJECTION_REACHABLE = True
+
 # inlined: allocated in the loop's own function, the buffers' shapes are known to LLVM
 # (a model's own loop of a two-contact scene ran 7-9 % slower with them from a call)
 @njit(inline="always")
@@ -356,22 +361,33 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         one_contact(G1, ia, nfa, Wi, WiHT, vf, v1, n, mu, e, vN0, reg, lcp_ctl, stats, pN, pT,
                     slip)
     elif na > 0:
-        m = na + nfa
-        sparse_delassus(G1, ia, fa, na, nfa, n, Wi, vf, H, hnz, hcnt, w, WiHT, Uf, Wd)
-        restitution_shift(Uf, na, ia, e, vN0)
-        several_contacts(lcp_step, na, nfa, ia, mu, e, vN0, reg, Wd, Uf, p, pN, pT, base, trow,
-                         rvel, Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb, idx,
-                         pcol, warm_on, k, k0, stats)
-        add_impulse(WiHT, p, vf, v1, m, n)
-        slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
+        if LCP_REACHABLE:
+            m = na + nfa
+            sparse_delassus(G1, ia, fa, na, nfa, n, Wi, vf, H, hnz, hcnt, w, WiHT, Uf, Wd)
+            restitution_shift(Uf, na, ia, e, vN0)
+            several_contacts(lcp_step, na, nfa, ia, mu, e, vN0, reg, Wd, Uf, p, pN, pT, base,
+                             trow, rvel, Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab,
+                             xb, idx, pcol, warm_on, k, k0, stats)
+            add_impulse(WiHT, p, vf, v1, m, n)
+            slip_rows(Wd, Uf, p, fa, na, nfa, m, slip)
+        else:
+            # the lean shared loop, run only where no LCP can arise (SHARED_LEAN): never
+            # reached; were it reached, the generic step would take the step
+            return LCP_HANDBACK
     # -- update: positions, then the projection
     for i in range(n):
         q1[i] = q[i] + hk * (th * v1[i] + (1.0 - th) * v[i])
     for i in range(nc):
         cnew[i] = pN[i] > 0.0
-    gaps_current = project_positions(projection, nc, n, mass_fn, gaps_fn, contacts_fn, HAS_GAPS,
-                                     const_mass, par, t1, q1, M, Mi, wk, sel, cnew, Gq, ia, X, S,
-                                     rs, pcol, dd, ident, flags, stats)
+    if PROJECTION_REACHABLE:
+        gaps_current = project_positions(projection, nc, n, mass_fn, gaps_fn, contacts_fn,
+                                         HAS_GAPS, const_mass, par, t1, q1, M, Mi, wk, sel, cnew,
+                                         Gq, ia, X, S, rs, pcol, dd, ident, flags, stats)
+    elif projection:
+        # the lean shared loop runs without projection only (SHARED_LEAN): never reached
+        return LCP_HANDBACK
+    else:
+        gaps_current = False
     if not all_finite(q1, v1, n):
         return NUMERICAL
     if nc > 0 and not gaps_current:
@@ -383,6 +399,29 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
 
 
 mj_loop = loop_template("mj_loop", globals())
+
+
+def lean_enough(nc, lcp_ctl, opts):
+    """Whether a run can take the lean shared loop: no contact LCP (:func:`lcp_needed`), no
+    projection.
+
+    Examples
+    --------
+    >>> lean_enough(1, new_lcp_control(1), (1.0, False)), lean_enough(2, new_lcp_control(2),
+    ...                                                                (1.0, False))
+    (True, False)
+    """
+    return not lcp_needed(nc, lcp_ctl) and isinstance(opts, tuple) and len(opts) == 2 \
+        and not opts[1]
+
+
+#: the shared loop's lean variant (moreau.integrators._loops.shared_core): the switches it is
+#: compiled with, and the test on (the number of contacts, the loop's arguments named) that
+#: picks it. A first use of a one-contact scene (the README's friction drive) compiles the
+#: loop without the several-contact branch (Delassus assembly, warm start, Lemke's call) and
+#: the projection: about a third of the full loop's compile
+SHARED_LEAN = ({"LCP_REACHABLE": False, "PROJECTION_REACHABLE": False}, lean_enough,
+               ("lcp_ctl", "opts"))
 
 
 # error_model="numpy": a division by zero gives inf/nan, which the loop's own

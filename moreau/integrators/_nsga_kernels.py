@@ -173,9 +173,10 @@ def smooth_stage(mass_fn, forces_fn, contacts_fn, lcp_step, par, q, v, a, acc, t
                                       lcp_ctl, stats)
             else:
                 L = _lcp_size(nb, ib, mu, base, trow)
+                # np.False_: a literal False would compile the LCP step a second time
                 piv, res, warm = lemke_solve(lcp_step, Wd, Uf, nb, ib, mu, lam, lamN, lamT, L, base,
                                              trow, Ml3, ql, dl, zl, wl, rayl, work, iwork, lay3,
-                                             lcp_ctl, Ab, xb, idx, pcol, False)
+                                             lcp_ctl, Ab, xb, idx, pcol, np.False_)
                 stats[S_PIVOTS] += piv
                 stats[S_LCP] += 1.0
             add_impulse(JiHT, lam, dx0, dx0, mb, n)
@@ -232,7 +233,7 @@ def impulse_stage(mass_fn, contacts_fn, lcp_step, par, q, v, qs, vs, tk, t1, n, 
             L = _lcp_size(na, ia, mu, base, trow)
             piv, res, warm = lemke_solve(lcp_step, Wd, Uf, na, ia, mu, p, pNi, pTi, L, base, trow,
                                          Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl, Ab, xb,
-                                         idx, pcol, False)
+                                         idx, pcol, np.False_)
             stats[S_PIVOTS] += piv
             stats[S_LCP] += 1.0
             for rr in range(na):
@@ -277,7 +278,7 @@ def correct_positions(mass_fn, gaps_fn, contacts_fn, lcp_step, HAS_GAPS, par, qs
         gap_block(Gq, ia, na, Mi, X, Wn, n)
         for c in range(na):
             gn[c] = Gq[ia[c], 0]
-        ne = 0
+        ne = np.int64(0)  # not a literal: see _driver.drive
         nun = np.int64(0)  # not a literal: see _mj_kernels.mj_loop
         for rr in range(na):
             if lamN[ia[rr]] > 0.0:
@@ -297,7 +298,7 @@ def correct_positions(mass_fn, gaps_fn, contacts_fn, lcp_step, HAS_GAPS, par, qs
             lst, piv, res, warm = lcp_step(Wn, gn, na, ia, mu0, nu, nuN, nuT, L2,
                                             base, trow, Ml2, ql, dl, zl, wl, rayl,
                                             work, iwork, lay2, lcp_ctl, Ab, xb, idx,
-                                            pcol, False)
+                                            pcol, np.False_)
             if lst != 0:
                 return LCP_HANDBACK
         else:
@@ -329,7 +330,7 @@ def correct_positions(mass_fn, gaps_fn, contacts_fn, lcp_step, HAS_GAPS, par, qs
                 lst, piv, res, warm = lcp_step(Ws, gs2, nun, iu, mu0, nuu, nuN, nuT,
                                                 L2, base, trow, Ml2, ql, dl, zl, wl,
                                                 rayl, work, iwork, lay2, lcp_ctl, Ab,
-                                                xb, idx, pcol, False)
+                                                xb, idx, pcol, np.False_)
                 if lst != 0:
                     return LCP_HANDBACK
                 for a_ in range(nun):

@@ -182,9 +182,10 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             times_ht(Mi, H, MiHT, m, n)
             rows_times(H, MiHT, Wd, m, n)
             L = _lcp_size(na, ia, mu, base, trow)
+            # np.False_: a literal False would compile the LCP step a second time
             lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pNn, pTn, L, base, trow,
                                            Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                           lcp_ctl, Ab, xb, idx, pcol, False)
+                                           lcp_ctl, Ab, xb, idx, pcol, np.False_)
             if lst != 0:
                 return LCP_HANDBACK
             if count:

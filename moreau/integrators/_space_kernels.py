@@ -311,7 +311,7 @@ def _exact_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, iwork, m
     u[:] = Uf
     # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
     ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                          EXACT_SWEEPS, Ml, ql, zl, wl)
+                                          np.int64(EXACT_SWEEPS), Ml, ql, zl, wl)
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
@@ -323,9 +323,10 @@ def _exact_polish_solve(W, Uf, mu_a, D, na, d, Ml, ql, dl, zl, wl, rayl, work, i
     u[:] = Uf
     # Lemke's scratch, unused by this cone, is Gauss–Seidel's (the loop sizes it >= 3 a contact)
     ok, res, qn = exact_gauss_seidel_into(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_POLISH_FROM,
-                                          EXACT_SWEEPS, Ml, ql, zl, wl)
+                                          np.int64(EXACT_SWEEPS), Ml, ql, zl, wl)
     if not ok:
-        ok, res, qn, _ = exact_newton_polish(W, Uf, mu_a, r, u, EXACT_TOL, EXACT_NEWTON)
+        ok, res, qn, _ = exact_newton_polish(W, Uf, mu_a, r, u, EXACT_TOL,
+                                             np.int64(EXACT_NEWTON))
     return np.int64(0 if ok else 1), np.int64(0), res, qn
 
 
@@ -514,7 +515,7 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     u = np.empty(0)
     for b in range(nb):
         _rotation(q, b, R)
-    nrec = 0
+    nrec = np.int64(0)  # not a literal: see _driver.drive
     k = k0
     status = OK
     while k - k0 < nmax:

@@ -92,9 +92,10 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
             Uf[r] += e[r] * min(vpre[r], 0.0)
         L = _lcp_size(na, ia, mu, base, trow)
         Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
+        # np.False_: a literal False would compile the LCP step a second time
         lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
                                         Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
-                                        lcp_ctl, Ab, xb, idx, pcol, False)
+                                        lcp_ctl, Ab, xb, idx, pcol, np.False_)
         if lst != 0:
             return LCP_HANDBACK
         stats[S_PIVOTS] += piv
@@ -183,7 +184,7 @@ def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, D
 def total_impulses(na, nfa, m, s, hk, ia, fa, b_st, Lam, Ptot, pN, pT, held):
     """The step's impulses: the one at its start plus the stages' forces by their weights, into
     ``pN``, ``pT``; returns how many contacts the last stage holds (listed in ``held``)."""
-    nh = 0
+    nh = np.int64(0)  # not a literal: see _driver.drive
     if na > 0:
         for c in range(m):
             acc = Ptot[c]

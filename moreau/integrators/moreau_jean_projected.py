@@ -143,9 +143,10 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             tau[0] = max(0.0, -gv[0] / S[0, 0])
         else:
             L = _lcp_size(s, ia, mu0, base, trow)
+            # np.False_: a literal False would compile the LCP step a second time
             lst, piv, res, warm = lcp_step(S, gv, s, ia, mu0, tau, nuN, nuT, L, base, trow,
                                            Ml, ql, dl, zl, wl, rayl, work, iwork, lay, lcp_ctl,
-                                           Ab, xb, idx, pcol, False)
+                                           Ab, xb, idx, pcol, np.False_)
             if lst != 0:
                 for i in range(nc):
                     closed[i] = cl0[i]

@@ -140,7 +140,7 @@ def _dot_sign(M, q, y, j):
     # [2^-960, 2^1000] (underflow would make the split inexact)
     n = q.shape[0]
     e = np.empty(2 * n + 1)
-    m = 0
+    m = np.int64(0)  # not a literal: it would compile _grow a second time
     for i in range(n):
         c = q[i] if j < 0 else M[i, j]
         p = c * y[i]

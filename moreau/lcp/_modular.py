@@ -345,7 +345,7 @@ def modular_step(M, q, d, basis, entering, P_all, flags):
     z0 = 2 * n
     # -- the structure of the basis: Z (its non-w variables), R, W
     isw = np.zeros(n, dtype=np.bool_)
-    k = 0
+    k = np.int64(0)  # not a literal: it would type (and compile) the calls on k twice
     for i in range(n):
         v = basis[i]
         if v < n:
@@ -983,7 +983,7 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
             if fm != 0.0 and fe - 53 < emin:
                 emin = fe - 53
     K = -emin
-    smax = 0
+    smax = np.int64(0)  # not a literal (see modular_step's k)
     logP = 0.0
     for c in range(k + 1):
         amax = 0.0
@@ -1034,9 +1034,9 @@ def exact_point(M, q, J, P_all, z, use_filter=True):
     A = np.empty((k, k + 1), dtype=np.int64)
     W = np.zeros((m + 2, m), dtype=np.int64)
     pow2 = np.empty(smax + 1, dtype=np.int64)
-    used = 0
+    used = np.int64(0)  # not literals (see modular_step's k)
     bad = 0
-    pi = 0
+    pi = np.int64(0)
     # the rows the elimination swaps in, as for the first prime: the same for
     # every prime means that each entry tested for zero was zero exactly when
     # it was zero modulo all of them (a nonzero minor is below their product),

@@ -662,7 +662,7 @@ def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
     # With B^-1 = I, of two rows tied in q_i/d_i the one with the larger
     # index is lexicographically smaller (its unit entry comes later), so a
     # forward scan keeps the last of the tied rows.
-    r = 0
+    r = np.int64(0)  # not a literal: it would type (and compile) _pivot a second time
     rr = q[0] / d[0]
     for i in range(1, n):
         ri = q[i] / d[i]
@@ -785,7 +785,7 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
             status = SECONDARY_RAY
             break
         lim = theta + TIE_TOL * abs(theta)
-        r = -1
+        r = np.int64(-1)  # not a literal (see the first pivot)
         nties = 0
         for i in range(n):
             a = col[i]
@@ -806,7 +806,7 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
                 for i in range(n):
                     a = col[i]
                     if i != zrow and a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
-                        c = _lex_compare(T, b, pos, n, zrow, i, a_z, a, qsum, exact_ok, True)
+                        c = _lex_compare(T, b, pos, n, zrow, i, a_z, a, qsum, exact_ok, np.True_)
                         if c == 1:
                             z0_tied = False
                             break
@@ -821,7 +821,7 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
                     a = col[i]
                     if a > 0.0 and unc[i] == 0.0 and b[i] / a <= lim:
                         c = _lex_compare(T, b, pos, n, i, best, a, col[best], qsum, exact_ok,
-                                         False)
+                                         np.False_)
                         if c == 2:
                             undecided = True
                             break
@@ -959,7 +959,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
             continue
         s = -pos[v] - 1
         cmax = 0.0
-        r = -1
+        r = np.int64(-1)  # not a literal (see _core's first pivot)
         best = 0.0
         for i in range(n):
             a = T[i, s]
@@ -1196,9 +1196,10 @@ def _balance_ruiz(M, q, rexp, cexp, sweeps):
     e0 = -math.frexp(mmax)[1] if mmax > 0.0 else 0
     for _ in range(sweeps):
         for i in range(n):
-            rexp[i] -= _geo_exponent(M, e0, rexp, cexp, i, True)
+            # np.bool_ flags: literals would compile _geo_exponent once for each value
+            rexp[i] -= _geo_exponent(M, e0, rexp, cexp, i, np.True_)
         for j in range(n):
-            cexp[j] -= _geo_exponent(M, e0, rexp, cexp, j, False)
+            cexp[j] -= _geo_exponent(M, e0, rexp, cexp, j, np.False_)
     return _unit_exponents(M, q, rexp, cexp)
 
 

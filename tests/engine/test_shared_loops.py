@@ -138,3 +138,33 @@ def test_specialised_loops_holds_for_its_block_and_leaves_a_user_setting_alone(m
     with specialised_loops():
         assert _loops.specialise_default() is False
     assert __import__("os").environ[_loops.SPECIALISE_ENV] == "0"
+
+
+def test_a_one_contact_run_takes_the_lean_shared_loop_with_the_full_loop_s_bits(monkeypatch):
+    # the friction drive (one contact, no projection) runs the lean form of the shared loop,
+    # compiled without the several-contact LCP and the projection; the full form, forced,
+    # gives the same arrays to the last bit (a projection run takes the full form)
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
+    monkeypatch.setattr(_loops, "TIER_UP_SECONDS", float("inf"))
+    scene = make_scene("friction-drive")
+    lean = _run(scene, 2.0, 2e-3)
+    runner = _loops.runner_for(scene.compiled_model())
+    assert list(runner._cores) == [True] and runner._special is None
+    assert runner._cores[True].py_func.__name__ == "mj_loop_lean_shared"
+
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops.SharedRunner, "_lean_for", lambda self, args, stub: False)
+    full = _run(scene, 2.0, 2e-3)
+    runner = _loops.runner_for(scene.compiled_model())
+    assert list(runner._cores) == [False]
+    assert lean.success and full.success and lean.stats["steps"] == full.stats["steps"] == 1000
+    for field in ("t", "q", "v", "regime", "force_N", "force_T", "slip_velocity", "gap"):
+        np.testing.assert_array_equal(getattr(lean, field), getattr(full, field), field)
+
+    monkeypatch.undo()
+    monkeypatch.setattr(_loops, "_CHOSEN", {})
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
+    q0, v0 = scene.initial_state()
+    simulate(scene, (0.0, 0.2), q0, v0, "moreau-jean", h=2e-3, projection=True)
+    assert list(_loops.runner_for(scene.compiled_model())._cores) == [False]
