@@ -102,6 +102,10 @@ class GranularColumnParams:
         [m/s^2].
     seed : int
         The random radii and start jitter.
+    mu_r : float
+        Rolling-resistance length [m] of every contact (:mod:`moreau.model.granular`);
+        0: the grains roll freely. The registered scene takes only 0; :func:`collapse`
+        takes any.
     """
 
     width: float = 0.02
@@ -115,12 +119,13 @@ class GranularColumnParams:
     restitution: float = 0.0
     gravity: float = 9.81
     seed: int = 0
+    mu_r: float = 0.0
 
     def __post_init__(self):
         for name in ("width", "aspect", "diameter", "density", "gravity"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "spread", in_closed_interval("spread", self.spread, 1e-3, 1.0))
-        for name in ("mu", "mu_floor", "mu_wall"):
+        for name in ("mu", "mu_floor", "mu_wall", "mu_r"):
             object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
         object.__setattr__(self, "restitution",
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
@@ -160,9 +165,9 @@ def column_system(params=None, *, gate=True, **overrides):
     walls = [HalfPlane((0.0, 0.0), (0.0, 1.0), mu=p.mu_floor),
              HalfPlane((0.0, 0.0), (1.0, 0.0), mu=p.mu_wall)]
     if gate:
-        walls.append(HalfPlane((L0, 0.0), (-1.0, 0.0), mu=0.0))
+        walls.append(HalfPlane((L0, 0.0), (-1.0, 0.0), mu=0.0, mu_r=0.0))
     sys = DiskSystem(radii, math.pi * radii ** 2, walls=walls, mu=p.mu,
-                     restitution=p.restitution, gravity=(0.0, -1.0))
+                     restitution=p.restitution, gravity=(0.0, -1.0), mu_r=p.mu_r / p.diameter)
     return sys, x0, L0
 
 
@@ -305,7 +310,7 @@ register_scene(SceneEntry(
     parameters=parameters_of(GranularColumnParams, {
         "width": "m", "aspect": "", "diameter": "m", "spread": "", "density": "kg/m^2",
         "mu": "", "mu_floor": "", "mu_wall": "", "restitution": "", "gravity": "m/s^2",
-        "seed": ""}),
+        "seed": "", "mu_r": "m"}),
     description=("collapse of a column of disks on a rough floor (runout against the aspect "
                  "ratio; contacts found every step by a broad phase in its study)"),
 ))

@@ -163,6 +163,11 @@ class SiloParams:
     wall_speed : float
         How fast the walls slide up after a pour [m/s].
     seed : int
+    mu_r : float
+        Rolling-resistance length [m] of every contact (between grains and with the walls
+        and floor; :mod:`moreau.model.granular`); 0: the grains roll freely. The
+        registered scene (a :class:`~moreau.model.granular.DiskScene`) takes only 0;
+        :func:`fill` takes any.
     """
 
     width: float = 0.03
@@ -177,13 +182,14 @@ class SiloParams:
     gravity: float = 9.81
     wall_speed: float = 0.011
     seed: int = 0
+    mu_r: float = 0.0
 
     def __post_init__(self):
         for name in ("width", "diameter", "density", "gravity"):
             object.__setattr__(self, name, positive(name, getattr(self, name)))
         object.__setattr__(self, "per_pour", positive_int("per_pour", self.per_pour))
         object.__setattr__(self, "spread", in_closed_interval("spread", self.spread, 1e-3, 1.0))
-        for name in ("mu", "mu_wall", "mu_floor", "wall_speed"):
+        for name in ("mu", "mu_wall", "mu_floor", "wall_speed", "mu_r"):
             object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
         object.__setattr__(self, "restitution",
                            in_closed_interval("restitution", self.restitution, 0.0, 1.0))
@@ -205,7 +211,7 @@ def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):
              HalfPlane((W, 0.0), (-1.0, 0.0), mu=p.mu_wall, surface_speed=-wall_speed)]
     radii = np.asarray(radii, dtype=float)
     return DiskSystem(radii, math.pi * radii ** 2, walls=walls, mu=p.mu,
-                      restitution=p.restitution, gravity=(0.0, -1.0))
+                      restitution=p.restitution, gravity=(0.0, -1.0), mu_r=p.mu_r / p.diameter)
 
 
 def silo(params=None, **overrides):
@@ -354,7 +360,7 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     h = positive("h", h)
     dz = positive("dz", dz)
     cs, r = impulses
-    f = np.asarray(r, dtype=float).reshape(-1, 2) / h
+    f = np.asarray(r, dtype=float).reshape(cs.size, -1) / h
     side = (cs.a == -2) | (cs.a == -3)
     # (left wall: t = (0, 1) points up; right wall: t = (0, -1))
     up = np.where(cs.a[side] == -2, f[side, 1], -f[side, 1])
@@ -507,7 +513,7 @@ register_scene(SceneEntry(
     parameters=parameters_of(SiloParams, {
         "width": "m", "per_pour": "", "diameter": "m", "spread": "", "density": "kg/m^2",
         "mu": "", "mu_wall": "", "mu_floor": "", "restitution": "", "gravity": "m/s^2",
-        "wall_speed": "m/s", "seed": ""}),
+        "wall_speed": "m/s", "seed": "", "mu_r": "m"}),
     description=("disks poured between two rough walls: Janssen's saturation of the floor's "
                  "load (contacts found every step by a broad phase in its study)"),
 ))
