@@ -13,7 +13,8 @@ slides them up for ``N`` steps and averages the cut profile over the last two th
 prints each wall contact: its normal force, ``T / (mu_w N)``, the disk's ``v_y`` and
 ``omega r`` and the slip ``u_T`` at the wall (0: the disk rolls or climbs with the wall).
 
-``--mu-r M`` gives every contact a rolling-resistance length of ``M`` grain diameters.
+``--mu-r M`` gives every contact a rolling-resistance length of ``M`` grain diameters;
+``--scatter S`` (``rest``) pours each disk with a horizontal speed uniform in ``[-S, S]``.
 
 Minutes a run on one core (12 pours of 30 disks: 6 to 17 minutes, the machine's load).
 The figures are the silo module's docstring's.
@@ -56,9 +57,9 @@ def _show_fit(label, mass, m_app, rho, W, mu_wall):
     return f
 
 
-def rest(p, pours):
+def rest(p, pours, scatter=0.0):
     t0 = time.process_time()
-    r = fill(pours, p)
+    r = fill(pours, p, scatter=scatter)
     print(f"fill: {time.process_time() - t0:.0f} s CPU, {int(np.sum(r['unconverged']))} weighing "
           f"steps above tol (worst residual {np.max(r['max_residual']):.1e})")
     print("pour   mass   m_app  wall_friction/(mu_w wall_normal)")
@@ -141,11 +142,12 @@ def main():
     ap.add_argument("--spread", type=float, default=0.8)
     ap.add_argument("--steps", type=int, default=300)
     ap.add_argument("--mu-r", type=float, default=0.0)
+    ap.add_argument("--scatter", type=float, default=0.0)
     a = ap.parse_args()
     p = SiloParams(per_pour=a.per_pour, seed=a.seed, spread=a.spread,
                    mu_r=a.mu_r * SiloParams.diameter)
     if a.mode == "rest":
-        rest(p, a.pours or 12)
+        rest(p, a.pours or 12, a.scatter)
     elif a.mode == "slide":
         slide(p, a.pours or 12, a.steps)
     else:

@@ -207,7 +207,7 @@ def deposit_front(x, radii, gap=0.05):
 
 
 def collapse(params=None, *, h=0.01, tol=1e-5, max_sweeps=500, max_time=200.0,
-             settle_time=60.0, **overrides):
+             settle_time=60.0, scatter=0.0, **overrides):
     """Settle the column behind its gate, remove the gate, and measure the deposit.
 
     The collapse runs until the deposit's front (:func:`deposit_front`) has
@@ -216,6 +216,10 @@ def collapse(params=None, *, h=0.01, tol=1e-5, max_sweeps=500, max_time=200.0,
     never stops, so the speeds do not tell), or ``max_time``. Rigid disks
     have no rolling resistance: a deposit one grain thick at its front keeps
     creeping, and its run ends at ``max_time`` with ``stopped`` False.
+    ``scatter``: the disks start settling with horizontal speeds drawn
+    uniformly in ``[-scatter, scatter]`` (grain units, seeded), which breaks
+    up the start lattice's columns (disks with rolling resistance stacked
+    on each other stand in them).
 
     Returns
     -------
@@ -227,9 +231,13 @@ def collapse(params=None, *, h=0.01, tol=1e-5, max_sweeps=500, max_time=200.0,
         before ``max_time``).
     """
     p = params_with(GranularColumnParams, params, overrides)
+    scatter = nonnegative("scatter", scatter)
     sys, x0, L0 = column_system(p, gate=True)
     opts = dict(theta=1.0, tol=tol, max_sweeps=max_sweeps)
-    packed = settle(sys, x0, np.zeros((sys.n_disks, 3)), h,
+    v0 = np.zeros((sys.n_disks, 3))
+    if scatter > 0.0:
+        v0[:, 0] = np.random.default_rng(p.seed + 1).uniform(-scatter, scatter, sys.n_disks)
+    packed = settle(sys, x0, v0, h,
                     max_steps=int(settle_time / h), speed_tol=2e-3, **opts)
     x = packed.x[-1]
     H0 = float(np.max(x[:, 1] + sys.radii))

@@ -233,13 +233,17 @@ def silo(params=None, **overrides):
 
 
 def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measure_steps=40,
-         tol=1e-6, **overrides):
+         tol=1e-6, scatter=0.0, **overrides):
     """Pour ``pours`` times; after each, settle, slide the walls up, settle, and weigh the floor.
 
     Each pour drops ``per_pour`` disks (a loose lattice just above the
     pile, :func:`~moreau.model.granular.random_fill`); the runs keep their
     contact impulses from one to the next (warm start), the settling runs
-    solve to ``100 tol``, the weighing to ``tol``.
+    solve to ``100 tol``, the weighing to ``tol``. ``scatter``: each poured
+    disk starts with a horizontal speed drawn uniformly in ``[-scatter,
+    scatter]`` (grain units, seeded), which breaks up the start lattice's
+    columns: disks with rolling resistance stacked on each other stand in
+    them (module docstring).
 
     Returns
     -------
@@ -254,6 +258,7 @@ def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measu
         ``profile``, :func:`wall_profile` of the last pour's last step.
     """
     p = params_with(SiloParams, params, overrides)
+    scatter = nonnegative("scatter", scatter)
     W = p.width / p.diameter
     V = p.wall_speed / math.sqrt(p.diameter * p.gravity)
     x = np.zeros((0, 2))
@@ -270,7 +275,11 @@ def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measu
                                    seed=p.seed + 7919 * k)
         radii = np.concatenate([radii, r_new])
         x = np.concatenate([x, x_new])
-        v = np.concatenate([v, np.zeros((p.per_pour, 3))])
+        v_new = np.zeros((p.per_pour, 3))
+        if scatter > 0.0:
+            v_new[:, 0] = np.random.default_rng(p.seed + 7919 * k + 1).uniform(
+                -scatter, scatter, p.per_pour)
+        v = np.concatenate([v, v_new])
         phi = np.concatenate([phi, np.zeros(p.per_pour)])
         fixed = silo_system(radii, p)
         moving = silo_system(radii, p, wall_speed=V)

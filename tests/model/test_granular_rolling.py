@@ -13,6 +13,8 @@ from moreau.errors import InputError
 from moreau.integrators.granular import simulate_disks
 from moreau.lcp import solve_lcp
 from moreau.model.granular import DiskScene, DiskSystem, HalfPlane
+from moreau.scenes.granular_column import collapse
+from moreau.scenes.silo import fill
 
 
 def _floor(mu, mu_r, R=0.5, alpha=0.0):
@@ -155,3 +157,14 @@ def test_negative_rolling_resistance_and_a_scene_with_it_are_refused_by_name():
     # a wall's own resistance alone makes the system rolling
     assert DiskSystem([0.5], [1.0], walls=[HalfPlane((0, 0), (0, 1), mu_r=0.01)]).rolling
     assert not DiskSystem([0.5], [1.0], walls=[HalfPlane((0, 0), (0, 1))]).rolling
+
+
+def test_the_studies_refuse_a_negative_scatter_and_mu_r_by_name_before_any_run():
+    with pytest.raises(InputError, match="`scatter`"):
+        fill(1, scatter=-0.1)
+    with pytest.raises(InputError, match="`scatter`"):
+        collapse(scatter=-0.1)
+    with pytest.raises(InputError, match="`mu_r`"):
+        fill(1, mu_r=-1e-4)
+    with pytest.raises(InputError, match="`mu_r`"):
+        collapse(mu_r=-1e-4)
