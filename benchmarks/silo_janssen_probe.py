@@ -14,7 +14,7 @@ prints each wall contact: its normal force, ``T / (mu_w N)``, the disk's ``v_y``
 ``omega r`` and the slip ``u_T`` at the wall (0: the disk rolls or climbs with the wall).
 
 ``--mu-r M`` gives every contact a rolling-resistance length of ``M`` grain diameters;
-``--scatter S`` (``rest``) pours each disk with a horizontal speed uniform in ``[-S, S]``.
+``--scatter S`` (``rest``, ``slide``) pours each disk with a horizontal speed uniform in ``[-S, S]``.
 
 Minutes a run on one core (12 pours of 30 disks: 6 to 17 minutes, the machine's load).
 The figures are the silo module's docstring's.
@@ -31,7 +31,7 @@ from moreau.model.granular import random_fill
 from moreau.scenes.silo import SiloParams, fill, fit_janssen, silo_system, wall_profile
 
 
-def _pour(p, pours, h=0.01, tol=1e-6):
+def _pour(p, pours, h=0.01, tol=1e-6, scatter=0.0):
     """Pours that settle with the walls at rest (no slide); the state and the last impulses."""
     W = p.width / p.diameter
     x, v, phi, radii = np.zeros((0, 2)), np.zeros((0, 3)), np.zeros(0), np.zeros(0)
@@ -41,7 +41,12 @@ def _pour(p, pours, h=0.01, tol=1e-6):
                                    seed=p.seed + 7919 * k)
         radii = np.concatenate([radii, r_new])
         x = np.concatenate([x, x_new])
-        v = np.concatenate([v, np.zeros((p.per_pour, 3))])
+        v_new = np.zeros((p.per_pour, 3))
+        if scatter > 0.0:
+            # (the same draws as fill's)
+            v_new[:, 0] = np.random.default_rng(p.seed + 7919 * k + 1).uniform(
+                -scatter, scatter, p.per_pour)
+        v = np.concatenate([v, v_new])
         phi = np.concatenate([phi, np.zeros(p.per_pour)])
         run = settle(silo_system(radii, p), x, v, h, phi0=phi, warm=warm, max_steps=1500,
                      speed_tol=2e-3, theta=1.0, tol=100 * tol, max_sweeps=500)
@@ -78,9 +83,9 @@ def rest(p, pours, scatter=0.0):
         print("{:5.1f} {:7.1f} {:7.1f} {:9.3f} {:9.3f} {:9.3f}".format(*row))
 
 
-def slide(p, pours, steps, V=0.05, h=0.01, tol=1e-5, chunk=5, dz=2.0):
+def slide(p, pours, steps, V=0.05, h=0.01, tol=1e-5, chunk=5, dz=2.0, scatter=0.0):
     t0 = time.process_time()
-    radii, x, v, phi, warm = _pour(p, pours, h)
+    radii, x, v, phi, warm = _pour(p, pours, h, scatter=scatter)
     moving = silo_system(radii, p, wall_speed=V)
     acc = None
     n = unconverged = 0
@@ -149,7 +154,7 @@ def main():
     if a.mode == "rest":
         rest(p, a.pours or 12, a.scatter)
     elif a.mode == "slide":
-        slide(p, a.pours or 12, a.steps)
+        slide(p, a.pours or 12, a.steps, scatter=a.scatter)
     else:
         roll(p, a.pours or 4)
 
