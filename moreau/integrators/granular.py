@@ -27,6 +27,15 @@ started from the last step's impulses of the same pairs of bodies (matched
 by :attr:`ContactSet.key <moreau.model.granular.ContactSet.key>`; a new
 pair starts at zero).
 
+*Rolling resistance.* Where the system has some (``mu_r > 0``,
+:class:`~moreau.model.granular.DiskSystem`), every active contact has a
+third row, the relative rolling ``u_R = omega_b - omega_a``, and the
+problem is the one of :mod:`moreau.contact.rolling` (``|M| <= mu_r N``, the
+couple against the roll), solved by
+:func:`~moreau.contact.rolling.solve_nsgs_rolling` with the same warm
+start, restart and certified stop; the impulses are interleaved ``[N, T,
+R]``. Without, the step is the one above, unchanged.
+
 If the warm-started solve ends above ``tol``, it is run again from zero
 (a warm start can stall where the impulses are not unique, a hyperstatic
 pile), and that answer replaces it only if it meets ``tol``; ``sweeps``
@@ -46,6 +55,7 @@ import time
 import numpy as np
 
 from .._validate import finite_array, in_closed_interval, positive, positive_int
+from ..contact.rolling import solve_nsgs_rolling
 from ..contact.solvers.nsgs import solve_nsgs
 from ..errors import InputError
 from ..model.granular import DiskSystem
@@ -85,7 +95,8 @@ class GranularResult:
         solves run again from zero.
     impulses : tuple
         ``(ContactSet, r)`` of the last step: its active contacts and their
-        impulses (interleaved ``[N, T]``).
+        impulses (interleaved ``[N, T]``, or ``[N, T, R]`` with rolling
+        resistance: ``R`` the couple's impulse on disk ``b``).
     """
 
     def __init__(self, t, x, phi, v, steps, status, message, timing, impulses, tol):
@@ -149,7 +160,9 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         The impulses a run ended with (:attr:`GranularResult.impulses`) to
         warm start the first step: a run continued where another stopped
         keeps its contact forces (a static packing's forces are not unique;
-        its history picks them).
+        its history picks them). Impulses of a run with rolling resistance
+        start one without (their couples dropped), and the other way round
+        (couples from zero).
 
     Returns
     -------
@@ -189,13 +202,21 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
                            "wall_impulse")}
     nw = system.n_walls
     timing = {"broad_phase": 0.0, "assembly": 0.0, "solve": 0.0}
+    rolling = system.rolling
+    width = 3 if rolling else 2
     prev_keys = np.zeros(0, dtype=np.int64)
-    prev_r = np.zeros((0, 2))
+    prev_r = np.zeros((0, width))
     if warm is not None and warm[0] is not None:
         prev_keys = np.asarray(warm[0].key, dtype=np.int64)
-        prev_r = np.asarray(warm[1], dtype=float).reshape(-1, 2)
-        if prev_r.shape[0] != prev_keys.size:
-            raise InputError("`warm` must be (ContactSet, impulses) with two impulses a contact")
+        given = np.asarray(warm[1], dtype=float).ravel()
+        if prev_keys.size == 0 or given.size not in (2 * prev_keys.size, 3 * prev_keys.size):
+            if given.size or prev_keys.size:
+                raise InputError("`warm` must be (ContactSet, impulses) with two (or three, "
+                                 "with rolling resistance) impulses a contact")
+        given = given.reshape(prev_keys.size, -1) if prev_keys.size else given.reshape(0, width)
+        prev_r = np.zeros((prev_keys.size, width))
+        k = min(width, given.shape[1])
+        prev_r[:, :k] = given[:, :k]
     closed_keys = prev_keys[prev_r[:, 0] > 0.0]
     status, message = 0, ""
     last = (None, np.zeros(0))
@@ -218,11 +239,12 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         v_free = vflat + dv_free
         na = ia.size
         if na:
-            H = system.jacobian(act)
+            H = system.jacobian(act, rolling=True) if rolling else system.jacobian(act)
             W = system.delassus(H)
-            q = H @ v_free + system.contact_offsets(act)
-            q[0::2] += act.e * np.minimum(uN[ia], 0.0)
-            r0 = np.zeros((na, 2))
+            q = H @ v_free + (system.contact_offsets(act, rolling=True) if rolling
+                              else system.contact_offsets(act))
+            q[0::width] += act.e * np.minimum(uN[ia], 0.0)
+            r0 = np.zeros((na, width))
             if prev_keys.size:
                 order = np.argsort(prev_keys)
                 pos = np.searchsorted(prev_keys, act.key, sorter=order)
@@ -230,14 +252,21 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
                 hit = prev_keys[order[pos]] == act.key
                 r0[hit] = prev_r[order[pos[hit]]]
             c2 = time.process_time()
-            sol = solve_nsgs(W, q, act.mu, r0=r0.ravel(), tol=tol, max_sweeps=max_sweeps,
-                             check_every=check_every)
+            if rolling:
+                def solver(**kw):
+                    return solve_nsgs_rolling(W, q, act.mu, act.mu_r, tol=tol,
+                                              max_sweeps=max_sweeps, check_every=check_every,
+                                              **kw)
+            else:
+                def solver(**kw):
+                    return solve_nsgs(W, q, act.mu, tol=tol, max_sweeps=max_sweeps,
+                                      check_every=check_every, **kw)
+            sol = solver(r0=r0.ravel())
             sweeps = sol.iterations
             if not sol.converged and np.any(r0):
                 # a warm start can stall where the impulses are not unique (a hyperstatic
                 # pile): measured 5000 sweeps stuck at 1.3e-6 where a cold start took 228
-                cold = solve_nsgs(W, q, act.mu, tol=tol, max_sweeps=max_sweeps,
-                                  check_every=check_every)
+                cold = solver()
                 sweeps += cold.iterations
                 if cold.converged:
                     # (only then: in a deep pile the warm start carries the iterations of the
@@ -262,7 +291,7 @@ def simulate_disks(system, x0, v0, n_steps, h, *, phi0=None, theta=0.5, tol=1e-6
         phi = phi + dq[:, 2]
         v = v1
         t = float(t0) + (k + 1) * h
-        rp = r.reshape(-1, 2)
+        rp = r.reshape(-1, width)
         prev_keys, prev_r = act.key, rp
         closed_keys = act.key[rp[:, 0] > 0.0] if na else np.zeros(0, dtype=np.int64)
         last = (act, r)

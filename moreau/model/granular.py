@@ -37,6 +37,23 @@ body ``a`` at rest, with ``n`` the unit vector from its nearest point to the
 centre of ``b`` (a half-plane: its outward normal), so ``g = dist - r_b``
 and the same rows hold with ``v_a = 0``, ``omega_a = 0``.
 
+Rolling resistance
+------------------
+With a rolling-resistance length ``mu_r > 0`` (:class:`DiskSystem`; per
+wall), each contact also transmits a couple ``M``, ``+M`` on ``b`` and
+``-M`` on ``a``, with ``|M| <= mu_r N`` (``N`` the normal force) and ``M``
+opposing the relative rolling ``u_R = omega_b - omega_a`` where it is not
+zero (:mod:`moreau.contact.rolling`). ``u_R`` is the rate of the relative
+rotation ``phi_b - phi_a``: zero where the pair turns as one rigid body
+(``omega_a = omega_b``), whatever it does; a couple does no work on a
+translation, so the power of ``M`` is ``M u_R``. ``mu_r`` is a length (the
+lever arm by which the normal force resists the roll, Coulomb's
+coefficient of rolling friction), so the same ``mu_r`` is the same
+resistance for a small and a large grain in contact; ``mu_r / r`` is the
+slope a disk of radius ``r`` rests on (``tests/model/test_granular.py``).
+The rows are then ``[N_i, T_i, R_i]`` per contact (``rolling=True`` of
+:meth:`DiskSystem.jacobian`).
+
 Examples
 --------
 Three disks on a floor, the third resting on the first two (five contacts):
@@ -82,7 +99,7 @@ class HalfPlane(NamedTuple):
     ``normal`` is normalised by :class:`DiskSystem`. ``surface_speed``: the
     wall's material slides along itself at this speed along ``t = (-n_y, n_x)``
     (a belt; the wall stays where it is, only the slip at its contacts
-    changes).
+    changes). ``mu_r``: its rolling-resistance length (default: the disks').
     """
 
     point: tuple
@@ -90,12 +107,14 @@ class HalfPlane(NamedTuple):
     mu: float = None
     restitution: float = None
     surface_speed: float = 0.0
+    mu_r: float = None
 
 
 class Segment(NamedTuple):
     """A fixed segment from ``start`` to ``end``, touched from either side and at its ends.
 
     ``surface_speed``: its material slides from ``start`` towards ``end`` at this speed.
+    ``mu_r``: its rolling-resistance length (default: the disks').
     """
 
     start: tuple
@@ -103,6 +122,7 @@ class Segment(NamedTuple):
     mu: float = None
     restitution: float = None
     surface_speed: float = 0.0
+    mu_r: float = None
 
 
 class ContactSet(NamedTuple):
@@ -122,6 +142,8 @@ class ContactSet(NamedTuple):
     key : ndarray of int64
         A number per pair of bodies, the same at every state and in any system that
         numbers the bodies alike: ``a * 2**32 + b``.
+    mu_r : ndarray
+        Rolling-resistance length of each contact.
     """
 
     a: np.ndarray
@@ -131,6 +153,7 @@ class ContactSet(NamedTuple):
     mu: np.ndarray
     e: np.ndarray
     key: np.ndarray
+    mu_r: np.ndarray
 
     @property
     def size(self):
@@ -349,12 +372,19 @@ class DiskSystem:
         Newton restitution between disks (and of walls that give none), in ``[0, 1]``.
     gravity : (float, float)
         The acceleration of gravity, in the system's units.
+    mu_r : float
+        Rolling-resistance length between disks (and of walls that give none), ``>= 0``,
+        in the system's units (module docstring); 0: disks roll freely, and
+        :func:`~moreau.integrators.granular.simulate_disks` solves the problem without
+        rolling rows.
 
     Attributes
     ----------
     n_disks : int
     inv_mass : ndarray, shape (3 N,)
         ``(1/m, 1/m, 1/I)`` per disk, ``I = m r^2 / 2``.
+    rolling : bool
+        Whether any contact (between disks or with a wall) has ``mu_r > 0``.
 
     Examples
     --------
@@ -368,7 +398,7 @@ class DiskSystem:
     """
 
     def __init__(self, radii, masses, *, walls=(), mu=0.5, restitution=0.0,
-                 gravity=(0.0, -1.0)):
+                 gravity=(0.0, -1.0), mu_r=0.0):
         radii = finite_array("radii", radii, ndim=1)
         n = radii.size
         if n == 0 or np.any(radii <= 0.0):
@@ -377,15 +407,17 @@ class DiskSystem:
         if np.any(masses <= 0.0):
             raise InputError("`masses` must be > 0 for every disk")
         mu = nonnegative("mu", mu)
+        mu_r = nonnegative("mu_r", mu_r)
         restitution = finite_scalar("restitution", restitution)
         if not 0.0 <= restitution <= 1.0:
             raise InputError(f"`restitution` must lie in [0, 1], got {restitution!r}")
         self.gravity = finite_array("gravity", gravity, shape=(2,))
         self.radii, self.masses, self.mu, self.restitution = radii, masses, mu, restitution
+        self.mu_r = mu_r
         self.n_disks = n
         self.inertias = 0.5 * masses * radii ** 2
         self.inv_mass = np.column_stack([1.0 / masses, 1.0 / masses, 1.0 / self.inertias]).ravel()
-        kind, p0, p1, wmu, we, wvel = [], [], [], [], [], []
+        kind, p0, p1, wmu, we, wvel, wmur = [], [], [], [], [], [], []
         for k, w in enumerate(walls):
             if isinstance(w, HalfPlane):
                 nrm = finite_array(f"walls[{k}].normal", w.normal, shape=(2,))
@@ -414,6 +446,7 @@ class DiskSystem:
             if not 0.0 <= e <= 1.0:
                 raise InputError(f"`walls[{k}].restitution` must lie in [0, 1], got {e!r}")
             wmu.append(m)
+            wmur.append(mu_r if w.mu_r is None else nonnegative(f"walls[{k}].mu_r", w.mu_r))
             we.append(e)
             wvel.append(finite_scalar(f"walls[{k}].surface_speed", w.surface_speed) * along)
         self.walls = tuple(walls)
@@ -423,6 +456,8 @@ class DiskSystem:
         self._p1 = np.array(p1, dtype=float).reshape(-1, 2)
         self._wall_mu = np.array(wmu, dtype=float)
         self._wall_e = np.array(we, dtype=float)
+        self._wall_mu_r = np.array(wmur, dtype=float)
+        self.rolling = bool(mu_r > 0.0 or np.any(self._wall_mu_r > 0.0))
         #: the velocity of each wall's material, shape (n_walls, 2)
         self.wall_velocity = np.array(wvel, dtype=float).reshape(-1, 2)
 
@@ -471,20 +506,24 @@ class DiskSystem:
             normal=np.concatenate([n_pair, n_wall]),
             mu=np.concatenate([np.full(i.size, self.mu), self._wall_mu[w]]),
             e=np.concatenate([np.full(i.size, self.restitution), self._wall_e[w]]),
-            key=a * (1 << 32) + bb)
+            key=a * (1 << 32) + bb,
+            mu_r=np.concatenate([np.full(i.size, self.mu_r), self._wall_mu_r[w]]))
 
-    def jacobian(self, contacts):
+    def jacobian(self, contacts, rolling=False):
         """The contact Jacobian ``H`` (CSR, ``2 nc x 3 N``), rows ``[N_i, T_i]`` interleaved.
 
         Row ``2 i``: ``u_N = n . (v_b - v_a)``; row ``2 i + 1``:
         ``u_T = t . (v_b - v_a) - r_a omega_a - r_b omega_b`` (module
-        docstring), a wall's terms left out.
+        docstring), a wall's terms left out. With ``rolling``, ``3 nc``
+        rows ``[N_i, T_i, R_i]``, row ``3 i + 2`` the relative rolling
+        ``u_R = omega_b - omega_a``.
         """
         c = contacts
         nc = c.size
         n = c.normal
         t = np.column_stack([-n[:, 1], n[:, 0]])
-        rows_n = 2 * np.arange(nc)
+        stride = 3 if rolling else 2
+        rows_n = stride * np.arange(nc)
         rows_t = rows_n + 1
         b, a = c.b, c.a
         disk_a = a >= 0
@@ -498,25 +537,33 @@ class DiskSystem:
         rows += [rows_n[ia], rows_n[ia], rows_t[ia], rows_t[ia], rows_t[ia]]
         cols += [3 * aa, 3 * aa + 1, 3 * aa, 3 * aa + 1, 3 * aa + 2]
         vals += [-n[ia, 0], -n[ia, 1], -t[ia, 0], -t[ia, 1], -ra[ia]]
+        if rolling:
+            rows_r = rows_n + 2
+            rows += [rows_r, rows_r[ia]]
+            cols += [3 * b + 2, 3 * aa + 2]
+            vals += [np.ones(nc), -np.ones(ia.size)]
         H = sps.csr_array((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                          shape=(2 * nc, self.ndof))
+                          shape=(stride * nc, self.ndof))
         H.sum_duplicates()
         return H
 
-    def contact_offsets(self, contacts):
+    def contact_offsets(self, contacts, rolling=False):
         """``w`` with ``u = H v + w``: the walls' surface velocities, interleaved ``[N_i, T_i]``.
 
         A contact with a wall whose material moves at ``V`` has
         ``u_N -= n . V`` (zero: ``V`` is along the wall) and ``u_T -= t . V``.
+        With ``rolling``, interleaved ``[N_i, T_i, R_i]``: a wall's material
+        translates, ``u_R`` has no offset.
         """
         c = contacts
-        w = np.zeros(2 * c.size)
+        s = 3 if rolling else 2
+        w = np.zeros(s * c.size)
         on_wall = np.flatnonzero(c.a < 0)
         if on_wall.size and np.any(self.wall_velocity):
             V = self.wall_velocity[-1 - c.a[on_wall]]
             n = c.normal[on_wall]
-            w[2 * on_wall] = -np.einsum("ij,ij->i", n, V)
-            w[2 * on_wall + 1] = -(-n[:, 1] * V[:, 0] + n[:, 0] * V[:, 1])
+            w[s * on_wall] = -np.einsum("ij,ij->i", n, V)
+            w[s * on_wall + 1] = -(-n[:, 1] * V[:, 0] + n[:, 0] * V[:, 1])
         return w
 
     def delassus(self, H):
@@ -612,6 +659,10 @@ class DiskScene(SIUnits, Scene):
                  force=1.0, default_window=1.0):
         if not isinstance(system, DiskSystem):
             raise InputError(f"`system` must be a DiskSystem, got {type(system).__name__}")
+        if system.rolling:
+            # a Scene's rows are normal and tangential; a couple row has no place in them
+            raise InputError("`system` must have no rolling resistance (`mu_r` = 0 for every "
+                             "contact) in a DiskScene: run it with simulate_disks")
         N = system.n_disks
         self.system = system
         x0 = finite_array("x0", x0, shape=(N, 2))
@@ -685,7 +736,7 @@ class DiskScene(SIUnits, Scene):
     def _rows(self, q):
         x, gap, n, turn = self._geometry(q)
         cs = ContactSet(self._a, self._b, gap, n, self.mu, self.restitution,
-                        self._a * (1 << 32) + self._b)
+                        self._a * (1 << 32) + self._b, np.zeros(self._a.size))
         H = self.system.jacobian(cs).toarray()
         return cs, H, self.system.contact_offsets(cs), turn
 
