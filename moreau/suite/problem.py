@@ -140,11 +140,13 @@ class Problem:
                       else float(abs(v - r) / sc[k]))
         return out
 
-    def describe(self):
+    def describe(self, reference=None):
+        """The problem's statement for the report (``reference``: computed already)."""
         return {"name": self.name, "title": self.title, "scene": self.scene,
                 "scene_parameters": self.scene_parameters(), "window": self.window,
                 "reference_kind": self.reference_kind, "source": self.source,
-                "tolerance": self.tolerance, "reference": self.reference(),
+                "tolerance": self.tolerance,
+                "reference": self.reference() if reference is None else dict(reference),
                 "scales": self.scales()}
 
 

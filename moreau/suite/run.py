@@ -22,8 +22,13 @@ count, a tolerance, a contact stiffness). Each cell ends in one outcome:
 A finished cell is written to ``OUT/cells/`` at once; a rerun of the same
 command reads the cells it finds there instead of computing them again, so
 an interrupted suite resumes.
+
+With ``MOREAU_SUITE_TRACE=FILE`` in the environment, each process appends
+one JSON line per task to ``FILE`` (its kind, process id, start and end
+time, CPU seconds): where a run's time goes, compiles included.
 """
 
+import concurrent.futures
 import json
 import math
 import os
@@ -211,20 +216,50 @@ _INSTANCES = {}
 _WARMED = set()
 
 
+def _problem_scene(pname):
+    if pname not in _INSTANCES:
+        prob = get_problem(pname)
+        _INSTANCES[pname] = [prob, prob.make_scene(), None]
+    return _INSTANCES[pname]
+
+
+def reference_of(pname, reference=None):
+    """The reference of problem ``pname``, computed once per process (or ``reference``, computed
+    elsewhere: the parent of a worker, so that a worker does not compute it again)."""
+    entry = _problem_scene(pname)
+    if entry[2] is None:
+        entry[2] = entry[0].reference() if reference is None else dict(reference)
+    return entry[2]
+
+
 def instance(pname, reference=None):
     """``(problem, scene, reference)`` of ``pname``, built once per process.
 
     ``reference``: the problem's reference computed elsewhere (the parent
     of a worker), so that a worker does not compute it again.
     """
-    if pname not in _INSTANCES:
-        prob = get_problem(pname)
-        _INSTANCES[pname] = (prob, prob.make_scene(),
-                             prob.reference() if reference is None else dict(reference))
-    return _INSTANCES[pname]
+    ref = reference_of(pname, reference)
+    prob, scene, _ = _problem_scene(pname)
+    return prob, scene, ref
+
+
+def _trace(kind, t0, c0, **kw):
+    # one line per task where MOREAU_SUITE_TRACE asks for it (see the module docstring)
+    path = os.environ.get("MOREAU_SUITE_TRACE")
+    if path:
+        with open(path, "a") as fh:
+            fh.write(json.dumps(dict(kind=kind, pid=os.getpid(), t0=t0, t1=time.time(),
+                                     cpu=time.process_time() - c0, **kw)) + "\n")
 
 
 def cell_task(pname, scheme, label, options, reference=None):
+    _t0, _c0 = time.time(), time.process_time()
+    row = _cell_task(pname, scheme, label, options, reference)
+    _trace("cell", _t0, _c0, p=pname, s=scheme, l=label, cpu_s=row.get("cpu_s"))
+    return row
+
+
+def _cell_task(pname, scheme, label, options, reference=None):
     """One cell, computed in this process (a worker's task): its row.
 
     The first cell of a (problem, scheme) pair in a process runs the scheme
@@ -265,7 +300,7 @@ def plan_cells(problems=None, schemes=None, quick=False, peers=True):
                              f"{', '.join(all_schemes)}; got {s!r}")
     plan = []
     for pname in problems:
-        prob, scene, _ = instance(pname)
+        prob, scene, _ = _problem_scene(pname)
         for s in schemes:
             try:
                 sets = settings_of(s, prob, scene, quick)
@@ -319,21 +354,30 @@ def _results(plan, todo, n_jobs, scheduler):
         for i in todo:
             yield i, cell_task(*plan[i])
         return
-    refs = {pname: instance(pname)[2] for pname in {plan[i][0] for i in todo}}
-    tasks = [joblib.delayed(warm_task)(*plan[i], refs[plan[i][0]])
-             for i in _first_of_each_scheme(plan, todo)]
-    tasks += [joblib.delayed(_indexed_cell)(i, *plan[i], refs[plan[i][0]]) for i in todo]
-    with worker_pool_config():
-        par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
-    gen = par(tasks)
+    names = list(dict.fromkeys(plan[i][0] for i in todo))
+    # the references are computed here, in a thread, while the workers compile the schemes
+    # (the first pool): the cells, which need them, go to the second pool
+    refs = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+    ref_of = refs.submit(lambda: {p: reference_of(p) for p in names})
+    warm = [joblib.delayed(warm_task)(*plan[i]) for i in _first_of_each_scheme(plan, todo)]
     ok = False
+    gen = None
     try:
-        for i, row in gen:
-            if i is not None:
-                yield i, row
+        with worker_pool_config():
+            pars = [joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
+                    for _ in range(2)]
+        gen = pars[0](warm)
+        for _ in gen:
+            pass
+        ref = ref_of.result()
+        gen = pars[1](joblib.delayed(pair_task)(pname, s, cells, ref[pname])
+                      for pname, s, cells in _pairs(plan, todo))
+        for out in gen:
+            yield from out
         ok = True
     finally:
-        if not ok:
+        refs.shutdown(wait=ok, cancel_futures=True)
+        if not ok and gen is not None:
             # closing joblib's generator stops handing out cells (Ctrl-C, an error)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
@@ -341,8 +385,22 @@ def _results(plan, todo, n_jobs, scheduler):
         end_worker_pool(kill=not ok)
 
 
-def _indexed_cell(i, *cell):
-    return i, cell_task(*cell)
+def _pairs(plan, todo):
+    """``[(problem, scheme, [(index, label, options)])]``: the cells ``todo`` grouped by
+    (problem, scheme), in the plan's order: one pool task each, so that a scheme's loop for a
+    problem is compiled (or loaded) by one worker, not by both at once."""
+    out = {}
+    for i in todo:
+        pname, s, label, options = plan[i]
+        out.setdefault((pname, s), []).append((i, label, options))
+    return [(p, s, cells) for (p, s), cells in out.items()]
+
+
+def pair_task(pname, scheme, cells, reference=None):
+    """The cells ``[(index, label, options)]`` of one (problem, scheme) pair, in this process
+    (a worker's task): ``[(index, row)]``."""
+    return [(i, cell_task(pname, scheme, label, options, reference))
+            for i, label, options in cells]
 
 
 def _first_of_each_scheme(plan, todo):
@@ -365,10 +423,12 @@ def warm_task(pname, scheme, label, options, reference=None):
     load it from numba's cache instead of compiling it again in every worker
     at once. Returns ``(None, scheme)``.
     """
-    prob, scene, _ = instance(pname, reference)
+    _t0, _c0 = time.time(), time.process_time()
+    prob, scene, _ = _problem_scene(pname)
     if (pname, scheme) not in _WARMED:
         _WARMED.add((pname, scheme))
         _warm_up(prob, scheme, options, scene)
+    _trace("warm", _t0, _c0, p=pname, s=scheme, l=label)
     return None, scheme
 
 
@@ -401,7 +461,9 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     Interrupted
         On Ctrl-C, after the cells finished so far are kept.
     """
+    _t0, _c0 = time.time(), time.process_time()
     problems, schemes, plan = plan_cells(problems, schemes, quick, peers)
+    _trace("plan", _t0, _c0)
     rows = [None] * len(plan)
     todo = []
     for i, (pname, s, label, _) in enumerate(plan):
@@ -431,7 +493,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     finally:
         if bar is not None:
             bar.close()
-    return {"rows": rows, "problems": [instance(p)[0].describe() for p in problems],
+    return {"rows": rows, "problems": [instance(p)[0].describe(reference_of(p)) for p in problems],
             "schemes": schemes, "jobs": n_jobs, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
                                           "computed": sum(1 for r in rows if not r.get("cached"))}}
