@@ -21,10 +21,11 @@ Examples
 
 import functools
 import json
-import math
 import os
 import pathlib
 import subprocess
+
+from .problem import judge
 
 __all__ = ["SICONOS_PYTHON", "SICONOS_OSIS", "peer_script", "siconos_available", "peer_names",
            "is_peer", "run_peer_cell", "PEER_SETTING"]
@@ -74,8 +75,9 @@ def _row(problem, scheme):
             "tolerance": problem.tolerance, "cpu_s": None, "wall_s": None, "steps": None}
 
 
-def run_peer_cell(problem, scheme, scene, reference=None):
-    """One peer cell: the Siconos OSI of ``scheme`` on ``problem`` (a row as ``run_cell``'s)."""
+def run_peer_cell(problem, scheme, scene, reference=None, judged=True):
+    """One peer cell: the Siconos OSI of ``scheme`` on ``problem`` (a row as ``run_cell``'s;
+    ``judged=False``: a finished run left for :func:`~moreau.suite.problem.judge`)."""
     row = _row(problem, scheme)
     osi = scheme.split(":", 1)[1]
     case = getattr(problem, "siconos_case", lambda s: None)(scene)
@@ -104,18 +106,6 @@ def run_peer_cell(problem, scheme, scene, reference=None):
         row.update(outcome="failed", cause=f"Siconos {osi}: {out['error']}")
         return row
     values = problem.siconos_values(out)
-    ref = problem.reference() if reference is None else reference
-    errors = problem.errors(values, ref)
-    row.update(values=values, errors=errors, cpu_s=out.get("seconds"), wall_s=out.get("seconds"),
+    row.update(values=values, cpu_s=out.get("seconds"), wall_s=out.get("seconds"),
                steps=out.get("steps"), status=0)
-    missing = [k for k, e in errors.items() if e is None]
-    row["max_error"] = math.inf if missing else max(errors.values(), default=0.0)
-    if missing:
-        row.update(outcome="inaccurate", cause="no value for " + ", ".join(missing))
-    elif row["max_error"] <= problem.tolerance:
-        row["outcome"] = "ok"
-    else:
-        worst = max(errors, key=errors.get)
-        row.update(outcome="inaccurate",
-                   cause=f"{worst} off by {errors[worst]:.3g} > {problem.tolerance:g}")
-    return row
+    return judge(problem, row, reference) if judged else row

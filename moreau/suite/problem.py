@@ -50,7 +50,7 @@ from ..errors import InputError
 from ..model.registry import make_scene
 
 __all__ = ["Problem", "register_problem", "get_problem", "problem_names", "problems",
-           "discover", "PENDING", "crossing_time"]
+           "discover", "PENDING", "crossing_time", "judge"]
 
 #: problems whose scene has not landed yet: ``{name: what will state it}``. The suite's page
 #: lists them; the module that registers the problem replaces the entry.
@@ -140,11 +140,13 @@ class Problem:
                       else float(abs(v - r) / sc[k]))
         return out
 
-    def describe(self):
+    def describe(self, reference=None):
+        """The problem's statement for the report (``reference``: computed already)."""
         return {"name": self.name, "title": self.title, "scene": self.scene,
                 "scene_parameters": self.scene_parameters(), "window": self.window,
                 "reference_kind": self.reference_kind, "source": self.source,
-                "tolerance": self.tolerance, "reference": self.reference(),
+                "tolerance": self.tolerance,
+                "reference": self.reference() if reference is None else dict(reference),
                 "scales": self.scales()}
 
 
@@ -217,3 +219,34 @@ def crossing_time(t, y, level, direction=-1, after=-math.inf):
                 return float(t[i])
             return float(t[i - 1] + (t[i] - t[i - 1]) * (-y[i - 1]) / (y[i] - y[i - 1]))
     return None
+
+
+def judge(problem, row, reference=None):
+    """Fill ``row``'s ``errors``, ``max_error``, ``outcome`` and ``cause`` from its ``values``.
+
+    The outcome is ``ok`` when every headline quantity is within the
+    problem's tolerance of ``reference`` (the problem's own by default),
+    else ``inaccurate``, naming the quantity with no value or the worst one.
+    Returns ``row``.
+
+    Examples
+    --------
+    >>> p = get_problem("sliding-block")
+    >>> ref = p.reference()
+    >>> judge(p, {"values": dict(ref)}, ref)["outcome"]
+    'ok'
+    """
+    errors = problem.errors(row["values"], reference)
+    row["errors"] = errors
+    missing = [k for k, e in errors.items() if e is None]
+    row["max_error"] = math.inf if missing else max(errors.values(), default=0.0)
+    if missing:
+        row["outcome"] = "inaccurate"
+        row["cause"] = "no value for " + ", ".join(missing)
+    elif row["max_error"] <= problem.tolerance:
+        row["outcome"] = "ok"
+    else:
+        worst = max(errors, key=errors.get)
+        row["outcome"] = "inaccurate"
+        row["cause"] = f"{worst} off by {errors[worst]:.3g} > {problem.tolerance:g}"
+    return row

@@ -175,6 +175,16 @@ def animate_problem(name, path, frames=30):
     Returns ``(path, None)``, or ``(None, cause)`` where both runs stop or
     the scene cannot draw itself.
     """
+    import time as _time
+    from .run import _trace
+    _t0, _c0 = _time.time(), _time.process_time()
+    try:
+        return _animate_problem(name, path, frames)
+    finally:
+        _trace("anim", _t0, _c0, p=name)
+
+
+def _animate_problem(name, path, frames=30):
     prob = get_problem(name)
     scene = prob.make_scene()
     q0, v0 = prob.start(scene)
@@ -186,6 +196,10 @@ def animate_problem(name, path, frames=30):
                 causes.append(f"the problem declines {scheme}: {reason}")
                 continue
             label, opts = settings_of(scheme, prob, scene, quick=True)[-1]
+            if "sample_dt" in opts:
+                # the frames are all that is drawn: a scheme that samples its own output is
+                # asked for those samples only (the suite's cells ask for 2000)
+                opts = dict(opts, sample_dt=prob.window / frames)
             try:
                 res = simulate(scene, (0.0, prob.window), q0, v0, scheme, **opts)
             except InputError as exc:
@@ -206,15 +220,23 @@ def animate_problem(name, path, frames=30):
     return path, None
 
 
-def _animate_all(jobs, n_jobs):
+def _problem_figures(problem, rows, wp_path, anim_path, frames):
+    # one problem's work-precision figure and animation: a task of the worker pool
+    plot_work_precision(problem, rows, wp_path)
+    if anim_path is None:
+        return None, None
+    return animate_problem(problem["name"], anim_path, frames)
+
+
+def _figures_all(jobs, n_jobs):
     # each animation reruns a scheme over its problem's window: on the worker pool, side by side
     if n_jobs == 1 or len(jobs) < 4:
-        return [animate_problem(*j) for j in jobs]
+        return [_problem_figures(*j) for j in jobs]
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, batch_size=1)
     ok = False
     try:
-        out = par(joblib.delayed(animate_problem)(*j) for j in jobs)
+        out = par(joblib.delayed(_problem_figures)(*j) for j in jobs)
         ok = True
     finally:
         end_worker_pool(kill=not ok)
@@ -229,6 +251,9 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     drawn by ``n_jobs`` local worker processes.
     """
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
+    import time as _time
+    from .run import _trace
+    _t0, _c0 = _time.time(), _time.process_time()
     paths = {}
     paths["csv"] = os.path.join(out, "suite.csv")
     _write_csv(paths["csv"], rows)
@@ -241,26 +266,27 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     with open(paths["json"], "w") as fh:
         json.dump(doc, fh, indent=1, default=lambda x: None if x != x else str(x))
     figures, animations = {}, {}
-    if plot and animation_frames:
-        jobs = [(p["name"], os.path.join(out, f"anim_{p['name']}.gif"), animation_frames)
-                for p in probs]
-        for (name, _, _), (done, cause) in zip(jobs, _animate_all(jobs, n_jobs)):
-            animations[name] = f"anim_{name}.gif" if done else cause
+    jobs = []
     for p in probs:
         prow = [r for r in rows if r["problem"] == p["name"]]
         pcsv = os.path.join(out, f"problem_{p['name']}.csv")
         _write_csv(pcsv, prow, list(p["reference"]))
         paths[f"csv_{p['name']}"] = pcsv
         if plot:
-            fig = f"wp_{p['name']}.png"
-            plot_work_precision(p, prow, os.path.join(out, fig))
-            figures[p["name"]] = fig
+            jobs.append((p, prow, os.path.join(out, f"wp_{p['name']}.png"),
+                         os.path.join(out, f"anim_{p['name']}.gif") if animation_frames else None,
+                         animation_frames))
+    for (p, _, _, anim, _), (done, cause) in zip(jobs, _figures_all(jobs, n_jobs)):
+        figures[p["name"]] = f"wp_{p['name']}.png"
+        if anim is not None:
+            animations[p["name"]] = f"anim_{p['name']}.gif" if done else cause
     if plot:
         plot_overview(rows, [p["name"] for p in probs], schemes, os.path.join(out, "overview.png"))
         figures["overview"] = "overview.png"
     paths.update({f"png_{k}": os.path.join(out, v) for k, v in figures.items()})
     paths.update({f"gif_{k}": os.path.join(out, v) for k, v in animations.items()
                   if v.endswith(".gif")})
+    _trace("report", _t0, _c0)
     paths["page"] = os.path.join(out, "index.md")
     with open(paths["page"], "w") as fh:
         fh.write(_page(report, figures, doc["provenance"], settings, animations))

@@ -22,10 +22,14 @@ count, a tolerance, a contact stiffness). Each cell ends in one outcome:
 A finished cell is written to ``OUT/cells/`` at once; a rerun of the same
 command reads the cells it finds there instead of computing them again, so
 an interrupted suite resumes.
+
+With ``MOREAU_SUITE_TRACE=FILE`` in the environment, each process appends
+one JSON line per task to ``FILE`` (its kind, process id, start and end
+time, CPU seconds): where a run's time goes, compiles included.
 """
 
+import concurrent.futures
 import json
-import math
 import os
 import re
 import time
@@ -39,9 +43,10 @@ from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_co
 
 from ..errors import InputError, Interrupted, MoreauError
 from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
+from ..lcp import solve_lcp
 from ..model.registry import discover as discover_scenes
 from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
-from .problem import get_problem, problem_names
+from .problem import get_problem, judge, problem_names
 
 __all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS",
            "DECLINED"]
@@ -122,13 +127,21 @@ def _cause(exc):
     return f"{type(exc).__name__}: {exc}"
 
 
-def run_cell(problem, scheme, label, options, scene=None, reference=None):
+#: the exceptions of a bug in a scheme or a scene: its cell fails, the suite goes on
+_BUGS = (ArithmeticError, ValueError, TypeError, AttributeError, IndexError, KeyError,
+         RuntimeError, NotImplementedError, np.linalg.LinAlgError)
+
+
+def run_cell(problem, scheme, label, options, scene=None, reference=None, judged=True):
     """Run one cell and return its row (see the module docstring for the outcomes).
 
     The row holds ``problem``, ``scheme``, ``setting`` (the label),
     ``outcome``, ``cause``, ``status``, ``values`` and ``errors`` (per
     headline quantity), ``max_error``, ``tolerance``, ``cpu_s`` (the process
-    time of the run and its measurement) and ``steps``.
+    time of the run and its measurement) and ``steps``. With
+    ``judged=False`` a run that finished is left for
+    :func:`~moreau.suite.problem.judge` (its outcome None, no reference
+    needed here).
     """
     row = {"problem": problem.name, "scheme": scheme, "setting": label, "outcome": None,
            "cause": "", "status": None, "values": {}, "errors": {}, "max_error": None,
@@ -139,7 +152,8 @@ def run_cell(problem, scheme, label, options, scene=None, reference=None):
         return row
     try:
         scene = problem.make_scene() if scene is None else scene
-        reference = problem.reference() if reference is None else reference
+        if judged and reference is None:
+            reference = problem.reference()
         q0, v0 = problem.start(scene)
         c0, w0 = time.process_time(), time.perf_counter()
         res = simulate(scene, (0.0, problem.window), q0, v0, scheme, **options)
@@ -152,26 +166,14 @@ def run_cell(problem, scheme, label, options, scene=None, reference=None):
             row["outcome"] = "refused" if res.status in REFUSED_STATUS else "failed"
             row["cause"] = f"status {res.status}: {res.message}"
             return row
-        errors = problem.errors(values, reference)
         row["values"] = {k: (None if v is None else float(v)) for k, v in values.items()}
-        row["errors"] = errors
-        missing = [k for k, e in errors.items() if e is None]
-        row["max_error"] = math.inf if missing else max(errors.values(), default=0.0)
-        if missing:
-            row["outcome"] = "inaccurate"
-            row["cause"] = "no value for " + ", ".join(missing)
-        elif row["max_error"] <= problem.tolerance:
-            row["outcome"] = "ok"
-        else:
-            worst = max(errors, key=errors.get)
-            row["outcome"] = "inaccurate"
-            row["cause"] = f"{worst} off by {errors[worst]:.3g} > {problem.tolerance:g}"
+        if judged:
+            judge(problem, row, reference)
     except InputError as exc:
         row.update(outcome="refused", cause=_cause(exc))
     except MoreauError as exc:
         row.update(outcome="failed", cause=_cause(exc))
-    except (ArithmeticError, ValueError, TypeError, AttributeError, IndexError, KeyError,
-            RuntimeError, NotImplementedError, np.linalg.LinAlgError) as exc:
+    except _BUGS as exc:
         # a bug in a scheme or a scene: the table says so, the suite goes on
         row.update(outcome="failed", cause="unexpected " + _cause(exc))
     return row
@@ -211,36 +213,71 @@ _INSTANCES = {}
 _WARMED = set()
 
 
+def _problem_scene(pname):
+    if pname not in _INSTANCES:
+        prob = get_problem(pname)
+        _INSTANCES[pname] = [prob, prob.make_scene(), None]
+    return _INSTANCES[pname]
+
+
+def reference_of(pname, reference=None):
+    """The reference of problem ``pname``, computed once per process (or ``reference``, computed
+    elsewhere: the parent of a worker, so that a worker does not compute it again)."""
+    entry = _problem_scene(pname)
+    if entry[2] is None:
+        entry[2] = entry[0].reference() if reference is None else dict(reference)
+    return entry[2]
+
+
 def instance(pname, reference=None):
     """``(problem, scene, reference)`` of ``pname``, built once per process.
 
     ``reference``: the problem's reference computed elsewhere (the parent
     of a worker), so that a worker does not compute it again.
     """
-    if pname not in _INSTANCES:
-        prob = get_problem(pname)
-        _INSTANCES[pname] = (prob, prob.make_scene(),
-                             prob.reference() if reference is None else dict(reference))
-    return _INSTANCES[pname]
+    ref = reference_of(pname, reference)
+    prob, scene, _ = _problem_scene(pname)
+    return prob, scene, ref
 
 
-def cell_task(pname, scheme, label, options, reference=None):
+def _trace(kind, t0, c0, **kw):
+    # one line per task where MOREAU_SUITE_TRACE asks for it (see the module docstring)
+    path = os.environ.get("MOREAU_SUITE_TRACE")
+    if path:
+        with open(path, "a") as fh:
+            fh.write(json.dumps(dict(kind=kind, pid=os.getpid(), t0=t0, t1=time.time(),
+                                     cpu=time.process_time() - c0, **kw)) + "\n")
+
+
+def cell_task(pname, scheme, label, options, reference=None, judged=True):
+    _t0, _c0 = time.time(), time.process_time()
+    row = _cell_task(pname, scheme, label, options, reference, judged)
+    _trace("cell", _t0, _c0, p=pname, s=scheme, l=label, cpu_s=row.get("cpu_s"))
+    return row
+
+
+def _cell_task(pname, scheme, label, options, reference=None, judged=True):
     """One cell, computed in this process (a worker's task): its row.
 
     The first cell of a (problem, scheme) pair in a process runs the scheme
     once first, untimed (over the window at :data:`WARM_UP_STEPS` steps, or
     over a twentieth of it for a scheme that takes no step), so that numba's
-    compilation (or loading) is not counted in the cell's time.
+    compilation (or loading) is not counted in the cell's time. With
+    ``judged=False`` the row is left for :func:`~moreau.suite.problem.judge`
+    and the problem's reference is not computed here.
     """
-    prob, scene, ref = instance(pname, reference)
+    if judged:
+        prob, scene, ref = instance(pname, reference)
+    else:
+        (prob, scene, _), ref = _problem_scene(pname), None
     if is_peer(scheme):
-        row = run_peer_cell(prob, scheme, scene, ref)
+        row = run_peer_cell(prob, scheme, scene, ref, judged=judged)
         row["cached"] = False
         return row
     if label != DECLINED and (pname, scheme) not in _WARMED:
         _WARMED.add((pname, scheme))
         _warm_up(prob, scheme, options, scene)
-    row = run_cell(prob, scheme, label, options, scene, ref)
+    row = run_cell(prob, scheme, label, options, scene, ref, judged=judged)
     row["cached"] = False
     return row
 
@@ -265,7 +302,7 @@ def plan_cells(problems=None, schemes=None, quick=False, peers=True):
                              f"{', '.join(all_schemes)}; got {s!r}")
     plan = []
     for pname in problems:
-        prob, scene, _ = instance(pname)
+        prob, scene, _ = _problem_scene(pname)
         for s in schemes:
             try:
                 sets = settings_of(s, prob, scene, quick)
@@ -319,20 +356,28 @@ def _results(plan, todo, n_jobs, scheduler):
         for i in todo:
             yield i, cell_task(*plan[i])
         return
-    refs = {pname: instance(pname)[2] for pname in {plan[i][0] for i in todo}}
-    tasks = [joblib.delayed(warm_task)(*plan[i], refs[plan[i][0]])
-             for i in _first_of_each_scheme(plan, todo)]
-    tasks += [joblib.delayed(_indexed_cell)(i, *plan[i], refs[plan[i][0]]) for i in todo]
+    # the workers run the cells and leave them unjudged; here a thread computes the problems'
+    # references meanwhile, and each row is judged against its problem's as it comes back
+    names = list(dict.fromkeys(plan[i][0] for i in todo))
+    # the LCP-based schemes and references all call Lemke's compiled kernels: compiled (or loaded)
+    # once here, before the pool, not by both workers and the thread at once (22 s each, cold)
+    solve_lcp(np.array([[2.0, -1.0], [-1.0, 2.0]]), np.array([-1.0, -1.0]), method="lemke")
+    refs = concurrent.futures.ThreadPoolExecutor(max_workers=1)
+    ref_of = {p: refs.submit(reference_of, p) for p in names}
+    pairs = _pairs(plan, todo)
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
-    gen = par(tasks)
+    gen = par(joblib.delayed(pair_task)(pname, s, cells) for pname, s, cells in pairs)
     ok = False
     try:
-        for i, row in gen:
-            if i is not None:
+        for out in gen:
+            for i, row in out:
+                if row["outcome"] is None:
+                    _judge_here(_problem_scene(plan[i][0])[0], row, ref_of[plan[i][0]].result())
                 yield i, row
         ok = True
     finally:
+        refs.shutdown(wait=ok, cancel_futures=True)
         if not ok:
             # closing joblib's generator stops handing out cells (Ctrl-C, an error)
             with warnings.catch_warnings():
@@ -341,8 +386,32 @@ def _results(plan, todo, n_jobs, scheduler):
         end_worker_pool(kill=not ok)
 
 
-def _indexed_cell(i, *cell):
-    return i, cell_task(*cell)
+def _judge_here(problem, row, reference):
+    try:
+        judge(problem, row, reference)
+    except _BUGS as exc:
+        row.update(outcome="failed", cause="unexpected " + _cause(exc))
+
+
+def _pairs(plan, todo):
+    """``[(problem, scheme, [(index, label, options)])]``: the cells ``todo`` grouped by
+    (problem, scheme), one pool task each, so that a scheme's loop for a problem is compiled (or
+    loaded) by one worker, not by both at once. The first pair of each scheme comes first:
+    on a cold cache the workers compile different schemes side by side."""
+    out = {}
+    for i in todo:
+        pname, s, label, options = plan[i]
+        out.setdefault((pname, s), []).append((i, label, options))
+    first = {(plan[i][0], plan[i][1]) for i in _first_of_each_scheme(plan, todo)}
+    return ([(p, s, cells) for (p, s), cells in out.items() if (p, s) in first]
+            + [(p, s, cells) for (p, s), cells in out.items() if (p, s) not in first])
+
+
+def pair_task(pname, scheme, cells):
+    """The cells ``[(index, label, options)]`` of one (problem, scheme) pair, in this process
+    (a worker's task), left unjudged: ``[(index, row)]``."""
+    return [(i, cell_task(pname, scheme, label, options, judged=False))
+            for i, label, options in cells]
 
 
 def _first_of_each_scheme(plan, todo):
@@ -355,21 +424,6 @@ def _first_of_each_scheme(plan, todo):
             seen.add(scheme)
             first.append(i)
     return first
-
-
-def warm_task(pname, scheme, label, options, reference=None):
-    """A pool's first tasks, one per scheme: its first cell's untimed warm-up, no row.
-
-    On a cold cache numba compiles each scheme here once, in one worker, the
-    workers compiling different schemes side by side; the cells that follow
-    load it from numba's cache instead of compiling it again in every worker
-    at once. Returns ``(None, scheme)``.
-    """
-    prob, scene, _ = instance(pname, reference)
-    if (pname, scheme) not in _WARMED:
-        _WARMED.add((pname, scheme))
-        _warm_up(prob, scheme, options, scene)
-    return None, scheme
 
 
 def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
@@ -401,7 +455,9 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     Interrupted
         On Ctrl-C, after the cells finished so far are kept.
     """
+    _t0, _c0 = time.time(), time.process_time()
     problems, schemes, plan = plan_cells(problems, schemes, quick, peers)
+    _trace("plan", _t0, _c0)
     rows = [None] * len(plan)
     todo = []
     for i, (pname, s, label, _) in enumerate(plan):
@@ -431,7 +487,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     finally:
         if bar is not None:
             bar.close()
-    return {"rows": rows, "problems": [instance(p)[0].describe() for p in problems],
+    return {"rows": rows, "problems": [instance(p)[0].describe(reference_of(p)) for p in problems],
             "schemes": schemes, "jobs": n_jobs, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
                                           "computed": sum(1 for r in rows if not r.get("cached"))}}
