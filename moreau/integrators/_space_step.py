@@ -17,12 +17,12 @@ SLIP_RTOL = 1e-9
 
 
 def check_cone(value):
-    """The ``cone`` option: ``"exact"`` or an integer number of directions ``>= 3``."""
-    if isinstance(value, str) and value == "exact":
+    """The ``cone`` option: ``"auto"``, ``"exact"`` or an integer number of directions ``>= 3``."""
+    if isinstance(value, str) and value in ("auto", "exact"):
         return value
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 3:
-        raise InputError(f'`cone` must be "exact" or an integer number of directions >= 3, '
-                         f'got {value!r}')
+        raise InputError(f'`cone` must be "auto", "exact" or an integer number of directions '
+                         f'>= 3, got {value!r}')
     return int(value)
 
 

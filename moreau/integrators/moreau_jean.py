@@ -205,7 +205,9 @@ H^T`` is the spatial Coulomb problem of :mod:`moreau.contact.cone3d` (Newton's
 impact law on the normal row), solved on the cone the option ``cone`` names:
 ``"exact"`` (Gauss–Seidel with the exact local solve and an Alart–Curnier
 Newton polish, certified by the De Saxcé natural-map residual) or an integer
-``d`` (the ``d``-direction polyhedral LCP by Lemke, default 8). An
+``d`` (the ``d``-direction polyhedral LCP by Lemke); the default ``"auto"``
+is ``d = 8`` on a scene of point contacts and the exact cone on a scene with
+a contact patch (below). An
 unsolved problem raises :class:`~moreau.errors.LCPError` with the residual.
 The centres move by ``h (theta v_{k+1} + (1 - theta) v_k)`` and each
 quaternion by the exponential map of the same weighted body rate
@@ -225,7 +227,8 @@ is refused. A contact with a patch (``contact_radius > 0``: Coulomb–Contensou
 friction, :mod:`moreau.model.space`) adds its drilling row to the three,
 and the step solves the round cone with three tangential rows
 (:func:`moreau.contact.cone3d.solve_exact_contensou`); it takes
-``cone="exact"`` only (another ``cone`` is refused by name). The step
+``cone="exact"`` (the default ``"auto"`` picks it) and refuses an integer
+``cone`` by name. The step
 runs in the compiled loop of :mod:`moreau.integrators._space_kernels` for
 scenes whose contacts are spheres and material points (pucks) against
 half-spaces, with or without a patch, the same step to rounding, the exact
@@ -484,11 +487,15 @@ class MoreauJean(TimeStepping):
         ``alpha`` of the joints' position residual at the step's start, so
         that the drift stays bounded instead of growing (module docstring,
         *Baumgarte*). 0 (default) leaves the rows as they are.
-    cone : "exact" or int
+    cone : "auto", "exact" or int
         On a spatial scene (:mod:`moreau.model.space`), the friction cone of
         each step's problem: ``"exact"`` or the number ``d >= 3`` of the
-        polyhedral cone's directions (default 8); see "Spatial scenes" in the
-        module docstring. Planar scenes ignore it.
+        polyhedral cone's directions; see "Spatial scenes" in the module
+        docstring. ``"auto"`` (default) is ``d = 8`` on a scene of point
+        contacts and ``"exact"`` on a scene with a contact patch
+        (``contact_radius > 0``: Coulomb–Contensou friction, which the
+        polyhedral cone does not model; an integer ``cone`` is refused there
+        by name). Planar scenes ignore it.
     lcp_method : {"auto", "lemke", "qp", "nsgs", "apgd"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
@@ -598,7 +605,7 @@ class MoreauJean(TimeStepping):
         joint_projection: bool = False
         joint_rows: str = "end"
         joint_baumgarte: float = 0.0
-        cone: str | int = 8
+        cone: str | int = "auto"
         lcp_tol: float | None = None
         lcp_max_iter: int | None = None
         lcp_omega: float | None = None
@@ -659,7 +666,11 @@ class MoreauJean(TimeStepping):
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
-        if self._space and getattr(self.scene, "drilling", False) and self.cone != "exact":
+        drilling = self._space and getattr(self.scene, "drilling", False)
+        if self.cone == "auto":
+            # the polyhedral cone has no drilling row; point contacts keep the 8 facets
+            self.cone = "exact" if drilling else 8
+        if drilling and self.cone != "exact":
             raise InputError(f"`cone` must be \"exact\" on scene {self.scene.name!r}: its "
                              f"Coulomb–Contensou friction (a contact with `contact_radius` > 0) "
                              f"has no polyhedral form here, got cone={self.cone!r}")

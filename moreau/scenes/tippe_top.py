@@ -16,9 +16,13 @@ Leine and Glocker). Their stem is left out (the eccentric sphere of Or,
 SIAM J. Appl. Math. 54 (1994) 597, and of Bou-Rabee, Marsden and Romero,
 SIAM J. Appl. Dyn. Syst. 3 (2004) 352, and Ueda, Sasaki and Watanabe, SIAM
 J. Appl. Dyn. Syst. 4 (2005) 1159). The patch is the option
-``contact_radius``, ``0`` by default (the point contact, the stored runs'
-scene); ``contact_radius=5e-4`` is Leine and Glocker's top with its
-Coulomb–Contensou friction (:mod:`moreau.model.space`).
+``contact_radius``, Leine and Glocker's ``5e-4`` m by default
+(``LEINE_GLOCKER_PATCH``): their published model is Coulomb–Contensou
+friction (:mod:`moreau.model.space`), and with it the top inverts in its
+exact motion. ``contact_radius=0`` is the point contact (Coulomb's cone
+alone), whose exact motion rolls upright and does not invert (below).
+Moreau–Jean's default ``cone="auto"`` solves the patched contact on the
+exact cone.
 
 Jellett's integral and the spin thresholds
 ------------------------------------------
@@ -59,9 +63,9 @@ the top rises to the tilt that minimises ``V`` and hangs there
 (:func:`final_tilt`).
 
 Sliding matters: a top whose contact point rolls without slipping keeps
-``J`` and its energy, and does not rise. In this model (a point contact,
-Coulomb's cone, no drilling friction) that is what the exact motion does at
-the defaults: the event-driven reference (``event-driven-space``) finds the
+``J`` and its energy, and does not rise. With a point contact
+(``contact_radius=0``: Coulomb's cone, no drilling friction) that is what
+the exact motion does at the other defaults: the event-driven reference (``event-driven-space``) finds the
 slip ending at ``t = 0.036 s``, after which the top rolls upright at
 constant energy (``cos(theta)`` 0.9993 at 3.9 s). A Moreau–Jean run inverts
 it through the step's own dissipation: the axis passes horizontal at 1.15,
@@ -71,7 +75,7 @@ reference. The thresholds above say where a dissipating top can end, not
 that this model's top dissipates; the inversion Leine and Glocker publish
 comes with their Coulomb–Contensou (drilling) friction.
 
-With the patch (``contact_radius=5e-4``) the contact spins about the normal
+With the patch (the default ``contact_radius=5e-4``) the contact spins about the normal
 and so slides in the ellipsoid's generalized sense all the time: friction
 keeps dissipating and the top turns over. Its drilling torque ``M_d n``
 has the moment ``M_d n . d = M_d (R - a cos theta)`` about ``d``, so
@@ -141,8 +145,8 @@ class TippeTopParams:
     contact_radius : float
         ``r`` [m], ``>= 0``: the contact patch's radius, whose drilling
         friction couples with the sliding force (Coulomb–Contensou friction,
-        :mod:`moreau.model.space`); ``0`` is the point contact. Leine and
-        Glocker's top has ``r = 0.5 mm``.
+        :mod:`moreau.model.space`); ``0`` is the point contact. Default
+        Leine and Glocker's ``r = 0.5 mm``.
     """
 
     mass: float = 6e-3
@@ -154,7 +158,7 @@ class TippeTopParams:
     gravity: float = 9.81
     spin: float = 180.0
     tilt: float = 0.1
-    contact_radius: float = 0.0
+    contact_radius: float = LEINE_GLOCKER_PATCH
 
     def __post_init__(self):
         for name in ("mass", "radius", "inertia_transverse", "inertia_axial", "mu", "gravity",
@@ -276,8 +280,9 @@ class TippeTopCase(SpatialCase):
     event-driven reference (``event-driven-space``) on the same model.
 
     The reference is the model's exact motion, whatever the parameters: with
-    the point contact (the scene's default) the top rolls upright, with a
-    contact patch it turns over (the module docstring).
+    the contact patch (the scene's default) the top turns over, with the
+    point contact (``contact_radius=0``) it rolls upright (the module
+    docstring).
     """
 
     headline_name = "axis height cos(theta)"
@@ -316,22 +321,6 @@ class TippeTopCase(SpatialCase):
         return []
 
 
-class LeineGlockerTopCase(TippeTopCase):
-    """``moreau compare``'s case of the tippe top: Leine and Glocker's top with its contact
-    patch (``contact_radius`` 0.5 mm unless given), whose drilling friction turns it over.
-
-    The point-contact top (``contact_radius=0``) rolls upright in its exact
-    motion, and a time-stepping run inverts it only through its own
-    numerical dissipation, at step counts a comparison cannot afford to
-    resolve (Moreau–Jean stays upright from about 32 000 steps over the
-    window); the patched top's inversion is the model's own.
-    """
-
-    def __init__(self, **params):
-        params.setdefault("contact_radius", LEINE_GLOCKER_PATCH)
-        super().__init__(**params)
-
-
 register_scene(SceneEntry(
     name="tippe-top",
     factory=tippe_top,
@@ -342,7 +331,7 @@ register_scene(SceneEntry(
                                               "tilt": "rad", "contact_radius": "m"}),
     description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
                  "threshold set by Jellett's integral, it turns its axis from up to down"),
-    case=LeineGlockerTopCase,
+    case=TippeTopCase,
     reference="exact",
     sweepable=("mu", "spin", "tilt", "offset"),
     mj_tolerance=5e-2,

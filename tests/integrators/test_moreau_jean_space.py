@@ -41,9 +41,9 @@ def test_a_spinning_sliding_ball_keeps_a_unit_quaternion_and_both_cones_end_roll
     assert np.max(np.abs(ends["exact"] - ends[8])) > 1e-4
 
 
-@pytest.mark.parametrize("cone, match", [("round", '`cone` must be "exact" or an integer'),
-                                         (2, '`cone` must be "exact" or an integer'),
-                                         (True, '`cone` must be "exact" or an integer')])
+@pytest.mark.parametrize("cone, match", [("round", '`cone` must be "auto", "exact" or an integer'),
+                                         (2, '`cone` must be "auto", "exact" or an integer'),
+                                         (True, '`cone` must be "auto", "exact" or an integer')])
 def test_a_bad_cone_is_refused_by_name(cone, match):
     sc = _ball()
     with pytest.raises(InputError, match=match):
