@@ -5,7 +5,9 @@ import math
 import numpy as np
 import pytest
 
+from moreau.errors import InputError
 from moreau.integrators import simulate
+from moreau.integrators.moreau_jean import MoreauJean
 from moreau.model.spatial import rotation_matrix
 from moreau.scenes.tippe_top import axis_height, final_tilt, spin_thresholds, tippe_top
 
@@ -28,7 +30,8 @@ def _jellett_and_energy(sc, q, v):
 
 
 def test_moreau_jean_keeps_jelletts_integral_while_friction_dissipates():
-    sc = tippe_top()
+    # the point contact: no drilling torque, so J is kept for any contact force
+    sc = tippe_top(contact_radius=0.0)
     q0, v0 = sc.initial_state()
     res = simulate(sc, (0.0, 10.0), q0, v0, "moreau-jean", h=0.05, cone="exact")
     assert res.status == 0
@@ -60,8 +63,8 @@ def test_the_spin_thresholds_bound_where_friction_leaves_the_top():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("spin, inverts", [(180.0, True), (100.0, False), (15.0, False)])
-def test_the_top_inverts_above_the_threshold_and_not_below(spin, inverts):
-    sc = tippe_top(spin=spin)
+def test_the_point_contact_top_inverts_by_the_steps_dissipation(spin, inverts):
+    sc = tippe_top(spin=spin, contact_radius=0.0)
     q0, v0 = sc.initial_state()
     res = simulate(sc, (0.0, 100.0), q0, v0, "moreau-jean", h=0.05, cone="exact")
     assert res.status == 0
@@ -84,8 +87,38 @@ def test_the_top_inverts_above_the_threshold_and_not_below(spin, inverts):
 
 
 #: Leine and Glocker's contact patch [m] (R. I. Leine, Ch. Glocker, Eur. J. Mech. A/Solids 22
-#: (2003) 193, as in Capobianco et al.'s tippe-top example, Int. J. Numer. Meth. Eng. 2021)
+#: (2003) 193, as in Capobianco et al.'s tippe-top example, Int. J. Numer. Meth. Eng. 2021),
+#: the scene's default
 PATCH = 5e-4
+
+
+def test_the_registered_top_is_leine_and_glockers_patched_top_on_the_exact_cone(monkeypatch):
+    import moreau.integrators.moreau_jean as mj_module
+    from moreau.scenes import registry
+    sc = registry.make_scene("tippe-top")
+    assert sc.params.contact_radius == PATCH and sc.drilling
+    q0, v0 = sc.initial_state()
+    # Moreau–Jean's default cone ("auto") is the exact one here, and 8 facets on the point
+    # contact; an explicit polyhedral cone on the patch is refused by name
+    assert MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.05).cone == "exact"
+    point = tippe_top(contact_radius=0.0)
+    assert MoreauJean(point, 0.0, *point.initial_state(), 1.0, h=0.05).cone == 8
+    with pytest.raises(InputError, match='`cone` must be "exact" on scene'):
+        MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.05, cone=8)
+    # default options over 40 steps: every step in the compiled loop (no Python step), the
+    # same run as the explicit exact cone, bit for bit
+    calls = [0]
+    step = mj_module.space_step
+
+    def counting(*args, **kwargs):
+        calls[0] += 1
+        return step(*args, **kwargs)
+    monkeypatch.setattr(mj_module, "space_step", counting)
+    res = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.05)
+    assert res.status == 0 and calls[0] == 0 and len(res.t) == 41
+    exact = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.05, cone="exact")
+    assert np.array_equal(res.q, exact.q) and np.array_equal(res.v, exact.v)
+    assert res.stats["max_residual"] <= 1e-10
 
 #: the axis through horizontal [s] with the patch: the event-driven reference (DOP853 at
 #: rtol 1e-10 and 1e-12 agree to 2e-13 s; test_the_event_driven_reference_...)
@@ -104,8 +137,8 @@ def test_with_its_contact_patch_the_top_turns_over_near_the_reference_time():
     # Coulomb–Contensou friction keeps the contact sliding (it spins about the normal), so
     # friction keeps dissipating and the top turns over: the point contact's top rolls
     # upright instead (tests/suite/test_problems_space.py)
-    sc = tippe_top(contact_radius=PATCH)
-    res = simulate(sc, (0.0, 26.0), *sc.initial_state(), "moreau-jean", h=0.05, cone="exact")
+    sc = tippe_top()
+    res = simulate(sc, (0.0, 26.0), *sc.initial_state(), "moreau-jean", h=0.05)
     assert res.status == 0
     # measured 0.99340 s at h = 0.05 units (1.96 ms), 0.0181 s behind the reference
     assert abs(_horizontal_time(res, sc) - T_HORIZONTAL - 0.0181) < 5e-4
@@ -117,7 +150,7 @@ def test_with_its_contact_patch_the_top_turns_over_near_the_reference_time():
 
 @pytest.mark.slow
 def test_the_event_driven_reference_and_moreau_jeans_convergence_to_its_turning_time():
-    sc = tippe_top(contact_radius=PATCH)
+    sc = tippe_top()
     q0, v0 = sc.initial_state()
     times = []
     for rtol in (1e-10, 1e-12):
@@ -128,7 +161,7 @@ def test_the_event_driven_reference_and_moreau_jeans_convergence_to_its_turning_
     assert abs(times[0] - times[1]) < 1e-9 and abs(times[1] - T_HORIZONTAL) < 1e-6
     errors = []
     for h in (0.05, 0.025, 0.0125):
-        res = simulate(sc, (0.0, 26.0), q0, v0, "moreau-jean", h=h, cone="exact")
+        res = simulate(sc, (0.0, 26.0), q0, v0, "moreau-jean", h=h)
         errors.append(_horizontal_time(res, sc) - times[1])
     # measured 0.0181, 0.0081, 0.0039 s (0.0019 s at h = 0.00625): first order, from above
     assert errors[0] > errors[1] > errors[2] > 0.0
@@ -141,8 +174,8 @@ def test_with_its_patch_the_top_inverts_above_the_threshold_and_not_below(spin, 
     # the published threshold (Rauch-Wojciechowski and Rutstam 2014; spin_thresholds) is
     # 120.3 rad/s for the inverted state and 21.8 rad/s for the upright one
     n_up, n_inv = spin_thresholds()
-    sc = tippe_top(spin=spin, contact_radius=PATCH)
-    res = simulate(sc, (0.0, 100.0), *sc.initial_state(), "moreau-jean", h=0.05, cone="exact")
+    sc = tippe_top(spin=spin)
+    res = simulate(sc, (0.0, 100.0), *sc.initial_state(), "moreau-jean", h=0.05)
     assert res.status == 0
     c = axis_height(res.q)
     if inverts:
