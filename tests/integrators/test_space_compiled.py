@@ -54,6 +54,10 @@ def _python_steps(monkeypatch):
 @pytest.mark.parametrize("name", [s for s in COMPILED if s not in INDETERMINATE])
 def test_the_compiled_loop_is_the_python_step_on_every_spatial_scene(name, options, monkeypatch):
     sc = registry.make_scene(name)
+    if sc.drilling and options["cone"] != "exact":
+        # a contact patch takes the exact cone only (the tippe top's default): the polyhedral
+        # cone runs on the same scene with point contacts
+        sc = registry.make_scene(name, contact_radius=0.0)
     q0, v0 = sc.initial_state()
     h = (sc.period or sc.default_span()) / 1000
     ref = simulate(sc, (0.0, 60 * h), q0, v0, "moreau-jean", h=h, fast=False, **options)
