@@ -16,7 +16,7 @@ NAMES = registry.scene_names()
 
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
-    assert NAMES == ["ball-chain", "bidirectional-drive", "billiard-backspin", "bouncing-ball",
+    assert NAMES == ["ball-chain", "ball-chain-3d", "bidirectional-drive", "billiard-backspin", "bouncing-ball",
                      "box-incline",
                      "disk-incline", "double-pendulum-stop", "flexible-rod-drive",
                      "friction-drive", "friction-drive-built", "granular-column", "masonry-arch",
@@ -51,7 +51,7 @@ def test_bad_parameters_are_refused_by_name_before_any_work(name):
 
 
 def test_unknown_scene_lists_the_known_ones():
-    with pytest.raises(InputError, match="`scene` must be one of 'ball-chain', 'bidirectional-drive'"):
+    with pytest.raises(InputError, match="`scene` must be one of 'ball-chain', 'ball-chain-3d', 'bidirectional-drive'"):
         registry.get_entry("belt")
 
 
