@@ -22,6 +22,7 @@ import csv
 import json
 import math
 import os
+import time
 
 import joblib
 
@@ -31,7 +32,7 @@ from ..integrators.base import simulate
 from ..provenance import provenance
 from .animate import write_animation
 from .problem import PENDING, get_problem
-from .run import OUTCOMES, settings_of
+from .run import OUTCOMES, settings_of, trace_task
 
 __all__ = ["overview", "write_report", "format_overview", "OUTCOME_COLOURS"]
 
@@ -175,13 +176,11 @@ def animate_problem(name, path, frames=30):
     Returns ``(path, None)``, or ``(None, cause)`` where both runs stop or
     the scene cannot draw itself.
     """
-    import time as _time
-    from .run import _trace
-    _t0, _c0 = _time.time(), _time.process_time()
+    _t0, _c0 = time.time(), time.process_time()
     try:
         return _animate_problem(name, path, frames)
     finally:
-        _trace("anim", _t0, _c0, p=name)
+        trace_task("anim", _t0, _c0, p=name)
 
 
 def _animate_problem(name, path, frames=30):
@@ -251,9 +250,7 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     drawn by ``n_jobs`` local worker processes.
     """
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
-    import time as _time
-    from .run import _trace
-    _t0, _c0 = _time.time(), _time.process_time()
+    _t0, _c0 = time.time(), time.process_time()
     paths = {}
     paths["csv"] = os.path.join(out, "suite.csv")
     _write_csv(paths["csv"], rows)
@@ -286,7 +283,7 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     paths.update({f"png_{k}": os.path.join(out, v) for k, v in figures.items()})
     paths.update({f"gif_{k}": os.path.join(out, v) for k, v in animations.items()
                   if v.endswith(".gif")})
-    _trace("report", _t0, _c0)
+    trace_task("report", _t0, _c0)
     paths["page"] = os.path.join(out, "index.md")
     with open(paths["page"], "w") as fh:
         fh.write(_page(report, figures, doc["provenance"], settings, animations))

@@ -240,8 +240,12 @@ def instance(pname, reference=None):
     return prob, scene, ref
 
 
-def _trace(kind, t0, c0, **kw):
-    # one line per task where MOREAU_SUITE_TRACE asks for it (see the module docstring)
+def trace_task(kind, t0, c0, **kw):
+    """Append one JSON line for a finished task where ``MOREAU_SUITE_TRACE`` names a file.
+
+    ``t0`` and ``c0`` are the task's start by ``time.time()`` and
+    ``time.process_time()``; ``kw`` adds fields (the module docstring).
+    """
     path = os.environ.get("MOREAU_SUITE_TRACE")
     if path:
         with open(path, "a") as fh:
@@ -252,7 +256,7 @@ def _trace(kind, t0, c0, **kw):
 def cell_task(pname, scheme, label, options, reference=None, judged=True):
     _t0, _c0 = time.time(), time.process_time()
     row = _cell_task(pname, scheme, label, options, reference, judged)
-    _trace("cell", _t0, _c0, p=pname, s=scheme, l=label, cpu_s=row.get("cpu_s"))
+    trace_task("cell", _t0, _c0, p=pname, s=scheme, l=label, cpu_s=row.get("cpu_s"))
     return row
 
 
@@ -457,7 +461,7 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     """
     _t0, _c0 = time.time(), time.process_time()
     problems, schemes, plan = plan_cells(problems, schemes, quick, peers)
-    _trace("plan", _t0, _c0)
+    trace_task("plan", _t0, _c0)
     rows = [None] * len(plan)
     todo = []
     for i, (pname, s, label, _) in enumerate(plan):
