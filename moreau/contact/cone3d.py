@@ -1005,8 +1005,10 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
     can cycle when ``mu`` is large), then Newton on the Alart–Curnier
     function (quadratic near a nondegenerate solution) to ``tol`` with half
     the Newton budget. If that fails, Newton restarts with the rest from
-    the 16-direction polyhedral solution (:func:`solve_polyhedral`), and
-    last under-relaxed Gauss–Seidel (each contact moved half way to its
+    the 16-direction polyhedral solution (:func:`solve_polyhedral`), then
+    from the 32-, 64- and 128-direction ones while it still fails (with a
+    large ``mu`` Lemke's answer need not be the one near the round cone's),
+    and last under-relaxed Gauss–Seidel (each contact moved half way to its
     local solution) spends the sweeps left. The answer is the point of
     least natural-map residual met; ``detail`` says which phases ran.
     Measured on 900 random problems with ``mu`` from 1.5 to 3: all
