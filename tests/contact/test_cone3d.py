@@ -352,6 +352,26 @@ def test_hard_problems_with_large_mu_converge_through_stall_detection_and_the_re
     assert sol.residual <= 1e-10 * np.linalg.norm(q)
 
 
+def test_a_stick_at_the_cone_s_edge_converges_from_a_finer_polygon():
+    # found by the property test: in the answer every contact sticks (one at
+    # |r_T| = 0.96 mu r_N), which also solves the 16-gon's LCP, but Lemke finds
+    # another solution there with contact 2 slipping; Newton from it (and from
+    # the same point at d = 32) stalls at 0.025, Gauss–Seidel at 3.6e-3; at
+    # d = 64 Lemke returns the sticking answer itself
+    W, q, _ = random_problem(np.random.default_rng(7656), 4)
+    mu = np.full(4, 2.0)
+    sol = solve_exact(W, q, mu)
+    assert sol.success, sol.detail
+    assert "64-direction polyhedral solution" in sol.detail
+    assert sol.residual <= 1e-10 * np.linalg.norm(q)
+    assert sol.residual == pytest.approx(cone_residual(W, q, mu, sol.r), abs=0)
+    r = sol.r.reshape(-1, 3)
+    assert np.all(r[:, 0] > 0) and np.all(np.hypot(r[:, 1], r[:, 2]) <= 2.0 * r[:, 0])
+    u = sol.u.reshape(-1, 3)
+    np.testing.assert_allclose(u, 0.0, rtol=0, atol=1e-9 * np.linalg.norm(q))   # all stick
+    assert sol.iterations["newton"] <= 30
+
+
 def test_the_qp_method_says_it_has_no_formulation_for_the_polyhedral_lcp():
     # M is copositive but not monotone (the row mu r_N - e^T beta has no
     # symmetric partner): the QP path refuses rather than guessing
