@@ -22,7 +22,8 @@ from .analysis.characteristic import efficiency_vs_frequency, motor_characterist
 from .analysis.classify import CLASSIFY_PERIODS
 from .analysis.statistical import MIN_PERIODS, PRECISION
 from .analysis.sweep import require_xarray, run_scene_sweep, sweep_values
-from .analysis.history import history_tag, plot_history, run_history, write_history
+from .analysis.history import (default_scheme, history_tag, plot_history, run_history,
+                               write_history)
 from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
 from .errors import BudgetExhaustedError, InputError, Interrupted, MoreauError
@@ -490,6 +491,8 @@ def _cmd_run(args):
         if not periodic:
             raise InputError(f"`--duration` is required: scene {entry.name!r} has no drive period")
         periods = 10.0
+    if args.scheme is None:
+        args.scheme = default_scheme(scene)
     cls = get_integrator(args.scheme)
     cls = cls.resolve(scene) if hasattr(cls, "resolve") else cls
     stepping = "h" in (scheme_options(cls) or ())
@@ -501,9 +504,7 @@ def _cmd_run(args):
             raise InputError("`--steps-per-period` needs `--periods`; with `--duration` give `--steps`")
         steps = int(round(args.steps_per_period * periods))
     if stepping and steps is None and "h" not in options:
-        if periods is None:
-            raise InputError(f"scheme {args.scheme!r} steps in time: give `--steps`")
-        steps = int(round(1000 * periods))
+        steps = 1000 if periods is None else int(round(1000 * periods))
     check_options(args.scheme, options, scene)
     shown = dict(options)
     if stepping and steps is not None:
@@ -853,11 +854,17 @@ def build_parser():
     r.add_argument("--duration", type=float, default=None,
                    help="time to simulate [s] (or the scene's time unit if it has no SI units)")
     r.add_argument("--steps", type=int, default=None,
-                   help="time-stepping schemes: steps over the whole run")
+                   help="time-stepping schemes: steps over the whole run (default 1000 per "
+                        "drive period, or 1000 over a `--duration` run)")
     r.add_argument("--samples", type=int, default=2000,
                    help="samples written, evenly spaced in time (default 2000)")
     _add_output_options(r, "run")
     _scene_command(r, _cmd_run)
+    # a spatial scene is refused by the event-driven reference: the scheme follows the scene
+    scheme_flag = r._option_string_actions["--scheme"]
+    scheme_flag.default = None
+    scheme_flag.help = ("any registered scheme (default: event-driven where it takes the scene, "
+                        "else moreau-jean)")
     b = sub.add_parser("bifurcation", help="stroboscopic section of the long-run motion against "
                                           "one parameter, period, Lyapunov exponent and "
                                           "bifurcation marks (CSV, JSON sidecar, figure)")

@@ -33,7 +33,8 @@ from ..integrators.base import get_integrator, scheme_options, simulate
 from ..provenance import provenance
 from ..regimes import Regime
 
-__all__ = ["run_history", "history_tag", "write_history", "plot_history", "MAX_SAMPLES"]
+__all__ = ["run_history", "history_tag", "write_history", "plot_history", "default_scheme",
+           "MAX_SAMPLES"]
 
 #: bound on the samples of one time history (a CSV of about 2 GB)
 MAX_SAMPLES = 10**7
@@ -44,6 +45,25 @@ MAX_STEPS = 10**9
 def _resolved(scheme, scene):
     cls = get_integrator(scheme)
     return cls.resolve(scene) if hasattr(cls, "resolve") else cls
+
+
+def default_scheme(scene):
+    """The scheme ``moreau run`` takes for ``scene`` when none is named.
+
+    The event-driven reference (the scene's own where it has one) where it
+    accepts the scene, else Moreau–Jean, which steps every scene: the generic
+    event-driven scheme refuses spatial bodies (quaternions, the spatial
+    friction cone) by name.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> default_scheme(make_scene("bouncing-ball")), default_scheme(make_scene("billiard-backspin"))
+    ('event-driven', 'moreau-jean')
+    """
+    if _resolved("event-driven", scene).refusal(scene) is None:
+        return "event-driven"
+    return "moreau-jean"
 
 
 def run_history(scene, *, periods=None, duration=None, scheme="event-driven", steps=None,

@@ -336,17 +336,32 @@ class Integrator:
     #: cone, :mod:`moreau.model.space`); the others refuse one by name, before any work
     solves_space = False
 
-    def __init__(self, scene, t0, q0, v0, t_bound):
+    @classmethod
+    def refusal(cls, scene):
+        """Why the scheme refuses ``scene`` by its kind (joints, spatial bodies), or None.
+
+        Examples
+        --------
+        >>> from moreau.scenes.bouncing_ball import BouncingBall
+        >>> get_integrator("moreau-jean").refusal(BouncingBall()) is None
+        True
+        """
         nj = joint_row_count(scene)
-        if nj and not self.solves_joints:
-            raise InputError(f"scheme {self.scheme!r} solves no joints: `scene` "
-                             f"{getattr(scene, 'name', type(scene).__name__)!r} has {nj} joint "
-                             f"(bilateral) rows; use 'moreau-jean'")
-        if is_spatial(scene) and not self.solves_space:
-            raise InputError(f"scheme {self.scheme!r} steps no spatial scene: `scene` "
-                             f"{getattr(scene, 'name', type(scene).__name__)!r} has spatial "
-                             "bodies (quaternion orientations, the spatial friction cone); use "
-                             "'moreau-jean'")
+        if nj and not cls.solves_joints:
+            return (f"scheme {cls.scheme!r} solves no joints: `scene` "
+                    f"{getattr(scene, 'name', type(scene).__name__)!r} has {nj} joint "
+                    f"(bilateral) rows; use 'moreau-jean'")
+        if is_spatial(scene) and not cls.solves_space:
+            return (f"scheme {cls.scheme!r} steps no spatial scene: `scene` "
+                    f"{getattr(scene, 'name', type(scene).__name__)!r} has spatial "
+                    "bodies (quaternion orientations, the spatial friction cone); use "
+                    "'moreau-jean'")
+        return None
+
+    def __init__(self, scene, t0, q0, v0, t_bound):
+        refused = self.refusal(scene)
+        if refused is not None:
+            raise InputError(refused)
         self.scene = scene
         self.t0 = finite_scalar("t0", t0)
         self.t_bound = finite_scalar("t_bound", t_bound)

@@ -96,3 +96,17 @@ def test_the_suite_animates_a_spatial_problem_with_moreau_jean(tmp_path):
     assert cause is None and path.endswith("puck.gif")
     with Image.open(path) as im:
         assert im.n_frames == 6
+
+
+@pytest.mark.slow  # the spatial Moreau-Jean kernels' compile: 62 s on the loaded machine
+def test_run_takes_a_scheme_that_steps_a_spatial_scene(tmp_path):
+    # without --scheme the event-driven reference would refuse the spatial bodies by name
+    import json
+    run = tmp_path / "run"
+    assert main(["run", "--scene", "billiard-backspin", "--duration", "0.05", "--steps", "20",
+                 "--samples", "5", "--out", str(run), "--no-plot", "--quiet"]) == 0
+    (side,) = run.glob("*.json")
+    assert json.loads(side.read_text())["scheme"] == "moreau-jean"
+    path, frames = animate_run(str(run), str(tmp_path / "b.gif"), max_frames=3)
+    with Image.open(path) as im:
+        assert im.n_frames == frames == 3
