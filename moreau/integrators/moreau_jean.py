@@ -667,7 +667,7 @@ class MoreauJean(TimeStepping):
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
         drilling = self._space and getattr(self.scene, "drilling", False)
-        if self.cone == "auto":
+        if self._space and self.cone == "auto":
             # the polyhedral cone has no drilling row; point contacts keep the 8 facets
             self.cone = "exact" if drilling else 8
         if drilling and self.cone != "exact":

@@ -70,7 +70,7 @@ True
 >>> registry.get_entry("no-such-scene")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-moreau.errors.InputError: `scene` must be one of 'ball-chain', 'bidirectional-drive', ...; got 'no-such-scene'
+moreau.errors.InputError: `scene` must be one of 'ball-chain', ...; got 'no-such-scene'
 """
 
 import dataclasses

@@ -15,14 +15,19 @@ from moreau.cli import main
     (["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean",
       "--option", "hh=0.1", "--steps", "10"], "`hh` is not an option of scheme 'moreau-jean'"),
     (["run", "--scene", "bouncing-ball", "--steps", "100"], "`--duration` is required"),
-    (["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean"],
-     "give `--steps`"),
     (["run", "--frequency", "185", "--steps", "100"], "`steps` applies to time-stepping schemes"),
     (["steady", "--scene", "bidirectional", "--frequency", "185", "--theta", "1"], "`--theta` does not act with `--scheme event-driven`"),
 ])
 def test_unused_scheme_setting_is_refused(argv, message, capsys):
     assert main(argv) == 2
     assert message in capsys.readouterr().err
+
+
+def test_a_time_stepping_run_without_steps_takes_a_thousand(tmp_path):
+    # `--duration` without `--steps`: the run's default step count, named in the file
+    assert main(["run", "--scene", "bouncing-ball", "--duration", "1", "--scheme", "moreau-jean",
+                 "--out", str(tmp_path)]) == 0
+    assert (tmp_path / "history_bouncing-ball_moreau-jean_steps1000.csv").is_file()
 
 
 def test_moreau_jean_steady_takes_its_tolerance(capsys):
