@@ -118,6 +118,24 @@ class IterativeResult:
 
 # -- input ---------------------------------------------------------------------------------------
 
+def csr_delassus(W, rows, rule):
+    """``W`` as a finite square CSR array of ``rows`` rows a contact, or an ``InputError``.
+
+    ``rule`` names the row count in the message (the callers' wording).
+    """
+    if sps.issparse(W):
+        W = sps.csr_array(W, dtype=float)
+        W.sum_duplicates()
+        if not np.all(np.isfinite(W.data)):
+            raise InputError("`W` must contain only finite values (no NaN or inf)")
+    else:
+        W = sps.csr_array(finite_array("W", W, ndim=2))
+    n = W.shape[0]
+    if W.shape != (n, n) or n % rows or n == 0:
+        raise InputError(f"`W` must be square with {rule}, got shape {W.shape}")
+    return W
+
+
 def check_problem(W, q, mu):
     """Validate FCLib-form data; return ``(W as CSR float64, q, mu)``.
 
@@ -137,17 +155,8 @@ def check_problem(W, q, mu):
     ...
     moreau.errors.InputError: `mu` must have one entry per contact (1), got shape (2,)
     """
-    if sps.issparse(W):
-        W = sps.csr_array(W, dtype=float)
-        W.sum_duplicates()
-        if not np.all(np.isfinite(W.data)):
-            raise InputError("`W` must contain only finite values (no NaN or inf)")
-    else:
-        W = sps.csr_array(finite_array("W", W, ndim=2))
+    W = csr_delassus(W, 2, "an even number (2 per contact) of rows")
     n = W.shape[0]
-    if W.shape != (n, n) or n % 2 or n == 0:
-        raise InputError(f"`W` must be square with an even number (2 per contact) of rows, "
-                         f"got shape {W.shape}")
     q = finite_array("q", q, shape=(n,))
     mu = finite_array("mu", mu, ndim=1)
     if mu.shape != (n // 2,):

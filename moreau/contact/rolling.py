@@ -340,17 +340,8 @@ def check_rolling_problem(W, q, mu, mu_r):
     ...
     moreau.errors.InputError: `mu_r` must be >= 0 for every contact
     """
-    if sps.issparse(W):
-        W = sps.csr_array(W, dtype=float)
-        W.sum_duplicates()
-        if not np.all(np.isfinite(W.data)):
-            raise InputError("`W` must contain only finite values (no NaN or inf)")
-    else:
-        W = sps.csr_array(finite_array("W", W, ndim=2))
+    W = _sparse.csr_delassus(W, 3, "a multiple of 3 rows (3 per contact)")
     n = W.shape[0]
-    if W.shape != (n, n) or n % 3 or n == 0:
-        raise InputError(f"`W` must be square with a multiple of 3 rows (3 per contact), got "
-                         f"shape {W.shape}")
     q = finite_array("q", q, shape=(n,))
     mu = finite_array("mu", mu, shape=(n // 3,))
     mu_r = finite_array("mu_r", mu_r, shape=(n // 3,))
