@@ -168,17 +168,28 @@ def check_problem(W, q, mu):
     return W, q, mu
 
 
-def diagonal_blocks(W):
-    """The ``2 x 2`` diagonal blocks of a CSR ``W``, shape ``(nc, 2, 2)``."""
-    nc = W.shape[0] // 2
-    d = W.diagonal()
-    off = W.diagonal(1)
-    low = W.diagonal(-1)
-    blocks = np.zeros((nc, 2, 2))
-    blocks[:, 0, 0] = d[0::2]
-    blocks[:, 1, 1] = d[1::2]
-    blocks[:, 0, 1] = off[0::2]
-    blocks[:, 1, 0] = low[0::2]
+@njit(cache=_CACHE)
+def diagonal_blocks(indptr, indices, data, nc, d):
+    """The ``d x d`` diagonal blocks of a CSR matrix, shape ``(nc, d, d)``.
+
+    ``d`` is 2 for the plane's contacts ``[N, T]``, 3 with a rolling row. The CSR
+    must hold one entry a column in a row (duplicates summed, as
+    :func:`check_problem` leaves it): each entry is copied, not added. One pass
+    over the nonzeros; scipy's three diagonals cost 2 ms at 12 000 contacts.
+
+    >>> import scipy.sparse as sps
+    >>> W = sps.csr_matrix(np.arange(16.0).reshape(4, 4))
+    >>> diagonal_blocks(W.indptr, W.indices, W.data, 2, 2)[1].tolist()
+    [[10.0, 11.0], [14.0, 15.0]]
+    """
+    blocks = np.zeros((nc, d, d))
+    for i in range(nc):
+        for row in range(d):
+            a = d * i + row
+            for k in range(indptr[a], indptr[a + 1]):
+                c = indices[k] - d * i
+                if 0 <= c < d:
+                    blocks[i, row, c] = data[k]
     return blocks
 
 
@@ -338,7 +349,7 @@ def record_check(indptr, indices, data, q, r, u, mu, it, hist_it, hist_res, nh, 
 
 _jit_cache.bind_cache_to_sources(
     [project_cone, _local_residual_sq, local_solve, _two_sum, velocities_compensated,
-     velocities, natural_map, record_check], [__file__, _certified.__file__])
+     velocities, natural_map, record_check, diagonal_blocks], [__file__, _certified.__file__])
 
 
 def problem_residual(W, q, mu, r):

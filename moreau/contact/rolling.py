@@ -169,6 +169,23 @@ def _solve3(A, c, x):
     return True
 
 
+@njit(cache=_CACHE, inline="always")
+def _piece_row(A, c, B, b, row, stick, slope):
+    # row ``row`` of a piece's linear system: sticking, the row's velocity vanishes
+    # (B[row] x = -b[row]); slipping, the impulse rides the cone's face,
+    # x[row] + slope x[0] = 0 (slope = mu times the slip's sign)
+    if stick:
+        for j in range(3):
+            A[row, j] = B[row, j]
+        c[row] = -b[row]
+    else:
+        for j in range(3):
+            A[row, j] = 0.0
+        A[row, 0] = slope
+        A[row, row] = 1.0
+        c[row] = 0.0
+
+
 @njit(cache=_CACHE)
 def local_solve_rolling(B, b, mu, mu_r):
     """Exact solution of one contact ``u = B r + b`` (``3 x 3``) with friction and rolling resistance.
@@ -207,27 +224,9 @@ def local_solve_rolling(B, b, mu, mu_r):
         kr = piece // 3     # the same for the rolling row
         st = 1.0 if kt == 1 else -1.0
         sr = 1.0 if kr == 1 else -1.0
-        for j in range(3):
-            A[0, j] = B[0, j]
-        c[0] = -b[0]
-        if kt == 0:
-            for j in range(3):
-                A[1, j] = B[1, j]
-            c[1] = -b[1]
-        else:
-            A[1, 0] = mu * st
-            A[1, 1] = 1.0
-            A[1, 2] = 0.0
-            c[1] = 0.0
-        if kr == 0:
-            for j in range(3):
-                A[2, j] = B[2, j]
-            c[2] = -b[2]
-        else:
-            A[2, 0] = mu_r * sr
-            A[2, 1] = 0.0
-            A[2, 2] = 1.0
-            c[2] = 0.0
+        _piece_row(A, c, B, b, 0, True, 0.0)
+        _piece_row(A, c, B, b, 1, kt == 0, mu * st)
+        _piece_row(A, c, B, b, 2, kr == 0, mu_r * sr)
         if not _solve3(A, c, x):
             continue
         ok = x[0] >= 0.0
@@ -306,19 +305,6 @@ def _nsgs(indptr, indices, data, blocks, q, mu, mu_r, r, max_sweeps, check_every
 
 
 @njit(cache=_CACHE)
-def _blocks(indptr, indices, data, nc):
-    blocks = np.zeros((nc, 3, 3))
-    for i in range(nc):
-        for row in range(3):
-            a = 3 * i + row
-            for k in range(indptr[a], indptr[a + 1]):
-                c = indices[k] - 3 * i
-                if 0 <= c < 3:
-                    blocks[i, row, c] = data[k]
-    return blocks
-
-
-@njit(cache=_CACHE)
 def _project_start(r, mu, mu_r):
     for i in range(mu.shape[0]):
         a = 3 * i
@@ -326,8 +312,8 @@ def _project_start(r, mu, mu_r):
 
 
 _jit_cache.bind_cache_to_sources(
-    [project_rolling_cone, _local_residual_sq, _solve3, local_solve_rolling, _natural_map, _nsgs,
-     _blocks, _project_start], [__file__, _sparse.__file__])
+    [project_rolling_cone, _local_residual_sq, _solve3, _piece_row, local_solve_rolling,
+     _natural_map, _nsgs, _project_start], [__file__, _sparse.__file__])
 
 
 def check_rolling_problem(W, q, mu, mu_r):
@@ -429,7 +415,7 @@ def solve_nsgs_rolling(W, q, mu, mu_r, *, r0=None, tol=1e-8, max_sweeps=10_000, 
     hist_it = np.zeros(nh_max, dtype=np.int64)
     hist_res = np.zeros(nh_max)
     best_r = np.empty_like(r)
-    blocks = _blocks(W.indptr, W.indices, W.data, mu.shape[0])
+    blocks = _sparse.diagonal_blocks(W.indptr, W.indices, W.data, mu.shape[0], 3)
     sweeps, nh = _nsgs(W.indptr, W.indices, W.data, blocks, q, mu, mu_r, r, max_sweeps,
                        check_every, tol * scale, hist_it, hist_res, best_r)
     res, res_abs, u = _residual(W, q, mu, mu_r, best_r)

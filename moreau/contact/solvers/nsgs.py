@@ -92,22 +92,7 @@ def _project_start(r, mu):
         r[2 * i], r[2 * i + 1] = project_cone(mu[i], r[2 * i], r[2 * i + 1])
 
 
-@njit(cache=_CACHE)
-def _blocks(indptr, indices, data, nc):
-    # diagonal_blocks's three scipy diagonals cost 2 ms at 12 000 contacts (CSR, duplicates
-    # summed by check_problem: one entry a column in a row)
-    blocks = np.zeros((nc, 2, 2))
-    for i in range(nc):
-        for row in range(2):
-            a = 2 * i + row
-            for k in range(indptr[a], indptr[a + 1]):
-                c = indices[k] - 2 * i
-                if c == 0 or c == 1:
-                    blocks[i, row, c] = data[k]
-    return blocks
-
-
-_jit_cache.bind_cache_to_sources([_nsgs, _project_start, _blocks], [__file__, _sparse.__file__])
+_jit_cache.bind_cache_to_sources([_nsgs, _project_start], [__file__, _sparse.__file__])
 
 
 def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, check_every=4):
@@ -167,7 +152,7 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     _project_start(r, mu)
     checks = _sparse.CheckRecord(q, max_sweeps, check_every)
     best_r = np.empty_like(r)
-    blocks = _blocks(W.indptr, W.indices, W.data, mu.shape[0])
+    blocks = _sparse.diagonal_blocks(W.indptr, W.indices, W.data, mu.shape[0], 2)
     sweeps, nh = _nsgs(W.indptr, W.indices, W.data, blocks, q, mu, r, max_sweeps, check_every,
                        tol * checks.scale, omega, checks.iterations, checks.residuals, best_r)
     return checks.result(W, q, mu, best_r, sweeps, nh, tol, "nsgs")
