@@ -67,8 +67,7 @@ class Problem:
     reference_kind = "closed form"
     source = ""
     tolerance = 1e-2
-    steps = (200, 1000, 5000)
-    quick_steps = (200, 2000)
+    steps = (100, 1000, 10000)
     #: ``{scheme: values}`` replacing the scheme's quick settings on this problem
     quick_settings = {}
     #: ``{scheme: reason}`` refused by name in every suite / in the quick suite
@@ -103,6 +102,12 @@ class Problem:
         if self.case_class is not None:
             return self._the_case().start()
         return scene.initial_state()
+
+    @property
+    def quick_steps(self):
+        """The quick suite's step counts: the two coarsest of :attr:`steps`, unless a problem
+        sets its own."""
+        return self.steps[:2]
 
     @property
     def window(self):

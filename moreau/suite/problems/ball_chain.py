@@ -19,13 +19,9 @@ class BallChainProblem(Problem):
     name = "ball-chain"
     title = "Newton's cradle (ball chain, simultaneous impact)"
     scene = "ball-chain"
-    reference_kind = "closed form"
     source = ("the simultaneous (block) impact of Moreau's sweeping process with Newton's law "
               "per contact, one LCP (see moreau.scenes.ball_chain); cf. B. Brogliato, "
               "Nonsmooth Mechanics, 3rd ed., Springer 2016, ch. 6")
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
 
     @property
     def window(self):

@@ -22,13 +22,10 @@ class BouncingBallProblem(Problem):
     name = "bouncing-ball"
     title = "Bouncing ball"
     scene = "bouncing-ball"
-    reference_kind = "closed form"
     source = ("closed form of the ball's flights between Newton impacts (geometric series of "
               "flight times, accumulating at the Zeno time); see moreau.scenes.bouncing_ball")
     window = 4.0
-    tolerance = 1e-2
     steps = (400, 4000, 40000)
-    quick_steps = (400, 4000)
     height = 0.6
 
     def scene_parameters(self):

@@ -20,12 +20,8 @@ class DiskInclineProblem(Problem):
     name = "disk-incline"
     title = "Disk rolling down a rough incline (planar builder, sticks)"
     scene = "disk-incline"
-    reference_kind = "closed form"
     source = ("closed form: rolling at (2/3) g sin(alpha) while mu >= tan(alpha) / 3 "
               "(moreau.scenes.disk_incline)")
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
     case_class = DiskInclineCase
     #: the closed form ``(s, s', w)`` at SI times
     exact = staticmethod(disk_incline_exact)

@@ -27,9 +27,7 @@ class FrictionDriveProblem(Problem):
               "its parameters; displacement per period against frequency); the value is the "
               "event-driven reference's")
     window = 2.0 * math.pi
-    tolerance = 1e-2
     steps = (200, 2000, 20000)
-    quick_steps = (200, 2000)
     case_class = FrictionDriveCase
 
     def case_parameters(self):

@@ -44,10 +44,8 @@ class GranularColumnProblem(Problem):
     source = ("the model's event-driven run (rtol 1e-10: 10 plastic impacts in the window); "
               "the column of moreau.scenes.granular_column (Lube et al. 2004, Staron and Hinch "
               "2005 for the collapse it starts)")
-    tolerance = 1e-2
     window = 2.0
     steps = (200, 2000, 20000)
-    quick_steps = (200, 2000)
     quick_declines = {"compliant-radau": _COMPLIANT_REASON, "compliant-rk45": _COMPLIANT_REASON}
     # Studer's extrapolation at tol 1e-10 takes 10 s of CPU here; 1e-4 is already 2e-5 off
     quick_settings = {"studer-extrapolation": (1e-4,)}

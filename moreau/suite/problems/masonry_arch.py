@@ -34,13 +34,9 @@ class MasonryArchProblem(Problem):
     name = "masonry-arch"
     title = "Masonry arch (4 voussoirs, t/R = 0.11 above the limit 0.10086): stands"
     scene = "masonry-arch"
-    reference_kind = "closed form"
     source = ("the safe theorem of limit analysis (Heyman 1966), the thrust-line LP of "
               "moreau.scenes.masonry_arch; Milankovitch 1907 for the continuous arch (0.1075)")
-    tolerance = 1e-2
     window = STAND_WINDOW
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
     quick_settings = {"schatzman-paoli": (100,)}
     quick_declines = {"event-driven": _ED_REASON, "event-driven-generic": _ED_REASON}
 

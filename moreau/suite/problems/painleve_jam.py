@@ -93,10 +93,7 @@ class PainleveJamProblem(Problem):
     source = ("F. Génot, B. Brogliato, New results on Painlevé paradoxes, Eur. J. Mech. A/Solids "
               "18 (1999) 653-677: the tangential impact (dynamic jam) as the solution from a "
               "paradoxical sliding state; the jam impulse from the rod's Newton-Euler equations")
-    tolerance = 1e-2
     window = 0.5
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
 
     def scene_parameters(self):
         return {"mu": MU}

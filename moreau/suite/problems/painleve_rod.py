@@ -22,9 +22,6 @@ class PainleveRodProblem(Problem):
     source = ("P. Painlevé, Sur les lois du frottement de glissement, C. R. Acad. Sci. 121 "
               "(1895) 112-115; the well-posedness condition as in F. Génot, B. Brogliato, New "
               "results on Painlevé paradoxes, Eur. J. Mech. A 18 (1999) 653-677")
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
     case_class = PainleveRodCase
 
     def scene_parameters(self):

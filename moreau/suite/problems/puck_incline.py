@@ -22,12 +22,8 @@ class PuckInclineProblem(Problem):
     name = "puck-incline"
     title = "Thin puck launched across a rough incline (spatial, mu = tan(alpha))"
     scene = "puck-incline"
-    reference_kind = "closed form"
     source = ("closed form: v (1 + cos psi) = const, the path in tan(psi/2) "
               "(moreau.scenes.puck_incline)")
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
     case_class = PuckInclineCase
 
     def reference(self):

@@ -68,12 +68,10 @@ class RockingBlockProblem(Problem):
               "Bull. Seismol. Soc. Am. 53(2) (1963) 403-417: the ratio 1 - (3/2) sin^2(alpha) "
               "of the angular velocities over an impact; phase times by quadrature and the "
               "Zeno sum of the settling time (moreau.scenes.rocking_block)")
-    tolerance = 1e-2
     window = 4.0
     # Moreau-Jean's settling time is first order (measured 2.6 %, 0.77 %, 0.33 % off at
     # 5000, 20000, 50000 steps): its finest quick setting is within the tolerance
     steps = (2000, 20000, 100000)
-    quick_steps = (2000, 20000)
     # compliant-rk45 takes 10 to 19 s of CPU a quick cell here (an explicit method on the
     # stiff contact over the Zeno settling), for the values compliant-radau gives in 2 s
     quick_declines = {"compliant-rk45": (

@@ -20,7 +20,6 @@ class RollingDiskProblem(Problem):
     scene = "rolling-disk"
     source = ("closed form: Omega^2 = 4 g cot(theta) / (6 b + a cos(theta)) for the thin disk "
               "(E. J. Routh, Advanced Rigid Dynamics, art. 244; moreau.scenes.rolling_disk)")
-    tolerance = 1e-2
     steps = (200, 1000, 5000)
     quick_steps = (200, 2000)
     case_class = RollingDiskCase

@@ -31,10 +31,8 @@ class SliderCrankClearanceProblem(Problem):
     source = ("P. Flores, J. Ambrósio, Revolute joints with clearance in multibody systems, "
               "Computers & Structures 82 (2004) 1359-1369 (the mechanism and its parameters); "
               "the ideal slider-crank's closed form (moreau.scenes.slider_crank)")
-    tolerance = 1e-2
     window = 1.5 * math.pi
     steps = (500, 2000, 8000)
-    quick_steps = (500, 2000)
 
     def _r(self):
         p = SliderCrankClearanceParams()

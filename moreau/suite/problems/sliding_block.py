@@ -12,11 +12,6 @@ STOP_FRACTION = 1e-3
 class StoppingProblem(Problem):
     """Shared by the block and the box: launched at ``speed``, decelerated by ``mu g`` until it sticks."""
 
-    reference_kind = "closed form"
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
-
     def scene_parameters(self):
         return {"mu": self.case_parameters()["mu"]}
 

@@ -18,13 +18,9 @@ class StickSlipMotorProblem(Problem):
     name = "stick-slip-motor"
     title = "Stick–slip motor (sawtooth drive)"
     scene = "stick-slip-motor"
-    reference_kind = "closed form"
     source = ("closed-form stick and slip segments of the piecewise-polynomial drive (see "
               "moreau.scenes.stick_slip_motor.exact)")
     window = 2.0 * math.pi
-    tolerance = 1e-2
-    steps = (100, 1000, 10000)
-    quick_steps = (100, 1000)
     case_class = StickSlipCase
 
     def reference(self):

@@ -30,7 +30,6 @@ class TippeTopProblem(Problem):
     source = ("the model's exact motion (event-driven-space: slip ends at 0.036 s, then rolling "
               "at constant energy and Jellett's integral); no drilling friction, so no inversion "
               "(moreau.scenes.tippe_top)")
-    tolerance = 1e-2
     steps = (2000, 8000, 32000)
     quick_steps = (2000, 32000)
     case_class = TippeTopCase

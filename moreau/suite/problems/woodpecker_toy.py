@@ -31,11 +31,9 @@ class WoodpeckerToyProblem(Problem):
               "TU München 1995, pp. 162ff. (parameters and the state on the limit cycle, four "
               "significant digits); R. I. Leine, Ch. Glocker and D. H. van Campen, J. Vib. "
               "Control 9 (2003) 25-78")
-    tolerance = 1e-2
     window = 40.0
     # Moreau-Jean at 40000 steps (h = 32 us): 0.67 % and 0.41 % off; at 4000, several %
     steps = (4000, 40000, 400000)
-    quick_steps = (4000, 40000)
     # the compliant contacts take 10 to 17 s of CPU a quick cell over the eight cycles (and
     # miss the cycle by 9 % and more): the quick suite runs their softest setting only, and
     # the model once
