@@ -5,6 +5,7 @@ backticks and stating the rule, before any numerical work is done.
 """
 
 import math
+import numbers
 
 import numpy as np
 
@@ -109,6 +110,25 @@ def positive_int(name, value):
         raise InputError(f"`{name}` must be an integer >= 1, got {value!r}")
     if value < 1:
         raise InputError(f"`{name}` must be an integer >= 1, got {value!r}")
+    return int(value)
+
+
+def whole_number(name, value, lo, hi):
+    """Return ``value`` as an int, or raise unless it is a whole number in ``[lo, hi]``.
+
+    An integer-valued float is taken (a count set from the command line or a
+    sweep arrives as one); a bool is not.
+
+    >>> whole_number("n", 3.0, 2, 5)
+    3
+    >>> whole_number("n", 2.5, 2, 5)
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `n` must be a whole number in [2, 5], got 2.5
+    """
+    whole = isinstance(value, numbers.Integral) or (isinstance(value, float) and value.is_integer())
+    if isinstance(value, bool) or not whole or not lo <= int(value) <= hi:
+        raise InputError(f"`{name}` must be a whole number in [{lo}, {hi}], got {value!r}")
     return int(value)
 
 

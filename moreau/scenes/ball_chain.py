@@ -51,8 +51,8 @@ contact ``i`` (balls ``i`` and ``i + 1``) is ``q_{i+1} - q_i - 2``.
 """
 
 import math
-import numbers
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import scipy.sparse as sps
@@ -62,7 +62,7 @@ from numba import njit
 
 from ..compiled import CompiledModel
 from .._validate import (check_fields, finite_array, finite_scalar, in_closed_interval,
-                         nonnegative, positive, positive_int, restitution)
+                         nonnegative, positive, positive_int, restitution, whole_number)
 from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
@@ -73,7 +73,7 @@ from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
-__all__ = ["BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
+__all__ = ["ChainParams", "BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
            "simultaneous_impact", "sor_omega"]
 
 #: the chain lengths the scene takes
@@ -86,13 +86,14 @@ SPARSE_FROM = 150
 
 
 @dataclass(frozen=True)
-class BallChainParams:
-    """SI parameters of the ball chain.
+class ChainParams:
+    """SI parameters every chain of balls has, on a line or in space.
 
     Attributes
     ----------
     n_balls : int
-        Number of balls ``N`` including the striker, a whole number in [2, 10 000].
+        Number of balls ``N`` including the striker, a whole number in [2,
+        ``max_balls``].
     mass : float
         Mass of each ball of the chain [kg], > 0.
     striker_mass : float
@@ -103,6 +104,31 @@ class BallChainParams:
         Speed of the striker towards the chain [m/s], > 0.
     restitution : float
         Newton restitution of every contact, in [0, 1].
+    """
+
+    #: the most balls the chain takes
+    max_balls: ClassVar[int] = MAX_BALLS
+
+    n_balls: int = 3
+    mass: float = 0.1
+    striker_mass: float = 0.1
+    radius: float = 0.01
+    striker_speed: float = 1.0
+    restitution: float = 1.0
+
+    def __post_init__(self):
+        object.__setattr__(self, "n_balls",
+                           whole_number("n_balls", self.n_balls, MIN_BALLS, self.max_balls))
+        check_fields(self, positive, "mass", "striker_mass", "radius", "striker_speed")
+        check_fields(self, restitution, "restitution")
+
+
+@dataclass(frozen=True)
+class BallChainParams(ChainParams):
+    """SI parameters of the ball chain: those of :class:`ChainParams` (up to 10 000 balls) and
+
+    Attributes
+    ----------
     striker_gap : float
         Initial gap between the striker and the chain [m], >= 0. The
         default, 1.1 radii, puts the impact at ``t* = 1.1`` scene units,
@@ -112,25 +138,10 @@ class BallChainParams:
         exactly, by coincidence).
     """
 
-    n_balls: int = 3
-    mass: float = 0.1
-    striker_mass: float = 0.1
-    radius: float = 0.01
-    striker_speed: float = 1.0
-    restitution: float = 1.0
     striker_gap: float = 0.011
 
     def __post_init__(self):
-        n = self.n_balls
-        if isinstance(n, bool) or not isinstance(n, numbers.Integral) and not (
-                isinstance(n, float) and n.is_integer()):
-            raise InputError(f"`n_balls` must be a whole number in [{MIN_BALLS}, {MAX_BALLS}], "
-                             f"got {n!r}")
-        if not MIN_BALLS <= int(n) <= MAX_BALLS:
-            raise InputError(f"`n_balls` must be in [{MIN_BALLS}, {MAX_BALLS}], got {n!r}")
-        object.__setattr__(self, "n_balls", int(n))
-        check_fields(self, positive, "mass", "striker_mass", "radius", "striker_speed")
-        check_fields(self, restitution, "restitution")
+        super().__post_init__()
         check_fields(self, nonnegative, "striker_gap")
 
 

@@ -89,16 +89,17 @@ are dear: seconds a step).
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
-from .._validate import check_fields, nonnegative, positive, restitution
+from .._validate import check_fields, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
-from .ball_chain import simultaneous_impact
+from .ball_chain import ChainParams, simultaneous_impact
 
 __all__ = ["BallChain3DParams", "ball_chain_3d", "block_result", "MAX_BALLS_3D",
            "PyramidParams", "sphere_pyramid", "pyramid_forces"]
@@ -108,23 +109,12 @@ MAX_BALLS_3D = 50
 
 
 @dataclass(frozen=True)
-class BallChain3DParams:
-    """SI parameters of the chain of spheres in space.
+class BallChain3DParams(ChainParams):
+    """SI parameters of the chain of spheres in space: those of
+    :class:`~moreau.scenes.ball_chain.ChainParams` (up to 50 spheres) and
 
     Attributes
     ----------
-    n_balls : int
-        Spheres ``N`` including the striker, a whole number in [2, 50].
-    mass : float
-        Mass of each sphere of the chain [kg], > 0.
-    striker_mass : float
-        Mass of the striker [kg], > 0.
-    radius : float
-        Radius of every sphere [m], > 0.
-    striker_speed : float
-        The striker's speed towards the chain [m/s], > 0.
-    restitution : float
-        Newton's restitution at every contact, in [0, 1].
     mu : float
         Coulomb friction at every contact, >= 0 (a central impact calls on
         none).
@@ -133,24 +123,13 @@ class BallChain3DParams:
         radii, puts the impact at ``t* = 1.1 r / V``, off the usual grids.
     """
 
-    n_balls: int = 3
-    mass: float = 0.1
-    striker_mass: float = 0.1
-    radius: float = 0.01
-    striker_speed: float = 1.0
-    restitution: float = 1.0
+    max_balls: ClassVar[int] = MAX_BALLS_3D
+
     mu: float = 0.0
     striker_gap: float = 0.011
 
     def __post_init__(self):
-        n = self.n_balls
-        if isinstance(n, bool) or not (isinstance(n, (int, np.integer)) or (
-                isinstance(n, float) and n.is_integer())) or not 2 <= int(n) <= MAX_BALLS_3D:
-            raise InputError(f"`n_balls` must be a whole number in [2, {MAX_BALLS_3D}], "
-                             f"got {n!r}")
-        object.__setattr__(self, "n_balls", int(n))
-        check_fields(self, positive, "mass", "striker_mass", "radius", "striker_speed")
-        check_fields(self, restitution, "restitution")
+        super().__post_init__()
         check_fields(self, nonnegative, "mu", "striker_gap")
 
 
