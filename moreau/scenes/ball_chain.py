@@ -73,7 +73,7 @@ from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
-__all__ = ["ChainParams", "BallChainParams", "BallChain", "two_ball_impact", "sequential_impacts",
+__all__ = ["ChainParams", "BallChainParams", "BallChain", "ChainImpactCase", "two_ball_impact", "sequential_impacts",
            "simultaneous_impact", "sor_omega"]
 
 #: the chain lengths the scene takes
@@ -419,37 +419,56 @@ def sor_omega(masses):
 
 # -- comparison case -----------------------------------------------------------------------------
 
-class BallChainCase(FactoryCase):
+class ChainImpactCase:
+    """A mixin for a chain's comparison case: the last ball's position up to two time units
+    after the striker's impact.
+
+    The reference is the model's exact answer, one simultaneous impact at
+    ``scene.impact_time`` (:func:`simultaneous_impact`), every ball at rest
+    before it and at its final speed after it; the window ends two time
+    units after the impact. The subclass gives :meth:`_last_start`.
+    """
+
+    def __init__(self, **params):
+        super().__init__(**params)
+        self.window = self.scene.impact_time + 2.0
+
+    def _last_start(self):
+        """The last ball's coordinate at the start and the balls' speeds along the chain."""
+        raise NotImplementedError
+
+    def _last(self, t):
+        sc = self.scene
+        x0, v0 = self._last_start()
+        v_after = simultaneous_impact(sc.masses, v0, sc.params.restitution)
+        # at rest until the impact, then at its final speed
+        return x0 + v_after[-1] * np.maximum(np.asarray(t, float) - sc.impact_time, 0.0)
+
+    def reference(self, rtol):
+        return float(self._last(self.window)), [(float(self.scene.impact_time), "0:S")]
+
+    def reference_grid(self):
+        return self._last(np.linspace(0.0, self.window, GRID + 1))
+
+
+class BallChainCase(ChainImpactCase, FactoryCase):
     """The striker's impact on the chain: where the last ball is two time units after it.
 
     The reference is the model's exact answer, one simultaneous impact at
     ``t* = gap / V`` (:func:`simultaneous_impact`), after which every ball
     flies at constant speed; the window ends two time units after the
-    impact. The headline (the last ball's position at the end) carries both
-    the impact's outcome and its time, so a scheme's error shows how well it
-    places the impact within its steps.
+    impact (:class:`ChainImpactCase`). The headline (the last ball's
+    position at the end) carries both the impact's outcome and its time, so
+    a scheme's error shows how well it places the impact within its steps.
     """
 
     headline_name = "position of the last ball after the impacts"
 
     scene_factory = BallChain
 
-    def __init__(self, **params):
-        super().__init__(**params)
-        self.window = self.scene.impact_time + 2.0
-
-    def _last_ball(self, t):
-        sc = self.scene
-        q0, v0 = sc.initial_state()
-        v_after = simultaneous_impact(sc.masses, v0, sc.params.restitution)
-        # at rest until the impact, then at its final speed
-        return q0[-1] + v_after[-1] * np.maximum(np.asarray(t, float) - sc.impact_time, 0.0)
-
-    def reference(self, rtol):
-        return float(self._last_ball(self.window)), [(float(self.scene.impact_time), "0:S")]
-
-    def reference_grid(self):
-        return self._last_ball(np.linspace(0.0, self.window, GRID + 1))
+    def _last_start(self):
+        q0, v0 = self.scene.initial_state()
+        return q0[-1], v0
 
     def coordinate(self, q):
         return q[:, -1]

@@ -94,12 +94,12 @@ from typing import ClassVar
 import numpy as np
 
 from .._validate import check_fields, nonnegative, positive
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
-from .ball_chain import ChainParams, simultaneous_impact
+from .ball_chain import ChainImpactCase, ChainParams
 
 __all__ = ["BallChain3DParams", "ball_chain_3d", "block_result", "MAX_BALLS_3D",
            "PyramidParams", "sphere_pyramid", "pyramid_forces"]
@@ -274,38 +274,24 @@ def sphere_pyramid(params=None, **overrides):
     return sc
 
 
-class BallChain3DCase(SpatialCase):
+class BallChain3DCase(ChainImpactCase, SpatialCase):
     """The last sphere's position along the chain two time units after the impact.
 
     The reference is the simultaneous impact at ``t* = gap / r`` (scene
     units), every sphere at rest before it and at its speed after it
-    (:func:`moreau.scenes.ball_chain.simultaneous_impact`).
+    (:class:`moreau.scenes.ball_chain.ChainImpactCase`).
     """
 
     headline_name = "position of the last sphere after the impacts"
 
     scene_factory = staticmethod(ball_chain_3d)
 
-    def __init__(self, **params):
-        super().__init__(**params)
-        self.window = self.scene.impact_time + 2.0
-
-    def _last(self, t):
-        sc = self.scene
-        q0, v0 = sc.initial_state()
-        n = sc.nbodies
-        after = simultaneous_impact(sc.masses, v0[0::6], self.p.restitution)
-        return q0[7 * (n - 1)] + after[-1] * np.maximum(np.asarray(t, float) - sc.impact_time,
-                                                        0.0)
+    def _last_start(self):
+        q0, v0 = self.scene.initial_state()
+        return q0[7 * (self.scene.nbodies - 1)], v0[0::6]
 
     def coordinate(self, q):
         return q[:, 7 * (self.scene.nbodies - 1)]
-
-    def reference(self, rtol):
-        return float(self._last(self.window)), [(float(self.scene.impact_time), "0:S")]
-
-    def reference_grid(self):
-        return self._last(np.linspace(0.0, self.window, GRID + 1))
 
     def headline_of_run(self, res):
         return float(res.q[-1, 7 * (self.scene.nbodies - 1)])
