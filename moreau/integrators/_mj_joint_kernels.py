@@ -257,17 +257,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
         except Exception:  # noqa: BLE001  (exactly singular: the generic step's failure too)
             status = SINGULAR
             break
-        n1 = 0.0
-        n2 = 0.0
-        for j in range(n):
-            c1 = 0.0
-            c2 = 0.0
-            for i in range(n):
-                c1 += abs(Wh[i, j])
-                c2 += abs(Wi[i, j])
-            n1 = max(n1, c1)
-            n2 = max(n2, c2)
-        cond = n1 * n2
+        cond = _norm1(Wh, n) * _norm1(Wi, n)
         if not (math.isfinite(cond) and cond < COND_MAX):
             status = SINGULAR
             break
