@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import finite_scalar, positive, times
+from .._validate import check_fields, finite_scalar, positive, times
 from ..analysis.cases import GRID, SpatialCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
@@ -67,10 +67,8 @@ class BilliardParams:
     spin: float = -40.0
 
     def __post_init__(self):
-        for name in ("mass", "radius", "gravity", "mu"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("speed", "spin"):
-            object.__setattr__(self, name, finite_scalar(name, getattr(self, name)))
+        check_fields(self, positive, "mass", "radius", "gravity", "mu")
+        check_fields(self, finite_scalar, "speed", "spin")
 
 
 def rolling_onset(p):

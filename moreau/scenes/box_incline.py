@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import in_open_interval, nonnegative, positive, times
+from .._validate import check_fields, in_open_interval, nonnegative, positive, times
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -99,10 +99,9 @@ class BoxInclineParams:
     speed: float = 0.5
 
     def __post_init__(self):
-        for name in ("mass", "half_length", "half_width", "half_height", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("mu", "speed"):
-            object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
+        check_fields(self, positive, "mass", "half_length", "half_width", "half_height",
+                     "gravity")
+        check_fields(self, nonnegative, "mu", "speed")
         object.__setattr__(self, "slope",
                            in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
         a, c = self.half_length, self.half_height

@@ -97,7 +97,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog
 
-from .._validate import nonnegative, positive, positive_int
+from .._validate import check_fields, nonnegative, positive, positive_int
 from ..errors import InputError
 from ..integrators import simulate
 from ..model.planar import HalfPlane, Model, Polygon
@@ -156,9 +156,8 @@ class MasonryArchParams:
             raise InputError(f"`thickness` (t / R) must be < 1 (the intrados radius "
                              f"R (1 - t/2) > 0 with room), got {t!r}")
         object.__setattr__(self, "thickness", t)
-        for name in ("radius", "density", "depth", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        check_fields(self, positive, "radius", "density", "depth", "gravity")
+        check_fields(self, nonnegative, "mu")
 
 
 def voussoir_geometry(n, thickness):

@@ -52,7 +52,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import in_open_interval, nonnegative, positive, finite_scalar, times
+from .._validate import (check_fields, in_open_interval, nonnegative, positive, finite_scalar,
+                         times)
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -95,9 +96,8 @@ class PuckInclineParams:
     heading: float = 0.5 * math.pi
 
     def __post_init__(self):
-        for name in ("mass", "radius", "gravity", "speed"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "mu", nonnegative("mu", self.mu))
+        check_fields(self, positive, "mass", "radius", "gravity", "speed")
+        check_fields(self, nonnegative, "mu")
         object.__setattr__(self, "slope",
                            in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
         h = finite_scalar("heading", self.heading)

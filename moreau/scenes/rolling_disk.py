@@ -69,7 +69,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import in_open_interval, positive
+from .._validate import check_fields, in_open_interval, positive
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -109,8 +109,7 @@ class RollingDiskParams:
     gravity: float = 9.81
 
     def __post_init__(self):
-        for name in ("mass", "radius", "circle", "mu", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        check_fields(self, positive, "mass", "radius", "circle", "mu", "gravity")
         object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
         low = 5.0 / 6.0 * self.radius * math.cos(self.tilt)
         if self.circle <= low:

@@ -103,7 +103,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import in_open_interval, nonnegative, positive
+from .._validate import check_fields, in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
@@ -161,9 +161,8 @@ class TippeTopParams:
     contact_radius: float = LEINE_GLOCKER_PATCH
 
     def __post_init__(self):
-        for name in ("mass", "radius", "inertia_transverse", "inertia_axial", "mu", "gravity",
-                     "spin"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
+        check_fields(self, positive, "mass", "radius", "inertia_transverse", "inertia_axial", "mu",
+                     "gravity", "spin")
         object.__setattr__(self, "offset", in_open_interval("offset", self.offset, 0.0, 1.0))
         object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
         object.__setattr__(self, "contact_radius", nonnegative("contact_radius",

@@ -89,7 +89,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .._validate import in_closed_interval, nonnegative, positive
+from .._validate import check_fields, nonnegative, positive, restitution
 from ..analysis.cases import GRID, FactoryCase
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
@@ -162,14 +162,11 @@ class WoodpeckerToyParams:
     gravity: float = 9.81
 
     def __post_init__(self):
-        for name in ("sleeve_mass", "sleeve_inertia", "bird_mass", "bird_inertia", "pole_radius",
-                     "sleeve_radius", "sleeve_half_height", "spring_offset", "bird_offset",
-                     "beak_height", "beak_offset", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        for name in ("spring", "mu"):
-            object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
-        for name in ("beak_restitution", "sleeve_restitution"):
-            object.__setattr__(self, name, in_closed_interval(name, getattr(self, name), 0.0, 1.0))
+        check_fields(self, positive, "sleeve_mass", "sleeve_inertia", "bird_mass", "bird_inertia",
+                     "pole_radius", "sleeve_radius", "sleeve_half_height", "spring_offset",
+                     "bird_offset", "beak_height", "beak_offset", "gravity")
+        check_fields(self, nonnegative, "spring", "mu")
+        check_fields(self, restitution, "beak_restitution", "sleeve_restitution")
         if not self.sleeve_radius > self.pole_radius:
             raise InputError(f"`sleeve_radius` ({self.sleeve_radius!r}) must exceed "
                              f"`pole_radius` ({self.pole_radius!r}): the sleeve needs play")
