@@ -112,6 +112,7 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.linalg.lapack import dgetrf as _getrf, dgetrs as _getrs
 
 from .. import _jit_cache
 from .._validate import finite_array, positive, positive_int
@@ -1992,19 +1993,20 @@ def solve_on_support(M, q, support, *, tol=None):
         raise InputError("`support` must be a sequence of integer indices") from None
     if B.size and (B.min() < 0 or B.max() >= n or np.unique(B).size != B.size):
         raise InputError(f"`support` must hold distinct indices in [0, {n}), got {B.tolist()}")
-    s = B.size
     z = np.zeros(n)
-    if s:
-        A = np.ascontiguousarray(M[np.ix_(B, B)])
-        x = -q[B]
-        if eliminate(A, x, np.int64(s), SUPPORT_PIVOT_RTOL, 0.0, np.empty(s, dtype=np.int64), z,
-                     B) < s:
+    if B.size:
+        A = M[np.ix_(B, B)]
+        # LAPACK's partial pivoting (getrf), with no compile on a cold start; a pivot at
+        # rounding level of its column is a singular block
+        lu, piv, _ = _getrf(A)
+        if not np.all(np.abs(np.diag(lu)) > SUPPORT_PIVOT_RTOL * np.max(np.abs(A), axis=0)):
             return None
+        z[B] = _getrs(lu, piv, -q[B])[0]
     residual = float(lcp_violation(M, q, z))
     if not residual <= tol:
         return None
     res = LCPResult(z, M @ z + q, SOLVED, 0, residual, "support")
-    res.detail = (f"Solved on the support guessed ({s} of {n} variables), with no pivot, and "
+    res.detail = (f"Solved on the support guessed ({B.size} of {n} variables), with no pivot, and "
                   f"checked on the data like any answer.")
     return res
 
