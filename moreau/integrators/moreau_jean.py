@@ -301,7 +301,9 @@ Statistics (``SimulationResult.stats``)
 one-contact enumeration or a warm start); ``direct_solves`` (the
 enumeration's share); ``warm_starts`` (the share solved without pivoting,
 in the regimes of the step before or on the previous support, compiled
-path only); ``pivots`` (Lemke pivots);
+path; on a spatial scene's Python step, a polyhedral LCP solved on the last
+one's support where Lemke would have finished its path in exact arithmetic,
+see :func:`moreau.lcp.solve_lcp`'s ``"auto"``); ``pivots`` (Lemke pivots);
 ``fallbacks`` (solves where ``"auto"`` fell back to QP); ``max_residual``
 (largest scaled complementarity residual, :func:`moreau.lcp.lcp_residual`
 of the friction LCP; on the compiled path Lemke's measure,
