@@ -72,7 +72,7 @@ def test_the_pyramids_contact_forces_are_the_closed_form(cone):
         # pivots on integers of thousands of bits (35 s); the step before's support solves
         # it: every Lemke solve is a short one (17 pivots on the first step's clean data)
         st = res.stats
-        assert st["lcp_solves"] == 20 and st["warm_starts"] >= 10
+        assert st["lcp_solves"] == 20 and st["warm_starts"] >= 5          # measured: 17
         assert st["pivots"] <= 20 * (st["lcp_solves"] - st["warm_starts"])
     assert np.all(res.regime == int(Regime.STICK))
     fN, fT = res.force_N[1:] * sc.force, res.force_T[1:] * sc.force
