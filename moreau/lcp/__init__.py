@@ -112,6 +112,8 @@ def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
                 or not 0 <= enumerate_max_n <= 20):
             raise InputError(f"`enumerate_max_n` must be an integer in [0, 20] (2^n pieces are "
                              f"visited), got {enumerate_max_n!r}")
+        if support is not None:
+            support = lemke._support_indices(support, len(q))
     first = lemke._solve(M, q, max_iter, tol, check_input, None, True)
     second = None
     if first is None and support is not None:

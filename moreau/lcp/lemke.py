@@ -1934,6 +1934,17 @@ def _raise_nonfinite(M, q, d):
     raise InputError("invalid LCP data")  # pragma: no cover - the checks above fire first
 
 
+def _support_indices(support, n):
+    """``support`` as an int64 array of distinct indices in ``[0, n)``; InputError otherwise."""
+    try:
+        B = np.asarray(support, dtype=np.int64).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("`support` must be a sequence of integer indices") from None
+    if B.size and (B.min() < 0 or B.max() >= n or np.unique(B).size != B.size):
+        raise InputError(f"`support` must hold distinct indices in [0, {n}), got {B.tolist()}")
+    return B
+
+
 #: :func:`solve_on_support` refuses a support whose ``M_BB`` has a pivot (Gaussian
 #: elimination with partial pivoting) below this times the largest entry of its column
 SUPPORT_PIVOT_RTOL = 1e-8
@@ -1987,12 +1998,7 @@ def solve_on_support(M, q, support, *, tol=None):
     finite_array("q", q)
     tol = DEFAULT_TOL if tol is None else positive("tol", tol)
     n = q.shape[0]
-    try:
-        B = np.asarray(support, dtype=np.int64).reshape(-1)
-    except (TypeError, ValueError):
-        raise InputError("`support` must be a sequence of integer indices") from None
-    if B.size and (B.min() < 0 or B.max() >= n or np.unique(B).size != B.size):
-        raise InputError(f"`support` must hold distinct indices in [0, {n}), got {B.tolist()}")
+    B = _support_indices(support, n)
     z = np.zeros(n)
     if B.size:
         A = M[np.ix_(B, B)]

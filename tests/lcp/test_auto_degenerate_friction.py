@@ -107,5 +107,7 @@ def test_a_support_is_taken_only_where_its_point_solves():
 @pytest.mark.parametrize("support, rule", [([0, 0], "distinct"), ([2], "in [0, 2)"),
                                            ([-1], "in [0, 2)"), (["a"], "integer")])
 def test_a_bad_support_is_refused_by_name(support, rule):
-    with pytest.raises(InputError, match=r"`support` must .*" + re.escape(rule)):
-        solve_on_support(np.eye(2), -np.ones(2), support)
+    for solve in (lambda: solve_on_support(np.eye(2), -np.ones(2), support),
+                  lambda: solve_lcp(np.eye(2), -np.ones(2), "auto", support=support)):
+        with pytest.raises(InputError, match=r"`support` must .*" + re.escape(rule)):
+            solve()
