@@ -301,7 +301,9 @@ Statistics (``SimulationResult.stats``)
 one-contact enumeration or a warm start); ``direct_solves`` (the
 enumeration's share); ``warm_starts`` (the share solved without pivoting,
 in the regimes of the step before or on the previous support, compiled
-path only); ``pivots`` (Lemke pivots);
+path; on a spatial scene's Python step, a polyhedral LCP solved on the last
+one's support where Lemke would have finished its path in exact arithmetic,
+see :func:`moreau.lcp.solve_lcp`'s ``"auto"``); ``pivots`` (Lemke pivots);
 ``fallbacks`` (solves where ``"auto"`` fell back to QP); ``max_residual``
 (largest scaled complementarity residual, :func:`moreau.lcp.lcp_residual`
 of the friction LCP; on the compiled path Lemke's measure,
@@ -663,6 +665,8 @@ class MoreauJean(TimeStepping):
         # the Python steps left after the compiled spatial loop handed back a first step,
         # and how many it takes the next time (see _space_block)
         self._python_steps_left, self._python_run = 0, 1
+        # the last polyhedral LCP's support, for the next Python step (_space_step.space_step)
+        self._lcp_memo = {}
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
@@ -862,7 +866,8 @@ class MoreauJean(TimeStepping):
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
         q1, v1, pN, pT, slip, regime = space_step(sc, q, v, t0, t1, h, self.theta, self._closed,
-                                                  self.mu_c, self.e_c, self.cone, self.counters)
+                                                  self.mu_c, self.e_c, self.cone, self.counters,
+                                                  self._lcp_memo)
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")

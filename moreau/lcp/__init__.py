@@ -27,7 +27,14 @@ check_input, friction, ...)``; :data:`METHODS` maps names to them.
     over-constrained contact problems, where each exact step costs
     milliseconds to seconds), the QP at Lemke's tolerance comes first; its
     solution is taken when it passes the check on the data (path ``("lemke",
-    "qp")``), else Lemke's path is finished exactly as above.
+    "qp")``), else Lemke's path is finished exactly as above. With the
+    option ``support`` (indices of a guessed support, e.g. the last time
+    step's), the point of that support
+    (:func:`moreau.lcp.lemke.solve_on_support`) comes before the QP there,
+    taken when it passes the same check (path ``("lemke", "support")``, no
+    pivot): the friction LCP of bodies at rest, whose data carry rounding
+    noise, keeps its support from step to step, where the exact path costs
+    seconds.
 
 Success means the same for every method: ``z`` passed
 :func:`lcp_violation` ``<= tol`` (``z >= -tol_z``, ``w = M z + q >=
@@ -96,7 +103,7 @@ __all__ = [
 
 
 def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
-          enumerate_max_n=decide.ENUMERATE_MAX_N):
+          enumerate_max_n=decide.ENUMERATE_MAX_N, support=None):
     # Lemke's answer is exact when it exists; the QP path is slower and
     # less accurate, so it only runs when pivoting did not deliver. A proof
     # of infeasibility is an answer too: no QP can overturn it.
@@ -105,8 +112,20 @@ def _auto(M, q, *, max_iter=None, tol=None, check_input=True, friction=None,
                 or not 0 <= enumerate_max_n <= 20):
             raise InputError(f"`enumerate_max_n` must be an integer in [0, 20] (2^n pieces are "
                              f"visited), got {enumerate_max_n!r}")
+        if support is not None:
+            support = lemke._support_indices(support, len(q))
     first = lemke._solve(M, q, max_iter, tol, check_input, None, True)
     second = None
+    if first is None and support is not None:
+        # a guessed support (a time step's warm start) before the QP and the exact path,
+        # checked on the data like them (see the module docstring)
+        guess = lemke.solve_on_support(M, q, support, tol=tol)
+        if guess is not None:
+            guess.path = ("lemke", "support")
+            guess.detail = (f"{guess.detail} Lemke first: its path needed more than "
+                            f"{lemke.DEFER_STEPS} steps decided in exact arithmetic, so the "
+                            f"support given was tried before finishing it exactly.")
+            return guess
     if first is None:
         # Lemke's path needs more than a few steps in exact arithmetic (degenerate,
         # over-constrained problems: each step on Python integers of thousands of

@@ -112,6 +112,7 @@ import math
 
 import numpy as np
 from numba import njit
+from scipy.linalg.lapack import dgetrf as _getrf, dgetrs as _getrs
 
 from .. import _jit_cache
 from .._validate import finite_array, positive, positive_int
@@ -148,6 +149,8 @@ __all__ = [
     "NOISE_TOL",
     "TIE_TOL",
     "DEFAULT_TOL",
+    "solve_on_support",
+    "SUPPORT_PIVOT_RTOL",
 ]
 
 #: a pivot-column entry above this times the column's largest magnitude is a
@@ -1929,6 +1932,89 @@ def _raise_nonfinite(M, q, d):
         if not np.all(d > 0):
             raise InputError("`covering` must be strictly positive")
     raise InputError("invalid LCP data")  # pragma: no cover - the checks above fire first
+
+
+def _support_indices(support, n):
+    """``support`` as an int64 array of distinct indices in ``[0, n)``; InputError otherwise."""
+    try:
+        B = np.asarray(support, dtype=np.int64).reshape(-1)
+    except (TypeError, ValueError):
+        raise InputError("`support` must be a sequence of integer indices") from None
+    if B.size and (B.min() < 0 or B.max() >= n or np.unique(B).size != B.size):
+        raise InputError(f"`support` must hold distinct indices in [0, {n}), got {B.tolist()}")
+    return B
+
+
+#: :func:`solve_on_support` refuses a support whose ``M_BB`` has a pivot (Gaussian
+#: elimination with partial pivoting) below this times the largest entry of its column
+SUPPORT_PIVOT_RTOL = 1e-8
+
+
+def solve_on_support(M, q, support, *, tol=None):
+    """The point of a guessed support, ``M_BB z_B = -q_B`` and ``z = 0`` off ``B``, if it solves.
+
+    A warm start for a sequence of LCPs that keep their solution's support
+    (the contact problems of a time-stepping scheme between contact
+    events): no pivoting, one ``|B| x |B|`` elimination. The point is
+    accepted only as any method's answer is, by the check on the caller's
+    data (:func:`moreau.lcp.lcp_violation`, at its worst over the rounding
+    of ``w = M z + q``, ``<= tol``), and only where ``M_BB`` is clearly
+    regular: every pivot of the elimination above
+    :data:`SUPPORT_PIVOT_RTOL` times the largest entry of its column.
+
+    Parameters
+    ----------
+    M : ndarray, shape (n, n)
+    q : ndarray, shape (n,)
+    support : array_like of int
+        The indices ``B`` of the guessed nonzero ``z``, each in ``[0, n)``,
+        without repeats.
+    tol : float, optional
+        The violation bound (default :data:`DEFAULT_TOL`, Lemke's).
+
+    Returns
+    -------
+    LCPResult or None
+        Solved, with ``pivots = 0`` and ``method = "support"``; None where
+        the support is refused (a singular ``M_BB``, or a point that fails
+        the check).
+
+    Raises
+    ------
+    InputError
+        Bad shapes, non-finite data, an index out of range or repeated.
+
+    Examples
+    --------
+    >>> M = np.array([[2.0, 1.0], [1.0, 2.0]])
+    >>> res = solve_on_support(M, np.array([-1.0, 1.0]), [0])
+    >>> res.method, res.pivots, res.z.tolist()
+    ('support', 0, [0.5, 0.0])
+    >>> solve_on_support(M, np.array([-1.0, 1.0]), [1]) is None    # z_1 = -0.5
+    True
+    """
+    M, q = coerce_lcp(M, q)
+    finite_array("M", M)
+    finite_array("q", q)
+    tol = DEFAULT_TOL if tol is None else positive("tol", tol)
+    n = q.shape[0]
+    B = _support_indices(support, n)
+    z = np.zeros(n)
+    if B.size:
+        A = M[np.ix_(B, B)]
+        # LAPACK's partial pivoting (getrf), with no compile on a cold start; a pivot at
+        # rounding level of its column is a singular block
+        lu, piv, _ = _getrf(A)
+        if not np.all(np.abs(np.diag(lu)) > SUPPORT_PIVOT_RTOL * np.max(np.abs(A), axis=0)):
+            return None
+        z[B] = _getrs(lu, piv, -q[B])[0]
+    residual = float(lcp_violation(M, q, z))
+    if not residual <= tol:
+        return None
+    res = LCPResult(z, M @ z + q, SOLVED, 0, residual, "support")
+    res.detail = (f"Solved on the support guessed ({B.size} of {n} variables), with no pivot, and "
+                  f"checked on the data like any answer.")
+    return res
 
 
 def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, covering=None):

@@ -59,16 +59,21 @@ def test_an_oblique_rough_chain_gives_the_block_result_along_its_line():
 
 # -- the resting pyramid ------------------------------------------------------------------------
 
-# the polyhedral cone: Lemke on the resting pyramid's degenerate LCP (six sticking contacts,
-# 60 unknowns at d = 8) took 27 s a step on the loaded machine (100 steps: 2712 s; d = 4: 232
-# s), with the forces to 7e-15: one step, with the long checks
-@pytest.mark.parametrize("cone, span", [("exact", 2.0), pytest.param(8, 0.1, marks=pytest.mark.slow)])
-def test_the_pyramids_contact_forces_are_the_closed_form(cone, span):
+@pytest.mark.parametrize("cone", ["exact", 8])
+def test_the_pyramids_contact_forces_are_the_closed_form(cone):
     sc = sphere_pyramid()                  # mu = 0.5 >= tan(beta/2) = 0.4025 / cos(pi/8)
     f = pyramid_forces(sc.params)
     q0, v0 = sc.initial_state()
-    res = simulate(sc, (0.0, span), q0, v0, "moreau-jean", h=0.1, cone=cone)
+    res = simulate(sc, (0.0, 2.0), q0, v0, "moreau-jean", h=0.1, cone=cone)
     assert res.status == 0, res.message
+    if cone == 8:
+        # the polyhedral LCP (six sticking contacts, 60 unknowns) of a step after the first
+        # has rounding noise in its data, on which Lemke's exact lexicographic path is 75
+        # pivots on integers of thousands of bits (35 s); the step before's support solves
+        # it: every Lemke solve is a short one (17 pivots on the first step's clean data)
+        st = res.stats
+        assert st["lcp_solves"] == 20 and st["warm_starts"] >= 5          # measured: 17
+        assert st["pivots"] <= 20 * (st["lcp_solves"] - st["warm_starts"])
     assert np.all(res.regime == int(Regime.STICK))
     fN, fT = res.force_N[1:] * sc.force, res.force_T[1:] * sc.force
     for got, want in ((fN[:, :3], f["normal_floor"]), (fN[:, 3:], f["normal_top"]),
