@@ -402,7 +402,7 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     h = positive("h", h)
     dz = positive("dz", dz)
     cs, r = impulses
-    f = np.asarray(r, dtype=float).reshape(cs.size, -1) / h
+    f = np.asarray(r, dtype=float).reshape(cs.size, -1 if cs.size else 2) / h
     side = (cs.a == -2) | (cs.a == -3)
     # (left wall: t = (0, 1) points up; right wall: t = (0, -1))
     up = np.where(cs.a[side] == -2, f[side, 1], -f[side, 1])

@@ -101,9 +101,9 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
 
     Examples
     --------
-    A tiny silo (12 disks, a few steps: the machinery, not a measurement):
+    A tiny silo (8 disks, a few steps: the machinery, not a measurement):
 
-    >>> r = sliding_profile(0, n_disks=12, width=0.015, settle_steps=60, transient_steps=2,
+    >>> r = sliding_profile(0, n_disks=8, width=0.015, settle_steps=20, transient_steps=2,
     ...                     measure_steps=4, dz=1.0)
     >>> r["samples"], r["depth"][:2].tolist(), bool(r["floor_m_app"] <= r["floor_mass"] + 1e-9)
     (2, [1.0, 2.0], True)
