@@ -63,3 +63,26 @@ def test_the_sliding_profile_refuses_bad_input_by_name_before_any_run():
         sliding_profile(0, scatter=-1.0)
     with pytest.raises(InputError, match="`nonsense`"):
         sliding_profile(0, nonsense=1.0)
+
+
+@pytest.mark.slow
+def test_the_ensemble_averaged_silo_load_saturates_as_janssens_law_within_ten_percent():
+    # issue 38's acceptance, the protocol of the study module: nine fillings (seeds 0-8) of 160
+    # disks (+-20 % radii, mu_r = 0.1 d) in a silo 6 d wide, the walls sliding up while the load
+    # across cuts every 2 d is weighed; their mean at equal depth, Janssen's law fitted once.
+    # Measured: K = 0.549 (m_sat = 44.6, lam = 10.9 d), deviations over the 10 cuts and the
+    # floor -3.9 % .. +8.4 % (rms 4.0 %), the worst on the floor; walls' friction mobilised to
+    # 92.8 %; 396 of the 900 sliding steps above NSGS's tol 1e-4. Each filling alone fits
+    # K = 0.36 .. 0.79 with worst deviations 9 % .. 45 %. Marginal: twelve fillings (seeds
+    # 0-11, measured once) fit K = 0.552 with a worst deviation of 10.2 % (rms 4.5 %), again
+    # on the floor (the cuts alone within 5.7 %), whose load stays above the law by 8-10 %
+    e = ensemble([sliding_profile(seed, n_disks=160) for seed in range(9)])
+    assert e["fillings"] == 9 and e["depth"].size == 11
+    assert e["max_deviation"] <= 0.10 and e["rms_deviation"] <= 0.05
+    # Janssen's premise: the walls' friction mobilised (nearly) fully, upward
+    assert e["mobilised"] > 0.9
+    # K between Rankine's active ratio and the sliding wall's (tan phi = mu_wall = 0.5)
+    k_a, k_w, _ = e["K_bounds"]
+    assert k_a <= e["K"] <= k_w
+    # saturation: the walls carry more than half the weight of the deepest 4 d
+    assert np.all(e["wall_fraction"][-2:] > 0.5)

@@ -47,9 +47,43 @@ below the top down to the floor), the worst of them, the fitted ``K``,
 and the walls' mobilised friction. The wall-supported fraction of the
 weight above a cut is ``1 - m_app / M``.
 
-Measured: see ``benchmarks/silo_janssen_ensemble.py`` (which runs it one
-filling at a time, writing each as it finishes) and the slow test in
-``tests/scenes/test_janssen_ensemble.py``.
+Measured (160 disks a filling, ``W = 6 d``, ``mu = mu_wall = mu_floor =
+0.5``, ``mu_r = 0.1 d``, ``wall_speed`` 0.05, ``h = 0.01``, 50 + 100 sliding
+steps, cuts every ``2 d``; about 25 s of CPU a filling), nine fillings
+(seeds 0-8), the fit range ten cuts ``2 d`` to ``20 d`` below the top and
+the floor (``21.9 d``):
+
+========  ======  ======  =====  ==============  =========
+depth     ``M``   m_app   s.e.   wall-supported  deviation
+========  ======  ======  =====  ==============  =========
+2.0       4.3     3.9     0.6    8.4 %           -3.9 %
+4.0       12.5    11.4    0.7    8.7 %           +4.7 %
+6.0       20.8    17.5    0.7    16.3 %          +4.8 %
+8.0       29.8    22.0    1.5    26.0 %          +1.4 %
+10.0      38.6    25.8    2.2    33.0 %          +0.1 %
+12.0      47.0    28.2    2.2    40.1 %          -3.0 %
+14.0      55.6    31.0    1.7    44.3 %          -2.5 %
+16.0      64.1    33.5    1.5    47.8 %          -1.6 %
+18.0      72.7    34.6    2.2    52.4 %          -3.5 %
+20.0      81.6    36.2    2.6    55.6 %          -3.3 %
+21.9      89.2    41.8    2.6    53.1 %          +8.4 %
+========  ======  ======  =====  ==============  =========
+
+``K = 0.549`` (``m_sat = 44.6``, ``lam = 10.9 d``), inside the range of
+the Mohr circle (``K_a = 0.38 <= K <= K_w = 0.67`` at ``tan phi = 0.5``);
+worst deviation 8.4 % (rms 4.0 %), on the floor; the walls' friction
+mobilised to 92.8 % of ``mu_w`` over the column; 396 of the 900 sliding
+steps ended above NSGS's ``tol = 1e-4`` (worst residual 3e-2). Issue 38's
+10 % is met, narrowly: the floor carries 8-10 % more than the law in every
+set of fillings measured (twelve fillings, seeds 0-11: ``K = 0.552``,
+worst 10.2 % on the floor, rms 4.5 %; the cuts alone within 5.7 %), and the
+standard error of the mean is 5-7 % of the load below ``8 d``. Each filling
+alone fits ``K`` = 0.36 .. 0.79 with worst deviations of 9 % .. 45 %: the
+law holds for the ensemble, not for one filling.
+
+``benchmarks/silo_janssen_ensemble.py`` runs it one filling at a time,
+writing each as it finishes; the slow test in
+``tests/scenes/test_janssen_ensemble.py`` holds the nine fillings.
 """
 
 import math
