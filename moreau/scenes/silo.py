@@ -154,10 +154,11 @@ Landry et al., Phys. Rev. E 67 (2003) 041303: the stress against depth averaged)
 filling (a seed) settles 160 disks of radii ``+-20 %`` with ``mu_r = 0.1 d`` in one pour,
 then both walls slide up at ``0.05`` while the load across cuts every ``2 d`` (the depth of
 a cut standing for a fill height) and on the floor is weighed; the fillings' loads are
-averaged at equal depth and Janssen's law fitted once. Nine fillings fit ``K = 0.55``
-(inside ``K_a .. K_w``), the walls mobilised to 93 %, and deviate from the law by 8.4 % at
-worst (on the floor; rms 4.0 %): issue 38's 10 % is met by the ensemble, narrowly (twelve
-fillings: 10.2 %), where no single filling comes within 9 %.
+averaged at equal depth and Janssen's law fitted once. The load across the cuts follows
+the law within 6 % (9, 12 and 14 fillings; ``K`` = 0.57 .. 0.60, inside ``K_a .. K_w``; the
+walls mobilised to 93 %), where no single filling comes within 9 %; the floor carries
+12-17 % more than that law (fitted with the cuts: worst 8.4 %, 10.2 %, 12.1 %, on the
+floor). Issue 38's 10 % holds for the load against depth inside the column, not on the floor.
 
 The registered scene (``make_scene("silo")``) is a silo's first pour at its
 start (the disks on a loose lattice above the floor) as a

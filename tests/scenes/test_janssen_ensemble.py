@@ -66,23 +66,27 @@ def test_the_sliding_profile_refuses_bad_input_by_name_before_any_run():
 
 
 @pytest.mark.slow
-def test_the_ensemble_averaged_silo_load_saturates_as_janssens_law_within_ten_percent():
+def test_the_ensemble_averaged_silo_load_saturates_with_depth_as_janssens_law():
     # issue 38's acceptance, the protocol of the study module: nine fillings (seeds 0-8) of 160
     # disks (+-20 % radii, mu_r = 0.1 d) in a silo 6 d wide, the walls sliding up while the load
     # across cuts every 2 d is weighed; their mean at equal depth, Janssen's law fitted once.
-    # Measured: K = 0.549 (m_sat = 44.6, lam = 10.9 d), deviations over the 10 cuts and the
-    # floor -3.9 % .. +8.4 % (rms 4.0 %), the worst on the floor; walls' friction mobilised to
-    # 92.8 %; 396 of the 900 sliding steps above NSGS's tol 1e-4. Each filling alone fits
-    # K = 0.36 .. 0.79 with worst deviations 9 % .. 45 %. Marginal: twelve fillings (seeds
-    # 0-11, measured once) fit K = 0.552 with a worst deviation of 10.2 % (rms 4.5 %), again
-    # on the floor (the cuts alone within 5.7 %), whose load stays above the law by 8-10 %
-    e = ensemble([sliding_profile(seed, n_disks=160) for seed in range(9)])
-    assert e["fillings"] == 9 and e["depth"].size == 11
-    assert e["max_deviation"] <= 0.10 and e["rms_deviation"] <= 0.05
+    # Measured, the ten cuts 2 d .. 20 d deep fitted: m_sat = 42.7, worst deviation 5.8 %
+    # (rms 3.0 %); the floor's load lies 11.7 % above that law (s.e. 6.2 %). Twelve and
+    # fourteen fillings (seeds 0-11, 0-13, measured once): the cuts within 4.5 % and 5.8 %, the
+    # floor 14.2 % and 16.9 % above (s.e. 4.9 %, 4.3 %): a systematic floor effect. With the
+    # floor in the fit: worst 8.4 %, 10.2 %, 12.1 % (K = 0.549, 0.552, 0.565), always on the
+    # floor. Walls' friction mobilised to 92.8 %; 396 of 900 sliding steps above tol 1e-4.
+    profiles = [sliding_profile(seed, n_disks=160) for seed in range(9)]
+    cuts = ensemble(profiles, floor=False)
+    assert cuts["fillings"] == 9 and cuts["depth"].size == 11
+    assert cuts["max_deviation"] <= 0.07 and cuts["rms_deviation"] <= 0.04
+    assert cuts["floor_deviation"] > 0.05
+    whole = ensemble(profiles)
+    assert whole["max_deviation"] == pytest.approx(abs(whole["deviation"][-1]))
     # Janssen's premise: the walls' friction mobilised (nearly) fully, upward
-    assert e["mobilised"] > 0.9
+    assert whole["mobilised"] > 0.9
     # K between Rankine's active ratio and the sliding wall's (tan phi = mu_wall = 0.5)
-    k_a, k_w, _ = e["K_bounds"]
-    assert k_a <= e["K"] <= k_w
+    k_a, k_w, _ = whole["K_bounds"]
+    assert k_a <= whole["K"] <= k_w and k_a <= cuts["K"] <= k_w
     # saturation: the walls carry more than half the weight of the deepest 4 d
-    assert np.all(e["wall_fraction"][-2:] > 0.5)
+    assert np.all(whole["wall_fraction"][-2:] > 0.5)

@@ -69,21 +69,38 @@ depth     ``M``   m_app   s.e.   wall-supported  deviation
 21.9      89.2    41.8    2.6    53.1 %          +8.4 %
 ========  ======  ======  =====  ==============  =========
 
-``K = 0.549`` (``m_sat = 44.6``, ``lam = 10.9 d``), inside the range of
-the Mohr circle (``K_a = 0.38 <= K <= K_w = 0.67`` at ``tan phi = 0.5``);
-worst deviation 8.4 % (rms 4.0 %), on the floor; the walls' friction
-mobilised to 92.8 % of ``mu_w`` over the column; 396 of the 900 sliding
-steps ended above NSGS's ``tol = 1e-4`` (worst residual 3e-2). Issue 38's
-10 % is met, narrowly: the floor carries 8-10 % more than the law in every
-set of fillings measured (twelve fillings, seeds 0-11: ``K = 0.552``,
-worst 10.2 % on the floor, rms 4.5 %; the cuts alone within 5.7 %), and the
-standard error of the mean is 5-7 % of the load below ``8 d``. Each filling
-alone fits ``K`` = 0.36 .. 0.79 with worst deviations of 9 % .. 45 %: the
-law holds for the ensemble, not for one filling.
+With the floor in the fit: ``K = 0.549`` (``m_sat = 44.6``, ``lam = 10.9
+d``), inside the range of the Mohr circle (``K_a = 0.38 <= K <= K_w =
+0.67`` at ``tan phi = 0.5``), worst deviation 8.4 % (rms 4.0 %), on the
+floor; the walls' friction mobilised to 92.8 % of ``mu_w`` over the
+column; 396 of the 900 sliding steps ended above NSGS's ``tol = 1e-4``
+(worst residual 3e-2). More fillings do not bring the floor closer:
+
+=========  ==========================  ==============================
+fillings   the cuts fitted (no floor)  the cuts and the floor fitted
+=========  ==========================  ==============================
+9 (0-8)    K 0.573, worst 5.8 %, rms   K 0.549, worst 8.4 %, rms 4.0 %
+           3.0 %; floor +11.7 %
+12 (0-11)  K 0.581, worst 4.5 %, rms   K 0.552, worst 10.2 %, rms 4.5 %
+           2.5 %; floor +14.2 %
+14 (0-13)  K 0.599, worst 5.8 %, rms   K 0.565, worst 12.1 %, rms 5.7 %
+           3.6 %; floor +16.9 %
+=========  ==========================  ==============================
+
+The load across the cuts, ``2 d`` to ``20 d`` below the top, follows
+Janssen's law within 6 % for every set of fillings (its saturation with
+depth: the walls carry 55 % of the weight above ``20 d``); the floor
+carries 12-17 % more than that law, three to four standard errors of the
+mean: the last ``2 d`` (the layer on the floor) hang little on the
+walls. Issue 38's 10 % holds for the depth profile inside the column,
+not for the floor (the floor was in the protocol's fit range from the
+start; the cuts-only fit was added after the floor's excess was seen).
+Each filling alone fits ``K`` = 0.36 .. 0.79 with worst deviations of 9 %
+.. 45 %: the law holds for the ensemble, not for one filling.
 
 ``benchmarks/silo_janssen_ensemble.py`` runs it one filling at a time,
 writing each as it finishes; the slow test in
-``tests/scenes/test_janssen_ensemble.py`` holds the nine fillings.
+``tests/scenes/test_janssen_ensemble.py`` holds the nine fillings' figures.
 """
 
 import math
@@ -95,7 +112,8 @@ from ...errors import InputError
 from ...integrators.granular import settle, simulate_disks
 from ...model.granular import random_fill
 from ...model.scene import params_with
-from ...scenes.silo import SiloParams, fit_janssen, janssen_k_bounds, silo_system, wall_profile
+from ...scenes.silo import (SiloParams, fit_janssen, janssen, janssen_k_bounds, silo_system,
+                            wall_profile)
 
 __all__ = ["sliding_profile", "ensemble"]
 
@@ -203,13 +221,15 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
     return out
 
 
-def ensemble(profiles, *, mu_wall=None, phi=None):
+def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
     """Average :func:`sliding_profile`'s fillings at equal depth and fit Janssen's law once.
 
     Parameters
     ----------
     profiles : sequence of dict
         Two fillings at least, of one silo (the same ``width`` and ``dz``).
+    floor : bool
+        Whether the floor is a point of the fit (else the cuts alone are).
     mu_wall : float, optional
         The walls' friction (default: the profiles').
     phi : float, optional
@@ -225,8 +245,9 @@ def ensemble(profiles, *, mu_wall=None, phi=None):
         wall-supported fraction of the weight above), ``mobilised`` (the
         walls' upward friction over ``mu_wall`` times their normal force,
         over the whole column, mean of the fillings), the fit's ``K``,
-        ``m_sat``, ``lam``, ``deviation`` (per point), ``max_deviation``,
-        ``rms_deviation``, ``K_bounds`` (``K_a, K_w, K_p``), ``fillings``,
+        ``m_sat``, ``lam``, ``deviation`` (per point fitted), ``max_deviation``,
+        ``rms_deviation`` (over them), ``floor_deviation`` (the floor's load
+        against the fitted law, whether fitted or not), ``K_bounds`` (``K_a, K_w, K_p``), ``fillings``,
         ``unconverged`` and ``steps`` (sliding steps, all fillings).
 
     Examples
@@ -244,6 +265,9 @@ def ensemble(profiles, *, mu_wall=None, phi=None):
     >>> e = ensemble([one(40.0), one(40.0)])
     >>> round(e["m_sat"], 6), e["max_deviation"] < 1e-6, e["depth"].tolist(), e["mobilised"]
     (20.0, True, [2.0, 4.0, 6.0, 8.0], 0.5)
+    >>> e = ensemble([one(40.0), one(40.0)], floor=False)
+    >>> e["deviation"].size, abs(e["floor_deviation"]) < 1e-6
+    (3, True)
     """
     profiles = list(profiles)
     if len(profiles) < 2:
@@ -263,7 +287,8 @@ def ensemble(profiles, *, mu_wall=None, phi=None):
     m, y = mass.mean(axis=0), load.mean(axis=0)
     W = float(profiles[0]["width"])
     rho = float(np.mean([pr["rho"] for pr in profiles]))
-    fit = fit_janssen(m, y, rho=rho, width=W, mu_wall=mu_wall)
+    n_fit = m.size if floor else m.size - 1
+    fit = fit_janssen(m[:n_fit], y[:n_fit], rho=rho, width=W, mu_wall=mu_wall)
     mobilised = float(np.mean([pr["floor_friction"] / (mu_wall * pr["floor_normal"])
                                for pr in profiles]))
     return {"depth": depth, "mass": m, "m_app": y,
@@ -272,6 +297,7 @@ def ensemble(profiles, *, mu_wall=None, phi=None):
             "m_sat": fit["m_sat"], "lam": fit["lam"], "deviation": fit["deviation"],
             "max_deviation": fit["max_deviation"],
             "rms_deviation": float(np.sqrt(np.mean(fit["deviation"] ** 2))),
+            "floor_deviation": float(y[-1] / janssen(m[-1], fit["m_sat"]) - 1.0),
             "K_bounds": janssen_k_bounds(phi, mu_wall), "fillings": len(profiles),
             "unconverged": int(sum(pr["unconverged"] for pr in profiles)),
             "steps": int(sum(pr["steps"] for pr in profiles))}
