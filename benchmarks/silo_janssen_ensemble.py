@@ -8,7 +8,7 @@ different seeds into one file).
 
 ``python benchmarks/silo_janssen_ensemble.py fit OUT [OUT ...] [--n-disks 160]`` reads
 the fillings (of that size) and prints :func:`moreau.studies.granular.janssen.ensemble`'s
-table: per cut, the mean mass above it, the load it carries, its standard error over
+fits (the cuts and the floor; the cuts alone) and table: per cut, the mean mass above it, the load it carries, its standard error over
 the fillings, the wall-supported fraction, the deviation from the fitted law.
 
 Minutes a filling on one core (160 disks: settling and 150 sliding steps); the figures
@@ -54,6 +54,10 @@ def fit(paths, n_disks):
     print(f"K = {e['K']:.3f} (K_a {ka:.2f}, K_w {kw:.2f}, K_p {kp:.2f}), m_sat = "
           f"{e['m_sat']:.1f}, lambda = {e['lam']:.1f} d; worst deviation "
           f"{e['max_deviation']:.1%}, rms {e['rms_deviation']:.1%}")
+    c = ensemble(profiles, floor=False)
+    print(f"the cuts alone fitted: K = {c['K']:.3f}, m_sat = {c['m_sat']:.1f}, worst deviation "
+          f"{c['max_deviation']:.1%}, rms {c['rms_deviation']:.1%}; the floor "
+          f"{c['floor_deviation']:+.1%} off that law")
     print("| depth (d) | mass above | load m_app | s.e. | wall-supported | deviation |")
     print("|---|---|---|---|---|---|")
     for row in zip(e["depth"], e["mass"], e["m_app"], e["m_app_sem"], e["wall_fraction"],
