@@ -147,6 +147,19 @@ packing of rigid disks keeps whatever wall friction its history leaves it
 (no elastic creep to keep the contacts slipping), which is Janssen's
 premise and what the experiments achieve with real grains.
 
+*Ensemble-averaged, walls sliding* (:mod:`moreau.studies.granular.janssen`): the
+protocol of the experiments and simulations that test Janssen's law (Vanel and Clement
+1999, above: the walls moved slowly to mobilise their friction, repeated fillings; J. W.
+Landry et al., Phys. Rev. E 67 (2003) 041303: the stress against depth averaged): each
+filling (a seed) settles 160 disks of radii ``+-20 %`` with ``mu_r = 0.1 d`` in one pour,
+then both walls slide up at ``0.05`` while the load across cuts every ``2 d`` (the depth of
+a cut standing for a fill height) and on the floor is weighed; the fillings' loads are
+averaged at equal depth and Janssen's law fitted once. The load across the cuts follows
+the law within 6 % (9, 12 and 14 fillings; ``K`` = 0.57 .. 0.60, inside ``K_a .. K_w``; the
+walls mobilised to 93 %), where no single filling comes within 9 %; the floor carries
+12-17 % more than that law (with the floor in the fit: worst 8.4 %, 10.2 %, 12.1 %, on
+the floor). Issue 38's 10 % holds for the load against depth inside the column, not on the floor.
+
 The registered scene (``make_scene("silo")``) is a silo's first pour at its
 start (the disks on a loose lattice above the floor) as a
 :class:`~moreau.model.granular.DiskScene`, its contacts fixed to those within
@@ -402,7 +415,7 @@ def wall_profile(system, x, impulses, h, *, dz=2.0):
     h = positive("h", h)
     dz = positive("dz", dz)
     cs, r = impulses
-    f = np.asarray(r, dtype=float).reshape(cs.size, -1) / h
+    f = np.asarray(r, dtype=float).reshape(cs.size, -1 if cs.size else 2) / h
     side = (cs.a == -2) | (cs.a == -3)
     # (left wall: t = (0, 1) points up; right wall: t = (0, -1))
     up = np.where(cs.a[side] == -2, f[side, 1], -f[side, 1])

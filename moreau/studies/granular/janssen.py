@@ -1,0 +1,303 @@
+"""Janssen's law in the silo, ensemble-averaged over independent fillings with sliding walls.
+
+The load a packing of rigid grains carries at rest is statically
+indeterminate: each filling's history picks it, and one filling's load
+scatters about Janssen's law (:mod:`moreau.scenes.silo`). The experiments
+and simulations that test the law do two things about it:
+
+* they mobilise the walls' friction by moving the walls slowly past the
+  grains and weigh the column while it moves (J. Vanel and E. Clement,
+  *Pressure screening and fluctuations at the bottom of a granular column*,
+  Eur. Phys. J. B 11 (1999) 525-533: Janssen's premise that the friction
+  is fully mobilised, which a column at rest does not meet);
+* they average over many independent fillings (Vanel and Clement's
+  repeated fillings; the discrete-element silos of J. W. Landry, G. S.
+  Grest, L. E. Silbert and S. J. Plimpton, *Confined granular packings:
+  structure, stress, and forces*, Phys. Rev. E 67 (2003) 041303, and of
+  Landry, Grest and Plimpton, *Discrete element simulations of stress
+  distributions in silos: crossover from two to three dimensions*, Powder
+  Technol. 139 (2004) 233-239, which fit Janssen's law to the vertical
+  stress against depth, averaged).
+
+The protocol here (:func:`sliding_profile`, :func:`ensemble`), per
+filling (its ``seed``):
+
+1. ``n_disks`` disks, radii uniform in ``[spread, 1] d / 2`` (the default
+   ``spread = 2/3``: radii ``+-20 %`` about their mean, which keeps a 2D
+   packing from crystallising), start on a loose lattice filling the silo
+   with random horizontal speeds in ``[-scatter, scatter]`` and settle
+   together (one pour; the seed draws the radii, the lattice's jitter and
+   the speeds); every contact resists rolling (``mu_r``, default ``0.1
+   d``: rigid round disks otherwise roll along a moving wall instead of
+   sliding on it, :mod:`moreau.scenes.silo`).
+2. Both walls slide up along themselves at ``wall_speed`` for
+   ``transient_steps`` (the friction turns up the walls), then for
+   ``measure_steps`` more, during which the load across horizontal cuts
+   every ``dz`` below the top (:func:`moreau.scenes.silo.wall_profile`:
+   the mass above a cut less the walls' upward friction on it) and on the
+   floor is sampled every ``every`` steps and averaged.
+
+:func:`ensemble` averages the fillings' profiles at equal depth (the
+cuts all fillings reach, and the floor), fits Janssen's law
+``m_app = m_sat (1 - exp(-M / m_sat))`` once
+(:func:`moreau.scenes.silo.fit_janssen`: ``M`` the mass above the cut,
+``m_app`` the load it carries) and reports each point's relative
+deviation from the fitted law over the fit range (every cut from ``dz``
+below the top down to the floor), the worst of them, the fitted ``K``,
+and the walls' mobilised friction. The wall-supported fraction of the
+weight above a cut is ``1 - m_app / M``.
+
+Measured (160 disks a filling, ``W = 6 d``, ``mu = mu_wall = mu_floor =
+0.5``, ``mu_r = 0.1 d``, ``wall_speed`` 0.05, ``h = 0.01``, 50 + 100 sliding
+steps, cuts every ``2 d``; about 25 s of CPU a filling), nine fillings
+(seeds 0-8), the fit range ten cuts ``2 d`` to ``20 d`` below the top and
+the floor (``21.9 d``):
+
+========  ======  ======  =====  ==============  =========
+depth     ``M``   m_app   s.e.   wall-supported  deviation
+========  ======  ======  =====  ==============  =========
+2.0       4.3     3.9     0.6    8.4 %           -3.9 %
+4.0       12.5    11.4    0.7    8.7 %           +4.7 %
+6.0       20.8    17.5    0.7    16.3 %          +4.8 %
+8.0       29.8    22.0    1.5    26.0 %          +1.4 %
+10.0      38.6    25.8    2.2    33.0 %          +0.1 %
+12.0      47.0    28.2    2.2    40.1 %          -3.0 %
+14.0      55.6    31.0    1.7    44.3 %          -2.5 %
+16.0      64.1    33.5    1.5    47.8 %          -1.6 %
+18.0      72.7    34.6    2.2    52.4 %          -3.5 %
+20.0      81.6    36.2    2.6    55.6 %          -3.3 %
+21.9      89.2    41.8    2.6    53.1 %          +8.4 %
+========  ======  ======  =====  ==============  =========
+
+With the floor in the fit: ``K = 0.549`` (``m_sat = 44.6``, ``lam = 10.9
+d``), inside the range of the Mohr circle (``K_a = 0.38 <= K <= K_w =
+0.67`` at ``tan phi = 0.5``), worst deviation 8.4 % (rms 4.0 %), on the
+floor; the walls' friction mobilised to 92.8 % of ``mu_w`` over the
+column; 396 of the 900 sliding steps ended above NSGS's ``tol = 1e-4``
+(worst residual 3e-2). More fillings do not bring the floor closer:
+
+=========  ==========================  ==============================
+fillings   the cuts fitted (no floor)  the cuts and the floor fitted
+=========  ==========================  ==============================
+9 (0-8)    K 0.573, worst 5.8 %, rms   K 0.549, worst 8.4 %, rms 4.0 %
+           3.0 %; floor +11.7 %
+12 (0-11)  K 0.581, worst 4.5 %, rms   K 0.552, worst 10.2 %, rms 4.5 %
+           2.5 %; floor +14.2 %
+14 (0-13)  K 0.599, worst 5.8 %, rms   K 0.565, worst 12.1 %, rms 5.7 %
+           3.6 %; floor +16.9 %
+=========  ==========================  ==============================
+
+The load across the cuts, ``2 d`` to ``20 d`` below the top, follows
+Janssen's law within 6 % for every set of fillings (its saturation with
+depth: the walls carry 55 % of the weight above ``20 d``); the floor
+carries 12-17 % more than that law, three to four standard errors of the
+mean: the last ``2 d`` (the layer on the floor) hang little on the
+walls. Issue 38's 10 % holds for the depth profile inside the column,
+not for the floor (the floor was in the protocol's fit range from the
+start; the cuts-only fit was added after the floor's excess was seen).
+Each filling alone fits ``K`` = 0.36 .. 0.79 with worst deviations of 9 %
+.. 45 %: the law holds for the ensemble, not for one filling.
+
+``benchmarks/silo_janssen_ensemble.py`` runs it one filling at a time,
+writing each as it finishes; the slow test in
+``tests/scenes/test_janssen_ensemble.py`` holds the nine fillings' figures.
+"""
+
+import math
+
+import numpy as np
+
+from ..._validate import nonnegative, positive, positive_int
+from ...errors import InputError
+from ...integrators.granular import settle, simulate_disks
+from ...model.granular import random_fill
+from ...model.scene import params_with
+from ...scenes.silo import (SiloParams, fit_janssen, janssen, janssen_k_bounds, silo_system,
+                            wall_profile)
+
+__all__ = ["sliding_profile", "ensemble"]
+
+#: the study's defaults: ``+-20 %`` radii, rolling resistance a tenth of a diameter
+DEFAULTS = {"spread": 2.0 / 3.0, "mu_r": 0.1 * SiloParams.diameter}
+
+
+def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, settle_steps=3000,
+                    transient_steps=50, measure_steps=100, every=2, dz=2.0, tol=1e-4,
+                    max_sweeps=300, **overrides):
+    """One filling of the silo, weighed across cuts while its walls slide (module docstring).
+
+    ``params`` and ``overrides`` are :class:`~moreau.scenes.silo.SiloParams`
+    (its ``seed`` and ``per_pour`` are not used: ``seed`` and ``n_disks``
+    are); without ``params``, the unnamed ones take the study's defaults
+    (``spread = 2/3``, ``mu_r = 0.1 d``) and then the silo's. Grain units: ``d``,
+    ``sqrt(d / g)``; ``wall_speed`` [m/s] as in ``SiloParams``.
+
+    Returns
+    -------
+    dict
+        ``depth`` (the cuts, ``dz, 2 dz, ...`` below the top, every one above
+        the lowest centre at every sample), ``mass`` (above each cut; over
+        ``g``, in ``density d^2``), ``m_app``, ``wall_friction``,
+        ``wall_normal`` (time means over the samples); ``floor_mass``,
+        ``floor_m_app``, ``floor_friction``, ``floor_normal`` (the same for
+        the whole column); ``floor_load`` and ``wall_support`` (the floor's
+        normal force and the walls' upward friction over ``g``, means over
+        every sliding step of the measurement, from the impulses) and
+        ``momentum_change`` (the disks' vertical momentum gained over it, per
+        unit time): ``floor_load + wall_support = floor_mass +
+        momentum_change``, the vertical balance of the scheme's step;``height`` (the packing's top, mean),
+        ``rho`` (its mass over ``W`` times ``height``), ``width``,
+        ``mu_wall``, ``samples``, ``settle_steps`` (taken),
+        ``unconverged`` (sliding steps above ``tol``), ``steps`` (sliding
+        steps), ``max_residual``.
+
+    Examples
+    --------
+    A tiny silo (8 disks, a few steps: the machinery, not a measurement):
+
+    >>> r = sliding_profile(0, n_disks=8, width=0.015, settle_steps=20, transient_steps=2,
+    ...                     measure_steps=4, dz=1.0)
+    >>> r["samples"], r["depth"][:2].tolist(), bool(r["floor_m_app"] <= r["floor_mass"] + 1e-9)
+    (2, [1.0, 2.0], True)
+    """
+    p = params_with(SiloParams, params, overrides if params is not None
+                    else {**DEFAULTS, **overrides})
+    seed = positive_int("seed", int(seed) + 1) - 1
+    n = positive_int("n_disks", n_disks)
+    scatter = nonnegative("scatter", scatter)
+    h = positive("h", h)
+    dz = positive("dz", dz)
+    every = positive_int("every", every)
+    measure_steps = positive_int("measure_steps", measure_steps)
+    transient_steps = positive_int("transient_steps", transient_steps + 1) - 1
+    if measure_steps < every:
+        raise InputError(f"`measure_steps` must be >= `every` ({every}), got {measure_steps}")
+    W = p.width / p.diameter
+    V = p.wall_speed / math.sqrt(p.diameter * p.gravity)
+    radii, x = random_fill(n, W, 0.5 * p.spread, 0.5, y0=0.05, seed=seed)
+    v = np.zeros((n, 3))
+    v[:, 0] = np.random.default_rng([seed, 1]).uniform(-scatter, scatter, n)
+    fixed = silo_system(radii, p)
+    moving = silo_system(radii, p, wall_speed=V)
+    run_opts = dict(theta=1.0, tol=tol, max_sweeps=max_sweeps)
+    run = settle(fixed, x, v, h, max_steps=settle_steps, speed_tol=2e-3, **run_opts)
+    taken = int(run.steps["t"].size)
+    x, v, phi, warm = run.x[-1], run.v[-1], run.phi[-1], run.impulses
+    if transient_steps:
+        run = simulate_disks(moving, x, v, transient_steps, h, phi0=phi, warm=warm,
+                             save_every=transient_steps, **run_opts)
+        x, v, phi, warm = run.x[-1], run.v[-1], run.phi[-1], run.impulses
+    keys = ("mass", "m_app", "wall_friction", "wall_normal")
+    profiles, tops = [], []
+    unconverged, residual, steps = 0, 0.0, 0
+    impulse = np.zeros(2)
+    p_start = float(fixed.masses @ v[:, 1])
+    for _ in range(measure_steps // every):
+        run = simulate_disks(moving, x, v, every, h, phi0=phi, warm=warm, save_every=every,
+                             **run_opts)
+        x, v, phi, warm = run.x[-1], run.v[-1], run.phi[-1], run.impulses
+        unconverged += int(run.unconverged.size)
+        residual = max(residual, run.max_residual)
+        steps += every
+        # (the floor's normal impulse; the walls' upward friction: t = (0, 1) on the left
+        # wall, (0, -1) on the right)
+        wi = run.steps["wall_impulse"]
+        impulse += [wi[:, 0, 0].sum(), (wi[:, 1, 1] - wi[:, 2, 1]).sum()]
+        profiles.append(wall_profile(moving, x, warm, h, dz=dz))
+        tops.append(float(np.max(x[:, 1] + radii)))
+    # (every cut but the last, the floor, lies k dz below that sample's top)
+    cuts = min(prof["depth"].size for prof in profiles) - 1
+    out = {"depth": dz * np.arange(1, cuts + 1)}
+    for k in keys:
+        out[k] = np.mean([prof[k][:cuts] for prof in profiles], axis=0)
+        out["floor_" + k.replace("wall_", "")] = float(np.mean([prof[k][-1] for prof in profiles]))
+    height = float(np.mean(tops))
+    duration = steps * h
+    out.update(floor_load=impulse[0] / duration, wall_support=impulse[1] / duration,
+               momentum_change=(float(fixed.masses @ v[:, 1]) - p_start) / duration)
+    out.update(height=height, rho=float(fixed.masses.sum()) / (W * height), width=W,
+               mu_wall=p.mu_wall, samples=len(profiles), settle_steps=taken,
+               unconverged=unconverged, steps=steps, max_residual=residual)
+    return out
+
+
+def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
+    """Average :func:`sliding_profile`'s fillings at equal depth and fit Janssen's law once.
+
+    Parameters
+    ----------
+    profiles : sequence of dict
+        Two fillings at least, of one silo (the same ``width`` and ``dz``).
+    floor : bool
+        Whether the floor is a point of the fit (else the cuts alone are).
+    mu_wall : float, optional
+        The walls' friction (default: the profiles').
+    phi : float, optional
+        The packing's friction angle for :func:`~moreau.scenes.silo.janssen_k_bounds`
+        (default ``atan(mu_wall)``).
+
+    Returns
+    -------
+    dict
+        ``depth`` (the common cuts, then the floor at the mean height),
+        ``mass``, ``m_app`` (means over the fillings), ``m_app_sem`` (their
+        standard errors), ``wall_fraction`` (``1 - m_app / mass``, the
+        wall-supported fraction of the weight above), ``mobilised`` (the
+        walls' upward friction over ``mu_wall`` times their normal force,
+        over the whole column, mean of the fillings), the fit's ``K``,
+        ``m_sat``, ``lam``, ``deviation`` (per point fitted), ``max_deviation``,
+        ``rms_deviation`` (over them), ``floor_deviation`` (the floor's load
+        against the fitted law, whether fitted or not), ``K_bounds`` (``K_a, K_w, K_p``), ``fillings``,
+        ``unconverged`` and ``steps`` (sliding steps, all fillings).
+
+    Examples
+    --------
+    Two fillings that both follow Janssen's law with ``m_sat = 20`` exactly:
+
+    >>> from moreau.scenes.silo import janssen
+    >>> def one(m_floor):
+    ...     m = np.array([10.0, 20.0, 30.0])
+    ...     return {"depth": np.array([2.0, 4.0, 6.0]), "mass": m, "m_app": janssen(m, 20.0),
+    ...             "floor_mass": m_floor, "floor_m_app": float(janssen(m_floor, 20.0)),
+    ...             "wall_friction": m - janssen(m, 20.0), "wall_normal": m,
+    ...             "floor_friction": 1.0, "floor_normal": 4.0, "height": 8.0, "rho": 1.0,
+    ...             "width": 6.0, "mu_wall": 0.5, "unconverged": 0, "steps": 10}
+    >>> e = ensemble([one(40.0), one(40.0)])
+    >>> round(e["m_sat"], 6), e["max_deviation"] < 1e-6, e["depth"].tolist(), e["mobilised"]
+    (20.0, True, [2.0, 4.0, 6.0, 8.0], 0.5)
+    >>> e = ensemble([one(40.0), one(40.0)], floor=False)
+    >>> e["deviation"].size, abs(e["floor_deviation"]) < 1e-6
+    (3, True)
+    """
+    profiles = list(profiles)
+    if len(profiles) < 2:
+        raise InputError(f"`profiles` must hold two fillings at least, got {len(profiles)}")
+    widths = {round(float(pr["width"]), 12) for pr in profiles}
+    if len(widths) != 1:
+        raise InputError(f"`profiles` must be of one silo width, got {sorted(widths)}")
+    mu_wall = profiles[0]["mu_wall"] if mu_wall is None else positive("mu_wall", mu_wall)
+    phi = math.atan(mu_wall) if phi is None else positive("phi", phi)
+    cuts = min(pr["depth"].size for pr in profiles)
+    if any(not np.allclose(pr["depth"][:cuts], profiles[0]["depth"][:cuts]) for pr in profiles):
+        raise InputError("`profiles` must have their cuts at the same depths (one `dz`)")
+    mass = np.array([np.append(pr["mass"][:cuts], pr["floor_mass"]) for pr in profiles])
+    load = np.array([np.append(pr["m_app"][:cuts], pr["floor_m_app"]) for pr in profiles])
+    height = float(np.mean([pr["height"] for pr in profiles]))
+    depth = np.append(profiles[0]["depth"][:cuts], height)
+    m, y = mass.mean(axis=0), load.mean(axis=0)
+    W = float(profiles[0]["width"])
+    rho = float(np.mean([pr["rho"] for pr in profiles]))
+    n_fit = m.size if floor else m.size - 1
+    fit = fit_janssen(m[:n_fit], y[:n_fit], rho=rho, width=W, mu_wall=mu_wall)
+    mobilised = float(np.mean([pr["floor_friction"] / (mu_wall * pr["floor_normal"])
+                               for pr in profiles]))
+    return {"depth": depth, "mass": m, "m_app": y,
+            "m_app_sem": load.std(axis=0, ddof=1) / math.sqrt(len(profiles)),
+            "wall_fraction": 1.0 - y / m, "mobilised": mobilised, "K": fit["K"],
+            "m_sat": fit["m_sat"], "lam": fit["lam"], "deviation": fit["deviation"],
+            "max_deviation": fit["max_deviation"],
+            "rms_deviation": float(np.sqrt(np.mean(fit["deviation"] ** 2))),
+            "floor_deviation": float(y[-1] / janssen(m[-1], fit["m_sat"]) - 1.0),
+            "K_bounds": janssen_k_bounds(phi, mu_wall), "fillings": len(profiles),
+            "unconverged": int(sum(pr["unconverged"] for pr in profiles)),
+            "steps": int(sum(pr["steps"] for pr in profiles))}
