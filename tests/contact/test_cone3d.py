@@ -556,3 +556,30 @@ def test_the_answer_lies_in_the_cone_and_its_residual_is_the_projection_s():
     assert np.all(np.hypot(r[:, 1], r[:, 2]) <= mu * r[:, 0] * (1 + 1e-15))
     assert sol.residual == cone_residual(W, q, mu, sol.r)
     assert sol.residual <= 1e-13 * np.linalg.norm(q)
+
+
+@pytest.mark.slow
+def test_one_contact_slip_under_strong_coupling_against_lemke_on_512_directions():
+    # where the enumeration finds one slip and no stick, the 512-gon's LCP (Lemke) slides
+    # within its facet bound pi/d of local_solve's direction (measured up to 5.9e-3 rad on
+    # these 25; the impulse's size moves up to 6 % where g = A_NN - mu A_NT.s is small)
+    rng = np.random.default_rng(1)
+    done = 0
+    while done < 25:
+        H = rng.standard_normal((3, 4))
+        A = H @ H.T / 4 + 1e-2 * np.eye(3)
+        b = rng.standard_normal(3)
+        b[0] = -abs(b[0]) * 10.0 ** rng.uniform(-4, 0)
+        mu = rng.uniform(1.0, 6.0) * A[0, 0] / (2 * math.hypot(A[0, 1], A[0, 2]))
+        stick = np.linalg.solve(A, -b)
+        if (stick[0] >= 0 and math.hypot(stick[1], stick[2]) <= mu * stick[0]) \
+                or len(_slips_by_enumeration(A, b, mu, n=1 << 14)) != 1:
+            continue
+        done += 1
+        r = local_solve(A, b, mu)
+        poly = solve_polyhedral(A, b, mu, 512)
+        assert poly.success
+        p = poly.r
+        angle = math.atan2(r[1] * p[2] - r[2] * p[1], r[1] * p[1] + r[2] * p[2])
+        assert abs(angle) <= np.pi / 512
+        assert p[0] == pytest.approx(r[0], rel=0.1)
