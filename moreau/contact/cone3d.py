@@ -999,6 +999,15 @@ def local_solve(A, b, mu):
     the sample's start (the cosine and sine rational in it: no
     trigonometry) to a bracket ``4e-15`` rad wide. Of
     several admissible roots the one with the least residual is kept.
+    Two roots can share a sample (under a strong coupling ``2 mu |A_NT| >
+    A_NN``, beside the angle where ``g`` changes sign); where the samples'
+    answer is not a solution to ``1e-12 |b|``, the roots of that condition,
+    a trigonometric polynomial of degree 2 (at most four), are isolated one
+    by one by subdividing the circle with a bound on its second derivative.
+    A symmetric positive definite ``A`` always has a solution: the problem
+    is the variational inequality of ``û(r)`` on ``K``, coercive as ``û(r) .
+    r >= r.A r + b.r`` on ``K`` (Hartman–Stampacchia), so one of the three
+    cases holds.
 
     Examples
     --------
