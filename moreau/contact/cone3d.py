@@ -1186,8 +1186,10 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
     residual on the data the one reported (where the projection misses the
     bound that Newton's iterate met, Newton goes on from it to a hundredth
     of the bound first). ``detail`` says which phases ran. Measured on
-    random problems of the property test's kind (``mu`` up to 3, one to
-    six contacts): see the changelog.
+    100 000 random problems of the property test's kind (``mu`` from 0 to
+    3, one to six contacts): all converge in the cones but one (five
+    contacts, ``mu = 2.55``: Newton stalls near 1e-2 from every start, and
+    Lemke's 128-direction LCP takes its exact-arithmetic path for minutes).
 
     Parameters
     ----------
