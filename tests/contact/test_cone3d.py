@@ -425,3 +425,161 @@ def test_an_isotropic_block_s_slip_in_closed_form_is_the_sampled_root():
         r, ref = local_solve(A, b, mu), local_solve(nudged, b, mu)
         assert math.hypot(r[1], r[2]) == pytest.approx(mu * r[0], rel=1e-15)   # it slips
         np.testing.assert_allclose(r, ref, rtol=0, atol=2e-15 * np.max(np.abs(ref)))
+
+
+def _slips_by_enumeration(A, b, mu, n=1 << 15):
+    # every slip of one contact from the Coulomb law itself, independently of local_solve:
+    # r = rho (1, -mu s) with s = (cos x, sin x), rho from u_N = 0, and u_T parallel to s;
+    # the sign changes of s x u_T (times g = A_NN - mu A_NT.s, which keeps it finite) on a
+    # grid of n angles, each refined by Brent's method
+    from scipy.optimize import brentq
+
+    def parts(x):
+        s = np.array([np.cos(x), np.sin(x)])
+        g = A[0, 0] - mu * (A[0, 1:] @ s)
+        gut = -b[0] * (A[1:, 0][:, None] - mu * A[1:, 1:] @ s) + g * b[1:, None]
+        return s, g, gut
+
+    def cross(x):
+        s, _, gut = parts(np.atleast_1d(x))
+        return s[0] * gut[1] - s[1] * gut[0]
+
+    grid = np.linspace(0.0, 2.0 * np.pi, n + 1)
+    f = cross(grid)
+    out = []
+    for k in np.flatnonzero(np.sign(f[:-1]) != np.sign(f[1:])):
+        x = brentq(lambda y: float(cross(y)[0]), grid[k], grid[k + 1], xtol=1e-15, rtol=1e-15)
+        s, g, gut = parts(np.array([x]))
+        if g[0] > 0 and s[:, 0] @ gut[:, 0] >= 0:
+            rho = -b[0] / g[0]
+            out.append(np.array([rho, *(-mu * rho * s[:, 0])]))
+    return out
+
+
+def _assert_coulomb_law(A, b, mu, r, rtol):
+    # the law's cases checked on u = A r + b directly, to rtol of the problem's scale
+    u = A @ r + b
+    scale = np.linalg.norm(b) + np.linalg.norm(A, 2) * np.linalg.norm(r)
+    tol = rtol * scale
+    rt, ut = np.hypot(r[1], r[2]), np.hypot(u[1], u[2])
+    assert r[0] >= 0 and rt <= mu * r[0] * (1 + 1e-12) and u[0] >= -tol
+    if r[0] == 0:
+        return "take-off"
+    assert abs(u[0]) <= tol                                    # Signorini, in contact
+    if ut <= tol:
+        return "stick"
+    assert rt == pytest.approx(mu * r[0], rel=rtol)            # on the cone's edge
+    assert r[1:] @ u[1:] == pytest.approx(-rt * ut, rel=rtol)   # against the sliding velocity
+    return "slip"
+
+
+def test_one_contact_slip_under_strong_coupling_is_found_where_two_roots_share_a_sample():
+    # found by a survey (seed 266869708, one contact, mu = 2.66, 2 mu |W_NT| = 6.2 W_NN):
+    # the slip's two roots x = 2.8605 and 2.9249 lie within one of the 64 samples, beside
+    # the angle where g changes sign; the samples missed them and the answer was the
+    # frictionless impulse (residual 5.3e-4 |q|, reported "not converged")
+    W, q, _ = random_problem(np.random.default_rng(266869708), 1)
+    mu = 2.66
+    r = local_solve(W, q, mu)
+    assert _assert_coulomb_law(W, q, mu, r, 1e-13) == "slip"
+    (ref,) = _slips_by_enumeration(W, q, mu)                    # the only slip; stick fails
+    np.testing.assert_allclose(r, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+    assert math.atan2(-r[2], -r[1]) == pytest.approx(2.8605, abs=1e-4)
+    sol = solve_exact(W, q, mu)
+    assert sol.success and sol.residual <= 1e-13 * np.linalg.norm(q), sol.detail
+    np.testing.assert_allclose(sol.r, ref, rtol=0, atol=1e-12 * np.abs(ref).max())
+
+
+def test_local_solve_on_strongly_coupled_blocks_is_one_of_the_enumerated_solutions():
+    # 2 mu |A_NT| from 1 to 6 A_NN (several slips can exist, two roots can lie close) and
+    # b_N from 1e-4 to 1e-1 of its size: before the roots' isolation one of these 150
+    # blocks (and about one in 150 for other seeds) had no answer; the law is checked on u
+    # directly, and the impulse is the stick impulse or one of the slips found by
+    # enumerating the angle
+    rng = np.random.default_rng(0)
+    kinds = {"take-off": 0, "stick": 0, "slip": 0}
+    for _ in range(150):
+        H = rng.standard_normal((3, 4))
+        A = H @ H.T / 4 + 1e-2 * np.eye(3)
+        b = rng.standard_normal(3)
+        b[0] = -abs(b[0]) * 10.0 ** rng.uniform(-4, -1)
+        mu = rng.uniform(1.0, 6.0) * A[0, 0] / (2 * math.hypot(A[0, 1], A[0, 2]))
+        r = local_solve(A, b, mu)
+        # the problem's conditioning: rho = -b_N / g grows as g -> 0 (measured to 1.2e-12)
+        kind = _assert_coulomb_law(A, b, mu, r, 1e-11)
+        kinds[kind] += 1
+        if kind == "stick":
+            np.testing.assert_allclose(r, np.linalg.solve(A, -b), rtol=1e-12)
+        else:
+            refs = _slips_by_enumeration(A, b, mu, n=1 << 11)
+            gap = min(np.abs(r - ref).max() for ref in refs) / np.abs(r).max()
+            assert gap <= 1e-8, (gap, A, b, mu)
+    assert kinds["slip"] >= 100 and kinds["stick"] >= 5, kinds
+
+
+def test_every_contact_sticking_converges_where_lemke_s_paths_miss_it():
+    # found by the property test: seed 7656, mu = 1.965 (and 1.97): every polygon's LCP
+    # answer (d = 16 to 256) has contact 1 slipping, Newton from each stalls at 7e-4, and
+    # Gauss–Seidel at 4e-4; the answer is -W^-1 q, every contact inside its cone
+    W, q, _ = random_problem(np.random.default_rng(7656), 4)
+    stick = np.linalg.solve(W, -q).reshape(-1, 3)
+    ratio = np.hypot(stick[:, 1], stick[:, 2]) / stick[:, 0]
+    assert 1.9 < ratio.max() < 1.965 and np.all(stick[:, 0] > 0)
+    sol = solve_exact(W, q, np.full(4, 1.965))
+    assert sol.success and "sticking impulse" in sol.detail, sol.detail
+    np.testing.assert_allclose(sol.r.reshape(-1, 3), stick, rtol=0,
+                               atol=1e-12 * np.abs(stick).max())
+
+
+def test_each_restart_has_its_own_newton_budget():
+    # found by a survey (seed 1088256468, mu = 2.843): Newton from the 16-gon's answer spent
+    # the budget, and the 32-gon's restart had none left (residual 5.6e-5, "not converged");
+    # with its own budget it converges in 5 steps
+    W, q, _ = random_problem(np.random.default_rng(1088256468), 4)
+    sol = solve_exact(W, q, np.full(4, 2.8433434961272916))
+    assert sol.success, sol.detail
+    assert "32-direction polyhedral solution (37 Lemke pivots, 5 step(s))" in sol.detail
+    assert sol.residual <= 1e-13 * np.linalg.norm(q)
+
+
+def test_the_answer_lies_in_the_cone_and_its_residual_is_the_projection_s():
+    # found by a survey (seed 1713186228, mu = 1.790): Newton's iterate met the bound
+    # (9.5e-11 |q|) at 3.3e-10 relative outside a cone, and its projection missed it;
+    # Newton now goes on before projecting, and the projection is the answer
+    W, q, _ = random_problem(np.random.default_rng(1713186228), 5)
+    mu = np.full(5, 1.7898405722666122)
+    sol = solve_exact(W, q, mu)
+    assert sol.success and "the answer's projection" in sol.detail, sol.detail
+    r = sol.r.reshape(-1, 3)
+    np.testing.assert_array_equal(sol.r, np.concatenate([project_cone(x, m) for x, m in
+                                                         zip(r, mu)]))
+    assert np.all(np.hypot(r[:, 1], r[:, 2]) <= mu * r[:, 0] * (1 + 1e-15))
+    assert sol.residual == cone_residual(W, q, mu, sol.r)
+    assert sol.residual <= 1e-13 * np.linalg.norm(q)
+
+
+@pytest.mark.slow
+def test_one_contact_slip_under_strong_coupling_against_lemke_on_512_directions():
+    # where the enumeration finds one slip and no stick, the 512-gon's LCP (Lemke) slides
+    # within its facet bound pi/d of local_solve's direction (measured up to 5.9e-3 rad on
+    # these 25; the impulse's size moves up to 6 % where g = A_NN - mu A_NT.s is small)
+    rng = np.random.default_rng(1)
+    done = 0
+    while done < 25:
+        H = rng.standard_normal((3, 4))
+        A = H @ H.T / 4 + 1e-2 * np.eye(3)
+        b = rng.standard_normal(3)
+        b[0] = -abs(b[0]) * 10.0 ** rng.uniform(-4, 0)
+        mu = rng.uniform(1.0, 6.0) * A[0, 0] / (2 * math.hypot(A[0, 1], A[0, 2]))
+        stick = np.linalg.solve(A, -b)
+        if (stick[0] >= 0 and math.hypot(stick[1], stick[2]) <= mu * stick[0]) \
+                or len(_slips_by_enumeration(A, b, mu, n=1 << 14)) != 1:
+            continue
+        done += 1
+        r = local_solve(A, b, mu)
+        poly = solve_polyhedral(A, b, mu, 512)
+        assert poly.success
+        p = poly.r
+        angle = math.atan2(r[1] * p[2] - r[2] * p[1], r[1] * p[1] + r[2] * p[2])
+        assert abs(angle) <= np.pi / 512
+        assert p[0] == pytest.approx(r[0], rel=0.1)
