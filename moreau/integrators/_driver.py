@@ -231,7 +231,7 @@ def loop_template(name, namespace):
     """
     for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
         namespace.setdefault(own, globals()[own])
-    tree = ast.parse(textwrap.dedent(inspect.getsource(drive)))
+    tree = ast.parse(_source(drive))
     fdef = tree.body[0]
     fdef.name = name
     if namespace.get("ADAPTIVE_STEPS", False):
@@ -324,8 +324,24 @@ def _adaptive(fdef):
     fdef.body[loop_at:loop_at] = ast.parse("t1 = t0\nhk = h\nlast = False").body
 
 
+@functools.lru_cache(maxsize=None)
+def _source(fn):
+    # inspect.getsource tokenizes the file from the function on: importing the schemes splices
+    # 54 functions 197 times, and the tokenizing was a fifth of the package's import time
+    return textwrap.dedent(inspect.getsource(fn))
+
+
 def _function_def(fn):
-    return ast.parse(textwrap.dedent(inspect.getsource(fn))).body[0]
+    # parsed afresh at each call: the splicer rewrites the tree it is given
+    return ast.parse(_source(fn)).body[0]
+
+
+@functools.lru_cache(maxsize=None)
+def _names(py):
+    """``(stored, all)``: the names ``py``'s source assigns, and all the names it holds."""
+    nodes = [n for n in ast.walk(_function_def(py)) if isinstance(n, ast.Name)]
+    return frozenset(n.id for n in nodes if isinstance(n.ctx, ast.Store)), \
+        frozenset(n.id for n in nodes)
 
 
 def _strip_docstring(body):
@@ -431,11 +447,10 @@ class _Splicer:
                 names[p] = tag + p
                 bind.append(ast.Assign(targets=[ast.Name(id=tag + p, ctx=ast.Store())],
                                        value=arg))
-        stored = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
-                  and isinstance(n.ctx, ast.Store)}
+        stored, read = _names(py)
         for nm in stored - set(params):
             names[nm] = tag + nm
-        self._globals(py, fdef, set(params) | stored, names)
+        self._globals(py, read - set(params) - stored, names)
         self.files.add(py.__code__.co_filename)
         body = [_Rename(names).visit(st) for st in _strip_docstring(fdef.body)]
         if kind == "helper":
@@ -450,9 +465,10 @@ class _Splicer:
         self.setup += self.stmts(setup)
         return bind + self.stmts(per_step)
 
-    def _globals(self, py, fdef, local, names):
-        """Bind the globals ``py``'s body reads in the namespace (renamed where taken)."""
-        for nm in sorted({n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)} - local):
+    def _globals(self, py, free, names):
+        """Bind the globals ``py``'s body reads (of the names ``free``) in the namespace
+        (renamed where taken)."""
+        for nm in sorted(free):
             if nm not in py.__globals__:
                 continue            # a builtin
             val = py.__globals__[nm]
