@@ -1,9 +1,12 @@
 """The registered granular scenes: every pair a candidate contact, the run `moreau run` takes."""
 
+import json
+
 import numpy as np
 import pytest
 
 from moreau.analysis.history import default_run
+from moreau.cli import main
 from moreau.errors import InputError
 from moreau.integrators.base import simulate
 from moreau.integrators.granular import simulate_disks
@@ -46,3 +49,12 @@ def test_the_registered_scenes_refuse_more_disks_than_every_pair_takes():
         silo(per_pour=EVERY_PAIR_MAX + 1)
     sc = silo(per_pour=EVERY_PAIR_MAX + 1 - 1)
     assert sc.ncontacts == 64 * 63 // 2 + 3 * 64
+
+
+def test_moreau_run_takes_the_scenes_own_default(tmp_path):
+    assert main(["run", "--scene", "silo", "--duration", "0.005", "--steps", "20", "--samples",
+                 "5", "--out", str(tmp_path), "--no-plot", "--quiet"]) == 0
+    (side,) = tmp_path.glob("*.json")
+    doc = json.loads(side.read_text())
+    assert doc["scheme"] == "moreau-jean" and doc["options"]["lcp_method"] == "nsgs"
+    assert doc["status"] == 0
