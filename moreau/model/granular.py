@@ -805,7 +805,12 @@ class DiskScene(SIUnits, Scene):
         return self._q0.copy(), self._v0.copy()
 
     def shapes(self, q, t=0.0):
-        """Disks, walls and the candidate contacts at SI coordinates ``q`` (:mod:`moreau.model.drawing`)."""
+        """Disks, walls and the candidate contacts at SI coordinates ``q`` (:mod:`moreau.model.drawing`).
+
+        A candidate whose gap exceeds a hundredth of the system's length unit is
+        marked ``"open"`` (an animation draws no point for it: with every pair a
+        candidate, most are far apart).
+        """
         qs = np.asarray(q, dtype=float) / self._qscale()
         x, gap, n, _ = self._geometry(qs)
         L = self.length
@@ -824,5 +829,7 @@ class DiskScene(SIUnits, Scene):
             out.append(circle(x[i] * L, sysm.radii[i] * L))
         for k in range(self._a.size):
             p = x[self._b[k]] - sysm.radii[self._b[k]] * n[k]
-            out.append(contact(k, p * L, n[k], (-n[k, 1], n[k, 0])))
+            c = contact(k, p * L, n[k], (-n[k, 1], n[k, 0]))
+            c["open"] = bool(gap[k] > 0.01)
+            out.append(c)
         return out

@@ -285,7 +285,7 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     paths["json"] = os.path.join(out, "suite.json")
     with open(paths["json"], "w") as fh:
         json.dump(doc, fh, indent=1, default=lambda x: None if x != x else str(x))
-    figures, animations = {}, {}
+    done_on_pool, figures, animations = animations, {}, {}
     jobs = []
     for p in probs:
         prow = [r for r in rows if r["problem"] == p["name"]]
@@ -295,10 +295,10 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
         if plot:
             jobs.append((p, prow, os.path.join(out, f"wp_{p['name']}.png"),
                          os.path.join(out, f"anim_{p['name']}.gif") if animation_frames else None,
-                         animation_frames, None if animations is None else
-                         tuple(animations.get(p["name"], (None, "no animation was drawn")))))
+                         animation_frames, None if done_on_pool is None else
+                         tuple(done_on_pool.get(p["name"], (None, "no animation was drawn")))))
     # with the animations drawn, a pool would start for a second of figures each: drawn here
-    drawn = animations is not None
+    drawn = done_on_pool is not None
     drawn_jobs = _figures_all(jobs, 1 if drawn else n_jobs)
     for (p, _, _, anim, _, _), (done, cause) in zip(jobs, drawn_jobs):
         figures[p["name"]] = f"wp_{p['name']}.png"
