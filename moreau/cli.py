@@ -22,7 +22,7 @@ from .analysis.characteristic import efficiency_vs_frequency, motor_characterist
 from .analysis.classify import CLASSIFY_PERIODS
 from .analysis.statistical import MIN_PERIODS, PRECISION
 from .analysis.sweep import require_xarray, run_scene_sweep, sweep_values
-from .analysis.history import (default_scheme, history_tag, plot_history, run_history,
+from .analysis.history import (default_run, history_tag, plot_history, run_history,
                                write_history)
 from .analysis.summary import check_periodic, steady_state_report
 from ._log import configure_cli
@@ -492,7 +492,8 @@ def _cmd_run(args):
             raise InputError(f"`--duration` is required: scene {entry.name!r} has no drive period")
         periods = 10.0
     if args.scheme is None:
-        args.scheme = default_scheme(scene)
+        args.scheme, own = default_run(scene)
+        options = {**own, **options}
     cls = get_integrator(args.scheme)
     cls = cls.resolve(scene) if hasattr(cls, "resolve") else cls
     stepping = "h" in (scheme_options(cls) or ())

@@ -34,7 +34,7 @@ from ..provenance import provenance
 from ..regimes import Regime
 
 __all__ = ["run_history", "history_tag", "write_history", "plot_history", "default_scheme",
-           "MAX_SAMPLES"]
+           "default_run", "MAX_SAMPLES"]
 
 #: bound on the samples of one time history (a CSV of about 2 GB)
 MAX_SAMPLES = 10**7
@@ -50,10 +50,11 @@ def _resolved(scheme, scene):
 def default_scheme(scene):
     """The scheme ``moreau run`` takes for ``scene`` when none is named.
 
-    The event-driven reference (the scene's own where it has one) where it
-    accepts the scene, else Moreau–Jean, which steps every scene: the generic
-    event-driven scheme refuses spatial bodies (quaternions, the spatial
-    friction cone) by name.
+    The scene's :attr:`~moreau.model.scene.Scene.run_default` where it names
+    one (:func:`default_run`); else the event-driven reference (the scene's own
+    where it has one) where it accepts the scene, else Moreau–Jean, which steps
+    every scene: the generic event-driven scheme refuses spatial bodies
+    (quaternions, the spatial friction cone) by name.
 
     Examples
     --------
@@ -61,9 +62,28 @@ def default_scheme(scene):
     >>> default_scheme(make_scene("bouncing-ball")), default_scheme(make_scene("billiard-backspin"))
     ('event-driven', 'moreau-jean')
     """
+    return default_run(scene)[0]
+
+
+def default_run(scene):
+    """The scheme and options ``moreau run`` takes for ``scene`` when no scheme is named.
+
+    The scene's own :attr:`~moreau.model.scene.Scene.run_default` where it
+    names one (a pile of disks: Moreau–Jean with NSGS), else
+    :func:`default_scheme`'s rule with the scheme's default options.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> default_run(make_scene("bouncing-ball")), default_run(make_scene("silo"))
+    (('event-driven', {}), ('moreau-jean', {'lcp_method': 'nsgs'}))
+    """
+    own = scene.run_default
+    if own is not None:
+        return own[0], dict(own[1])
     if _resolved("event-driven", scene).refusal(scene) is None:
-        return "event-driven"
-    return "moreau-jean"
+        return "event-driven", {}
+    return "moreau-jean", {}
 
 
 def run_history(scene, *, periods=None, duration=None, scheme="event-driven", steps=None,

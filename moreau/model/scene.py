@@ -171,6 +171,10 @@ class Scene:
     #: a run of the scene's natural length in its own time, for a run that names none
     #: (the conformance suite); None: ten drive periods, or 1 without a drive
     default_window = None
+    #: ``(scheme, {option: value})`` that ``moreau run`` takes where no scheme is named, or
+    #: None: the event-driven reference where it takes the scene, else Moreau–Jean
+    #: (:func:`moreau.analysis.history.default_scheme`)
+    run_default = None
 
     def inside_valid_region(self, t, q, v):
         """Whether each state lies in the region where the model holds.

@@ -62,11 +62,16 @@ runs several aspect ratios and fits both laws (:func:`fit_runout`).
 
 The registered scene (``make_scene("granular-column")``) is the column at
 its release, the disks on their loose start lattice, as a
-:class:`~moreau.model.granular.DiskScene`: its contacts fixed to those
-within half a diameter at the start, which holds while the column only
-settles (every scheme runs it; a run stops, status -6, where a contact
-outside them closes). Units: the ``diameter`` ``d``, ``sqrt(d / g)``, the
-mass ``density d^2`` of a unit square of grains.
+:class:`~moreau.model.granular.DiskScene` whose candidate contacts are every
+pair of disks and every disk with the floor and the wall (``margin=None``):
+each step measures them all, so the contacts close and open as the column
+collapses and spreads, however far it runs (every scheme runs it; ``moreau
+run`` takes Moreau–Jean with NSGS where no scheme is named). The pairs grow
+as the square of the disks: the scene takes at most
+:data:`~moreau.model.granular.EVERY_PAIR_MAX` disks (61 at ``width = 0.035``
+at ``aspect = 1``; the default, 20 disks, 230 candidates); :func:`collapse`
+runs larger columns with the broad phase. Units: the ``diameter`` ``d``,
+``sqrt(d / g)``, the mass ``density d^2`` of a unit square of grains.
 """
 
 import math
@@ -79,7 +84,8 @@ from scipy.sparse.csgraph import connected_components
 from .._validate import in_closed_interval, nonnegative, positive, positive_int
 from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
-from ..model.granular import DiskScene, DiskSystem, HalfPlane, grid_pairs, random_fill
+from ..model.granular import (EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, grid_pairs,
+                              random_fill)
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
@@ -187,16 +193,26 @@ def column_system(params=None, *, gate=True, **overrides):
 def granular_column(params=None, **overrides):
     """The registered scene: the column at its release (a :class:`DiskScene`, module docstring).
 
+    Every pair of disks and every disk with the floor and the wall is a
+    candidate contact; a column of more than
+    :data:`~moreau.model.granular.EVERY_PAIR_MAX` disks is refused, naming
+    ``width`` and ``aspect``.
+
     Examples
     --------
     >>> sc = granular_column(width=0.02, aspect=0.5)
-    >>> sc.name, sc.ndof, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) >= 0.0))
-    ('granular-column', 30, True)
+    >>> sc.name, sc.ndof, sc.ncontacts, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) >= 0.0))
+    ('granular-column', 30, 65, True)
     """
     p = params_with(GranularColumnParams, params, overrides)
     sys, x0, _ = column_system(p, gate=False)
+    if sys.n_disks > EVERY_PAIR_MAX:
+        raise InputError(f"`width` = {p.width!r} m and `aspect` = {p.aspect!r} fill the column "
+                         f"with {sys.n_disks} disks; the registered scene (every pair a "
+                         f"candidate contact) takes at most {EVERY_PAIR_MAX}: run collapse() "
+                         f"for a larger column (a broad phase every step)")
     d = p.diameter
-    return DiskScene(sys, x0, margin=0.5, name="granular-column", length=d,
+    return DiskScene(sys, x0, margin=None, name="granular-column", length=d,
                      time=math.sqrt(d / p.gravity), force=p.density * d * d * p.gravity,
                      default_window=2.0)
 

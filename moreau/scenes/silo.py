@@ -162,9 +162,14 @@ the floor). Issue 38's 10 % holds for the load against depth inside the column, 
 
 The registered scene (``make_scene("silo")``) is a silo's first pour at its
 start (the disks on a loose lattice above the floor) as a
-:class:`~moreau.model.granular.DiskScene`, its contacts fixed to those within
-half a diameter at the start; :func:`fill` runs the pours with the broad
-phase every step (:func:`moreau.integrators.granular.simulate_disks`).
+:class:`~moreau.model.granular.DiskScene` whose candidate contacts are every
+pair of disks and every disk with the floor and both walls
+(``margin=None``): the pour falls and settles with its contacts measured
+every step (``moreau run`` takes Moreau–Jean with NSGS where no scheme is
+named: the default pour of 18 disks, 207 candidates, runs 0.2 s in about 2 s
+of CPU). It takes at most :data:`~moreau.model.granular.EVERY_PAIR_MAX`
+disks (``per_pour``); :func:`fill` runs the pours with the broad phase every
+step (:func:`moreau.integrators.granular.simulate_disks`).
 Units: the ``diameter`` ``d``, ``sqrt(d / g)``, the mass ``density d^2``.
 """
 
@@ -177,7 +182,7 @@ from scipy.optimize import minimize_scalar
 from .._validate import in_closed_interval, nonnegative, positive, positive_int
 from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
-from ..model.granular import DiskScene, DiskSystem, HalfPlane, random_fill
+from ..model.granular import EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, random_fill
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
@@ -263,17 +268,26 @@ def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):
 def silo(params=None, **overrides):
     """The registered scene: the first pour at its start (a :class:`DiskScene`, module docstring).
 
+    Every pair of disks and every disk with the floor and the walls is a
+    candidate contact; a pour of more than
+    :data:`~moreau.model.granular.EVERY_PAIR_MAX` disks is refused, naming
+    ``per_pour``.
+
     Examples
     --------
     >>> sc = silo()
-    >>> sc.name, sc.ndof, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) >= 0.0))
-    ('silo', 54, True)
+    >>> sc.name, sc.ndof, sc.ncontacts, bool(np.all(sc.gaps(sc.initial_state()[0], 0.0) >= 0.0))
+    ('silo', 54, 207, True)
     """
     p = params_with(SiloParams, params, overrides)
+    if p.per_pour > EVERY_PAIR_MAX:
+        raise InputError(f"`per_pour` must be at most {EVERY_PAIR_MAX} in the registered scene "
+                         f"(every pair a candidate contact), got {p.per_pour}: fill() pours "
+                         f"more with a broad phase every step")
     W = p.width / p.diameter
     radii, x0 = random_fill(p.per_pour, W, 0.5 * p.spread, 0.5, seed=p.seed)
     d = p.diameter
-    return DiskScene(silo_system(radii, p), x0, margin=0.5, name="silo", length=d,
+    return DiskScene(silo_system(radii, p), x0, margin=None, name="silo", length=d,
                      time=math.sqrt(d / p.gravity), force=p.density * d * d * p.gravity,
                      default_window=2.0)
 

@@ -23,6 +23,7 @@ import json
 import os
 
 import numpy as np
+from PIL import Image
 
 from ..errors import InputError
 from ..model.registry import make_scene
@@ -155,8 +156,9 @@ def write_animation(scene, cols, out, title, fps=20, max_frames=100):
     """Draw ``scene`` along the SI columns ``cols`` (``t``, ``q_i``, ``force_N_i``, ``force_T_i``).
 
     ``cols`` maps the names of ``Scene.si_columns`` (without units) to
-    arrays, as :func:`load_run` reads them. Writes ``out`` (.gif: Pillow,
-    .mp4: ffmpeg) and returns ``(path, frames)``.
+    arrays, as :func:`load_run` reads them. A contact shape marked
+    ``"open"`` is not drawn. Writes ``out`` (.gif: Pillow, .mp4: ffmpeg) and
+    returns ``(path, frames)``.
     """
     import matplotlib
     matplotlib.use("Agg")
@@ -203,7 +205,8 @@ def write_animation(scene, cols, out, title, fps=20, max_frames=100):
             elif s["kind"] == "line":
                 xs, ys = zip(*s["points"])
                 drawn.extend(ax.plot(xs, ys, "-", color="k" if colour != "C0" else "C0", lw=2))
-            elif s["kind"] == "contact":
+            elif s["kind"] == "contact" and not s.get("open"):
+                # (a candidate the scene marks open, far from touching, carries no force)
                 (x, y), i = s["point"], s["index"]
                 drawn.extend(ax.plot([x], [y], "o", color="C3", ms=4))
                 f = fN[k, i] * np.array(s["normal"]) + fT[k, i] * np.array(s["tangent"])
@@ -213,14 +216,34 @@ def write_animation(scene, cols, out, title, fps=20, max_frames=100):
                         arrowprops=dict(arrowstyle="->", color="C3", lw=1.5)))
         return drawn
 
-    writer = (animation.PillowWriter(fps=fps) if ext == ".gif"
-              else animation.FFMpegWriter(fps=fps))
     try:
-        # the writer's own loop: one draw per frame (FuncAnimation.save draws each twice)
-        with writer.saving(fig, out, dpi=80):
-            for n in range(len(frames)):
-                draw(n)
-                writer.grab_frame()
+        if ext == ".gif":
+            _write_gif(fig, ax, draw, len(frames), out, fps)
+        else:
+            writer = animation.FFMpegWriter(fps=fps)
+            # the writer's own loop: one draw per frame (FuncAnimation.save draws each twice)
+            with writer.saving(fig, out, dpi=80):
+                for n in range(len(frames)):
+                    draw(n)
+                    writer.grab_frame()
     finally:
         plt.close(fig)
     return out, len(frames)
+
+
+def _write_gif(fig, ax, draw, count, out, fps):
+    # the axes, their ticks and labels are drawn once and each frame's bodies, contacts and
+    # title over a copy of them (a full draw a frame spent two thirds of its time on the axes)
+    fig.set_dpi(80)
+    canvas = fig.canvas
+    ax.set_title(" ", fontsize=9)
+    canvas.draw()
+    background = canvas.copy_from_bbox(fig.bbox)
+    images = []
+    for n in range(count):
+        canvas.restore_region(background)
+        for artist in draw(n) + [ax.title]:
+            ax.draw_artist(artist)
+        images.append(Image.fromarray(np.asarray(canvas.buffer_rgba())).convert("RGB"))
+    images[0].save(out, save_all=True, append_images=images[1:], duration=int(1000 / fps),
+                   loop=0)

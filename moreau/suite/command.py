@@ -9,7 +9,8 @@ from ..errors import InputError
 from ..outputs import claim_outputs
 from .animate import animate_run
 from .history import compare_to_history, load_history, record_run
-from .report import format_overview, write_report
+from .problem import problem_names
+from .report import animation_tasks, format_overview, write_report
 from .run import cell_task, instance, run_suite, settings_of
 
 __all__ = ["add_commands"]
@@ -41,10 +42,12 @@ def _cmd_suite(args):
                                              "peers": not args.no_peers}, args.force)
     t0 = time.perf_counter()
     n_jobs = None if args.jobs is None and args.quick else check_jobs(_jobs(args), 2)
+    # the animations are tasks of the cells' pool, not of a second one after the last cell
+    tasks = [] if args.no_plot else animation_tasks(problems or problem_names(), str(out))
     report = run_suite(problems=problems, schemes=schemes, quick=args.quick,
                        cache_dir=os.path.join(out, "cells"), progress=not args.quiet,
                        n_jobs=n_jobs, scheduler=args.scheduler,
-                       peers=not args.no_peers)
+                       peers=not args.no_peers, tasks=tasks)
     report["wall_time_s"] = time.perf_counter() - t0
     if hist is not None:
 
@@ -55,7 +58,8 @@ def _cmd_suite(args):
                                       _options(r, args.quick)))
         record_run(args.compare_to, hist, report["rows"], calibration, args.quick)
     paths = write_report(report, out, settings=settings, plot=not args.no_plot,
-                         n_jobs=report["jobs"] if args.scheduler is None else 1)
+                         n_jobs=report["jobs"] if args.scheduler is None else 1,
+                         animations=report["tasks"])
     cells = report["cells"]
     if hist is not None:
         flags = report["flags"]

@@ -34,7 +34,7 @@ from .animate import write_animation
 from .problem import PENDING, get_problem
 from .run import OUTCOMES, settings_of, trace_task
 
-__all__ = ["overview", "write_report", "format_overview", "OUTCOME_COLOURS"]
+__all__ = ["overview", "write_report", "format_overview", "OUTCOME_COLOURS", "animation_tasks"]
 
 #: colours of the outcomes in the overview (ok: shaded by error within the tolerance)
 OUTCOME_COLOURS = {"ok": "#2ca25f", "inaccurate": "#fdae61", "failed": "#d7191c",
@@ -219,12 +219,32 @@ def _animate_problem(name, path, frames=30):
     return path, None
 
 
-def _problem_figures(problem, rows, wp_path, anim_path, frames):
-    # one problem's work-precision figure and animation: a task of the worker pool
+def _problem_figures(problem, rows, wp_path, anim_path, frames, drawn=None):
+    # one problem's work-precision figure and animation (unless `drawn` already holds it, drawn
+    # on the cells' pool): a task of the worker pool
     plot_work_precision(problem, rows, wp_path)
     if anim_path is None:
         return None, None
+    if drawn is not None:
+        return drawn
     return animate_problem(problem["name"], anim_path, frames)
+
+
+def animation_tasks(problems, out, frames=30):
+    """The page's animations as further tasks of the suite's pool.
+
+    :func:`~moreau.suite.run.run_suite`'s ``tasks``: ``[(name,
+    animate_problem, (name, path, frames))]``, one per problem.
+
+    :func:`write_report` given their results (``animations``) draws no animation itself.
+
+    Examples
+    --------
+    >>> [(k, a[1:]) for k, _, a in animation_tasks(["bouncing-ball"], "out", 5)]
+    [('bouncing-ball', ('out/anim_bouncing-ball.gif', 5))]
+    """
+    return [(name, animate_problem, (name, os.path.join(out, f"anim_{name}.gif"), frames))
+            for name in problems]
 
 
 def _figures_all(jobs, n_jobs):
@@ -242,12 +262,15 @@ def _figures_all(jobs, n_jobs):
     return out
 
 
-def write_report(report, out, settings=None, plot=True, animation_frames=30, n_jobs=1):
+def write_report(report, out, settings=None, plot=True, animation_frames=30, n_jobs=1,
+                 animations=None):
     """Write the table, figures and ``index.md`` of a suite run to ``out``; return the paths.
 
     With ``plot``, each problem also gets a short animation (``anim_<name>.gif``,
     at most ``animation_frames`` frames; 0: none) of its event-driven run,
-    drawn by ``n_jobs`` local worker processes.
+    drawn by ``n_jobs`` local worker processes; ``animations`` (``{name:
+    (path, cause)}``, drawn on the cells' pool by :func:`animation_tasks`)
+    holds them already drawn: the work-precision figures are then drawn here.
     """
     rows, probs, schemes = report["rows"], report["problems"], report["schemes"]
     _t0, _c0 = time.time(), time.process_time()
@@ -262,7 +285,7 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
     paths["json"] = os.path.join(out, "suite.json")
     with open(paths["json"], "w") as fh:
         json.dump(doc, fh, indent=1, default=lambda x: None if x != x else str(x))
-    figures, animations = {}, {}
+    done_on_pool, figures, animations = animations, {}, {}
     jobs = []
     for p in probs:
         prow = [r for r in rows if r["problem"] == p["name"]]
@@ -272,8 +295,12 @@ def write_report(report, out, settings=None, plot=True, animation_frames=30, n_j
         if plot:
             jobs.append((p, prow, os.path.join(out, f"wp_{p['name']}.png"),
                          os.path.join(out, f"anim_{p['name']}.gif") if animation_frames else None,
-                         animation_frames))
-    for (p, _, _, anim, _), (done, cause) in zip(jobs, _figures_all(jobs, n_jobs)):
+                         animation_frames, None if done_on_pool is None else
+                         tuple(done_on_pool.get(p["name"], (None, "no animation was drawn")))))
+    # with the animations drawn, a pool would start for a second of figures each: drawn here
+    drawn = done_on_pool is not None
+    drawn_jobs = _figures_all(jobs, 1 if drawn else n_jobs)
+    for (p, _, _, anim, _, _), (done, cause) in zip(jobs, drawn_jobs):
         figures[p["name"]] = f"wp_{p['name']}.png"
         if anim is not None:
             animations[p["name"]] = f"anim_{p['name']}.gif" if done else cause

@@ -42,7 +42,9 @@ from tqdm import tqdm
 from ..analysis.engine import connect_scheduler, end_worker_pool, worker_pool_config
 
 from ..errors import InputError, Interrupted, MoreauError
-from ..integrators.base import INTEGRATORS, get_integrator, propagate_interrupts, scheme_options, simulate
+from ..integrators.base import (INTEGRATORS, get_integrator, propagate_interrupts, scheme_options,
+                                simulate)
+from ..integrators.time_stepping import TimeStepping
 from ..lcp import solve_lcp
 from ..model.registry import discover as discover_scenes
 from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
@@ -334,8 +336,22 @@ def _keep_cell(path, row):
     os.replace(tmp, path)
 
 
-def _results(plan, todo, n_jobs, scheduler):
-    """``(index, row)`` of the cells ``todo`` (indices into ``plan``), as they finish."""
+def _keyed_task(key, function, args):
+    # a further task of the cells' pool (an animation): its result, marked by its key
+    return (_TASK, key, function(*args))
+
+
+_TASK = "task"
+
+
+def _results(plan, todo, n_jobs, scheduler, tasks=(), done_tasks=None):
+    """``(index, row)`` of the cells ``todo`` (indices into ``plan``), as they finish.
+
+    ``tasks`` (``[(key, function, args)]``) run after the cells, on the same
+    pool where there is one (else here, once the cells are done); their
+    results go into ``done_tasks`` by key.
+    """
+    done_tasks = {} if done_tasks is None else done_tasks
     if scheduler is not None:
         from distributed import as_completed  # optional dependency, checked by the CLI
         client, own = connect_scheduler(scheduler)
@@ -355,10 +371,14 @@ def _results(plan, todo, n_jobs, scheduler):
         finally:
             if own:
                 client.close()
+        for key, function, args in tasks:
+            done_tasks[key] = function(*args)
         return
-    if n_jobs == 1 or len(todo) <= 1:
+    if n_jobs == 1 or len(todo) + len(tasks) <= 1:
         for i in todo:
             yield i, cell_task(*plan[i])
+        for key, function, args in tasks:
+            done_tasks[key] = function(*args)
         return
     # the workers run the cells and leave them unjudged; here a thread computes the problems'
     # references meanwhile, and each row is judged against its problem's as it comes back
@@ -371,10 +391,16 @@ def _results(plan, todo, n_jobs, scheduler):
     pairs = _pairs(plan, todo)
     with worker_pool_config():
         par = joblib.Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
-    gen = par(joblib.delayed(pair_task)(pname, s, cells) for pname, s, cells in pairs)
+    # the further tasks (the page's animations, seconds each) come last: they fill the
+    # workers' tail, where a second pool would start after the last cell
+    gen = par([joblib.delayed(pair_task)(pname, schemes) for pname, schemes in pairs]
+              + [joblib.delayed(_keyed_task)(*t) for t in tasks])
     ok = False
     try:
         for out in gen:
+            if isinstance(out, tuple) and out[0] == _TASK:
+                done_tasks[out[1]] = out[2]
+                continue
             for i, row in out:
                 if row["outcome"] is None:
                     _judge_here(_problem_scene(plan[i][0])[0], row, ref_of[plan[i][0]].result())
@@ -397,42 +423,71 @@ def _judge_here(problem, row, reference):
         row.update(outcome="failed", cause="unexpected " + _cause(exc))
 
 
+#: the modules of the classes every scheme builds on: a class from them makes no family
+_SHARED_BASES = {c.__module__ for c in TimeStepping.__mro__}
+
+
+def scheme_family(name, scene):
+    """The class whose compiled code scheme ``name`` shares with its relatives on ``scene``.
+
+    The scheme's class as it runs ``scene`` (the scene's own reference for
+    ``event-driven``), followed up its bases to the last one that is not
+    common to every scheme: Moreau–Jean's projected variant is Moreau–Jean's,
+    both compliant schemes are the compliant model's, ``event-driven`` on a
+    scene without a reference of its own is ``event-driven-generic``. A
+    peer, or a name no class answers to, is its own family.
+
+    Examples
+    --------
+    >>> from moreau.scenes import make_scene
+    >>> ball = make_scene("bouncing-ball")
+    >>> scheme_family("moreau-jean-projected", ball) is scheme_family("moreau-jean", ball)
+    True
+    >>> [scheme_family(s, ball).__name__ for s in ("compliant-radau", "event-driven")]
+    ['_Compliant', 'GenericEventDriven']
+    """
+    if is_peer(name):
+        return name
+    try:
+        cls, _ = _options_of(name, scene)
+    except MoreauError:
+        return name
+    own = [c for c in cls.__mro__ if c.__module__ not in _SHARED_BASES]
+    return own[-1] if own else cls
+
+
 def _pairs(plan, todo):
-    """``[(problem, scheme, [(index, label, options)])]``: the cells ``todo`` grouped by
-    (problem, scheme), one pool task each, so that a scheme's loop for a problem is compiled (or
-    loaded) by one worker, not by both at once. The first pair of each scheme comes first:
-    on a cold cache the workers compile different schemes side by side."""
+    """``[(problem, [(scheme, [(index, label, options)])])]``: the cells ``todo`` grouped by
+    problem and scheme family (:func:`scheme_family`), one pool task each, so that the code a
+    family compiles for a problem is compiled (or loaded) by one worker, not by both at once
+    (Moreau–Jean and its projected variant on the granular column: 27-32 s of CPU each, cold).
+    The first task of each family comes first: on a cold cache the workers compile different
+    families side by side."""
     out = {}
     for i in todo:
         pname, s, label, options = plan[i]
-        out.setdefault((pname, s), []).append((i, label, options))
-    first = {(plan[i][0], plan[i][1]) for i in _first_of_each_scheme(plan, todo)}
-    return ([(p, s, cells) for (p, s), cells in out.items() if (p, s) in first]
-            + [(p, s, cells) for (p, s), cells in out.items() if (p, s) not in first])
+        fam = scheme_family(s, _problem_scene(pname)[1])
+        out.setdefault((pname, fam), {}).setdefault(s, []).append((i, label, options))
+    first, seen = [], set()
+    for (pname, fam), by_scheme in out.items():
+        runs = any(label != DECLINED for cells in by_scheme.values() for _, label, _ in cells)
+        if fam not in seen and runs and not is_peer(next(iter(by_scheme))):
+            seen.add(fam)
+            first.append((pname, fam))
+    order = first + [key for key in out if key not in set(first)]
+    return [(key[0], list(out[key].items())) for key in order]
 
 
-def pair_task(pname, scheme, cells):
-    """The cells ``[(index, label, options)]`` of one (problem, scheme) pair, in this process
-    (a worker's task), left unjudged: ``[(index, row)]``."""
+def pair_task(pname, schemes):
+    """The cells of one problem's schemes ``[(scheme, [(index, label, options)])]``, in this
+    process (a worker's task), left unjudged: ``[(index, row)]``."""
     return [(i, cell_task(pname, scheme, label, options, judged=False))
-            for i, label, options in cells]
-
-
-def _first_of_each_scheme(plan, todo):
-    """Indices of the first cell of each scheme in ``todo`` that runs in this process (no peer, no
-    declined one): the warm-up tasks a pool takes before the cells."""
-    seen, first = set(), []
-    for i in todo:
-        pname, scheme, label, _ = plan[i]
-        if scheme not in seen and label != DECLINED and not is_peer(scheme):
-            seen.add(scheme)
-            first.append(i)
-    return first
+            for scheme, cells in schemes for i, label, options in cells]
 
 
 def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
-              n_jobs=1, scheduler=None, peers=True):
-    """Run every scheme on every problem; return ``{"rows", "problems", "schemes", "cells"}``.
+              n_jobs=1, scheduler=None, peers=True, tasks=()):
+    """Run every scheme on every problem: ``{"rows", "problems", "schemes", "cells", "tasks"}``.
 
     Parameters
     ----------
@@ -453,6 +508,10 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
         to be computed, else 1). The report's ``jobs`` says how many ran.
     scheduler : str, optional
         A Dask scheduler's address: the cells run there instead.
+    tasks : sequence of (key, function, args)
+        Further work for the same workers, after the cells (the page's
+        animations): ``function(*args)`` of each, in the report's ``tasks``
+        by key. Where there is no pool they run here once the cells are done.
 
     Raises
     ------
@@ -475,11 +534,12 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     if n_jobs is None:
         n_jobs = (os.cpu_count() or 1) if len(todo) >= AUTO_POOL_CELLS else 1
     bar = None
+    done_tasks = {}
     if progress:
         bar = tqdm(total=len(plan), initial=done, desc="suite", unit="cell", disable=None)
     try:
         with propagate_interrupts():
-            for i, row in _results(plan, todo, n_jobs, scheduler):
+            for i, row in _results(plan, todo, n_jobs, scheduler, list(tasks), done_tasks):
                 rows[i] = row
                 if cache_dir:
                     _keep_cell(cell_path(cache_dir, *plan[i][:3]), row)
@@ -494,7 +554,8 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     return {"rows": rows, "problems": [instance(p)[0].describe(reference_of(p)) for p in problems],
             "schemes": schemes, "jobs": n_jobs, "cells": {"total": len(plan),
                                           "cached": sum(1 for r in rows if r.get("cached")),
-                                          "computed": sum(1 for r in rows if not r.get("cached"))}}
+                                          "computed": sum(1 for r in rows if not r.get("cached"))},
+            "tasks": done_tasks}
 
 
 def _json_default(x):

@@ -26,14 +26,13 @@ class GranularColumnProblem(Problem):
     height of the centres, each against the event-driven reference on the
     same model (rtol 1e-10), relative to ``d``, tolerance 1 %.
 
-    Why not the runout against the aspect ratio: the registered scene keeps
-    the contacts of its start, valid while the column only settles (its
-    collapse makes new contacts, status -6), and the event-driven reference
-    itself stops at ``t = 3.88`` (no solution of an impact's LCP, Lemke's
-    secondary ray) as the column spreads; and the model's runout departs from
-    the published laws (Lube et al. 2004, Balmforth and Kerswell 2005, Staron
-    and Hinch 2005; the scene's docstring), so that no published runout can
-    judge a scheme on it. :func:`~moreau.scenes.granular_column.runout_study`
+    Why not the runout against the aspect ratio: the event-driven reference
+    stops at ``t = 3.88`` (no solution of an impact's LCP, Lemke's secondary
+    ray) as the column spreads (the registered scene itself follows the
+    collapse: every pair of disks is a candidate contact); and the model's
+    runout departs from the published laws (Lube et al. 2004, Balmforth and
+    Kerswell 2005, Staron and Hinch 2005; the scene's docstring), so that no
+    published runout can judge a scheme on it. :func:`~moreau.scenes.granular_column.runout_study`
     measures the runout with the broad phase.
     """
 
