@@ -73,6 +73,10 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
         rows = scene.contact_rows(q)                    # (nc, 3, nvel): [n, t1, t2]
         vN0 = rows[:, 0, :] @ v
         g0 = scene.gaps(q, t0)
+        if getattr(scene, "box_index", ()):
+            # a box contact's slot may have no point at q (its rows zero): closed or not, it
+            # is not in the problem
+            closed = closed & scene.contacts_in_use(q)
         active = np.flatnonzero((g0 + 0.5 * h * vN0 <= 0.0) | closed)
         if active.size and getattr(scene, "drilling", False):
             v1 = _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e,
