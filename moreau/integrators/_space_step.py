@@ -53,8 +53,16 @@ def _cross(a):
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
-def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
-    """One step; returns ``(q1, v1, pN, pT, slip, regime)`` (``pT``, ``slip``: magnitudes)."""
+def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, warm=None):
+    """One step; returns ``(q1, v1, pN, pT, slip, regime)`` (``pT``, ``slip``: magnitudes).
+
+    ``warm``, an (nc, 3) array or None: the exact cone's solver starts from
+    its rows (the last step's impulses of the contacts active again) and the
+    step writes its own impulses there. A resting stack's faces make a
+    degenerate problem (four points a face), where Gauss–Seidel from zero
+    takes hundreds of sweeps to a solution that the last step's impulses
+    already are.
+    """
     # the forces without the gyroscopic term, which the rotation's own implicit step takes
     gyro = scene.gyroscopic(v)
     f = scene.forces(q, v, t1) - gyro
@@ -91,6 +99,9 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
             # (built in the layout from the scene's checked data); one contact's polyhedral
             # problem in closed form where certified, as the compiled loop solves it
             sol = _one_contact(W, U_free, mu[active], cone)
+            if sol is None and warm is not None and cone == "exact":
+                sol = solve_cone(W, U_free, mu[active], cone, check=False,
+                                 r0=warm[active].reshape(-1))
             if sol is None:
                 sol = solve_cone(W, U_free, mu[active], cone, check=False)
             counters["lcp_solves"] += 1
@@ -102,6 +113,9 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters):
                                f"({sol.method} cone, {active.size} contacts) was not solved: "
                                f"{sol.status}, residual {sol.residual:.3g}; {sol.detail}")
             r = sol.r.reshape(-1, 3)
+            if warm is not None:
+                warm[:] = 0.0
+                warm[active] = r
             v1 = v_free + MinvHT @ sol.r
             U = (H @ v1).reshape(-1, 3)
             scale = max(float(np.max(np.abs(U_free))), 1e-300)

@@ -876,8 +876,12 @@ class MoreauJean(TimeStepping):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
+        if getattr(sc, "box_index", ()) and not hasattr(self, "_warm_cone"):
+            # box contacts: the exact cone starts from the last step's impulses (space_step)
+            self._warm_cone = np.zeros((sc.ncontacts, 3))
         q1, v1, pN, pT, slip, regime = space_step(sc, q, v, t0, t1, h, self.theta, self._closed,
-                                                  self.mu_c, self.e_c, self.cone, self.counters)
+                                                  self.mu_c, self.e_c, self.cone, self.counters,
+                                                  getattr(self, "_warm_cone", None))
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")
