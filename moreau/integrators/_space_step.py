@@ -55,12 +55,20 @@ def _cross(a):
     return np.array([[0.0, -a[2], a[1]], [a[2], 0.0, -a[0]], [-a[1], a[0], 0.0]])
 
 
-def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, memo=None):
+def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, memo=None,
+               warm=None):
     """One step; returns ``(q1, v1, pN, pT, slip, regime)`` (``pT``, ``slip``: magnitudes).
 
     ``memo`` (a dict kept by the caller from step to step) remembers the
     support of the last polyhedral LCP of several contacts, by its active
     contacts, for :func:`_polyhedral`.
+
+    ``warm``, an (nc, 3) array or None: the exact cone's solver starts from
+    its rows (the last step's impulses of the contacts active again) and the
+    step writes its own impulses there. A resting stack's faces make a
+    degenerate problem (four points a face), where Gauss–Seidel from zero
+    takes hundreds of sweeps to a solution that the last step's impulses
+    already are.
     """
     # the forces without the gyroscopic term, which the rotation's own implicit step takes
     gyro = scene.gyroscopic(v)
@@ -80,6 +88,10 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, mem
         rows = scene.contact_rows(q)                    # (nc, 3, nvel): [n, t1, t2]
         vN0 = rows[:, 0, :] @ v
         g0 = scene.gaps(q, t0)
+        if getattr(scene, "box_index", ()):
+            # a box contact's slot may have no point at q (its rows zero): closed or not, it
+            # is not in the problem
+            closed = closed & scene.contacts_in_use(q)
         active = np.flatnonzero((g0 + 0.5 * h * vN0 <= 0.0) | closed)
         if active.size and getattr(scene, "drilling", False):
             v1 = _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e,
@@ -96,7 +108,10 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, mem
             sol = _one_contact(W, U_free, mu[active], cone)
             if sol is None and cone != "exact" and memo is not None:
                 sol = _polyhedral(W, U_free, mu[active], cone, active, memo, counters)
-            elif sol is None:
+            elif sol is None and warm is not None and cone == "exact":
+                sol = solve_cone(W, U_free, mu[active], cone, check=False,
+                                 r0=warm[active].reshape(-1))
+            if sol is None:
                 sol = solve_cone(W, U_free, mu[active], cone, check=False)
             counters["lcp_solves"] += 1
             counters["max_residual"] = max(counters["max_residual"], sol.relative_residual)
@@ -107,6 +122,9 @@ def space_step(scene, q, v, t0, t1, h, theta, closed, mu, e, cone, counters, mem
                                f"({sol.method} cone, {active.size} contacts) was not solved: "
                                f"{sol.status}, residual {sol.residual:.3g}; {sol.detail}")
             r = sol.r.reshape(-1, 3)
+            if warm is not None:
+                warm[:] = 0.0
+                warm[active] = r
             v1 = v_free + MinvHT @ sol.r
             U = (H @ v1).reshape(-1, 3)
             scale = max(float(np.max(np.abs(U_free))), 1e-300)

@@ -149,6 +149,11 @@ class SpaceEventDriven(Integrator):
                              f"{name!r} is planar; use 'event-driven'")
         super().__init__(scene, t0, q0, v0, t_bound)
         self.options = o = self._take_options(options, keywords)
+        if getattr(scene, "box_index", ()):
+            raise InputError(f"scheme 'event-driven-space' keeps one persistent contact with a "
+                             f"half-space: `scene` {name!r} has box contacts between bodies "
+                             f"(sphere-box, box-box), whose points change as they move; use "
+                             f"'moreau-jean'")
         if scene.ncontacts != 1:
             raise InputError(f"scheme 'event-driven-space' keeps one persistent contact: `scene` "
                              f"{name!r} has {scene.ncontacts} contacts; use 'moreau-jean'")

@@ -207,7 +207,9 @@ impact law on the normal row), solved on the cone the option ``cone`` names:
 Newton polish, certified by the De Saxcé natural-map residual) or an integer
 ``d`` (the ``d``-direction polyhedral LCP by Lemke); the default ``"auto"``
 is ``d = 8`` on a scene of point contacts and the exact cone on a scene with
-a contact patch (below). An
+a contact patch (below) or with box contacts between bodies (sphere–box,
+box–box, :meth:`moreau.model.space.SpaceModel.add_box_contact`: the Python
+step finds their points at every step; the compiled loop refuses them). An
 unsolved problem raises :class:`~moreau.errors.LCPError` with the residual.
 The centres move by ``h (theta v_{k+1} + (1 - theta) v_k)`` and each
 quaternion by the exponential map of the same weighted body rate
@@ -497,7 +499,9 @@ class MoreauJean(TimeStepping):
         contacts and ``"exact"`` on a scene with a contact patch
         (``contact_radius > 0``: Coulomb–Contensou friction, which the
         polyhedral cone does not model; an integer ``cone`` is refused there
-        by name). Planar scenes ignore it.
+        by name) or with box contacts between bodies (a stack's resting
+        faces, four points each, make degenerate polyhedral LCPs on which
+        Lemke's pivots cost seconds a step). Planar scenes ignore it.
     lcp_method : {"auto", "lemke", "qp", "nsgs", "apgd"}
         Method of :func:`moreau.lcp.solve_lcp`. With ``"auto"`` a step with
         one active contact is solved in closed form and several active
@@ -672,8 +676,10 @@ class MoreauJean(TimeStepping):
                              "are not its velocities' integrals); use projection=False")
         drilling = self._space and getattr(self.scene, "drilling", False)
         if self._space and self.cone == "auto":
-            # the polyhedral cone has no drilling row; point contacts keep the 8 facets
-            self.cone = "exact" if drilling else 8
+            # the polyhedral cone has no drilling row; point contacts keep the 8 facets but
+            # between boxes, whose resting faces make degenerate LCPs (Lemke's exact
+            # arithmetic, seconds a step)
+            self.cone = "exact" if drilling or getattr(self.scene, "box_index", ()) else 8
         if drilling and self.cone != "exact":
             raise InputError(f"`cone` must be \"exact\" on scene {self.scene.name!r}: its "
                              f"Coulomb–Contensou friction (a contact with `contact_radius` > 0) "
@@ -755,6 +761,15 @@ class MoreauJean(TimeStepping):
             return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
         if not self._space:
             return super()._choose_compiled(fast, model, lcp_method, lemke_max_iter, warm_start)
+        if getattr(self.scene, "box_index", ()):
+            # box contacts between bodies change their points as the bodies move: the
+            # Python step finds them at every step, the compiled loop cannot state them
+            if fast is True:
+                raise InputError(f"`fast=True`: the compiled spatial step cannot state box "
+                                 f"contacts between bodies (sphere-box, box-box: their points "
+                                 f"change as the bodies move); scene {self.scene.name!r} has "
+                                 f"them: use fast='auto' or False (the generic step)")
+            return super()._choose_compiled(False, None, lcp_method, lemke_max_iter, warm_start)
         # a spatial scene's compiled loop is this module's own (its scene has no compiled model)
         tables = None
         if fast is not False:
@@ -865,9 +880,12 @@ class MoreauJean(TimeStepping):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
+        if getattr(sc, "box_index", ()) and not hasattr(self, "_warm_cone"):
+            # box contacts: the exact cone starts from the last step's impulses (space_step)
+            self._warm_cone = np.zeros((sc.ncontacts, 3))
         q1, v1, pN, pT, slip, regime = space_step(sc, q, v, t0, t1, h, self.theta, self._closed,
                                                   self.mu_c, self.e_c, self.cone, self.counters,
-                                                  self._lcp_memo)
+                                                  self._lcp_memo, getattr(self, "_warm_cone", None))
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")

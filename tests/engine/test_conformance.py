@@ -60,7 +60,10 @@ def test_initial_state_is_admissible(name):
 
 # the flexible rod's reference resolves its 17 kHz bending mode inside a 185 Hz period
 # (130 s on 2 cores, a tenth of the default run): it runs with the long checks (-m slow)
-HEAVY = {"flexible-rod-drive"}
+HEAVY = {"flexible-rod-drive",
+         # 1000 Python steps of the resting cubes: where the exact cone's Newton polish fails on
+         # the degenerate faces the solver restarts from exact-arithmetic Lemke (134 s, loaded)
+         "box-stack-3d"}
 
 
 @pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in HEAVY else

@@ -17,7 +17,7 @@ NAMES = registry.scene_names()
 def test_discovery_finds_every_scene_module_that_registers_one():
     # the shipped scenes, found without any list of them
     assert NAMES == ["ball-chain", "ball-chain-3d", "bidirectional-drive", "billiard-backspin", "bouncing-ball",
-                     "box-incline",
+                     "box-incline", "box-stack-3d",
                      "disk-incline", "double-pendulum-stop", "flexible-rod-drive",
                      "friction-drive", "friction-drive-built", "granular-column", "masonry-arch",
                      "painleve-rod", "piezo-drive", "puck-incline", "rocking-block",

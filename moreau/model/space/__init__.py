@@ -144,6 +144,74 @@ contact is added and raised (:class:`~moreau.errors.IllPosedError`) during
 a run. These rows are held to central differences of the gap and of the two
 material points' relative position in ``tests/model``.
 
+Contacts with boxes
+-------------------
+A :class:`Box` (half-extents ``h``, body frame) touches a half-space
+through its corners, material points (above: a face resting on the plane
+carries its weight on four). :meth:`SpaceModel.add_box_contact` joins a
+sphere or a box of body ``a`` to a box of body ``b``; its points are found
+at every configuration ``q``, each with a normal ``n`` from ``a`` to ``b``,
+a gap ``g`` and the offsets ``s_a``, ``s_b`` (world, from the centres of
+mass) of the two points whose relative velocity the rows give, by the same
+formula as the spheres' pair: ``e . Delta = (e^T, (R_b^T (s_b x e))^T) v_b
+- (e^T, (R_a^T (s_a x e))^T) v_a``, ``e in {n, t1, t2}``, ``(t1, t2) =
+tangent_basis(n)``. For each kind of point ``g' = n . Delta`` holds exactly,
+so one row serves the gap and the slip; ``w = R omega`` below.
+
+* *Vertex of b on a face of a* (outward normal ``n = R_a (+-e_i)``, half-extent
+  ``h_i``): ``p = x_b + R_b c`` (``c`` the corner), ``g = n . (p - x_a) -
+  h_i``, ``s_a = p - x_a``, ``s_b = p - x_b``. As ``n' = w_a x n``, ``n' . (p
+  - x_a) = -n . (w_a x s_a)`` and ``g' = n . (x_b' + w_b x s_b - x_a' - w_a x
+  s_a)``. A vertex of ``a`` on a face of ``b`` is the same with the roles
+  swapped, ``n = -R_b (+-e_j)``.
+* *Edge against edge*: the lines ``P_a + t d_a`` and ``P_b + u d_b`` (unit
+  directions, ``c = d_a . d_b``) have the closest points ``c_a``, ``c_b`` at
+  ``t = (r . d_a - c r . d_b) / (1 - c^2)``, ``u = (c r . d_a - r . d_b) / (1
+  - c^2)``, ``r = P_b - P_a``; ``n = +-(d_a x d_b) / |d_a x d_b|`` (turned
+  from ``a`` to ``b``), ``g = n . (c_b - c_a)``, ``s_a = c_a - x_a``, ``s_b =
+  c_b - x_b``. As ``c_b - c_a = g n`` and ``n' . n = 0``, and the points'
+  slides along the edges are normal to ``n``, ``g' = n . Delta``.
+* *Sphere a against box b*: the box's point ``y`` closest to the sphere's
+  centre ``p`` (the centre's box coordinates clamped to ``+-h``), ``n = (y -
+  p) / |y - p|``, ``g = |y - p| - r``, ``s_a = R_a c + r n``, ``s_b = y -
+  x_b``; ``y`` slides only along the box's surface, normal to ``n``. A
+  centre inside the box has no closest point on the surface: raised
+  (:class:`~moreau.errors.IllPosedError`).
+
+Which points. Two boxes are tested on the 15 separating axes (the six face
+normals and the nine products ``R_a e_i x R_b e_j``, those of parallel edges
+left out): the separation along a unit axis ``L`` is ``|L . (x_b - x_a)| -
+sum_i h_a,i |L . R_a e_i| - sum_j h_b,j |L . R_b e_j|``, and the axis of the
+largest separation decides (a face of ``a`` before one of ``b``, a face before
+an edge pair unless the pair separates more by :data:`._boxes.EDGE_PREFERENCE`
+of the least half-extent). Beyond the contact's ``margin`` there is no point;
+a penetration past it is raised (:class:`~moreau.errors.IllPosedError`: the
+step let the boxes sink into each other). On a face axis that face is the
+reference, the other box's face most anti-parallel to it the incident face,
+and the incident quadrilateral is clipped by the reference face's four side
+planes (Sutherland–Hodgman): each vertex of the clipped polygon is an incident
+vertex on the reference face, an incident edge crossing a reference edge, or
+a reference vertex on the incident face, and is stated by its kind as above;
+those with ``g <= margin`` are the points, up to eight. On an edge axis the
+two supporting edges give one point. A contact between two boxes keeps eight
+slots; a slot without a point has the gap ``margin`` and zero rows
+(:meth:`SpaceScene.contacts_in_use`), and Moreau–Jean's step leaves it out.
+
+Drift (the rows' rate at constant velocities): ``d/dt (e . Delta) = e' .
+Delta + e . (w_b x s_b' - w_a x s_a')``, ``t1'``, ``t2'`` from ``n'`` as for
+the spheres' pair. A vertex of ``b`` on a face of ``a``: ``n' = w_a x n``,
+``s_b' = w_b x s_b``, ``s_a' = x_b' + w_b x s_b - x_a'``. Edges: ``d' = w x
+d``, ``n' = +-(m' - (n . m') n) / |m|`` with ``m = d_a x d_b``, and the
+closest points' slides ``t'``, ``u'`` solve ``t' - c u' = Delta . d_a + r .
+d_a'``, ``c t' - u' = Delta . d_b + r . d_b'`` (``r = c_b - c_a``, the rates
+of ``r . d_a = r . d_b = 0``), ``s_a' = w_a x s_a + t' d_a``, ``s_b' = w_b x
+s_b + u' d_b``. Sphere and box: the centre moves at ``p' = x_a' + w_a x R_a
+c``, ``y' = x_b' + w_b x s_b + R_b P R_b^T (p' - x_b' - w_b x (p - x_b))``
+(``P`` keeps the free coordinates), ``n' = ((y' - p') - (n . (y' - p')) n) /
+|y - p|``, ``s_a' = w_a x R_a c + r n'``. The rows and drifts are held to
+central differences of the gaps, of the two material points' relative
+position and of the rows on tumbling bodies in ``tests/model``.
+
 Coulomb–Contensou friction
 --------------------------
 A contact added with ``contact_radius = r > 0`` touches through a flat
@@ -202,14 +270,16 @@ import numpy as np
 
 from ..._validate import finite_array, finite_scalar, nonnegative, positive
 from ...errors import IllPosedError, InputError
-from ..drawing import circle, contact, line
+from ..drawing import circle, contact, line, polygon
 from ..scene import Scene
 from ..units import SI_UNITS, columns_of
 from ..spatial import check_inertia, check_unit_quaternion, rotate_body, rotation_matrix
+from ._boxes import box_box, sphere_box
+from ._boxes import drift as _box_drift
 
 __all__ = ["Sphere", "Puck", "Box", "Capsule", "Disk", "HalfSpace", "SpaceModel", "SpaceScene", "tangent_basis",
            "point_rows", "advance_coordinates", "rim_offset", "FLAT_SIN", "DRILLING_LEVER",
-           "CONCENTRIC_TOL"]
+           "CONCENTRIC_TOL", "BOX_MARGIN"]
 
 #: ``r* / r``: a uniform pressure on a patch of radius ``r`` resists pure spin with the torque
 #: ``mu N r*`` (the module docstring's "Coulomb–Contensou friction")
@@ -222,6 +292,15 @@ FLAT_SIN = 1e-8
 #: two spheres whose centres are closer than this fraction of their radii's sum have no
 #: normal (the line of centres is rounding): refused when added and during a run
 CONCENTRIC_TOL = 1e-8
+
+
+#: the default margin of a contact with a box between two bodies, as a fraction of the least
+#: half-extent of its two shapes: points with gaps up to it are listed, a penetration past it
+#: is refused during a run
+BOX_MARGIN = 0.5
+
+#: the contact kinds with a box between two bodies, whose points change as the bodies move
+_BOX_KINDS = ("sphere-box", "box-box")
 
 
 def tangent_basis(normal):
@@ -370,6 +449,19 @@ class Box:
                          or not 0 <= k < 8 for k in ks) or len(set(ks)) != len(ks):
             raise InputError(f"`corners` must be distinct corner numbers in 0..7, got {corners!r}")
         self.corners = [int(k) for k in ks]
+
+    def inertia(self, mass):
+        """The principal moments [kg m^2] of a uniform box of ``mass`` [kg], ``> 0``:
+        ``m (h_y^2 + h_z^2) / 3`` and its turns.
+
+        Examples
+        --------
+        >>> Box((1.0, 2.0, 3.0)).inertia(3.0).tolist()
+        [13.0, 10.0, 5.0]
+        """
+        m = positive("mass", mass)
+        h2 = self.half_extents ** 2
+        return m / 3.0 * np.array([h2[1] + h2[2], h2[0] + h2[2], h2[0] + h2[1]])
 
     def points(self, scale):
         k = np.array(self.corners)
@@ -637,6 +729,86 @@ class SpaceModel:
                               "centre": sphere_a.centre / L, "centre_b": sphere_b.centre / L})
         return [len(self.contacts) - 1]
 
+    def add_box_contact(self, body_a, shape_a, body_b, box_b, mu=0.0, restitution=0.0,
+                        margin=None):
+        """A contact between a :class:`Sphere` or a :class:`Box` of ``body_a`` and a :class:`Box`
+        of ``body_b``; returns the indices of its points.
+
+        The module docstring's "Contacts with boxes": a sphere against a box
+        touches at the box's point closest to the sphere's centre (one
+        contact); two boxes touch at up to eight points found each time the
+        contact is evaluated (the separating-axis test, then the clipped
+        faces or the two edges), eight contacts whose unused ones report the
+        gap ``margin`` and zero rows. The normal points from ``a`` to ``b``.
+        A box's ``corners`` name its contacts with half-spaces only.
+
+        ``margin`` [m], ``> 0``: points with gaps up to it are listed, and a
+        penetration past it is raised during a run
+        (:class:`~moreau.errors.IllPosedError`); default :data:`BOX_MARGIN`
+        times the least half-extent (or radius) of the two shapes. ``mu`` >=
+        0, ``restitution`` in [0, 1] as in :meth:`add_contact`. Refused by
+        name: a body that is not an added one, the same body twice, a
+        ``shape_a`` that is not a Sphere or a Box, a ``box_b`` that is not a
+        Box, and shapes that interpenetrate past the margin (a sphere's
+        centre in the box) at the bodies' initial positions.
+
+        Examples
+        --------
+        >>> m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+        >>> a = m.add_body(1.0, Box((0.1, 0.1, 0.05)).inertia(1.0), position=(0.0, 0.0, 0.05))
+        >>> b = m.add_body(1.0, Box((0.1, 0.1, 0.05)).inertia(1.0), position=(0.0, 0.0, 0.15))
+        >>> m.add_box_contact(a, Box((0.1, 0.1, 0.05)), b, Box((0.1, 0.1, 0.05)), mu=0.5)
+        [0, 1, 2, 3, 4, 5, 6, 7]
+        >>> sc = m.build("two boxes")
+        >>> q0, _ = sc.initial_state()
+        >>> (sc.gaps(q0, 0.0).round(12) + 0.0).tolist()    # four corners touch, four unused
+        [0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 0.5]
+        """
+        for name, value in (("body_a", body_a), ("body_b", body_b)):
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
+                    or not 0 <= value < len(self.bodies):
+                raise InputError(f"`{name}` must be the index of an added body "
+                                 f"(0..{len(self.bodies) - 1}), got {value!r}")
+        if body_a == body_b:
+            raise InputError(f"`body_b` must be another body than `body_a`, got {body_b!r} twice")
+        if not isinstance(shape_a, (Sphere, Box)):
+            raise InputError(f"`shape_a` must be a Sphere or a Box, got {type(shape_a).__name__}")
+        if not isinstance(box_b, Box):
+            raise InputError(f"`box_b` must be a Box (a sphere against a box names the sphere "
+                             f"first), got {type(box_b).__name__}")
+        mu = nonnegative("mu", mu)
+        e = finite_scalar("restitution", restitution)
+        if not 0.0 <= e <= 1.0:
+            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        L = self.length
+        least = min(float(box_b.half_extents.min()),
+                    shape_a.radius if isinstance(shape_a, Sphere) else float(shape_a.half_extents.min()))
+        margin = BOX_MARGIN * least if margin is None else positive("margin", margin)
+        base = {"body": int(body_a), "body_b": int(body_b), "plane": None, "mu": mu, "e": e,
+                "point": None, "half_b": box_b.half_extents / L, "margin": margin / L}
+        if isinstance(shape_a, Sphere):
+            new = [dict(base, kind="sphere-box", radius=shape_a.radius / L,
+                        centre=shape_a.centre / L)]
+        else:
+            first = len(self.contacts)
+            new = [dict(base, kind="box-box", radius=0.0, centre=None,
+                        half=shape_a.half_extents / L, first=first, slot=k) for k in range(8)]
+        # the initial positions must be stated (a sphere's centre outside the box, boxes not
+        # interpenetrating past the margin)
+        xa, xb = (self.bodies[k]["position"] / L for k in (body_a, body_b))
+        Ra, Rb = (rotation_matrix(self.bodies[k]["orientation"], check=False)
+                  for k in (body_a, body_b))
+        try:
+            if isinstance(shape_a, Sphere):
+                sphere_box(xa, Ra, new[0]["centre"], new[0]["radius"], xb, Rb, new[0]["half_b"])
+            else:
+                box_box(xa, Ra, new[0]["half"], xb, Rb, new[0]["half_b"], margin / L)
+        except IllPosedError as exc:
+            raise InputError(f"`body_b`'s box and `body_a`'s shape must not interpenetrate at "
+                             f"the initial positions: {exc}") from None
+        self.contacts.extend(new)
+        return list(range(len(self.contacts) - len(new), len(self.contacts)))
+
     def build(self, name, default_window=None):
         """The :class:`SpaceScene` of the model, in the scene's units."""
         if not self.bodies:
@@ -691,6 +863,10 @@ class SpaceScene(Scene):
         self.contact_pairs = [(c["body"], c.get("body_b", -1)) for c in model.contacts]
         #: the contacts between two bodies' spheres (:meth:`SpaceModel.add_pair_contact`)
         self.pair_index = [i for i, c in enumerate(model.contacts) if c["kind"] == "pair"]
+        #: the contacts with a box between two bodies (:meth:`SpaceModel.add_box_contact`),
+        #: whose points the scene finds at each configuration
+        self.box_index = [i for i, c in enumerate(model.contacts) if c["kind"] in _BOX_KINDS]
+        self._box_cache = []
         self.mu = np.array([c["mu"] for c in model.contacts])
         self.restitution = np.array([c["e"] for c in model.contacts])
         #: each contact's patch radius ``r`` (scene units; 0: a point contact)
@@ -788,11 +964,53 @@ class SpaceScene(Scene):
         n = d / L
         return a, b, Ra, Rb, ca, cb, n, L, ca + c["radius"] * n, cb - c["radius_b"] * n
 
+    def _box_point(self, q, i, Rs=None):
+        # (a, b, Ra, Rb, the point of contact i or None for an unused slot): the module
+        # docstring's "Contacts with boxes"; a pair's points are found once per configuration
+        c = self._contacts[i]
+        a, b = c["body"], c["body_b"]
+        Rs = Rs or self._rotations(q)
+        key = q.tobytes()
+        entry = next((d for k, d in self._box_cache if k == key), None)
+        if entry is None:
+            entry = {}
+            self._box_cache = ([self._box_cache[-1], (key, entry)] if self._box_cache
+                               else [(key, entry)])
+        first = c.get("first", i)
+        if first not in entry:
+            xa, xb = q[7 * a:7 * a + 3], q[7 * b:7 * b + 3]
+            try:
+                if c["kind"] == "sphere-box":
+                    entry[first] = [sphere_box(xa, Rs[a], c["centre"], c["radius"], xb, Rs[b],
+                                               c["half_b"])]
+                else:
+                    entry[first] = box_box(xa, Rs[a], c["half"], xb, Rs[b], c["half_b"],
+                                           c["margin"])
+            except IllPosedError as exc:
+                raise IllPosedError(f"contact {first} (bodies {a} and {b}): {exc}") from None
+        pts = entry[first]
+        slot = c.get("slot", 0)
+        return a, b, Rs[a], Rs[b], (pts[slot] if slot < len(pts) else None)
+
+    def contacts_in_use(self, q):
+        """Whether each contact has a point at ``q``: False only for the unused slots of a
+        contact between two boxes (:meth:`SpaceModel.add_box_contact`). Shape (nc,)."""
+        q = np.asarray(q, dtype=float)
+        out = np.ones(self.ncontacts, dtype=bool)
+        Rs = self._rotations(q)
+        for i in self.box_index:
+            out[i] = self._box_point(q, i, Rs)[4] is not None
+        return out
+
     def gaps(self, q, t):
         q = np.asarray(q, dtype=float)
         out = np.empty(self.ncontacts)
         Rs = self._rotations(q)
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] in _BOX_KINDS:
+                pt = self._box_point(q, i, Rs)[4]
+                out[i] = self._contacts[i]["margin"] if pt is None else pt.g
+                continue
             if self._contacts[i]["kind"] == "pair":
                 c = self._contacts[i]
                 out[i] = self._pair_geometry(q, i, Rs)[7] - c["radius"] - c["radius_b"]
@@ -807,6 +1025,10 @@ class SpaceScene(Scene):
         q = np.asarray(q, dtype=float)
         out = []
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] in _BOX_KINDS:
+                _, _, Ra, _, pt = self._box_point(q, i)
+                out.append((Ra, np.zeros(3) if pt is None else pt.sa))
+                continue
             if self._contacts[i]["kind"] == "pair":
                 g = self._pair_geometry(q, i)
                 out.append((g[2], g[8]))
@@ -827,6 +1049,12 @@ class SpaceScene(Scene):
         Rs, R0s = self._rotations(q), self._rotations(q_at)
         out = np.empty((self.ncontacts, 3))
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] in _BOX_KINDS:
+                a, b, _, _, pt = self._box_point(q_at, i, R0s)
+                out[i] = 0.0 if pt is None else (
+                    q[7 * b:7 * b + 3] + Rs[b] @ (R0s[b].T @ pt.sb)
+                    - q[7 * a:7 * a + 3] - Rs[a] @ (R0s[a].T @ pt.sa))
+                continue
             if self._contacts[i]["kind"] == "pair":
                 a, b, _, _, _, _, _, _, sa, sb = self._pair_geometry(q_at, i, R0s)
                 out[i] = (q[7 * b:7 * b + 3] + Rs[b] @ (R0s[b].T @ sb)
@@ -842,6 +1070,15 @@ class SpaceScene(Scene):
         out = np.zeros((self.ncontacts, 3, self.nvel))
         Rs = self._rotations(q)
         for i in range(self.ncontacts):
+            if self._contacts[i]["kind"] in _BOX_KINDS:
+                a, b, Ra, Rb, pt = self._box_point(q, i, Rs)
+                if pt is not None:
+                    E = _frame(pt.n)
+                    out[i, :, 6 * b:6 * b + 3] = E
+                    out[i, :, 6 * b + 3:6 * b + 6] = _cross_rows(pt.sb, E) @ Rb
+                    out[i, :, 6 * a:6 * a + 3] = -E
+                    out[i, :, 6 * a + 3:6 * a + 6] = -(_cross_rows(pt.sa, E) @ Ra)
+                continue
             if self._contacts[i]["kind"] == "pair":
                 a, b, Ra, Rb, _, _, n, _, sa, sb = self._pair_geometry(q, i, Rs)
                 E = _frame(n)
@@ -893,6 +1130,16 @@ class SpaceScene(Scene):
         wT = np.zeros(2 * len(fi))
         for i in range(self.ncontacts):
             c = self._contacts[i]
+            if c["kind"] in _BOX_KINDS:
+                a, b, Ra, Rb, pt = self._box_point(q, i)
+                if pt is not None:
+                    d = _box_drift(pt, v[6 * a:6 * a + 3], Ra @ v[6 * a + 3:6 * a + 6],
+                                   v[6 * b:6 * b + 3], Rb @ v[6 * b + 3:6 * b + 6], Rb)
+                    wN[i] = d[0]
+                    if i in fi:
+                        j = fi.index(i)
+                        wT[2 * j], wT[2 * j + 1] = d[1], d[2]
+                continue
             if c["kind"] == "pair":
                 dN, dT = self._pair_drift(q, v, i)
                 wN[i] = dN
@@ -985,10 +1232,24 @@ class SpaceScene(Scene):
             d = d / (np.hypot(*d) or 1.0) * 20.0 * L
             out.append(line([p0 - d, p0 + d], "ground"))
         Rs = self._rotations(qs)
+        boxes = {}
+        for c in self._contacts:
+            if c["kind"] in _BOX_KINDS:
+                boxes[c["body_b"]] = c["half_b"]
+                if c["kind"] == "box-box":
+                    boxes[c["body"]] = c["half"]
+        for b, h in boxes.items():
+            # the box's side view: the outline (x, z) of its corners
+            pts = (qs[7 * b:7 * b + 3] + Box(h).points(1.0) @ Rs[b].T) * L
+            out.append(polygon(_hull(pts[:, [0, 2]])))
         for i, c in enumerate(self._contacts):
             b = c["body"]
             x = qs[7 * b:7 * b + 3] * L
-            if c["kind"] == "pair":
+            if c["kind"] in _BOX_KINDS:
+                if c["kind"] == "sphere-box":
+                    y = x + Rs[b] @ c["centre"] * L
+                    out.append(circle((y[0], y[2]), c["radius"] * L))
+            elif c["kind"] == "pair":
                 for bb, cc, rr in ((b, c["centre"], c["radius"]),
                                    (c["body_b"], c["centre_b"], c["radius_b"])):
                     y = (qs[7 * bb:7 * bb + 3] + Rs[bb] @ cc) * L
@@ -1005,12 +1266,17 @@ class SpaceScene(Scene):
                     x = x + self._rotations(qs)[b] @ c["centre"] * L
                 out.append(circle((x[0], x[2]), c["radius"] * L))
         for b in range(self.nbodies):
-            if not any((c["body"] == b or c.get("body_b") == b) and c["point"] is None
-                       for c in self._contacts):
+            if b not in boxes and not any((c["body"] == b or c.get("body_b") == b)
+                                          and c["point"] is None for c in self._contacts):
                 x = qs[7 * b:7 * b + 3] * L
                 out.append(circle((x[0], x[2]), 0.05 * L))
         for i in range(self.ncontacts):
-            if self._contacts[i]["kind"] == "pair":
+            if self._contacts[i]["kind"] in _BOX_KINDS:
+                a, _, _, _, pt = self._box_point(qs, i, Rs)
+                if pt is None:
+                    continue
+                x, s, n = qs[7 * a:7 * a + 3], pt.sa, pt.n
+            elif self._contacts[i]["kind"] == "pair":
                 a, _, _, _, _, _, n, _, s, _ = self._pair_geometry(qs, i, Rs)
                 x = qs[7 * a:7 * a + 3]
             else:
@@ -1027,11 +1293,16 @@ class SpaceScene(Scene):
         frame of their line of centres at ``q``, which it then needs (an
         :class:`~moreau.errors.InputError` naming ``q`` without it).
         """
-        if q is None and self.pair_index:
+        if q is None and (self.pair_index or self.box_index):
             raise InputError(f"`q` must be given: scene {self.name!r} has contacts between "
                              f"two bodies, whose frames turn with them")
         out = []
         for i, c in enumerate(self._contacts):
+            if c["kind"] in _BOX_KINDS:
+                # (an unused slot: the world's z frame, its rows being zero)
+                pt = self._box_point(np.asarray(q, dtype=float), i)[4]
+                out.append(tuple(_frame(np.array([0.0, 0.0, 1.0]) if pt is None else pt.n)))
+                continue
             if c["kind"] == "pair":
                 out.append(tuple(_frame(self._pair_geometry(np.asarray(q, dtype=float), i)[6])))
             else:
@@ -1078,6 +1349,24 @@ class SpaceScene(Scene):
 #: the keys of a contact that :meth:`SpaceScene.contact_table` knows
 _TABLE_KEYS = {"kind", "body", "plane", "mu", "e", "radius", "point", "centre",
                "contact_radius"}
+
+
+def _hull(points):
+    # the convex hull of 2D points, counter-clockwise (Andrew's monotone chain)
+    pts = sorted(map(tuple, np.asarray(points, dtype=float)))
+    if len(pts) < 3:
+        return pts
+
+    def half(seq):
+        out = []
+        for p in seq:
+            while len(out) >= 2 and ((out[-1][0] - out[-2][0]) * (p[1] - out[-2][1])
+                                     - (out[-1][1] - out[-2][1]) * (p[0] - out[-2][0])) <= 0.0:
+                out.pop()
+            out.append(p)
+        return out[:-1]
+
+    return half(pts) + half(pts[::-1])
 
 
 def _least_axis(n):
