@@ -285,3 +285,37 @@ def test_a_contact_patch_runs_in_the_loop_as_the_python_step(monkeypatch):
     assert {Regime.POSITIVE} <= set(res.regime[:, 0])
     assert res.stats["max_residual"] == pytest.approx(ref.stats["max_residual"], rel=1e-9,
                                                       abs=1e-15)
+
+
+@pytest.mark.parametrize("cone", ["exact", 8])
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_the_ball_chain_s_pair_contacts_run_in_the_loop_as_the_python_step(n, cone, monkeypatch):
+    # contacts between two bodies: rows on both bodies' six velocities, the Delassus blocks of
+    # contacts sharing a sphere (n >= 3: the exact cone's Newton polish compiled in), every
+    # step in the loop, the Python step's run to rounding, the block result after the impact
+    from moreau.scenes.ball_chain_3d import ball_chain_3d, block_result
+    sc = ball_chain_3d(n_balls=n)
+    q0, v0 = sc.initial_state()
+    span = (0.0, sc.impact_time + 0.3)
+    ref = simulate(sc, span, q0, v0, "moreau-jean", h=0.01, fast=False, cone=cone)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, span, q0, v0, "moreau-jean", h=0.01, fast=True, cone=cone)
+    assert calls[0] == 0 and res.status == 0
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+    assert res.stats["lcp_solves"] == ref.stats["lcp_solves"] > 0
+    after = res.t > sc.impact_time + 0.01
+    assert np.max(np.abs(res.v[after][:, 0::6] - block_result(n))) <= 1e-12
+    assert np.max(np.abs(ref.v[after][:, 0::6] - block_result(n))) <= 1e-12
+
+
+def test_concentric_spheres_in_the_loop_are_the_python_step_s_failure(monkeypatch):
+    # the loop hands the step back where a pair's centres meet; the Python step names it
+    from moreau.scenes.ball_chain_3d import ball_chain_3d
+    sc = ball_chain_3d(n_balls=2)
+    q0, v0 = sc.initial_state()
+    q0[7:10] = q0[0:3]
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 0.1), q0, v0, "moreau-jean", h=0.01, fast=True)
+    assert calls[0] == 1 and res.status == -5
+    assert "IllPosedError: the spheres of contact 0 (bodies 0 and 1) are concentric" in res.message
