@@ -319,3 +319,40 @@ def test_concentric_spheres_in_the_loop_are_the_python_step_s_failure(monkeypatc
     res = simulate(sc, (0.0, 0.1), q0, v0, "moreau-jean", h=0.01, fast=True)
     assert calls[0] == 1 and res.status == -5
     assert "IllPosedError: the spheres of contact 0 (bodies 0 and 1) are concentric" in res.message
+
+
+def _tumbling_pair():
+    # two tumbling bodies with eccentric spheres: they hit each other (mu = 0.3, e = 0.4) and
+    # a tilted floor, slipping and sticking; the pair's rows turn with both bodies
+    from moreau.model.spatial import quat_exp
+    rng = np.random.default_rng(3)
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.1, -0.2, 1.0))
+    a = m.add_body(1.0, [0.002, 0.003, 0.0025], position=(0.0, 0.0, 0.06),
+                   orientation=quat_exp(0.5 * rng.standard_normal(3)), velocity=(0.3, 0.1, 0.0),
+                   angular_velocity=(2.0, -3.0, 5.0))
+    b = m.add_body(2.0, [0.004, 0.003, 0.0045], position=(0.09, 0.06, 0.12),
+                   orientation=quat_exp(0.5 * rng.standard_normal(3)),
+                   velocity=(-0.4, -0.3, 0.0), angular_velocity=(-4.0, 1.0, 3.0))
+    ca, cb = (0.01, -0.005, 0.002), (-0.003, 0.004, 0.01)
+    m.add_pair_contact(a, Sphere(0.05, centre=ca), b, Sphere(0.04, centre=cb), mu=0.3,
+                       restitution=0.4)
+    m.add_contact(a, Sphere(0.05, centre=ca), floor, mu=0.2)
+    m.add_contact(b, Sphere(0.04, centre=cb), floor, mu=0.5)
+    return m.build("tumbling pair")
+
+
+@pytest.mark.parametrize("cone", ["exact", 8])
+def test_eccentric_spheres_of_two_tumbling_bodies_run_in_the_loop_as_the_python_step(cone,
+                                                                                      monkeypatch):
+    sc = _tumbling_pair()
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=0.02, fast=False, cone=cone)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=0.02, fast=True, cone=cone)
+    assert calls[0] == 0 and res.status == 0
+    # every contact carries a force, the pair's too, and some slip while others stick
+    assert np.all(np.max(ref.force_N, axis=0) > 10.0)
+    assert {Regime.POSITIVE, Regime.STICK} <= set(ref.regime.ravel())
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
