@@ -8,8 +8,11 @@ place of a compiled model. A step is the Python step's
 operations, written over each body's six columns: the free velocity (the
 gyroscopic part by the body's own implicit 3x3 Newton), the contact rows of
 the scene's shapes against its half-spaces
-(:meth:`moreau.model.space.SpaceScene.contact_table`), the Delassus matrix
-``W = H M^-1 H^T`` of the active contacts, then the cone:
+(:meth:`moreau.model.space.SpaceScene.contact_table`) and of its sphere
+pairs between two bodies (:meth:`~moreau.model.space.SpaceScene.pair_table`:
+rows on both bodies' six velocities, the frame of the line of centres), the
+Delassus matrix ``W = H M^-1 H^T`` of the active contacts (a block between
+two contacts wherever they share a body), then the cone:
 
 (the cone's solver is an argument called through a pointer,
 :func:`space_solver`, so that a run compiles and links only its own):
@@ -67,16 +70,21 @@ _SLIP_RTOL = 1e-9
 
 
 class SpaceTables:
-    """A spatial scene as the compiled loop takes it: ``tables`` (:func:`space_tables`) and an
-    unused ``par`` (the block runner passes a compiled model's parameters first)."""
+    """A spatial scene as the compiled loop takes it: ``tables`` (:func:`space_tables`), the
+    contacts' second bodies ``pairs`` (:meth:`~moreau.model.space.SpaceScene.pair_table`, None
+    without contacts between two bodies) and an unused ``par`` (the block runner passes a
+    compiled model's parameters first)."""
 
-    __slots__ = ("tables", "par", "several", "drilling")
+    __slots__ = ("tables", "pairs", "par", "several", "drilling")
 
-    def __init__(self, tables):
+    def __init__(self, tables, pairs=None):
         self.tables = tables
+        self.pairs = pairs
         self.par = np.zeros(1)
         #: some body has several contacts: the exact cone may need Newton's polish
         bodies = tables[5][:, 0]
+        if pairs is not None:
+            bodies = np.concatenate([bodies, pairs[pairs[:, 0] >= 0.0, 0]])
         self.several = bool(bodies.size > np.unique(bodies).size)
         #: some frictional contact has a patch: Coulomb–Contensou's solver
         self.drilling = bool(np.any(tables[11] > 0.0))
@@ -85,7 +93,9 @@ class SpaceTables:
 def space_tables(scene, cone, mu, e):
     """The compiled loop's description of a spatial scene, or None where it has none.
 
-    A :class:`SpaceTables` of the tuple ``(masses, inertias, Minv blocks (nb, 6, 6), gyroscopic flags,
+    A :class:`SpaceTables` (with the scene's
+    :meth:`~moreau.model.space.SpaceScene.pair_table`) of the tuple ``(masses, inertias,
+    Minv blocks (nb, 6, 6), gyroscopic flags,
     gravity, contact table, mu, e, facet directions (2, d), Lemke's pivot
     limit per number of active contacts, d, drilling levers)`` (``d = 0``: the
     exact cone; a contact's lever ``r* > 0`` where it has a patch and
@@ -110,7 +120,13 @@ def space_tables(scene, cone, mu, e):
             np.ascontiguousarray(scene.inertias, dtype=float).reshape(nb, 3, 3), blocks, gyro,
             np.ascontiguousarray(scene.gravity, dtype=float), np.ascontiguousarray(table),
             np.ascontiguousarray(mu, dtype=float), np.ascontiguousarray(e, dtype=float),
-            np.ascontiguousarray(D), maxit, np.int64(d), _levers(scene, mu)))
+            np.ascontiguousarray(D), maxit, np.int64(d), _levers(scene, mu)),
+        _pair_table(scene))
+
+
+def _pair_table(scene):
+    pairs = scene.pair_table() if hasattr(scene, "pair_table") else None
+    return None if pairs is None else np.ascontiguousarray(pairs, dtype=float)
 
 
 def _levers(scene, mu):
@@ -175,6 +191,74 @@ def _rows(ct, i, R, s, rows):
         rows[i, k, 2] = e2
         for j in range(3):
             rows[i, k, 3 + j] = c0 * R[b, 0, j] + c1 * R[b, 1, j] + c2 * R[b, 2, j]
+
+
+@njit(cache=True)
+def _pair_line(ct, pp, i, q, R, x):
+    # a contact between two bodies' spheres (moreau.model.space, "Contacts between two
+    # spheres"), body a's sphere in the table ct, body b's in pp (SpaceScene.pair_table):
+    # x[0:3] = R_a c_a, x[3:6] = R_b c_b, x[6:9] = n; returns the centres' distance L, n
+    # left as it was where L <= pp[i, 5] (no normal: the caller hands the step back)
+    a = int(ct[i, 0])
+    b = int(pp[i, 0])
+    for k in range(3):
+        x[k] = R[a, k, 0] * ct[i, 3] + R[a, k, 1] * ct[i, 4] + R[a, k, 2] * ct[i, 5]
+        x[3 + k] = R[b, k, 0] * pp[i, 2] + R[b, k, 1] * pp[i, 3] + R[b, k, 2] * pp[i, 4]
+    d0 = (q[7 * b] + x[3]) - (q[7 * a] + x[0])
+    d1 = (q[7 * b + 1] + x[4]) - (q[7 * a + 1] + x[1])
+    d2 = (q[7 * b + 2] + x[5]) - (q[7 * a + 2] + x[2])
+    L = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    if L > pp[i, 5]:
+        x[6] = d0 / L
+        x[7] = d1 / L
+        x[8] = d2 / L
+    return L
+
+
+@njit(cache=True)
+def _pair_rows(ct, pp, i, R, x, rows, rowsb):
+    # the pair's rows [n, t1, t2] on its two bodies from _pair_line's x: rowsb[i, k] = (e,
+    # R_b^T (s_b x e)) on body b, rows[i, k] = -(e, R_a^T (s_a x e)) on body a, with s_a =
+    # R_a c_a + r_a n, s_b = R_b c_b - r_b n and the frame of tangent_basis(n)
+    # (moreau.model.space._frame, written out the same way); x[9:18] takes the frame
+    a = int(ct[i, 0])
+    b = int(pp[i, 0])
+    n0, n1, n2 = x[6], x[7], x[8]
+    a0, a1, a2 = abs(n0), abs(n1), abs(n2)
+    k = (0 if a0 <= a2 else 2) if a0 <= a1 else (1 if a1 <= a2 else 2)
+    nk = n0 if k == 0 else (n1 if k == 1 else n2)
+    x[12] = -nk * n0
+    x[13] = -nk * n1
+    x[14] = -nk * n2
+    x[12 + k] += 1.0
+    f = 1.0 / math.sqrt(x[12] * x[12] + x[13] * x[13] + x[14] * x[14])
+    u0, u1, u2 = x[12] * f, x[13] * f, x[14] * f
+    x[9], x[10], x[11] = n0, n1, n2
+    x[12], x[13], x[14] = u0, u1, u2
+    x[15] = n1 * u2 - n2 * u1
+    x[16] = n2 * u0 - n0 * u2
+    x[17] = n0 * u1 - n1 * u0
+    ra = ct[i, 2]
+    rb = pp[i, 1]
+    sa0, sa1, sa2 = x[0] + ra * n0, x[1] + ra * n1, x[2] + ra * n2
+    sb0, sb1, sb2 = x[3] - rb * n0, x[4] - rb * n1, x[5] - rb * n2
+    for kk in range(3):
+        e0, e1, e2 = x[9 + 3 * kk], x[10 + 3 * kk], x[11 + 3 * kk]
+        ca0 = sa1 * e2 - sa2 * e1
+        ca1 = sa2 * e0 - sa0 * e2
+        ca2 = sa0 * e1 - sa1 * e0
+        cb0 = sb1 * e2 - sb2 * e1
+        cb1 = sb2 * e0 - sb0 * e2
+        cb2 = sb0 * e1 - sb1 * e0
+        rows[i, kk, 0] = -e0
+        rows[i, kk, 1] = -e1
+        rows[i, kk, 2] = -e2
+        rowsb[i, kk, 0] = e0
+        rowsb[i, kk, 1] = e1
+        rowsb[i, kk, 2] = e2
+        for j in range(3):
+            rows[i, kk, 3 + j] = -(ca0 * R[a, 0, j] + ca1 * R[a, 1, j] + ca2 * R[a, 2, j])
+            rowsb[i, kk, 3 + j] = cb0 * R[b, 0, j] + cb1 * R[b, 1, j] + cb2 * R[b, 2, j]
 
 
 @njit(cache=True)
@@ -425,7 +509,9 @@ def run_space_loop(*args):
     """:func:`space_loop` with the solver (argument 13) passed as a pointer, not linked in.
 
     The loop is compiled once for the argument types with the solver typed
-    by :data:`SOLVE_SIGNATURE` (from numba's disk cache where it is there).
+    by :data:`SOLVE_SIGNATURE` (from numba's disk cache where it is there):
+    once for scenes without contacts between two bodies (``pairs``, argument
+    16, None) and once, the bigger loop, for scenes with them.
     """
     # one signature whatever the caller's scalars (an integer t0, a numpy bool)
     args = list(args)
@@ -434,30 +520,35 @@ def run_space_loop(*args):
     for i in (6, 7, 14):
         args[i] = int(args[i])
     args[15] = bool(args[15])
-    if not _LOOP:
-        types = [nbtypes.FunctionType(SOLVE_SIGNATURE) if i == 13 else numba.typeof(a)
-                 for i, a in enumerate(args)]
-        space_loop.compile(tuple(types))
+    key = args[16] is None
+    if key not in _LOOP:
+        types = tuple(nbtypes.FunctionType(SOLVE_SIGNATURE) if i == 13 else numba.typeof(a)
+                      for i, a in enumerate(args))
+        space_loop.disable_compile(False)
+        space_loop.compile(types)
         space_loop.disable_compile()
-        # its one compiled entry, called directly: the dispatcher would type the solver
+        # its compiled entry, called directly: the dispatcher would type the solver
         # (a _Solver) as a Python object; the other arguments have the types compiled for
         # (the conversions above)
-        _LOOP.append(next(iter(space_loop.overloads.values())).entry_point)
-    return _LOOP[0](*args)
+        _LOOP[key] = space_loop.overloads[types].entry_point
+    return _LOOP[key](*args)
 
 
-_LOOP = []
+_LOOP = {}
 
 
 @njit(cache=True)
 def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed, solve,
-               save_every, record_initial, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+               save_every, record_initial, pairs, rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
                stats):
     """Up to ``nmax`` Moreau–Jean steps of a spatial scene from ``(q, v)`` at ``t0 + k0 h``.
 
     ``tables`` is :func:`space_tables`'s tuple, ``closed`` the contacts
     closed in the step before (updated), ``solve`` the cone's solver
-    (:func:`space_solver`, called through a pointer), ``par`` unused (the block runner's
+    (:func:`space_solver`, called through a pointer), ``pairs`` the scene's
+    :meth:`~moreau.model.space.SpaceScene.pair_table` (None without contacts
+    between two bodies: numba prunes their branches, and such a scene's loop
+    is compiled without them), ``par`` unused (the block runner's
     slot of a compiled model's parameters). The recording buffers and
     ``stats`` are those of every compiled block. Returns ``(status, k,
     nrec)``: ``OK``, :data:`LCP_HANDBACK` (the contact problem of step ``k``
@@ -508,6 +599,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
     rayl = np.zeros(Lmax + 1)
     work, iwork = lemke_workspace(Lmax)
     qt = np.empty(4)
+    if pairs is not None:
+        # a pair contact's rows on its body b, their M^-1 H^T columns there, its geometry
+        rowsb = np.zeros((ncm, 3, 6))
+        MHTb = np.empty((4 * ncm, 6))
+        pg = np.empty(18)
     W = np.empty((0, 0))
     Uf = np.empty(0)
     mu_a = np.empty(0)
@@ -561,8 +657,17 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             pT[i] = 0.0
             slip[i] = 0.0
             reg[i] = 0
-            g0[i] = _gap(ct, i, q, R, s)
-            _rows(ct, i, R, s, rows)
+            if pairs is not None and pairs[i, 0] >= 0.0:
+                L = _pair_line(ct, pairs, i, q, R, pg)
+                if not L > pairs[i, 5]:
+                    # concentric spheres: the Python step raises with its diagnosis
+                    status = LCP_HANDBACK
+                    break
+                g0[i] = L - ct[i, 2] - pairs[i, 1]
+                _pair_rows(ct, pairs, i, R, pg, rows, rowsb)
+            else:
+                g0[i] = _gap(ct, i, q, R, s)
+                _rows(ct, i, R, s, rows)
             b = int(ct[i, 0])
             sz[i] = 3
             if lever[i] > 0.0:
@@ -571,10 +676,16 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             acc = 0.0
             for j in range(6):
                 acc += rows[i, 0, j] * v[6 * b + j]
+            if pairs is not None and pairs[i, 0] >= 0.0:
+                bb = int(pairs[i, 0])
+                for j in range(6):
+                    acc += rowsb[i, 0, j] * v[6 * bb + j]
             vN0[i] = acc
             if g0[i] + 0.5 * hk * vN0[i] <= 0.0 or closed[i]:
                 ia[na] = i
                 na += 1
+        if pairs is not None and status != OK:
+            break
         if na:
             for a in range(na):
                 st[a + 1] = st[a] + sz[ia[a]]
@@ -593,21 +704,58 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                     acc = 0.0
                     for j in range(6):
                         acc += rows[i, kk, j] * vfree[6 * b + j]
+                    if pairs is not None and pairs[i, 0] >= 0.0:
+                        bb = int(pairs[i, 0])
+                        for j in range(6):
+                            acc2 = 0.0
+                            for l in range(6):
+                                acc2 += bMinv[bb, j, l] * rowsb[i, kk, l]
+                            MHTb[row, j] = acc2
+                        for j in range(6):
+                            acc += rowsb[i, kk, j] * vfree[6 * bb + j]
                     Uf_all[row] = acc
                 Uf_all[st[a]] += e[i] * min(vN0[i], 0.0)
-            # W = H M^-1 H^T by contact pairs: zero between two bodies' contacts
-            for a in range(na):
-                i = ia[a]
-                ba = int(ct[i, 0])
-                for c in range(na):
-                    same = ba == int(ct[ia[c], 0])
-                    for kk in range(sz[i]):
-                        for ll in range(sz[ia[c]]):
-                            acc = 0.0
-                            if same:
-                                for j in range(6):
-                                    acc += rows[i, kk, j] * MHT[st[c] + ll, j]
-                            Wf[st[a] + kk, st[c] + ll] = acc
+            if pairs is not None:
+                # W = H M^-1 H^T by contact pairs, each side on each side of the other where
+                # their bodies are one (a half-space contact has one side: pairs[i, 0] < 0)
+                for a in range(na):
+                    i = ia[a]
+                    ai = int(ct[i, 0])
+                    bi = int(pairs[i, 0])
+                    for c in range(na):
+                        ac = int(ct[ia[c], 0])
+                        bc = int(pairs[ia[c], 0])
+                        for kk in range(sz[i]):
+                            for ll in range(sz[ia[c]]):
+                                acc = 0.0
+                                oc = st[c] + ll
+                                if ai == ac:
+                                    for j in range(6):
+                                        acc += rows[i, kk, j] * MHT[oc, j]
+                                if ai == bc:
+                                    for j in range(6):
+                                        acc += rows[i, kk, j] * MHTb[oc, j]
+                                if bi >= 0 and bi == ac:
+                                    for j in range(6):
+                                        acc += rowsb[i, kk, j] * MHT[oc, j]
+                                if bi >= 0 and bi == bc:
+                                    for j in range(6):
+                                        acc += rowsb[i, kk, j] * MHTb[oc, j]
+                                Wf[st[a] + kk, oc] = acc
+            else:
+                # W = H M^-1 H^T by contact pairs: zero between two bodies' contacts
+                for a in range(na):
+                    i = ia[a]
+                    ba = int(ct[i, 0])
+                    for c in range(na):
+                        same = ba == int(ct[ia[c], 0])
+                        for kk in range(sz[i]):
+                            for ll in range(sz[ia[c]]):
+                                acc = 0.0
+                                if same:
+                                    for j in range(6):
+                                        acc += rows[i, kk, j] * MHT[st[c] + ll, j]
+                                Wf[st[a] + kk, st[c] + ll] = acc
             if n3 != W.shape[0]:
                 # the solvers take contiguous arrays of the problem's size: new ones only
                 # when the number of active contacts changes
@@ -644,6 +792,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                     if sz[ia[a]] == 4:
                         dv += MHT[o + 3, j] * r[o + 3]
                     v1[6 * b + j] += dv
+                if pairs is not None and pairs[ia[a], 0] >= 0.0:
+                    bb = int(pairs[ia[a], 0])
+                    for j in range(6):
+                        v1[6 * bb + j] += (MHTb[o, j] * r[o] + MHTb[o + 1, j] * r[o + 1]
+                                           + MHTb[o + 2, j] * r[o + 2])
             scale = 1e-300
             for a in range(n3):
                 scale = max(scale, abs(Uf[a]))
@@ -654,6 +807,10 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
                     acc = 0.0
                     for j in range(6):
                         acc += rows[i, kk, j] * v1[6 * b + j]
+                    if pairs is not None and pairs[i, 0] >= 0.0:
+                        bb = int(pairs[i, 0])
+                        for j in range(6):
+                            acc += rowsb[i, kk, j] * v1[6 * bb + j]
                     U[kk] = acc
                 o = st[a]
                 pN[i] = r[o]
@@ -688,8 +845,17 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
         for b in range(nb):
             _rotation(q1, b, R1)
         for i in range(nc):
-            g1[i] = _gap(ct, i, q1, R1, s)
+            if pairs is not None and pairs[i, 0] >= 0.0:
+                L = _pair_line(ct, pairs, i, q1, R1, pg)
+                if not L > pairs[i, 5]:
+                    status = LCP_HANDBACK
+                    break
+                g1[i] = L - ct[i, 2] - pairs[i, 1]
+            else:
+                g1[i] = _gap(ct, i, q1, R1, s)
             stats[S_PEN] = max(stats[S_PEN], -g1[i])
+        if pairs is not None and status != OK:
+            break
         if record_initial:
             _record(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, tk,
                     q, v, reg, pN, pT, hk, slip, g0, nc)

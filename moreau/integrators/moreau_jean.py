@@ -233,7 +233,8 @@ and the step solves the round cone with three tangential rows
 ``cone`` by name. The step
 runs in the compiled loop of :mod:`moreau.integrators._space_kernels` for
 scenes whose contacts are spheres and material points (pucks) against
-half-spaces, with or without a patch, the same step to rounding, the exact
+half-spaces, with or without a patch, and spheres of two bodies against each
+other, the same step to rounding, the exact
 cone's Newton polish included
 (several contacts on one body: a puck's rim points, a box's corners); a
 contact problem the loop does not finish (the exact cone where that Newton
@@ -776,7 +777,7 @@ class MoreauJean(TimeStepping):
             tables = space_tables(self.scene, self.cone, self.mu_c, self.e_c)
         if fast is True and tables is None:
             raise InputError(f"`fast=True`: the compiled spatial step knows spheres and material "
-                             f"points against half-spaces; scene "
+                             f"points against half-spaces and spheres against spheres; scene "
                              f"{self.scene.name!r} has other contacts: use fast='auto' or False "
                              "(the generic step)")
         super()._choose_compiled(fast, tables, lcp_method, lemke_max_iter, warm_start)
@@ -946,7 +947,8 @@ class MoreauJean(TimeStepping):
         q, v, closed = self.q.copy(), self.v.copy(), self._closed.copy()
         status = self._run_block(None, (q, v, self._model.tables, float(self.theta), closed,
                                          space_solver(self.cone, self._model.several,
-                                                      self._model.drilling)), ())
+                                                      self._model.drilling)),
+                                 (self._model.pairs,))
         self.q, self.v, self._closed = q, v, closed
         if status == LCP_HANDBACK:
             if self._k == k0:

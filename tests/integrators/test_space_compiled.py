@@ -285,3 +285,74 @@ def test_a_contact_patch_runs_in_the_loop_as_the_python_step(monkeypatch):
     assert {Regime.POSITIVE} <= set(res.regime[:, 0])
     assert res.stats["max_residual"] == pytest.approx(ref.stats["max_residual"], rel=1e-9,
                                                       abs=1e-15)
+
+
+@pytest.mark.parametrize("cone", ["exact", 8])
+@pytest.mark.parametrize("n", [2, 3, 4])
+def test_the_ball_chain_s_pair_contacts_run_in_the_loop_as_the_python_step(n, cone, monkeypatch):
+    # contacts between two bodies: rows on both bodies' six velocities, the Delassus blocks of
+    # contacts sharing a sphere (n >= 3: the exact cone's Newton polish compiled in), every
+    # step in the loop, the Python step's run to rounding, the block result after the impact
+    from moreau.scenes.ball_chain_3d import ball_chain_3d, block_result
+    sc = ball_chain_3d(n_balls=n)
+    q0, v0 = sc.initial_state()
+    span = (0.0, sc.impact_time + 0.3)
+    ref = simulate(sc, span, q0, v0, "moreau-jean", h=0.01, fast=False, cone=cone)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, span, q0, v0, "moreau-jean", h=0.01, fast=True, cone=cone)
+    assert calls[0] == 0 and res.status == 0
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)
+    assert res.stats["lcp_solves"] == ref.stats["lcp_solves"] > 0
+    after = res.t > sc.impact_time + 0.01
+    assert np.max(np.abs(res.v[after][:, 0::6] - block_result(n))) <= 1e-12
+    assert np.max(np.abs(ref.v[after][:, 0::6] - block_result(n))) <= 1e-12
+
+
+def test_concentric_spheres_in_the_loop_are_the_python_step_s_failure(monkeypatch):
+    # the loop hands the step back where a pair's centres meet; the Python step names it
+    from moreau.scenes.ball_chain_3d import ball_chain_3d
+    sc = ball_chain_3d(n_balls=2)
+    q0, v0 = sc.initial_state()
+    q0[7:10] = q0[0:3]
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 0.1), q0, v0, "moreau-jean", h=0.01, fast=True)
+    assert calls[0] == 1 and res.status == -5
+    assert "IllPosedError: the spheres of contact 0 (bodies 0 and 1) are concentric" in res.message
+
+
+def _tumbling_pair():
+    # two tumbling bodies with eccentric spheres: they hit each other (mu = 0.3, e = 0.4) and
+    # a tilted floor, slipping and sticking; the pair's rows turn with both bodies
+    from moreau.model.spatial import quat_exp
+    rng = np.random.default_rng(3)
+    m = SpaceModel(gravity=(0.0, 0.0, -9.81), length=0.05)
+    floor = m.add_half_space((0.0, 0.0, 0.0), (0.1, -0.2, 1.0))
+    a = m.add_body(1.0, [0.002, 0.003, 0.0025], position=(0.0, 0.0, 0.06),
+                   orientation=quat_exp(0.5 * rng.standard_normal(3)), velocity=(0.3, 0.1, 0.0),
+                   angular_velocity=(2.0, -3.0, 5.0))
+    b = m.add_body(2.0, [0.004, 0.003, 0.0045], position=(0.09, 0.06, 0.12),
+                   orientation=quat_exp(0.5 * rng.standard_normal(3)),
+                   velocity=(-0.4, -0.3, 0.0), angular_velocity=(-4.0, 1.0, 3.0))
+    ca, cb = (0.01, -0.005, 0.002), (-0.003, 0.004, 0.01)
+    m.add_pair_contact(a, Sphere(0.05, centre=ca), b, Sphere(0.04, centre=cb), mu=0.3,
+                       restitution=0.4)
+    m.add_contact(a, Sphere(0.05, centre=ca), floor, mu=0.2)
+    m.add_contact(b, Sphere(0.04, centre=cb), floor, mu=0.5)
+    return m.build("tumbling pair")
+
+
+@pytest.mark.parametrize("cone", ["exact", 8])
+def test_eccentric_spheres_of_two_tumbling_bodies_run_in_the_loop_as_the_python_step(cone,
+                                                                                      monkeypatch):
+    sc = _tumbling_pair()
+    q0, v0 = sc.initial_state()
+    ref = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=0.02, fast=False, cone=cone)
+    calls = _python_steps(monkeypatch)
+    res = simulate(sc, (0.0, 3.0), q0, v0, "moreau-jean", h=0.02, fast=True, cone=cone)
+    assert calls[0] == 0 and res.status == 0
+    # every contact carries a force, the pair's too, and some slip while others stick
+    assert np.all(np.max(ref.force_N, axis=0) > 10.0)
+    assert {Regime.POSITIVE, Regime.STICK} <= set(ref.regime.ravel())
+    _assert_same(ref, res)
+    assert np.array_equal(ref.regime, res.regime)

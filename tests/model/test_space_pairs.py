@@ -7,6 +7,7 @@ import pytest
 from moreau.check import check_scene
 from moreau.errors import IllPosedError, InputError
 from moreau.integrators import simulate
+from moreau.integrators.moreau_jean import MoreauJean
 from moreau.model.space import Box, SpaceModel, Sphere, advance_coordinates
 from moreau.model.spatial import quat_exp, rotation_matrix
 
@@ -85,12 +86,14 @@ def _free_pair(mu, e, anisotropic):
     return m.build("free pair")
 
 
+@pytest.mark.parametrize("fast", [False, True], ids=["python-step", "compiled-loop"])
 @pytest.mark.parametrize("cone", ["exact", 8])
-def test_an_oblique_impact_in_free_space_keeps_momentum_to_rounding(cone):
+def test_an_oblique_impact_in_free_space_keeps_momentum_to_rounding(cone, fast):
     # spinning, eccentric, rough (mu = 0.4, e = 0.7): the impulses are equal and opposite
     sc = _free_pair(0.4, 0.7, True)
     q0, v0 = sc.initial_state()
-    res = simulate(sc, (0.0, 1.2), q0, v0, "moreau-jean", h=0.02, cone=cone)
+    assert MoreauJean(sc, 0.0, q0, v0, 1.2, h=0.02, fast=fast)._fast == fast
+    res = simulate(sc, (0.0, 1.2), q0, v0, "moreau-jean", h=0.02, cone=cone, fast=fast)
     assert res.status == 0 and res.stats["lcp_solves"] >= 1 and np.max(res.force_T) > 0.0
     P0, _ = _mom(sc, res.q[0], res.v[0])
     P1, _ = _mom(sc, res.q[-1], res.v[-1])
@@ -99,7 +102,7 @@ def test_an_oblique_impact_in_free_space_keeps_momentum_to_rounding(cone):
     # frictionless and elastic between isotropic spheres: energy and angular momentum too
     sc = _free_pair(0.0, 1.0, False)
     q0, v0 = sc.initial_state()
-    res = simulate(sc, (0.0, 1.2), q0, v0, "moreau-jean", h=0.02, cone=cone)
+    res = simulate(sc, (0.0, 1.2), q0, v0, "moreau-jean", h=0.02, cone=cone, fast=fast)
     (P0, L0), (P1, L1) = _mom(sc, res.q[0], res.v[0]), _mom(sc, res.q[-1], res.v[-1])
     E = [0.5 * sum(sc.masses[k] * v[6 * k:6 * k + 3] @ v[6 * k:6 * k + 3]
                    + v[6 * k + 3:6 * k + 6] @ sc.inertias[k] @ v[6 * k + 3:6 * k + 6]
@@ -143,6 +146,5 @@ def test_bad_pair_contacts_are_refused_by_name():
     q0, v0 = sc.initial_state()
     with pytest.raises(InputError, match="keeps one persistent contact with a half-space"):
         simulate(sc, (0.0, 1.0), q0, v0, "event-driven-space")
-    # the compiled spatial loop knows contacts with half-spaces only
-    with pytest.raises(InputError, match="`fast=True`: the compiled spatial step knows"):
-        simulate(sc, (0.0, 1.0), q0, v0, "moreau-jean", h=0.1, fast=True)
+    # the compiled spatial loop takes contacts between two bodies
+    assert MoreauJean(sc, 0.0, q0, v0, 1.0, h=0.1, fast=True)._fast

@@ -1316,11 +1316,12 @@ class SpaceScene(Scene):
         (3)]`` in the scene's units, ``kind`` 0 for a sphere about the centre
         of mass (``s = -radius n``), 1 for an eccentric sphere (``s = R c -
         radius n``, ``c`` its centre) and 2 for a material point (``s = R
-        c``, ``c`` the point), as in the module docstring. None where a
-        contact is of none of these kinds, or joins two bodies
-        (:meth:`SpaceModel.add_pair_contact`). A contact patch
-        (``contact_radius > 0``) leaves its row as it is: its lever is
-        :attr:`drilling_levers`.
+        c``, ``c`` the point), as in the module docstring, and 3 for a
+        contact between two bodies' spheres (:meth:`SpaceModel.add_pair_contact`):
+        ``body`` and ``radius``, ``c`` of its sphere on body ``a``, the rest
+        in :meth:`pair_table`. None where a contact is of none of these
+        kinds. A contact patch (``contact_radius > 0``) leaves its row as it
+        is: its lever is :attr:`drilling_levers`.
 
         Examples
         --------
@@ -1332,6 +1333,9 @@ class SpaceScene(Scene):
         """
         out = np.zeros((self.ncontacts, 18))
         for i, c in enumerate(self._contacts):
+            if c["kind"] == "pair":
+                out[i, :6] = [c["body"], 3, c["radius"], *c["centre"]]
+                continue
             # a contact's shape is read from these keys only: any other kind has no row
             if not set(c) <= _TABLE_KEYS or c.get("kind", "sphere") not in ("sphere", "point"):
                 return None
@@ -1343,6 +1347,36 @@ class SpaceScene(Scene):
             else:
                 kind, offset = 0, np.zeros(3)
             out[i] = np.concatenate([[c["body"], kind, c["radius"]], offset, y0, n, t1, t2])
+        return out
+
+    def pair_table(self):
+        """Each contact's body ``b`` for a compiled step: None without contacts between bodies.
+
+        Row ``i``: ``[b, radius, c (3), L_min]`` of a contact between two
+        bodies' spheres (:meth:`SpaceModel.add_pair_contact`; its body ``a``'s
+        sphere is in :meth:`contact_table`), in the scene's units: body
+        ``b``, its sphere's radius and centre (body frame), and the distance
+        of centres ``L_min = CONCENTRIC_TOL (r_a + r_b)`` at or below which
+        the contact has no normal; ``[-1, 0, ...]`` for a contact with a
+        half-space.
+
+        Examples
+        --------
+        >>> m = SpaceModel()
+        >>> a = m.add_body(1.0, [0.004] * 3)
+        >>> b = m.add_body(1.0, [0.004] * 3, position=(0.25, 0.0, 0.0))
+        >>> _ = m.add_pair_contact(a, Sphere(0.1), b, Sphere(0.15))
+        >>> m.build("pair").pair_table()[0, :5].tolist()
+        [1.0, 0.15, 0.0, 0.0, 0.0]
+        """
+        if not self.pair_index:
+            return None
+        out = np.zeros((self.ncontacts, 6))
+        out[:, 0] = -1.0
+        for i in self.pair_index:
+            c = self._contacts[i]
+            out[i] = [c["body_b"], c["radius_b"], *c["centre_b"],
+                      CONCENTRIC_TOL * (c["radius"] + c["radius_b"])]
         return out
 
 
