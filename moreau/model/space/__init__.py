@@ -1274,6 +1274,12 @@ class SpaceScene(Scene):
             if self._contacts[i]["kind"] in _BOX_KINDS:
                 a, _, _, _, pt = self._box_point(qs, i, Rs)
                 if pt is None:
+                    # an unused slot of a box-box contact: listed, marked open (not drawn),
+                    # as every contact index is in a drawing
+                    x = qs[7 * a:7 * a + 3] * L
+                    c = contact(i, (x[0], x[2]), (0.0, 1.0))
+                    c["open"] = True
+                    out.append(c)
                     continue
                 x, s, n = qs[7 * a:7 * a + 3], pt.sa, pt.n
             elif self._contacts[i]["kind"] == "pair":
