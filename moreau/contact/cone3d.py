@@ -419,7 +419,7 @@ def build_polyhedral_lcp(W, q, mu, d=8, *, check=True):
     return PolyhedralLCP(M, B.T @ q, B, D)
 
 
-def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
+def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True, support=None):
     """Solve the spatial friction problem with the ``d``-direction polyhedral cone.
 
     Parameters
@@ -437,6 +437,10 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
     check : bool
         False skips :func:`check_cone_problem`, for a caller that built the
         problem in its layout from checked data (a scheme's step).
+    support : array of int, optional
+        A guessed support of the LCP's answer (the last step's), passed to
+        ``"auto"`` (:func:`moreau.lcp.solve_lcp`), which tries it only where
+        Lemke's path would be finished in exact arithmetic.
 
     Returns
     -------
@@ -455,7 +459,10 @@ def solve_polyhedral(W, q, mu, d=8, *, method="auto", tol=None, check=True):
     """
     W, q, mu = check_cone_problem(W, q, mu) if check else _trusted(W, q, mu)
     lcp = build_polyhedral_lcp(W, q, mu, d, check=False)
-    res = solve_lcp(lcp.M, lcp.q, method, tol=tol)
+    if support is None:
+        res = solve_lcp(lcp.M, lcp.q, method, tol=tol)
+    else:
+        res = solve_lcp(lcp.M, lcp.q, method, tol=tol, support=support)
     r = lcp.impulses(res.z)
     u = W @ r + q
     residual = math.sqrt(_natural_sq(r, u, mu))

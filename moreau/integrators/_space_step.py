@@ -5,11 +5,10 @@ See :mod:`moreau.integrators.moreau_jean` ("Spatial scenes") for the scheme.
 
 import numpy as np
 
-from ..contact.cone3d import (CONVERGED, ConeSolution, build_polyhedral_lcp, facet_directions,
-                              natural_map_sq, polyhedral_one_contact, solve_cone,
-                              solve_exact_contensou)
+from ..contact.cone3d import (CONVERGED, ConeSolution, facet_directions, natural_map_sq,
+                              polyhedral_one_contact, solve_cone, solve_exact_contensou,
+                              solve_polyhedral)
 from ..errors import InputError, LCPError
-from ..lcp import STATUS_MESSAGES, solve_lcp
 from ..model.space import advance_coordinates
 from ..regimes import Regime
 
@@ -169,29 +168,14 @@ def _polyhedral(W, U_free, mu, d, active, memo, counters):
     the step before solves it with no pivot.
     """
     key = (tuple(active.tolist()), d)
-    lcp = build_polyhedral_lcp(W, U_free, mu, d, check=False)
-    support = memo.get(key)
-    if support is None:
-        res = solve_lcp(lcp.M, lcp.q, "auto")
-    else:
-        res = solve_lcp(lcp.M, lcp.q, "auto", support=support)
+    sol = solve_polyhedral(W, U_free, mu, d, check=False, support=memo.get(key))
+    res = sol.lcp
     memo.clear()
     if res.success:
         memo[key] = np.flatnonzero(res.z > 0.0)
         if res.method == "support":
             counters["warm_starts"] = counters.get("warm_starts", 0) + 1
-    r = lcp.impulses(res.z)
-    u = W @ r + U_free
-    residual = float(np.sqrt(natural_map_sq(r, u, mu)))
-    qn = float(np.linalg.norm(U_free))
-    status = CONVERGED if res.success else STATUS_MESSAGES.get(res.status, str(res.status))
-    detail = (f"LCP of size {lcp.M.shape[0]} ({lcp.d} directions), method {res.method!r}, path "
-              f"{'/'.join(res.path) if res.path else res.method}, LCP violation "
-              f"{res.residual:.3g}.")
-    if getattr(res, "detail", None):
-        detail += " " + res.detail
-    return ConeSolution(r, u, status, residual, residual / qn if qn > 0 else residual,
-                        {"pivots": int(res.pivots)}, f"polyhedral-{lcp.d}", detail, lcp=res)
+    return sol
 
 
 def _contensou_contacts(scene, q, v_free, Minv, rows, vN0, active, t0, mu, e, counters,
