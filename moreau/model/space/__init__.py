@@ -558,6 +558,26 @@ class HalfSpace:
             self.t2 = np.cross(self.normal, self.t1)
 
 
+def _friction_and_restitution(mu, restitution):
+    """A contact's checked ``(mu, e)``: ``mu >= 0``, ``restitution`` in [0, 1]."""
+    mu = nonnegative("mu", mu)
+    e = finite_scalar("restitution", restitution)
+    if not 0.0 <= e <= 1.0:
+        raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+    return mu, e
+
+
+def _two_bodies(body_a, body_b, nbodies):
+    """Refuse by name a contact's bodies that are not two distinct added ones."""
+    for name, value in (("body_a", body_a), ("body_b", body_b)):
+        if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
+                or not 0 <= value < nbodies:
+            raise InputError(f"`{name}` must be the index of an added body "
+                             f"(0..{nbodies - 1}), got {value!r}")
+    if body_a == body_b:
+        raise InputError(f"`body_b` must be another body than `body_a`, got {body_b!r} twice")
+
+
 class SpaceModel:
     """Free rigid bodies in space and their contacts with the ground's half-spaces.
 
@@ -641,10 +661,7 @@ class SpaceModel:
         if isinstance(shape, Capsule):
             return [k for s in shape.spheres()
                     for k in self.add_contact(body, s, plane, mu, restitution)]
-        mu = nonnegative("mu", mu)
-        e = finite_scalar("restitution", restitution)
-        if not 0.0 <= e <= 1.0:
-            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        mu, e = _friction_and_restitution(mu, restitution)
         r_patch = nonnegative("contact_radius", contact_radius)
         if r_patch > 0.0 and isinstance(shape, Disk):
             raise InputError("`contact_radius` must be 0 on a Disk: its rim touches along a "
@@ -697,21 +714,12 @@ class SpaceModel:
         >>> round(float(m.build("pair").gaps(q, 0.0)[0]), 12)      # 0.25 - 0.1 - 0.1
         0.05
         """
-        for name, value in (("body_a", body_a), ("body_b", body_b)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
-                    or not 0 <= value < len(self.bodies):
-                raise InputError(f"`{name}` must be the index of an added body "
-                                 f"(0..{len(self.bodies) - 1}), got {value!r}")
-        if body_a == body_b:
-            raise InputError(f"`body_b` must be another body than `body_a`, got {body_b!r} twice")
+        _two_bodies(body_a, body_b, len(self.bodies))
         for name, shape in (("sphere_a", sphere_a), ("sphere_b", sphere_b)):
             if not isinstance(shape, Sphere):
                 raise InputError(f"`{name}` must be a Sphere (contacts between two bodies are "
                                  f"sphere against sphere), got {type(shape).__name__}")
-        mu = nonnegative("mu", mu)
-        e = finite_scalar("restitution", restitution)
-        if not 0.0 <= e <= 1.0:
-            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        mu, e = _friction_and_restitution(mu, restitution)
         centres = []
         for b, shape in ((body_a, sphere_a), (body_b, sphere_b)):
             body = self.bodies[b]
@@ -764,22 +772,13 @@ class SpaceModel:
         >>> (sc.gaps(q0, 0.0).round(12) + 0.0).tolist()    # four corners touch, four unused
         [0.0, 0.0, 0.0, 0.0, 0.5, 0.5, 0.5, 0.5]
         """
-        for name, value in (("body_a", body_a), ("body_b", body_b)):
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
-                    or not 0 <= value < len(self.bodies):
-                raise InputError(f"`{name}` must be the index of an added body "
-                                 f"(0..{len(self.bodies) - 1}), got {value!r}")
-        if body_a == body_b:
-            raise InputError(f"`body_b` must be another body than `body_a`, got {body_b!r} twice")
+        _two_bodies(body_a, body_b, len(self.bodies))
         if not isinstance(shape_a, (Sphere, Box)):
             raise InputError(f"`shape_a` must be a Sphere or a Box, got {type(shape_a).__name__}")
         if not isinstance(box_b, Box):
             raise InputError(f"`box_b` must be a Box (a sphere against a box names the sphere "
                              f"first), got {type(box_b).__name__}")
-        mu = nonnegative("mu", mu)
-        e = finite_scalar("restitution", restitution)
-        if not 0.0 <= e <= 1.0:
-            raise InputError(f"`restitution` must be in [0, 1], got {e!r}")
+        mu, e = _friction_and_restitution(mu, restitution)
         L = self.length
         least = min(float(box_b.half_extents.min()),
                     shape_a.radius if isinstance(shape_a, Sphere) else float(shape_a.half_extents.min()))
