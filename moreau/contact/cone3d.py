@@ -722,6 +722,24 @@ def _turn(c0, s0, t):
 
 
 @njit(cache=True, inline="always")
+def _illinois_narrow(x, fx, lo, flo, wlo, hi, fhi, whi, side):
+    # the bracket after the point x of value fx: x replaces the end whose value has its sign;
+    # Illinois halves the weight (wlo, whi) of the end that stays twice in a row, where plain
+    # regula falsi would keep it and converge linearly
+    if (fx < 0.0) == (flo < 0.0):
+        lo, flo, wlo = x, fx, fx
+        if side < 0:
+            whi *= 0.5
+        side = -1
+    else:
+        hi, fhi, whi = x, fx, fx
+        if side > 0:
+            wlo *= 0.5
+        side = 1
+    return lo, flo, wlo, hi, fhi, whi, side
+
+
+@njit(cache=True, inline="always")
 def _refine_angle(A, b, mu, c0, s0, flo, fhi):
     # a root of the slip function in the sample [phi0, phi0 + step] (cos phi0 = c0, sin phi0 =
     # s0; flo, fhi its ends' values, of opposite signs) as (cos, sin), by the Illinois variant
@@ -752,16 +770,8 @@ def _refine_angle(A, b, mu, c0, s0, flo, fhi):
         fx, _, _ = _slip_cs(A, b, mu, cx, sx)
         if fx == 0.0:
             return cx, sx
-        if (fx < 0.0) == (flo < 0.0):
-            lo, flo, wlo = x, fx, fx
-            if side < 0:
-                whi *= 0.5
-            side = -1
-        else:
-            hi, fhi, whi = x, fx, fx
-            if side > 0:
-                wlo *= 0.5
-            side = 1
+        lo, flo, wlo, hi, fhi, whi, side = _illinois_narrow(x, fx, lo, flo, wlo, hi, fhi, whi,
+                                                            side)
     return _end(c0, s0, lo if abs(flo) <= abs(fhi) else hi)
 
 
@@ -889,16 +899,8 @@ def _trig2_root(k0, p1, p2, k1, k2, lo, hi, flo, fhi):
         fx, _ = _trig2(k0, p1, p2, k1, k2, x)
         if fx == 0.0:
             return x
-        if (fx < 0.0) == (flo < 0.0):
-            lo, flo, wlo = x, fx, fx
-            if side < 0:
-                whi *= 0.5
-            side = -1
-        else:
-            hi, fhi, whi = x, fx, fx
-            if side > 0:
-                wlo *= 0.5
-            side = 1
+        lo, flo, wlo, hi, fhi, whi, side = _illinois_narrow(x, fx, lo, flo, wlo, hi, fhi, whi,
+                                                            side)
     return lo if abs(flo) <= abs(fhi) else hi
 
 
