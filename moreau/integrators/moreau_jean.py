@@ -670,8 +670,11 @@ class MoreauJean(TimeStepping):
         # the Python steps left after the compiled spatial loop handed back a first step,
         # and how many it takes the next time (see _space_block)
         self._python_steps_left, self._python_run = 0, 1
-        # the last polyhedral LCP's support, for the next Python step (_space_step.space_step)
+        # the last polyhedral LCP's support, for the next Python step (_space_step.space_step);
+        # on box contacts the exact cone starts from the last step's impulses
         self._lcp_memo = {}
+        self._warm_cone = (np.zeros((self.scene.ncontacts, 3))
+                           if self._space and getattr(self.scene, "box_index", ()) else None)
         if self._space and self.projection:
             raise InputError("`projection` is not defined on a spatial scene (its coordinates "
                              "are not its velocities' integrals); use projection=False")
@@ -881,12 +884,9 @@ class MoreauJean(TimeStepping):
         sc = self.scene
         t0, q, v = self.t, self.q, self.v
         t1, h = next_time(self.t0, self._k, self.h, self.t_bound)
-        if getattr(sc, "box_index", ()) and not hasattr(self, "_warm_cone"):
-            # box contacts: the exact cone starts from the last step's impulses (space_step)
-            self._warm_cone = np.zeros((sc.ncontacts, 3))
         q1, v1, pN, pT, slip, regime = space_step(sc, q, v, t0, t1, h, self.theta, self._closed,
                                                   self.mu_c, self.e_c, self.cone, self.counters,
-                                                  self._lcp_memo, getattr(self, "_warm_cone", None))
+                                                  self._lcp_memo, self._warm_cone)
         if not (np.all(np.isfinite(q1)) and np.all(np.isfinite(v1))):
             self.counters["steps"] -= 1
             self._fail(-5, f"non-finite state after the step at t = {t0!r}")
