@@ -208,6 +208,52 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
     return status, k, nrec
 
 
+class _Template:
+    """A loop template that is spliced on first use (:func:`loop_template`).
+
+    Splicing parses and rewrites the driver and the step rule, about a tenth
+    of a CPU second a loop; built at import, it was paid by every process
+    that imports :mod:`moreau.integrators`, which runs no loop in most of
+    them. The name, module and docstring are known without building; any
+    other attribute (``__code__``, ``__moreau_source__``, ...) and a call
+    build the function once and are taken from it.
+    """
+
+    def __init__(self, name, namespace):
+        self.__name__ = self.__qualname__ = name
+        self._namespace = namespace
+        self._fn = None
+
+    @property
+    def __module__(self):
+        return self._namespace["__name__"]
+
+    @property
+    def __doc__(self):
+        return drive.__doc__
+
+    @property
+    def __wrapped__(self):
+        # inspect.signature follows it to the built function's parameters
+        return self._built()
+
+    def _built(self):
+        if self._fn is None:
+            self._fn = _splice_template(self.__name__, self._namespace)
+        return self._fn
+
+    def __getattr__(self, attr):
+        if attr.startswith("_") and not attr.startswith("__"):
+            raise AttributeError(attr)     # the instance's own private fields, before __init__
+        return getattr(self._built(), attr)
+
+    def __call__(self, *args):
+        return self._built()(*args)
+
+    def __repr__(self):
+        return f"<loop template {self.__module__}.{self.__name__}>"
+
+
 def loop_template(name, namespace):
     """The driver with the step rule of the scheme module whose globals are ``namespace`` spliced in.
 
@@ -227,8 +273,14 @@ def loop_template(name, namespace):
     (:class:`_Splicer`). The template's qualified name is ``name`` (numba
     names a function's disk-cache files after it); its source is kept in
     ``__moreau_source__`` for the shared loop's rewrite, and the files
-    spliced into it in ``__moreau_sources__``.
+    spliced into it in ``__moreau_sources__``. It is built on first use
+    (:class:`_Template`): an import splices nothing.
     """
+    return _Template(name, namespace)
+
+
+def _splice_template(name, namespace):
+    # loop_template's work, done at the template's first use
     for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
         namespace.setdefault(own, globals()[own])
     tree = ast.parse(_source(drive))
