@@ -566,6 +566,32 @@ class Integrator:
         if self._want_pieces:
             self._pieces.append(Piece(grid, state, sample))
 
+    def _follow_phase(self, sol, row):
+        """Record the smooth phase ``sol`` (:func:`scipy.integrate.solve_ivp` with dense
+        output, over ``y = (q, v)``) and move ``t`` to its end; returns ``y`` there.
+
+        A failed integration raises :class:`~moreau.errors.MoreauError`. The phase's dense
+        output is its exact motion (to the ODE tolerance), handed over by
+        :meth:`_add_piece` with ``row(t, q, v)`` the sample at ``t``; its own steps are
+        where an event function is checked. The samples due in the phase are recorded by
+        ``_record_state``.
+        """
+        if sol.status < 0:
+            raise MoreauError(f"smooth-phase integration failed at t = {sol.t[-1]:.12g}: "
+                              f"{sol.message}")
+        n = self.scene.ndof
+        t_end = float(sol.t[-1])
+        dense = sol.sol
+        if self._want_pieces:
+            grid = np.append(dense.ts[dense.ts < t_end], t_end)
+            self._add_piece(grid, dense, lambda t: row(t, dense(t)[:n], dense(t)[n:]))
+        while self._next_sample < t_end:
+            ys = dense(self._next_sample)
+            self._record_state(self._next_sample, ys[:n], ys[n:])
+            self._next_sample += self.sample_dt
+        self.t = t_end
+        return sol.y[:, -1]
+
     def _take_pieces(self):
         """The motion since the previous call, as a list of pieces."""
         if self.exact_motion:

@@ -1159,28 +1159,11 @@ class GenericEventDriven(Integrator):
         sol = solve_ivp(rhs, (self.t, self.t_bound), y0, method=self.ode_method, rtol=self.rtol,
                         atol=self.atol, events=events or None, dense_output=True,
                         max_step=self.max_step)
-        if sol.status < 0:
-            raise MoreauError(f"smooth-phase integration failed at t = {sol.t[-1]:.12g}: "
-                              f"{sol.message}")
-        n = self.scene.ndof
-        t_end = float(sol.t[-1])
+        t0, mode = self.t, self.mode.copy()
+        y1 = self._follow_phase(sol, lambda t, q, v: self._sample_row(t, q, v, mode))
         if self.phases is not None:
-            self.phases.append((self.t, t_end, sol.sol, self.mode.copy()))
-        if self._want_pieces:
-            # the phase's dense output is its exact motion (to the ODE tolerance), in the
-            # phase's mode; its steps are where an event function is checked
-            mode, dense = self.mode.copy(), sol.sol
-            grid = np.append(dense.ts[dense.ts < t_end], t_end)
-            self._add_piece(grid, dense,
-                            lambda t, mode=mode, dense=dense: self._sample_row(
-                                t, dense(t)[:n], dense(t)[n:], mode))
-        # samples of the smooth phase
-        while self._next_sample < t_end:
-            ys = sol.sol(self._next_sample)
-            self._record_state(self._next_sample, ys[:n], ys[n:])
-            self._next_sample += self.sample_dt
-        self.t = t_end
-        y1 = sol.y[:, -1]
+            self.phases.append((t0, self.t, sol.sol, self.mode.copy()))
+        n = self.scene.ndof
         self.q, self.v = y1[:n].copy(), y1[n:].copy()
         if sol.status != 1:
             self.q, self.v = self._project(self.t, self.q, self.v, self.mode)

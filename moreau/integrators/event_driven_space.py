@@ -373,21 +373,7 @@ class SpaceEventDriven(Integrator):
         sol = solve_ivp(lambda t, y: self._rates(t, y, evaluate(t, y)[0]), (t0, self.t_bound), y0,
                         method="DOP853", rtol=self.options.rtol, atol=self.options.atol,
                         events=events, dense_output=True, max_step=self.options.max_step)
-        if sol.status < 0:
-            raise MoreauError(f"smooth-phase integration failed at t = {sol.t[-1]:.12g}: "
-                              f"{sol.message}")
-        t_end = float(sol.t[-1])
-        dense = sol.sol
-        if self._want_pieces:
-            grid = np.append(dense.ts[dense.ts < t_end], t_end)
-            self._add_piece(grid, dense, lambda t: self._sample_row(
-                t, dense(t)[:n], dense(t)[n:], mode, d))
-        while self._next_sample < t_end:
-            ys = dense(self._next_sample)
-            self._record_state(self._next_sample, ys[:n], ys[n:])
-            self._next_sample += self.sample_dt
-        self.t = t_end
-        y1 = sol.y[:, -1]
+        y1 = self._follow_phase(sol, lambda t, q, v: self._sample_row(t, q, v, mode, d))
         q, v = y1[:n].copy(), y1[n:].copy()
         if sol.status != 1:
             self.q, self.v = self._restart(q, v, mode)

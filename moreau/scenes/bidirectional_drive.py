@@ -62,7 +62,7 @@ velocity, so rod ``b``'s Painlevé configuration is *positive* slip with
 """
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -205,11 +205,7 @@ def _drift(par, q, v, t, Dr):
 
 def params_from_kwargs(**kwargs):
     """Build :class:`BidirectionalDriveParams` from keyword arguments, ignoring ``None`` values."""
-    names = {f.name for f in fields(BidirectionalDriveParams)}
-    unknown = set(kwargs) - names
-    if unknown:
-        raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
-    return BidirectionalDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
+    return BidirectionalDriveParams.from_kwargs(**kwargs)
 
 
 class BidirectionalDrive(StatorMotion, DriveUnits, CompiledScene):

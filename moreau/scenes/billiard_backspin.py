@@ -33,7 +33,7 @@ from .._validate import check_fields, finite_scalar, positive, times
 from ..analysis.cases import GRID, SpatialCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
-from ..model.space import SpaceModel, Sphere
+from ._sphere_on_plane import sphere_on_plane
 
 __all__ = ["BilliardParams", "billiard_backspin", "billiard_exact", "rolling_onset"]
 
@@ -95,16 +95,7 @@ def billiard_backspin(params=None, **overrides):
     True
     """
     p = params_with(BilliardParams, params, overrides)
-    r = p.radius
-    m = SpaceModel(gravity=(0.0, 0.0, -p.gravity), length=r, mass=p.mass)
-    cloth = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0))
-    ball = m.add_body(p.mass, [0.4 * p.mass * r * r] * 3, position=(0.0, 0.0, r),
-                      velocity=(p.speed, 0.0, 0.0), angular_velocity=(0.0, p.spin, 0.0),
-                      name="ball")
-    m.add_contact(ball, Sphere(r), cloth, mu=p.mu)
-    sc = m.build("billiard-backspin", default_window=20.0)
-    sc.params = p
-    return sc
+    return sphere_on_plane("billiard-backspin", p, (0.0, 0.0, -p.gravity), p.spin, "ball", 20.0)
 
 
 def billiard_exact(params, t):

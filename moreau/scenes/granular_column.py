@@ -81,13 +81,14 @@ import numpy as np
 from scipy.sparse import coo_array
 from scipy.sparse.csgraph import connected_components
 
-from .._validate import in_closed_interval, nonnegative, positive, positive_int
+from .._validate import nonnegative
 from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
 from ..model.granular import (EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, grid_pairs,
                               random_fill)
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
+from ._grains import check_grain_params
 
 __all__ = ["GranularColumnParams", "granular_column", "column_system", "deposit_front",
            "collapse", "runout_study", "fit_runout"]
@@ -141,17 +142,8 @@ class GranularColumnParams:
     mu_r: float = 0.0
 
     def __post_init__(self):
-        for name in ("width", "aspect", "diameter", "density", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "spread", in_closed_interval("spread", self.spread, 1e-3, 1.0))
-        for name in ("mu", "mu_floor", "mu_wall", "mu_r"):
-            object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
-        object.__setattr__(self, "seed", positive_int("seed", int(self.seed) + 1) - 1)
-        if self.width / self.diameter < 2.05:
-            raise InputError(f"`width` must hold two grains (>= 2.05 `diameter`), got "
-                             f"{self.width!r} m for {self.diameter!r} m grains")
+        check_grain_params(self, ("width", "aspect", "diameter", "density", "gravity"),
+                           ("mu", "mu_floor", "mu_wall", "mu_r"))
 
 
 def column_system(params=None, *, gate=True, **overrides):

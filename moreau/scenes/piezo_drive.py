@@ -102,7 +102,7 @@ from .. import _validate as V
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
-from .friction_drive.rod import OneRod, RodParams, one_rod_mass
+from .friction_drive.rod import OneRod, RodParams, one_rod_mass, rod_rows
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
 from ..model.drawing import rod_drive_shapes
@@ -292,11 +292,8 @@ def _contacts_rig(par, q, t, G, need_gap, need_T):
     w, dw, _ = _stroke(par, t)
     if need_gap:
         G[0, 0] = par[2] - s - w
-    G[0, 1] = -dw
-    G[0, 3] = -math.cos(q[0])
-    if need_T:
-        G[0, 5] = s
-        G[0, 6] = 1.0
+    # the friction drive's rod rows, the stator's rate dw given as u10 st = dw * 1
+    rod_rows(G, 0, 0, 1, 2, 1.0, dw, s, math.cos(q[0]), 1.0, need_T)
 
 
 @njit(cache=True)

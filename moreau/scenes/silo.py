@@ -185,6 +185,7 @@ from ..integrators.granular import settle, simulate_disks
 from ..model.granular import EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, random_fill
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
+from ._grains import check_grain_params
 
 __all__ = ["SiloParams", "silo", "silo_system", "fill", "fill_average", "fit_janssen", "janssen",
            "wall_profile", "janssen_k_bounds"]
@@ -236,18 +237,8 @@ class SiloParams:
     mu_r: float = 0.0
 
     def __post_init__(self):
-        for name in ("width", "diameter", "density", "gravity"):
-            object.__setattr__(self, name, positive(name, getattr(self, name)))
-        object.__setattr__(self, "per_pour", positive_int("per_pour", self.per_pour))
-        object.__setattr__(self, "spread", in_closed_interval("spread", self.spread, 1e-3, 1.0))
-        for name in ("mu", "mu_wall", "mu_floor", "wall_speed", "mu_r"):
-            object.__setattr__(self, name, nonnegative(name, getattr(self, name)))
-        object.__setattr__(self, "restitution",
-                           in_closed_interval("restitution", self.restitution, 0.0, 1.0))
-        object.__setattr__(self, "seed", positive_int("seed", int(self.seed) + 1) - 1)
-        if self.width / self.diameter < 2.05:
-            raise InputError(f"`width` must hold two grains (>= 2.05 `diameter`), got "
-                             f"{self.width!r} m for {self.diameter!r} m grains")
+        check_grain_params(self, ("width", "diameter", "density", "gravity"),
+                           ("mu", "mu_wall", "mu_floor", "wall_speed", "mu_r"), counts=("per_pour",))
 
 
 def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):

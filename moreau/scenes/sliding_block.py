@@ -35,6 +35,7 @@ from ..model.scene import FromParams
 from .._validate import finite_scalar
 from ..analysis.cases import GRID, CompareCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
+from ._block_on_line import block_contacts, block_mass
 
 __all__ = ["SlidingBlockParams", "SlidingBlock"]
 
@@ -123,7 +124,7 @@ class SlidingBlock(FromParams, SIUnits, CompiledScene):
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = [math.sin(self.alpha), math.cos(self.alpha)]
-        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
+        return CompiledModel(block_mass, _forces, block_contacts, _drift, par, 2, 1, True, False)
 
     def shapes(self, q, t=0.0):
         """The plane (inclined by ``alpha``), the block (a point mass, drawn 0.2 length units wide) and its contact."""
@@ -278,24 +279,9 @@ class SlidingBlockCase(CompareCase):
 # -- compiled model (moreau.compiled); par: sin(alpha), cos(alpha) -------------------------
 
 @njit(cache=True)
-def _mass(par, q, M):
-    M[0, 0] = 1.0
-    M[1, 1] = 1.0
-
-
-@njit(cache=True)
 def _forces(par, q, v, t, D, need_jac):
     D[0, 0] = par[0]
     D[1, 0] = -par[1]
-
-
-@njit(cache=True)
-def _contacts(par, q, t, G, need_gap, need_T):
-    if need_gap:
-        G[0, 0] = q[1]
-    G[0, 4] = 1.0
-    if need_T:
-        G[0, 5] = 1.0
 
 
 @njit(cache=True)

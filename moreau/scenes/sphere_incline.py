@@ -33,7 +33,7 @@ from dataclasses import dataclass
 from ..analysis.cases import SpatialCase
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
-from ..model.space import SpaceModel, Sphere
+from ._sphere_on_plane import sphere_on_plane
 from .disk_incline import INCLINE_UNITS, InclineCase, InclineParams, incline_motion, rolls_down
 
 __all__ = ["SphereInclineParams", "sphere_incline", "sphere_incline_exact", "rolls"]
@@ -69,16 +69,9 @@ def sphere_incline(params=None, **overrides):
     ([0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0], 1.0)
     """
     p = params_with(SphereInclineParams, params, overrides)
-    g, a, r = p.gravity, p.slope, p.radius
-    m = SpaceModel(gravity=(g * math.sin(a), 0.0, -g * math.cos(a)), length=r, mass=p.mass)
-    floor = m.add_half_space((0.0, 0.0, 0.0), (0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0))
-    ball = m.add_body(p.mass, [0.4 * p.mass * r * r] * 3, position=(0.0, 0.0, r),
-                      velocity=(p.speed, 0.0, 0.0), angular_velocity=(0.0, p.speed / r, 0.0),
-                      name="sphere")
-    m.add_contact(ball, Sphere(r), floor, mu=p.mu)
-    sc = m.build("sphere-incline", default_window=10.0)
-    sc.params = p
-    return sc
+    g, a = p.gravity, p.slope
+    return sphere_on_plane("sphere-incline", p, (g * math.sin(a), 0.0, -g * math.cos(a)),
+                           p.speed / p.radius, "sphere", 10.0)
 
 
 def sphere_incline_exact(params, t):

@@ -264,15 +264,12 @@ def _contact_bodies(st):
 def _mass(st):
     lines = ["@njit(cache=True)", "def mass(par, q, M):"]
     for k in range(st.nb):
-        kind, d, o = st.body(k)
-        if kind == K.FREE:
-            lines.append(f"    M[{d}, {d}] = par[{o + 2}]; M[{d + 1}, {d + 1}] = par[{o + 2}]; "
-                         f"M[{d + 2}, {d + 2}] = par[{o + 3}]")
-        elif kind == K.GUIDED:
-            # a guided body's inertia is about its frame's origin (par[o + 3])
-            for j, dj in enumerate(st.dofs(k)):
-                if dj is not None:
-                    lines.append(f"    M[{dj}, {dj}] = par[{o + (3 if j == 2 else 2)}]")
+        o = st.body(k)[2]
+        # mass par[o + 2] on x and y, inertia par[o + 3] on theta (a guided body's about its
+        # frame's origin); a fixed body has no dof
+        for j, dj in enumerate(st.dofs(k)):
+            if dj is not None:
+                lines.append(f"    M[{dj}, {dj}] = par[{o + (3 if j == 2 else 2)}]")
     return lines
 
 
@@ -333,14 +330,10 @@ def _forces(st):
              f"    for i in range({n}):", "        D[i, 0] = 0.0", "        if need_jac:",
              f"            for j in range({2 * n}):", "                D[i, 1 + j] = 0.0"]
     for k in range(st.nb):
-        kind, d, o = st.body(k)
-        if kind == K.FREE:
-            lines.append(f"    D[{d}, 0] += par[{o + 2}] * par[7]; "
-                         f"D[{d + 1}, 0] += par[{o + 2}] * par[8]")
-        elif kind == K.GUIDED:
-            for dj, gj in zip(st.dofs(k)[:2], (7, 8)):
-                if dj is not None:
-                    lines.append(f"    D[{dj}, 0] += par[{o + 2}] * par[{gj}]")
+        o = st.body(k)[2]
+        for dj, gj in zip(st.dofs(k)[:2], (7, 8)):
+            if dj is not None:
+                lines.append(f"    D[{dj}, 0] += par[{o + 2}] * par[{gj}]")
     used = set()
     for f in range(st.nf):
         kind, o = st.force(f)

@@ -21,7 +21,7 @@ times (:func:`moreau.compiled.memo_sincos`).
 """
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -116,6 +116,25 @@ class RodParams:
     def with_(self, **changes):
         """Copy with some parameters changed (validated again)."""
         return replace(self, **changes)
+
+    @classmethod
+    def from_kwargs(cls, **kwargs):
+        """The parameters from keyword arguments, ``None`` values left at their defaults.
+
+        Examples
+        --------
+        >>> RodParams.from_kwargs(mu=0.2, m=None).mu
+        0.2
+        >>> RodParams.from_kwargs(x10=1e-6)
+        Traceback (most recent call last):
+        ...
+        moreau.errors.InputError: unknown parameter(s) ['x10']; known: ['k', 'length', 'm', 'm2', 'mu', 'phi0']
+        """
+        names = {f.name for f in fields(cls)}
+        unknown = set(kwargs) - names
+        if unknown:
+            raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
+        return cls(**{k: v for k, v in kwargs.items() if v is not None})
 
 
 class OneRod:

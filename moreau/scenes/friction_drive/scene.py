@@ -74,7 +74,7 @@ preload), so with ``preload = 0`` every result is the same to the last bit.
 """
 
 import math
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -361,11 +361,7 @@ def _drift(par, q, v, t, Dr):
 
 def params_from_kwargs(**kwargs):
     """Build :class:`FrictionDriveParams` from keyword arguments, ignoring ``None`` values."""
-    names = {f.name for f in fields(FrictionDriveParams)}
-    unknown = set(kwargs) - names
-    if unknown:
-        raise InputError(f"unknown parameter(s) {sorted(unknown)}; known: {sorted(names)}")
-    return FrictionDriveParams(**{k: v for k, v in kwargs.items() if v is not None})
+    return FrictionDriveParams.from_kwargs(**kwargs)
 
 
 class FrictionDriveCase(DriveCase):

@@ -45,6 +45,7 @@ from ...model.scene import params_with
 from ...analysis.cases import GRID, CompareCase, regime_switches
 from ...integrators import get_integrator, simulate
 from ...model.registry import Parameter, SceneEntry, parameters_of, register_scene
+from .._block_on_line import block_contacts, block_mass
 
 __all__ = ["StickSlipMotorParams", "StickSlipMotor", "SineDrive", "SawtoothDrive"]
 
@@ -463,7 +464,7 @@ class StickSlipMotor(SIUnits, CompiledScene):
             par[2], par[5] = 1.0, m
             par[6:6 + m], par[10:10 + m] = d._starts, d._acc
             par[14:14 + m], par[18:18 + m] = d._vel, d._pos
-        return CompiledModel(_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
+        return CompiledModel(block_mass, _forces, _contacts, _drift, par, 2, 1, True, False)
 
 
 class StickSlipCase(CompareCase):
@@ -538,12 +539,6 @@ def _drive(par, t):
 
 
 @njit(cache=True)
-def _mass(par, q, M):
-    M[0, 0] = 1.0
-    M[1, 1] = 1.0
-
-
-@njit(cache=True)
 def _forces(par, q, v, t, D, need_jac):
     D[0, 0] = -par[0]
     D[1, 0] = -par[1]
@@ -551,11 +546,9 @@ def _forces(par, q, v, t, D, need_jac):
 
 @njit(cache=True)
 def _contacts(par, q, t, G, need_gap, need_T):
-    if need_gap:
-        G[0, 0] = q[1]
-    G[0, 4] = 1.0
+    block_contacts(par, q, t, G, need_gap, need_T)
     if need_T:
-        G[0, 5] = 1.0
+        # the stator moves under the block: its rate enters the slip
         G[0, 2] = -_drive(par, t)[1]
 
 
