@@ -45,6 +45,7 @@ import ast
 import functools
 import inspect
 import textwrap
+import types
 
 import numpy as np
 from numba import njit
@@ -208,6 +209,10 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
     return status, k, nrec
 
 
+#: the attributes a loop template gives of the function it builds
+_FUNCTION_ATTRS = frozenset(dir(types.FunctionType)) | {"__moreau_source__", "__moreau_sources__"}
+
+
 class _Template:
     """A loop template that is spliced on first use (:func:`loop_template`).
 
@@ -243,8 +248,10 @@ class _Template:
         return self._fn
 
     def __getattr__(self, attr):
-        if attr.startswith("_") and not attr.startswith("__"):
-            raise AttributeError(attr)     # the instance's own private fields, before __init__
+        # only what a spliced function has builds it: a probe such as hasattr(t, "py_func")
+        # (the disk-cache binding looks for numba functions among a module's globals) must not
+        if attr not in _FUNCTION_ATTRS:
+            raise AttributeError(attr)
         return getattr(self._built(), attr)
 
     def __call__(self, *args):
