@@ -558,6 +558,25 @@ def test_the_answer_lies_in_the_cone_and_its_residual_is_the_projection_s():
     assert sol.residual <= 1e-13 * np.linalg.norm(q)
 
 
+def test_four_contacts_sticking_and_one_open_are_found_without_the_finer_polygons():
+    # found by a survey (k = 28735, seed 2839128055, mu = 2.551): Newton stalls near 1e-2
+    # from every start, and the 128-gon's Lemke path took its exact-arithmetic path for
+    # minutes; the answer has contacts 0-3 sticking inside their cones and contact 4 open
+    W, q, _ = random_problem(np.random.default_rng(2839128055), 5)
+    mu = np.full(5, 2.5510825666154826)
+    sol = solve_exact(W, q, mu)
+    assert sol.success, sol.detail
+    assert "31 sets of sticking and open contacts (touching: [0, 1, 2, 3])" in sol.detail
+    assert sol.residual == cone_residual(W, q, mu, sol.r)
+    assert sol.residual <= 1e-13 * np.linalg.norm(q)
+    r = sol.r.reshape(-1, 3)
+    np.testing.assert_array_equal(r[4], 0.0)
+    assert sol.u[12] > 1.0                                      # contact 4 lifts off
+    stick = np.linalg.solve(W[:12, :12], -q[:12]).reshape(-1, 3)
+    np.testing.assert_allclose(r[:4], stick, rtol=0, atol=1e-12 * np.abs(stick).max())
+    assert np.all(np.hypot(r[:4, 1], r[:4, 2]) < 0.95 * mu[:4] * r[:4, 0])
+
+
 @pytest.mark.slow
 def test_one_contact_slip_under_strong_coupling_against_lemke_on_512_directions():
     # where the enumeration finds one slip and no stick, the 512-gon's LCP (Lemke) slides
