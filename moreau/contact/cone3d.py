@@ -1291,6 +1291,21 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
         r_n, res_n, newton = _newton(W, q, mu, r, (int(max_newton) + 1) // 2, tol_sq)
         if res_n < res:
             r, res = r_n, res_n
+    if res > tol_sq and max_newton > 0 and q.shape[0] > 3:
+        # W singular (more contact rows than the bodies' freedoms: a resting stack of
+        # boxes, four points a face): every contact sticking with the least-norm impulse
+        # r = -W^+ q, where np.linalg.solve's is noise, is the answer of a stack at rest
+        # (box-stack-3d, three cubes: 1.5e-14 |q|, where Newton stalled and the
+        # 16-gon's Lemke path met exact arithmetic on W's rounding); taken only where
+        # it meets the bound on the data
+        r_ls, _, rank, _ = np.linalg.lstsq(W, -q, rcond=None)
+        if rank < q.shape[0] and np.all(np.isfinite(r_ls)):
+            r_ls = _project_all(r_ls, mu)
+            res_ls = _natural_sq(r_ls, W @ r_ls + q, mu)
+            if res_ls <= tol_sq:
+                r, res = r_ls, res_ls
+                how.append(f"the least-norm sticking impulse -W^+ q (W of rank {rank} < "
+                           f"{q.shape[0]}) is the answer")
     if res > tol_sq and max_newton > 0:
         # Gauss–Seidel stalled and Newton did not converge from its point:
         # start Newton again from the polyhedral cone's solution (Lemke always
