@@ -110,6 +110,7 @@ See their docstrings for the exact argument types.
 
 import math
 import time
+from fractions import Fraction
 
 import numpy as np
 from numba import njit
@@ -2375,7 +2376,6 @@ def _exact_walk(M, q, covering, basis, entering, max_iter, pivots, deadline):
             return _exact.SOLVED, [0.0] * n, None, 0, False
         # z0 enters at the lexicographic minimum of (q_i, e_i) / d_i: the smallest
         # q_i / d_i (compared exactly), ties to the larger index, as exact_lemke
-        from fractions import Fraction
         ratios = [Fraction(float(q[i])) / Fraction(float(d[i])) for i in range(n)]
         r = 0
         for i in range(1, n):

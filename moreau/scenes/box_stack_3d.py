@@ -174,8 +174,8 @@ def box_stack_3d(params=None, **overrides):
     --------
     >>> sc = box_stack_3d()
     >>> q0, v0 = sc.initial_state()
-    >>> sc.ncontacts, int(sc.contacts_in_use(q0).sum())      # 4 + 8 slots, 8 points
-    (12, 8)
+    >>> sc.ncontacts, int(sc.contacts_in_use(q0).sum())      # 4 + 2 x 8 slots, 12 points
+    (20, 12)
     """
     p = params_with(BoxStack3DParams, params, overrides)
     g, al, a = p.gravity, p.slope, p.half_size
