@@ -49,7 +49,10 @@ integers take the step (:func:`moreau.lcp._exact.exact_step`). The whole
 path is finished in exact arithmetic only where a hand-over state repeats,
 where the basis is not
 lexicographically positive for the caller's data (the path then starts
-afresh) or too close to singular for floating point to follow. The path is
+afresh) or too close to singular for floating point to follow; from
+``n = 33`` that path is walked one compiled exact step at a time, and the
+exact part of a call stops at :data:`EXACT_TIME_BUDGET` CPU seconds with
+:data:`MAX_ITER` and a detail naming the budget. The path is
 the exact lexicographic one and cannot cycle. One exception, for cost: where
 ``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
 is a solution up to rounding, certified on the data as always), where the
