@@ -28,6 +28,7 @@ Variables are numbered as in the kernel: ``w_j -> j``, ``z_j -> n + j``,
 ``z0 -> 2 n``.
 """
 
+import time
 from fractions import Fraction
 
 import numpy as np
@@ -37,6 +38,8 @@ __all__ = ["exact_lemke", "exact_step", "basis_point", "integer_data"]
 SOLVED = 0
 RAY = 1
 MAX_ITER = 2
+#: the deadline given to :func:`exact_lemke` passed before the path's end
+BUDGET = 3
 
 
 def integer_data(*arrays):
@@ -134,8 +137,9 @@ def lex_positive(T, n):
     return True
 
 
-def _from_basis(Mi, qi, di, basis):
-    # the tableau of a given basis, by integer pivots from the all-w basis
+def _from_basis(Mi, qi, di, basis, deadline=None):
+    # the tableau of a given basis, by integer pivots from the all-w basis;
+    # rows is BUDGET when the deadline passes first
     n = len(qi)
     T = _tableau(Mi, qi, di)
     D = 1
@@ -143,6 +147,8 @@ def _from_basis(Mi, qi, di, basis):
     for v in basis:
         if v < n:
             continue
+        if deadline is not None and time.process_time() > deadline:
+            return None, None, BUDGET
         r = next((i for i in range(n) if rows[i] < n and rows[i] not in basis and T[i][v] != 0),
                  None)
         if r is None:
@@ -152,7 +158,8 @@ def _from_basis(Mi, qi, di, basis):
     return T, D, rows
 
 
-def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivots=0, trace=None):
+def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivots=0, trace=None,
+                deadline=None):
     """Lexicographic Lemke in exact integer arithmetic on the caller's floats.
 
     Parameters
@@ -171,11 +178,14 @@ def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivo
         Pivots made before the hand-over (counted in the result).
     trace : list, optional
         Receives ``(entering, leaving)`` of every pivot after the first.
+    deadline : float, optional
+        A ``time.process_time()`` value past which the path stops, checked
+        between pivots (status :data:`BUDGET`, ``z`` None).
 
     Returns
     -------
     status : int
-        0 solved, 1 secondary ray, 2 pivot limit.
+        0 solved, 1 secondary ray, 2 pivot limit, 3 the deadline passed.
     z : list of Fraction
         The terminal point (on a ray, the point where the ray starts).
     ray : list of Fraction or None
@@ -201,7 +211,9 @@ def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivo
     resumed = False
     T = None
     if basis is not None and entering is not None and z0 in basis:
-        T, D, rows = _from_basis(Mi, qi, di, list(basis))
+        T, D, rows = _from_basis(Mi, qi, di, list(basis), deadline)
+        if rows == BUDGET:
+            return BUDGET, None, None, pivots, True
         if T is not None and lex_positive(T, n) and all(row[2 * n + 1] >= 0 for row in T):
             resumed = True
         else:
@@ -224,6 +236,8 @@ def exact_lemke(M, q, d=None, *, basis=None, entering=None, max_iter=10**6, pivo
         pivots = 1
         entering = leaving + n
     while pivots < max_iter:
+        if deadline is not None and time.process_time() > deadline:
+            return BUDGET, None, None, pivots, resumed
         s = entering
         best = -1
         for i in range(n):

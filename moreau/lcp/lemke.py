@@ -49,7 +49,10 @@ integers take the step (:func:`moreau.lcp._exact.exact_step`). The whole
 path is finished in exact arithmetic only where a hand-over state repeats,
 where the basis is not
 lexicographically positive for the caller's data (the path then starts
-afresh) or too close to singular for floating point to follow. The path is
+afresh) or too close to singular for floating point to follow; from
+``n = 33`` that path is walked one compiled exact step at a time, and the
+exact part of a call stops at :data:`EXACT_TIME_BUDGET` CPU seconds with
+:data:`MAX_ITER` and a detail naming the budget. The path is
 the exact lexicographic one and cannot cycle. One exception, for cost: where
 ``z0``'s ratio ties another row's within rounding, ``z0`` leaves (the point
 is a solution up to rounding, certified on the data as always), where the
@@ -109,6 +112,8 @@ See their docstrings for the exact argument types.
 """
 
 import math
+import time
+from fractions import Fraction
 
 import numpy as np
 from numba import njit
@@ -2141,6 +2146,21 @@ def _packed_result(M, q, out, status, pivots, residual, note):
 DEFER_STEPS = 4
 
 
+#: CPU seconds (``time.process_time``) that the exact-arithmetic part of one Lemke call may
+#: take: past it the call ends with status ``MAX_ITER`` and a detail naming this budget, and
+#: the caller's fallback (``"auto"``: the QP) runs. The compiled exact walk takes 10 to
+#: 400 ms a step at n = 216 to 650 (12 s for the 883 steps of seed 2839128055's 128-gon,
+#: where the whole tableau of Python integers took minutes); a path that needs more is
+#: given up rather than left to run
+EXACT_TIME_BUDGET = 10.0
+
+# from this size on, a path finished in exact arithmetic is walked step by step with
+# the compiled exact step (_exact_walk: the k x k block of the basis's non-w variables)
+# rather than on the whole tableau of Python integers (_exact.exact_lemke: 2 n + 2
+# columns of integers that grow with every pivot; 1.6 s a pivot at n = 650)
+_WALK_MIN_N = 33
+
+
 def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=False):
     # The compiled pivoting met a tie rounding could not decide, or a repeated
     # basis. That step is decided in exact arithmetic (_exact.exact_step, on
@@ -2160,6 +2180,7 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
     first = handoff
     seen = set()
     start = np.empty(2 * n + 3)
+    deadline = time.process_time() + EXACT_TIME_BUDGET
     # the steps in compiled code first (_exact_run); what it leaves (a step too
     # large for its moduli, a refused basis, a repeat, the limit) goes on here
     # as before, with the Python integers
@@ -2176,7 +2197,8 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
         if defer:
             return None
         return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
-                             out[2 * n:3 * n].astype(np.int64).tolist(), int(out[3 * n]))
+                             out[2 * n:3 * n].astype(np.int64).tolist(), int(out[3 * n]),
+                             deadline=deadline)
     while status == _HANDOFF_TIE or status == _HANDOFF_CYCLE:
         basis = out[2 * n:3 * n].astype(np.int64)
         entering = int(out[3 * n])
@@ -2185,7 +2207,9 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             return None
         if key in seen or steps > 2 * n + 16:
             return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
-                                 basis.tolist(), entering)
+                                 basis.tolist(), entering, deadline=deadline)
+        if time.process_time() > deadline:
+            return _budget_result(M, q, first, pivots, steps)
         seen.add(key)
         info = out[3 * n + 1:_OUT * n + 4]
         if not info.any():
@@ -2202,7 +2226,7 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             return None
         if step is None:
             return _exact_finish(M, q, covering, out, status, pivots, max_iter, tol,
-                                 basis.tolist(), entering)
+                                 basis.tolist(), entering, deadline=deadline)
         kind, leaving, b = step
         steps += 1
         start[:n] = basis
@@ -2247,8 +2271,10 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
                     return _packed_result(M, q, out, SOLVED, int(start[n + 2]), residual, note)
         if start[n + 1] == _RESUME_PATH:
             return _exact_finish(M, q, covering, out, first, int(start[n + 2]), max_iter, tol,
-                                 start[:n].astype(np.int64).tolist(), int(start[n]))
-        return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol)
+                                 start[:n].astype(np.int64).tolist(), int(start[n]),
+                                 deadline=deadline)
+        return _exact_finish(M, q, covering, out, first, pivots, max_iter, tol,
+                             deadline=deadline)
     if status == SOLVED:
         # the point of the terminal basis in exact arithmetic, correctly rounded
         # (M_JJ z_J = -q_J, J its z variables): the answer the exact path gives
@@ -2313,17 +2339,119 @@ def _prove_secondary_ray(res, M, q, ray, pivots):
     res.detail = f"{why} `ray` holds the direction (dz, dz0) (after {pivots} pivots)."
 
 
-def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=None, entering=None):
+def _budget_result(M, q, handoff, pivots, steps):
+    # the exact-arithmetic part spent EXACT_TIME_BUDGET: no answer, said so
+    n = len(q)
+    res = _LemkeResult(np.zeros(n), q.copy(), MAX_ITER, pivots,
+                       float(lcp_violation(M, q, np.zeros(n))))
+    res.detail = (f"Pivoting met {_why(handoff)}; the path's exact-arithmetic part stopped at "
+                  f"its time budget ({EXACT_TIME_BUDGET:g} CPU s, "
+                  f"moreau.lcp.lemke.EXACT_TIME_BUDGET) after {pivots} pivots"
+                  f"{f' ({steps} decided exactly)' if steps else ''}, with no answer.")
+    return res
+
+
+def _exact_walk(M, q, covering, basis, entering, max_iter, pivots, deadline):
+    # exact_lemke's path (the same pivots, the same end) one step at a time by
+    # the compiled exact step (_modular.modular_step; the Python integers'
+    # _exact.exact_step where its moduli do not reach), from the given basis
+    # when the step accepts it (lexicographically positive for the data), else
+    # afresh. Returns exact_lemke's tuple, z as floats correctly rounded, or
+    # _exact.BUDGET (the budget) with the pivots made; on a secondary
+    # ray, exact_lemke finishes from the ray's basis (it ends at once)
+    n = len(q)
+    d = np.ones(n) if covering is None else covering
+    z0 = 2 * n
+    P = _modular.primes()
+    flags = np.empty(n)
+    resumed = False
+    b = None
+    if basis is not None and entering is not None and z0 in basis:
+        b = np.array(basis, dtype=np.int64)
+        e = int(entering)
+        first = _modular.modular_step(M, q, d, b, np.int64(e), P, flags)
+        if first[0] == _modular.STEP_TOO_BIG:
+            first = (_modular.STEP_REFUSED, -1) if _exact.exact_step(M, q, d, b, e) is None \
+                else first
+        resumed = first[0] != _modular.STEP_REFUSED
+    if not resumed:
+        if np.min(q) >= 0.0:
+            return _exact.SOLVED, [0.0] * n, None, 0, False
+        # z0 enters at the lexicographic minimum of (q_i, e_i) / d_i: the smallest
+        # q_i / d_i (compared exactly), ties to the larger index, as exact_lemke
+        ratios = [Fraction(float(q[i])) / Fraction(float(d[i])) for i in range(n)]
+        r = 0
+        for i in range(1, n):
+            if ratios[i] <= ratios[r]:
+                r = i
+        b = np.arange(n, dtype=np.int64)
+        b[r] = z0
+        e = r + n
+        pivots = 1
+    while pivots < max_iter:
+        if time.process_time() > deadline:
+            return _exact.BUDGET, None, None, pivots, resumed
+        outcome, leaving = _modular.modular_step(M, q, d, b, np.int64(e), P, flags)
+        if outcome == _modular.STEP_TOO_BIG:
+            step = _exact.exact_step(M, q, d, b, e)
+            outcome = (_modular.STEP_REFUSED if step is None else
+                       _modular.STEP_RAY if step[0] == "ray" else _modular.STEP_PIVOT)
+            leaving = -1 if step is None or step[0] == "ray" else step[1]
+        if outcome != _modular.STEP_PIVOT:
+            # a ray (or, which the exact steps rule out, a refused basis): exact_lemke
+            # from this basis ends the path and gives the ray
+            st, zx, rayx, piv, again = _exact.exact_lemke(M, q, covering, basis=b.tolist(),
+                                                          entering=e, max_iter=max_iter,
+                                                          pivots=pivots, deadline=deadline)
+            # (pivots counted as the walk counts them; afresh, which the exact steps
+            # rule out, from exact_lemke's start)
+            return st, zx, rayx, piv, resumed and again
+        pivots += 1
+        b[b == leaving] = e
+        if leaving == z0:
+            J = np.array([v - n for v in b if n <= v < z0], dtype=np.int64)
+            z = np.zeros(n)
+            if not _modular.exact_point(M, q, J, P, z, np.bool_(True)):
+                z = _exact.basis_point(M, q, J.tolist())
+                if z is None:
+                    # singular, which a terminal basis is not, or outside the floats' range
+                    return _exact.SOLVED, None, None, pivots, resumed
+            return _exact.SOLVED, list(z), None, pivots, resumed
+        e = leaving + n if leaving < n else leaving - n
+    return _exact.MAX_ITER, None, None, pivots, resumed
+
+
+def _exact_finish(M, q, covering, out, handoff, pivots, max_iter, tol, basis=None, entering=None,
+                  deadline=None):
     # the path is finished in exact arithmetic (moreau.lcp._exact) from the
     # basis the floating-point path handed over (None: afresh), or afresh when
     # that basis is not lexicographically positive for the caller's data, and
-    # its end is judged on the caller's data
+    # its end is judged on the caller's data; past the deadline (process time)
+    # the call ends without an answer (_budget_result)
     n = len(q)
-    st, zx, rayx, piv, resumed = _exact.exact_lemke(M, q, covering, basis=basis,
-                                                     entering=entering, max_iter=max_iter,
-                                                     pivots=pivots)
+    if deadline is None:
+        deadline = time.process_time() + EXACT_TIME_BUDGET
+    if n >= _WALK_MIN_N:
+        st, zx, rayx, piv, resumed = _exact_walk(M, q, covering, basis, entering, max_iter,
+                                                 pivots, deadline)
+        if st == _exact.BUDGET or (st == _exact.MAX_ITER and zx is None):
+            if st == _exact.BUDGET:
+                return _budget_result(M, q, handoff, piv if resumed else pivots + piv, 0)
+            res = _LemkeResult(np.zeros(n), q.copy(), MAX_ITER, piv,
+                               float(lcp_violation(M, q, np.zeros(n))))
+            res.detail = (f"Pivoting met {_why(handoff)} and was walked on in exact arithmetic "
+                          f"to the pivot limit. {_DETAIL[MAX_ITER]} (after {piv} pivots)")
+            return res
+    else:
+        st, zx, rayx, piv, resumed = _exact.exact_lemke(M, q, covering, basis=basis,
+                                                         entering=entering, max_iter=max_iter,
+                                                         pivots=pivots, deadline=deadline)
+        if st == _exact.BUDGET:
+            return _budget_result(M, q, handoff, piv if resumed else pivots + piv, 0)
     total = piv if resumed else pivots + piv
     try:
+        if zx is None:
+            raise OverflowError
         z = np.array([float(v) for v in zx]) if n else np.zeros(0)
     except OverflowError:
         # the exact point lies outside the range of doubles

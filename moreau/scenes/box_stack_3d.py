@@ -94,10 +94,11 @@ class BoxStack3DParams:
     Attributes
     ----------
     n_boxes : int
-        Cubes ``N``, a whole number in [1, 10]. The default is two: on three
-        resting cubes the exact cone's Newton polish fails now and then (a
-        degenerate problem, four points a face) and the solver restarts from
-        polyhedral LCPs in exact arithmetic, minutes a step.
+        Cubes ``N``, a whole number in [1, 10] (default 3). On resting cubes
+        the contact problem is singular (four points a face, more contact
+        rows than freedoms); where the exact cone's Newton polish stalls on it,
+        the least-norm sticking impulse is its answer (:func:`moreau.contact.
+        cone3d.solve_exact`).
     mass : float
         Each cube's mass [kg], > 0.
     half_size : float
@@ -116,7 +117,7 @@ class BoxStack3DParams:
         [m/s^2], > 0.
     """
 
-    n_boxes: int = 2
+    n_boxes: int = 3
     mass: float = 1.0
     half_size: float = 0.05
     mu: float = 0.5
@@ -173,8 +174,8 @@ def box_stack_3d(params=None, **overrides):
     --------
     >>> sc = box_stack_3d()
     >>> q0, v0 = sc.initial_state()
-    >>> sc.ncontacts, int(sc.contacts_in_use(q0).sum())      # 4 + 8 slots, 8 points
-    (12, 8)
+    >>> sc.ncontacts, int(sc.contacts_in_use(q0).sum())      # 4 + 2 x 8 slots, 12 points
+    (20, 12)
     """
     p = params_with(BoxStack3DParams, params, overrides)
     g, al, a = p.gravity, p.slope, p.half_size

@@ -10,6 +10,7 @@ r_T = -mu r_N q_T / |q_T| and u_T = q_T (1 - (7/2) mu (-q_N) / |q_T|).
 """
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -556,6 +557,45 @@ def test_the_answer_lies_in_the_cone_and_its_residual_is_the_projection_s():
     assert np.all(np.hypot(r[:, 1], r[:, 2]) <= mu * r[:, 0] * (1 + 1e-15))
     assert sol.residual == cone_residual(W, q, mu, sol.r)
     assert sol.residual <= 1e-13 * np.linalg.norm(q)
+
+
+def test_four_contacts_sticking_and_one_open_are_found_without_the_finer_polygons():
+    # found by a survey (k = 28735, seed 2839128055, mu = 2.551): Newton stalls near 1e-2
+    # from every start, and the 128-gon's Lemke path took its exact-arithmetic path for
+    # minutes; the answer has contacts 0-3 sticking inside their cones and contact 4 open
+    W, q, _ = random_problem(np.random.default_rng(2839128055), 5)
+    mu = np.full(5, 2.5510825666154826)
+    sol = solve_exact(W, q, mu)
+    assert sol.success, sol.detail
+    assert "31 sets of sticking and open contacts (touching: [0, 1, 2, 3])" in sol.detail
+    assert sol.residual == cone_residual(W, q, mu, sol.r)
+    assert sol.residual <= 1e-13 * np.linalg.norm(q)
+    r = sol.r.reshape(-1, 3)
+    np.testing.assert_array_equal(r[4], 0.0)
+    assert sol.u[12] > 1.0                                      # contact 4 lifts off
+    stick = np.linalg.solve(W[:12, :12], -q[:12]).reshape(-1, 3)
+    np.testing.assert_allclose(r[:4], stick, rtol=0, atol=1e-12 * np.abs(stick).max())
+    assert np.all(np.hypot(r[:4, 1], r[:4, 2]) < 0.95 * mu[:4] * r[:4, 0])
+
+
+def test_a_resting_stack_s_singular_problem_is_solved_by_the_least_norm_sticking_impulse():
+    # box-stack-3d with three cubes, a step at rest (12 contacts, four a face; W of rank 18
+    # of 36): Newton stalled (9.3e-13 against the bound 8e-13), the 16-gon's Lemke path
+    # met exact arithmetic on W's rounding (294 exact pivots in 120 CPU s unfinished), and
+    # -W^-1 q is noise (r_N < 0, |r_T| / r_N = 26); the least-norm -W^+ q is the answer
+    d = np.load(Path(__file__).with_name("box_stack_3_resting_step.npz"))
+    W, q, mu = d["W"], d["q"], d["mu"]
+    assert np.linalg.matrix_rank(W) == 18
+    sol = solve_exact(W, q, mu, r0=d["r0"])
+    assert sol.success and "least-norm sticking impulse -W^+ q (W of rank 18 < 36)" in sol.detail
+    assert sol.residual == cone_residual(W, q, mu, sol.r)
+    assert sol.residual <= 1e-13 * np.linalg.norm(q)
+    r = sol.r.reshape(-1, 3)
+    # each cube (1 kg) weighs h g: the plane's four points carry three, each interface's
+    # the cubes above, shared equally (the least norm), with no friction
+    per_point = np.repeat([3.0, 2.0, 1.0], 4) * r[:, 0].sum() / 24.0
+    np.testing.assert_allclose(r[:, 0], per_point, rtol=1e-10)
+    np.testing.assert_allclose(r[:, 1:], 0.0, atol=1e-11 * r[:, 0].max())  # 4e-12 measured
 
 
 @pytest.mark.slow

@@ -37,6 +37,7 @@ n = 40 case below is such data):
 * Murty's exponential examples (``2^n`` pivots).
 """
 
+import time
 from fractions import Fraction
 
 import numpy as np
@@ -287,3 +288,59 @@ def test_degenerate_n40_that_cycled_is_solved_on_the_exact_path():
     z_out, w_out, ray = np.zeros(n), np.zeros(n), np.zeros(n + 1)
     st_, piv, _ = lemke_core(M, q, np.ones(n), z_out, w_out, ray, work, iwork, 10**6, 1e-9)
     assert st_ != MAX_ITER and piv < 1000
+
+
+def test_the_compiled_exact_walk_is_the_whole_tableau_s_path():
+    # _exact_finish walks a path of n >= 33 one exact step at a time (the k x k block of
+    # the basis's z variables, compiled) instead of pivoting the whole tableau of Python
+    # integers (1.6 s a pivot at n = 650): the same pivots, the same end, the same point
+    # (correctly rounded) and ray on these degenerate problems (n = 33 .. 40)
+    from moreau.lcp._exact import exact_lemke
+    from moreau.lcp.lemke import _exact_walk
+    def zmat(seed, n=34):
+        # s I - B, B >= 0 integer: a secondary ray after 21 to 38 pivots for these seeds
+        rng = np.random.default_rng(seed)
+        B = rng.integers(0, 3, (n, n)).astype(float)
+        np.fill_diagonal(B, 0.0)
+        q = rng.integers(-2, 3, n).astype(float)
+        q[rng.random(n) < 0.5] = 0.0
+        q[0] = -1.0
+        return (float(seed % 4) * np.eye(n) - B) * 0.5, q
+
+    ends = set()
+    for seed in (0, 1, 2, 3, 8, 9, 10):
+        # degenerate_40's family at n = 33-36 (solved in 3 to 7 pivots), then rays
+        M, q = degenerate_40(seed, 33 + seed) if seed < 4 else zmat(seed)
+        st_a, z_a, ray_a, piv_a, _ = exact_lemke(M, q)
+        st_b, z_b, ray_b, piv_b, resumed = _exact_walk(M, q, None, None, None, 10**6, 0,
+                                                        time.process_time() + 60.0)
+        assert (st_b, piv_b, resumed) == (st_a, piv_a, False)
+        assert [float(v) for v in z_b] == [float(v) for v in z_a]
+        if st_a == 1:
+            assert [float(v) for v in ray_b] == [float(v) for v in ray_a]
+        ends.add(st_a)
+    assert ends == {0, 1}                                   # solutions and rays both met
+
+
+def test_a_spent_exact_arithmetic_budget_is_a_pivot_limit_that_names_it(monkeypatch):
+    # a problem whose path is finished in exact arithmetic (found among degenerate_40's
+    # family at n = 6; 8 pivots), with no time left: no answer, said so, and "auto"
+    # goes on to its fallback
+    from moreau.lcp import lemke
+    from moreau.lcp.lemke import _exact_walk
+    M, q = degenerate_40(25, 6)
+    res = solve_lcp(M, q)
+    assert res.success and res.pivots == 8 and "finished in exact arithmetic" in res.detail
+    monkeypatch.setattr(lemke, "EXACT_TIME_BUDGET", -1.0)
+    spent = solve_lcp(M, q)
+    assert spent.status == MAX_ITER and not spent.success
+    assert "stopped at its time budget (-1 CPU s, moreau.lcp.lemke.EXACT_TIME_BUDGET)" \
+        in spent.detail
+    np.testing.assert_array_equal(spent.z, 0.0)
+    np.testing.assert_array_equal(spent.w, q)
+    auto = solve_lcp(M, q, "auto")
+    assert auto.path[-1] == "qp" and "Lemke first" in auto.detail
+    # the walk (n >= 33) stops at the deadline too, before its first pivot
+    M, q = degenerate_40(0, 40)
+    st_, z, _, piv, _ = _exact_walk(M, q, None, None, None, 10**6, 0, time.process_time() - 1.0)
+    assert st_ == 3 and z is None and piv == 1

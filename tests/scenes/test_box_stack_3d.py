@@ -47,6 +47,24 @@ def test_a_resting_stack_carries_the_mass_above_on_each_interface_and_stays_at_r
         assert kinds == ["ee", "ee", "fa", "fa"]
 
 
+def test_three_resting_cubes_on_the_eight_direction_pyramid_carry_the_mass_above():
+    # the polyhedral cone (d = 8, Lemke on 12 contacts' 120-row LCP each step) on the
+    # default stack: the same totals, at rest, every impulse inside its pyramid
+    sc = box_stack_3d()
+    assert sc.nbodies == 3
+    q0, v0 = sc.initial_state()
+    h, steps = 0.02, 40
+    res = simulate(sc, (0.0, steps * h), q0, v0, "moreau-jean", h=h, cone=8)
+    assert res.status == 0, res.message
+    for k, total in enumerate(_interface_totals(sc, res)):
+        assert np.max(np.abs(total - (3 - k))) <= 1e-10 * (3 - k)
+    assert np.max(np.abs(res.v)) <= 1e-12 * steps
+    assert np.max(np.abs(res.q - q0)) <= 1e-10
+    assert np.max(res.slip_velocity) <= 1e-12
+    # the inscribed octagon: |r_T| <= mu r_N
+    assert np.all(res.force_T <= 0.5 * res.force_N * (1.0 + 1e-9) + 1e-15)
+
+
 def test_a_sliding_cube_decelerates_at_mu_g_and_stops_at_v_squared_over_2_mu_g():
     p = BoxStack3DParams(n_boxes=1, speed=0.5, mu=0.4)
     sc = box_stack_3d(p)
@@ -103,7 +121,7 @@ def test_a_cube_on_an_incline_stays_below_the_friction_angle_and_slides_above_it
     ({"half_size": 0.0}, "`half_size` must be > 0"),
     ({"mass": -1.0}, "`mass` must be > 0"),
     ({"slope": 1.6}, "`slope` must be in"),
-    ({"offset": 0.06}, "stack would topple at interface 1"),
+    ({"n_boxes": 2, "offset": 0.06}, "stack would topple at interface 1"),
     ({"n_boxes": 3, "mu": 0.5, "speed": 1.0}, "stack would topple at interface 0"),
 ])
 def test_bad_parameters_are_refused_by_name(kwargs, match):
