@@ -61,8 +61,8 @@ def test_initial_state_is_admissible(name):
 # the flexible rod's reference resolves its 17 kHz bending mode inside a 185 Hz period
 # (130 s on 2 cores, a tenth of the default run): it runs with the long checks (-m slow)
 HEAVY = {"flexible-rod-drive",
-         # 1000 Python steps of the resting cubes: where the exact cone's Newton polish fails on
-         # the degenerate faces the solver restarts from exact-arithmetic Lemke (134 s, loaded)
+         # 1000 Python steps of three resting cubes on the exact cone, whose Delassus operator
+         # is singular at rest (8.7 CPU s of steps; 32 s with its reference, loaded)
          "box-stack-3d"}
 
 
