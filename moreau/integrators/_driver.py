@@ -449,7 +449,10 @@ class _Splicer:
     target and its other returns the caller's; an argument that is not a
     name is bound once, in :attr:`setup`, so it must not change from step to
     step. The globals a spliced body reads are added to the namespace, under
-    another name where the namespace binds the name to something else.
+    another name where the namespace binds the name to something else, except
+    the names in the namespace's ``SPLICE_SWITCHES``: compile-time switches of
+    the spliced code that the caller's module sets to its own values (numba
+    prunes the branches they guard).
     """
 
     def __init__(self, namespace):
@@ -527,9 +530,12 @@ class _Splicer:
     def _globals(self, py, free, names):
         """Bind the globals ``py``'s body reads (of the names ``free``) in the namespace
         (renamed where taken)."""
+        switches = self.ns.get("SPLICE_SWITCHES", ())
         for nm in sorted(free):
             if nm not in py.__globals__:
                 continue            # a builtin
+            if nm in switches:
+                continue            # a compile-time switch the caller's module sets itself
             val = py.__globals__[nm]
             have = self.ns.get(nm, val)
             if have is val or (type(have) is type(val) and isinstance(val, (int, float, bool))

@@ -24,6 +24,8 @@ from numba import njit
 
 from ._driver import loop_template, spliced
 from ._mj_kernels import OK, S_PEN, SINGULAR, _classify, _lcp_step, lcp_buffers  # noqa: F401
+# read by moreau.integrators._loops
+from ._mj_kernels import SHARED_INDIRECT, _lcp_step_unused  # noqa: F401
 from ._step_parts import (add_impulse, affine_rows, all_finite, gap_block, gaps_at, gather_rows,
                           held_gaps, index_set, invert, move_back, times_ht)
 from ._tdg_kernels import _solve_small, _stage_problem
@@ -77,7 +79,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 def midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs, vs, qm, tb, tm,
                       hb, n, nc, cl, Mi, D, qe, vf, v1, pN, pT, sl, act, ia, fa, Gm, Ge, Hm, He,
                       wm, we, ea, vpre, Dir, force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl,
-                      stats):
+                      stats, lcp_step):
     """``v1`` after one Moreau midpoint step of ``hb`` from ``(qs, vs)`` at ``tb`` (``qm`` its
     midpoint, ``Mi`` the inverse mass there); returns how many contacts are active in it."""
     forces_fn(par, qm, vs, tm, D, False)
@@ -113,7 +115,7 @@ def midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
             ea[r] = 0.0 if cl[ia[r]] else e[ia[r]]
         times_ht(Mi, Hm, Dir, m, n)
         st = _stage_problem(He, we, Dir, vf, ea, vpre, n, na, nfa, ia, mu, force_lemke, p, pN,
-                            pT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+                            pT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step)
         if st != OK:
             return st
         add_impulse(Dir, p, vf, v1, m, n)
@@ -127,7 +129,7 @@ def sequence(mass_fn, forces_fn, contacts_fn, gaps_fn, HAS_GAPS, const_mass, hav
              q, v, closed, last_reg, t, H, j, n, nc, M, Mi, wk, D, qm, qe, qs, vs, vf, v1, pN, pT,
              sl, reg, reg0, cl, act, ia, fa, Gm, Ge, G1, Hm, He, wm, we, ea, vpre, Dir, force_lemke,
              p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, cnt, Y, sq_smooth, sq_missed,
-             sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg):
+             sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg, lcp_step):
     """Sequence ``j``: ``j`` Moreau midpoint steps of ``H / j`` from ``(q, v)`` at ``t``, into
     row ``j - 1`` of the table ``Y`` (state, the first and the last step's mean accelerations)
     and of the ``sq_*`` arrays. Returns ``(same_last, have_Mi)``: whether it ends in the regimes
@@ -159,7 +161,8 @@ def sequence(mass_fn, forces_fn, contacts_fn, gaps_fn, HAS_GAPS, const_mass, hav
         na = midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
                                vs, qm, tb, tm, hb, n, nc, cl, Mi, D, qe, vf, v1, pN, pT,
                                sl, act, ia, fa, Gm, Ge, Hm, He, wm, we, ea, vpre, Dir,
-                               force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+                               force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats,
+                               lcp_step)
         # the mean accelerations of the first and the last base step: at the ends of
         # the macro step to O(hb), and extrapolated with the state
         if ib == 0:
@@ -375,7 +378,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 e, q, v, closed, last_reg, t, H, j, n, nc, M, Mi, wk, D, qm, qe, qs, vs, vf, v1,
                 pN, pT, sl, reg, reg0, cl, act, ia, fa, Gm, Ge, G1, Hm, He, wm, we, ea, vpre, Dir,
                 force_lemke, p, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, cnt, Y, sq_smooth,
-                sq_missed, sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg)
+                sq_missed, sq_closing, sq_closed, sq_pN, sq_pT, sq_slip, sq_reg, lcp_step)
             jdone = j
             # after sequence j: go on, or decide
             if j == 1:

@@ -18,6 +18,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
                           _residual, _stop_at, grid_step, lcp_buffers, record_sample)
 from ._driver import loop_template, spliced
+# read by moreau.integrators._loops
+from ._mj_kernels import SHARED_INDIRECT, _lcp_step_unused  # noqa: F401
 from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, held_gaps, index_set,
                           invert, move_back, record_contacts, start_contacts, times_ht)
 
@@ -30,7 +32,7 @@ __all__ = ["tdg_loop"]
 # bouncing ball about 7 % slower
 @njit(inline="always")
 def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke, p, pN, pT,
-                   U, Wd, Uf, base, trow, lw, lcp_ctl, stats):
+                   U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step):
     """Impulse ``p`` along ``Dir`` (``M^-1 H^T``) making ``Hm v + wm`` obey Newton–Coulomb.
 
     ``e`` and ``vpre`` (per row of ``ia``) give Newton's law
@@ -39,7 +41,9 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
     (``Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol``, those of
     :func:`moreau.integrators._mj_kernels._lcp_step`). Writes ``p`` (stacked rows), ``pN``, ``pT`` (by contact)
     and ``U`` (the local velocities after the impulse). Returns a status of
-    :mod:`moreau.integrators._mj_kernels`.
+    :mod:`moreau.integrators._mj_kernels`. ``lcp_step`` is the loop's LCP step: in the
+    shared loop a pointer (:data:`SHARED_INDIRECT`), so that Lemke is not linked and
+    optimised again inside the loop, and a stand-in where no LCP can arise.
     """
     m = na + nfa
     need = False
@@ -93,7 +97,7 @@ def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke,
         L = _lcp_size(na, ia, mu, base, trow)
         Ml, ql, dl, zl, wl, rayl, work, iwork, lay, Ab, xb, idx, pcol = lw
         # np.False_: a literal False would compile the LCP step a second time
-        lst, piv, res, warm = _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
+        lst, piv, res, warm = lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow,
                                         Ml, ql, dl, zl, wl, rayl, work, iwork, lay,
                                         lcp_ctl, Ab, xb, idx, pcol, np.False_)
         if lst != 0:
@@ -159,7 +163,7 @@ def step_workspace(n, nc, opts, lcp_ctl):
 
 @spliced(step_returns=True)
 def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, Dirs, v0, p, Ptot,
-                     force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats):
+                     force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step):
     """The impulsive part at ``t_n+``: Newton's law on the pre-step velocities, into ``v0`` and
     ``Ptot``; ``Dirs[0] = M^-1 H^T`` at the step's start."""
     gather_rows(G0, ia, fa, na, nfa, n, H, w)
@@ -168,7 +172,7 @@ def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, D
         ez[r] = vN0[ia[r]]
     times_ht(Mi0, H, Dirs[0], m, n)
     st = _stage_problem(H, w, Dirs[0], v0, ea, ez, n, na, nfa, ia, mu, force_lemke, p,
-                        sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+                        sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step)
     if st != OK:
         return st
     for c in range(m):
@@ -277,7 +281,8 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     m = na + nfa
     if na > 0:
         impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, Dirs, v0, p,
-                         Ptot, force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats)
+                         Ptot, force_lemke, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats,
+                         lcp_step)
     # the non-impulsive part: half-explicit Runge-Kutta on the Lobatto nodes
     forces_fn(par, q, v0, tk, D, False)  # noqa: F821
     for i in range(n):
@@ -309,7 +314,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             kc = hk * (b_st[st_i - 1] if fin else a_st[st_i, st_i - 1])
             st = _stage_problem(H, w, Dirs[st_i - 1], vi, ea, ez, n, na, nfa, ia, mu,
                                 force_lemke, p, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl,
-                                stats)
+                                stats, lcp_step)
             if st != OK:
                 return st
             for c in range(m):

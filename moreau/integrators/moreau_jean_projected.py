@@ -63,6 +63,11 @@ __all__ = ["MoreauJeanProjected", "mjp_loop"]
 #: PROJECTION_MAXITER Gauss–Newton iterations
 PROJECTION_TOL = 1e-14
 PROJECTION_MAXITER = 8
+#: Moreau–Jean's switch of its own projection, set here for its step spliced into this loop
+#: (moreau.integrators._driver.loop_template): that step runs with ``projection`` False, so
+#: its projection is never taken and numba prunes it instead of compiling it
+PROJECTION_REACHABLE = False
+SPLICE_SWITCHES = ("PROJECTION_REACHABLE",)
 
 
 @njit(cache=True)

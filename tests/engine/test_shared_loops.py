@@ -168,3 +168,19 @@ def test_a_one_contact_run_takes_the_lean_shared_loop_with_the_full_loop_s_bits(
     q0, v0 = scene.initial_state()
     simulate(scene, (0.0, 0.2), q0, v0, "moreau-jean", h=2e-3, projection=True)
     assert list(_loops.runner_for(scene.compiled_model())._cores) == [False]
+
+
+@pytest.mark.parametrize("module", ["_mj_kernels", "_sp_kernels", "_nsga_kernels", "_tdg_kernels",
+                                    "_studer_kernels", "moreau_jean_projected"])
+def test_every_scheme_s_loop_calls_the_lcp_step_through_its_argument(module):
+    # through the argument, the shared loop gets Lemke as a pointer (not linked in and optimised
+    # again with the loop) and a one-contact run the stand-in; a kernel that called the global
+    # _lcp_step (as TDG's stage problem did) linked Lemke into TDG's and Studer's loops
+    import importlib
+
+    mod = importlib.import_module(f"moreau.integrators.{module}")
+    assert "_lcp_step" in mod.SHARED_INDIRECT
+    callers = [name for name, f in vars(mod).items()
+               if getattr(getattr(f, "py_func", None), "__module__", None) == mod.__name__
+               and "_lcp_step" in f.py_func.__code__.co_names]
+    assert callers == []

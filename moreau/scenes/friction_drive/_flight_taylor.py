@@ -180,7 +180,10 @@ def flight_steps(tau, phi, dphi, tau_end, skip, cleared, a, P, b, sin_phi0, u10,
             return FAILED, tau, phi, dphi, steps, cleared
         if tau + h >= tau_end or tau_end - (tau + h) < 1e-14 * max(1.0, abs(tau_end)):
             h = tau_end - tau
-        coef[steps, :] = x
+        # element by element: a slice assignment compiles numba's shape-mismatch error
+        # message (string formatting, about 2.5 CPU s on a cold cache)
+        for j in range(n + 1):
+            coef[steps, j] = x[j]
         starts[steps] = tau
         widths[steps] = h
         steps += 1
