@@ -19,17 +19,22 @@ from moreau.scenes.granular_column import fit_runout
 from moreau.studies.granular.runout import runout_rows
 
 
-def run(out, cases):
+def run(out, cases, seeds):
     def write(row):
         row["cpu_s"] = time.process_time() - t0[0]
+        row["seed"] = seed
         with open(out, "a") as f:
             f.write(json.dumps(row) + "\n")
-        print(f"a = {row['aspect']:.2f}: runout {row['runout']:.2f}, stopped {row['stopped']}, "
+        print(f"seed {seed}, a = {row['aspect']:.2f}: runout {row['runout']:.2f}, stopped {row['stopped']}, "
               f"{row['cpu_s']:.0f} s CPU", flush=True)
         t0[0] = time.process_time()
 
     t0 = [time.process_time()]
-    runout_rows([tuple(float(s) for s in c.split(":")) for c in cases], on_row=write)
+    pairs = [tuple(float(s) for s in c.split(":")) for c in cases]
+    # (every aspect ratio with one seed before the next seed: an interrupted run keeps a
+    # whole curve per seed done)
+    for seed in seeds:
+        runout_rows(pairs, on_row=write, seed=seed)
 
 
 def fit(paths, split):
@@ -55,9 +60,10 @@ def main():
     ap.add_argument("out")
     ap.add_argument("more", nargs="*")
     ap.add_argument("--split", type=float, default=3.0)
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0])
     a = ap.parse_args()
     if a.mode == "run":
-        run(a.out, a.more)
+        run(a.out, a.more, a.seeds)
     else:
         fit([a.out] + a.more, a.split)
 

@@ -46,6 +46,16 @@ def test_the_ensemble_averages_at_equal_depth_and_fits_once():
     assert np.allclose(e["m_app_sem"][:4], janssen(e["mass"][:4], 20.0) * 0.05, rtol=1e-9)
     assert e["mobilised"] == pytest.approx(0.8) and e["steps"] == 200 and e["unconverged"] == 2
     assert np.allclose(e["wall_fraction"], 1.0 - e["m_app"] / e["mass"])
+    # per band between cuts: the walls carry what the law says; the synthetic walls push 2 dM
+    # (mu_wall dN = dM), so the friction is mobilised as much as it carries; K by hand
+    assert np.allclose(e["band_wall_share"][:4], e["band_law_share"][:4], rtol=1e-6)
+    assert np.allclose(e["band_mobilised"][:4], e["band_wall_share"][:4], rtol=1e-12)
+    k_top = 20.0 / (2 * 2.0) / (0.5 * janssen(10.0, 20.0) / 6.0)
+    assert e["band_K"][0] == pytest.approx(k_top, rel=1e-9)
+    # the floor band (the last cut, 8 d, to the floor at the height 10 d): 10 of mass, 2 d
+    assert e["band_K"][-1] == pytest.approx(
+        (2.5 - 80.0) / (2 * 2.0) / (0.5 * (janssen(40.0, 20.0) + janssen(50.0, 20.0)) / 6.0),
+        rel=1e-9)
     # one filling alone is refused, as are two silos of different widths
     with pytest.raises(InputError, match="`profiles`"):
         ensemble([_synthetic(20.0, 1.0, up)])
@@ -59,6 +69,10 @@ def test_the_sliding_profile_refuses_bad_input_by_name_before_any_run():
         sliding_profile(0, n_disks=0)
     with pytest.raises(InputError, match="`measure_steps`"):
         sliding_profile(0, measure_steps=1, every=2)
+    with pytest.raises(InputError, match="`slide_tol`"):
+        sliding_profile(0, slide_tol=0.0)
+    with pytest.raises(InputError, match="`slide_sweeps`"):
+        sliding_profile(0, slide_sweeps=0)
     with pytest.raises(InputError, match="`scatter`"):
         sliding_profile(0, scatter=-1.0)
     with pytest.raises(InputError, match="`nonsense`"):

@@ -123,14 +123,17 @@ DEFAULTS = {"spread": 2.0 / 3.0, "mu_r": 0.1 * SiloParams.diameter}
 
 def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, settle_steps=3000,
                     transient_steps=50, measure_steps=100, every=2, dz=2.0, tol=1e-4,
-                    max_sweeps=300, **overrides):
+                    max_sweeps=300, slide_tol=None, slide_sweeps=None, **overrides):
     """One filling of the silo, weighed across cuts while its walls slide (module docstring).
 
     ``params`` and ``overrides`` are :class:`~moreau.scenes.silo.SiloParams`
     (its ``seed`` and ``per_pour`` are not used: ``seed`` and ``n_disks``
     are); without ``params``, the unnamed ones take the study's defaults
     (``spread = 2/3``, ``mu_r = 0.1 d``) and then the silo's. Grain units: ``d``,
-    ``sqrt(d / g)``; ``wall_speed`` [m/s] as in ``SiloParams``.
+    ``sqrt(d / g)``; ``wall_speed`` [m/s] as in ``SiloParams``. NSGS stops at
+    ``tol`` or ``max_sweeps`` while the packing settles, and at ``slide_tol``
+    or ``slide_sweeps`` (default: the same) while the walls slide, so that one
+    packing can be weighed with solves of different accuracy.
 
     Returns
     -------
@@ -149,7 +152,9 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
         ``rho`` (its mass over ``W`` times ``height``), ``width``,
         ``mu_wall``, ``samples``, ``settle_steps`` (taken),
         ``unconverged`` (sliding steps above ``tol``), ``steps`` (sliding
-        steps), ``max_residual``.
+        steps), ``max_residual``, ``kinetic`` (the disks' kinetic energy at
+        the samples, mean, over ``g d`` times the packing's mass: a speed
+        squared in ``g d``).
 
     Examples
     --------
@@ -170,6 +175,9 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
     every = positive_int("every", every)
     measure_steps = positive_int("measure_steps", measure_steps)
     transient_steps = positive_int("transient_steps", transient_steps + 1) - 1
+    slide_tol = tol if slide_tol is None else positive("slide_tol", slide_tol)
+    slide_sweeps = max_sweeps if slide_sweeps is None else positive_int("slide_sweeps",
+                                                                        slide_sweeps)
     if measure_steps < every:
         raise InputError(f"`measure_steps` must be >= `every` ({every}), got {measure_steps}")
     W = p.width / p.diameter
@@ -179,8 +187,9 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
     v[:, 0] = np.random.default_rng([seed, 1]).uniform(-scatter, scatter, n)
     fixed = silo_system(radii, p)
     moving = silo_system(radii, p, wall_speed=V)
-    run_opts = dict(theta=1.0, tol=tol, max_sweeps=max_sweeps)
-    run = settle(fixed, x, v, h, max_steps=settle_steps, speed_tol=2e-3, **run_opts)
+    run = settle(fixed, x, v, h, max_steps=settle_steps, speed_tol=2e-3, theta=1.0, tol=tol,
+                 max_sweeps=max_sweeps)
+    run_opts = dict(theta=1.0, tol=slide_tol, max_sweeps=slide_sweeps)
     taken = int(run.steps["t"].size)
     x, v, phi, warm = run.x[-1], run.v[-1], run.phi[-1], run.impulses
     if transient_steps:
@@ -188,7 +197,7 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
                              save_every=transient_steps, **run_opts)
         x, v, phi, warm = run.x[-1], run.v[-1], run.phi[-1], run.impulses
     keys = ("mass", "m_app", "wall_friction", "wall_normal")
-    profiles, tops = [], []
+    profiles, tops, kinetic = [], [], []
     unconverged, residual, steps = 0, 0.0, 0
     impulse = np.zeros(2)
     p_start = float(fixed.masses @ v[:, 1])
@@ -205,6 +214,8 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
         impulse += [wi[:, 0, 0].sum(), (wi[:, 1, 1] - wi[:, 2, 1]).sum()]
         profiles.append(wall_profile(moving, x, warm, h, dz=dz))
         tops.append(float(np.max(x[:, 1] + radii)))
+        kinetic.append(0.5 * float(fixed.masses @ (v[:, 0] ** 2 + v[:, 1] ** 2)
+                                   + fixed.inertias @ v[:, 2] ** 2))
     # (every cut but the last, the floor, lies k dz below that sample's top)
     cuts = min(prof["depth"].size for prof in profiles) - 1
     out = {"depth": dz * np.arange(1, cuts + 1)}
@@ -217,7 +228,8 @@ def sliding_profile(seed, params=None, *, n_disks=150, scatter=0.5, h=0.01, sett
                momentum_change=(float(fixed.masses @ v[:, 1]) - p_start) / duration)
     out.update(height=height, rho=float(fixed.masses.sum()) / (W * height), width=W,
                mu_wall=p.mu_wall, samples=len(profiles), settle_steps=taken,
-               unconverged=unconverged, steps=steps, max_residual=residual)
+               unconverged=unconverged, steps=steps, max_residual=residual,
+               kinetic=float(np.mean(kinetic)) / float(fixed.masses.sum()))
     return out
 
 
@@ -248,7 +260,14 @@ def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
         ``m_sat``, ``lam``, ``deviation`` (per point fitted), ``max_deviation``,
         ``rms_deviation`` (over them), ``floor_deviation`` (the floor's load
         against the fitted law, whether fitted or not), ``K_bounds`` (``K_a, K_w, K_p``), ``fillings``,
-        ``unconverged`` and ``steps`` (sliding steps, all fillings).
+        ``unconverged`` and ``steps`` (sliding steps, all fillings). Per band
+        between successive points (the top to the first cut, ..., the last
+        cut to the floor), from the means: ``band_wall_share`` (the walls'
+        upward friction on the band's disks over their weight),
+        ``band_law_share`` (the same by the fitted law), ``band_mobilised``
+        (that friction over ``mu_wall`` times the walls' normal force on the
+        band) and ``band_K`` (the walls' mean normal stress on the band over
+        the vertical stress ``m_app / W`` at its middle).
 
     Examples
     --------
@@ -259,7 +278,8 @@ def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
     ...     m = np.array([10.0, 20.0, 30.0])
     ...     return {"depth": np.array([2.0, 4.0, 6.0]), "mass": m, "m_app": janssen(m, 20.0),
     ...             "floor_mass": m_floor, "floor_m_app": float(janssen(m_floor, 20.0)),
-    ...             "wall_friction": m - janssen(m, 20.0), "wall_normal": m,
+    ...             "wall_friction": m - janssen(m, 20.0),
+    ...             "wall_normal": 2 * (m - janssen(m, 20.0)),
     ...             "floor_friction": 1.0, "floor_normal": 4.0, "height": 8.0, "rho": 1.0,
     ...             "width": 6.0, "mu_wall": 0.5, "unconverged": 0, "steps": 10}
     >>> e = ensemble([one(40.0), one(40.0)])
@@ -268,6 +288,8 @@ def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
     >>> e = ensemble([one(40.0), one(40.0)], floor=False)
     >>> e["deviation"].size, abs(e["floor_deviation"]) < 1e-6
     (3, True)
+    >>> np.allclose(e["band_wall_share"][:3], e["band_law_share"][:3]), e["band_mobilised"][:3]
+    (True, array([1., 1., 1.]))
     """
     profiles = list(profiles)
     if len(profiles) < 2:
@@ -287,11 +309,23 @@ def ensemble(profiles, *, floor=True, mu_wall=None, phi=None):
     m, y = mass.mean(axis=0), load.mean(axis=0)
     W = float(profiles[0]["width"])
     rho = float(np.mean([pr["rho"] for pr in profiles]))
+    friction = np.mean([np.append(pr["wall_friction"][:cuts], pr["floor_friction"])
+                        for pr in profiles], axis=0)
+    normal = np.mean([np.append(pr["wall_normal"][:cuts], pr["floor_normal"])
+                      for pr in profiles], axis=0)
     n_fit = m.size if floor else m.size - 1
     fit = fit_janssen(m[:n_fit], y[:n_fit], rho=rho, width=W, mu_wall=mu_wall)
     mobilised = float(np.mean([pr["floor_friction"] / (mu_wall * pr["floor_normal"])
                                for pr in profiles]))
-    return {"depth": depth, "mass": m, "m_app": y,
+    d_mass, d_friction, d_normal, dz = (np.diff(np.append(0.0, q))
+                                        for q in (m, friction, normal, depth))
+    y_mid = 0.5 * (np.append(0.0, y[:-1]) + y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bands = {"band_wall_share": d_friction / d_mass,
+                 "band_law_share": 1.0 - np.diff(np.append(0.0, janssen(m, fit["m_sat"]))) / d_mass,
+                 "band_mobilised": d_friction / (mu_wall * d_normal),
+                 "band_K": d_normal / (2.0 * dz) / (y_mid / W)}
+    return {**bands, "depth": depth, "mass": m, "m_app": y,
             "m_app_sem": load.std(axis=0, ddof=1) / math.sqrt(len(profiles)),
             "wall_fraction": 1.0 - y / m, "mobilised": mobilised, "K": fit["K"],
             "m_sat": fit["m_sat"], "lam": fit["lam"], "deviation": fit["deviation"],
