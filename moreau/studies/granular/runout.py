@@ -52,10 +52,15 @@ aimed at narrow ``L0`` (the packing estimate of
 is used. One seed a column: the scatter between fillings is not measured.
 """
 
+import math
+
+import numpy as np
+
+from ..._validate import positive
 from ...errors import InputError
 from ...scenes.granular_column import collapse, fit_runout
 
-__all__ = ["runout_rows"]
+__all__ = ["runout_rows", "runout_ensemble", "runout_summary"]
 
 #: the study's defaults: ``+-20 %`` radii, rolling resistance a tenth of a diameter,
 #: random horizontal start speeds (columns of rolling-resistant disks stand in the start
@@ -100,3 +105,137 @@ def runout_rows(cases, *, a_split=3.0, on_row=None, **options):
             on_row(row)
     fit = fit_runout([r["aspect"] for r in rows], [r["runout"] for r in rows], a_split)
     return rows, fit
+
+
+def runout_ensemble(cases, seeds, *, a_split=3.0, on_row=None, **options):
+    """Collapse every ``(aspect, L0)`` column once per seed; the rows and their summary.
+
+    The seed draws the column's radii, its start lattice's jitter and its
+    start speeds (:func:`~moreau.scenes.granular_column.collapse`), so each
+    seed is an independent filling of the same column. The columns run one
+    at a time, every case with one seed before the next seed (an interrupted
+    run keeps whole curves); ``on_row(row)`` is called as each finishes.
+    ``options`` as for :func:`runout_rows`.
+
+    Returns
+    -------
+    rows : list of dict
+        :func:`runout_rows`'s, each with its ``seed``.
+    summary : dict
+        :func:`runout_summary` of the rows.
+
+    Examples
+    --------
+    >>> rows, s = runout_ensemble([(0.5, 3.0)], [0, 1], max_time=0.3, settle_time=0.2)
+    >>> [r["seed"] for r in rows], s["n"].tolist(), s["p"] is None
+    ([0, 1], [2], True)
+    """
+    cases = [(float(a), float(L0)) for a, L0 in cases]
+    if not cases:
+        raise InputError("`cases` must hold one (aspect, L0) pair at least")
+    seeds = _seeds(seeds)
+    a_split = positive("a_split", a_split)
+    rows = []
+    for seed in seeds:
+        def tag(row, seed=seed):
+            row["seed"] = seed
+            if on_row is not None:
+                on_row(row)
+
+        rows += runout_rows(cases, a_split=a_split, on_row=tag, seed=seed, **options)[0]
+    return rows, runout_summary(rows, a_split=a_split)
+
+
+def runout_summary(rows, *, a_split=3.0):
+    """Mean and spread of the runout over seeds per column, and both branches fitted with errors.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        One per column run, each with ``aim`` (the aspect ratio aimed at),
+        ``L0``, ``aspect`` (measured) and ``runout``; the runs of one
+        ``(aim, L0)`` are seeds of one column.
+    a_split : float
+        The branches' divide on the measured aspect ratio (each run by its own).
+
+    Returns
+    -------
+    dict
+        Per column (sorted by ``aim``): ``aim``, ``L0``, ``n`` (runs),
+        ``aspect`` and ``runout`` (means), ``aspect_std``, ``runout_std``
+        (standard deviations over the seeds, ``ddof = 1``; NaN for one run),
+        ``runout_sem`` (``runout_std / sqrt(n)``). The fits on every run:
+        ``c``, ``p`` and ``p_se`` (``runout = c a^p`` above ``a_split``, a
+        line in log-log, the slope's standard error from the residuals;
+        None without three runs at two aspect ratios at least), ``c_small``,
+        ``p_small``, ``p_small_se`` (the same below), ``lambda`` and
+        ``lambda_se`` (``runout = lambda a`` below, least squares through
+        the origin; None without two runs), ``a_split``.
+
+    Examples
+    --------
+    Two seeds of three columns on ``2 a^(2/3)`` above ``a = 3``, ``+-0.1`` about it:
+
+    >>> a = [4.0, 4.0, 8.0, 8.0, 16.0, 16.0]
+    >>> r = [2 * x ** (2 / 3) + d for x, d in zip(a, [0.1, -0.1] * 3)]
+    >>> rows = [{"aim": x, "L0": 5.0, "aspect": x, "runout": y} for x, y in zip(a, r)]
+    >>> s = runout_summary(rows)
+    >>> s["runout"].round(4).tolist(), s["runout_std"].round(4).tolist()
+    ([5.0397, 8.0, 12.6992], [0.1414, 0.1414, 0.1414])
+    >>> round(s["p"], 2), s["p_se"] < 0.02, s["lambda"] is None
+    (0.67, True, True)
+    """
+    rows = list(rows)
+    if not rows:
+        raise InputError("`rows` must hold one run at least")
+    a_split = positive("a_split", a_split)
+    for k, row in enumerate(rows):
+        missing = [key for key in ("aim", "L0", "aspect", "runout") if key not in row]
+        if missing:
+            raise InputError(f"`rows` must give every run's aim, L0, aspect and runout; run {k} "
+                             f"lacks {', '.join(missing)}")
+    groups = {}
+    for row in rows:
+        groups.setdefault((float(row["aim"]), float(row["L0"])), []).append(row)
+    keys = sorted(groups)
+    out = {"aim": np.array([k[0] for k in keys]), "L0": np.array([k[1] for k in keys]),
+           "n": np.array([len(groups[k]) for k in keys])}
+    for name in ("aspect", "runout"):
+        vals = [np.array([float(r[name]) for r in groups[k]]) for k in keys]
+        out[name] = np.array([v.mean() for v in vals])
+        out[name + "_std"] = np.array([v.std(ddof=1) if v.size > 1 else math.nan for v in vals])
+    out["runout_sem"] = out["runout_std"] / np.sqrt(out["n"])
+    a = np.array([float(r["aspect"]) for r in rows])
+    y = np.array([float(r["runout"]) for r in rows])
+    large, small = a > a_split, a <= a_split
+    for part, c_key, p_key in ((large, "c", "p"), (small, "c_small", "p_small")):
+        out[c_key], out[p_key], out[p_key + "_se"] = _power_fit(a[part], y[part])
+    out["lambda"] = out["lambda_se"] = None
+    if np.count_nonzero(small) >= 2:
+        x, z = a[small], y[small]
+        lam = float(x @ z / (x @ x))
+        out["lambda"] = lam
+        out["lambda_se"] = float(math.sqrt(np.sum((z - lam * x) ** 2) / (x.size - 1) / (x @ x)))
+    out["a_split"] = float(a_split)
+    return out
+
+
+def _power_fit(a, y):
+    """``y = c a^p`` by least squares in log-log, and the slope's standard error."""
+    if a.size < 3 or np.unique(a).size < 2 or np.any(y <= 0.0):
+        return None, None, None
+    la, ly = np.log(a), np.log(y)
+    p, logc = np.polyfit(la, ly, 1)
+    resid = ly - (p * la + logc)
+    sxx = float(np.sum((la - la.mean()) ** 2))
+    return float(math.exp(logc)), float(p), float(math.sqrt(resid @ resid / (a.size - 2) / sxx))
+
+
+def _seeds(seeds):
+    try:
+        seeds = [int(s) for s in seeds]
+    except (TypeError, ValueError):
+        raise InputError(f"`seeds` must be a sequence of whole numbers, got {seeds!r}") from None
+    if not seeds or len(set(seeds)) != len(seeds) or min(seeds) < 0:
+        raise InputError(f"`seeds` must hold one seed at least, distinct and >= 0, got {seeds}")
+    return seeds
