@@ -45,7 +45,7 @@ def fit(paths, split):
     for r in rows:
         print(f"| {r['aim']:g} | {r['L0']:g} | {r.get('seed', 0)} | {r['n_disks']} | "
               f"{r['aspect']:.2f} | {r['runout']:.2f} | {r['stopped']} | "
-              f"{r['unconverged']} of {r['steps']} | {r.get('cpu_s', 0):.0f} |")
+              f"{r.get('unconverged')} of {r.get('steps')} | {r.get('cpu_s', 0):.0f} |")
     s = runout_summary(rows, a_split=split)
     print("| a aimed | runs | a (mean +- sd) | runout mean | sd | s.e. |")
     print("|---|---|---|---|---|---|")

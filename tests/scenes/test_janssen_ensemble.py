@@ -39,7 +39,7 @@ def _synthetic(m_sat, scale, noise):
 def test_the_ensemble_averages_at_equal_depth_and_fits_once():
     # two fillings off the law by +-5 % at each cut average to the law exactly
     up = np.array([0.05, -0.05, 0.05, -0.05])
-    e = ensemble([_synthetic(20.0, 1.0, up), _synthetic(20.0, 1.0, -up)])
+    e = ensemble([_synthetic(20.0, 1.0, up), _synthetic(20.0, 1.0, -up)], floor=True)
     assert e["m_sat"] == pytest.approx(20.0, rel=1e-6) and e["max_deviation"] < 1e-6
     # K = W / (2 mu_w lam), lam = m_sat / (rho W)
     assert e["K"] == pytest.approx(6.0 / (2 * 0.5 * 20.0 / (0.8 * 6.0)), rel=1e-6)
@@ -95,7 +95,7 @@ def test_the_ensemble_averaged_silo_load_saturates_with_depth_as_janssens_law():
     assert cuts["fillings"] == 9 and cuts["depth"].size == 11
     assert cuts["max_deviation"] <= 0.07 and cuts["rms_deviation"] <= 0.04
     assert cuts["floor_deviation"] > 0.05
-    whole = ensemble(profiles)
+    whole = ensemble(profiles, floor=True)
     assert whole["max_deviation"] == pytest.approx(abs(whole["deviation"][-1]))
     # Janssen's premise: the walls' friction mobilised (nearly) fully, upward
     assert whole["mobilised"] > 0.9
