@@ -583,7 +583,7 @@ def test_a_resting_stack_s_singular_problem_is_solved_by_the_least_norm_sticking
     # of 36): Newton stalled (9.3e-13 against the bound 8e-13), the 16-gon's Lemke path
     # met exact arithmetic on W's rounding (294 exact pivots in 120 CPU s unfinished), and
     # -W^-1 q is noise (r_N < 0, |r_T| / r_N = 26); the least-norm -W^+ q is the answer
-    d = np.load(Path(__file__).with_name("box_stack_3_resting_step.npz"))
+    d = np.load(Path(__file__).parents[1] / "data" / "box_stack_3_resting_step.npz")
     W, q, mu = d["W"], d["q"], d["mu"]
     assert np.linalg.matrix_rank(W) == 18
     sol = solve_exact(W, q, mu, r0=d["r0"])
