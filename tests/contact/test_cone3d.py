@@ -353,19 +353,25 @@ def test_hard_problems_with_large_mu_converge_through_stall_detection_and_the_re
     assert sol.residual <= 1e-10 * np.linalg.norm(q)
 
 
+def _solved_found_case(seed, nc, mu_value):
+    # a problem a search found: solved, and the residual reported is the one on the data
+    W, q, _ = random_problem(np.random.default_rng(seed), nc)
+    mu = np.full(nc, mu_value)
+    sol = solve_exact(W, q, mu)
+    assert sol.success, sol.detail
+    assert sol.residual == cone_residual(W, q, mu, sol.r)
+    return W, q, mu, sol
+
+
 def test_a_stick_at_the_cone_s_edge_converges_from_a_finer_polygon():
     # found by the property test: in the answer every contact sticks (one at
     # |r_T| = 0.96 mu r_N), which also solves the 16-gon's LCP, but Lemke finds
     # another solution there with contact 2 slipping; Newton from it (and from
     # the same point at d = 32) stalls at 0.025, Gauss–Seidel at 3.6e-3; at
     # d = 64 Lemke returns the sticking answer itself
-    W, q, _ = random_problem(np.random.default_rng(7656), 4)
-    mu = np.full(4, 2.0)
-    sol = solve_exact(W, q, mu)
-    assert sol.success, sol.detail
+    W, q, mu, sol = _solved_found_case(7656, 4, 2.0)
     assert "64-direction polyhedral solution" in sol.detail
     assert sol.residual <= 1e-10 * np.linalg.norm(q)
-    assert sol.residual == pytest.approx(cone_residual(W, q, mu, sol.r), abs=0)
     r = sol.r.reshape(-1, 3)
     assert np.all(r[:, 0] > 0) and np.all(np.hypot(r[:, 1], r[:, 2]) <= 2.0 * r[:, 0])
     u = sol.u.reshape(-1, 3)
@@ -563,12 +569,8 @@ def test_four_contacts_sticking_and_one_open_are_found_without_the_finer_polygon
     # found by a survey (k = 28735, seed 2839128055, mu = 2.551): Newton stalls near 1e-2
     # from every start, and the 128-gon's Lemke path took its exact-arithmetic path for
     # minutes; the answer has contacts 0-3 sticking inside their cones and contact 4 open
-    W, q, _ = random_problem(np.random.default_rng(2839128055), 5)
-    mu = np.full(5, 2.5510825666154826)
-    sol = solve_exact(W, q, mu)
-    assert sol.success, sol.detail
+    W, q, mu, sol = _solved_found_case(2839128055, 5, 2.5510825666154826)
     assert "31 sets of sticking and open contacts (touching: [0, 1, 2, 3])" in sol.detail
-    assert sol.residual == cone_residual(W, q, mu, sol.r)
     assert sol.residual <= 1e-13 * np.linalg.norm(q)
     r = sol.r.reshape(-1, 3)
     np.testing.assert_array_equal(r[4], 0.0)
