@@ -333,8 +333,11 @@ def _splice_template(name, namespace):
     return fn
 
 
-#: the helpers :func:`loop_template` splices in where a step rule calls them (their Python functions)
-_SPLICED = set()
+#: the helpers :func:`loop_template` splices in where a step rule calls them (their Python
+#: functions), each with its ``step_returns``
+_SPLICED = {}
+#: the helpers whose rules (:func:`_check_spliced`) are checked
+_CHECKED = set()
 
 
 def spliced(fn=None, *, step_returns=False):
@@ -350,9 +353,23 @@ def spliced(fn=None, *, step_returns=False):
     assigned, and its only ``return`` is its last statement, unless
     ``step_returns``: then its other ``return X`` return ``X`` from the step
     rule it is spliced into (a status; such a helper serves step rules only).
+    A helper breaking these rules is refused here, or, for the package's own
+    helpers, when a template first splices it: reading and parsing their
+    sources at import cost every process that imports the schemes half its
+    import time.
     """
     if fn is None:
         return functools.partial(spliced, step_returns=step_returns)
+    if not fn.__module__.startswith(__package__.split(".")[0] + "."):
+        _check_spliced(fn, step_returns)
+    _SPLICED[fn] = step_returns
+    return njit(inline="always", error_model="numpy")(fn)
+
+
+def _check_spliced(fn, step_returns):
+    """Refuse a :func:`spliced` helper that assigns a parameter or returns early (once a helper)."""
+    if fn in _CHECKED:
+        return
     fdef = _function_def(fn)
     params = {a.arg for a in fdef.args.args}
     stored = {n.id for n in ast.walk(fdef) if isinstance(n, ast.Name)
@@ -365,8 +382,7 @@ def spliced(fn=None, *, step_returns=False):
     if returns and not step_returns and not (len(returns) == 1 and body
                                              and body[-1] is returns[0]):
         raise TypeError(f"spliced helper {fn.__name__} returns before its last statement")
-    _SPLICED.add(fn)
-    return njit(inline="always", error_model="numpy")(fn)
+    _CHECKED.add(fn)
 
 
 def _adaptive(fdef):
@@ -469,6 +485,7 @@ class _Splicer:
         if py is None:
             return None, None
         if py in _SPLICED:
+            _check_spliced(py, _SPLICED[py])
             return "helper", py
         if _is_step_rule(py):
             return "step", py

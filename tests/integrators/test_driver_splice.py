@@ -26,6 +26,17 @@ def test_a_helper_that_returns_before_its_end_is_refused():
         spliced(early)
 
 
+def test_the_package_s_own_helper_is_checked_when_it_is_first_spliced():
+    # the package's helpers are read and parsed when a template splices them, not at import
+    def bump(x):
+        x = x + 1
+        return x
+    bump.__module__ = "moreau.integrators._fake_kernels"
+    helper = spliced(bump)                     # accepted for now: nothing parsed yet
+    with pytest.raises(TypeError, match=r"assigns its parameters \['x'\]"):
+        _driver._Splicer({"bump": helper}).stmts(ast.parse("y = bump(z)").body)
+
+
 def _calls(source):
     return {n.func.id for n in ast.walk(ast.parse(source))
             if isinstance(n, ast.Call) and isinstance(n.func, ast.Name)}
