@@ -194,6 +194,16 @@ def _rows(ct, i, R, s, rows):
 
 
 @njit(cache=True)
+def _pair_gap(ct, pp, i, q, R, x):
+    # (ok, gap) of a pair, its line left in x (_pair_line); not ok where the centres are
+    # within the pair's bound (concentric spheres: no normal), which the Python step diagnoses
+    L = _pair_line(ct, pp, i, q, R, x)
+    if not L > pp[i, 5]:
+        return False, 0.0
+    return True, L - ct[i, 2] - pp[i, 1]
+
+
+@njit(cache=True)
 def _pair_line(ct, pp, i, q, R, x):
     # a contact between two bodies' spheres (moreau.model.space, "Contacts between two
     # spheres"), body a's sphere in the table ct, body b's in pp (SpaceScene.pair_table):
@@ -658,12 +668,12 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             slip[i] = 0.0
             reg[i] = 0
             if pairs is not None and pairs[i, 0] >= 0.0:
-                L = _pair_line(ct, pairs, i, q, R, pg)
-                if not L > pairs[i, 5]:
+                ok, g = _pair_gap(ct, pairs, i, q, R, pg)
+                if not ok:
                     # concentric spheres: the Python step raises with its diagnosis
                     status = LCP_HANDBACK
                     break
-                g0[i] = L - ct[i, 2] - pairs[i, 1]
+                g0[i] = g
                 _pair_rows(ct, pairs, i, R, pg, rows, rowsb)
             else:
                 g0[i] = _gap(ct, i, q, R, s)
@@ -846,11 +856,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             _rotation(q1, b, R1)
         for i in range(nc):
             if pairs is not None and pairs[i, 0] >= 0.0:
-                L = _pair_line(ct, pairs, i, q1, R1, pg)
-                if not L > pairs[i, 5]:
+                ok, g = _pair_gap(ct, pairs, i, q1, R1, pg)
+                if not ok:
                     status = LCP_HANDBACK
                     break
-                g1[i] = L - ct[i, 2] - pairs[i, 1]
+                g1[i] = g
             else:
                 g1[i] = _gap(ct, i, q1, R1, s)
             stats[S_PEN] = max(stats[S_PEN], -g1[i])
