@@ -50,8 +50,8 @@ from ..model.registry import discover as discover_scenes
 from .peers import PEER_SETTING, is_peer, peer_names, run_peer_cell
 from .problem import get_problem, judge, problem_names
 
-__all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "OUTCOMES", "REFUSED_STATUS",
-           "DECLINED"]
+__all__ = ["scheme_names", "settings_of", "run_cell", "run_suite", "same_runs", "OUTCOMES",
+           "REFUSED_STATUS", "DECLINED"]
 
 #: the outcomes, best first
 OUTCOMES = ("ok", "inaccurate", "failed", "refused")
@@ -485,6 +485,49 @@ def pair_task(pname, schemes):
             for scheme, cells in schemes for i, label, options in cells]
 
 
+def same_runs(plan, todo):
+    """``{i: j}``: cell ``i`` of ``todo`` is the run of cell ``j`` under another name.
+
+    Two cells are one run where their schemes resolve to the same class on
+    the problem's scene and their settings are the same: ``event-driven`` on
+    a scene without a reference of its own is ``event-driven-generic``, and on
+    the friction drive it is ``friction-drive-walker``. The cell of the
+    scheme that is the class itself (``event-driven-generic``) is computed,
+    the others take its row (:func:`_same_run_row`).
+
+    Examples
+    --------
+    >>> plan = [("bouncing-ball", s, "rtol=1e-06", {"rtol": 1e-6})
+    ...         for s in ("event-driven", "event-driven-generic", "moreau-jean")]
+    >>> same_runs(plan, [0, 1, 2])
+    {0: 1}
+    """
+    keys = []
+    for i in todo:
+        pname, s, label, options = plan[i]
+        if label == DECLINED or is_peer(s):
+            continue
+        try:
+            cls, _ = _options_of(s, _problem_scene(pname)[1])
+        except MoreauError:
+            continue
+        # the scheme that is its class first: its cell is the one computed
+        keys.append((get_integrator(s) is not cls, i, (pname, cls, label,
+                                                        repr(sorted(options.items())))))
+    first, out = {}, {}
+    for _, i, key in sorted(keys):
+        j = first.setdefault(key, i)
+        if j != i:
+            out[i] = j
+    return out
+
+
+def _same_run_row(row, scheme):
+    # the row of scheme ``scheme``, whose run is ``row``'s (same_runs): it says whose
+    note = f"the same run as {row['scheme']} (the same scheme on this scene)"
+    return dict(row, scheme=scheme, cause="; ".join(c for c in (row["cause"], note) if c))
+
+
 def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress=True,
               n_jobs=1, scheduler=None, peers=True, tasks=()):
     """Run every scheme on every problem: ``{"rows", "problems", "schemes", "cells", "tasks"}``.
@@ -531,6 +574,11 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
         else:
             rows[i] = row
     done = len(plan) - len(todo)
+    same = same_runs(plan, todo)
+    copies = {}
+    for i, j in same.items():
+        copies.setdefault(j, []).append(i)
+    todo = [i for i in todo if i not in same]
     if n_jobs is None:
         n_jobs = (os.cpu_count() or 1) if len(todo) >= AUTO_POOL_CELLS else 1
     bar = None
@@ -540,12 +588,13 @@ def run_suite(problems=None, schemes=None, quick=False, cache_dir=None, progress
     try:
         with propagate_interrupts():
             for i, row in _results(plan, todo, n_jobs, scheduler, list(tasks), done_tasks):
-                rows[i] = row
-                if cache_dir:
-                    _keep_cell(cell_path(cache_dir, *plan[i][:3]), row)
-                done += 1
-                if bar is not None:
-                    bar.update(1)
+                for k in [i] + copies.get(i, []):
+                    rows[k] = row if k == i else _same_run_row(row, plan[k][1])
+                    if cache_dir:
+                        _keep_cell(cell_path(cache_dir, *plan[k][:3]), rows[k])
+                    done += 1
+                    if bar is not None:
+                        bar.update(1)
     except KeyboardInterrupt:
         raise Interrupted(done, len(plan), cache_dir, "suite", unit="cells") from None
     finally:

@@ -104,6 +104,29 @@ def test_subset_table_flags_and_page(tmp_path, doubles):
     assert "provenance" in doc and paths["csv"].endswith("suite.csv")
 
 
+def test_a_scheme_that_is_another_on_the_scene_is_run_once(tmp_path, monkeypatch):
+    # event-driven on a scene without a reference of its own is event-driven-generic: the
+    # suite runs it once and gives both columns its row, each kept, the copy saying whose it is
+    import moreau.suite.run as run_mod
+    ran = []
+    real = run_mod.simulate
+    monkeypatch.setattr(run_mod, "simulate", lambda *a, **k: ran.append(a[4]) or real(*a, **k))
+    schemes = ["event-driven", "event-driven-generic", "moreau-jean"]
+    rep = run_suite(problems=["sliding-block"], schemes=schemes, quick=True,
+                    cache_dir=str(tmp_path), progress=False)
+    assert "event-driven" not in ran and {"event-driven-generic", "moreau-jean"} <= set(ran)
+    rows = {(r["scheme"], r["setting"]): r for r in rep["rows"]}
+    copies = [k for k in rows if k[0] == "event-driven"]
+    assert copies and len(rows) == len(rep["rows"])
+    for _, label in copies:
+        copy, run = rows[("event-driven", label)], rows[("event-driven-generic", label)]
+        assert copy["cause"] == "the same run as event-driven-generic (the same scheme on this scene)"
+        assert {k: v for k, v in copy.items() if k not in ("scheme", "cause")} == \
+            {k: v for k, v in run.items() if k not in ("scheme", "cause")}
+        assert (tmp_path / "sliding-block" / "event-driven" / f"{label}.json").exists()
+    assert rep["cells"]["computed"] == len(rep["rows"])
+
+
 def test_cli_refuses_before_work(tmp_path, capsys):
     assert main(["suite", "--problems", "no-such", "--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
