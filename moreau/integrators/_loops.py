@@ -111,6 +111,9 @@ def _build(model, template, stub=False):
     fns = model.functions()
     paths = {k: _import_path(f) for k, f in fns.items()}
     cacheable = all(p is not None for p in paths.values())
+    # the template spliced first: splicing adds the driver's and the spliced helpers' names
+    # to the module's globals, which the model's loop runs in a copy of
+    code = template.__code__
     module = sys.modules[template.__module__]
     namespace = dict(vars(module))
     namespace.update(consts, mass_fn=model.mass, forces_fn=model.forces,
@@ -125,7 +128,7 @@ def _build(model, template, stub=False):
     # per model, from the import paths of its functions and its constants
     tag = repr(sorted(paths.items())) + repr(sorted(consts.items())) + ("stub" if stub else "")
     name = template.__name__ + "_" + hashlib.sha256(tag.encode()).hexdigest()[:16]
-    fn = types.FunctionType(template.__code__, namespace, name, template.__defaults__)
+    fn = types.FunctionType(code, namespace, name, template.__defaults__)
     fn.__qualname__ = name
     fn.__module__ = template.__module__
     fn.__doc__ = template.__doc__

@@ -90,6 +90,30 @@ def test_functions_defined_in_a_function_run_compiled_in_memory(monkeypatch):
     assert len(np.unique(a.regime)) >= 2
 
 
+def test_a_models_own_loop_is_built_in_a_fresh_process_with_every_name_it_reads():
+    # a model's own loop runs in a copy of its scheme module's globals, to which splicing the
+    # template adds the driver's and the spliced helpers' names: in a fresh process, where no
+    # shared loop spliced it first, every global the loop reads must still be there (built,
+    # not compiled: a missing name is numba's NameError at the loop's first compile)
+    script = textwrap.dedent("""
+        import builtins, dis, sys
+        sys.path.insert(0, sys.argv[1])
+        from belt_scene import local_belt_block
+        from moreau.integrators import _loops, _mj_kernels, _sp_kernels
+        Local, _ = local_belt_block()
+        for template in (_sp_kernels.sp_loop, _mj_kernels.mj_loop):
+            fn = _loops._build(Local().compiled_model(), template).py_func
+            names = {i.argval for i in dis.get_instructions(fn.__code__)
+                     if i.opname == "LOAD_GLOBAL"}
+            print(template.__name__, sorted(n for n in names
+                                            if n not in fn.__globals__ and not hasattr(builtins, n)))
+    """)
+    out = subprocess.run([sys.executable, "-c", script, HERE], capture_output=True, text=True,
+                         check=True).stdout
+    assert out.split("\n")[:2] == ["sp_loop []", "mj_loop []"]
+    assert "CTL_IA" in _sp_kernels.sp_loop.__globals__ and "S_PEN" in _sp_kernels.sp_loop.__globals__
+
+
 def test_an_importable_model_is_cached_and_an_edit_recompiles(tmp_path):
     # a user's model module, run in fresh processes: the second loads the compiled loop
     # from numba's disk cache; after an edit of the model, the third compiles again and
