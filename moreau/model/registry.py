@@ -81,6 +81,7 @@ import pkgutil
 from typing import Callable, NamedTuple, Optional
 
 from ..errors import InputError
+from .params import declaration
 
 __all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
            "make_scene", "discover", "scene_modules", "parameters_of", "describe", "default_scene",
@@ -313,23 +314,28 @@ def make_scene(name, **params):
     return entry.factory(**params)
 
 
-def parameters_of(params_class, units, docs=None, extra=()):
+def parameters_of(params_class, units=None, docs=None, extra=()):
     """:class:`Parameter` tuples from a frozen parameter dataclass.
 
-    ``units`` maps every field to its SI unit ("" for dimensionless);
-    ``docs`` optionally to a one-line description; ``extra`` are further
-    :class:`Parameter` entries (e.g. the drive frequency) put first.
+    Each field's unit and doc come from its declaration
+    (:mod:`moreau.model.params`), or from ``units`` (every field to its SI
+    unit, "" for dimensionless) and ``docs`` (a one-line description) where
+    given; ``extra`` are further :class:`Parameter` entries (e.g. the drive
+    frequency) put first.
     """
-    docs = docs or {}
     out = list(extra)
     for f in dataclasses.fields(params_class):
-        if f.name not in units:
-            raise InputError(f"`units` has no entry for the parameter `{f.name}` of "
-                             f"{params_class.__name__}")
-        default = f.default
-        if default is dataclasses.MISSING:
-            default = f.default_factory()  # type: ignore[misc]
-        out.append(Parameter(f.name, units[f.name], default, docs.get(f.name, "")))
+        decl = declaration(f)
+        if units is not None:
+            if f.name not in units:
+                raise InputError(f"`units` has no entry for the parameter `{f.name}` of "
+                                 f"{params_class.__name__}")
+            out.append(Parameter(f.name, units[f.name], f.default, (docs or {}).get(f.name, "")))
+        elif decl is None:
+            raise InputError(f"the parameter `{f.name}` of {params_class.__name__} is not "
+                             f"declared (moreau.model.params)")
+        else:
+            out.append(Parameter(f.name, decl.unit, f.default, decl.doc))
     return tuple(out)
 
 
