@@ -314,28 +314,26 @@ def make_scene(name, **params):
     return entry.factory(**params)
 
 
-def parameters_of(params_class, units=None, docs=None, extra=()):
-    """:class:`Parameter` tuples from a frozen parameter dataclass.
+def parameters_of(params_class, extra=()):
+    """:class:`Parameter` tuples from a frozen parameter dataclass whose fields are declared
+    (:mod:`moreau.model.params`): each field's name, default, unit and doc, in field order.
 
-    Each field's unit and doc come from its declaration
-    (:mod:`moreau.model.params`), or from ``units`` (every field to its SI
-    unit, "" for dimensionless) and ``docs`` (a one-line description) where
-    given; ``extra`` are further :class:`Parameter` entries (e.g. the drive
+    ``extra`` are further :class:`Parameter` entries (e.g. the drive
     frequency) put first.
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import BouncingBallParams
+    >>> parameters_of(BouncingBallParams)[0]
+    Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball')
     """
     out = list(extra)
     for f in dataclasses.fields(params_class):
         decl = declaration(f)
-        if units is not None:
-            if f.name not in units:
-                raise InputError(f"`units` has no entry for the parameter `{f.name}` of "
-                                 f"{params_class.__name__}")
-            out.append(Parameter(f.name, units[f.name], f.default, (docs or {}).get(f.name, "")))
-        elif decl is None:
+        if decl is None:
             raise InputError(f"the parameter `{f.name}` of {params_class.__name__} is not "
                              f"declared (moreau.model.params)")
-        else:
-            out.append(Parameter(f.name, decl.unit, f.default, decl.doc))
+        out.append(Parameter(f.name, decl.unit, f.default, decl.doc))
     return tuple(out)
 
 
