@@ -323,9 +323,13 @@ def parameters_of(params_class, extra=()):
 
     Examples
     --------
-    >>> from moreau.scenes.bouncing_ball import BouncingBallParams
-    >>> parameters_of(BouncingBallParams)[0]
-    Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball')
+    >>> from dataclasses import dataclass
+    >>> from moreau.model.params import MASS, Declared
+    >>> @dataclass(frozen=True)
+    ... class BallParams(Declared):
+    ...     mass: float = MASS(0.1, "Mass of the ball")
+    >>> parameters_of(BallParams)
+    (Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball'),)
     """
     out = list(extra)
     for f in dataclasses.fields(params_class):
