@@ -25,7 +25,7 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import finite_array
+from .._validate import finite_array, positive
 from ..errors import InputError
 from ..model.params import GRAVITY, LENGTH, MASS, RADIUS, RESTITUTION, Declared
 from ..model.drawing import circle, contact, line
