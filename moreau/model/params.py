@@ -172,8 +172,9 @@ class Declared:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
+        fields = _fields_in_order(cls)
         doc = cls.__dict__.get("__doc__")
-        if not doc or not _fields_in_order(cls):
+        if not doc or not fields:
             return
         if "{attributes}" in doc:
             head, _, tail = doc.partition("{attributes}")

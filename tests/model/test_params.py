@@ -97,6 +97,4 @@ def test_an_undeclared_field_is_refused_when_the_class_is_made():
     with pytest.raises(TypeError, match="the field `height` of BadParams must be declared"):
         @dataclasses.dataclass(frozen=True)
         class BadParams(Declared):
-            """A class with a plain field."""
-
             height: float = 1.0
