@@ -81,29 +81,6 @@ def restitution(name, value):
     return in_closed_interval(name, value, 0.0, 1.0)
 
 
-def check_fields(params, rule, *names):
-    """Replace each named field of the frozen dataclass ``params`` by ``rule(name, value)``.
-
-    The parameter classes of the scenes check their fields in their
-    ``__post_init__`` with one line per rule.
-
-    >>> from dataclasses import dataclass
-    >>> @dataclass(frozen=True)
-    ... class P:
-    ...     mass: float = 1
-    ...     def __post_init__(self):
-    ...         check_fields(self, positive, "mass")
-    >>> P(2).mass, type(P(2).mass).__name__
-    (2.0, 'float')
-    >>> P(0)
-    Traceback (most recent call last):
-    ...
-    moreau.errors.InputError: `mass` must be > 0, got 0.0
-    """
-    for name in names:
-        object.__setattr__(params, name, rule(name, getattr(params, name)))
-
-
 def positive_int(name, value):
     """Return ``value`` as an int, or raise unless it is an integer >= 1."""
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)):

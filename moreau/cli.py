@@ -152,7 +152,10 @@ def add_scene_flags(p):
         if _flag(name) in p._option_string_actions:
             continue
         unit = f" [{prm.unit}]" if prm.unit and prm.unit != "choice" else ""
-        what = prm.doc or name
+        # a scene's own words only where every scene taking the flag says the same
+        docs = {get_entry(s).parameters[get_entry(s).parameter_names().index(name)].doc
+                for s in scenes}
+        what = prm.doc if len(docs) == 1 and prm.doc else name
         p.add_argument(_flag(name), dest=name, type=_scene_flag_type(prm), default=None,
                        help=_help(f"{what}{unit}, same as --set {name}=VALUE (scenes: "
                                   f"{', '.join(scenes)})"))

@@ -81,6 +81,7 @@ import pkgutil
 from typing import Callable, NamedTuple, Optional
 
 from ..errors import InputError
+from .params import declaration
 
 __all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
            "make_scene", "discover", "scene_modules", "parameters_of", "describe", "default_scene",
@@ -313,23 +314,30 @@ def make_scene(name, **params):
     return entry.factory(**params)
 
 
-def parameters_of(params_class, units, docs=None, extra=()):
-    """:class:`Parameter` tuples from a frozen parameter dataclass.
+def parameters_of(params_class, extra=()):
+    """:class:`Parameter` tuples from a frozen parameter dataclass whose fields are declared
+    (:mod:`moreau.model.params`): each field's name, default, unit and doc, in field order.
 
-    ``units`` maps every field to its SI unit ("" for dimensionless);
-    ``docs`` optionally to a one-line description; ``extra`` are further
-    :class:`Parameter` entries (e.g. the drive frequency) put first.
+    ``extra`` are further :class:`Parameter` entries (e.g. the drive
+    frequency) put first.
+
+    Examples
+    --------
+    >>> from dataclasses import dataclass
+    >>> from moreau.model.params import MASS, Declared
+    >>> @dataclass(frozen=True)
+    ... class BallParams(Declared):
+    ...     mass: float = MASS(0.1, "Mass of the ball")
+    >>> parameters_of(BallParams)
+    (Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball'),)
     """
-    docs = docs or {}
     out = list(extra)
     for f in dataclasses.fields(params_class):
-        if f.name not in units:
-            raise InputError(f"`units` has no entry for the parameter `{f.name}` of "
-                             f"{params_class.__name__}")
-        default = f.default
-        if default is dataclasses.MISSING:
-            default = f.default_factory()  # type: ignore[misc]
-        out.append(Parameter(f.name, units[f.name], default, docs.get(f.name, "")))
+        decl = declaration(f)
+        if decl is None:
+            raise InputError(f"the parameter `{f.name}` of {params_class.__name__} is not "
+                             f"declared (moreau.model.params)")
+        out.append(Parameter(f.name, decl.unit, f.default, decl.doc))
     return tuple(out)
 
 

@@ -1,38 +1,49 @@
-"""The checks of the grain parameters shared by :mod:`moreau.scenes.granular_column` and
-:mod:`moreau.scenes.silo` (one rule, one message, for both)."""
+"""The grain parameters shared by :mod:`moreau.scenes.granular_column` and
+:mod:`moreau.scenes.silo`, declared once (one rule, one message, for both)."""
 
-from .._validate import in_closed_interval, nonnegative, positive, positive_int
+from .._validate import in_closed_interval, positive_int
 from ..errors import InputError
+from ..model.params import NONNEGATIVE, POSITIVE, UNIT_INTERVAL, Declaration, Declared, Rule
 
-__all__ = ["check_grain_params"]
+__all__ = ["Grains", "WIDTH", "DIAMETER", "SPREAD", "DENSITY", "GRAIN_MU", "GRAIN_RESTITUTION",
+           "SEED", "MU_R"]
 
 
-def check_grain_params(p, positive_names, nonnegative_names, counts=()):
-    """Check and store, in place, the fields of the frozen dataclass ``p`` of a box of grains.
+def _seed(name, value):
+    """``value`` as a whole number >= 0 (a float's fraction dropped)."""
+    return positive_int(name, int(value) + 1) - 1
 
-    In this order: ``positive_names`` > 0, ``counts`` whole numbers >= 1, ``spread`` in
-    ``[1e-3, 1]``, ``nonnegative_names`` >= 0, ``restitution`` in ``[0, 1]``, ``seed`` a
-    whole number >= 0, and ``width`` at least ``2.05 diameter`` (two grains side by side).
+
+WIDTH = Declaration("m", POSITIVE)
+DIAMETER = Declaration("m", POSITIVE, "The largest grain's diameter")
+SPREAD = Declaration("", Rule(in_closed_interval, "in [1e-3, 1]", (1e-3, 1.0)),
+                     "Smallest over largest radius")
+DENSITY = Declaration("kg/m^2", POSITIVE, "Mass per unit area of the grains")
+GRAIN_MU = Declaration("", NONNEGATIVE)
+GRAIN_RESTITUTION = Declaration("", UNIT_INTERVAL, "Newton restitution of every contact")
+SEED = Declaration("", Rule(_seed, "a whole number >= 0"), "The random radii and start jitter")
+MU_R = Declaration("m", NONNEGATIVE, "Rolling-resistance length of every contact")
+
+
+class Grains(Declared):
+    """A box of grains' parameters: each field checked by its declaration, then ``width`` at
+    least ``2.05 diameter`` (two grains side by side).
 
     Examples
     --------
-    >>> from types import SimpleNamespace
-    >>> p = SimpleNamespace(width=0.01, diameter=0.005, spread=0.8, restitution=0.0, seed=0)
-    >>> check_grain_params(p, ("width", "diameter"), ())
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Box(Grains):
+    ...     width: float = WIDTH(0.01)
+    ...     diameter: float = DIAMETER(0.005)
+    >>> Box()
     Traceback (most recent call last):
     ...
     moreau.errors.InputError: `width` must hold two grains (>= 2.05 `diameter`), got 0.01 m for 0.005 m grains
     """
-    for name in positive_names:
-        object.__setattr__(p, name, positive(name, getattr(p, name)))
-    for name in counts:
-        object.__setattr__(p, name, positive_int(name, getattr(p, name)))
-    object.__setattr__(p, "spread", in_closed_interval("spread", p.spread, 1e-3, 1.0))
-    for name in nonnegative_names:
-        object.__setattr__(p, name, nonnegative(name, getattr(p, name)))
-    object.__setattr__(p, "restitution",
-                       in_closed_interval("restitution", p.restitution, 0.0, 1.0))
-    object.__setattr__(p, "seed", positive_int("seed", int(p.seed) + 1) - 1)
-    if p.width / p.diameter < 2.05:
-        raise InputError(f"`width` must hold two grains (>= 2.05 `diameter`), got "
-                         f"{p.width!r} m for {p.diameter!r} m grains")
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.width / self.diameter < 2.05:
+            raise InputError(f"`width` must hold two grains (>= 2.05 `diameter`), got "
+                             f"{self.width!r} m for {self.diameter!r} m grains")

@@ -61,12 +61,14 @@ from scipy.linalg import eigvalsh_tridiagonal
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import (check_fields, finite_array, finite_scalar, in_closed_interval,
-                         nonnegative, positive, positive_int, restitution, whole_number)
+from .._validate import (finite_array, finite_scalar, in_closed_interval, positive, positive_int,
+                         restitution, whole_number)
 from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ..lcp.active_set import solve_active_set
+from ..model.params import (MASS, NONNEGATIVE, POSITIVE, RADIUS, RESTITUTION, SPEED, Declaration,
+                            Declared, param)
 from ..model.drawing import circle, contact
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
@@ -86,63 +88,40 @@ SPARSE_FROM = 150
 
 
 @dataclass(frozen=True)
-class ChainParams:
-    """SI parameters every chain of balls has, on a line or in space.
-
-    Attributes
-    ----------
-    n_balls : int
-        Number of balls ``N`` including the striker, a whole number in [2,
-        ``max_balls``].
-    mass : float
-        Mass of each ball of the chain [kg], > 0.
-    striker_mass : float
-        Mass of the striker [kg], > 0.
-    radius : float
-        Radius of every ball [m], > 0.
-    striker_speed : float
-        Speed of the striker towards the chain [m/s], > 0.
-    restitution : float
-        Newton restitution of every contact, in [0, 1].
-    """
+class ChainParams(Declared):
+    """SI parameters every chain of balls has, on a line or in space."""
 
     #: the most balls the chain takes
     max_balls: ClassVar[int] = MAX_BALLS
 
-    n_balls: int = 3
-    mass: float = 0.1
-    striker_mass: float = 0.1
-    radius: float = 0.01
-    striker_speed: float = 1.0
-    restitution: float = 1.0
+    n_balls: int = param(3, doc="Number of balls ``N`` including the striker",
+                         note="A whole number in [2, ``max_balls``].")
+    mass: float = MASS(0.1, "Mass of each ball of the chain")
+    striker_mass: float = MASS(0.1, "Mass of the striker")
+    radius: float = RADIUS(0.01, "Radius of every ball")
+    striker_speed: float = SPEED(1.0, "Speed of the striker towards the chain", rule=POSITIVE)
+    restitution: float = RESTITUTION(1.0, "Newton restitution of every contact")
 
     def __post_init__(self):
         object.__setattr__(self, "n_balls",
                            whole_number("n_balls", self.n_balls, MIN_BALLS, self.max_balls))
-        check_fields(self, positive, "mass", "striker_mass", "radius", "striker_speed")
-        check_fields(self, restitution, "restitution")
+        super().__post_init__()
+
+
+#: the striker's gap to the chain: the default, 1.1 radii, puts the impact at ``t* = 1.1 r / V``
+STRIKER_GAP = Declaration("m", NONNEGATIVE, "Initial gap between the striker and the chain")
 
 
 @dataclass(frozen=True)
 class BallChainParams(ChainParams):
     """SI parameters of the ball chain: those of :class:`ChainParams` (up to 10 000 balls) and
+    the striker's gap."""
 
-    Attributes
-    ----------
-    striker_gap : float
-        Initial gap between the striker and the chain [m], >= 0. The
-        default, 1.1 radii, puts the impact at ``t* = 1.1`` scene units,
-        off the grids of the usual step counts over the comparison window
-        ``t* + 2`` (at ``t* = 1`` the window's 150 and 1500 steps would
-        land a step on ``t*`` and Moreau–Jean would place the impact
-        exactly, by coincidence).
-    """
-
-    striker_gap: float = 0.011
-
-    def __post_init__(self):
-        super().__post_init__()
-        check_fields(self, nonnegative, "striker_gap")
+    striker_gap: float = STRIKER_GAP(0.011, note=(
+        "The default, 1.1 radii, puts the impact at ``t* = 1.1`` scene units, off the grids of "
+        "the usual step counts over the comparison window ``t* + 2`` (at ``t* = 1`` the "
+        "window's 150 and 1500 steps would land a step on ``t*`` and Moreau–Jean would place "
+        "the impact exactly, by coincidence)."))
 
 
 class BallChain(FromParams, SIUnits, CompiledScene):
@@ -508,9 +487,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="ball-chain",
     factory=BallChain,
-    parameters=parameters_of(BallChainParams, {"n_balls": "", "mass": "kg", "striker_mass": "kg",
-                                               "radius": "m", "striker_speed": "m/s",
-                                               "restitution": "", "striker_gap": "m"}),
+    parameters=parameters_of(BallChainParams),
     description="a striker hits a resting chain of N balls: simultaneous impacts (Newton's cradle)",
     case=BallChainCase,
     reference="exact",

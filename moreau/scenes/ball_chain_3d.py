@@ -93,13 +93,13 @@ from typing import ClassVar
 
 import numpy as np
 
-from .._validate import check_fields, nonnegative, positive
 from ..analysis.cases import SpatialCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, RADIUS, Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
-from .ball_chain import ChainImpactCase, ChainParams
+from .ball_chain import STRIKER_GAP, ChainImpactCase, ChainParams
 
 __all__ = ["BallChain3DParams", "ball_chain_3d", "block_result", "MAX_BALLS_3D",
            "PyramidParams", "sphere_pyramid", "pyramid_forces"]
@@ -111,26 +111,18 @@ MAX_BALLS_3D = 50
 @dataclass(frozen=True)
 class BallChain3DParams(ChainParams):
     """SI parameters of the chain of spheres in space: those of
-    :class:`~moreau.scenes.ball_chain.ChainParams` (up to 50 spheres) and
-
-    Attributes
-    ----------
-    mu : float
-        Coulomb friction at every contact, >= 0 (a central impact calls on
-        none).
-    striker_gap : float
-        The striker's initial gap to the chain [m], >= 0; the default, 1.1
-        radii, puts the impact at ``t* = 1.1 r / V``, off the usual grids.
-    """
+    :class:`~moreau.scenes.ball_chain.ChainParams` (up to 50 spheres), friction and the
+    striker's gap."""
 
     max_balls: ClassVar[int] = MAX_BALLS_3D
 
-    mu: float = 0.0
-    striker_gap: float = 0.011
+    mu: float = MU(0.0, "Coulomb friction at every contact",
+                   note="A central impact calls on none.")
+    striker_gap: float = STRIKER_GAP(0.011, note="The default, 1.1 radii, puts the impact at "
+                                                 "``t* = 1.1 r / V``, off the usual grids.")
 
-    def __post_init__(self):
-        super().__post_init__()
-        check_fields(self, nonnegative, "mu", "striker_gap")
+
+
 
 
 def ball_chain_3d(params=None, **overrides):
@@ -184,35 +176,27 @@ def block_result(n_balls, speed=1.0):
 
 
 @dataclass(frozen=True)
-class PyramidParams:
-    """SI parameters of the resting pyramid of four spheres (the module docstring).
+class PyramidParams(Declared):
+    """SI parameters of the resting pyramid of four spheres (the module docstring)."""
 
-    Attributes
-    ----------
-    mass, radius : float
-        Each sphere's [kg], [m], > 0.
-    spread : float
-        The bottom spheres' distance between centres over ``2 radius``, in
-        ``(1, sqrt(3))``: above 1 they do not touch, below ``sqrt(3)`` the top
-        sphere rests above them.
-    mu : float
-        Coulomb friction at every contact, >= 0 (it holds for ``mu >= tan(beta / 2)``).
-    gravity : float
-        [m/s^2], > 0.
-    """
-
-    mass: float = 0.2
-    radius: float = 0.05
-    spread: float = 1.2
-    mu: float = 0.5
-    gravity: float = 9.81
+    mass: float = MASS(0.2, "Mass of each sphere")
+    radius: float = RADIUS(0.05, "Radius of each sphere")
+    spread: float = param(1.2, "", doc="The bottom spheres' distance between centres over "
+                                       "``2 radius``",
+                          note="In ``(1, sqrt(3))``: above 1 they do not touch, below "
+                               "``sqrt(3)`` the top sphere rests above them.")
+    mu: float = MU(0.5, "Coulomb friction at every contact",
+                   note="It holds for ``mu >= tan(beta / 2)``.")
+    gravity: float = GRAVITY(9.81)
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "gravity")
-        check_fields(self, nonnegative, "mu")
+        super().__post_init__()
         if not 1.0 < self.spread < math.sqrt(3.0):
             raise InputError(f"`spread` must be in (1, sqrt(3)) (the bottom spheres apart, the "
                              f"top one above them), got {self.spread!r}")
+
+
+
 
 
 def pyramid_forces(params=None, **overrides):
@@ -300,10 +284,7 @@ class BallChain3DCase(ChainImpactCase, SpatialCase):
 register_scene(SceneEntry(
     name="ball-chain-3d",
     factory=ball_chain_3d,
-    parameters=parameters_of(BallChain3DParams, {"n_balls": "", "mass": "kg",
-                                                 "striker_mass": "kg", "radius": "m",
-                                                 "striker_speed": "m/s", "restitution": "",
-                                                 "mu": "", "striker_gap": "m"}),
+    parameters=parameters_of(BallChain3DParams),
     description=("a striker hits a resting chain of N spheres in space through sphere-sphere "
                  "contacts: the simultaneous impact's block result (closed form)"),
     case=BallChain3DCase,

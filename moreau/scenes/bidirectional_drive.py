@@ -68,13 +68,14 @@ import numpy as np
 
 from .. import _validate as V
 from ..errors import InputError
+from ..model.params import FINITE, NONNEGATIVE, param
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from numba import njit
 
 from ..compiled import CompiledModel
-from .friction_drive.rod import (MEMO_SLOTS, RodParams, StatorMotion, memo_sincos, rod_forces, rod_gap,
-                                  rod_rows)
+from .friction_drive.rod import (AMPLITUDE, MEMO_SLOTS, ROD_RESTITUTION, ROTOR_LOAD, RodParams,
+                                  StatorMotion, memo_sincos, rod_forces, rod_gap, rod_rows)
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import params_with
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
@@ -92,15 +93,7 @@ class BidirectionalDriveParams(RodParams):
     what they mean in :class:`~moreau.scenes.friction_drive.FrictionDriveParams`
     and are shared by both rods (they are mirror images).
 
-    Parameters
-    ----------
-    m, m2, k, length, phi0, mu, load, restitution : float
-        As in :class:`FrictionDriveParams` (the paper's values by default).
-    x10_a, x10_b : float
-        Stator displacement amplitudes of rods ``a`` and ``b`` [m], ``>= 0``
-        (0 leaves the rod unexcited) and ``2 x10 < length sin(phi0)``.
-    phase : float
-        Phase lag ``delta`` [rad] of stator ``b`` behind stator ``a``, finite.
+    {attributes}
 
     Examples
     --------
@@ -109,20 +102,20 @@ class BidirectionalDriveParams(RodParams):
     (2e-06, 0.0, 0.0)
     """
 
-    x10_a: float = 2.0e-6
-    x10_b: float = 2.0e-6
-    phase: float = 0.0
-    load: float = 0.0
-    restitution: float = 0.0
+    x10_a: float = AMPLITUDE(2.0e-6, "Stator displacement amplitude of rod ``a``",
+                             rule=NONNEGATIVE, note="0 leaves the rod unexcited.")
+    x10_b: float = AMPLITUDE(2.0e-6, "Stator displacement amplitude of rod ``b``",
+                             rule=NONNEGATIVE, note="0 leaves the rod unexcited.")
+    phase: float = param(0.0, "rad", FINITE, "Phase lag ``delta`` of stator ``b`` behind stator "
+                                             "``a``")
+    load: float = ROTOR_LOAD(0.0)
+    restitution: float = ROD_RESTITUTION(0.0)
 
     def __post_init__(self):
         super().__post_init__()
-        V.check_fields(self, V.finite_scalar, "load", "phase")
-        V.check_fields(self, V.restitution, "restitution")
-        for name in ("x10_a", "x10_b"):
-            x = V.nonnegative(name, getattr(self, name))
-            self._check_amplitude(name, x)
-            object.__setattr__(self, name, x)
+        self._check_amplitude("x10_a", self.x10_a)
+        self._check_amplitude("x10_b", self.x10_b)
+
 
     def rod(self, which):
         """The :class:`FrictionDriveParams` of rod ``"a"`` or ``"b"`` alone.
@@ -349,14 +342,10 @@ class BidirectionalDriveCase(DriveCase):
         return float(np.max(scene.u10))
 
 
-#: SI units of the parameters of :class:`BidirectionalDriveParams`
-UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "",
-         "x10_a": "m", "x10_b": "m", "phase": "rad", "load": "N", "restitution": ""}
-
 register_scene(SceneEntry(
     name="bidirectional-drive",
     factory=BidirectionalDrive,
-    parameters=parameters_of(BidirectionalDriveParams, UNITS, extra=(
+    parameters=parameters_of(BidirectionalDriveParams, extra=(
         Parameter("frequency", "Hz", 185.0, "common drive frequency"),)),
     description="the paper's proposed two-rod drive: two mirrored rods on one rotor (two contacts)",
     case=BidirectionalDriveCase,

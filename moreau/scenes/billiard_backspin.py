@@ -29,8 +29,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, finite_scalar, positive, times
+from .._validate import times
 from ..analysis.cases import GRID, SpatialCase
+from ..model.params import FINITE, GRAVITY, MASS, MU, POSITIVE, RADIUS, Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ._sphere_on_plane import sphere_on_plane
@@ -39,36 +40,19 @@ __all__ = ["BilliardParams", "billiard_backspin", "billiard_exact", "rolling_ons
 
 
 @dataclass(frozen=True)
-class BilliardParams:
-    """SI parameters of the ball struck with spin.
+class BilliardParams(Declared):
+    """SI parameters of the ball struck with spin."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0 (a pool ball: 0.17).
-    radius : float
-        [m], > 0 (a pool ball: 0.028575).
-    mu : float
-        Ball-cloth friction, > 0 (0.2).
-    gravity : float
-        [m/s^2], > 0.
-    speed : float
-        Launch speed along ``x`` [m/s], finite.
-    spin : float
-        Launch spin about ``y`` [rad/s] (``speed / radius`` rolls; negative is
-        backspin), finite.
-    """
+    mass: float = MASS(0.17, note="A pool ball: 0.17.")
+    radius: float = RADIUS(0.028575, note="A pool ball: 0.028575.")
+    mu: float = MU(0.2, "Ball-cloth friction", rule=POSITIVE)
+    gravity: float = GRAVITY(9.81)
+    speed: float = param(2.0, "m/s", FINITE, "Launch speed along ``x``")
+    spin: float = param(-40.0, "rad/s", FINITE, "Launch spin about ``y``",
+                        "``speed / radius`` rolls; negative is backspin.")
 
-    mass: float = 0.17
-    radius: float = 0.028575
-    mu: float = 0.2
-    gravity: float = 9.81
-    speed: float = 2.0
-    spin: float = -40.0
 
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "gravity", "mu")
-        check_fields(self, finite_scalar, "speed", "spin")
+
 
 
 def rolling_onset(p):
@@ -142,9 +126,7 @@ class BilliardCase(SpatialCase):
 register_scene(SceneEntry(
     name="billiard-backspin",
     factory=billiard_backspin,
-    parameters=parameters_of(BilliardParams, {"mass": "kg", "radius": "m", "mu": "",
-                                              "gravity": "m/s^2", "speed": "m/s",
-                                              "spin": "rad/s"}),
+    parameters=parameters_of(BilliardParams),
     description=("billiard ball struck with backspin: slides, then rolls from t* = "
                  "2 (v0 - r w0) / (7 mu g) at (5 v0 + 2 r w0) / 7 (closed form)"),
     case=BilliardCase,

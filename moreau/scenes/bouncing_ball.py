@@ -25,8 +25,9 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import check_fields, finite_array, positive, restitution
+from .._validate import finite_array, positive
 from ..errors import InputError
+from ..model.params import GRAVITY, LENGTH, MASS, RADIUS, RESTITUTION, Declared
 from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
 from ..model.compiled_scene import CompiledScene
@@ -42,32 +43,14 @@ BallImpacts = namedtuple("BallImpacts", ["t", "v_before", "v_after"])
 
 
 @dataclass(frozen=True)
-class BouncingBallParams:
-    """SI parameters of the bouncing ball.
+class BouncingBallParams(Declared):
+    """SI parameters of the bouncing ball."""
 
-    Attributes
-    ----------
-    mass : float
-        Mass of the ball [kg], > 0.
-    radius : float
-        Radius [m], > 0.
-    gravity : float
-        Gravitational acceleration [m/s^2], > 0.
-    restitution : float
-        Newton coefficient of restitution, in [0, 1].
-    length : float
-        Reference length [m] that fixes the units, > 0.
-    """
-
-    mass: float = 0.1
-    radius: float = 0.05
-    gravity: float = 9.81
-    restitution: float = 0.5
-    length: float = 1.0
-
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "gravity", "length")
-        check_fields(self, restitution, "restitution")
+    mass: float = MASS(0.1, "Mass of the ball")
+    radius: float = RADIUS(0.05, "Radius of the ball")
+    gravity: float = GRAVITY(9.81)
+    restitution: float = RESTITUTION(0.5)
+    length: float = LENGTH(1.0)
 
 
 class BouncingBall(FromParams, SIUnits, CompiledScene):
@@ -328,8 +311,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="bouncing-ball",
     factory=BouncingBall,
-    parameters=parameters_of(BouncingBallParams, {"mass": "kg", "radius": "m", "gravity": "m/s^2",
-                                                  "restitution": "", "length": "m"}),
+    parameters=parameters_of(BouncingBallParams),
     description="ball bouncing on a rigid floor: impacts, Zeno accumulation (exact solution)",
     case=BouncingBallCase,
     reference="exact",

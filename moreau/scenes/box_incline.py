@@ -52,9 +52,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, in_open_interval, nonnegative, positive, times
+from .._validate import times
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, SLOPE, SPEED, Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Box, SpaceModel
@@ -63,24 +64,10 @@ __all__ = ["BoxInclineParams", "box_incline", "box_incline_motion", "slides", "s
 
 
 @dataclass(frozen=True)
-class BoxInclineParams:
+class BoxInclineParams(Declared):
     """SI parameters of the box on the incline.
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    half_length, half_width, half_height : float
-        Half-edges [m] down the slope, across it and along its normal, > 0.
-    slope : float
-        Inclination ``alpha`` [rad], in (0, pi/2).
-    mu : float
-        Coulomb friction at each corner, >= 0; the default 0.2 is below
-        ``tan(0.3) = 0.309``: the box slides, speeding up.
-    gravity : float
-        [m/s^2], > 0.
-    speed : float
-        Launch speed down the slope line [m/s], >= 0.
+    {attributes}
 
     Raises
     ------
@@ -89,21 +76,19 @@ class BoxInclineParams:
         slides, ``c tan(alpha) >= a`` at rest), naming ``mu`` or ``slope``.
     """
 
-    mass: float = 0.5
-    half_length: float = 0.1
-    half_width: float = 0.05
-    half_height: float = 0.05
-    slope: float = 0.3
-    mu: float = 0.2
-    gravity: float = 9.81
-    speed: float = 0.5
+    mass: float = MASS(0.5)
+    half_length: float = param(0.1, "m", POSITIVE, "Half-edge down the slope")
+    half_width: float = param(0.05, "m", POSITIVE, "Half-edge across the slope")
+    half_height: float = param(0.05, "m", POSITIVE, "Half-edge along the slope's normal")
+    slope: float = SLOPE(0.3, "Inclination ``alpha``")
+    mu: float = MU(0.2, "Coulomb friction at each corner",
+                   note="The default 0.2 is below ``tan(0.3) = 0.309``: the box slides, "
+                        "speeding up.")
+    gravity: float = GRAVITY(9.81)
+    speed: float = SPEED(0.5, "Launch speed down the slope line")
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "half_length", "half_width", "half_height",
-                     "gravity")
-        check_fields(self, nonnegative, "mu", "speed")
-        object.__setattr__(self, "slope",
-                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+        super().__post_init__()
         a, c = self.half_length, self.half_height
         if slides(self) and self.mu * c >= a:
             raise InputError(f"`mu` times `half_height` must be below `half_length` while the "
@@ -113,6 +98,9 @@ class BoxInclineParams:
             raise InputError(f"`slope`'s tangent times `half_height` must be below "
                              f"`half_length` (else the box at rest tips over its front edge), "
                              f"got c tan(slope) = {c * math.tan(self.slope)!r} >= a = {a!r}")
+
+
+
 
 
 def slides(p):
@@ -212,10 +200,7 @@ class BoxInclineCase(SpatialCase):
 register_scene(SceneEntry(
     name="box-incline",
     factory=box_incline,
-    parameters=parameters_of(BoxInclineParams, {"mass": "kg", "half_length": "m",
-                                                "half_width": "m", "half_height": "m",
-                                                "slope": "rad", "mu": "", "gravity": "m/s^2",
-                                                "speed": "m/s"}),
+    parameters=parameters_of(BoxInclineParams),
     description=("box on its four bottom corners sliding down a rough incline in space at "
                  "g (sin a - mu cos a), at rest for mu > tan a; the front and back corners' "
                  "normal forces (closed form)"),

@@ -71,9 +71,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, nonnegative, positive, times
+from .._validate import times
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, SPEED, Declared, param, whole_number
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Box, SpaceModel
@@ -88,52 +89,26 @@ STACK_SQUEEZE = 1e-13
 
 
 @dataclass(frozen=True)
-class BoxStack3DParams:
-    """SI parameters of the stack of cubes.
+class BoxStack3DParams(Declared):
+    """SI parameters of the stack of cubes."""
 
-    Attributes
-    ----------
-    n_boxes : int
-        Cubes ``N``, a whole number in [1, 10] (default 3). On resting cubes
-        the contact problem is singular (four points a face, more contact
-        rows than freedoms); where the exact cone's Newton polish stalls on it,
-        the least-norm sticking impulse is its answer (:func:`moreau.contact.
-        cone3d.solve_exact`).
-    mass : float
-        Each cube's mass [kg], > 0.
-    half_size : float
-        Each cube's half-edge ``a`` [m], > 0.
-    mu : float
-        Coulomb friction at every contact, >= 0.
-    offset : float
-        Each cube's shift down the slope line from the one below [m]; with
-        the slope, ``mu`` and the speed it must keep the stack upright (the
-        module docstring).
-    slope : float
-        The plane's inclination [rad], in [0, pi/2).
-    speed : float
-        Every cube's initial speed down the slope line [m/s], >= 0.
-    gravity : float
-        [m/s^2], > 0.
-    """
-
-    n_boxes: int = 3
-    mass: float = 1.0
-    half_size: float = 0.05
-    mu: float = 0.5
-    offset: float = 0.0
-    slope: float = 0.0
-    speed: float = 0.0
-    gravity: float = 9.81
+    n_boxes: int = param(3, "", whole_number(1, MAX_BOXES), "Number of cubes ``N``",
+                         "On resting cubes the contact problem is singular (four points a face, "
+                         "more contact rows than freedoms); where the exact cone's Newton polish "
+                         "stalls on it, the least-norm sticking impulse is its answer "
+                         "(:func:`moreau.contact.cone3d.solve_exact`).")
+    mass: float = MASS(1.0, "Each cube's mass")
+    half_size: float = param(0.05, "m", POSITIVE, "Each cube's half-edge ``a``")
+    mu: float = MU(0.5, "Coulomb friction at every contact")
+    offset: float = param(0.0, "m", doc="Each cube's shift down the slope line from the one below",
+                          note="With the slope, ``mu`` and the speed it must keep the stack "
+                               "upright (the module docstring).")
+    slope: float = param(0.0, "rad", doc="The plane's inclination", note="In [0, pi/2).")
+    speed: float = SPEED(0.0, "Every cube's initial speed down the slope line")
+    gravity: float = GRAVITY(9.81)
 
     def __post_init__(self):
-        n = self.n_boxes
-        if isinstance(n, bool) or not (isinstance(n, (int, np.integer)) or (
-                isinstance(n, float) and n.is_integer())) or not 1 <= int(n) <= MAX_BOXES:
-            raise InputError(f"`n_boxes` must be a whole number in [1, {MAX_BOXES}], got {n!r}")
-        object.__setattr__(self, "n_boxes", int(n))
-        check_fields(self, positive, "mass", "half_size", "gravity")
-        check_fields(self, nonnegative, "mu", "speed")
+        super().__post_init__()
         if not (isinstance(self.offset, (int, float)) and math.isfinite(self.offset)):
             raise InputError(f"`offset` must be a finite number [m], got {self.offset!r}")
         if not (isinstance(self.slope, (int, float)) and 0.0 <= self.slope < 0.5 * math.pi):
@@ -144,6 +119,9 @@ class BoxStack3DParams:
                              f"normal resultant inside its face (the stack would topple at "
                              f"interface {k}, which has no closed form here), got offset = "
                              f"{self.offset!r}, mu = {self.mu!r}, slope = {self.slope!r}")
+
+
+
 
 
 def _slides(p):
@@ -251,9 +229,7 @@ class BoxStack3DCase(SpatialCase):
 register_scene(SceneEntry(
     name="box-stack-3d",
     factory=box_stack_3d,
-    parameters=parameters_of(BoxStack3DParams, {"n_boxes": "", "mass": "kg", "half_size": "m",
-                                                "mu": "", "offset": "m", "slope": "rad",
-                                                "speed": "m/s", "gravity": "m/s^2"}),
+    parameters=parameters_of(BoxStack3DParams),
     description=("a stack of N cubes face on face (box-box contacts found every step) at rest, "
                  "sliding or on an incline: h g times the mass above on every interface, the "
                  "block's mu g deceleration (closed form)"),

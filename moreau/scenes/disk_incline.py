@@ -35,48 +35,27 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, in_open_interval, nonnegative, positive, times
+from .._validate import times
 from ..analysis.cases import ClosedFormPath, FactoryCase
 from ..model.planar import Circle, HalfPlane, Model
+from ..model.params import GRAVITY, MASS, MU, RADIUS, SLOPE, SPEED, Declared
 from ..model.scene import as_params, params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 
-__all__ = ["InclineParams", "DiskInclineParams", "INCLINE_UNITS", "disk_incline_model", "disk_incline", "disk_incline_exact",
+__all__ = ["InclineParams", "DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact",
            "incline_motion", "rolls_down"]
 
 
 @dataclass(frozen=True)
-class InclineParams:
-    """SI parameters of a round body on an incline (the disk's and the sphere's).
+class InclineParams(Declared):
+    """SI parameters of a round body on an incline (the disk's and the sphere's)."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    radius : float
-        [m], > 0.
-    slope : float
-        Inclination ``alpha`` [rad], in (0, pi/2).
-    mu : float
-        Coulomb friction at the contact, >= 0.
-    gravity : float
-        [m/s^2], > 0.
-    speed : float
-        Initial speed down the slope [m/s], rolling, >= 0.
-    """
-
-    mass: float = 1.0
-    radius: float = 0.1
-    slope: float = 0.3
-    mu: float = 0.5
-    gravity: float = 9.81
-    speed: float = 0.2
-
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "gravity")
-        check_fields(self, nonnegative, "mu", "speed")
-        object.__setattr__(self, "slope",
-                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+    mass: float = MASS(1.0)
+    radius: float = RADIUS(0.1)
+    slope: float = SLOPE(0.3, "Inclination ``alpha``")
+    mu: float = MU(0.5, "Coulomb friction at the contact")
+    gravity: float = GRAVITY(9.81)
+    speed: float = SPEED(0.2, "Initial speed down the slope, rolling")
 
 
 @dataclass(frozen=True)
@@ -84,9 +63,7 @@ class DiskInclineParams(InclineParams):
     """SI parameters of the disk on an incline (those of :class:`InclineParams`)."""
 
 
-#: the units of the parameters of a round body on an incline
-INCLINE_UNITS = {"mass": "kg", "radius": "m", "slope": "rad", "mu": "", "gravity": "m/s^2",
-                 "speed": "m/s"}
+
 
 
 def disk_incline_model(params=None, **overrides):
@@ -191,7 +168,7 @@ class DiskInclineCase(InclineCase, FactoryCase):
 register_scene(SceneEntry(
     name="disk-incline",
     factory=disk_incline,
-    parameters=parameters_of(DiskInclineParams, INCLINE_UNITS),
+    parameters=parameters_of(DiskInclineParams),
     description=("disk rolling down a rough incline at (2/3) g sin(alpha), built with the "
                  "planar builder (closed form)"),
     case=DiskInclineCase,

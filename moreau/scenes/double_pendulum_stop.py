@@ -42,6 +42,7 @@ import numpy as np
 from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Point, Segment
+from ..model.params import Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
@@ -50,29 +51,24 @@ __all__ = ["DoublePendulumStopParams", "double_pendulum_stop_model", "double_pen
 
 
 @dataclass(frozen=True)
-class DoublePendulumStopParams:
-    """SI parameters of the double pendulum against a wall."""
+class DoublePendulumStopParams(Declared):
+    """SI parameters of the double pendulum against a wall (checked where the model is built)."""
 
-    #: upper link's length [m]
-    length1: float = 1.0
-    #: lower link's length [m]
-    length2: float = 1.0
-    #: upper link's mass [kg]
-    mass1: float = 1.0
-    #: lower link's mass [kg]
-    mass2: float = 1.0
-    #: the wall's abscissa [m]: the half-plane x >= wall
-    wall: float = 0.8
-    #: Newton restitution of the tip's impacts
-    restitution: float = 1.0
-    #: Coulomb friction at the wall
-    mu: float = 0.0
-    #: initial angle of the upper link's axis from +x [rad] (at rest)
-    theta1: float = math.pi
-    #: initial angle of the lower link's axis from +x [rad] (at rest)
-    theta2: float = math.pi
-    #: gravity [m/s^2], along -y
-    gravity: float = 9.81
+    length1: float = param(1.0, "m", doc="Upper link's length")
+    length2: float = param(1.0, "m", doc="Lower link's length")
+    mass1: float = param(1.0, "kg", doc="Upper link's mass")
+    mass2: float = param(1.0, "kg", doc="Lower link's mass")
+    wall: float = param(0.8, "m", doc="The wall's abscissa: the half-plane x >= wall")
+    restitution: float = param(1.0, doc="Newton restitution of the tip's impacts")
+    mu: float = param(0.0, doc="Coulomb friction at the wall")
+    theta1: float = param(math.pi, "rad", doc="Initial angle of the upper link's axis from +x "
+                                              "(at rest)")
+    theta2: float = param(math.pi, "rad", doc="Initial angle of the lower link's axis from +x "
+                                              "(at rest)")
+    gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
+
+
+
 
 
 def _checked(p):
@@ -210,9 +206,7 @@ class DoublePendulumStopCase(FactoryCase):
 register_scene(SceneEntry(
     name="double-pendulum-stop",
     factory=double_pendulum_stop,
-    parameters=parameters_of(DoublePendulumStopParams, {
-        "length1": "m", "length2": "m", "mass1": "kg", "mass2": "kg", "wall": "m",
-        "restitution": "", "mu": "", "theta1": "rad", "theta2": "rad", "gravity": "m/s^2"}),
+    parameters=parameters_of(DoublePendulumStopParams),
     description=("a double pendulum built with two revolute joints whose lower tip strikes "
                  "a wall (moreau.model.planar), Moreau-Jean only: energy conserved at e = 1"),
     case=DoublePendulumStopCase,

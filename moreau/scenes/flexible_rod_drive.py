@@ -98,11 +98,13 @@ from ..compiled import CompiledModel
 from ..errors import InputError
 from ..analysis.cases import DriveCase
 from ..analysis.steady_state import find_steady_state
+from ..model.params import NONNEGATIVE, POSITIVE, Rule, param
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import params_with
-from .friction_drive.rod import OneRod, RodParams, StatorMotion
+from .friction_drive.rod import (AMPLITUDE, PRELOAD, ROD_RESTITUTION, ROTOR_LOAD, OneRod, RodParams,
+                                  StatorMotion)
 from .friction_drive.scene import FrictionDrive, FrictionDriveParams
 from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
@@ -181,21 +183,11 @@ def _modes(name, value):
 class FlexibleRodDriveParams(RodParams):
     """Physical parameters of the flexible-rod drive, in SI units.
 
-    Parameters
-    ----------
-    m, m2, k, length, phi0, mu, x10, load, restitution : float
-        As in :class:`~moreau.scenes.friction_drive.FrictionDriveParams` (the
-        paper's values by default); ``m`` and ``length`` are the beam's mass
-        and length.
-    modes : int
-        Number ``N`` of bending modes, ``0 .. MAX_MODES`` (0: the rigid rod).
-    EI : float
-        Bending stiffness [N m^2], > 0.
-    damping : float
-        Modal damping ratio ``zeta`` of every bending mode, >= 0.
-    preload : float
-        Preload ``F_p`` [N], >= 0, on the rigid rotation as in the rigid scene
-        (the generalised force ``f_p cos phi``).
+    Those of :class:`~moreau.scenes.friction_drive.FrictionDriveParams` (the
+    paper's values by default), ``m`` and ``length`` the beam's mass and
+    length, and the beam's bending.
+
+    {attributes}
 
     Examples
     --------
@@ -204,21 +196,20 @@ class FlexibleRodDriveParams(RodParams):
     (2, 0.1)
     """
 
-    x10: float = 2.0e-6
-    load: float = 0.0
-    restitution: float = 0.0
-    modes: int = 1
-    EI: float = 1.0e-6
-    damping: float = 0.02
-    preload: float = 0.0
+    x10: float = AMPLITUDE(2.0e-6)
+    load: float = ROTOR_LOAD(0.0)
+    restitution: float = ROD_RESTITUTION(0.0)
+    modes: int = param(1, "", Rule(_modes, f"an integer in 0..{MAX_MODES}"),
+                       f"number of bending modes (0 = rigid rod, at most {MAX_MODES})")
+    EI: float = param(1.0e-6, "N m^2", POSITIVE, "bending stiffness of the rod")
+    damping: float = param(0.02, "", NONNEGATIVE, "modal damping ratio of every mode")
+    preload: float = PRELOAD(0.0, note="On the rigid rotation as in the rigid scene (the "
+                                       "generalised force ``f_p cos phi``).")
 
     def __post_init__(self):
-        # the rigid rod's parameters are checked by the rigid rod's own rules
-        self.rigid()
-        V.check_fields(self, V.nonnegative, "preload")
-        object.__setattr__(self, "modes", _modes("modes", self.modes))
-        V.check_fields(self, V.positive, "EI")
-        V.check_fields(self, V.nonnegative, "damping")
+        super().__post_init__()
+        self._check_amplitude("x10", self.x10)
+
 
     def rigid(self):
         """The rigid rod's :class:`FrictionDriveParams` (these parameters without the beam's)."""
@@ -536,18 +527,10 @@ def stress_cases():
 STEPS_STIFF = 1000
 
 
-#: SI units of the parameters of :class:`FlexibleRodDriveParams`
-UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "", "x10": "m",
-         "load": "N", "restitution": "", "modes": "", "EI": "N m^2", "damping": "",
-         "preload": "N"}
-
-DOCS = {"modes": f"number of bending modes (0 = rigid rod, at most {MAX_MODES})",
-        "EI": "bending stiffness of the rod", "damping": "modal damping ratio of every mode"}
-
 register_scene(SceneEntry(
     name="flexible-rod-drive",
     factory=FlexibleRodDrive,
-    parameters=parameters_of(FlexibleRodDriveParams, UNITS, DOCS, extra=(
+    parameters=parameters_of(FlexibleRodDriveParams, extra=(
         Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
     description="the friction drive with an Euler-Bernoulli tilt rod: rigid rotation plus N "
                 "bending modes",

@@ -61,7 +61,7 @@ from ..model.registry import Parameter, SceneEntry, parameters_of, register_scen
 from ..model.scene import params_with
 from .._validate import positive
 from .friction_drive import FrictionDriveParams, PAPER_DEFAULTS
-from .friction_drive.scene import UNITS, FrictionDriveCase
+from .friction_drive.scene import FrictionDriveCase
 
 __all__ = ["friction_drive_model", "friction_drive_built"]
 
@@ -136,7 +136,7 @@ class FrictionDriveBuiltCase(FrictionDriveCase):
 register_scene(SceneEntry(
     name="friction-drive-built",
     factory=friction_drive_built,
-    parameters=parameters_of(FrictionDriveParams, UNITS, extra=(
+    parameters=parameters_of(FrictionDriveParams, extra=(
         Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
     description=("the paper's friction drive stated with the planar builder (moreau.model.planar): "
                  "the same equations as friction-drive"),

@@ -86,9 +86,11 @@ from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
 from ..model.granular import (EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, grid_pairs,
                               random_fill)
+from ..model.params import GRAVITY, POSITIVE, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
-from ._grains import check_grain_params
+from ._grains import (DENSITY, DIAMETER, GRAIN_MU, GRAIN_RESTITUTION, MU_R, SEED, SPREAD, WIDTH,
+                      Grains)
 
 __all__ = ["GranularColumnParams", "granular_column", "column_system", "deposit_front",
            "collapse", "runout_study", "fit_runout"]
@@ -99,51 +101,27 @@ _PACKING = 0.8
 
 
 @dataclass(frozen=True)
-class GranularColumnParams:
-    """SI parameters of the column (see the module docstring).
+class GranularColumnParams(Grains):
+    """SI parameters of the column (see the module docstring)."""
 
-    Attributes
-    ----------
-    width : float
-        ``L0`` [m].
-    aspect : float
-        The aspect ratio aimed at, ``H0 / L0`` (the column is filled to it and
-        settles a little lower: :func:`collapse` measures it).
-    diameter : float
-        The largest grain's diameter [m].
-    spread : float
-        Smallest over largest radius, in ``(0, 1]``.
-    density : float
-        Mass per unit area of the grains [kg/m^2].
-    mu, mu_floor, mu_wall : float
-        Friction between grains, with the floor, with the left wall.
-    restitution : float
-    gravity : float
-        [m/s^2].
-    seed : int
-        The random radii and start jitter.
-    mu_r : float
-        Rolling-resistance length [m] of every contact (:mod:`moreau.model.granular`);
-        0: the grains roll freely. The registered scene takes only 0; :func:`collapse`
-        takes any.
-    """
+    width: float = WIDTH(0.02, "Width ``L0`` of the column")
+    aspect: float = param(1.0, "", POSITIVE, "The aspect ratio aimed at, ``H0 / L0``",
+                          "The column is filled to it and settles a little lower: "
+                          ":func:`collapse` measures it.")
+    diameter: float = DIAMETER(0.005)
+    spread: float = SPREAD(0.8)
+    density: float = DENSITY(10.0)
+    mu: float = GRAIN_MU(0.5, "Friction between grains")
+    mu_floor: float = GRAIN_MU(0.5, "Friction with the floor")
+    mu_wall: float = GRAIN_MU(0.5, "Friction with the left wall")
+    restitution: float = GRAIN_RESTITUTION(0.0)
+    gravity: float = GRAVITY(9.81)
+    seed: int = SEED(0)
+    mu_r: float = MU_R(0.0, note="0: the grains roll freely (:mod:`moreau.model.granular`). The "
+                                 "registered scene takes only 0; :func:`collapse` takes any.")
 
-    width: float = 0.02
-    aspect: float = 1.0
-    diameter: float = 0.005
-    spread: float = 0.8
-    density: float = 10.0
-    mu: float = 0.5
-    mu_floor: float = 0.5
-    mu_wall: float = 0.5
-    restitution: float = 0.0
-    gravity: float = 9.81
-    seed: int = 0
-    mu_r: float = 0.0
 
-    def __post_init__(self):
-        check_grain_params(self, ("width", "aspect", "diameter", "density", "gravity"),
-                           ("mu", "mu_floor", "mu_wall", "mu_r"))
+
 
 
 def column_system(params=None, *, gate=True, **overrides):
@@ -336,10 +314,7 @@ def runout_study(aspects=(0.5, 1.0, 2.0, 4.0, 8.0), *, width=0.03, a_split=2.0, 
 register_scene(SceneEntry(
     name="granular-column",
     factory=granular_column,
-    parameters=parameters_of(GranularColumnParams, {
-        "width": "m", "aspect": "", "diameter": "m", "spread": "", "density": "kg/m^2",
-        "mu": "", "mu_floor": "", "mu_wall": "", "restitution": "", "gravity": "m/s^2",
-        "seed": "", "mu_r": "m"}),
+    parameters=parameters_of(GranularColumnParams),
     description=("collapse of a column of disks on a rough floor (runout against the aspect "
                  "ratio; contacts found every step by a broad phase in its study)"),
 ))

@@ -97,10 +97,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import linprog
 
-from .._validate import check_fields, nonnegative, positive, positive_int
+from .._validate import nonnegative, positive, positive_int
 from ..errors import InputError
 from ..integrators import simulate
 from ..model.planar import HalfPlane, Model, Polygon
+from ..model.params import GRAVITY, MU, POSITIVE, RADIUS, Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
@@ -112,36 +113,19 @@ PRELOAD = 1e-14
 
 
 @dataclass(frozen=True)
-class MasonryArchParams:
-    """SI parameters of the masonry arch.
+class MasonryArchParams(Declared):
+    """SI parameters of the masonry arch."""
 
-    Attributes
-    ----------
-    voussoirs : int
-        Number of voussoirs ``n``, in [2, 60].
-    thickness : float
-        Thickness over centreline radius ``t / R``, in (0, 1).
-    radius : float
-        Centreline radius ``R`` [m], > 0.
-    mu : float
-        Friction coefficient of every joint, >= 0 (0.6: enough for the
-        semicircular arch, whose limit needs 0.4 at most, see
-        :func:`limit_thickness`).
-    density : float
-        Of the stone [kg/m^3], > 0.
-    depth : float
-        Of the arch, out of its plane [m], > 0.
-    gravity : float
-        [m/s^2], > 0.
-    """
-
-    voussoirs: int = 4
-    thickness: float = 0.15
-    radius: float = 1.0
-    mu: float = 0.6
-    density: float = 2000.0
-    depth: float = 0.5
-    gravity: float = 9.81
+    voussoirs: int = param(4, doc="Number of voussoirs ``n``", note="In [2, 60].")
+    thickness: float = param(0.15, doc="Thickness over centreline radius ``t / R``",
+                             note="In (0, 1).")
+    radius: float = RADIUS(1.0, "Centreline radius ``R``")
+    mu: float = MU(0.6, "Friction coefficient of every joint",
+                   note="0.6: enough for the semicircular arch, whose limit needs 0.4 at most, "
+                        "see :func:`limit_thickness`.")
+    density: float = param(2000.0, "kg/m^3", POSITIVE, "Density of the stone")
+    depth: float = param(0.5, "m", POSITIVE, "Depth of the arch, out of its plane")
+    gravity: float = GRAVITY(9.81)
 
     def __post_init__(self):
         n = self.voussoirs
@@ -156,8 +140,10 @@ class MasonryArchParams:
             raise InputError(f"`thickness` (t / R) must be < 1 (the intrados radius "
                              f"R (1 - t/2) > 0 with room), got {t!r}")
         object.__setattr__(self, "thickness", t)
-        check_fields(self, positive, "radius", "density", "depth", "gravity")
-        check_fields(self, nonnegative, "mu")
+        super().__post_init__()
+
+
+
 
 
 def voussoir_geometry(n, thickness):
@@ -395,9 +381,7 @@ def minimal_thickness(voussoirs, lo=0.05, hi=0.2, tol=1e-3, **kwargs):
 register_scene(SceneEntry(
     name="masonry-arch",
     factory=masonry_arch,
-    parameters=parameters_of(MasonryArchParams, {
-        "voussoirs": "", "thickness": "", "radius": "m", "mu": "", "density": "kg/m^3",
-        "depth": "m", "gravity": "m/s^2"}),
+    parameters=parameters_of(MasonryArchParams),
     description=("a semicircular arch of voussoirs on two abutments under its own weight: "
                  "stands or collapses with its thickness (Heyman 1966, Milankovitch 1907)"),
 ))

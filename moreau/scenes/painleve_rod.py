@@ -42,9 +42,9 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import (check_fields, finite_array, finite_scalar, nonnegative, positive,
-                         restitution)
+from .._validate import finite_array, finite_scalar, nonnegative, restitution
 from ..errors import InputError, PainleveError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ..model.drawing import contact, line
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
@@ -81,34 +81,15 @@ def painleve_critical_mu(phi):
 
 
 @dataclass(frozen=True)
-class PainleveRodParams:
-    """SI parameters of the rod.
+class PainleveRodParams(Declared):
+    """SI parameters of the rod."""
 
-    Attributes
-    ----------
-    mass : float
-        Mass of the rod [kg], > 0.
-    length : float
-        Full length of the rod [m], > 0.
-    mu : float
-        Coulomb friction coefficient at the tip, >= 0. The default 2 exceeds
-        the paradox threshold 4/3.
-    gravity : float
-        Gravitational acceleration [m/s^2], > 0.
-    restitution : float
-        Newton restitution of the tip contact, in [0, 1].
-    """
-
-    mass: float = 1.0
-    length: float = 1.0
-    mu: float = 2.0
-    gravity: float = 9.81
-    restitution: float = 0.0
-
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "length", "gravity")
-        check_fields(self, nonnegative, "mu")
-        check_fields(self, restitution, "restitution")
+    mass: float = MASS(1.0, "Mass of the rod")
+    length: float = param(1.0, "m", POSITIVE, "Full length of the rod")
+    mu: float = MU(2.0, "Coulomb friction coefficient at the tip",
+                   note="The default 2 exceeds the paradox threshold 4/3.")
+    gravity: float = GRAVITY(9.81)
+    restitution: float = RESTITUTION(0.0, "Newton restitution of the tip contact")
 
 
 class PainleveRod(FromParams, SIUnits, CompiledScene):
@@ -437,8 +418,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="painleve-rod",
     factory=PainleveRod,
-    parameters=parameters_of(PainleveRodParams, {"mass": "kg", "length": "m", "mu": "",
-                                                 "gravity": "m/s^2", "restitution": ""}),
+    parameters=parameters_of(PainleveRodParams),
     description="rod sliding on its tip in the Painlevé configuration",
     case=PainleveRodCase,
     sweepable=("mu", "mass", "length"),

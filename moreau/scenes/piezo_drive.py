@@ -102,9 +102,11 @@ from .. import _validate as V
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..analysis.cases import DriveCase
-from .friction_drive.rod import OneRod, RodParams, one_rod_mass, rod_rows
+from .friction_drive.rod import (PRELOAD, ROD_RESTITUTION, ROTOR_LOAD, OneRod, RodParams,
+                                  one_rod_mass, rod_rows)
 from ._piezo_stack import (WAVEFORMS, bouc_wen_branch, loop_top, periodic_pass, saturate,
                            steady_loop_ends, waveform)
+from ..model.params import MASS, NONNEGATIVE, POSITIVE, param
 from ..model.drawing import rod_drive_shapes
 from ..model.units import DriveUnits
 from ..model.compiled_scene import CompiledScene
@@ -120,32 +122,11 @@ TWO_PI = 2.0 * math.pi
 class PiezoDriveParams(RodParams):
     """Physical parameters of the voltage-driven friction drive, in SI units.
 
-    Parameters
-    ----------
-    m, m2, k, length, phi0, mu, load, restitution : float
-        Rod, rotor, spring, friction, load and restitution as in
-        :class:`~moreau.scenes.friction_drive.FrictionDriveParams`.
-    preload : float
-        Preload ``F_p`` [N], >= 0: the force pressing the rod tip on the rotor
-        at rest, as in :class:`~moreau.scenes.friction_drive.FrictionDriveParams`
-        (0: the paper's drive, which touches without force at zero voltage).
-    m1 : float
-        Stator mass [kg], > 0.
-    k1 : float
-        Stack stiffness holding the stator [N/m], > 0 (resonance
-        ``sqrt(k1 / (m + m1)) / 2 pi``, 2 kHz by default).
-    c1 : float
-        Stack damping [N s/m], >= 0.
-    gain : float
-        Stack gain ``d``: free displacement per volt [m/V], > 0.
-    voltage : float
-        Peak voltage ``U_pp`` [V], > 0; the voltage runs between 0 and ``U_pp``.
-    alpha : float
-        Bouc–Wen weight of the hysteresis, in [0, 1); 0 switches it off.
-    beta, gamma : float
-        Bouc–Wen shape [1/V]: ``beta > 0``, ``|gamma| <= beta`` (a bounded loop).
-    u_sat : float
-        Saturation voltage [V], > 0; ``inf`` for a linear stack.
+    The rod, rotor, spring, friction, load, restitution and preload as in
+    :class:`~moreau.scenes.friction_drive.FrictionDriveParams`, and the stator's
+    piezo stack.
+
+    {attributes}
 
     Examples
     --------
@@ -154,25 +135,27 @@ class PiezoDriveParams(RodParams):
     2e-06
     """
 
-    load: float = 0.0
-    restitution: float = 0.0
-    preload: float = 0.01
-    m1: float = 2.0e-3
-    k1: float = 3.2e5
-    c1: float = 15.0
-    gain: float = 6.0e-8
-    voltage: float = 100.0
-    alpha: float = 0.3
-    beta: float = 0.02
-    gamma: float = 0.005
-    u_sat: float = 150.0
+    load: float = ROTOR_LOAD(0.0)
+    restitution: float = ROD_RESTITUTION(0.0)
+    preload: float = PRELOAD(0.01, note="0: the paper's drive, which touches without force at "
+                                        "zero voltage.")
+    m1: float = MASS(2.0e-3, "Stator mass")
+    k1: float = param(3.2e5, "N/m", POSITIVE, "Stack stiffness holding the stator",
+                      "Resonance ``sqrt(k1 / (m + m1)) / 2 pi``, 2 kHz by default.")
+    c1: float = param(15.0, "N s/m", NONNEGATIVE, "Stack damping")
+    gain: float = param(6.0e-8, "m/V", POSITIVE, "Stack gain ``d``: free displacement per volt")
+    voltage: float = param(100.0, "V", POSITIVE, "Peak voltage ``U_pp``",
+                           "The voltage runs between 0 and ``U_pp``.")
+    alpha: float = param(0.3, "", doc="Bouc–Wen weight of the hysteresis",
+                         note="In [0, 1); 0 switches it off.")
+    beta: float = param(0.02, "1/V", POSITIVE, "Bouc–Wen shape ``beta``")
+    gamma: float = param(0.005, "1/V", doc="Bouc–Wen shape ``gamma``",
+                         note="``|gamma| <= beta`` (a bounded loop).")
+    u_sat: float = param(150.0, "V", doc="Saturation voltage",
+                         note="> 0; ``inf`` for a linear stack.")
 
     def __post_init__(self):
         super().__post_init__()
-        V.check_fields(self, V.positive, "m1", "k1", "gain", "voltage", "beta")
-        V.check_fields(self, V.nonnegative, "c1", "preload")
-        V.check_fields(self, V.finite_scalar, "load")
-        V.check_fields(self, V.restitution, "restitution")
         a = V.finite_scalar("alpha", self.alpha)
         if not 0.0 <= a < 1.0:
             raise InputError(f"`alpha` must be in [0, 1), got {a!r}")
@@ -187,6 +170,9 @@ class PiezoDriveParams(RodParams):
                 and us == math.inf):
             us = V.positive("u_sat", us)
         object.__setattr__(self, "u_sat", float(us))
+
+
+
 
 
 PIEZO_DEFAULTS = PiezoDriveParams()
@@ -665,15 +651,10 @@ class PiezoDriveCase(DriveCase):
         return scene.velocity_scale
 
 
-#: SI units of the parameters of :class:`PiezoDriveParams`
-UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "",
-         "load": "N", "restitution": "", "preload": "N", "m1": "kg", "k1": "N/m", "c1": "N s/m", "gain": "m/V",
-         "voltage": "V", "alpha": "", "beta": "1/V", "gamma": "1/V", "u_sat": "V"}
-
 register_scene(SceneEntry(
     name="piezo-drive",
     factory=PiezoDrive,
-    parameters=parameters_of(PiezoDriveParams, UNITS, extra=(
+    parameters=parameters_of(PiezoDriveParams, extra=(
         Parameter("frequency", "Hz", 1400.0, "drive frequency"),
         Parameter("waveform", "choice", "sine", "voltage waveform: sine, triangle or square"),
         Parameter("smoothing", "", 0.2, "triangle corner / square edge smoothing, in (0, 1)"),

@@ -52,10 +52,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import (check_fields, in_open_interval, nonnegative, positive, finite_scalar,
-                         times)
+from .._validate import finite_scalar, times
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, RADIUS, SLOPE, SPEED, Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Puck, SpaceModel
@@ -64,46 +64,30 @@ __all__ = ["PuckInclineParams", "puck_incline", "puck_incline_path"]
 
 
 @dataclass(frozen=True)
-class PuckInclineParams:
-    """SI parameters of the puck on the incline.
+class PuckInclineParams(Declared):
+    """SI parameters of the puck on the incline."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0 (an ice-hockey puck: 0.17).
-    radius : float
-        [m], > 0 (an ice-hockey puck: 0.038).
-    slope : float
-        Inclination ``alpha`` [rad], in (0, pi/2).
-    mu : float
-        Coulomb friction, >= 0; the default ``tan(0.3)`` is ``tan(slope)`` at the
-        default slope, where the path has its closed form.
-    gravity : float
-        [m/s^2], > 0.
-    speed : float
-        Launch speed [m/s], > 0.
-    heading : float
-        Launch direction from the down-slope line, towards ``+y`` [rad], in
-        (-pi, pi); ``pi/2`` (the default) is horizontal.
-    """
-
-    mass: float = 0.17
-    radius: float = 0.038
-    slope: float = 0.3
-    mu: float = math.tan(0.3)
-    gravity: float = 9.81
-    speed: float = 1.0
-    heading: float = 0.5 * math.pi
+    mass: float = MASS(0.17, note="An ice-hockey puck: 0.17.")
+    radius: float = RADIUS(0.038, note="An ice-hockey puck: 0.038.")
+    slope: float = SLOPE(0.3, "Inclination ``alpha``")
+    mu: float = MU(math.tan(0.3), "Coulomb friction",
+                   note="The default ``tan(0.3)`` is ``tan(slope)`` at the default slope, where "
+                        "the path has its closed form.")
+    gravity: float = GRAVITY(9.81)
+    speed: float = SPEED(1.0, "Launch speed", rule=POSITIVE)
+    heading: float = param(0.5 * math.pi, "rad",
+                           doc="Launch direction from the down-slope line, towards ``+y``",
+                           note="In (-pi, pi); ``pi/2`` (the default) is horizontal.")
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "gravity", "speed")
-        check_fields(self, nonnegative, "mu")
-        object.__setattr__(self, "slope",
-                           in_open_interval("slope", self.slope, 0.0, 0.5 * math.pi))
+        super().__post_init__()
         h = finite_scalar("heading", self.heading)
         if not -math.pi < h < math.pi:
             raise InputError(f"`heading` must be in (-pi, pi), got {h!r}")
         object.__setattr__(self, "heading", h)
+
+
+
 
 
 def puck_incline(params=None, **overrides):
@@ -229,9 +213,7 @@ class PuckInclineCase(ClosedFormPath, SpatialCase):
 register_scene(SceneEntry(
     name="puck-incline",
     factory=puck_incline,
-    parameters=parameters_of(PuckInclineParams, {"mass": "kg", "radius": "m",
-                                                 "slope": "rad", "mu": "", "gravity": "m/s^2",
-                                                 "speed": "m/s", "heading": "rad"}),
+    parameters=parameters_of(PuckInclineParams),
     description=("flat puck launched across a rough incline: its path in closed form for "
                  "mu = tan(alpha), the polyhedral cone's facets against the exact cone"),
     case=PuckInclineCase,

@@ -69,10 +69,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import quad, solve_ivp
 
-from .._validate import (check_fields, finite_array, finite_scalar, nonnegative, positive,
-                         restitution)
+from .._validate import finite_array, finite_scalar, restitution
 from ..analysis.cases import GRID, FactoryCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
@@ -97,38 +97,20 @@ def housner_ratio(alpha):
 
 
 @dataclass(frozen=True)
-class RockingBlockParams:
-    """SI parameters of the rocking block.
+class RockingBlockParams(Declared):
+    """SI parameters of the rocking block."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    width, height : float
-        [m], > 0.
-    mu : float
-        Coulomb friction at both corners, >= 0.
-    gravity : float
-        [m/s^2], > 0.
-    restitution : float
-        Newton restitution at the corners, in [0, 1].
-    tilt : float
-        Initial tilt on the left corner [rad], in ``[0, atan(width / height))``
-        (beyond it the block topples).
-    """
-
-    mass: float = 1.0
-    width: float = 0.2
-    height: float = 0.4
-    mu: float = 10.0
-    gravity: float = 9.81
-    restitution: float = 0.0
-    tilt: float = 0.05
+    mass: float = MASS(1.0)
+    width: float = param(0.2, "m", POSITIVE, "Width of the block")
+    height: float = param(0.4, "m", POSITIVE, "Height of the block")
+    mu: float = MU(10.0, "Coulomb friction at both corners")
+    gravity: float = GRAVITY(9.81)
+    restitution: float = RESTITUTION(0.0, "Newton restitution at the corners")
+    tilt: float = param(0.05, "rad", doc="Initial tilt on the left corner",
+                        note="In ``[0, atan(width / height))``: beyond it the block topples.")
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "width", "height", "gravity")
-        check_fields(self, nonnegative, "mu")
-        check_fields(self, restitution, "restitution")
+        super().__post_init__()
         alpha = math.atan(self.width / self.height)
         tilt = finite_scalar("tilt", self.tilt)
         if not 0.0 <= tilt < alpha:
@@ -361,9 +343,7 @@ class RockingBlockCase(FactoryCase):
 register_scene(SceneEntry(
     name="rocking-block",
     factory=RockingBlock,
-    parameters=parameters_of(RockingBlockParams, {"mass": "kg", "width": "m", "height": "m",
-                                                  "mu": "", "gravity": "m/s^2",
-                                                  "restitution": "", "tilt": "rad"}),
+    parameters=parameters_of(RockingBlockParams),
     description=("block rocking on two frictional corners to rest: Housner's impacts "
                  "(Housner 1963) accumulating on two contacts"),
     case=RockingBlockCase,

@@ -60,6 +60,7 @@ import numpy as np
 from .._validate import finite_scalar, positive
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Polygon, TimeFunction
+from ..model.params import FINITE, param
 from ..model.scene import params_with
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from .rocking_block import RockingBlock, RockingBlockCase, RockingBlockParams
@@ -70,20 +71,15 @@ __all__ = ["RockingBlockBuiltParams", "rocking_block_model", "rocking_block_buil
 
 @dataclass(frozen=True)
 class RockingBlockBuiltParams(RockingBlockParams):
-    """SI parameters of the built rocking block: :class:`RockingBlockParams` and the floor's motion.
+    """SI parameters of the built rocking block: :class:`RockingBlockParams` and the floor's
+    motion."""
 
-    Attributes
-    ----------
-    base_acceleration : float
-        The floor's constant horizontal acceleration [m/s^2], from rest at
-        ``t = 0`` (0: a fixed floor).
-    """
+    base_acceleration: float = param(0.0, "m/s^2", FINITE,
+                                     "The floor's constant horizontal acceleration",
+                                     "From rest at ``t = 0`` (0: a fixed floor).")
 
-    base_acceleration: float = 0.0
 
-    def __post_init__(self):
-        super().__post_init__()
-        finite_scalar("base_acceleration", self.base_acceleration)
+
 
 
 def rocking_onset_acceleration(width, height, gravity=9.81):
@@ -179,10 +175,7 @@ class RockingBlockBuiltCase(RockingBlockCase):
 register_scene(SceneEntry(
     name="rocking-block-built",
     factory=rocking_block_built,
-    parameters=parameters_of(RockingBlockBuiltParams,
-                             {"mass": "kg", "width": "m", "height": "m", "mu": "",
-                              "gravity": "m/s^2", "restitution": "", "tilt": "rad",
-                              "base_acceleration": "m/s^2"}),
+    parameters=parameters_of(RockingBlockBuiltParams),
     description=("the rocking block stated with the planar builder (moreau.model.planar): "
                  "the same equations as rocking-block"),
     case=RockingBlockBuiltCase,

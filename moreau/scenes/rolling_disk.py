@@ -69,9 +69,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, in_open_interval, positive
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
+from ..model.params import GRAVITY, MASS, MU, POSITIVE, RADIUS, Declared, open_interval, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Disk, SpaceModel
@@ -82,35 +82,21 @@ __all__ = ["RollingDiskParams", "rolling_disk", "steady_motion", "rolling_disk_e
 
 
 @dataclass(frozen=True)
-class RollingDiskParams:
-    """SI parameters of the rolling disk in steady precession.
+class RollingDiskParams(Declared):
+    """SI parameters of the rolling disk in steady precession."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    radius : float
-        The disk's radius ``a`` [m], > 0.
-    tilt : float
-        ``theta`` [rad], the disk's plane from the horizontal, in (0, pi/2).
-    circle : float
-        ``rho`` [m], the radius of the contact point's circle, > (5/6) a cos(theta).
-    mu : float
-        Coulomb friction, at least the ratio ``Omega^2 b / g`` that rolling needs.
-    gravity : float
-        [m/s^2], > 0.
-    """
-
-    mass: float = 0.1
-    radius: float = 0.05
-    tilt: float = 1.2
-    circle: float = 0.25
-    mu: float = 0.8
-    gravity: float = 9.81
+    mass: float = MASS(0.1)
+    radius: float = RADIUS(0.05, "The disk's radius ``a``")
+    tilt: float = param(1.2, "rad", open_interval(0.0, 0.5 * math.pi, "0, pi/2"),
+                        "Tilt ``theta`` of the disk's plane from the horizontal")
+    circle: float = param(0.25, "m", POSITIVE, "Radius ``rho`` of the contact point's circle",
+                          "It must be > (5/6) a cos(theta).")
+    mu: float = MU(0.8, "Coulomb friction", rule=POSITIVE,
+                   note="At least the ratio ``Omega^2 b / g`` that rolling needs.")
+    gravity: float = GRAVITY(9.81)
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "circle", "mu", "gravity")
-        object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
+        super().__post_init__()
         low = 5.0 / 6.0 * self.radius * math.cos(self.tilt)
         if self.circle <= low:
             raise InputError(f"`circle` must be > (5/6) radius cos(tilt) = {low!r} m (no steady "
@@ -119,6 +105,9 @@ class RollingDiskParams:
         if self.mu < need:
             raise InputError(f"`mu` must be >= {need!r}, the friction over the weight that "
                              f"rolling on this circle needs, got {self.mu!r}")
+
+
+
 
 
 def _rates(p):
@@ -259,8 +248,7 @@ class RollingDiskCase(ClosedFormPath, SpatialCase):
 register_scene(SceneEntry(
     name="rolling-disk",
     factory=rolling_disk,
-    parameters=parameters_of(RollingDiskParams, {"mass": "kg", "radius": "m", "tilt": "rad",
-                                                 "circle": "m", "mu": "", "gravity": "m/s^2"}),
+    parameters=parameters_of(RollingDiskParams),
     description=("thin disk rolling without slipping in steady precession on a plane: "
                  "Omega^2 = 4 g cot(theta) / (6 b + a cos(theta)) (Routh art. 244)"),
     case=RollingDiskCase,

@@ -185,62 +185,40 @@ from .._validate import in_closed_interval, nonnegative, positive, positive_int
 from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
 from ..model.granular import EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, random_fill
+from ..model.params import GRAVITY, SPEED, Rule, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
-from ._grains import check_grain_params
+from ._grains import (DENSITY, DIAMETER, GRAIN_MU, GRAIN_RESTITUTION, MU_R, SEED, SPREAD, WIDTH,
+                      Grains)
 
 __all__ = ["SiloParams", "silo", "silo_system", "fill", "fill_average", "fit_janssen", "janssen",
            "wall_profile", "janssen_k_bounds"]
 
 
 @dataclass(frozen=True)
-class SiloParams:
-    """SI parameters of the silo (see the module docstring).
+class SiloParams(Grains):
+    """SI parameters of the silo (see the module docstring)."""
 
-    Attributes
-    ----------
-    width : float
-        ``W`` [m], between the walls.
-    per_pour : int
-        Disks poured at a time.
-    diameter : float
-        The largest grain's diameter [m].
-    spread : float
-        Smallest over largest radius, in ``(0, 1]``.
-    density : float
-        Mass per unit area of the grains [kg/m^2].
-    mu, mu_wall, mu_floor : float
-        Friction between grains, with the walls, with the floor.
-    restitution : float
-    gravity : float
-        [m/s^2].
-    wall_speed : float
-        How fast the walls slide up after a pour [m/s].
-    seed : int
-    mu_r : float
-        Rolling-resistance length [m] of every contact (between grains and with the walls
-        and floor; :mod:`moreau.model.granular`); 0: the grains roll freely. The
-        registered scene (a :class:`~moreau.model.granular.DiskScene`) takes only 0;
-        :func:`fill` takes any.
-    """
+    width: float = WIDTH(0.03, "Width ``W`` between the walls")
+    per_pour: int = param(18, "", Rule(positive_int, "an integer >= 1"),
+                          "Disks poured at a time")
+    diameter: float = DIAMETER(0.005)
+    spread: float = SPREAD(0.8)
+    density: float = DENSITY(10.0)
+    mu: float = GRAIN_MU(0.5, "Friction between grains")
+    mu_wall: float = GRAIN_MU(0.5, "Friction with the walls")
+    mu_floor: float = GRAIN_MU(0.5, "Friction with the floor")
+    restitution: float = GRAIN_RESTITUTION(0.0)
+    gravity: float = GRAVITY(9.81)
+    wall_speed: float = SPEED(0.011, "How fast the walls slide up after a pour")
+    seed: int = SEED(0)
+    mu_r: float = MU_R(0.0, note="Between grains and with the walls and floor "
+                                 "(:mod:`moreau.model.granular`); 0: the grains roll freely. The "
+                                 "registered scene (a :class:`~moreau.model.granular.DiskScene`) "
+                                 "takes only 0; :func:`fill` takes any.")
 
-    width: float = 0.03
-    per_pour: int = 18
-    diameter: float = 0.005
-    spread: float = 0.8
-    density: float = 10.0
-    mu: float = 0.5
-    mu_wall: float = 0.5
-    mu_floor: float = 0.5
-    restitution: float = 0.0
-    gravity: float = 9.81
-    wall_speed: float = 0.011
-    seed: int = 0
-    mu_r: float = 0.0
 
-    def __post_init__(self):
-        check_grain_params(self, ("width", "diameter", "density", "gravity"),
-                           ("mu", "mu_wall", "mu_floor", "wall_speed", "mu_r"), counts=("per_pour",))
+
 
 
 def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):
@@ -572,10 +550,7 @@ def fit_janssen(mass, m_app, *, rho, width, mu_wall):
 register_scene(SceneEntry(
     name="silo",
     factory=silo,
-    parameters=parameters_of(SiloParams, {
-        "width": "m", "per_pour": "", "diameter": "m", "spread": "", "density": "kg/m^2",
-        "mu": "", "mu_wall": "", "mu_floor": "", "restitution": "", "gravity": "m/s^2",
-        "wall_speed": "m/s", "seed": "", "mu_r": "m"}),
+    parameters=parameters_of(SiloParams),
     description=("disks poured between two rough walls: Janssen's saturation of the floor's "
                  "load (contacts found every step by a broad phase in its study)"),
 ))

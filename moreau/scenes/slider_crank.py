@@ -54,6 +54,7 @@ import numpy as np
 from ..analysis.cases import GRID, TWO_PI, FactoryCase
 from ..errors import InputError
 from ..model.planar import Model, Polygon, Segment, TimeFunction
+from ..model.params import Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 
@@ -61,21 +62,18 @@ __all__ = ["SliderCrankParams", "slider_crank_model", "slider_crank", "slider_ki
 
 
 @dataclass(frozen=True)
-class SliderCrankParams:
-    """SI parameters of the ideal slider-crank."""
+class SliderCrankParams(Declared):
+    """SI parameters of the ideal slider-crank (checked where the model is built)."""
 
-    #: crank radius [m]
-    crank_radius: float = 0.05
-    #: rod length [m], > crank_radius
-    rod_length: float = 0.2
-    #: crank angular speed [rad/s]
-    crank_speed: float = 10.0
-    #: rod mass [kg] (a uniform bar)
-    rod_mass: float = 0.5
-    #: slider mass [kg]
-    slider_mass: float = 0.3
-    #: gravity [m/s^2], along -y
-    gravity: float = 9.81
+    crank_radius: float = param(0.05, "m", doc="Crank radius")
+    rod_length: float = param(0.2, "m", doc="Rod length", note="It must exceed ``crank_radius``.")
+    crank_speed: float = param(10.0, "rad/s", doc="Crank angular speed")
+    rod_mass: float = param(0.5, "kg", doc="Rod mass", note="A uniform bar.")
+    slider_mass: float = param(0.3, "kg", doc="Slider mass")
+    gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
+
+
+
 
 
 #: the slider's drawn block [m] (its inertia is that of this block)
@@ -179,9 +177,7 @@ class SliderCrankCase(FactoryCase):
 register_scene(SceneEntry(
     name="slider-crank",
     factory=slider_crank,
-    parameters=parameters_of(SliderCrankParams, {"crank_radius": "m", "rod_length": "m",
-                                                 "crank_speed": "rad/s", "rod_mass": "kg",
-                                                 "slider_mass": "kg", "gravity": "m/s^2"}),
+    parameters=parameters_of(SliderCrankParams),
     description=("the ideal slider-crank, crank driven at constant speed, built with joints "
                  "(moreau.model.planar): Moreau-Jean against the closed-form kinematics"),
     case=SliderCrankCase,

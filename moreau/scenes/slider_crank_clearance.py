@@ -62,6 +62,7 @@ from ..analysis.cases import GRID, TWO_PI
 from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
 from ..model.planar import Circle, Model, Polygon, Segment, TimeFunction
+from ..model.params import Declared, param
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from .slider_crank import SliderCrankCase
@@ -71,33 +72,27 @@ __all__ = ["SliderCrankClearanceParams", "slider_crank_clearance_model",
 
 
 @dataclass(frozen=True)
-class SliderCrankClearanceParams:
-    """SI parameters of the slider-crank with a clearance joint (Flores and Ambrósio 2004)."""
+class SliderCrankClearanceParams(Declared):
+    """SI parameters of the slider-crank with a clearance joint (Flores and Ambrósio 2004),
+    checked where the model is built."""
 
-    #: crank radius [m]
-    crank_radius: float = 0.05
-    #: rod length [m] (crank pin to the bearing's centre), > crank_radius
-    rod_length: float = 0.12
-    #: crank angular speed [rad/s] (5000 rpm)
-    crank_speed: float = 5000.0 * 2.0 * math.pi / 60.0
-    #: rod mass [kg]
-    rod_mass: float = 0.21
-    #: rod centroidal inertia [kg m^2]
-    rod_inertia: float = 2.5e-4
-    #: slider mass [kg]
-    slider_mass: float = 0.14
-    #: slider centroidal inertia [kg m^2]
-    slider_inertia: float = 1e-4
-    #: radial clearance R_h - R_p [m]
-    clearance: float = 5e-4
-    #: journal (pin) radius R_p [m]
-    pin_radius: float = 0.01
-    #: Coulomb friction between journal and bearing
-    mu: float = 0.0
-    #: Newton restitution of the journal-bearing impacts
-    restitution: float = 0.9
-    #: gravity [m/s^2], along -y
-    gravity: float = 9.81
+    crank_radius: float = param(0.05, "m", doc="Crank radius")
+    rod_length: float = param(0.12, "m", doc="Rod length, crank pin to the bearing's centre",
+                              note="It must exceed ``crank_radius``.")
+    crank_speed: float = param(5000.0 * 2.0 * math.pi / 60.0, "rad/s",
+                               doc="Crank angular speed", note="5000 rpm.")
+    rod_mass: float = param(0.21, "kg", doc="Rod mass")
+    rod_inertia: float = param(2.5e-4, "kg m^2", doc="Rod centroidal inertia")
+    slider_mass: float = param(0.14, "kg", doc="Slider mass")
+    slider_inertia: float = param(1e-4, "kg m^2", doc="Slider centroidal inertia")
+    clearance: float = param(5e-4, "m", doc="Radial clearance ``R_h - R_p``")
+    pin_radius: float = param(0.01, "m", doc="Journal (pin) radius ``R_p``")
+    mu: float = param(0.0, doc="Coulomb friction between journal and bearing")
+    restitution: float = param(0.9, doc="Newton restitution of the journal-bearing impacts")
+    gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
+
+
+
 
 
 def _checked(p):
@@ -201,11 +196,7 @@ class SliderCrankClearanceCase(SliderCrankCase):
 register_scene(SceneEntry(
     name="slider-crank-clearance",
     factory=slider_crank_clearance,
-    parameters=parameters_of(SliderCrankClearanceParams, {
-        "crank_radius": "m", "rod_length": "m", "crank_speed": "rad/s", "rod_mass": "kg",
-        "rod_inertia": "kg m^2", "slider_mass": "kg", "slider_inertia": "kg m^2",
-        "clearance": "m", "pin_radius": "m", "mu": "", "restitution": "",
-        "gravity": "m/s^2"}),
+    parameters=parameters_of(SliderCrankClearanceParams),
     description=("the slider-crank of Flores and Ambrosio (2004) with a revolute clearance "
                  "joint between rod and slider (moreau.model.planar), Moreau-Jean only"),
     case=SliderCrankClearanceCase,

@@ -25,9 +25,9 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import (check_fields, finite_array, in_open_interval, nonnegative, positive,
-                         restitution)
+from .._validate import finite_array, restitution
 from ..errors import InputError
+from ..model.params import GRAVITY, LENGTH, MASS, MU, RESTITUTION, Declared, open_interval, param
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
@@ -46,40 +46,18 @@ BlockMotion = namedtuple("BlockMotion", ["t_stop", "sticks", "a_before", "a_afte
 
 
 @dataclass(frozen=True)
-class SlidingBlockParams:
-    """SI parameters of the sliding block.
+class SlidingBlockParams(Declared):
+    """SI parameters of the sliding block."""
 
-    Attributes
-    ----------
-    mass : float
-        Mass of the block [kg], > 0.
-    mu : float
-        Coulomb friction coefficient, >= 0.
-    incline : float
-        Inclination ``alpha`` of the plane [rad], in (-pi/2, pi/2).
-    gravity : float
-        Gravitational acceleration [m/s^2], > 0.
-    restitution : float
-        Newton restitution of the contact, in [0, 1] (matters only if the
-        block is dropped onto the plane).
-    length : float
-        Reference length [m] that fixes the units, > 0.
-    """
-
-    mass: float = 1.0
-    mu: float = 0.3
-    incline: float = 0.0
-    gravity: float = 9.81
-    restitution: float = 0.0
-    length: float = 1.0
-
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "gravity", "length")
-        check_fields(self, nonnegative, "mu")
-        object.__setattr__(self, "incline",
-                           in_open_interval("incline", self.incline, -math.pi / 2, math.pi / 2,
-                                            "in the open interval (-pi/2, pi/2)"))
-        check_fields(self, restitution, "restitution")
+    mass: float = MASS(1.0, "Mass of the block")
+    mu: float = MU(0.3)
+    incline: float = param(0.0, "rad", open_interval(-math.pi / 2, math.pi / 2, "-pi/2, pi/2",
+                                                     "in the open interval (-pi/2, pi/2)"),
+                           "Inclination alpha of the plane")
+    gravity: float = GRAVITY(9.81)
+    restitution: float = RESTITUTION(0.0, "Newton restitution of the contact",
+                                     note="It matters only if the block is dropped onto the plane.")
+    length: float = LENGTH(1.0)
 
 
 class SlidingBlock(FromParams, SIUnits, CompiledScene):
@@ -293,9 +271,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="sliding-block",
     factory=SlidingBlock,
-    parameters=parameters_of(SlidingBlockParams, {"mass": "kg", "mu": "", "incline": "rad",
-                                                  "gravity": "m/s^2", "restitution": "",
-                                                  "length": "m"}),
+    parameters=parameters_of(SlidingBlockParams),
     description="block sliding to rest on a plane (exact solution)",
     case=SlidingBlockCase,
     reference="exact",

@@ -42,8 +42,9 @@ import numpy as np
 from numba import njit
 
 from ..compiled import CompiledModel
-from .._validate import check_fields, finite_array, nonnegative, positive, restitution, times
+from .._validate import finite_array, restitution, times
 from ..errors import InputError
+from ..model.params import GRAVITY, LENGTH, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ..model.drawing import contact, line, polygon
 from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
@@ -56,38 +57,18 @@ __all__ = ["SlidingBoxParams", "SlidingBox"]
 
 
 @dataclass(frozen=True)
-class SlidingBoxParams:
-    """SI parameters of the sliding box.
+class SlidingBoxParams(Declared):
+    """SI parameters of the sliding box."""
 
-    Attributes
-    ----------
-    mass : float
-        Mass [kg], > 0.
-    half_width, half_height : float
-        Half the box's width and height [m], > 0.
-    mu : float
-        Coulomb friction at both corners, >= 0; ``mu * half_height < half_width``
-        keeps both corners on the floor while sliding.
-    gravity : float
-        [m/s^2], > 0.
-    restitution : float
-        Newton restitution at the corners, in [0, 1].
-    length : float
-        Reference length [m] that fixes the units, > 0.
-    """
-
-    mass: float = 1.0
-    half_width: float = 0.5
-    half_height: float = 0.25
-    mu: float = 0.4
-    gravity: float = 9.81
-    restitution: float = 0.0
-    length: float = 1.0
-
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "half_width", "half_height", "gravity", "length")
-        check_fields(self, nonnegative, "mu")
-        check_fields(self, restitution, "restitution")
+    mass: float = MASS(1.0)
+    half_width: float = param(0.5, "m", POSITIVE, "Half the box's width")
+    half_height: float = param(0.25, "m", POSITIVE, "Half the box's height")
+    mu: float = MU(0.4, "Coulomb friction at both corners",
+                   note="``mu * half_height < half_width`` keeps both corners on the floor "
+                        "while sliding.")
+    gravity: float = GRAVITY(9.81)
+    restitution: float = RESTITUTION(0.0, "Newton restitution at the corners")
+    length: float = LENGTH(1.0)
 
 
 class SlidingBox(FromParams, SIUnits, CompiledScene):
@@ -289,9 +270,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="sliding-box",
     factory=SlidingBox,
-    parameters=parameters_of(SlidingBoxParams, {"mass": "kg", "half_width": "m", "half_height": "m",
-                                                "mu": "", "gravity": "m/s^2", "restitution": "",
-                                                "length": "m"}),
+    parameters=parameters_of(SlidingBoxParams),
     description="box sliding to rest on two frictional corners (two contacts, exact solution)",
     case=SlidingBoxCase,
     reference="exact",

@@ -31,10 +31,11 @@ import math
 from dataclasses import dataclass
 
 from ..analysis.cases import SpatialCase
+from ..model.params import RADIUS
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import as_params, params_with
 from ._sphere_on_plane import sphere_on_plane
-from .disk_incline import INCLINE_UNITS, InclineCase, InclineParams, incline_motion, rolls_down
+from .disk_incline import InclineCase, InclineParams, incline_motion, rolls_down
 
 __all__ = ["SphereInclineParams", "sphere_incline", "sphere_incline_exact", "rolls"]
 
@@ -44,7 +45,10 @@ class SphereInclineParams(InclineParams):
     """SI parameters of the sphere on an incline: those of :class:`InclineParams`, radius
     5 cm by default."""
 
-    radius: float = 0.05
+    radius: float = RADIUS(0.05)
+
+
+
 
 
 def rolls(p):
@@ -100,7 +104,7 @@ class SphereInclineCase(InclineCase, SpatialCase):
 register_scene(SceneEntry(
     name="sphere-incline",
     factory=sphere_incline,
-    parameters=parameters_of(SphereInclineParams, INCLINE_UNITS),
+    parameters=parameters_of(SphereInclineParams),
     description=("sphere rolling down a rough incline in space at (5/7) g sin(alpha), slipping "
                  "below mu = (2/7) tan(alpha) (closed form)"),
     case=SphereInclineCase,

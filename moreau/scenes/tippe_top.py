@@ -103,10 +103,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._validate import check_fields, in_open_interval, nonnegative, positive
 from ..analysis.cases import GRID, SpatialCase
 from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
+from ..model.params import (GRAVITY, MASS, MU, NONNEGATIVE, POSITIVE, RADIUS, Declared,
+                            open_interval, param)
 from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
@@ -121,55 +122,39 @@ LEINE_GLOCKER_PATCH = 5e-4
 
 
 @dataclass(frozen=True)
-class TippeTopParams:
-    """SI parameters of the tippe top (Leine and Glocker 2003, without the stem).
+class TippeTopParams(Declared):
+    """SI parameters of the tippe top (Leine and Glocker 2003, without the stem)."""
 
-    Attributes
-    ----------
-    mass : float
-        [kg], > 0.
-    radius : float
-        The sphere's radius ``R`` [m], > 0.
-    offset : float
-        ``alpha = a / R``: the centre of mass below the sphere's centre, in (0, 1).
-    inertia_transverse, inertia_axial : float
-        ``A`` and ``C`` [kg m^2] about the centre of mass, > 0, with ``C <= 2 A``.
-    mu : float
-        Coulomb friction, > 0.
-    gravity : float
-        [m/s^2], > 0.
-    spin : float
-        ``n0`` [rad/s] about the symmetry axis, > 0.
-    tilt : float
-        ``theta0`` [rad], the axis from the upward vertical, in (0, pi/2).
-    contact_radius : float
-        ``r`` [m], ``>= 0``: the contact patch's radius, whose drilling
-        friction couples with the sliding force (Coulomb–Contensou friction,
-        :mod:`moreau.model.space`); ``0`` is the point contact. Default
-        Leine and Glocker's ``r = 0.5 mm``.
-    """
-
-    mass: float = 6e-3
-    radius: float = 0.015
-    offset: float = 0.2
-    inertia_transverse: float = 8e-7
-    inertia_axial: float = 7e-7
-    mu: float = 0.3
-    gravity: float = 9.81
-    spin: float = 180.0
-    tilt: float = 0.1
-    contact_radius: float = LEINE_GLOCKER_PATCH
+    mass: float = MASS(6e-3)
+    radius: float = RADIUS(0.015, "The sphere's radius ``R``")
+    offset: float = param(0.2, "", open_interval(0.0, 1.0, "0, 1"),
+                          "Offset ``alpha = a / R`` of the centre of mass below the sphere's "
+                          "centre")
+    inertia_transverse: float = param(8e-7, "kg m^2", POSITIVE,
+                                      "Transverse inertia ``A`` about the centre of mass")
+    inertia_axial: float = param(7e-7, "kg m^2", POSITIVE,
+                                 "Axial inertia ``C`` about the centre of mass",
+                                 "It must be <= 2 A.")
+    mu: float = MU(0.3, "Coulomb friction", rule=POSITIVE)
+    gravity: float = GRAVITY(9.81)
+    spin: float = param(180.0, "rad/s", POSITIVE, "Initial spin ``n0`` about the symmetry axis")
+    tilt: float = param(0.1, "rad", open_interval(0.0, 0.5 * math.pi, "0, pi/2"),
+                        "Initial tilt ``theta0`` of the axis from the upward vertical")
+    contact_radius: float = param(LEINE_GLOCKER_PATCH, "m", NONNEGATIVE,
+                                  "Contact patch's radius ``r``",
+                                  "Its drilling friction couples with the sliding force "
+                                  "(Coulomb–Contensou friction, :mod:`moreau.model.space`); "
+                                  "``0`` is the point contact. Default Leine and Glocker's "
+                                  "``r = 0.5 mm``.")
 
     def __post_init__(self):
-        check_fields(self, positive, "mass", "radius", "inertia_transverse", "inertia_axial", "mu",
-                     "gravity", "spin")
-        object.__setattr__(self, "offset", in_open_interval("offset", self.offset, 0.0, 1.0))
-        object.__setattr__(self, "tilt", in_open_interval("tilt", self.tilt, 0.0, 0.5 * math.pi))
-        object.__setattr__(self, "contact_radius", nonnegative("contact_radius",
-                                                               self.contact_radius))
+        super().__post_init__()
         if self.inertia_axial > 2.0 * self.inertia_transverse:
             raise InputError(f"`inertia_axial` must be <= 2 inertia_transverse (the triangle "
                              f"inequality), got {self.inertia_axial!r}")
+
+
+
 
 
 def _jellett(p):
@@ -323,11 +308,7 @@ class TippeTopCase(SpatialCase):
 register_scene(SceneEntry(
     name="tippe-top",
     factory=tippe_top,
-    parameters=parameters_of(TippeTopParams, {"mass": "kg", "radius": "m", "offset": "",
-                                              "inertia_transverse": "kg m^2",
-                                              "inertia_axial": "kg m^2", "mu": "",
-                                              "gravity": "m/s^2", "spin": "rad/s",
-                                              "tilt": "rad", "contact_radius": "m"}),
+    parameters=parameters_of(TippeTopParams),
     description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
                  "threshold set by Jellett's integral, it turns its axis from up to down"),
     case=TippeTopCase,

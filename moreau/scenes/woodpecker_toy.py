@@ -89,11 +89,12 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from .._validate import check_fields, nonnegative, positive, restitution
 from ..analysis.cases import GRID, FactoryCase
 from ..compiled import CompiledModel
 from ..errors import InputError, MoreauError
 from ..integrators import simulate
+from ..model.params import (GRAVITY, MASS, MU, NONNEGATIVE, POSITIVE, RESTITUTION, Declaration,
+                            Declared, param)
 from ..model.compiled_scene import CompiledScene
 from ..model.drawing import circle, contact, line, polygon
 from ..model.registry import SceneEntry, parameters_of, register_scene
@@ -116,57 +117,36 @@ LEINE_2001 = {"period": 0.1452, "min_bird_angle": -0.53, "eigenfrequency": 72.91
               "equilibrium": (-0.1034, -0.2216), "jamming_mu": 0.285}
 
 
+#: a length of the toy's drawing (Glocker's names, the module docstring)
+SIZE = Declaration("m", POSITIVE)
+#: a centroidal moment of inertia
+INERTIA = Declaration("kg m^2", POSITIVE)
+
+
 @dataclass(frozen=True)
-class WoodpeckerToyParams:
-    """SI parameters of the woodpecker toy (Glocker 1995; names as his, module docstring).
+class WoodpeckerToyParams(Declared):
+    """SI parameters of the woodpecker toy (Glocker 1995; names as his, module docstring)."""
 
-    Attributes
-    ----------
-    sleeve_mass, bird_mass : float
-        ``m_M``, ``m_S`` [kg], > 0.
-    sleeve_inertia, bird_inertia : float
-        ``J_M``, ``J_S`` [kg m^2], > 0 (about the centres of mass).
-    spring : float
-        ``c_phi`` [N m/rad], >= 0.
-    pole_radius, sleeve_radius : float
-        ``r_0 < r_M`` [m].
-    sleeve_half_height : float
-        ``h_M`` [m], > 0.
-    spring_offset, bird_offset : float
-        ``l_M`` (sleeve centre to the spring), ``l_G`` (spring to the bird's centre of mass) [m].
-    beak_height, beak_offset : float
-        ``h_S``, ``l_S``: the beak at ``(-l_S, h_S)`` from the bird's centre of mass [m].
-    mu : float
-        Coulomb friction at the three contacts, >= 0.
-    beak_restitution, sleeve_restitution : float
-        Newton restitution at the beak and at the sleeve's edges, in [0, 1].
-    gravity : float
-        [m/s^2], > 0.
-    """
-
-    sleeve_mass: float = 0.0003
-    sleeve_inertia: float = 5.0e-9
-    bird_mass: float = 0.0045
-    bird_inertia: float = 7.0e-7
-    spring: float = 0.0056
-    pole_radius: float = 0.0025
-    sleeve_radius: float = 0.0031
-    sleeve_half_height: float = 0.0058
-    spring_offset: float = 0.010
-    bird_offset: float = 0.015
-    beak_height: float = 0.020
-    beak_offset: float = 0.0201
-    mu: float = 0.3
-    beak_restitution: float = 0.5
-    sleeve_restitution: float = 0.0
-    gravity: float = 9.81
+    sleeve_mass: float = MASS(0.0003, "Sleeve mass ``m_M``")
+    sleeve_inertia: float = INERTIA(5.0e-9, "Sleeve inertia ``J_M`` about its centre of mass")
+    bird_mass: float = MASS(0.0045, "Bird mass ``m_S``")
+    bird_inertia: float = INERTIA(7.0e-7, "Bird inertia ``J_S`` about its centre of mass")
+    spring: float = param(0.0056, "N m/rad", NONNEGATIVE, "Spring stiffness ``c_phi``")
+    pole_radius: float = SIZE(0.0025, "Pole radius ``r_0``")
+    sleeve_radius: float = SIZE(0.0031, "Sleeve radius ``r_M``", note="It must exceed ``r_0``.")
+    sleeve_half_height: float = SIZE(0.0058, "Sleeve half-height ``h_M``")
+    spring_offset: float = SIZE(0.010, "Spring offset ``l_M``, the sleeve's centre to the spring")
+    bird_offset: float = SIZE(0.015, "Bird offset ``l_G``, the spring to the bird's centre of mass")
+    beak_height: float = SIZE(0.020, "Beak height ``h_S``: the beak at ``(-l_S, h_S)`` from "
+                                     "the bird's centre of mass")
+    beak_offset: float = SIZE(0.0201, "Beak offset ``l_S``")
+    mu: float = MU(0.3, "Coulomb friction at the three contacts")
+    beak_restitution: float = RESTITUTION(0.5, "Newton restitution at the beak")
+    sleeve_restitution: float = RESTITUTION(0.0, "Newton restitution at the sleeve's edges")
+    gravity: float = GRAVITY(9.81)
 
     def __post_init__(self):
-        check_fields(self, positive, "sleeve_mass", "sleeve_inertia", "bird_mass", "bird_inertia",
-                     "pole_radius", "sleeve_radius", "sleeve_half_height", "spring_offset",
-                     "bird_offset", "beak_height", "beak_offset", "gravity")
-        check_fields(self, nonnegative, "spring", "mu")
-        check_fields(self, restitution, "beak_restitution", "sleeve_restitution")
+        super().__post_init__()
         if not self.sleeve_radius > self.pole_radius:
             raise InputError(f"`sleeve_radius` ({self.sleeve_radius!r}) must exceed "
                              f"`pole_radius` ({self.pole_radius!r}): the sleeve needs play")
@@ -455,12 +435,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="woodpecker-toy",
     factory=WoodpeckerToy,
-    parameters=parameters_of(WoodpeckerToyParams, {
-        "sleeve_mass": "kg", "sleeve_inertia": "kg m^2", "bird_mass": "kg",
-        "bird_inertia": "kg m^2", "spring": "N m/rad", "pole_radius": "m", "sleeve_radius": "m",
-        "sleeve_half_height": "m", "spring_offset": "m", "bird_offset": "m", "beak_height": "m",
-        "beak_offset": "m", "mu": "", "beak_restitution": "", "sleeve_restitution": "",
-        "gravity": "m/s^2"}),
+    parameters=parameters_of(WoodpeckerToyParams),
     case=WoodpeckerToyCase,
     description=("Glocker's woodpecker toy: a sleeve jamming on a pole and a bird on a "
                  "torsion spring, three frictional contacts (Glocker 1995; Leine, Glocker "

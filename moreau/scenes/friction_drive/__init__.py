@@ -17,7 +17,7 @@ Importing the package registers the scene, its reference scheme and that
 scheme's steady-state solver.
 """
 
-from .scene import (PAPER_DEFAULTS, UNITS, FrictionDrive, FrictionDriveCase, FrictionDriveParams,
+from .scene import (PAPER_DEFAULTS, FrictionDrive, FrictionDriveCase, FrictionDriveParams,
                     params_from_kwargs)
 from .walker import ContactState, EventDriven, FrictionDriveWalker, impact_impulses
 from .floquet import GrazingEvent, walker_monodromy, walker_period_map_slope

@@ -27,10 +27,11 @@ import numpy as np
 
 from numba import njit
 
-from ... import _validate as V
 from ...compiled import memo_sincos
 from ..._validate import positive
 from ...errors import InputError
+from ...model.params import (FINITE, MASS, MU, NONNEGATIVE, POSITIVE, UNIT_INTERVAL, Declaration,
+                             Declared, open_interval, param)
 
 __all__ = ["rod_gap", "rod_forces", "rod_rows", "one_rod_mass", "memo_sincos", "MEMO_SLOTS",
            "RodParams", "OneRod"]
@@ -72,20 +73,30 @@ def rod_rows(G, r, j, rotor, n, sgn, u10, s, c, st, need_T):
         G[r, 3 + n + rotor] = 1.0
 
 
+#: a stator's displacement amplitude (the rod drives' x10), also below ``length sin(phi0) / 2``
+AMPLITUDE = Declaration("m", POSITIVE, "Stator displacement amplitude",
+                        "It must be below ``length sin(phi0) / 2``: the rod must not pass the "
+                        "horizontal while in contact.")
+#: the load on the rotor
+ROTOR_LOAD = Declaration("N", FINITE, "Load ``F_L`` on the rotor")
+#: the restitution of the rod-rotor impacts
+ROD_RESTITUTION = Declaration("", UNIT_INTERVAL, "Newton restitution coefficient ``e`` of the "
+                                                 "rod-rotor impacts")
+#: the preload pressing the rod tip on the rotor
+PRELOAD = Declaration("N", NONNEGATIVE, "Preload ``F_p``",
+                      "The normal force pressing the rod tip on the rotor at rest, from a soft "
+                      "pre-compressed preload spring (:mod:`moreau.scenes.friction_drive`, "
+                      "\"Preload\").")
+
+
 @dataclass(frozen=True)
-class RodParams:
+class RodParams(Declared):
     """The parameters every rod drive shares, in SI units (the paper's values by default).
 
     The rod drives' parameter classes extend it, so that these fields come
     first, in this order, with these defaults and rules, in each of them.
 
-    Parameters
-    ----------
-    m, m2, k, length, phi0, mu : float
-        Rod and rotor masses [kg], spring stiffness [N/m] and rod length [m],
-        each > 0; the rod's tilt at rest [rad], in (0, pi/2); the friction
-        coefficient, >= 0 (as in
-        :class:`~moreau.scenes.friction_drive.FrictionDriveParams`).
+    {attributes}
 
     Examples
     --------
@@ -93,18 +104,14 @@ class RodParams:
     RodParams(m=1e-05, m2=0.002, k=10000.0, length=0.001, phi0=0.7853981633974483, mu=0.2)
     """
 
-    m: float = 2.0e-5
-    m2: float = 2.0e-3
-    k: float = 1.0e4
-    length: float = 1.0e-3
-    phi0: float = math.pi / 4
-    mu: float = 0.1
-
-    def __post_init__(self):
-        V.check_fields(self, V.positive, "m", "m2", "k", "length")
-        object.__setattr__(self, "phi0", V.in_open_interval("phi0", self.phi0, 0.0, math.pi / 2,
-                                                            "in the open interval (0, pi/2)"))
-        V.check_fields(self, V.nonnegative, "mu")
+    m: float = MASS(2.0e-5, "Rod mass")
+    m2: float = MASS(2.0e-3, "Rotor mass")
+    k: float = param(1.0e4, "N/m", POSITIVE, "Supporting spring stiffness")
+    length: float = param(1.0e-3, "m", POSITIVE, "Rod length")
+    phi0: float = param(math.pi / 4, "rad", open_interval(0.0, math.pi / 2, "0, pi/2",
+                                                          "in the open interval (0, pi/2)"),
+                        "Initial tilt of the rod")
+    mu: float = MU(0.1)
 
     def _check_amplitude(self, name, x):
         # the rod must stay above the horizontal while in contact

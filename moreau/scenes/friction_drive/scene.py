@@ -78,7 +78,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ... import _validate as V
 from ...errors import InputError, MoreauError
 from ...regimes import Regime
 from ...model.drawing import rod_drive_shapes
@@ -86,8 +85,8 @@ from ...model.units import DriveUnits
 from numba import njit
 
 from ...compiled import CompiledModel
-from .rod import (MEMO_SLOTS, OneRod, RodParams, StatorMotion, memo_sincos, one_rod_mass,
-                  rod_forces, rod_gap, rod_rows)
+from .rod import (AMPLITUDE, MEMO_SLOTS, PRELOAD, ROD_RESTITUTION, ROTOR_LOAD, OneRod, RodParams,
+                  StatorMotion, memo_sincos, one_rod_mass, rod_forces, rod_gap, rod_rows)
 from ...model.compiled_scene import CompiledScene
 from ...model.scene import params_with
 from ...analysis.cases import GRID, TWO_PI, DriveCase, regime_switches
@@ -102,31 +101,7 @@ __all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
 class FrictionDriveParams(RodParams):
     """Physical parameters of the friction drive, in SI units.
 
-    Parameters
-    ----------
-    m : float
-        Rod mass [kg], > 0.
-    m2 : float
-        Rotor mass [kg], > 0.
-    k : float
-        Supporting spring stiffness [N/m], > 0.
-    length : float
-        Rod length [m], > 0.
-    phi0 : float
-        Initial tilt of the rod [rad], in (0, pi/2).
-    mu : float
-        Coulomb friction coefficient, >= 0.
-    x10 : float
-        Stator displacement amplitude [m], > 0 and ``2 x10 < length sin(phi0)``
-        (the rod must not pass the horizontal while in contact).
-    load : float
-        Load ``F_L`` on the rotor [N].
-    restitution : float
-        Newton restitution coefficient ``e`` of the rod-rotor impacts, in [0, 1].
-    preload : float
-        Preload ``F_p`` [N], >= 0: the normal force pressing the rod tip on the
-        rotor at rest, from a soft pre-compressed preload spring (module
-        docstring, "Preload").
+    {attributes}
 
     Examples
     --------
@@ -135,17 +110,13 @@ class FrictionDriveParams(RodParams):
     (0.2, 2e-05)
     """
 
-    x10: float = 2.0e-6
-    load: float = 0.0
-    restitution: float = 0.0
-    preload: float = 0.0
+    x10: float = AMPLITUDE(2.0e-6)
+    load: float = ROTOR_LOAD(0.0)
+    restitution: float = ROD_RESTITUTION(0.0)
+    preload: float = PRELOAD(0.0)
 
     def __post_init__(self):
         super().__post_init__()
-        V.check_fields(self, V.positive, "x10")
-        V.check_fields(self, V.finite_scalar, "load")
-        V.check_fields(self, V.restitution, "restitution")
-        V.check_fields(self, V.nonnegative, "preload")
         self._check_amplitude("x10", self.x10)
 
 
@@ -409,15 +380,10 @@ class FrictionDriveCase(DriveCase):
         return self._trajectory_error(res), regime_switches(ss.regimes), ss.mode
 
 
-
-#: SI units of the parameters of :class:`FrictionDriveParams`
-UNITS = {"m": "kg", "m2": "kg", "k": "N/m", "length": "m", "phi0": "rad", "mu": "", "x10": "m",
-         "load": "N", "restitution": "", "preload": "N"}
-
 register_scene(SceneEntry(
     name="friction-drive",
     factory=FrictionDrive,
-    parameters=parameters_of(FrictionDriveParams, UNITS, extra=(
+    parameters=parameters_of(FrictionDriveParams, extra=(
         Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
     description="the paper's friction drive of a piezoelectric motor (steady state)",
     case=FrictionDriveCase,

@@ -36,8 +36,9 @@ import numpy as np
 from numba import njit
 
 from ...compiled import CompiledModel
-from ..._validate import check_fields, finite_scalar, in_open_interval, positive, restitution
+from ..._validate import finite_scalar, in_open_interval, positive, restitution
 from ...errors import InputError
+from ...model.params import LOAD, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ...model.drawing import contact, polygon
 from ...model.compiled_scene import CompiledScene
 from ...model.units import SIUnits
@@ -306,38 +307,22 @@ def make_drive(drive):
 
 
 @dataclass(frozen=True)
-class StickSlipMotorParams:
-    """SI parameters of the stick–slip motor.
+class StickSlipMotorParams(Declared):
+    """SI parameters of the stick–slip motor."""
 
-    Attributes
-    ----------
-    mass : float
-        Slider mass [kg], > 0.
-    normal_force : float
-        Constant force pressing the slider onto the stator [N], > 0.
-    mu : float
-        Coulomb friction coefficient, > 0 (without friction nothing moves).
-    amplitude : float
-        Stator displacement amplitude ``X`` [m], > 0 (half the stroke of the
-        sawtooth, the fundamental's amplitude of the sine drive).
-    load : float
-        External force on the slider opposing positive motion [N], finite.
-    restitution : float
-        Newton restitution of the contact, in [0, 1] (irrelevant while the
-        slider stays pressed on).
-    """
+    mass: float = MASS(0.01, "Slider mass")
+    normal_force: float = param(1.0, "N", POSITIVE,
+                                "Constant force pressing the slider onto the stator")
+    mu: float = MU(0.2, rule=POSITIVE, note="Without friction nothing moves.")
+    amplitude: float = param(1e-6, "m", POSITIVE, "Stator displacement amplitude ``X``",
+                             "Half the stroke of the sawtooth, the fundamental's amplitude of "
+                             "the sine drive.")
+    load: float = LOAD(0.0, "External force on the slider opposing positive motion")
+    restitution: float = RESTITUTION(0.0, "Newton restitution of the contact",
+                                     note="Irrelevant while the slider stays pressed on.")
 
-    mass: float = 0.01
-    normal_force: float = 1.0
-    mu: float = 0.2
-    amplitude: float = 1e-6
-    load: float = 0.0
-    restitution: float = 0.0
 
-    def __post_init__(self):
-        check_fields(self, positive, "mass", "normal_force", "mu", "amplitude")
-        check_fields(self, finite_scalar, "load")
-        check_fields(self, restitution, "restitution")
+
 
 
 class StickSlipMotor(SIUnits, CompiledScene):
@@ -561,9 +546,7 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="stick-slip-motor",
     factory=StickSlipMotor,
-    parameters=parameters_of(StickSlipMotorParams, {"mass": "kg", "normal_force": "N", "mu": "",
-                                                    "amplitude": "m", "load": "N",
-                                                    "restitution": ""}, extra=(
+    parameters=parameters_of(StickSlipMotorParams, extra=(
         Parameter("frequency", "Hz", 1000.0, "drive frequency"),
         Parameter("drive", "choice", "sawtooth", "stator waveform: sawtooth or sine"))),
     description="stick-slip (inertial) motor: a slider on a stator driven by a sawtooth or sine",
