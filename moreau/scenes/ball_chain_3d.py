@@ -122,9 +122,6 @@ class BallChain3DParams(ChainParams):
                                                  "``t* = 1.1 r / V``, off the usual grids.")
 
 
-
-
-
 def ball_chain_3d(params=None, **overrides):
     """The scene (a :class:`~moreau.model.space.SpaceScene`) of the chain of spheres.
 
@@ -194,9 +191,6 @@ class PyramidParams(Declared):
         if not 1.0 < self.spread < math.sqrt(3.0):
             raise InputError(f"`spread` must be in (1, sqrt(3)) (the bottom spheres apart, the "
                              f"top one above them), got {self.spread!r}")
-
-
-
 
 
 def pyramid_forces(params=None, **overrides):

@@ -52,9 +52,6 @@ class BilliardParams(Declared):
                         "``speed / radius`` rolls; negative is backspin.")
 
 
-
-
-
 def rolling_onset(p):
     """``(t*, v*)``: the time [s] the ball starts rolling and its speed then [m/s].
 

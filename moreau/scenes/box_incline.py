@@ -100,9 +100,6 @@ class BoxInclineParams(Declared):
                              f"got c tan(slope) = {c * math.tan(self.slope)!r} >= a = {a!r}")
 
 
-
-
-
 def slides(p):
     """Whether the box slides at some time: launched (``speed > 0``) or ``mu < tan(slope)``."""
     return p.speed > 0.0 or p.mu < math.tan(p.slope)

@@ -121,9 +121,6 @@ class BoxStack3DParams(Declared):
                              f"{self.offset!r}, mu = {self.mu!r}, slope = {self.slope!r}")
 
 
-
-
-
 def _slides(p):
     return p.speed > 0.0 or p.mu < math.tan(p.slope)
 

@@ -63,9 +63,6 @@ class DiskInclineParams(InclineParams):
     """SI parameters of the disk on an incline (those of :class:`InclineParams`)."""
 
 
-
-
-
 def disk_incline_model(params=None, **overrides):
     """The builder's model of the disk on the incline (SI parameters of :class:`DiskInclineParams`)."""
     p = params_with(DiskInclineParams, params, overrides)

@@ -68,9 +68,6 @@ class DoublePendulumStopParams(Declared):
     gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
 
 
-
-
-
 def _checked(p):
     for name in ("length1", "length2", "mass1", "mass2", "gravity"):
         value = getattr(p, name)

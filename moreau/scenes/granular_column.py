@@ -121,9 +121,6 @@ class GranularColumnParams(Grains):
                                  "registered scene takes only 0; :func:`collapse` takes any.")
 
 
-
-
-
 def column_system(params=None, *, gate=True, **overrides):
     """The column's :class:`DiskSystem` and its start centres, in grain units.
 

@@ -143,9 +143,6 @@ class MasonryArchParams(Declared):
         super().__post_init__()
 
 
-
-
-
 def voussoir_geometry(n, thickness):
     """The voussoirs of a unit-radius arch: joint angles, corners, weights, centroids, inertias.
 

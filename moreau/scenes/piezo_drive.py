@@ -172,9 +172,6 @@ class PiezoDriveParams(RodParams):
         object.__setattr__(self, "u_sat", float(us))
 
 
-
-
-
 PIEZO_DEFAULTS = PiezoDriveParams()
 
 

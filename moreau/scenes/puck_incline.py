@@ -87,9 +87,6 @@ class PuckInclineParams(Declared):
         object.__setattr__(self, "heading", h)
 
 
-
-
-
 def puck_incline(params=None, **overrides):
     """The scene (a :class:`~moreau.model.space.SpaceScene`) of the puck on the incline.
 

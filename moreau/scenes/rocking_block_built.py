@@ -79,9 +79,6 @@ class RockingBlockBuiltParams(RockingBlockParams):
                                      "From rest at ``t = 0`` (0: a fixed floor).")
 
 
-
-
-
 def rocking_onset_acceleration(width, height, gravity=9.81):
     """The base acceleration ``g b / h`` [m/s^2] above which a block that does not slide starts to rock.
 

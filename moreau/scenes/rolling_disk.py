@@ -107,9 +107,6 @@ class RollingDiskParams(Declared):
                              f"rolling on this circle needs, got {self.mu!r}")
 
 
-
-
-
 def _rates(p):
     # (Omega, b, omega_3) in SI: the module docstring's relation for the thin disk
     a, th, g = p.radius, p.tilt, p.gravity

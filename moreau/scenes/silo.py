@@ -218,9 +218,6 @@ class SiloParams(Grains):
                                  "takes only 0; :func:`fill` takes any.")
 
 
-
-
-
 def silo_system(radii, params=None, *, wall_speed=0.0, **overrides):
     """The silo's :class:`DiskSystem` for disks of ``radii`` (grain units): floor, left, right wall.
 

@@ -73,9 +73,6 @@ class SliderCrankParams(Declared):
     gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
 
 
-
-
-
 #: the slider's drawn block [m] (its inertia is that of this block)
 _SLIDER_SIZE = (0.04, 0.02)
 

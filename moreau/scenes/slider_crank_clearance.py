@@ -92,9 +92,6 @@ class SliderCrankClearanceParams(Declared):
     gravity: float = param(9.81, "m/s^2", doc="Gravity, along -y")
 
 
-
-
-
 def _checked(p):
     for name in ("crank_radius", "rod_length", "crank_speed", "rod_mass", "rod_inertia",
                  "slider_mass", "slider_inertia", "clearance", "pin_radius"):

@@ -48,9 +48,6 @@ class SphereInclineParams(InclineParams):
     radius: float = RADIUS(0.05)
 
 
-
-
-
 def rolls(p):
     """Whether the sphere rolls: ``mu >= (2/7) tan(alpha)``.
 

@@ -154,9 +154,6 @@ class TippeTopParams(Declared):
                              f"inequality), got {self.inertia_axial!r}")
 
 
-
-
-
 def _jellett(p):
     R, a = p.radius, p.offset * p.radius
     return p.inertia_axial * p.spin * (R * math.cos(p.tilt) - a)

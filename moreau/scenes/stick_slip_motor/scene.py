@@ -322,9 +322,6 @@ class StickSlipMotorParams(Declared):
                                      note="Irrelevant while the slider stays pressed on.")
 
 
-
-
-
 class StickSlipMotor(SIUnits, CompiledScene):
     """Slider pressed on a stator that vibrates along the slider's path.
 
@@ -493,7 +490,6 @@ class StickSlipCase(CompareCase):
 
     def headline_of_run(self, res):
         return float(res.q[-1, 0] - res.q[0, 0])
-
 
 
 # -- compiled model (moreau.compiled) ---------------------------------------------------
