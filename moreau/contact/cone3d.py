@@ -483,6 +483,28 @@ ONE_CONTACT_TOL = 1e-12
 
 
 @njit(cache=True)
+def _stick(A, b0, b1, b2):
+    # A r = -b by Cramer's rule on the 3x3 block: (True, r) where det A > 0, else False; the
+    # adjugate's entries as scalars (no array allocated in this hot branch)
+    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
+    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
+    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
+    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
+    if not det > 0.0:
+        return False, 0.0, 0.0, 0.0
+    i01 = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
+    i11 = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
+    i21 = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
+    i02 = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
+    i12 = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
+    i22 = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    rn = -(c00 * b0 + i01 * b1 + i02 * b2) / det
+    r1 = -(c01 * b0 + i11 * b1 + i12 * b2) / det
+    r2 = -(c02 * b0 + i21 * b1 + i22 * b2) / det
+    return True, rn, r1, r2
+
+
+@njit(cache=True)
 def polyhedral_one_contact(W, q, mu, D, r):
     """One contact's polyhedral problem (:func:`build_polyhedral_lcp`) in closed form, certified.
 
@@ -559,22 +581,10 @@ def polyhedral_one_contact(W, q, mu, D, r):
              abs(W[1, 1]) + abs(W[1, 2]) + abs(W[2, 1]) + abs(W[2, 2]))
     tol_w = ONE_CONTACT_TOL * sc
     tol_z = tol_w / mm
-    # stick: W r = -q by Cramer's rule
-    c00 = W[1, 1] * W[2, 2] - W[1, 2] * W[2, 1]
-    c01 = W[1, 2] * W[2, 0] - W[1, 0] * W[2, 2]
-    c02 = W[1, 0] * W[2, 1] - W[1, 1] * W[2, 0]
-    det = W[0, 0] * c00 + W[0, 1] * c01 + W[0, 2] * c02
+    # stick: W r = -q
     a1, a2 = -f1, -f2                      # the sliding impulse's direction, failing stick
-    if det > 0.0:
-        i01 = W[0, 2] * W[2, 1] - W[0, 1] * W[2, 2]
-        i11 = W[0, 0] * W[2, 2] - W[0, 2] * W[2, 0]
-        i21 = W[0, 1] * W[2, 0] - W[0, 0] * W[2, 1]
-        i02 = W[0, 1] * W[1, 2] - W[0, 2] * W[1, 1]
-        i12 = W[0, 2] * W[1, 0] - W[0, 0] * W[1, 2]
-        i22 = W[0, 0] * W[1, 1] - W[0, 1] * W[1, 0]
-        rn = -(c00 * n0 + i01 * f1 + i02 * f2) / det
-        r1 = -(c01 * n0 + i11 * f1 + i12 * f2) / det
-        r2 = -(c02 * n0 + i21 * f1 + i22 * f2) / det
+    ok, rn, r1, r2 = _stick(W, n0, f1, f2)
+    if ok:
         if rn >= 0.0:
             # inside the polygon of vertices mu r_N D_k: below every facet's line, whose
             # outward normal is D_k + D_k+1 and whose offset is mu r_N (1 + D_k.D_k+1)
@@ -791,22 +801,9 @@ def _local(A, b, mu):
         return 0.0, 0.0, 0.0
     if mu == 0.0:
         return -b[0] / A[0, 0], 0.0, 0.0
-    # stick: A r = -b (Cramer's rule on the 3x3 block)
-    c00 = A[1, 1] * A[2, 2] - A[1, 2] * A[2, 1]
-    c01 = A[1, 2] * A[2, 0] - A[1, 0] * A[2, 2]
-    c02 = A[1, 0] * A[2, 1] - A[1, 1] * A[2, 0]
-    det = A[0, 0] * c00 + A[0, 1] * c01 + A[0, 2] * c02
-    if det > 0.0:
-        # the adjugate's entries as scalars (no array allocated in this hot branch)
-        i01 = A[0, 2] * A[2, 1] - A[0, 1] * A[2, 2]
-        i11 = A[0, 0] * A[2, 2] - A[0, 2] * A[2, 0]
-        i21 = A[0, 1] * A[2, 0] - A[0, 0] * A[2, 1]
-        i02 = A[0, 1] * A[1, 2] - A[0, 2] * A[1, 1]
-        i12 = A[0, 2] * A[1, 0] - A[0, 0] * A[1, 2]
-        i22 = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
-        rn = -(c00 * b[0] + i01 * b[1] + i02 * b[2]) / det
-        r1 = -(c01 * b[0] + i11 * b[1] + i12 * b[2]) / det
-        r2 = -(c02 * b[0] + i21 * b[1] + i22 * b[2]) / det
+    # stick: A r = -b
+    ok, rn, r1, r2 = _stick(A, b[0], b[1], b[2])
+    if ok:
         if rn >= 0.0 and math.hypot(r1, r2) <= mu * rn:
             return rn, r1, r2
     # slip: roots of F(phi) = s_perp . (g u_T) with g > 0 and s . u_T >= 0
