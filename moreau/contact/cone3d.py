@@ -1133,6 +1133,15 @@ def _alart_curnier(W, q, mu, rho, r):
     return phi, J
 
 
+def _restart(W, q, mu, start, max_newton, tol_sq, r, res):
+    """Newton from ``start`` (its own budget): its answer where better than ``(r, res)``,
+    and its steps."""
+    r_n, res_n, more = _newton(W, q, mu, start.copy(), int(max_newton), tol_sq)
+    if res_n < res:
+        return r_n, res_n, more
+    return r, res, more
+
+
 def _newton(W, q, mu, r, max_iter, tol_sq):
     """Nonsmooth Newton on the Alart–Curnier function with an Armijo search.
 
@@ -1318,12 +1327,10 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
         # each restart has its own budget of max_newton steps
         poly = solve_polyhedral(W, q, mu, _RESTART_D)
         if poly.success:
-            r_n, res_n, more = _newton(W, q, mu, poly.r.copy(), int(max_newton), tol_sq)
+            r, res, more = _restart(W, q, mu, poly.r, max_newton, tol_sq, r, res)
             newton += more
             how.append(f"Newton restarted from the {_RESTART_D}-direction polyhedral solution "
                        f"({poly.iterations['pivots']} Lemke pivots)")
-            if res_n < res:
-                r, res = r_n, res_n
             if res > tol_sq:
                 # each contact sticking or open, r_S = -W_SS^-1 q_S on the touching set S:
                 # an answer Newton can stall beside (seed 2839128055, mu 2.55: four stick,
@@ -1351,12 +1358,10 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
                     # Newton would repeat its steps
                     continue
                 start = poly.r
-                r_n, res_n, more = _newton(W, q, mu, poly.r.copy(), int(max_newton), tol_sq)
+                r, res, more = _restart(W, q, mu, poly.r, max_newton, tol_sq, r, res)
                 newton += more
                 how.append(f"Newton restarted from the {d}-direction polyhedral solution "
                            f"({poly.iterations['pivots']} Lemke pivots, {more} step(s))")
-                if res_n < res:
-                    r, res = r_n, res_n
         if res > tol_sq:
             # every contact sticking, r = -W^-1 q, projected on the cones: the answer
             # itself where it lies in them (mu above every contact's |r_T| / r_N there),
@@ -1366,12 +1371,10 @@ def solve_exact(W, q, mu, *, tol=1e-10, max_sweeps=500, max_newton=30, polish_fr
             except np.linalg.LinAlgError:
                 stick = None
             if stick is not None and np.all(np.isfinite(stick)):
-                r_n, res_n, more = _newton(W, q, mu, stick, int(max_newton), tol_sq)
+                r, res, more = _restart(W, q, mu, stick, max_newton, tol_sq, r, res)
                 newton += more
                 how.append(f"Newton restarted from the sticking impulse -W^-1 q projected on "
                            f"the cones ({more} step(s))")
-                if res_n < res:
-                    r, res = r_n, res_n
     if res > tol_sq and sweeps < max_sweeps:
         r = r.copy()
         u = W @ r + q
