@@ -1456,6 +1456,18 @@ def exact_gauss_seidel(W, q, mu, r, u, tol, polish_from, max_sweeps):
                                    np.empty((3, 3)), np.empty(3), np.empty(n), np.empty(n))
 
 
+# inlined by numba, like _stick
+@njit(inline="always")
+def _bound_sq(q, tol):
+    # ||q||, the scale of the bound (1 where q = 0) and the bound squared, (tol scale)^2
+    qn = 0.0
+    for j in range(q.shape[0]):
+        qn += q[j] * q[j]
+    qn = math.sqrt(qn)
+    scale = qn if qn > 0.0 else 1.0
+    return qn, scale, (tol * scale) ** 2
+
+
 @njit(cache=True)
 def exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps, A, b, r_in, u_in):
     """:func:`exact_gauss_seidel` on the caller's scratch: ``A`` (at least 3 x 3), ``b`` (at
@@ -1474,12 +1486,7 @@ def exact_gauss_seidel_into(W, q, mu, r, u, tol, polish_from, max_sweeps, A, b, 
     (True, [1.0, -0.3, -0.4])
     """
     n = q.shape[0]
-    qn = 0.0
-    for j in range(n):
-        qn += q[j] * q[j]
-    qn = math.sqrt(qn)
-    scale = qn if qn > 0.0 else 1.0
-    tol_sq = (tol * scale) ** 2
+    qn, scale, tol_sq = _bound_sq(q, tol)
     switch_sq = (max(tol, polish_from) * scale) ** 2
     # np.int64: a literal (the global) would compile _pgs_into again
     _, res = _pgs_into(W, q, mu, r, u, max_sweeps, switch_sq, 1.0, np.int64(_STALL), A, b)
@@ -1693,12 +1700,7 @@ def exact_newton_polish(W, q, mu, r, u, tol, max_newton):
     """
     n = q.shape[0]
     nc = mu.shape[0]
-    qn = 0.0
-    for j in range(n):
-        qn += q[j] * q[j]
-    qn = math.sqrt(qn)
-    scale = qn if qn > 0.0 else 1.0
-    tol_sq = (tol * scale) ** 2
+    qn, scale, tol_sq = _bound_sq(q, tol)
     rho = np.empty(nc)
     for i in range(nc):
         rho[i] = 1.0 / W[3 * i, 3 * i]
