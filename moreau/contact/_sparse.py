@@ -51,7 +51,8 @@ from moreau.lcp._certified import two_prod
 #: package's own import caches
 _CACHE = __name__.startswith("moreau.")
 
-__all__ = ["IterativeResult", "check_problem", "project_cone", "local_solve", "natural_map",
+__all__ = ["IterativeResult", "check_problem", "project_cone", "start_impulses", "local_solve",
+           "natural_map",
            "problem_residual", "delassus", "disk_jacobian", "chain_impact_problem",
            "stacked_disks_problem", "DENSE_CROSSOVER"]
 
@@ -221,6 +222,30 @@ def project_cone(mu, rn, rt):
 
 
 @njit(cache=_CACHE)
+def _project_start(r, mu):
+    # compiled: a Python loop over the contacts cost about 0.8 us a contact (one dispatch of
+    # project_cone each), 10 ms at 12 000 contacts, more than ten sweeps of a warm-started step
+    for i in range(mu.shape[0]):
+        r[2 * i], r[2 * i + 1] = project_cone(mu[i], r[2 * i], r[2 * i + 1])
+
+
+def start_impulses(r0, q, mu):
+    """An iterative solver's first impulses: ``r0`` (checked, copied) or zero, on the cones.
+
+    Examples
+    --------
+    >>> q, mu = np.array([-1.0, 0.0]), np.array([0.5])
+    >>> start_impulses([1.0, 2.0], q, mu).tolist()
+    [1.6, 0.8]
+    >>> start_impulses(None, q, mu).tolist()
+    [0.0, 0.0]
+    """
+    r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
+    _project_start(r, mu)
+    return r
+
+
+@njit(cache=_CACHE)
 def _local_residual_sq(Wnn, Wnt, Wtn, Wtt, bn, bt, mu, rn, rt):
     un = Wnn * rn + Wnt * rt + bn
     ut = Wtn * rn + Wtt * rt + bt
@@ -345,7 +370,7 @@ def record_check(indptr, indices, data, q, r, u, mu, it, hist_it, hist_res, nh, 
 
 
 _jit_cache.bind_cache_to_sources(
-    [project_cone, _local_residual_sq, local_solve, _two_sum, velocities_compensated,
+    [project_cone, _project_start, _local_residual_sq, local_solve, _two_sum, velocities_compensated,
      velocities, natural_map, record_check, diagonal_blocks], [__file__, _certified.__file__])
 
 

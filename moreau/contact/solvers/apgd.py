@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from moreau import _jit_cache
-from moreau._validate import finite_array, finite_scalar, positive_int
+from moreau._validate import finite_scalar, positive_int
 from moreau.contact import _sparse
 from moreau.contact._sparse import check_problem, project_cone, record_check, velocities
 from moreau.errors import InputError
@@ -176,9 +176,7 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     if L <= 0.0:
         # W = 0: the impulses change no velocity; start from zero and report
         L = 1.0
-    x = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
-    for i in range(mu.shape[0]):
-        x[2 * i], x[2 * i + 1] = project_cone(mu[i], x[2 * i], x[2 * i + 1])
+    x = _sparse.start_impulses(r0, q, mu)
     checks = _sparse.CheckRecord(q, max_iter, check_every)
     best_r = np.empty_like(x)
     it, nh = _apgd(W.indptr, W.indices, W.data, q, mu, x, float(L), max_iter, check_every,

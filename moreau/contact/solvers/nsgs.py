@@ -22,7 +22,7 @@ import numpy as np
 from numba import njit
 
 from moreau import _jit_cache
-from moreau._validate import finite_array, finite_scalar, positive_int
+from moreau._validate import finite_scalar, positive_int
 from moreau.contact import _sparse
 from moreau.contact._sparse import check_problem, local_solve, project_cone, record_check
 from moreau.errors import InputError
@@ -84,15 +84,7 @@ def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_
     return sweeps, nh
 
 
-@njit(cache=_CACHE)
-def _project_start(r, mu):
-    # compiled: a Python loop over the contacts cost about 0.8 us a contact (one dispatch of
-    # project_cone each), 10 ms at 12 000 contacts, more than ten sweeps of a warm-started step
-    for i in range(mu.shape[0]):
-        r[2 * i], r[2 * i + 1] = project_cone(mu[i], r[2 * i], r[2 * i + 1])
-
-
-_jit_cache.bind_cache_to_sources([_nsgs, _project_start], [__file__, _sparse.__file__])
+_jit_cache.bind_cache_to_sources([_nsgs], [__file__, _sparse.__file__])
 
 
 def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, check_every=4):
@@ -148,8 +140,7 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     omega = finite_scalar("omega", omega)
     if not 0.0 < omega < 2.0:
         raise InputError(f"`omega` must lie in (0, 2), got {omega!r}")
-    r = np.zeros_like(q) if r0 is None else finite_array("r0", r0, shape=q.shape).copy()
-    _project_start(r, mu)
+    r = _sparse.start_impulses(r0, q, mu)
     checks = _sparse.CheckRecord(q, max_sweeps, check_every)
     best_r = np.empty_like(r)
     blocks = _sparse.diagonal_blocks(W.indptr, W.indices, W.data, mu.shape[0], 2)
