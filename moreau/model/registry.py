@@ -319,7 +319,8 @@ def parameters_of(params_class, extra=()):
     (:mod:`moreau.model.params`): each field's name, default, unit and doc, in field order.
 
     ``extra`` are further :class:`Parameter` entries (e.g. the drive
-    frequency) put first.
+    frequency) put first. A doc is plain text here (for the command line and
+    JSON): the reST literal marks of the docstring's version go.
 
     Examples
     --------
@@ -327,9 +328,9 @@ def parameters_of(params_class, extra=()):
     >>> from moreau.model.params import MASS, Declared
     >>> @dataclass(frozen=True)
     ... class BallParams(Declared):
-    ...     mass: float = MASS(0.1, "Mass of the ball")
+    ...     mass: float = MASS(0.1, "Mass of the ball ``m``")
     >>> parameters_of(BallParams)
-    (Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball'),)
+    (Parameter(name='mass', unit='kg', default=0.1, doc='Mass of the ball m'),)
     """
     out = list(extra)
     for f in dataclasses.fields(params_class):
@@ -337,7 +338,7 @@ def parameters_of(params_class, extra=()):
         if decl is None:
             raise InputError(f"the parameter `{f.name}` of {params_class.__name__} is not "
                              f"declared (moreau.model.params)")
-        out.append(Parameter(f.name, decl.unit, f.default, decl.doc))
+        out.append(Parameter(f.name, decl.unit, f.default, decl.doc.replace("``", "")))
     return tuple(out)
 
 
