@@ -5,16 +5,25 @@ import pathlib
 import subprocess
 import sys
 
+import pytest
+
 import moreau
 
 ROOT = pathlib.Path(__file__).parents[2]
 
 
-def test_version_flag_prints_the_package_version():
-    for flag in ("--version", "-V"):
-        run = subprocess.run([sys.executable, "-m", "moreau", flag], capture_output=True, text=True)
-        assert run.returncode == 0
-        assert run.stdout.strip() == f"moreau {moreau.__version__}"
+def test_version_flag_prints_the_package_version(capsys):
+    # the long flag through `python -m moreau` (the entry point), the short one through the
+    # same parser in this process (a second interpreter start would check nothing more)
+    run = subprocess.run([sys.executable, "-m", "moreau", "--version"], capture_output=True,
+                         text=True)
+    assert run.returncode == 0
+    assert run.stdout.strip() == f"moreau {moreau.__version__}"
+    from moreau.cli import main
+    with pytest.raises(SystemExit) as stop:
+        main(["-V"])
+    assert stop.value.code == 0
+    assert capsys.readouterr().out.strip() == f"moreau {moreau.__version__}"
 
 
 def test_the_version_is_written_once():
