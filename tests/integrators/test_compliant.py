@@ -55,7 +55,9 @@ def test_kelvin_voigt_ball_rebounds_as_the_one_dof_contact_model(e):
     k = 1e6
     ball = make_scene("bouncing-ball", restitution=e)
     q0, v0 = ball.initial_state()
-    r = simulate(ball, (0.0, 1.6), q0, v0, "compliant-radau", stiffness=k, rtol=1e-10,
+    # to 1.45: the first contact (from t = sqrt(2)) ends at 1.4166; the flight after it was
+    # 15 % of the run to 1.6 and gives no sample the checks read
+    r = simulate(ball, (0.0, 1.45), q0, v0, "compliant-radau", stiffness=k, rtol=1e-10,
                  atol=1e-13)
     assert r.success
     v = r.v[:, 0]
