@@ -21,8 +21,8 @@ COMMON = ("t", "q", "v", "force_N", "force_T", "slip_velocity", "gap", "regime")
 
 #: scenes whose short run is a tenth (20 steps of the same h): the box on the incline, whose
 #: Python step solves the exact cone at its four corners (12 ms a step: 2.5 of the file's CPU
-#: s over 200 steps); it sticks with all four contacts loaded from the first step on, in 20
-#: steps as in 200, so every check below sees the same kinds of values
+#: s over 200 steps); it slides down (regime POSITIVE) on all four loaded contacts from the
+#: first step on, in 20 steps as in 200, so every check below sees the same kinds of values
 TENTH = {"box-incline"}
 
 
