@@ -153,8 +153,7 @@ def add_scene_flags(p):
             continue
         unit = f" [{prm.unit}]" if prm.unit and prm.unit != "choice" else ""
         # a scene's own words only where every scene taking the flag says the same
-        docs = {get_entry(s).parameters[get_entry(s).parameter_names().index(name)].doc
-                for s in scenes}
+        docs = {q.doc for s in scenes for q in get_entry(s).parameters if q.name == name}
         what = prm.doc if len(docs) == 1 and prm.doc else name
         p.add_argument(_flag(name), dest=name, type=_scene_flag_type(prm), default=None,
                        help=_help(f"{what}{unit}, same as --set {name}=VALUE (scenes: "
