@@ -69,6 +69,7 @@ Three disks on a floor, the third resting on the first two (five contacts):
 """
 
 import math
+from collections import namedtuple
 from typing import NamedTuple
 
 import numpy as np
@@ -93,36 +94,35 @@ _CACHE = __name__.startswith("moreau.")
 _HALF_PLANE, _SEGMENT = 0, 1
 
 
-class HalfPlane(NamedTuple):
-    """The fixed half-plane ``{p : n . (p - point) <= 0}``; disks stay on the side ``n`` points to.
+#: a wall's material after its geometry, with the defaults (None: the disks' value)
+_WALL_MATERIAL = (("mu", None), ("restitution", None), ("surface_speed", 0.0), ("mu_r", None))
+
+
+def _wall(name, geometry, doc):
+    """A wall's named tuple: the fields ``geometry``, then :data:`_WALL_MATERIAL`."""
+    cls = namedtuple(name, geometry + tuple(f for f, _ in _WALL_MATERIAL),
+                     defaults=tuple(d for _, d in _WALL_MATERIAL), module=__name__)
+    cls.__doc__ = doc
+    return cls
+
+
+HalfPlane = _wall("HalfPlane", ("point", "normal"), """\
+The fixed half-plane ``{p : n . (p - point) <= 0}``; disks stay on the side ``n`` points to.
 
     ``normal`` is normalised by :class:`DiskSystem`. ``surface_speed``: the
     wall's material slides along itself at this speed along ``t = (-n_y, n_x)``
     (a belt; the wall stays where it is, only the slip at its contacts
     changes). ``mu_r``: its rolling-resistance length (default: the disks').
-    """
+    ``mu`` and ``restitution``: the wall's own (default: the disks').
+    """)
 
-    point: tuple
-    normal: tuple
-    mu: float = None
-    restitution: float = None
-    surface_speed: float = 0.0
-    mu_r: float = None
-
-
-class Segment(NamedTuple):
-    """A fixed segment from ``start`` to ``end``, touched from either side and at its ends.
+Segment = _wall("Segment", ("start", "end"), """\
+A fixed segment from ``start`` to ``end``, touched from either side and at its ends.
 
     ``surface_speed``: its material slides from ``start`` towards ``end`` at this speed.
-    ``mu_r``: its rolling-resistance length (default: the disks').
-    """
-
-    start: tuple
-    end: tuple
-    mu: float = None
-    restitution: float = None
-    surface_speed: float = 0.0
-    mu_r: float = None
+    ``mu_r``: its rolling-resistance length (default: the disks'). ``mu`` and
+    ``restitution``: the wall's own (default: the disks').
+    """)
 
 
 class ContactSet(NamedTuple):
@@ -163,6 +163,15 @@ class ContactSet(NamedTuple):
 # -- the broad phase ---------------------------------------------------------------------------
 
 @njit(cache=_CACHE)
+def _touch(x, radii, margin, k, j):
+    # whether the gap between disks k and j is at most `margin`
+    ddx = x[j, 0] - x[k, 0]
+    ddy = x[j, 1] - x[k, 1]
+    reach = radii[k] + radii[j] + margin
+    return ddx * ddx + ddy * ddy <= reach * reach
+
+
+@njit(cache=_CACHE)
 def _grid_pairs(x, radii, margin, out_i, out_j, fill):
     n = x.shape[0]
     if n < 2:
@@ -199,12 +208,7 @@ def _grid_pairs(x, radii, margin, out_i, out_j, fill):
                 hi = np.searchsorted(sk, key, side="right")
                 for m in range(lo, hi):
                     j = order[m]
-                    if j <= k:
-                        continue
-                    ddx = x[j, 0] - x[k, 0]
-                    ddy = x[j, 1] - x[k, 1]
-                    reach = radii[k] + radii[j] + margin
-                    if ddx * ddx + ddy * ddy <= reach * reach:
+                    if j > k and _touch(x, radii, margin, k, j):
                         if fill:
                             out_i[count] = k
                             out_j[count] = j
@@ -218,10 +222,7 @@ def _brute_pairs(x, radii, margin, out_i, out_j, fill):
     count = 0
     for k in range(n):
         for j in range(k + 1, n):
-            ddx = x[j, 0] - x[k, 0]
-            ddy = x[j, 1] - x[k, 1]
-            reach = radii[k] + radii[j] + margin
-            if ddx * ddx + ddy * ddy <= reach * reach:
+            if _touch(x, radii, margin, k, j):
                 if fill:
                     out_i[count] = k
                     out_j[count] = j
