@@ -14,6 +14,20 @@ Nothing is written or removed here, so a read-only install is unaffected. If
 numba's cache internals are not what this module expects (another numba
 version), the functions fall back to compiling in memory each process:
 slower, never stale.
+
+Examples
+--------
+A function bound to its module's sources has no machine code until its
+first call (:func:`bind_cache_to_sources`, :func:`has_cached_code`):
+
+>>> from numba import njit
+>>> @njit
+... def f(x):
+...     return x + 1
+>>> bind_cache_to_sources([f], [__file__]) in ("bound", "memory")
+True
+>>> has_cached_code(f), f(1), has_cached_code(f)
+(False, 2, True)
 """
 
 import hashlib
@@ -68,12 +82,7 @@ def bind_cache_to_sources(dispatchers, paths):
 
     Examples
     --------
-    >>> from numba import njit
-    >>> @njit
-    ... def f(x):
-    ...     return x + 1
-    >>> bind_cache_to_sources([f], [__file__]) in ("bound", "memory")
-    True
+    See the module's docstring.
     """
     digest = sources_digest(paths)
     mode = "bound"
@@ -107,12 +116,7 @@ def has_cached_code(dispatcher):
 
     Examples
     --------
-    >>> from numba import njit
-    >>> @njit
-    ... def f(x):
-    ...     return x + 1
-    >>> has_cached_code(f), f(1), has_cached_code(f)
-    (False, 2, True)
+    See the module's docstring.
     """
     if getattr(dispatcher, "signatures", None):
         return True
