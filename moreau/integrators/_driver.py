@@ -71,19 +71,21 @@ def grid_step(t0, k, h, t_bound):
 
 @njit(cache=True)
 def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
-                  reg, pN, pT, h, slip, G, n, nc):
-    """Write sample ``nrec`` of a compiled loop: time, state, and per contact the regime, the
-    forces (impulse / step), the slip velocity and the gap (column 0 of ``G``)."""
+                  reg, pN, pT, h, slip, gap, nc):
+    """Write sample ``nrec`` of a compiled loop and return ``nrec + 1``: time, state, and per
+    contact the regime, the forces (impulse / step), the slip velocity and the gap."""
     rec_t[nrec] = t
-    for j in range(n):
+    for j in range(q.shape[0]):
         rec_q[nrec, j] = q[j]
+    for j in range(v.shape[0]):
         rec_v[nrec, j] = v[j]
     for i in range(nc):
         rec_reg[nrec, i] = reg[i]
         rec_fN[nrec, i] = pN[i] / h
         rec_fT[nrec, i] = pT[i] / h
         rec_slip[nrec, i] = slip[i]
-        rec_gap[nrec, i] = G[i, 0]
+        rec_gap[nrec, i] = gap[i]
+    return nrec + 1
 
 
 def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, record_initial,
@@ -185,9 +187,8 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
         if status != OK:
             break
         if record_initial:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0[:, 0], nc)
             record_initial = False
         for i in range(nc):
             G0[i, 0] = Gq[i, 0]
@@ -199,9 +200,8 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
         if to_save == 0:
             to_save = save_every
         if to_save == save_every or last:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq[:, 0], nc)
         if last:
             break
     for i in range(nc):

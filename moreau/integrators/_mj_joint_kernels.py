@@ -403,9 +403,8 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
             reg[i] = _classify(pN[i], pT[i], mu[i])
             cnew[i] = pN[i] > 0.0
         if record_initial:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          tk, q, v, reg, pN, pT, hk, slip, G0, n, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0[:, 0], nc)
             record_initial = False
         for i in range(nc):
             closed[i] = cnew[i]
@@ -414,9 +413,8 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
             v[j] = v1[j]
         k += 1
         if k % save_every == 0 or last:
-            record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec,
-                          t1, q, v, reg, pN, pT, hk, slip, Gq, n, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq[:, 0], nc)
         if last:
             break
     return status, k, nrec

@@ -54,7 +54,7 @@ from ..model import spatial as _spatial
 from ..model.spatial import rotate_into
 from . import _contact_step, _driver
 from ._contact_step import LCP_HANDBACK, NUMERICAL, OK, S_LCP, S_PEN, S_PIVOTS, S_RES
-from ._driver import grid_step
+from ._driver import grid_step, record_sample
 
 __all__ = ["SpaceTables", "space_tables", "space_loop", "space_solver", "run_space_loop",
            "SOLVE_SIGNATURE", "EXACT_TOL", "EXACT_POLISH_FROM", "EXACT_SWEEPS", "EXACT_NEWTON"]
@@ -867,9 +867,8 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
         if pairs is not None and status != OK:
             break
         if record_initial:
-            _record(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, tk,
-                    q, v, reg, pN, pT, hk, slip, g0, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, tk, q, v, reg, pN, pT, hk, slip, g0, nc)
             record_initial = False
         for j in range(nq):
             q[j] = q1[j]
@@ -883,28 +882,11 @@ def space_loop(par, mu, e, t0, h, t_bound, k0, nmax, q, v, tables, theta, closed
             closed[i] = pN[i] > 0.0
         k += 1
         if k % save_every == 0 or last:
-            _record(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t1,
-                    q, v, reg, pN, pT, hk, slip, g1, nc)
-            nrec += 1
+            nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
+                                 nrec, t1, q, v, reg, pN, pT, hk, slip, g1, nc)
         if last:
             break
     return status, k, nrec
-
-
-@njit(cache=True)
-def _record(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v, reg,
-            pN, pT, h, slip, gap, nc):
-    rec_t[nrec] = t
-    for j in range(q.shape[0]):
-        rec_q[nrec, j] = q[j]
-    for j in range(v.shape[0]):
-        rec_v[nrec, j] = v[j]
-    for i in range(nc):
-        rec_reg[nrec, i] = reg[i]
-        rec_fN[nrec, i] = pN[i] / h
-        rec_fT[nrec, i] = pT[i] / h
-        rec_slip[nrec, i] = slip[i]
-        rec_gap[nrec, i] = gap[i]
 
 
 #: every source whose compiled code ends up in this module's functions
