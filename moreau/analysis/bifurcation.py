@@ -563,12 +563,16 @@ REFINE_XTOL = 1e-6
 REFINE_EVALS = 40
 
 
-def _real_multipliers(ss):
+def _beyond(ss, side):
+    """``lambda - side`` for the real Floquet multiplier of sign ``side`` (+1 or -1) farthest
+    from 0 (NaN without one)."""
     m = ss.floquet_multipliers
     if m is None:
-        return np.zeros(0)
+        return math.nan
     m = np.asarray(m, dtype=complex)
-    return m[np.abs(m.imag) <= 1e-9 * np.maximum(1.0, np.abs(m))].real
+    r = m[np.abs(m.imag) <= 1e-9 * np.maximum(1.0, np.abs(m))].real
+    r = r[side * r > 0]
+    return side * float(np.max(side * r)) - side if r.size else math.nan
 
 
 def flip_scalar(ss):
@@ -579,29 +583,20 @@ def flip_scalar(ss):
     Examples
     --------
     >>> from types import SimpleNamespace
-    >>> flip_scalar(SimpleNamespace(floquet_multipliers=np.array([0.3, -1.2])))
-    -0.19999999999999996
+    >>> orbit = SimpleNamespace(floquet_multipliers=np.array([0.5, 0.3, -1.2]))
+    >>> flip_scalar(orbit), fold_scalar(orbit)
+    (-0.19999999999999996, -0.5)
     """
-    r = _real_multipliers(ss)
-    r = r[r < 0]
-    return float(np.min(r)) + 1.0 if r.size else math.nan
+    return _beyond(ss, -1.0)
 
 
 def fold_scalar(ss):
     """``lambda - 1`` for the largest positive real Floquet multiplier (NaN without one).
 
     It reaches 0 where the multiplier reaches +1: a saddle-node (fold), where
-    the orbit meets another and both disappear.
-
-    Examples
-    --------
-    >>> from types import SimpleNamespace
-    >>> fold_scalar(SimpleNamespace(floquet_multipliers=np.array([0.5, -0.2])))
-    -0.5
+    the orbit meets another and both disappear. Example: :func:`flip_scalar`.
     """
-    r = _real_multipliers(ss)
-    r = r[r > 0]
-    return float(np.max(r)) - 1.0 if r.size else math.nan
+    return _beyond(ss, 1.0)
 
 
 def _try(orbit_at, v):
