@@ -354,16 +354,20 @@ def natural_map(r, u, mu):
 
 
 @njit(cache=_CACHE, inline="always")
-def record_check(indptr, indices, data, q, r, u, mu, it, hist_it, hist_res, nh, best, best_r,
-                 tol_abs):
-    """An iterative solver's check after iteration ``it``: the true residual of ``r``
+def record_check(indptr, indices, data, q, r, u, mu, it, budget, check_every, hist_it, hist_res,
+                 nh, best, best_r, tol_abs):
+    """An iterative solver's check after iteration ``it`` of ``budget``, when due (at the
+    start, every ``check_every`` iterations and at the budget): the true residual of ``r``
     recorded, the best iterate kept; returns ``(nh, best, stop)``, ``stop`` where the
     residual meets ``tol_abs`` or is no longer finite."""
+    if it % check_every != 0 and it != budget:
+        return nh, best, False
     velocities(indptr, indices, data, q, r, u)
     res = math.sqrt(natural_map(r, u, mu))
     hist_it[nh] = it
     hist_res[nh] = res
-    if res < best:
+    # the first iterate is kept whatever its residual (a NaN one stops the solver there)
+    if nh == 0 or res < best:
         best = res
         best_r[:] = r
     return nh + 1, best, (not math.isfinite(res)) or res <= tol_abs
@@ -431,6 +435,21 @@ class CheckRecord:
         n = budget // check_every + 2
         self.iterations = np.zeros(n, dtype=np.int64)
         self.residuals = np.zeros(n)
+
+    @classmethod
+    def run(cls, kernel, W, q, mu, r0, tol, budget, check_every, solver, *extra):
+        """``kernel`` from ``r0`` (:func:`start_impulses`) and its :meth:`result`.
+
+        ``kernel(indptr, indices, data, q, mu, r, budget, check_every, tol_abs, hist_it,
+        hist_res, best_r, *extra)`` fills the history by :func:`record_check` and returns
+        its iterations and checks.
+        """
+        r = start_impulses(r0, q, mu)
+        checks = cls(q, budget, check_every)
+        best_r = np.empty_like(r)
+        it, nh = kernel(W.indptr, W.indices, W.data, q, mu, r, budget, check_every,
+                        tol * checks.scale, checks.iterations, checks.residuals, best_r, *extra)
+        return checks.result(W, q, mu, best_r, it, nh, tol, solver)
 
     def result(self, W, q, mu, best_r, iterations, n_checks, tol, solver):
         """The :class:`IterativeResult` of ``best_r``, its residual recomputed (compensated sums)."""

@@ -56,12 +56,14 @@ def solution_of(problem, result, budget):
                            result.iterations, result.message, (result.solver,), None)
 
 
-def solve_local(problem, budget, tol, solver, **options):
+def solve_local(problem, solver, budget_option, budget, tol, **options):
     """``problem`` solved by ``solver(W, q, mu, tol=..., **options)`` in FCLib's layout.
 
-    ``budget`` is the iteration limit that ``options`` give the solver (see
-    :func:`solution_of`); ``tol`` ``None`` is :data:`DEFAULT_TOL`.
+    ``budget`` is the iteration limit given to the solver as its keyword
+    ``budget_option`` (see :func:`solution_of`); ``tol`` ``None`` is
+    :data:`DEFAULT_TOL`.
     """
     W, q, mu = local_problem(problem)
-    res = solver(W, q, mu, tol=DEFAULT_TOL if tol is None else tol, **options)
+    res = solver(W, q, mu, tol=DEFAULT_TOL if tol is None else tol, **{budget_option: budget},
+                 **options)
     return solution_of(problem, res, budget)

@@ -81,23 +81,20 @@ def lipschitz_bound(W, iters=30):
 
 
 @njit(cache=_CACHE)
-def _apgd(indptr, indices, data, q, mu, x, L, max_iter, check_every, tol_abs, hist_it, hist_res,
-          best_r):
+def _apgd(indptr, indices, data, q, mu, x, max_iter, check_every, tol_abs, hist_it, hist_res,
+          best_r, L):
     nc = mu.shape[0]
     n = q.shape[0]
     y = x.copy()
     x_new = np.empty_like(x)
     g = np.empty_like(x)
     u = np.empty_like(x)
-    best_r[:] = x
-    nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, 0, hist_it, hist_res, 0,
-                                  math.inf, best_r, tol_abs)
+    nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, 0, max_iter, check_every,
+                                  hist_it, hist_res, 0, math.inf, best_r, tol_abs)
     it = 0
-    if stop:
-        return it, nh
     theta = 1.0
     step = 1.0 / L
-    while it < max_iter:
+    while not stop and it < max_iter:
         velocities(indptr, indices, data, q, y, g)
         for i in range(nc):
             g[2 * i] += mu[i] * abs(g[2 * i + 1])
@@ -119,11 +116,8 @@ def _apgd(indptr, indices, data, q, mu, x, L, max_iter, check_every, tol_abs, hi
             theta = theta_new
         x[:] = x_new
         it += 1
-        if it % check_every == 0 or it == max_iter:
-            nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, it, hist_it,
-                                          hist_res, nh, best, best_r, tol_abs)
-            if stop:
-                break
+        nh, best, stop = record_check(indptr, indices, data, q, x, u, mu, it, max_iter,
+                                      check_every, hist_it, hist_res, nh, best, best_r, tol_abs)
     return it, nh
 
 
@@ -176,12 +170,8 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
     if L <= 0.0:
         # W = 0: the impulses change no velocity; start from zero and report
         L = 1.0
-    x = _sparse.start_impulses(r0, q, mu)
-    checks = _sparse.CheckRecord(q, max_iter, check_every)
-    best_r = np.empty_like(x)
-    it, nh = _apgd(W.indptr, W.indices, W.data, q, mu, x, float(L), max_iter, check_every,
-                   tol * checks.scale, checks.iterations, checks.residuals, best_r)
-    return checks.result(W, q, mu, best_r, it, nh, tol, "apgd")
+    return _sparse.CheckRecord.run(_apgd, W, q, mu, r0, tol, max_iter, check_every, "apgd",
+                                   float(L))
 
 
 def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
@@ -210,8 +200,8 @@ def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
     >>> sol.status, sol.method, np.round(sol.p, 9).tolist()
     ('solved', 'apgd', [1.0, -0.5])
     """
-    budget = 100_000 if max_iter is None else max_iter
-    return _iterative.solve_local(problem, budget, tol, solve_apgd, max_iter=budget,
+    return _iterative.solve_local(problem, solve_apgd, "max_iter",
+                                  100_000 if max_iter is None else max_iter, tol,
                                   check_every=check_every, L=L)
 
 

@@ -40,17 +40,14 @@ __all__ = ["solve_nsgs", "solve"]
 
 
 @njit(cache=_CACHE)
-def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_abs, omega,
-          hist_it, hist_res, best_r):
+def _nsgs(indptr, indices, data, q, mu, r, max_sweeps, check_every, tol_abs, hist_it, hist_res,
+          best_r, blocks, omega):
     nc = mu.shape[0]
     u = np.empty_like(q)
-    best_r[:] = r
-    nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, 0, hist_it, hist_res, 0,
-                                  math.inf, best_r, tol_abs)
+    nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, 0, max_sweeps, check_every,
+                                  hist_it, hist_res, 0, math.inf, best_r, tol_abs)
     sweeps = 0
-    if stop:
-        return sweeps, nh
-    while sweeps < max_sweeps:
+    while not stop and sweeps < max_sweeps:
         for i in range(nc):
             a = 2 * i
             Wnn = blocks[i, 0, 0]
@@ -76,11 +73,8 @@ def _nsgs(indptr, indices, data, blocks, q, mu, r, max_sweeps, check_every, tol_
             r[a] = sn
             r[a + 1] = st
         sweeps += 1
-        if sweeps % check_every == 0 or sweeps == max_sweeps:
-            nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, sweeps, hist_it,
-                                          hist_res, nh, best, best_r, tol_abs)
-            if stop:
-                break
+        nh, best, stop = record_check(indptr, indices, data, q, r, u, mu, sweeps, max_sweeps,
+                                      check_every, hist_it, hist_res, nh, best, best_r, tol_abs)
     return sweeps, nh
 
 
@@ -140,13 +134,9 @@ def solve_nsgs(W, q, mu, *, r0=None, tol=1e-8, max_sweeps=10_000, omega=1.0, che
     omega = finite_scalar("omega", omega)
     if not 0.0 < omega < 2.0:
         raise InputError(f"`omega` must lie in (0, 2), got {omega!r}")
-    r = _sparse.start_impulses(r0, q, mu)
-    checks = _sparse.CheckRecord(q, max_sweeps, check_every)
-    best_r = np.empty_like(r)
     blocks = _sparse.diagonal_blocks(W.indptr, W.indices, W.data, mu.shape[0], 2)
-    sweeps, nh = _nsgs(W.indptr, W.indices, W.data, blocks, q, mu, r, max_sweeps, check_every,
-                       tol * checks.scale, omega, checks.iterations, checks.residuals, best_r)
-    return checks.result(W, q, mu, best_r, sweeps, nh, tol, "nsgs")
+    return _sparse.CheckRecord.run(_nsgs, W, q, mu, r0, tol, max_sweeps, check_every, "nsgs",
+                                   blocks, omega)
 
 
 def solve(problem, *, max_iter=None, tol=None, omega=1.0, check_every=4):
@@ -177,8 +167,8 @@ def solve(problem, *, max_iter=None, tol=None, omega=1.0, check_every=4):
     >>> sol.status, sol.method, sol.p.tolist()
     ('solved', 'nsgs', [1.0, -0.5])
     """
-    budget = 10_000 if max_iter is None else max_iter
-    return _iterative.solve_local(problem, budget, tol, solve_nsgs, max_sweeps=budget,
+    return _iterative.solve_local(problem, solve_nsgs, "max_sweeps",
+                                  10_000 if max_iter is None else max_iter, tol,
                                   omega=omega, check_every=check_every)
 
 
