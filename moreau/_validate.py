@@ -109,15 +109,30 @@ def whole_number(name, value, lo, hi):
     return int(value)
 
 
+def float_array(name, value, what="an array of real numbers"):
+    """Return ``value`` as a float array (itself when it is one), or raise: `name` must be ``what``.
+
+    Examples
+    --------
+    >>> float_array("t", [1, 2]).tolist()
+    [1.0, 2.0]
+    >>> float_array("t", "abc", "an array of times")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `t` must be an array of times
+    """
+    try:
+        return np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError(f"`{name}` must be {what}") from None
+
+
 def finite_array(name, value, shape=None, ndim=None):
     """Return ``value`` as a float array after checking shape and finiteness.
 
     ``shape`` may contain ``None`` for a free dimension.
     """
-    try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"`{name}` must be an array of real numbers") from None
+    a = float_array(name, value)
     if ndim is not None and a.ndim != ndim:
         raise InputError(f"`{name}` must have {ndim} dimension(s), got shape {a.shape}")
     if shape is not None:

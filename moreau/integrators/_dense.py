@@ -27,7 +27,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from .._validate import finite_scalar
+from .._validate import finite_scalar, float_array
 from ..errors import InputError, MoreauError
 from .result import STATUS_MESSAGES
 
@@ -143,10 +143,7 @@ def check_t_eval(t_eval, t0, t1):
     ...
     moreau.errors.InputError: `t_eval` must be sorted in increasing order; t_eval[1] = 0.2 follows 0.5
     """
-    try:
-        a = np.asarray(t_eval, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"`t_eval` must be an array of times, got {t_eval!r}") from None
+    a = float_array("t_eval", t_eval, "an array of times")
     if a.ndim != 1:
         raise InputError(f"`t_eval` must be one-dimensional, got shape {a.shape}")
     bad = np.flatnonzero(~np.isfinite(a))

@@ -120,7 +120,7 @@ from numba import njit
 from scipy.linalg.lapack import dgetrf as _getrf, dgetrs as _getrs
 
 from .. import _jit_cache
-from .._validate import finite_array, positive, positive_int
+from .._validate import finite_array, float_array, positive, positive_int
 from ..errors import InputError
 from . import _certified, _exact, _modular, certify
 from ._certified import farkas_float
@@ -1896,10 +1896,7 @@ def _real(name, a):
 
 def _as_matrix(M):
     _real("M", M)
-    try:
-        a = np.asarray(M, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError("`M` must be an array of real numbers") from None
+    a = float_array("M", M)
     if a.ndim != 2:
         raise InputError(f"`M` must be a square 2-D array, got shape {a.shape}")
     # C order: a Fortran-ordered or strided array would compile the whole solver
@@ -1909,10 +1906,7 @@ def _as_matrix(M):
 
 def _as_vector(q, name="q"):
     _real(name, q)
-    try:
-        a = np.asarray(q, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(f"`{name}` must be an array of real numbers") from None
+    a = float_array(name, q)
     if a.ndim != 1:
         raise InputError(f"`{name}` must be a 1-D array, got shape {a.shape}")
     return np.ascontiguousarray(a)
