@@ -22,8 +22,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
 from ._mj_kernels import grid_step  # noqa: F401
 from ._driver import loop_template, spliced
 from ._step_parts import (add_impulse, all_finite, dense_delassus, gap_block, gaps_at, gather_rows,
-                          index_set, invert, lemke_solve, move_by, one_row_impulse, record_contacts,
-                          restitution_shift, rows_times, slip_rows, times_ht)
+                          index_set, invert, lemke_solve, mass_inverse, move_by, one_row_impulse,
+                          record_contacts, restitution_shift, rows_times, slip_rows, times_ht)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 
 __all__ = ["nsga_loop", "CONVERGENCE"]
@@ -217,11 +217,8 @@ def impulse_stage(mass_fn, contacts_fn, lcp_step, par, q, v, qs, vs, tk, t1, n, 
             for j in range(n):
                 acc_v += G0[i, 3 + j] * v[j]
             vN0[i] = acc_v
-        mass_fn(par, qs, M)  # noqa: F821
-        ok = invert(M, Mi, wk, n)
+        mass_inverse(mass_fn, par, qs, M, Mi, wk, n, SINGULAR)  # noqa: F821
         have_mi = True
-        if not ok:
-            return SINGULAR
         contacts_fn(par, qs, t1, Gs, True, True)  # noqa: F821
         m = na + nfa
         dense_delassus(Gs, ia, fa, na, nfa, n, Mi, vs, H, w, MiHT, Uf, Wd)
@@ -268,11 +265,8 @@ def correct_positions(mass_fn, gaps_fn, contacts_fn, lcp_step, HAS_GAPS, par, qs
         if gmin >= -POSITION_TOL and gheld <= POSITION_TOL:
             break
         if not have_mi:
-            mass_fn(par, qs, M)  # noqa: F821
-            ok = invert(M, Mi, wk, n)
+            mass_inverse(mass_fn, par, qs, M, Mi, wk, n, SINGULAR)  # noqa: F821
             have_mi = True
-            if not ok:
-                return SINGULAR
         if n > 0:
             contacts_fn(par, q1, t1, Gq, True, False)  # noqa: F821
         gap_block(Gq, ia, na, Mi, X, Wn, n)

@@ -28,9 +28,8 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
                           lcp_buffers)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
 from ._driver import loop_template
-from ._step_parts import (add_impulse, affine_rows, contact_block, gather_rows, gaps_at,
-                          index_set, invert, record_contacts, rows_times, slip_rows, solve_one,
-                          times_ht)
+from ._step_parts import (add_impulse, affine_rows, contact_block, gaps_at, gather_rows, index_set,
+                          mass_inverse, record_contacts, rows_times, slip_rows, solve_one, times_ht)
 
 __all__ = ["sp_loop"]
 
@@ -85,10 +84,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
                 # what the forces see at the next node (see the scheme's module docstring)
                 vf1[i] = vh[i] + 0.5 * hk * acc[i] + 0.5 * dvc[i]
             if not const_mass:
-                mass_fn(par, q1, M)
-                ok = invert(M, Mi, wk, n)
-                if not ok:
-                    return SINGULAR
+                mass_inverse(mass_fn, par, q1, M, Mi, wk, n, SINGULAR)
             forces_fn(par, q1, vf1, t1, D, False)
             finite = True
             for i in range(n):
@@ -115,10 +111,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             Gn = Gq
         else:
             # the call's first node: its mass, forces and gaps
-            mass_fn(par, q, M)
-            ok = invert(M, Mi, wk, n)
-            if not ok:
-                return SINGULAR
+            mass_inverse(mass_fn, par, q, M, Mi, wk, n, SINGULAR)
             forces_fn(par, q, vf, tk, D, False)
             for i in range(n):
                 a_i = 0.0

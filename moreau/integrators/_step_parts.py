@@ -26,11 +26,11 @@ from ._contact_step import (LCP_HANDBACK, PAINLEVE, S_DIRECT, S_LCP, S_PEN, _cla
                             _stop_at)
 from ._driver import spliced
 
-__all__ = ["invert", "gaps_at", "index_set", "gather_rows", "affine_rows", "times_ht",
-           "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows", "all_finite",
-           "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
-           "restitution_shift", "lemke_solve", "move_by", "move_back", "held_gaps", "dense_delassus", "one_row_impulse",
-           "COND_MAX"]
+__all__ = ["invert", "mass_inverse", "gaps_at", "index_set", "gather_rows", "affine_rows",
+           "times_ht", "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows",
+           "all_finite", "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
+           "restitution_shift", "lemke_solve", "move_by", "move_back", "held_gaps",
+           "dense_delassus", "one_row_impulse", "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
 COND_MAX = 1e14
@@ -174,6 +174,15 @@ def invert(A, Ai, wk, n):
     else:
         ok = _invert_gj(A, Ai, wk, n)
     return ok
+
+
+@spliced(step_returns=True)
+def mass_inverse(mass_fn, par, q, M, Mi, wk, n, fail):
+    """``M = M(q)`` and ``Mi = M^-1``; a singular ``M`` ends the step with the status ``fail``."""
+    mass_fn(par, q, M)
+    ok = invert(M, Mi, wk, n)
+    if not ok:
+        return fail
 
 
 @spliced

@@ -27,7 +27,7 @@ from ._mj_kernels import OK, S_PEN, SINGULAR, _classify, _lcp_step, lcp_buffers 
 # read by moreau.integrators._loops
 from ._mj_kernels import SHARED_INDIRECT, _lcp_step_unused  # noqa: F401
 from ._step_parts import (add_impulse, affine_rows, all_finite, gap_block, gaps_at, gather_rows,
-                          held_gaps, index_set, invert, move_back, times_ht)
+                          held_gaps, index_set, mass_inverse, move_back, times_ht)
 from ._tdg_kernels import _solve_small, _stage_problem
 
 __all__ = ["studer_loop", "STUDER_COUNTERS", "NOT_FINITE", "TOO_MANY", "DENSE_IMPACT",
@@ -153,10 +153,7 @@ def sequence(mass_fn, forces_fn, contacts_fn, gaps_fn, HAS_GAPS, const_mass, hav
         for i in range(n):
             qm[i] = qs[i] + 0.5 * hb * vs[i]
         if not (const_mass and fresh):
-            mass_fn(par, qm, M)
-            ok = invert(M, Mi, wk, n)
-            if not ok:
-                return SINGULAR
+            mass_inverse(mass_fn, par, qm, M, Mi, wk, n, SINGULAR)
             fresh = True
         na = midpoint_velocity(forces_fn, contacts_fn, gaps_fn, HAS_GAPS, par, mu, e, qs,
                                vs, qm, tb, tm, hb, n, nc, cl, Mi, D, qe, vf, v1, pN, pT,
@@ -294,10 +291,7 @@ def project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, have_Mi, p
             for j in range(n):
                 Mp[i, j] = Mi[i, j]
     else:
-        mass_fn(par, q1, M)
-        ok = invert(M, Mp, wk, n)
-        if not ok:
-            return SINGULAR
+        mass_inverse(mass_fn, par, q1, M, Mp, wk, n, SINGULAR)
     for it in range(4):
         gaps_at(HAS_GAPS, gaps_fn, contacts_fn, par, q1, t1, G1)
         gm = held_gaps(G1, held, nh, gx)
@@ -314,10 +308,7 @@ def project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, have_Mi, p
         if dmax <= 4e-16 * qmax:
             break
     if not const_mass:
-        mass_fn(par, q1, M)
-        ok = invert(M, Mp, wk, n)
-        if not ok:
-            return SINGULAR
+        mass_inverse(mass_fn, par, q1, M, Mp, wk, n, SINGULAR)
     contacts_fn(par, q1, t1, G1, False, True)
     gap_block(G1, held, nh, Mp, MW, S, n)
     for r in range(nh):

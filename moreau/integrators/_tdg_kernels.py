@@ -21,7 +21,7 @@ from ._driver import loop_template, spliced
 # read by moreau.integrators._loops
 from ._mj_kernels import SHARED_INDIRECT, _lcp_step_unused  # noqa: F401
 from ._step_parts import (all_finite, gap_block, gaps_at, gather_rows, held_gaps, index_set,
-                          invert, move_back, record_contacts, start_contacts, times_ht)
+                          mass_inverse, move_back, record_contacts, start_contacts, times_ht)
 
 __all__ = ["tdg_loop"]
 
@@ -217,10 +217,7 @@ def project_held(mass_fn, gaps_fn, contacts_fn, HAS_GAPS, const_mass, par, t1, n
             for j in range(n):
                 Mi[i, j] = Mi0[i, j]
     else:
-        mass_fn(par, qi, M)  # noqa: F821
-        ok = invert(M, Mi, wk, n)
-        if not ok:
-            return SINGULAR
+        mass_inverse(mass_fn, par, qi, M, Mi, wk, n, SINGULAR)  # noqa: F821
     qmax = 1.0
     for j in range(n):
         qmax = max(qmax, abs(qi[j]))
@@ -266,10 +263,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     s = cs.shape[0]
     ...  # the steps (moreau.integrators._driver.loop_template)
     if not (const_mass and flags[0] != 0):
-        mass_fn(par, q, M)  # noqa: F821
-        ok = invert(M, Mi0, wk, n)
-        if not ok:
-            return SINGULAR
+        mass_inverse(mass_fn, par, q, M, Mi0, wk, n, SINGULAR)  # noqa: F821
         flags[0] = 1
     for j in range(n):
         v0[j] = v[j]
@@ -327,10 +321,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         if fin:
             break
         if not const_mass:
-            mass_fn(par, qi, M)  # noqa: F821
-            ok = invert(M, Mi, wk, n)
-            if not ok:
-                return SINGULAR
+            mass_inverse(mass_fn, par, qi, M, Mi, wk, n, SINGULAR)  # noqa: F821
         else:
             for i in range(n):
                 for j in range(n):

@@ -52,7 +52,7 @@ from ._contact_step import (LCP_HANDBACK, NUMERICAL, OK, S_PEN, S_PROJ,  # noqa:
                             SHARED_INDIRECT, _lcp_size, _lcp_step, _lcp_step_unused,
                             lcp_buffers)
 from ._driver import loop_template
-from ._step_parts import gap_block, gaps_at, invert, move_by
+from ._step_parts import gap_block, gaps_at, mass_inverse, move_by
 from ._mj_kernels import step_rule as _mj_step
 from ._mj_kernels import step_workspace as _mj_workspace
 from .moreau_jean import MoreauJean, ThetaOptions
@@ -129,10 +129,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
         if gmin >= -PROJECTION_TOL:
             break
         if not have_mi:
-            mass_fn(par, q1, M)
-            ok = invert(M, Mi, wk, n)
-            if not ok:
-                return NUMERICAL
+            mass_inverse(mass_fn, par, q1, M, Mi, wk, n, NUMERICAL)
             have_mi = True
         contacts_fn(par, q1, t1, Gq, False, False)
         s = np.int64(0)  # not a literal: see _mj_kernels.step_rule
