@@ -106,8 +106,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from .._validate import positive, relative_tolerance
-from ..errors import InputError
+from .._validate import positive, relative_tolerance, whole_number
 from ..regimes import Regime
 from .result import SimulationResult  # noqa: F401  (named in result's docstring)
 from ._blocks import FAST_BLOCK, keep_rows, result_of_rows, states_since
@@ -130,13 +129,6 @@ MAX_MACRO_STEPS = 10**7
 #: normal velocity is above ``-CLOSED_SPEED (1 + |v|)``, starts closed
 CLOSED_GAP = 1e-12
 CLOSED_SPEED = 1e-9
-
-
-def _columns_option(columns):
-    if isinstance(columns, bool) or not isinstance(columns, (int, np.integer)) \
-            or not 2 <= columns <= 8:
-        raise InputError(f"`columns` must be a whole number in [2, 8], got {columns!r}")
-    return int(columns)
 
 
 @register_integrator("studer-extrapolation")
@@ -219,7 +211,7 @@ class StuderExtrapolation(TimeStepping):
         painleve: str = "impulse"
 
         _rules: ClassVar[dict] = {"tol": lambda v: relative_tolerance("tol", v),
-                                  "columns": _columns_option,
+                                  "columns": lambda v: whole_number("columns", v, 2, 8),
                                   "h0": optional(lambda v: positive("h0", v)),
                                   "h_min": optional(lambda v: positive("h_min", v))}
 
