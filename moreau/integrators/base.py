@@ -19,7 +19,7 @@ from typing import Any, Callable, ClassVar, Sequence, TYPE_CHECKING
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._validate import finite_scalar
+from .._validate import finite_scalar, positive, relative_tolerance
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
 from ..model import registry as scene_registry
 from ..model.scene import is_spatial, joint_row_count, velocity_count
@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # annotations only: the scenes package imports this one at ru
     from ..model.scene import Scene
 
 __all__ = ["Integrator", "simulate", "propagate_interrupts", "INTEGRATORS", "register_integrator", "get_integrator",
-           "check_options", "SchemeOptions", "scheme_of"]
+           "check_options", "SchemeOptions", "EventDrivenOptions", "scheme_of"]
 
 #: registry name -> Integrator subclass, filled by :func:`register_integrator`
 INTEGRATORS = {}
@@ -83,7 +83,7 @@ def check_options(name, options, scene=None):
     >>> check_options("event-driven-generic", {"theta": 0.5})
     Traceback (most recent call last):
     ...
-    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, ode_method, max_step, sample_dt, gap_tol, vel_tol, zeno_rtol, max_impacts, lcp_method, record_pieces
+    moreau.errors.InputError: `theta` is not an option of scheme 'event-driven-generic'; its options: rtol, atol, max_step, sample_dt, vel_tol, ode_method, gap_tol, zeno_rtol, max_impacts, lcp_method, record_pieces
     >>> check_options("moreau-jean", {"theta": 2.0})
     Traceback (most recent call last):
     ...
@@ -244,6 +244,24 @@ class SchemeOptions:
     def integrator(self):
         """The :class:`Integrator` subclass these options are for."""
         return get_integrator(self.scheme)
+
+
+@dataclasses.dataclass(frozen=True)
+class EventDrivenOptions(SchemeOptions):
+    """The options every event-driven scheme has: its smooth phases' ODE solver, its samples
+    and its velocity tolerance (each scheme's own follow; see its class for their meaning)."""
+    rtol: float = 1e-12
+    atol: float = 1e-14
+    max_step: float = 1.0
+    sample_dt: float | None = None
+    vel_tol: float = 1e-9
+
+    _rules: ClassVar[dict] = {
+        "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
+        "atol": lambda v: positive("atol", v),
+        "max_step": lambda v: positive("max_step", v),
+        "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
+        "vel_tol": lambda v: positive("vel_tol", v)}
 
 
 def scheme_of(method, options=None):
@@ -421,24 +439,19 @@ class Integrator:
         region = getattr(self.scene, "valid_region", None) is not None
         snapshot = self._snapshot() if region else None
         try:
-            self._step_impl()
-        except PainleveError as exc:
-            self._fail(-1, str(exc))
-        except ContactLostError as exc:
-            self._fail(-2, str(exc))
-        except LCPError as exc:
-            self._fail(-3, str(exc))
+            stepped = self._attempt(self._step_impl)
         except InputError:
             raise
         except (MoreauError, FloatingPointError) as exc:
             self._fail(-5, f"{STATUS_MESSAGES[-5]} {type(exc).__name__}: {exc}")
         else:
-            self.counters["steps"] += 1
-            if self._stop_if_diverged():
-                return self.status
-            if self.t >= self.t_bound:
-                self.status = "finished"
-                self.message = STATUS_MESSAGES[0]
+            if stepped:
+                self.counters["steps"] += 1
+                if self._stop_if_diverged():
+                    return self.status
+                if self.t >= self.t_bound:
+                    self.status = "finished"
+                    self.message = STATUS_MESSAGES[0]
         if region:
             self._check_region(snapshot)
         return self.status
@@ -539,6 +552,22 @@ class Integrator:
         For drivers such as :func:`simulate` that catch ``KeyboardInterrupt``.
         """
         self._fail(-4, message or STATUS_MESSAGES[-4])
+
+    def _attempt(self, fn):
+        """``fn()`` and True, or False where it raised a failure of the run (a Painlevé
+        paradox, a lost contact, a contact problem without solution), recorded as the run's
+        status and message with its code (-1, -2, -3)."""
+        try:
+            fn()
+        except PainleveError as exc:
+            self._fail(-1, str(exc))
+        except ContactLostError as exc:
+            self._fail(-2, str(exc))
+        except LCPError as exc:
+            self._fail(-3, str(exc))
+        else:
+            return True
+        return False
 
     def _fail(self, code, message):
         if code in (-1, -3, -5):

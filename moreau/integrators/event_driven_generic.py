@@ -103,12 +103,12 @@ from typing import ClassVar
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import nonnegative, positive, positive_int, relative_tolerance
+from .._validate import nonnegative, positive_int
 from ..errors import InputError, LCPError, MoreauError, PainleveError
 from ..lcp import METHODS as LCP_SOLVERS, build_friction_lcp, friction_impulses, solve_lcp
 from ..model.scene import joint_row_count
 from ..regimes import Regime
-from .base import Integrator, SchemeOptions, get_integrator, register_integrator
+from .base import EventDrivenOptions, Integrator, get_integrator, register_integrator
 from .contact_problem import MAX_PIECES_CONTACTS, friction_pieces
 from .result import Event
 
@@ -544,26 +544,20 @@ class GenericEventDriven(Integrator):
     solves_joints = True
 
     @dataclasses.dataclass(frozen=True)
-    class Options(SchemeOptions):
+    class Options(EventDrivenOptions):
         """Options of :class:`GenericEventDriven` (its parameters after ``t_bound``)."""
-        rtol: float = 1e-12
         atol: float = 1e-15
-        ode_method: str = "DOP853"
         max_step: float = 0.1
-        sample_dt: float | None = None
+        ode_method: str = "DOP853"
         gap_tol: float = 1e-13
-        vel_tol: float = 1e-9
         zeno_rtol: float = 1e-6
         max_impacts: int = 10000
         lcp_method: str = "lemke"
         record_pieces: bool = False
 
         _rules: ClassVar[dict] = {
-            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
-            "atol": lambda v: positive("atol", v),
+            **EventDrivenOptions._rules,
             "ode_method": lambda v: _one_of("ode_method", v, ("DOP853", "Radau")),
-            "max_step": lambda v: positive("max_step", v),
-            "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
             "gap_tol": lambda v: nonnegative("gap_tol", v),
             "vel_tol": lambda v: nonnegative("vel_tol", v),
             "zeno_rtol": lambda v: nonnegative("zeno_rtol", v),
@@ -596,26 +590,24 @@ class GenericEventDriven(Integrator):
         self.counters.update({"events": 0, "impacts": 0, "lcp_solves": 0, "rhs": 0,
                               "segments": 0})
         self._next_sample = self.t0 + self.sample_dt
-        try:
-            g = scene.gaps(self.q, self.t)
-            if np.any(g < -self.gap_tol):
-                i = int(np.argmin(g))
-                raise InputError(f"`q0` penetrates contact {i}: gap = {g[i]:.3g} < 0")
-            self._update_vscale(self.q, self.v, self.t)
-            # a driven scene may start at rest: its rheonomic contact
-            # velocities over the run set the scale then
-            for tk in np.linspace(self.t0, self.t_bound, 17):
-                _, wN, _, wT = scene.contact_jacobians(self.q, tk)
-                self._vscale = max(self._vscale, float(np.max(np.abs(wN), initial=0.0)),
-                                   float(np.max(np.abs(wT), initial=0.0)))
-            self._resolve(kind="start")
-        except PainleveError as exc:
-            self._fail(-1, str(exc))
-            return
-        except LCPError as exc:
-            self._fail(-3, str(exc))
-            return
-        self._record_state(self.t, self.q, self.v)
+        if self._attempt(self._first_mode):
+            self._record_state(self.t, self.q, self.v)
+
+    def _first_mode(self):
+        # the start's mode, from the velocity scale (a failure stops the run at once)
+        scene = self.scene
+        g = scene.gaps(self.q, self.t)
+        if np.any(g < -self.gap_tol):
+            i = int(np.argmin(g))
+            raise InputError(f"`q0` penetrates contact {i}: gap = {g[i]:.3g} < 0")
+        self._update_vscale(self.q, self.v, self.t)
+        # a driven scene may start at rest: its rheonomic contact
+        # velocities over the run set the scale then
+        for tk in np.linspace(self.t0, self.t_bound, 17):
+            _, wN, _, wT = scene.contact_jacobians(self.q, tk)
+            self._vscale = max(self._vscale, float(np.max(np.abs(wN), initial=0.0)),
+                               float(np.max(np.abs(wT), initial=0.0)))
+        self._resolve(kind="start")
 
     # -- scales and tolerances ------------------------------------------------
     def _update_vscale(self, q, v, t):

@@ -69,17 +69,15 @@ rolling friction; no rolling with a contact patch (above).
 
 import dataclasses
 import math
-from typing import ClassVar
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from .._validate import positive, relative_tolerance
 from ..errors import ContactLostError, InputError, MoreauError, PainleveError
 from ..model.scene import is_spatial
 from ..model.spatial import quat_multiply
 from ..regimes import Regime
-from .base import Integrator, SchemeOptions, register_integrator
+from .base import EventDrivenOptions, Integrator, register_integrator
 from .result import Event
 
 __all__ = ["SpaceEventDriven"]
@@ -125,20 +123,8 @@ class SpaceEventDriven(Integrator):
     solves_space = True
 
     @dataclasses.dataclass(frozen=True)
-    class Options(SchemeOptions):
+    class Options(EventDrivenOptions):
         """Options of :class:`SpaceEventDriven` (its parameters after ``t_bound``)."""
-        rtol: float = 1e-12
-        atol: float = 1e-14
-        max_step: float = 1.0
-        sample_dt: float | None = None
-        vel_tol: float = 1e-9
-
-        _rules: ClassVar[dict] = {
-            "rtol": lambda v: relative_tolerance("rtol", v, floor=False),
-            "atol": lambda v: positive("atol", v),
-            "max_step": lambda v: positive("max_step", v),
-            "sample_dt": lambda v: None if v is None else positive("sample_dt", v),
-            "vel_tol": lambda v: positive("vel_tol", v)}
 
     takes_options_object = True
 
@@ -183,15 +169,12 @@ class SpaceEventDriven(Integrator):
                              f"zero), got gap {g:.3g} and normal velocity {vN:.3g}: scheme "
                              "'event-driven-space' keeps the contact closed")
         self.mode, self.direction = _SLIDE, None
-        try:
-            self.mode, self.direction = self._decide(self.t, *self._restart(self.q, self.v, None))
-        except ContactLostError as exc:
-            self._fail(-2, str(exc))
-            return
-        except PainleveError as exc:
-            self._fail(-1, str(exc))
-            return
-        self._record_state(self.t, self.q, self.v)
+        if self._attempt(self._first_mode):
+            self._record_state(self.t, self.q, self.v)
+
+    def _first_mode(self):
+        # the start's mode (a failure stops the run at once)
+        self.mode, self.direction = self._decide(self.t, *self._restart(self.q, self.v, None))
 
     # -- the contact's equations -------------------------------------------------------
     def _vtol(self):
