@@ -37,10 +37,14 @@ class Scheme(tuple):
 
     Examples
     --------
-    >>> Scheme.moreau_jean(0.5, 2000).label
-    'mj_theta0.5'
-    >>> Scheme("compliant-rk45", options={"stiffness": 1e6}).label
-    'compliant-rk45_stiffness1e+06'
+    A scheme's names: short, in full, and in words.
+
+    >>> mj = Scheme.moreau_jean(0.5, 2000)
+    >>> mj.label, mj.full_label, mj.description
+    ('mj_theta0.5', 'moreau-jean_theta0.5_N2000', 'Moreau–Jean θ = 0.5 (2000 steps/period)')
+    >>> rk = Scheme("compliant-rk45", options={"stiffness": 1e6})
+    >>> rk.label, rk.description
+    ('compliant-rk45_stiffness1e+06', 'compliant-rk45 (stiffness=1e+06)')
     >>> from moreau.integrators.moreau_jean import MoreauJean
     >>> Scheme(MoreauJean.Options(theta=0.5), steps_per_period=2000).label
     'mj_theta0.5'
@@ -113,40 +117,24 @@ class Scheme(tuple):
 
     @property
     def full_label(self):
-        """:attr:`label` without the short forms: the scheme's name, its step and its options.
-
-        Examples
-        --------
-        >>> Scheme.moreau_jean(1.0, 1000).full_label
-        'moreau-jean_theta1_N1000'
-        """
-        parts = [self.name]
-        if self.theta is not None:
-            parts.append(f"theta{self.theta:g}")
-        if self.steps_per_period is not None:
-            parts.append(f"N{self.steps_per_period}")
-        parts += [f"{k}{v:g}" if isinstance(v, float) else f"{k}{v}" for k, v in self[4]]
-        return "_".join(parts)
+        """:attr:`label` without the short forms: the scheme's name, its step and its options."""
+        return "_".join([self.name] + self._parts("theta{:g}", "N{}", ""))
 
     @property
     def description(self):
-        """The settings in words, for figure legends.
-
-        Examples
-        --------
-        >>> Scheme.moreau_jean(0.5, 2000).description
-        'Moreau–Jean θ = 0.5 (2000 steps/period)'
-        >>> Scheme("compliant-rk45", options={"stiffness": 1e6}).description
-        'compliant-rk45 (stiffness=1e+06)'
-        """
+        """The settings in words, for figure legends (examples: :class:`Scheme`)."""
         if self.name == "moreau-jean":
-            text = f"Moreau\u2013Jean \u03b8 = {self.theta:g} ({self.steps_per_period} steps/period)"
-        else:
-            extra = ([f"\u03b8 = {self.theta:g}"] if self.theta is not None else []) + (
-                [f"{self.steps_per_period} steps/period"] if self.steps_per_period else [])
-            extra += [f"{k}={v:g}" if isinstance(v, float) else f"{k}={v}" for k, v in self[4]]
-            text = self.name + (f" ({', '.join(extra)})" if extra else "")
-        return text
+            return f"Moreau\u2013Jean \u03b8 = {self.theta:g} ({self.steps_per_period} steps/period)"
+        extra = self._parts("\u03b8 = {:g}", "{} steps/period", "=")
+        return self.name + (f" ({', '.join(extra)})" if extra else "")
+
+    def _parts(self, theta, steps, sep):
+        # the settings made, each in its format: theta's, the steps', an option's `name sep value`
+        parts = [theta.format(self.theta)] if self.theta is not None else []
+        if self.steps_per_period is not None:
+            parts.append(steps.format(self.steps_per_period))
+        return parts + [f"{k}{sep}{v:g}" if isinstance(v, float) else f"{k}{sep}{v}"
+                        for k, v in self[4]]
 
     def __getnewargs__(self):
         return (self[0], self[1], self[2], self[3], dict(self[4]))
