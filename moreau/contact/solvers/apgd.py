@@ -149,13 +149,17 @@ def solve_apgd(W, q, mu, *, r0=None, tol=1e-8, max_iter=100_000, check_every=10,
 
     Examples
     --------
+    The block of :func:`~moreau.contact.solvers.nsgs.solve_nsgs`'s example: APGD
+    converges to NSGS's impulses.
+
     >>> import numpy as np
-    >>> from moreau.contact.solvers.apgd import solve_apgd
+    >>> from moreau.contact.solvers.nsgs import solve_nsgs
     >>> W = np.array([[2.0, 0.5, 1.0, 0.5], [0.5, 2.0, 0.5, 1.0],
     ...               [1.0, 0.5, 2.0, 0.5], [0.5, 1.0, 0.5, 2.0]])
-    >>> res = solve_apgd(W, [-1.0, 0.2, -1.0, 0.2], [0.3, 0.3], tol=1e-10)
-    >>> res.status, res.residual <= 1e-10
-    ('converged', True)
+    >>> q, mu = [-1.0, 0.2, -1.0, 0.2], [0.3, 0.3]
+    >>> res = solve_apgd(W, q, mu, tol=1e-10)
+    >>> res.status, res.residual <= 1e-10, bool(np.allclose(res.r, solve_nsgs(W, q, mu).r))
+    ('converged', True, True)
     """
     W, q, mu = check_problem(W, q, mu)
     tol = _sparse.checked_tolerance(tol)
@@ -179,26 +183,26 @@ def solve(problem, *, max_iter=None, tol=None, check_every=10, L=None):
 
     Parameters
     ----------
-    problem : ContactProblem
-        Without equality rows.
+    problem, tol
+        As for ``"nsgs"`` (:func:`moreau.contact.solvers.nsgs.solve`).
     max_iter : int, optional
         The budget of gradient steps, 100 000 by default.
-    tol : float, optional
-        Tolerance on the natural-map residual, 1e-8 by default.
     check_every, L
         As for :func:`solve_apgd`.
 
     Returns
     -------
     ContactSolution
-        As for ``"nsgs"`` (:func:`moreau.contact.solvers.nsgs.solve`).
+        As for ``"nsgs"``.
 
     Examples
     --------
+    The problem of ``"nsgs"``'s example, solved to the same impulses:
+
     >>> from moreau.contact import ContactProblem, solve as solve_contact
-    >>> sol = solve_contact(ContactProblem(np.eye(2), [-1.0, 1.0], [0.5]), "apgd", tol=1e-12)
-    >>> sol.status, sol.method, np.round(sol.p, 9).tolist()
-    ('solved', 'apgd', [1.0, -0.5])
+    >>> problem = ContactProblem(np.eye(2), [-1.0, 1.0], [0.5])
+    >>> [np.round(solve_contact(problem, m, tol=1e-12).p, 9).tolist() for m in ("apgd", "nsgs")]
+    [[1.0, -0.5], [1.0, -0.5]]
     """
     return _iterative.solve_local(problem, solve_apgd, "max_iter",
                                   100_000 if max_iter is None else max_iter, tol,
