@@ -43,9 +43,7 @@ from ..contact import _one_contact as _one_contact_module
 from ..lcp.lemke import DEFAULT_TOL
 from ..lcp.mlcp import RANK_RTOL
 from ._contact_step import LCP_HANDBACK, NUMERICAL, OK, SINGULAR, _classify
-from . import _driver, _step_parts
 from ._driver import grid_step, record_sample
-from ._step_parts import COND_MAX, norm1
 
 __all__ = ["run_joint_block", "J_STAT_NAMES"]
 
@@ -55,6 +53,8 @@ _one_contact = _one_contact_module._one_contact
 #: (:func:`moreau.lcp.mlcp.mlcp_residual`), the largest penetration and joint residual
 J_STAT_NAMES = ("lcp_solves", "max_residual", "max_penetration", "max_drift")
 _EPS = float(np.finfo(float).eps)
+#: the generic step's bound on the 1-norm condition number of ``W_hat`` (moreau_jean._inverse)
+COND_MAX = 1e14
 
 
 @njit(cache=True)
@@ -153,6 +153,17 @@ SURE_REGULAR = 1e10
 
 
 @njit(cache=True)
+def _norm1(A, k):
+    out = 0.0
+    for j in range(k):
+        c = 0.0
+        for i in range(k):
+            c += abs(A[i, j])
+        out = max(out, c)
+    return out
+
+
+@njit(cache=True)
 def _regular(A, k):
     """Whether the equality block ``A`` has full rank by its singular values (as equality_block).
 
@@ -170,7 +181,7 @@ def _regular(A, k):
                 return False
     Ac = np.ascontiguousarray(A)
     try:
-        c = k * norm1(Ac, k) * norm1(np.linalg.inv(Ac), k)
+        c = k * _norm1(Ac, k) * _norm1(np.linalg.inv(Ac), k)
         if math.isfinite(c) and c < SURE_REGULAR:
             return True
     except Exception:  # noqa: BLE001  (an exactly singular A: the SVD decides)
@@ -246,7 +257,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
         except Exception:  # noqa: BLE001  (exactly singular: the generic step's failure too)
             status = SINGULAR
             break
-        cond = norm1(Wh, n) * norm1(Wi, n)
+        cond = _norm1(Wh, n) * _norm1(Wi, n)
         if not (math.isfinite(cond) and cond < COND_MAX):
             status = SINGULAR
             break
@@ -443,5 +454,6 @@ def run_joint_block(mass, forces, contacts, joints, *args):
 
 
 #: every source whose machine code is in the loop
-KERNEL_SOURCES = (__file__, _one_contact_module.__file__, _driver.__file__) + _step_parts.SOURCES
-_jit_cache.bind_cache_to_sources([mj_joint_loop, _mlcp_check, _regular, _refined], KERNEL_SOURCES)
+KERNEL_SOURCES = (__file__, _one_contact_module.__file__)
+_jit_cache.bind_cache_to_sources([mj_joint_loop, _mlcp_check, _regular, _norm1, _refined],
+                                 KERNEL_SOURCES)

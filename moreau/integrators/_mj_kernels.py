@@ -435,7 +435,7 @@ def no_gaps(par, q, t, G):
 
 #: every source whose compiled code ends up in this module's functions and in
 #: the runners built on mj_loop (Lemke is linked in; globals are frozen in)
-KERNEL_SOURCES = (__file__, _driver.__file__) + _step_parts.SOURCES + _contact_step.KERNEL_SOURCES
+KERNEL_SOURCES = (__file__, _driver.__file__, _step_parts.__file__) + _contact_step.KERNEL_SOURCES
 
 # numba checks a cached kernel against this file only: tie it to all of them so
 # that editing Lemke cannot leave stale machine code in use

@@ -22,9 +22,6 @@ import math
 import numpy as np
 from numba import njit
 
-from .. import _jit_cache
-from ..lcp import _modular
-from ..lcp._modular import gauss_jordan
 from ._contact_step import (LCP_HANDBACK, PAINLEVE, S_DIRECT, S_LCP, S_PEN, _classify, _one_contact, _residual,
                             _stop_at)
 from ._driver import spliced
@@ -33,7 +30,7 @@ __all__ = ["invert", "mass_inverse", "gaps_at", "index_set", "gather_rows", "aff
            "times_ht", "rows_times", "contact_block", "solve_one", "add_impulse", "slip_rows",
            "all_finite", "record_contacts", "gap_block", "start_contacts", "sparse_delassus",
            "restitution_shift", "lemke_solve", "move_by", "move_back", "held_gaps",
-           "dense_delassus", "one_row_impulse", "norm1", "COND_MAX"]
+           "dense_delassus", "one_row_impulse", "COND_MAX"]
 
 #: a matrix whose 1-norm condition number reaches this is singular to working precision
 COND_MAX = 1e14
@@ -124,21 +121,46 @@ def _invert_gj(A, out, work, n):
     for i in range(n):
         for j in range(n):
             work[i, j] = A[i, j]
-    if not gauss_jordan(work, out, n):
-        return False
-    return norm1(A, n) * norm1(out, n) < COND_MAX
-
-
-@njit(cache=True, inline="always")
-def norm1(A, n):
-    """The 1-norm of ``A[:n, :n]``: its largest column sum of magnitudes."""
-    out = 0.0
+            out[i, j] = 1.0 if i == j else 0.0
+    for c in range(n):
+        piv = c
+        best = abs(work[c, c])
+        for r in range(c + 1, n):
+            if abs(work[r, c]) > best:
+                best = abs(work[r, c])
+                piv = r
+        if best == 0.0:
+            return False
+        if piv != c:
+            for j in range(n):
+                tmp = work[c, j]
+                work[c, j] = work[piv, j]
+                work[piv, j] = tmp
+                tmp = out[c, j]
+                out[c, j] = out[piv, j]
+                out[piv, j] = tmp
+        inv = 1.0 / work[c, c]
+        for j in range(n):
+            work[c, j] *= inv
+            out[c, j] *= inv
+        for r in range(n):
+            if r != c:
+                fct = work[r, c]
+                if fct != 0.0:
+                    for j in range(n):
+                        work[r, j] -= fct * work[c, j]
+                        out[r, j] -= fct * out[c, j]
+    na = 0.0
+    ni = 0.0
     for j in range(n):
-        c = 0.0
+        sa = 0.0
+        si = 0.0
         for i in range(n):
-            c += abs(A[i, j])
-        out = max(out, c)
-    return out
+            sa += abs(A[i, j])
+            si += abs(out[i, j])
+        na = max(na, sa)
+        ni = max(ni, si)
+    return na * ni < COND_MAX
 
 
 
@@ -488,9 +510,3 @@ def one_row_impulse(W, U, i, fr, mu, ei, vpre, p, pN, pT, lcp_ctl, stats):
     pN[i] = pn
     pT[i] = pt
     return res
-
-
-#: every source whose machine code is in this module's compiled functions (_invert_gj links
-#: the LCP module's Gauss–Jordan)
-SOURCES = (__file__, _modular.__file__)
-_jit_cache.bind_cache_to_sources([_invert_small, _invert_gj, norm1], SOURCES)

@@ -771,42 +771,6 @@ def _entry_sign(Zc, adj, P, Pinv, W, half, m, k, zi, v, t, res, C, X, einv, sd):
     return sd * _sign(res, m, P, Pinv, W, half)
 
 
-@njit(cache=True, error_model="numpy")
-def gauss_jordan(W, X, n):
-    """``X = W^-1`` (``n x n``) by Gauss–Jordan elimination with partial pivoting.
-
-    ``W`` is overwritten. False where a pivot is zero (``X`` is then partly
-    written): ``W`` is singular, or its entries are not all finite.
-    """
-    for a in range(n):
-        for b in range(n):
-            X[a, b] = 1.0 if a == b else 0.0
-    for col in range(n):
-        piv = col
-        big = 0.0
-        for a in range(col, n):
-            if abs(W[a, col]) > big:
-                big = abs(W[a, col])
-                piv = a
-        if not big > 0.0:
-            return False
-        if piv != col:
-            for b in range(n):
-                W[col, b], W[piv, b] = W[piv, b], W[col, b]
-                X[col, b], X[piv, b] = X[piv, b], X[col, b]
-        inv = 1.0 / W[col, col]
-        for b in range(n):
-            W[col, b] *= inv
-            X[col, b] *= inv
-        for a in range(n):
-            f = W[a, col]
-            if a != col and f != 0.0:
-                for b in range(n):
-                    W[a, b] -= f * W[col, b]
-                    X[a, b] -= f * X[col, b]
-    return True
-
-
 @njit(cache=True)
 def _approx_inverse(G, X, k, gk):
     # X ~ G^-1 by Gauss-Jordan with partial pivoting, and (alpha, ||X||_inf),
@@ -814,10 +778,33 @@ def _approx_inverse(G, X, k, gk):
     # (gk = gamma_(k+2)), so that ||G^-1 - X||_inf <= alpha ||X||_inf / (1 -
     # alpha) where alpha < 1 (Neumann series). alpha is inf where a pivot is
     # zero or X is not finite.
-    if not gauss_jordan(G.copy(), X, k):
-        return np.inf, np.inf
+    A = np.empty((k, 2 * k))
     for a in range(k):
         for b in range(k):
+            A[a, b] = G[a, b]
+            A[a, k + b] = 1.0 if a == b else 0.0
+    for col in range(k):
+        piv = col
+        big = 0.0
+        for a in range(col, k):
+            if abs(A[a, col]) > big:
+                big = abs(A[a, col])
+                piv = a
+        if not big > 0.0:
+            return np.inf, np.inf
+        if piv != col:
+            _swap_rows(A, col, piv)
+        inv = 1.0 / A[col, col]
+        for b in range(2 * k):
+            A[col, b] *= inv
+        for a in range(k):
+            f = A[a, col]
+            if a != col and f != 0.0:
+                for b in range(2 * k):
+                    A[a, b] -= f * A[col, b]
+    for a in range(k):
+        for b in range(k):
+            X[a, b] = A[a, k + b]
             if not abs(X[a, b]) < np.inf:
                 return np.inf, np.inf
     alpha = 0.0
