@@ -43,6 +43,7 @@ from ..contact import _one_contact as _one_contact_module
 from ..lcp.lemke import DEFAULT_TOL
 from ..lcp.mlcp import RANK_RTOL
 from ._contact_step import LCP_HANDBACK, NUMERICAL, OK, SINGULAR, _classify
+from . import _driver
 from ._driver import grid_step, record_sample
 
 __all__ = ["run_joint_block", "J_STAT_NAMES"]
@@ -454,6 +455,6 @@ def run_joint_block(mass, forces, contacts, joints, *args):
 
 
 #: every source whose machine code is in the loop
-KERNEL_SOURCES = (__file__, _one_contact_module.__file__)
+KERNEL_SOURCES = (__file__, _one_contact_module.__file__, _driver.__file__)
 _jit_cache.bind_cache_to_sources([mj_joint_loop, _mlcp_check, _regular, _norm1, _refined],
                                  KERNEL_SOURCES)
