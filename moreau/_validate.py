@@ -34,13 +34,26 @@ def finite_scalar(name, value):
                          f"(a {type(value).__name__})")
     if isinstance(value, (complex, np.complexfloating)):
         raise InputError(f"`{name}` must be a real number, got {value!r}")
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise InputError(f"`{name}` must be a real number, got {value!r}") from None
+    x = as_float(name, value)
     if not math.isfinite(x):
         raise InputError(f"`{name}` must be finite, got {x!r}")
     return x
+
+
+def as_float(name, value, what="be a real number"):
+    """Return ``float(value)``, or raise where it has none: `name` must ``what``.
+
+    Examples
+    --------
+    >>> as_float("events[0]", None, "return a real number")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `events[0]` must return a real number, got None
+    """
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise InputError(f"`{name}` must {what}, got {value!r}") from None
 
 
 def positive(name, value):

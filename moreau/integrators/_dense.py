@@ -27,7 +27,7 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from .._validate import finite_scalar, float_array
+from .._validate import as_float, finite_scalar, float_array
 from ..errors import InputError, MoreauError
 from .result import STATUS_MESSAGES
 
@@ -229,11 +229,7 @@ class OutputTracker:
         self._g_last = [self._g(i, t0, y0) for i in range(len(events))]
 
     def _g(self, i, t, y):
-        val = self.events[i](t, y)
-        try:
-            g = float(val)
-        except (TypeError, ValueError):
-            raise InputError(f"`events[{i}]` must return a real number, got {val!r}") from None
+        g = as_float(f"events[{i}]", self.events[i](t, y), "return a real number")
         if not math.isfinite(g):
             raise MoreauError(f"`events[{i}]` returned {g!r} at t = {t!r}")
         return g
