@@ -36,12 +36,13 @@ from .._validate import finite_array
 from ..errors import InputError, MoreauError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import scheme_options
+from ..model.registry import MJ_TOLERANCE
 from ..regimes import REGIME_LETTERS
 from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
-__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "ClosedFormPath", "GRID", "switching_error", "flatten",
+__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "ExactReference", "ClosedFormPath", "GRID", "switching_error", "flatten",
            "contact_switches", "regime_switches", "switches", "drop_reversal_sticks"]
 
 TWO_PI = 2.0 * math.pi
@@ -128,6 +129,13 @@ def flatten(per_contact):
 class CompareCase:
     """One scene set up for comparison (a subclass per scene)."""
 
+    #: the scene's conformance tolerance, its registry entry's ``mj_tolerance``: how close
+    #: Moreau–Jean at 1000 steps must come to the reference, relative to its size
+    mj_tolerance = MJ_TOLERANCE
+    #: the reference the scene's registry entry lists (its ``reference``): "exact" for the
+    #: model's exact motion (:class:`ExactReference`), None for the generic event-driven scheme
+    listed_reference = None
+    #: the name of the reference's rows in ``moreau compare``
     ref_scheme = "exact"
     ref_rtols = (None,)
     tight_rtol = None
@@ -284,7 +292,14 @@ class SpatialCase(FactoryCase):
                         h=self.window / n, theta=theta, cone=cone)
 
 
-class ClosedFormPath:
+class ExactReference:
+    """A mixin for a case whose reference is the model's exact motion (a closed form where
+    there is one): the scene's registry entry lists its reference as "exact"."""
+
+    listed_reference = "exact"
+
+
+class ClosedFormPath(ExactReference):
     """A mixin for a case whose reference is a closed form of its coordinate in time.
 
     The subclass gives :meth:`path`; the reference is that path at the end

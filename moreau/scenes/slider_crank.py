@@ -55,7 +55,7 @@ from ..analysis.cases import GRID, TWO_PI, FactoryCase
 from ..errors import InputError
 from ..model.planar import Model, Polygon, Segment, TimeFunction
 from ..model.params import Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 
 __all__ = ["SliderCrankParams", "slider_crank_model", "slider_crank", "slider_kinematics"]
@@ -141,6 +141,9 @@ def slider_crank(params=None, **overrides):
         "slider-crank", default_window=TWO_PI)
 
 
+slider_crank.Params = SliderCrankParams
+
+
 class SliderCrankCase(FactoryCase):
     """One crank turn: the slider's position against the closed form."""
 
@@ -149,11 +152,10 @@ class SliderCrankCase(FactoryCase):
     trajectory_scale = 0.25
 
     scene_factory = staticmethod(slider_crank)
-    params_class = SliderCrankParams
 
     def __init__(self, **params):
         super().__init__(**params)
-        p = params_with(self.params_class, None, params)
+        p = params_with(self.scene_factory.Params, None, params)
         # in the scene's units (length l, time 1 / omega)
         self._r, self._l = p.crank_radius / p.rod_length, 1.0
 
@@ -174,9 +176,7 @@ class SliderCrankCase(FactoryCase):
 register_scene(SceneEntry(
     name="slider-crank",
     factory=slider_crank,
-    parameters=parameters_of(SliderCrankParams),
     description=("the ideal slider-crank, crank driven at constant speed, built with joints "
                  "(moreau.model.planar): Moreau-Jean against the closed-form kinematics"),
     case=SliderCrankCase,
-    mj_tolerance=1e-2,
 ))
