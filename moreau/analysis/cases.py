@@ -142,6 +142,9 @@ class CompareCase:
     window = TWO_PI            # the "period" the steps are counted over
     headline_name = ""
     projection = False
+    #: whether a Moreau–Jean row's switching times are measured against the reference's
+    #: (False: the row is compared on its headline and trajectory only)
+    compares_switches = True
 
     def parameters(self):
         return {}
@@ -215,7 +218,8 @@ class CompareCase:
     def measure(self, n, theta, lcp, out):
         """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
         _, res = out
-        return self._trajectory_error(res), self._run_switches(res, self.window / n), None
+        switches = self._run_switches(res, self.window / n) if self.compares_switches else []
+        return self._trajectory_error(res), switches, None
 
     def _on_grid(self, res):
         """Whether the run ``res`` has a sample at every time of the comparison grid."""
@@ -308,6 +312,8 @@ class ClosedFormPath(ExactReference):
     the window, :meth:`first_regime`).
     """
 
+    compares_switches = False
+
     def path(self, tau):
         """The coordinate (scene units) at the scene times ``tau`` (an array)."""
         raise NotImplementedError
@@ -321,9 +327,6 @@ class ClosedFormPath(ExactReference):
 
     def reference_grid(self):
         return self.path(np.linspace(0.0, self.window, GRID + 1))
-
-    def _run_switches(self, res, h):
-        return []
 
 
 class DriveCase(CompareCase):

@@ -179,6 +179,7 @@ class BoxInclineCase(ExactReference, SpatialCase):
 
     headline_name = "distance down the slope"
     window = 10.0
+    compares_switches = False
 
     scene_factory = staticmethod(box_incline)
 
@@ -194,9 +195,6 @@ class BoxInclineCase(ExactReference, SpatialCase):
         s, _, _, _ = box_incline_motion(self.p, np.linspace(0.0, self.window, GRID + 1)
                                         * self.scene.time)
         return s / self.scene.length
-
-    def _run_switches(self, res, h):
-        return []
 
 
 register_scene(SceneEntry(

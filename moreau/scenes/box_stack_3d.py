@@ -204,6 +204,7 @@ class BoxStack3DCase(ExactReference, SpatialCase):
 
     headline_name = "top cube's height above the plane"
     window = 4.0
+    compares_switches = False
 
     scene_factory = staticmethod(box_stack_3d)
 
@@ -223,9 +224,6 @@ class BoxStack3DCase(ExactReference, SpatialCase):
 
     def headline_of_run(self, res):
         return float(res.q[-1, 7 * (self.scene.nbodies - 1) + 2])
-
-    def _run_switches(self, res, h):
-        return []
 
 
 register_scene(SceneEntry(

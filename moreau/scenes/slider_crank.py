@@ -150,6 +150,8 @@ class SliderCrankCase(FactoryCase):
     headline_name = "slider position at the end of the window"
     window = 0.75 * TWO_PI
     trajectory_scale = 0.25
+    # no contact: no regime, no switch
+    compares_switches = False
 
     scene_factory = staticmethod(slider_crank)
 
@@ -167,10 +169,6 @@ class SliderCrankCase(FactoryCase):
 
     def reference_grid(self):
         return slider_kinematics(np.linspace(0.0, self.window, GRID + 1), self._r, self._l)[0]
-
-    def _run_switches(self, res, h):
-        # no contact: no regime, no switch
-        return []
 
 
 register_scene(SceneEntry(

@@ -274,6 +274,7 @@ class TippeTopCase(ExactReference, SpatialCase):
     mj_tolerance = 5e-2
     headline_name = "axis height cos(theta)"
     window = 100.0
+    compares_switches = False
 
     scene_factory = staticmethod(tippe_top)
 
@@ -303,9 +304,6 @@ class TippeTopCase(ExactReference, SpatialCase):
 
     def headline_of_run(self, res):
         return float(axis_height(res.q[-1:])[0])
-
-    def _run_switches(self, res, h):
-        return []
 
 
 register_scene(SceneEntry(
