@@ -39,7 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import GRID, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Point, Segment
 from ..model.params import Declared, param
@@ -148,7 +148,7 @@ def pendulum_energy(scene, q, v):
     return 0.5 * np.einsum("ij,jk,ik->i", v, M, v) - q @ f
 
 
-class DoublePendulumStopCase(FactoryCase):
+class DoublePendulumStopCase(ExactReference, FactoryCase):
     """The energy after the window against its initial value (conserved at ``e = 1``, ``mu = 0``).
 
     Energies are counted from the pendulum hanging at rest (both links

@@ -345,7 +345,7 @@ class PainleveRodCase(CompareCase):
     """The rod sliding on its tip on the well-posed side; reference: the sliding ODE by DOP853."""
 
     mj_tolerance = 2e-2
-    ref_scheme = "sliding-ode"
+    listed_reference = ref_scheme = "sliding-ode"
     ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
     tight_rtol = 1e-13
     window = 0.5

@@ -70,7 +70,7 @@ import numpy as np
 from scipy.integrate import quad, solve_ivp
 
 from .._validate import finite_array, finite_scalar, restitution
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import GRID, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ..model.units import SIUnits
@@ -314,7 +314,7 @@ class RockingBlock(FromParams, SIUnits, CompiledScene):
         return theta, omega
 
 
-class RockingBlockCase(FactoryCase):
+class RockingBlockCase(ExactReference, FactoryCase):
     """The block from its release to halfway through its second rocking phase: tilt against the exact rocking."""
 
     mj_tolerance = 2e-2

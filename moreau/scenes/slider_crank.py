@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, TWO_PI, FactoryCase
+from ..analysis.cases import GRID, TWO_PI, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.planar import Model, Polygon, Segment, TimeFunction
 from ..model.params import Declared, param
@@ -144,7 +144,7 @@ def slider_crank(params=None, **overrides):
 slider_crank.Params = SliderCrankParams
 
 
-class SliderCrankCase(FactoryCase):
+class SliderCrankCase(ExactReference, FactoryCase):
     """One crank turn: the slider's position against the closed form."""
 
     headline_name = "slider position at the end of the window"

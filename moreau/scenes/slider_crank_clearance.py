@@ -170,6 +170,9 @@ class SliderCrankClearanceCase(SliderCrankCase):
     which no step size removes. Contact switches are not compared.
     """
 
+    listed_reference = None
+    ref_scheme = "event-driven-generic"
+
     scene_factory = staticmethod(slider_crank_clearance)
 
     def _reference_run(self, rtol):
