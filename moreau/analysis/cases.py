@@ -36,12 +36,13 @@ from .._validate import finite_array
 from ..errors import InputError, MoreauError, ResidualFloorError
 from ..integrators import get_integrator, simulate
 from ..integrators.base import scheme_options
+from ..model.registry import MJ_TOLERANCE
 from ..regimes import REGIME_LETTERS
 from .mj_steady_state import moreau_jean_steady_state
 from .scheme_settings import make_scheme, steady_of
 from .steady_state import find_steady_state
 
-__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "ClosedFormPath", "GRID", "switching_error", "flatten",
+__all__ = ["CompareCase", "DriveCase", "FactoryCase", "SceneCase", "SpatialCase", "ExactReference", "ClosedFormPath", "GRID", "switching_error", "flatten",
            "contact_switches", "regime_switches", "switches", "drop_reversal_sticks"]
 
 TWO_PI = 2.0 * math.pi
@@ -128,12 +129,22 @@ def flatten(per_contact):
 class CompareCase:
     """One scene set up for comparison (a subclass per scene)."""
 
+    #: the scene's conformance tolerance, its registry entry's ``mj_tolerance``: how close
+    #: Moreau–Jean at 1000 steps must come to the reference, relative to its size
+    mj_tolerance = MJ_TOLERANCE
+    #: the reference the scene's registry entry lists (its ``reference``): "exact" for the
+    #: model's exact motion (:class:`ExactReference`), None for the generic event-driven scheme
+    listed_reference = None
+    #: the name of the reference's rows in ``moreau compare``
     ref_scheme = "exact"
     ref_rtols = (None,)
     tight_rtol = None
     window = TWO_PI            # the "period" the steps are counted over
     headline_name = ""
     projection = False
+    #: whether a Moreau–Jean row's switching times are measured against the reference's
+    #: (False: the row is compared on its headline and trajectory only)
+    compares_switches = True
 
     def parameters(self):
         return {}
@@ -207,7 +218,8 @@ class CompareCase:
     def measure(self, n, theta, lcp, out):
         """``(trajectory_error, switches, mode)`` of a Moreau–Jean row from its timed output."""
         _, res = out
-        return self._trajectory_error(res), self._run_switches(res, self.window / n), None
+        switches = self._run_switches(res, self.window / n) if self.compares_switches else []
+        return self._trajectory_error(res), switches, None
 
     def _on_grid(self, res):
         """Whether the run ``res`` has a sample at every time of the comparison grid."""
@@ -284,7 +296,14 @@ class SpatialCase(FactoryCase):
                         h=self.window / n, theta=theta, cone=cone)
 
 
-class ClosedFormPath:
+class ExactReference:
+    """A mixin for a case whose reference is the model's exact motion (a closed form where
+    there is one): the scene's registry entry lists its reference as "exact"."""
+
+    listed_reference = "exact"
+
+
+class ClosedFormPath(ExactReference):
     """A mixin for a case whose reference is a closed form of its coordinate in time.
 
     The subclass gives :meth:`path`; the reference is that path at the end
@@ -292,6 +311,8 @@ class ClosedFormPath:
     the run's last sample, and no switch is compared (the regime holds over
     the window, :meth:`first_regime`).
     """
+
+    compares_switches = False
 
     def path(self, tau):
         """The coordinate (scene units) at the scene times ``tau`` (an array)."""
@@ -306,9 +327,6 @@ class ClosedFormPath:
 
     def reference_grid(self):
         return self.path(np.linspace(0.0, self.window, GRID + 1))
-
-    def _run_switches(self, res, h):
-        return []
 
 
 class DriveCase(CompareCase):

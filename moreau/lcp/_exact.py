@@ -340,7 +340,9 @@ def exact_step(M, q, d, basis, entering):
         the basis is singular or not
         lexicographically positive for the data (a right-hand side below
         zero, or a zero one whose row of ``B^-1`` starts negative): no
-        exact step can start from it.
+        exact step can start from it; None too when a right-hand side after
+        the step lies outside the range of floats (the floating path cannot
+        go on from there; the exact path can).
 
     Examples
     --------
@@ -441,7 +443,10 @@ def exact_step(M, q, d, basis, entering):
     # the true right-hand side is bq_i / D on a Z row and bq_i / (D 2^K) on a w row
     den = [D if v >= n else D << K for v in basis]
     if not best:
-        return "ray", None, [x / dd for x, dd in zip(bq, den)]
+        try:
+            return "ray", None, [x / dd for x, dd in zip(bq, den)]
+        except OverflowError:
+            return None
     z0_rows = [i for i in best if basis[i] == z0]
     if z0_rows:
         r = z0_rows[0]
@@ -464,8 +469,11 @@ def exact_step(M, q, d, basis, entering):
     # row denominators cancel in a_i / a_r); a row with a_i = 0 keeps b_i, the
     # same rational with smaller integers (int / int rounds correctly either way)
     br, ar = bq[r], ae[r]
-    b = [br / ar if i == r else ((bq[i] * ar - ae[i] * br) / (ar * den[i]) if ae[i]
-                                 else bq[i] / den[i]) for i in range(n)]
+    try:
+        b = [br / ar if i == r else ((bq[i] * ar - ae[i] * br) / (ar * den[i]) if ae[i]
+                                     else bq[i] / den[i]) for i in range(n)]
+    except OverflowError:
+        return None
     return "pivot", basis[r], b
 
 

@@ -170,6 +170,10 @@ class Declared:
     return: a float for an int given, say).
     """
 
+    #: the names of the parameters a sweep may vary (the scene registry's ``sweepable``);
+    #: a scene's parameters besides these fields, as a drive's frequency, may be named
+    sweepable = ()
+
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         fields = _fields_in_order(cls)

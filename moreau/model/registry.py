@@ -19,23 +19,31 @@ An entry holds:
     units where the scene has them;
 ``parameters``
     :class:`Parameter` tuples (name, unit, default, description), every
-    keyword the factory takes;
+    keyword the factory takes; when the entry does not give them, those of
+    the factory's parameter class ``factory.Params`` (a
+    :class:`~moreau.model.scene.FromParams` scene's class attribute; a
+    function factory is given it as ``factory.Params = ParamsClass``), by
+    :func:`parameters_of`;
 ``description``
     one line for listings;
 ``case``
     the scene's comparison case (a :class:`moreau.analysis.cases.CompareCase`
     subclass) for ``moreau compare``, or None;
 ``reference``
-    the name of the scene's own exact or high-precision reference scheme,
-    or None where the generic event-driven scheme is the reference;
+    the name of the scene's own exact or high-precision reference scheme
+    ("exact" for a closed form), or None where the generic event-driven
+    scheme is the reference; when the entry does not give it, the case's
+    ``listed_reference``;
 ``sweepable``
-    the parameters a sweep may vary;
+    the parameters a sweep may vary; when the entry does not give them,
+    the ``sweepable`` of the factory's ``Params`` (none without one);
 ``aliases``
     former names that commands still accept;
 ``mj_tolerance``
     how close Moreau–Jean at the conformance test's step must come to the
     reference (relative to the motion's scale): the scene's stated
-    tolerance for the conformance suite.
+    tolerance for the conformance suite; when the entry does not give it,
+    the case's ``mj_tolerance`` (:data:`MJ_TOLERANCE` without a case).
 ``default``
     the scene commands take when none is named (one scene: the paper's).
 ``stress``
@@ -85,7 +93,7 @@ from .params import declaration
 
 __all__ = ["Parameter", "SceneEntry", "register_scene", "get_entry", "scene_names", "entries",
            "make_scene", "discover", "scene_modules", "parameters_of", "describe", "default_scene",
-           "register_hook", "hook", "resolve_hook", "HOOK_KINDS"]
+           "register_hook", "hook", "resolve_hook", "HOOK_KINDS", "MJ_TOLERANCE"]
 
 
 class Parameter(NamedTuple):
@@ -98,22 +106,65 @@ class Parameter(NamedTuple):
     doc: str = ""
 
 
+#: the conformance tolerance of a scene whose entry and case state none
+MJ_TOLERANCE = 1e-2
+
+
 @dataclasses.dataclass(frozen=True)
 class SceneEntry:
-    """A registered scene (see the module docstring for the fields)."""
+    """A registered scene (see the module docstring for the fields).
+
+    ``parameters``, ``sweepable``, ``reference`` and ``mj_tolerance`` left
+    out (None) are read from the factory and the case; given, they win.
+
+    Examples
+    --------
+    >>> from moreau.model.examples import Drop
+    >>> SceneEntry(name="drop", factory=Drop, description="a point dropped")
+    Traceback (most recent call last):
+    ...
+    moreau.errors.InputError: `parameters` of scene 'drop' must be given: its factory Drop has no parameter class `Params` to read them from (a FromParams scene's class attribute, or a function factory's attribute)
+    >>> SceneEntry(name="drop", factory=Drop, description="a point dropped",
+    ...            parameters=()).mj_tolerance
+    0.01
+    """
 
     name: str
     factory: Callable
-    parameters: tuple
-    description: str
+    parameters: Optional[tuple] = None
+    description: Optional[str] = None
     case: Optional[type] = None
     reference: Optional[str] = None
-    sweepable: tuple = ()
-    mj_tolerance: float = 1e-2
+    sweepable: Optional[tuple] = None
+    mj_tolerance: Optional[float] = None
     #: former names that commands still accept
     aliases: tuple = ()
     default: bool = False
     stress: Optional[Callable] = None
+
+    def __post_init__(self):
+        if self.description is None:
+            raise InputError(f"`description` of scene {self.name!r} must be given: one line "
+                             f"for `moreau scenes`")
+        derived = {}
+        params_class = getattr(self.factory, "Params", None)
+        if self.parameters is None:
+            if params_class is None:
+                name = getattr(self.factory, "__name__", repr(self.factory))
+                raise InputError(f"`parameters` of scene {self.name!r} must be given: its "
+                                 f"factory {name} has no parameter class `Params` to read them "
+                                 f"from (a FromParams scene's class attribute, or a function "
+                                 f"factory's attribute)")
+            derived["parameters"] = parameters_of(params_class)
+        if self.sweepable is None:
+            derived["sweepable"] = getattr(params_class, "sweepable", ())
+        if self.reference is None:
+            derived["reference"] = getattr(self.case, "listed_reference", None)
+        if self.mj_tolerance is None:
+            derived["mj_tolerance"] = getattr(self.case, "mj_tolerance", MJ_TOLERANCE)
+        for key, value in derived.items():
+            # frozen: the derived fields are set once, here, as the constructor would
+            object.__setattr__(self, key, value)
 
     @property
     def sweep(self):

@@ -63,7 +63,7 @@ from numba import njit
 from ..compiled import CompiledModel
 from .._validate import (finite_array, finite_scalar, in_closed_interval, positive, positive_int,
                          restitution, whole_number)
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import GRID, ExactReference, FactoryCase
 from ..errors import InputError, LCPError, MoreauError
 from ..lcp import solve_lcp
 from ..lcp.active_set import solve_active_set
@@ -73,7 +73,7 @@ from ..model.drawing import circle, contact
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 
 __all__ = ["ChainParams", "BallChainParams", "BallChain", "ChainImpactCase", "two_ball_impact", "sequential_impacts",
            "simultaneous_impact", "sor_omega"]
@@ -101,6 +101,8 @@ class ChainParams(Declared):
     radius: float = RADIUS(0.01, "Radius of every ball")
     striker_speed: float = SPEED(1.0, "Speed of the striker towards the chain", rule=POSITIVE)
     restitution: float = RESTITUTION(1.0, "Newton restitution of every contact")
+
+    sweepable = ("restitution", "striker_mass", "n_balls")
 
     def __post_init__(self):
         object.__setattr__(self, "n_balls",
@@ -398,7 +400,7 @@ def sor_omega(masses):
 
 # -- comparison case -----------------------------------------------------------------------------
 
-class ChainImpactCase:
+class ChainImpactCase(ExactReference):
     """A mixin for a chain's comparison case: the last ball's position up to two time units
     after the striker's impact.
 
@@ -407,6 +409,8 @@ class ChainImpactCase:
     before it and at its final speed after it; the window ends two time
     units after the impact. The subclass gives :meth:`_last_start`.
     """
+
+    mj_tolerance = 1e-3
 
     def __init__(self, **params):
         super().__init__(**params)
@@ -487,10 +491,6 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="ball-chain",
     factory=BallChain,
-    parameters=parameters_of(BallChainParams),
     description="a striker hits a resting chain of N balls: simultaneous impacts (Newton's cradle)",
     case=BallChainCase,
-    reference="exact",
-    sweepable=("restitution", "striker_mass", "n_balls"),
-    mj_tolerance=1e-3,
 ))

@@ -96,7 +96,7 @@ import numpy as np
 from ..analysis.cases import SpatialCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, RADIUS, Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
 from .ball_chain import STRIKER_GAP, ChainImpactCase, ChainParams
@@ -153,6 +153,9 @@ def ball_chain_3d(params=None, **overrides):
     sc.params = p
     sc.impact_time = p.striker_gap / r
     return sc
+
+
+ball_chain_3d.Params = BallChain3DParams
 
 
 def block_result(n_balls, speed=1.0):
@@ -278,11 +281,7 @@ class BallChain3DCase(ChainImpactCase, SpatialCase):
 register_scene(SceneEntry(
     name="ball-chain-3d",
     factory=ball_chain_3d,
-    parameters=parameters_of(BallChain3DParams),
     description=("a striker hits a resting chain of N spheres in space through sphere-sphere "
                  "contacts: the simultaneous impact's block result (closed form)"),
     case=BallChain3DCase,
-    reference="exact",
-    sweepable=("restitution", "striker_mass", "n_balls"),
-    mj_tolerance=1e-3,
 ))

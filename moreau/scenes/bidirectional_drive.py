@@ -111,6 +111,9 @@ class BidirectionalDriveParams(RodParams):
     load: float = ROTOR_LOAD(0.0)
     restitution: float = ROD_RESTITUTION(0.0)
 
+    sweepable = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10_a", "x10_b", "phase",
+                 "load", "restitution")
+
     def __post_init__(self):
         super().__post_init__()
         self._check_amplitude("x10_a", self.x10_a)
@@ -233,13 +236,14 @@ class BidirectionalDrive(StatorMotion, DriveUnits, CompiledScene):
 
     ndof = 3
     name = "bidirectional-drive"
+    Params = BidirectionalDriveParams
     #: each rod's geometry (tip towards the rotor, contact above its hinge) holds only there
     valid_region = "0 < phi_a, phi_b < pi/2 (each rod leans towards the rotor from below upright)"
     period = 2.0 * math.pi
     cyclic_coordinates = (2,)
 
     def __init__(self, params=None, frequency=185.0, **overrides):
-        self.params = p = params_with(BidirectionalDriveParams, params, overrides)
+        self.params = p = params_with(self.Params, params, overrides)
         self.frequency = V.positive("frequency", frequency)
         self.omega = 2.0 * math.pi * self.frequency
         self.J = p.m2 / p.m
@@ -334,6 +338,7 @@ class BidirectionalDriveCase(DriveCase):
     ``NSP|NP`` at 185 Hz).
     """
 
+    mj_tolerance = 5e-3
     scene_class = BidirectionalDrive
     default_params = {"x10_b": 1.0e-6}
 
@@ -349,8 +354,5 @@ register_scene(SceneEntry(
         Parameter("frequency", "Hz", 185.0, "common drive frequency"),)),
     description="the paper's proposed two-rod drive: two mirrored rods on one rotor (two contacts)",
     case=BidirectionalDriveCase,
-    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10_a", "x10_b", "phase",
-               "load", "restitution"),
-    mj_tolerance=5e-3,
     aliases=("bidirectional",),
 ))

@@ -30,9 +30,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import times
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import GRID, ExactReference, SpatialCase
 from ..model.params import FINITE, GRAVITY, MASS, MU, POSITIVE, RADIUS, Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import as_params, params_with
 from ._sphere_on_plane import sphere_on_plane
 
@@ -50,6 +50,8 @@ class BilliardParams(Declared):
     speed: float = param(2.0, "m/s", FINITE, "Launch speed along ``x``")
     spin: float = param(-40.0, "rad/s", FINITE, "Launch spin about ``y``",
                         "``speed / radius`` rolls; negative is backspin.")
+
+    sweepable = ("mu", "speed", "spin")
 
 
 def rolling_onset(p):
@@ -79,6 +81,9 @@ def billiard_backspin(params=None, **overrides):
     return sphere_on_plane("billiard-backspin", p, (0.0, 0.0, -p.gravity), p.spin, "ball", 20.0)
 
 
+billiard_backspin.Params = BilliardParams
+
+
 def billiard_exact(params, t):
     """``(x, v, w)``: distance, speed along ``x`` and spin at times ``t`` [s] (SI).
 
@@ -102,7 +107,7 @@ def billiard_exact(params, t):
     return x, v, w
 
 
-class BilliardCase(SpatialCase):
+class BilliardCase(ExactReference, SpatialCase):
     """The ball over the window: distance along ``x`` against the closed form."""
 
     headline_name = "distance along the cloth"
@@ -123,11 +128,7 @@ class BilliardCase(SpatialCase):
 register_scene(SceneEntry(
     name="billiard-backspin",
     factory=billiard_backspin,
-    parameters=parameters_of(BilliardParams),
     description=("billiard ball struck with backspin: slides, then rolls from t* = "
                  "2 (v0 - r w0) / (7 mu g) at (5 v0 + 2 r w0) / 7 (closed form)"),
     case=BilliardCase,
-    reference="exact",
-    sweepable=("mu", "speed", "spin"),
-    mj_tolerance=1e-2,
 ))

@@ -32,8 +32,8 @@ from ..model.drawing import circle, contact, line
 from ..model.units import SIUnits, SIValues
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
-from ..analysis.cases import GRID, CompareCase
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..analysis.cases import GRID, CompareCase, ExactReference
+from ..model.registry import SceneEntry, register_scene
 
 __all__ = ["BouncingBallParams", "BouncingBall", "BallImpacts", "SIValues"]
 
@@ -51,6 +51,8 @@ class BouncingBallParams(Declared):
     gravity: float = GRAVITY(9.81)
     restitution: float = RESTITUTION(0.5)
     length: float = LENGTH(1.0)
+
+    sweepable = ("restitution", "radius", "gravity", "mass")
 
 
 class BouncingBall(FromParams, SIUnits, CompiledScene):
@@ -247,9 +249,10 @@ class BouncingBall(FromParams, SIUnits, CompiledScene):
         return y[:, None], v[:, None]
 
 
-class BouncingBallCase(CompareCase):
+class BouncingBallCase(ExactReference, CompareCase):
     """The ball dropped from rest at ``height`` [m] (centre), window 2.6: three impacts against the exact solution."""
 
+    mj_tolerance = 5e-2
     window = 2.6
     headline_name = "height at the end of the window"
 
@@ -311,10 +314,6 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="bouncing-ball",
     factory=BouncingBall,
-    parameters=parameters_of(BouncingBallParams),
     description="ball bouncing on a rigid floor: impacts, Zeno accumulation (exact solution)",
     case=BouncingBallCase,
-    reference="exact",
-    sweepable=("restitution", "radius", "gravity", "mass"),
-    mj_tolerance=5e-2,
 ))

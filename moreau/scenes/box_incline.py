@@ -53,10 +53,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._validate import times
-from ..analysis.cases import GRID, SpatialCase
+from ..analysis.cases import GRID, ExactReference, SpatialCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, POSITIVE, SLOPE, SPEED, Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Box, SpaceModel
 
@@ -86,6 +86,8 @@ class BoxInclineParams(Declared):
                         "speeding up.")
     gravity: float = GRAVITY(9.81)
     speed: float = SPEED(0.5, "Launch speed down the slope line")
+
+    sweepable = ("mu", "slope", "speed")
 
     def __post_init__(self):
         super().__post_init__()
@@ -130,6 +132,9 @@ def box_incline(params=None, **overrides):
     return sc
 
 
+box_incline.Params = BoxInclineParams
+
+
 def box_incline_motion(params, t):
     """``(s, s', N_front, N_back)`` at times ``t`` [s] (SI): the distance and speed down the
     slope, and the normal forces [N] on the two down-slope and the two up-slope corners.
@@ -169,11 +174,12 @@ def stop_time(p):
     return p.speed / -acc if acc < 0.0 else 0.0
 
 
-class BoxInclineCase(SpatialCase):
+class BoxInclineCase(ExactReference, SpatialCase):
     """The box over the window: its distance down the slope against the closed form."""
 
     headline_name = "distance down the slope"
     window = 10.0
+    compares_switches = False
 
     scene_factory = staticmethod(box_incline)
 
@@ -190,19 +196,12 @@ class BoxInclineCase(SpatialCase):
                                         * self.scene.time)
         return s / self.scene.length
 
-    def _run_switches(self, res, h):
-        return []
-
 
 register_scene(SceneEntry(
     name="box-incline",
     factory=box_incline,
-    parameters=parameters_of(BoxInclineParams),
     description=("box on its four bottom corners sliding down a rough incline in space at "
                  "g (sin a - mu cos a), at rest for mu > tan a; the front and back corners' "
                  "normal forces (closed form)"),
     case=BoxInclineCase,
-    reference="exact",
-    sweepable=("mu", "slope", "speed"),
-    mj_tolerance=1e-2,
 ))

@@ -40,7 +40,7 @@ from ..analysis.cases import ClosedFormPath, FactoryCase
 from ..model.planar import Circle, HalfPlane, Model
 from ..model.params import GRAVITY, MASS, MU, RADIUS, SLOPE, SPEED, Declared
 from ..model.scene import as_params, params_with
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 
 __all__ = ["InclineParams", "DiskInclineParams", "disk_incline_model", "disk_incline", "disk_incline_exact",
            "incline_motion", "rolls_down"]
@@ -56,6 +56,8 @@ class InclineParams(Declared):
     mu: float = MU(0.5, "Coulomb friction at the contact")
     gravity: float = GRAVITY(9.81)
     speed: float = SPEED(0.2, "Initial speed down the slope, rolling")
+
+    sweepable = ("mu", "slope", "speed")
 
 
 @dataclass(frozen=True)
@@ -91,6 +93,9 @@ def disk_incline(params=None, **overrides):
     sc = disk_incline_model(p).build("disk-incline", default_window=10.0)
     sc.params = p
     return sc
+
+
+disk_incline.Params = DiskInclineParams
 
 
 def rolls_down(p, k):
@@ -165,11 +170,7 @@ class DiskInclineCase(InclineCase, FactoryCase):
 register_scene(SceneEntry(
     name="disk-incline",
     factory=disk_incline,
-    parameters=parameters_of(DiskInclineParams),
     description=("disk rolling down a rough incline at (2/3) g sin(alpha), built with the "
                  "planar builder (closed form)"),
     case=DiskInclineCase,
-    reference="exact",
-    sweepable=("mu", "slope", "speed"),
-    mj_tolerance=1e-2,
 ))

@@ -39,11 +39,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import GRID, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Point, Segment
 from ..model.params import Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 
 __all__ = ["DoublePendulumStopParams", "double_pendulum_stop_model", "double_pendulum_stop",
@@ -122,6 +122,9 @@ def double_pendulum_stop(params=None, **overrides):
         "double-pendulum-stop", default_window=10.0)
 
 
+double_pendulum_stop.Params = DoublePendulumStopParams
+
+
 def pendulum_energy(scene, q, v):
     """The energy of every sample (rows of ``q``, ``v``), in the scene's units.
 
@@ -145,7 +148,7 @@ def pendulum_energy(scene, q, v):
     return 0.5 * np.einsum("ij,jk,ik->i", v, M, v) - q @ f
 
 
-class DoublePendulumStopCase(FactoryCase):
+class DoublePendulumStopCase(ExactReference, FactoryCase):
     """The energy after the window against its initial value (conserved at ``e = 1``, ``mu = 0``).
 
     Energies are counted from the pendulum hanging at rest (both links
@@ -156,9 +159,12 @@ class DoublePendulumStopCase(FactoryCase):
     rounding (:mod:`moreau.integrators.moreau_jean`, *Energy*).
     """
 
+    mj_tolerance = 5e-2
     headline_name = "energy above the hanging rest at the end of the window (conserved)"
     #: the first strike (t = 2.4) and the swing back
     window = 3.0
+    # the reference is an invariant, not a trajectory: no switching times to compare
+    compares_switches = False
 
     scene_factory = staticmethod(double_pendulum_stop)
 
@@ -195,17 +201,11 @@ class DoublePendulumStopCase(FactoryCase):
         e = self.energy(res.q, res.v)
         return float(np.max(np.abs(e - self.initial_energy())) / abs(self.initial_energy()))
 
-    def _run_switches(self, res, h):
-        # the reference is an invariant, not a trajectory: no switching times to compare
-        return []
-
 
 register_scene(SceneEntry(
     name="double-pendulum-stop",
     factory=double_pendulum_stop,
-    parameters=parameters_of(DoublePendulumStopParams),
     description=("a double pendulum built with two revolute joints whose lower tip strikes "
                  "a wall (moreau.model.planar), Moreau-Jean only: energy conserved at e = 1"),
     case=DoublePendulumStopCase,
-    mj_tolerance=5e-2,
 ))

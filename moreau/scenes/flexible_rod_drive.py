@@ -105,8 +105,8 @@ from ..model.compiled_scene import CompiledScene
 from ..model.scene import params_with
 from .friction_drive.rod import (AMPLITUDE, PRELOAD, ROD_RESTITUTION, ROTOR_LOAD, OneRod, RodParams,
                                   StatorMotion)
-from .friction_drive.scene import FrictionDrive, FrictionDriveParams
-from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
+from .friction_drive.scene import FREQUENCY, FrictionDrive, FrictionDriveParams
+from ..model.registry import SceneEntry, parameters_of, register_scene
 
 __all__ = ["FlexibleRodDriveParams", "FlexibleRodDrive", "pinned_free_modes", "MAX_MODES"]
 
@@ -206,6 +206,9 @@ class FlexibleRodDriveParams(RodParams):
     preload: float = PRELOAD(0.0, note="On the rigid rotation as in the rigid scene (the "
                                        "generalised force ``f_p cos phi``).")
 
+    sweepable = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load",
+                 "restitution", "modes", "EI", "damping", "preload")
+
     def __post_init__(self):
         super().__post_init__()
         self._check_amplitude("x10", self.x10)
@@ -260,12 +263,13 @@ class FlexibleRodDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     """
 
     name = "flexible-rod-drive"
+    Params = FlexibleRodDriveParams
     period = 2.0 * math.pi
     #: the rod angle is in rad; the modal amplitudes and the rotor are lengths
     angle_coordinates = (0,)
 
     def __init__(self, params=None, frequency=185.0, **overrides):
-        self.params = p = params_with(FlexibleRodDriveParams, params, overrides)
+        self.params = p = params_with(self.Params, params, overrides)
         self._scale_one_rod(p, frequency)
         self.N = n = p.modes
         self.ndof = n + 2
@@ -476,6 +480,7 @@ class FlexibleRodDriveCase(DriveCase):
     it well below the Moreau–Jean errors it measures (5e-3 at 1000 steps).
     """
 
+    mj_tolerance = 5e-3
     tight_rtol = 1e-9
     ref_rtols = (1e-4, 1e-6, 1e-8, 1e-9)
 
@@ -530,13 +535,9 @@ STEPS_STIFF = 1000
 register_scene(SceneEntry(
     name="flexible-rod-drive",
     factory=FlexibleRodDrive,
-    parameters=parameters_of(FlexibleRodDriveParams, extra=(
-        Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
+    parameters=parameters_of(FlexibleRodDriveParams, extra=(FREQUENCY,)),
     description="the friction drive with an Euler-Bernoulli tilt rod: rigid rotation plus N "
                 "bending modes",
     case=FlexibleRodDriveCase,
-    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
-               "modes", "EI", "damping", "preload"),
-    mj_tolerance=5e-3,
     stress=stress_cases,
 ))

@@ -57,11 +57,11 @@ import math
 import numpy as np
 
 from ..model.planar import HalfPlane, Model, Point, TimeFunction
-from ..model.registry import Parameter, SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, parameters_of, register_scene
 from ..model.scene import params_with
 from .._validate import positive
 from .friction_drive import FrictionDriveParams, PAPER_DEFAULTS
-from .friction_drive.scene import FrictionDriveCase
+from .friction_drive.scene import FREQUENCY, FrictionDriveCase
 
 __all__ = ["friction_drive_model", "friction_drive_built"]
 
@@ -136,12 +136,9 @@ class FrictionDriveBuiltCase(FrictionDriveCase):
 register_scene(SceneEntry(
     name="friction-drive-built",
     factory=friction_drive_built,
-    parameters=parameters_of(FrictionDriveParams, extra=(
-        Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
+    parameters=parameters_of(FrictionDriveParams, extra=(FREQUENCY,)),
     description=("the paper's friction drive stated with the planar builder (moreau.model.planar): "
                  "the same equations as friction-drive"),
     case=FrictionDriveBuiltCase,
-    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
-               "preload"),
-    mj_tolerance=5e-3,
+    sweepable=FrictionDriveParams.sweepable,
 ))

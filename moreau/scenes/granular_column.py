@@ -87,7 +87,7 @@ from ..integrators.granular import settle, simulate_disks
 from ..model.granular import (EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, grid_pairs,
                               random_fill)
 from ..model.params import GRAVITY, POSITIVE, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 from ._grains import (DENSITY, DIAMETER, GRAIN_MU, GRAIN_RESTITUTION, MU_R, SEED, SPREAD, WIDTH,
                       Grains)
@@ -182,6 +182,9 @@ def granular_column(params=None, **overrides):
     return DiskScene(sys, x0, margin=None, name="granular-column", length=d,
                      time=math.sqrt(d / p.gravity), force=p.density * d * d * p.gravity,
                      default_window=2.0)
+
+
+granular_column.Params = GranularColumnParams
 
 
 def deposit_front(x, radii, gap=0.05):
@@ -311,7 +314,6 @@ def runout_study(aspects=(0.5, 1.0, 2.0, 4.0, 8.0), *, width=0.03, a_split=2.0, 
 register_scene(SceneEntry(
     name="granular-column",
     factory=granular_column,
-    parameters=parameters_of(GranularColumnParams),
     description=("collapse of a column of disks on a rough floor (runout against the aspect "
                  "ratio; contacts found every step by a broad phase in its study)"),
 ))

@@ -102,7 +102,7 @@ from ..errors import InputError
 from ..integrators import simulate
 from ..model.planar import HalfPlane, Model, Polygon
 from ..model.params import GRAVITY, MU, POSITIVE, RADIUS, Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 
 __all__ = ["MasonryArchParams", "masonry_arch", "arch_model", "voussoir_geometry",
@@ -230,6 +230,9 @@ def masonry_arch(params=None, **overrides):
     return arch_model(params, **overrides).build(
         "masonry-arch", valid_region="every voussoir turned by less than 0.2 rad",
         inside=_in_place, default_window=10.0)
+
+
+masonry_arch.Params = MasonryArchParams
 
 
 # -- the exact limit (safe theorem, an LP) ----------------------------------------------------
@@ -378,7 +381,6 @@ def minimal_thickness(voussoirs, lo=0.05, hi=0.2, tol=1e-3, **kwargs):
 register_scene(SceneEntry(
     name="masonry-arch",
     factory=masonry_arch,
-    parameters=parameters_of(MasonryArchParams),
     description=("a semicircular arch of voussoirs on two abutments under its own weight: "
                  "stands or collapses with its thickness (Heyman 1966, Milankovitch 1907)"),
 ))

@@ -53,7 +53,7 @@ from scipy.integrate import solve_ivp
 
 from ..analysis.cases import GRID, CompareCase
 from ..errors import MoreauError
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 
 __all__ = ["PainleveRodParams", "PainleveRod", "painleve_critical_mu", "PAINLEVE_MU_MIN"]
 
@@ -90,6 +90,8 @@ class PainleveRodParams(Declared):
                    note="The default 2 exceeds the paradox threshold 4/3.")
     gravity: float = GRAVITY(9.81)
     restitution: float = RESTITUTION(0.0, "Newton restitution of the tip contact")
+
+    sweepable = ("mu", "mass", "length")
 
 
 class PainleveRod(FromParams, SIUnits, CompiledScene):
@@ -342,7 +344,8 @@ class PainleveRod(FromParams, SIUnits, CompiledScene):
 class PainleveRodCase(CompareCase):
     """The rod sliding on its tip on the well-posed side; reference: the sliding ODE by DOP853."""
 
-    ref_scheme = "sliding-ode"
+    mj_tolerance = 2e-2
+    listed_reference = ref_scheme = "sliding-ode"
     ref_rtols = (1e-4, 1e-6, 1e-8, 1e-10)
     tight_rtol = 1e-13
     window = 0.5
@@ -418,9 +421,6 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="painleve-rod",
     factory=PainleveRod,
-    parameters=parameters_of(PainleveRodParams),
     description="rod sliding on its tip in the Painlevé configuration",
     case=PainleveRodCase,
-    sweepable=("mu", "mass", "length"),
-    mj_tolerance=2e-2,
 ))

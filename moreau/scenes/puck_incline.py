@@ -56,7 +56,7 @@ from .._validate import finite_scalar, times
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, POSITIVE, RADIUS, SLOPE, SPEED, Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Puck, SpaceModel
 
@@ -78,6 +78,8 @@ class PuckInclineParams(Declared):
     heading: float = param(0.5 * math.pi, "rad",
                            doc="Launch direction from the down-slope line, towards ``+y``",
                            note="In (-pi, pi); ``pi/2`` (the default) is horizontal.")
+
+    sweepable = ("mu", "slope", "speed", "heading")
 
     def __post_init__(self):
         super().__post_init__()
@@ -110,6 +112,9 @@ def puck_incline(params=None, **overrides):
     sc = m.build("puck-incline", default_window=16.0)
     sc.params = p
     return sc
+
+
+puck_incline.Params = PuckInclineParams
 
 
 def _tau_at(F_target, tau0):
@@ -210,11 +215,7 @@ class PuckInclineCase(ClosedFormPath, SpatialCase):
 register_scene(SceneEntry(
     name="puck-incline",
     factory=puck_incline,
-    parameters=parameters_of(PuckInclineParams),
     description=("flat puck launched across a rough incline: its path in closed form for "
                  "mu = tan(alpha), the polyhedral cone's facets against the exact cone"),
     case=PuckInclineCase,
-    reference="exact",
-    sweepable=("mu", "slope", "speed", "heading"),
-    mj_tolerance=1e-2,
 ))

@@ -70,13 +70,13 @@ import numpy as np
 from scipy.integrate import quad, solve_ivp
 
 from .._validate import finite_array, finite_scalar, restitution
-from ..analysis.cases import GRID, FactoryCase
+from ..analysis.cases import GRID, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, POSITIVE, RESTITUTION, Declared, param
 from ..model.units import SIUnits
 from ..model.compiled_scene import CompiledScene
 from ..model.scene import FromParams
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from .sliding_box import SlidingBox
 
 __all__ = ["RockingBlockParams", "RockingBlock", "housner_ratio"]
@@ -108,6 +108,8 @@ class RockingBlockParams(Declared):
     restitution: float = RESTITUTION(0.0, "Newton restitution at the corners")
     tilt: float = param(0.05, "rad", doc="Initial tilt on the left corner",
                         note="In ``[0, atan(width / height))``: beyond it the block topples.")
+
+    sweepable = ("mu", "tilt", "width", "height")
 
     def __post_init__(self):
         super().__post_init__()
@@ -312,9 +314,10 @@ class RockingBlock(FromParams, SIUnits, CompiledScene):
         return theta, omega
 
 
-class RockingBlockCase(FactoryCase):
+class RockingBlockCase(ExactReference, FactoryCase):
     """The block from its release to halfway through its second rocking phase: tilt against the exact rocking."""
 
+    mj_tolerance = 2e-2
     headline_name = "tilt at the end of the window"
     window = 1.0
 
@@ -343,10 +346,7 @@ class RockingBlockCase(FactoryCase):
 register_scene(SceneEntry(
     name="rocking-block",
     factory=RockingBlock,
-    parameters=parameters_of(RockingBlockParams),
     description=("block rocking on two frictional corners to rest: Housner's impacts "
                  "(Housner 1963) accumulating on two contacts"),
     case=RockingBlockCase,
-    sweepable=("mu", "tilt", "width", "height"),
-    mj_tolerance=2e-2,
 ))

@@ -62,7 +62,7 @@ from ..errors import InputError
 from ..model.planar import HalfPlane, Model, Polygon, TimeFunction
 from ..model.params import FINITE, param
 from ..model.scene import params_with
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from .rocking_block import RockingBlock, RockingBlockCase, RockingBlockParams
 
 __all__ = ["RockingBlockBuiltParams", "rocking_block_model", "rocking_block_built",
@@ -153,6 +153,9 @@ def rocking_block_built(params=None, **overrides):
         default_window=RockingBlock.default_window)
 
 
+rocking_block_built.Params = RockingBlockBuiltParams
+
+
 class RockingBlockBuiltCase(RockingBlockCase):
     """The hand-written block's comparison case (Housner's exact rocking) run on the built scene."""
 
@@ -172,10 +175,7 @@ class RockingBlockBuiltCase(RockingBlockCase):
 register_scene(SceneEntry(
     name="rocking-block-built",
     factory=rocking_block_built,
-    parameters=parameters_of(RockingBlockBuiltParams),
     description=("the rocking block stated with the planar builder (moreau.model.planar): "
                  "the same equations as rocking-block"),
     case=RockingBlockBuiltCase,
-    sweepable=("mu", "tilt", "width", "height"),
-    mj_tolerance=2e-2,
 ))

@@ -72,7 +72,7 @@ import numpy as np
 from ..analysis.cases import ClosedFormPath, SpatialCase
 from ..errors import InputError
 from ..model.params import GRAVITY, MASS, MU, POSITIVE, RADIUS, Declared, open_interval, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import as_params, params_with
 from ..model.space import Disk, SpaceModel
 from ..model.spatial import quat_exp, quat_multiply, rotation_matrix
@@ -94,6 +94,8 @@ class RollingDiskParams(Declared):
     mu: float = MU(0.8, "Coulomb friction", rule=POSITIVE,
                    note="At least the ratio ``Omega^2 b / g`` that rolling needs.")
     gravity: float = GRAVITY(9.81)
+
+    sweepable = ("tilt", "circle", "mu")
 
     def __post_init__(self):
         super().__post_init__()
@@ -220,9 +222,13 @@ def rolling_disk(params=None, **overrides):
     return sc
 
 
+rolling_disk.Params = RollingDiskParams
+
+
 class RollingDiskCase(ClosedFormPath, SpatialCase):
     """The disk over a quarter precession period: its axis' precession angle against ``Omega t``."""
 
+    mj_tolerance = 2e-2
     headline_name = "precession angle"
 
     scene_factory = staticmethod(rolling_disk)
@@ -245,11 +251,7 @@ class RollingDiskCase(ClosedFormPath, SpatialCase):
 register_scene(SceneEntry(
     name="rolling-disk",
     factory=rolling_disk,
-    parameters=parameters_of(RollingDiskParams),
     description=("thin disk rolling without slipping in steady precession on a plane: "
                  "Omega^2 = 4 g cot(theta) / (6 b + a cos(theta)) (Routh art. 244)"),
     case=RollingDiskCase,
-    reference="exact",
-    sweepable=("tilt", "circle", "mu"),
-    mj_tolerance=2e-2,
 ))

@@ -186,7 +186,7 @@ from ..errors import InputError
 from ..integrators.granular import settle, simulate_disks
 from ..model.granular import EVERY_PAIR_MAX, DiskScene, DiskSystem, HalfPlane, random_fill
 from ..model.params import GRAVITY, SPEED, Rule, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 from ._grains import (DENSITY, DIAMETER, GRAIN_MU, GRAIN_RESTITUTION, MU_R, SEED, SPREAD, WIDTH,
                       Grains)
@@ -258,6 +258,9 @@ def silo(params=None, **overrides):
     return DiskScene(silo_system(radii, p), x0, margin=None, name="silo", length=d,
                      time=math.sqrt(d / p.gravity), force=p.density * d * d * p.gravity,
                      default_window=2.0)
+
+
+silo.Params = SiloParams
 
 
 def fill(pours, params=None, *, h=0.01, settle_steps=1500, slide_steps=30, measure_steps=40,
@@ -547,7 +550,6 @@ def fit_janssen(mass, m_app, *, rho, width, mu_wall):
 register_scene(SceneEntry(
     name="silo",
     factory=silo,
-    parameters=parameters_of(SiloParams),
     description=("disks poured between two rough walls: Janssen's saturation of the floor's "
                  "load (contacts found every step by a broad phase in its study)"),
 ))

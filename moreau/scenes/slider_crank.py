@@ -51,11 +51,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..analysis.cases import GRID, TWO_PI, FactoryCase
+from ..analysis.cases import GRID, TWO_PI, ExactReference, FactoryCase
 from ..errors import InputError
 from ..model.planar import Model, Polygon, Segment, TimeFunction
 from ..model.params import Declared, param
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 
 __all__ = ["SliderCrankParams", "slider_crank_model", "slider_crank", "slider_kinematics"]
@@ -141,19 +141,23 @@ def slider_crank(params=None, **overrides):
         "slider-crank", default_window=TWO_PI)
 
 
-class SliderCrankCase(FactoryCase):
+slider_crank.Params = SliderCrankParams
+
+
+class SliderCrankCase(ExactReference, FactoryCase):
     """One crank turn: the slider's position against the closed form."""
 
     headline_name = "slider position at the end of the window"
     window = 0.75 * TWO_PI
     trajectory_scale = 0.25
+    # no contact: no regime, no switch
+    compares_switches = False
 
     scene_factory = staticmethod(slider_crank)
-    params_class = SliderCrankParams
 
     def __init__(self, **params):
         super().__init__(**params)
-        p = params_with(self.params_class, None, params)
+        p = params_with(self.scene_factory.Params, None, params)
         # in the scene's units (length l, time 1 / omega)
         self._r, self._l = p.crank_radius / p.rod_length, 1.0
 
@@ -166,17 +170,11 @@ class SliderCrankCase(FactoryCase):
     def reference_grid(self):
         return slider_kinematics(np.linspace(0.0, self.window, GRID + 1), self._r, self._l)[0]
 
-    def _run_switches(self, res, h):
-        # no contact: no regime, no switch
-        return []
-
 
 register_scene(SceneEntry(
     name="slider-crank",
     factory=slider_crank,
-    parameters=parameters_of(SliderCrankParams),
     description=("the ideal slider-crank, crank driven at constant speed, built with joints "
                  "(moreau.model.planar): Moreau-Jean against the closed-form kinematics"),
     case=SliderCrankCase,
-    mj_tolerance=1e-2,
 ))

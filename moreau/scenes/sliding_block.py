@@ -33,8 +33,8 @@ from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
 from ..model.scene import FromParams
 from .._validate import finite_scalar
-from ..analysis.cases import GRID, CompareCase
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..analysis.cases import GRID, CompareCase, ExactReference
+from ..model.registry import SceneEntry, register_scene
 from ._block_on_line import block_contacts, block_mass
 
 __all__ = ["SlidingBlockParams", "SlidingBlock"]
@@ -58,6 +58,8 @@ class SlidingBlockParams(Declared):
     restitution: float = RESTITUTION(0.0, "Newton restitution of the contact",
                                      note="It matters only if the block is dropped onto the plane.")
     length: float = LENGTH(1.0)
+
+    sweepable = ("mu", "incline", "mass")
 
 
 class SlidingBlock(FromParams, SIUnits, CompiledScene):
@@ -228,7 +230,7 @@ class SlidingBlock(FromParams, SIUnits, CompiledScene):
         return float(u0)
 
 
-class SlidingBlockCase(CompareCase):
+class SlidingBlockCase(ExactReference, CompareCase):
     """The block launched at ``speed`` [m/s] until it sticks: stopping distance against the exact solution."""
 
     headline_name = "stopping distance"
@@ -271,10 +273,6 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="sliding-block",
     factory=SlidingBlock,
-    parameters=parameters_of(SlidingBlockParams),
     description="block sliding to rest on a plane (exact solution)",
     case=SlidingBlockCase,
-    reference="exact",
-    sweepable=("mu", "incline", "mass"),
-    mj_tolerance=1e-2,
 ))

@@ -50,8 +50,8 @@ from ..model.compiled_scene import CompiledScene
 from ..model.units import SIUnits
 from ..model.scene import FromParams
 from .._validate import finite_scalar
-from ..analysis.cases import GRID, CompareCase, flatten
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..analysis.cases import GRID, CompareCase, ExactReference, flatten
+from ..model.registry import SceneEntry, register_scene
 
 __all__ = ["SlidingBoxParams", "SlidingBox"]
 
@@ -69,6 +69,8 @@ class SlidingBoxParams(Declared):
     gravity: float = GRAVITY(9.81)
     restitution: float = RESTITUTION(0.0, "Newton restitution at the corners")
     length: float = LENGTH(1.0)
+
+    sweepable = ("mu", "half_width", "half_height", "mass")
 
 
 class SlidingBox(FromParams, SIUnits, CompiledScene):
@@ -190,7 +192,7 @@ class SlidingBox(FromParams, SIUnits, CompiledScene):
         return q, v
 
 
-class SlidingBoxCase(CompareCase):
+class SlidingBoxCase(ExactReference, CompareCase):
     """The box launched at ``speed`` [m/s] on its two corners: stopping distance against the exact solution."""
 
     headline_name = "stopping distance"
@@ -270,10 +272,6 @@ def _drift(par, q, v, t, Dr):
 register_scene(SceneEntry(
     name="sliding-box",
     factory=SlidingBox,
-    parameters=parameters_of(SlidingBoxParams),
     description="box sliding to rest on two frictional corners (two contacts, exact solution)",
     case=SlidingBoxCase,
-    reference="exact",
-    sweepable=("mu", "half_width", "half_height", "mass"),
-    mj_tolerance=1e-2,
 ))

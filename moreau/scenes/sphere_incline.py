@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 from ..analysis.cases import SpatialCase
 from ..model.params import RADIUS
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import as_params, params_with
 from ._sphere_on_plane import sphere_on_plane
 from .disk_incline import InclineCase, InclineParams, incline_motion, rolls_down
@@ -75,6 +75,9 @@ def sphere_incline(params=None, **overrides):
                            p.speed / p.radius, "sphere", 10.0)
 
 
+sphere_incline.Params = SphereInclineParams
+
+
 def sphere_incline_exact(params, t):
     """``(s, s', w)``: distance and speed down the slope, rotation rate, at times ``t`` [s] (SI).
 
@@ -101,11 +104,7 @@ class SphereInclineCase(InclineCase, SpatialCase):
 register_scene(SceneEntry(
     name="sphere-incline",
     factory=sphere_incline,
-    parameters=parameters_of(SphereInclineParams),
     description=("sphere rolling down a rough incline in space at (5/7) g sin(alpha), slipping "
                  "below mu = (2/7) tan(alpha) (closed form)"),
     case=SphereInclineCase,
-    reference="exact",
-    sweepable=("mu", "slope", "speed"),
-    mj_tolerance=1e-2,
 ))

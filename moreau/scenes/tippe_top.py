@@ -108,7 +108,7 @@ from ..errors import InputError, MoreauError
 from ..integrators.base import simulate
 from ..model.params import (GRAVITY, MASS, MU, NONNEGATIVE, POSITIVE, RADIUS, Declared,
                             open_interval, param)
-from ..model.registry import SceneEntry, parameters_of, register_scene
+from ..model.registry import SceneEntry, register_scene
 from ..model.scene import params_with
 from ..model.space import SpaceModel, Sphere
 from ..model.spatial import quat_exp, rotation_matrix
@@ -146,6 +146,8 @@ class TippeTopParams(Declared):
                                   "(Coulomb–Contensou friction, :mod:`moreau.model.space`); "
                                   "``0`` is the point contact. Default Leine and Glocker's "
                                   "``r = 0.5 mm``.")
+
+    sweepable = ("mu", "spin", "tilt", "offset")
 
     def __post_init__(self):
         super().__post_init__()
@@ -256,6 +258,9 @@ def tippe_top(params=None, **overrides):
     return sc
 
 
+tippe_top.Params = TippeTopParams
+
+
 class TippeTopCase(SpatialCase):
     """The top over the window: its axis' height ``cos(theta)`` at the end, against the
     event-driven reference (``event-driven-space``) on the same model.
@@ -266,8 +271,11 @@ class TippeTopCase(SpatialCase):
     docstring).
     """
 
+    listed_reference = ref_scheme = "event-driven-space"
+    mj_tolerance = 5e-2
     headline_name = "axis height cos(theta)"
     window = 100.0
+    compares_switches = False
 
     scene_factory = staticmethod(tippe_top)
 
@@ -298,18 +306,11 @@ class TippeTopCase(SpatialCase):
     def headline_of_run(self, res):
         return float(axis_height(res.q[-1:])[0])
 
-    def _run_switches(self, res, h):
-        return []
-
 
 register_scene(SceneEntry(
     name="tippe-top",
     factory=tippe_top,
-    parameters=parameters_of(TippeTopParams),
     description=("tippe top (eccentric sphere, Leine and Glocker 2003): spun above the "
                  "threshold set by Jellett's integral, it turns its axis from up to down"),
     case=TippeTopCase,
-    reference="exact",
-    sweepable=("mu", "spin", "tilt", "offset"),
-    mj_tolerance=5e-2,
 ))

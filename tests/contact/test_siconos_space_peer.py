@@ -17,21 +17,19 @@ import pytest
 
 from moreau.integrators import simulate
 from moreau.scenes.puck_incline import puck_incline
+from moreau.suite.peers import siconos_available
 
 BENCH = pathlib.Path(__file__).resolve().parents[2] / "benchmarks" / "siconos_space_peer.py"
 
 
+@pytest.mark.skipif(not siconos_available(), reason="/usr/bin/python3 has no Siconos (Debian "
+                    "python3-siconos)")
 def test_siconos_puck_agrees_with_ours_over_twenty_steps():
     bench = runpy.run_path(str(BENCH), run_name="siconos_space_peer_under_test")
     sc = puck_incline()
     n, window = 20, 20 * sc.default_window / 1000
     job = bench["scene_job"](sc, window, n, 1.0, 1)
-    try:
-        peer, err = bench["call_siconos"](job)
-    except OSError:
-        pytest.skip("no /usr/bin/python3 (the system interpreter of Debian's python3-siconos)")
-    if peer is None and "No module named 'siconos" in err:
-        pytest.skip("/usr/bin/python3 has no siconos (Debian python3-siconos)")
+    peer, err = bench["call_siconos"](job)
     assert peer is not None, err
     q0, v0 = sc.initial_state()
     res = simulate(sc, (0.0, window), q0, v0, "moreau-jean", h=window / n, theta=1.0,

@@ -120,3 +120,26 @@ def test_a_registered_steady_solver_is_used_by_find_steady_state():
     finally:
         steady_solvers._SOLVERS.pop("test-scheme")
     assert calls == [{"marker": 1}] and ss.mode == "NP"
+
+
+def _reference_class(name, scene):
+    from moreau.integrators.base import get_integrator
+    from moreau.integrators.event_driven_generic import EventDrivenReference
+    cls = get_integrator(name)
+    return cls.resolve(scene) if cls is EventDrivenReference else cls
+
+
+@pytest.mark.parametrize("name", [n for n in NAMES if registry.get_entry(n).case is not None])
+def test_the_listed_reference_is_what_compare_runs_as_the_reference(name):
+    # `moreau scenes` lists the reference; `moreau compare` names its rows by the case's
+    # ref_scheme: a scheme run on the scene (the same class as the listed one) or, where it
+    # is no scheme ("exact", the Painleve rod's "sliding-ode"), the listed name itself
+    entry = registry.get_entry(name)
+    listed = registry.describe(entry)["reference"]
+    ref = entry.case.ref_scheme
+    try:
+        ours = _reference_class(ref, registry.make_scene(name))
+    except InputError:
+        assert listed == ref
+        return
+    assert ours is _reference_class(listed, registry.make_scene(name))

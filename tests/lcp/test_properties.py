@@ -1,7 +1,7 @@
 """Property tests: what a solved result promises, and that failures stay finite."""
 
 import numpy as np
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import HealthCheck, assume, example, given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -94,9 +94,19 @@ def test_every_triangular_p_matrix_lcp_is_solved(prob):
     assert_complementary(M, q, res.z, TOL["lemke"])
 
 
+def _subnormal_tie():
+    # found by hypothesis: after a tie, a right-hand side of the exact step (about
+    # 1 / 2.2e-309) lies beyond the floats and rounding it raised OverflowError; the exact
+    # path now goes on from that basis and solves it (z_6 = 4.5e108)
+    M = np.full((6, 6), 2.22507386e-309)
+    M[4, 5], M[5, 1] = 1.0, -1.0
+    return M, np.array([0.0, -1.0, 0.0, 0.0, 0.0, 0.0])
+
+
 @SETTINGS
 @given(square_problems(max_n=6, elements=st.floats(-1e6, 1e6, width=64)),
        st.sampled_from([1e-200, 1e-60, 1.0, 1e60, 1e200]), st.sampled_from([1e-200, 1.0, 1e200]))
+@example(_subnormal_tie(), 1.0, 1e-200)
 def test_no_status_ever_comes_with_a_nan(prob, sm, sq):
     M, q = prob
     M = M * sm

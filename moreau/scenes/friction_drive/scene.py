@@ -94,7 +94,7 @@ from ...analysis.steady_state import find_steady_state
 from ...integrators import simulate
 from ...model.registry import Parameter, SceneEntry, parameters_of, register_scene
 
-__all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS"]
+__all__ = ["FrictionDriveParams", "FrictionDrive", "PAPER_DEFAULTS", "FREQUENCY"]
 
 
 @dataclass(frozen=True)
@@ -115,12 +115,19 @@ class FrictionDriveParams(RodParams):
     restitution: float = ROD_RESTITUTION(0.0)
     preload: float = PRELOAD(0.0)
 
+    sweepable = ("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load",
+                 "restitution", "preload")
+
     def __post_init__(self):
         super().__post_init__()
         self._check_amplitude("x10", self.x10)
 
 
 PAPER_DEFAULTS = FrictionDriveParams()
+
+#: the drive frequency, a one-rod drive's parameter besides its SI parameters (the paper's
+#: 185 Hz by default)
+FREQUENCY = Parameter("frequency", "Hz", 185.0, "drive frequency")
 
 
 class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
@@ -153,6 +160,7 @@ class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
 
     ndof = 2
     name = "friction-drive"
+    Params = FrictionDriveParams
     period = 2.0 * math.pi
     cyclic_coordinates = (1,)
     #: the scene's own high-precision event-driven scheme, which
@@ -162,7 +170,7 @@ class FrictionDrive(OneRod, StatorMotion, DriveUnits, CompiledScene):
     def __init__(self, params=None, frequency=185.0, **overrides):
         if params is None:
             params = PAPER_DEFAULTS
-        params = params_with(FrictionDriveParams, params, overrides)
+        params = params_with(self.Params, params, overrides)
         self.params = params
         self._scale_one_rod(params, frequency)
 
@@ -338,6 +346,7 @@ def params_from_kwargs(**kwargs):
 class FrictionDriveCase(DriveCase):
     """The friction drive's steady state; reference: the walker's steady state (contact segments in closed form)."""
 
+    mj_tolerance = 5e-3
     ref_scheme = "event-driven"
     # the compiled steady state is cheap: go far enough to show the plateaus
     default_steps = (50, 100, 200, 500, 1000, 2000, 5000, 10000, 20000)
@@ -383,13 +392,9 @@ class FrictionDriveCase(DriveCase):
 register_scene(SceneEntry(
     name="friction-drive",
     factory=FrictionDrive,
-    parameters=parameters_of(FrictionDriveParams, extra=(
-        Parameter("frequency", "Hz", 185.0, "drive frequency"),)),
+    parameters=parameters_of(FrictionDriveParams, extra=(FREQUENCY,)),
     description="the paper's friction drive of a piezoelectric motor (steady state)",
     case=FrictionDriveCase,
     reference="friction-drive-walker",
-    sweepable=("frequency", "m", "m2", "k", "length", "phi0", "mu", "x10", "load", "restitution",
-               "preload"),
-    mj_tolerance=5e-3,
     default=True,
 ))

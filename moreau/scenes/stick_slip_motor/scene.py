@@ -321,6 +321,8 @@ class StickSlipMotorParams(Declared):
     restitution: float = RESTITUTION(0.0, "Newton restitution of the contact",
                                      note="Irrelevant while the slider stays pressed on.")
 
+    sweepable = ("frequency", "mass", "normal_force", "mu", "amplitude", "load")
+
 
 class StickSlipMotor(SIUnits, CompiledScene):
     """Slider pressed on a stator that vibrates along the slider's path.
@@ -357,11 +359,12 @@ class StickSlipMotor(SIUnits, CompiledScene):
 
     ndof = 2
     name = "stick-slip-motor"
+    Params = StickSlipMotorParams
     period = TWO_PI
     cyclic_coordinates = (0,)
 
     def __init__(self, params=None, frequency=1000.0, drive="sawtooth", **overrides):
-        p = params_with(StickSlipMotorParams, params, overrides)
+        p = params_with(self.Params, params, overrides)
         f = positive("frequency", frequency)
         self.drive = make_drive(drive)
         self.params = p
@@ -548,6 +551,4 @@ register_scene(SceneEntry(
     description="stick-slip (inertial) motor: a slider on a stator driven by a sawtooth or sine",
     case=StickSlipCase,
     reference="stick-slip-exact",
-    sweepable=("frequency", "mass", "normal_force", "mu", "amplitude", "load"),
-    mj_tolerance=1e-2,
 ))
