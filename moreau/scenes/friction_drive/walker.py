@@ -847,13 +847,16 @@ class EventDriven(Integrator):
 
     Examples
     --------
+    Two drive periods from rest, one event a step (``simulate(..., "event-driven")`` runs
+    these steps for this scene):
+
     >>> from moreau.scenes.friction_drive import FrictionDrive
-    >>> from moreau.integrators import simulate
     >>> sc = FrictionDrive(frequency=185.0)
-    >>> q0, v0 = sc.rest_state()
-    >>> res = simulate(sc, (0.0, 4 * 3.141592653589793), q0, v0, "event-driven")
-    >>> res.success
-    True
+    >>> walker = EventDriven(sc, 0.0, *sc.rest_state(), 4 * np.pi)
+    >>> while walker.step() == "running":
+    ...     pass
+    >>> walker.status, walker.t == 4 * np.pi, walker.counters["events"]
+    ('finished', True, 4)
     """
 
     exact_motion = True
