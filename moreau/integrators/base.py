@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike
 from .._validate import finite_scalar, positive, relative_tolerance
 from ..errors import ContactLostError, InputError, LCPError, MoreauError, PainleveError
 from ..model import registry as scene_registry
-from ..model.scene import is_spatial, joint_row_count, velocity_count
+from ..model.scene import fill_docstring, is_spatial, joint_row_count, velocity_count
 from ._dense import (OutputTracker, Piece, check_events, check_t_eval, interpolated_piece,
                      join_to_last, stack_rows)
 from ._divergence import (GROWTH as DIVERGENCE_GROWTH, bounded_velocities, divergence,
@@ -334,6 +334,10 @@ class Integrator:
     """
 
     scheme = ""
+    #: the entries of a scheme's Parameters section that the line ``{start}`` of its class
+    #: docstring stands for: the scene and the start, this class's parameters
+    START_PARAMETERS = ("scene : Scene", "t0, q0, v0, t_bound",
+                        "    See :class:`~moreau.integrators.base.Integrator`.")
     #: True where the scheme hands its exact motion between samples to :func:`simulate`
     #: (event-driven schemes, through :meth:`_add_piece`); False where the motion between
     #: recorded samples is their linear interpolation (time stepping): ``t_eval`` samples
@@ -375,6 +379,10 @@ class Integrator:
                     "bodies (quaternion orientations, the spatial friction cone); use "
                     "'moreau-jean'")
         return None
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        fill_docstring(cls, "{start}", cls.START_PARAMETERS)
 
     def __init__(self, scene, t0, q0, v0, t_bound):
         refused = self.refusal(scene)

@@ -491,9 +491,7 @@ class GenericEventDriven(Integrator):
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
+    {start}
     rtol, atol : float
         Tolerances of the smooth-phase integrator (``atol`` absolute, per
         state component).

@@ -466,9 +466,7 @@ class MoreauJean(TimeStepping):
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
+    {start}
     h : float
         Time step (dimensionless), > 0. The grid is ``t0 + k h``; the last
         step is shortened to end on ``t_bound``.

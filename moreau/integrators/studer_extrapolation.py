@@ -137,9 +137,7 @@ class StuderExtrapolation(TimeStepping):
 
     Parameters
     ----------
-    scene : Scene
-    t0, q0, v0, t_bound
-        See :class:`~moreau.integrators.base.Integrator`.
+    {start}
     tol : float
         Local error tolerance, in ``[100 eps, 1e-2]`` (what float64 can
         certify); positions and velocities are measured relative to ``1 + |y|``.

@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError, MoreauError
 from .units import columns_of
 
-__all__ = ["Scene", "params_with", "as_params", "FromParams", "joint_row_count", "velocity_count",
+__all__ = ["Scene", "params_with", "as_params", "FromParams", "fill_docstring", "joint_row_count", "velocity_count",
            "is_spatial"]
 
 # central differences balance truncation (step^2) against rounding (eps / step)
@@ -340,6 +340,29 @@ def as_params(cls, params):
     return params if isinstance(params, cls) else cls(**params)
 
 
+def fill_docstring(cls, line, entries):
+    """Replace the line ``line`` of ``cls``'s own docstring by ``entries``, one a line at its indent.
+
+    So that a docstring section every class of a family shares is written once.
+
+    Examples
+    --------
+    >>> class A:
+    ...     '''Doc.
+    ...
+    ...     {two}
+    ...     '''
+    >>> fill_docstring(A, "{two}", ("first", "second"))
+    >>> A.__doc__.splitlines()[2:4]
+    ['    first', '    second']
+    """
+    doc = cls.__dict__.get("__doc__")
+    if doc and line in doc:
+        head, _, tail = doc.partition(line)
+        indent = head[head.rfind("\n") + 1:]
+        cls.__doc__ = head + ("\n" + indent).join(entries) + tail
+
+
 class FromParams:
     """A scene made from one frozen dataclass of SI parameters, its class attribute ``Params``.
 
@@ -375,15 +398,11 @@ class FromParams:
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
-        doc = cls.__dict__.get("__doc__")
-        if doc and "{params}" in doc:
-            head, _, tail = doc.partition("{params}")
-            indent = head[head.rfind("\n") + 1:]
-            entries = ("Parameters", "----------", f"params : {cls.Params.__name__}, optional",
-                       "    SI parameters; the defaults if omitted.",
-                       "**overrides",
-                       "    Individual parameters replacing those of ``params``, by name.")
-            cls.__doc__ = head + ("\n" + indent).join(entries) + tail
+        if cls.Params is not None:
+            fill_docstring(cls, "{params}", (
+                "Parameters", "----------", f"params : {cls.Params.__name__}, optional",
+                "    SI parameters; the defaults if omitted.", "**overrides",
+                "    Individual parameters replacing those of ``params``, by name."))
 
     def __init__(self, params=None, **overrides):
         self.params = params_with(self.Params, params, overrides)
