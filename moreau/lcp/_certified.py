@@ -213,6 +213,12 @@ def farkas_float(M, q, y):
     return 1 if sure else 0
 
 
+def lcp_arrays(M, q, z):
+    """``M``, ``q`` and a candidate ``z`` as C-ordered float arrays (the compiled checks' layout)."""
+    return (np.ascontiguousarray(M, dtype=float), np.ascontiguousarray(q, dtype=float),
+            np.ascontiguousarray(z, dtype=float))
+
+
 def lcp_violation(M, q, z, w=None):
     """How far ``z`` is from solving ``LCP(M, q)``, in units fixed by the data alone.
 
@@ -270,9 +276,7 @@ def lcp_violation(M, q, z, w=None):
     >>> float(lcp_violation(M, q, np.array([61896.45733205, 26698.41102792]))) > 0.1
     True
     """
-    M = np.ascontiguousarray(M, dtype=float)
-    q = np.ascontiguousarray(q, dtype=float)
-    z = np.ascontiguousarray(z, dtype=float)
+    M, q, z = lcp_arrays(M, q, z)
     if z.size == 0:
         return 0.0
     if not (np.all(np.isfinite(z)) and np.all(np.isfinite(M)) and np.all(np.isfinite(q))):

@@ -8,7 +8,7 @@ them into text.
 
 import numpy as np
 
-from ._certified import lcp_violation
+from ._certified import lcp_arrays, lcp_violation
 
 __all__ = [
     "LCPResult",
@@ -69,9 +69,8 @@ def lcp_residual(M, q, z, w=None):
 
     Parameters
     ----------
-    M : ndarray, shape (n, n)
-    q : ndarray, shape (n,)
-    z : ndarray, shape (n,)
+    M, q, z
+        As for :func:`lcp_violation`.
     w : ndarray, shape (n,), optional
         ``M @ z + q``; computed when not given.
 
@@ -96,9 +95,7 @@ def lcp_residual(M, q, z, w=None):
     >>> float(lcp_residual(M, q, np.array([1/3, 1/3]))) < 1e-15
     True
     """
-    M = np.asarray(M, dtype=float)
-    q = np.asarray(q, dtype=float)
-    z = np.asarray(z, dtype=float)
+    M, q, z = lcp_arrays(M, q, z)
     if z.size == 0:
         return 0.0
     if w is None:
