@@ -30,9 +30,15 @@ True
 (False, 2, True)
 """
 
+import contextlib
 import hashlib
 import os
 import types
+
+try:
+    import fcntl
+except ImportError:  # Windows: the compile lock is skipped
+    fcntl = None
 
 try:
     # numba's internal cache classes: another numba version may not have this one
@@ -40,7 +46,8 @@ try:
 except ImportError:
     NullCache = None
 
-__all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code", "dependency_files"]
+__all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code", "dependency_files",
+           "compile_lock"]
 
 
 def sources_digest(paths):
@@ -127,6 +134,44 @@ def has_cached_code(dispatcher):
     except Exception:
         # a null cache, another numba version: nothing known to be on disk
         return False
+
+
+@contextlib.contextmanager
+def compile_lock(dispatcher):
+    """Hold a lock file next to ``dispatcher``'s disk cache while it compiles.
+
+    Processes that start together (pytest-xdist workers, a sweep's workers)
+    would each compile the same function; with the lock the later ones
+    wait and then load the first one's machine code from the cache. Without
+    a writable cache folder or ``fcntl`` (Windows) it holds nothing.
+
+    Examples
+    --------
+    >>> from numba import njit
+    >>> @njit
+    ... def f(x):
+    ...     return x + 1
+    >>> with compile_lock(f):
+    ...     f(1)
+    2
+    """
+    fh = None
+    try:
+        folder = dispatcher._cache._cache_path
+        name = dispatcher.py_func.__qualname__
+        fh = open(os.path.join(folder, f"{name}.moreau-lock"), "a")
+        fcntl.flock(fh, fcntl.LOCK_EX)
+    except Exception:
+        # no lock to be had (read-only install, no fcntl, other numba internals,
+        # a function without a disk cache): compiling twice is slower, never wrong
+        if fh is not None:
+            fh.close()
+        fh = None
+    try:
+        yield
+    finally:
+        if fh is not None:
+            fh.close()
 
 
 def dependency_files(functions):

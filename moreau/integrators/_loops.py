@@ -46,17 +46,12 @@ import threading
 import time
 import types
 
-try:
-    import fcntl
-except ImportError:  # Windows: the shared loops' compile lock is skipped
-    fcntl = None
-
 import numba
 from numba import njit
 from numba.core import types as nbtypes
 
 from .. import _jit_cache
-from .._jit_cache import dependency_files
+from .._jit_cache import compile_lock as _compile_lock, dependency_files
 from .._log import note
 from . import _mj_kernels
 from ._mj_kernels import no_gaps
@@ -422,34 +417,6 @@ class SharedRunner:
     def dispatcher(self):
         """The numba dispatcher that runs now (None before the first call)."""
         return self._special if self._special is not None else self._core
-
-
-@contextlib.contextmanager
-def _compile_lock(dispatcher):
-    """Hold a lock file next to ``dispatcher``'s disk cache while it compiles.
-
-    Processes that start together (pytest-xdist workers, a sweep's workers)
-    would each compile the same shared loop; with the lock the later ones
-    wait and then load the first one's machine code from the cache. Without
-    a writable cache folder or ``fcntl`` (Windows) it holds nothing.
-    """
-    fh = None
-    try:
-        folder = dispatcher._cache._cache_path
-        name = dispatcher.py_func.__qualname__
-        fh = open(os.path.join(folder, f"{name}.moreau-lock"), "a")
-        fcntl.flock(fh, fcntl.LOCK_EX)
-    except Exception:
-        # no lock to be had (read-only install, no fcntl, other numba internals):
-        # compiling twice is slower, never wrong
-        if fh is not None:
-            fh.close()
-        fh = None
-    try:
-        yield
-    finally:
-        if fh is not None:
-            fh.close()
 
 
 #: environment variable: "1" runs every model in its own specialised loop, "0" always

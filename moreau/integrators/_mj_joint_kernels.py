@@ -446,7 +446,9 @@ def run_joint_block(mass, forces, contacts, joints, *args):
     with _LOCK:
         if sig not in _COMPILED:
             mj_joint_loop.disable_compile(False)
-            mj_joint_loop.compile(sig)
+            # processes that reach it together compile it once (_jit_cache.compile_lock)
+            with _jit_cache.compile_lock(mj_joint_loop):
+                mj_joint_loop.compile(sig)
             _COMPILED.add(sig)
         # compiling only on the explicit signature: a call converts the model's
         # dispatchers to its function pointers instead of compiling a loop for each model

@@ -535,7 +535,9 @@ def run_space_loop(*args):
         types = tuple(nbtypes.FunctionType(SOLVE_SIGNATURE) if i == 13 else numba.typeof(a)
                       for i, a in enumerate(args))
         space_loop.disable_compile(False)
-        space_loop.compile(types)
+        # processes that reach it together compile it once (_jit_cache.compile_lock)
+        with _jit_cache.compile_lock(space_loop):
+            space_loop.compile(types)
         space_loop.disable_compile()
         # its compiled entry, called directly: the dispatcher would type the solver
         # (a _Solver) as a Python object; the other arguments have the types compiled for

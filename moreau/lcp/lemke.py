@@ -2067,6 +2067,20 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     return _solve(M, q, max_iter, tol, check_input, covering)
 
 
+def _solve_ones_first(M, q, out, max_iter, tol):
+    # the first call compiles the solver (or loads it from the disk cache) under the
+    # compile lock: processes that reach it together (pytest's or a sweep's workers)
+    # compile it once, the others load the machine code (15 CPU s each otherwise)
+    global _solve_ones
+    with _jit_cache.compile_lock(_solve_packed_ones):
+        result = _solve_packed_ones(M, q, out, max_iter, tol)
+    _solve_ones = _solve_packed_ones
+    return result
+
+
+_solve_ones = _solve_ones_first
+
+
 def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     # positional twin of solve(): the entry point calls it directly, since a
     # keyword call costs a noticeable part of a 4-variable solve
@@ -2093,7 +2107,7 @@ def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     if max_iter is None:
         max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
     if covering is None:
-        status, pivots, residual = _solve_packed_ones(
+        status, pivots, residual = _solve_ones(
             M, q, out, max_iter, DEFAULT_TOL if tol is None else tol,
         )
     else:
