@@ -200,7 +200,7 @@ def check_cone_problem(W, q, mu):
     mu_arr = np.asarray(mu, dtype=float) if not isinstance(mu, str) else None
     if mu_arr is None or mu_arr.ndim > 1:
         raise InputError(f"`mu` must be a number or an array of shape ({nc},), got {mu!r}")
-    mu_arr = finite_array("mu", np.broadcast_to(mu_arr, (nc,)) if mu_arr.ndim == 0 else mu_arr,
+    mu_arr = finite_array("mu", np.full(nc, mu_arr) if mu_arr.ndim == 0 else mu_arr,
                           shape=(nc,))
     bad = np.flatnonzero(mu_arr < 0.0)
     if bad.size:
@@ -2233,7 +2233,7 @@ def check_block_problem(W, q, mu, sizes):
     mu_arr = np.asarray(mu, dtype=float) if not isinstance(mu, str) else None
     if mu_arr is None or mu_arr.ndim > 1:
         raise InputError(f"`mu` must be a number or an array of shape ({nc},), got {mu!r}")
-    mu_arr = finite_array("mu", np.broadcast_to(mu_arr, (nc,)) if mu_arr.ndim == 0 else mu_arr,
+    mu_arr = finite_array("mu", np.full(nc, mu_arr) if mu_arr.ndim == 0 else mu_arr,
                           shape=(nc,))
     if np.any(mu_arr < 0.0):
         raise InputError(f"`mu` must be >= 0 for every contact, got {mu_arr.tolist()!r}")
