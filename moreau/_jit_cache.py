@@ -28,6 +28,13 @@ first call (:func:`bind_cache_to_sources`, :func:`has_cached_code`):
 True
 >>> has_cached_code(f), f(1), has_cached_code(f)
 (False, 2, True)
+
+Processes that may compile one function together hold :func:`compile_lock`
+while they do (without a disk cache, it holds nothing):
+
+>>> with compile_lock(f):
+...     f(2)
+3
 """
 
 import contextlib
@@ -147,13 +154,7 @@ def compile_lock(dispatcher):
 
     Examples
     --------
-    >>> from numba import njit
-    >>> @njit
-    ... def f(x):
-    ...     return x + 1
-    >>> with compile_lock(f):
-    ...     f(1)
-    2
+    See the module's docstring.
     """
     fh = None
     try:
