@@ -49,10 +49,19 @@ PREAMBLES = {
         "import numpy as np\n"
         "M = np.array([[2.0, 1.0], [1.0, 2.0]])\n"
         "q = np.array([-5.0, -6.0])\n"),
+    # the guide's short registration: a ball scene and its case under the guide's names
+    "register_scene(SceneEntry(": (
+        "from moreau.model.registry import SceneEntry, get_entry, register_scene\n"
+        "from moreau.scenes.bouncing_ball import BouncingBall as Ball\n"
+        "from moreau.scenes.bouncing_ball import BouncingBallCase as BallCase\n"),
 }
 
 #: what each snippet's last names must hold after it ran (a check that could fail)
 CHECKS = {
+    "register_scene(SceneEntry(":
+        "e, ref = get_entry('ball'), get_entry('bouncing-ball')\n"
+        "assert e.parameters == ref.parameters and e.sweepable == ref.sweepable\n"
+        "assert e.reference == 'exact' and e.mj_tolerance == BallCase.mj_tolerance == 5e-2",
     "import math":
         "assert res.success and abs(down / (9.81 * math.sin(slope) / 3.0 * si['t'][-1] ** 2)"
         " - 1.0) < 0.01",
