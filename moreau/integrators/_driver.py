@@ -49,10 +49,11 @@ import types
 
 import numpy as np
 from numba import njit
+from numba.extending import overload
 
 from ._contact_step import CTL_IA, OK
 
-__all__ = ["drive", "grid_step", "record_sample", "loop_template", "spliced", "STEP_FUNCTIONS"]
+__all__ = ["drive", "grid_step", "record_sample", "gap_of", "loop_template", "spliced", "STEP_FUNCTIONS"]
 
 #: the names under which a scheme module gives its step (see the module docstring)
 STEP_FUNCTIONS = ("step_workspace", "step_rule")
@@ -69,11 +70,33 @@ def grid_step(t0, k, h, t_bound):
     return tk, t1, h, False
 
 
+def gap_of(gaps, i):
+    """The gap of contact ``i``: ``gaps[i]`` of a vector, ``gaps[i, 0]`` of a contact table.
+
+    Examples
+    --------
+    >>> float(gap_of(np.array([[0.5, 1.0], [0.25, 1.0]]), 1)), float(gap_of(np.array([0.5, 0.25]), 1))
+    (0.25, 0.25)
+    """
+    return gaps[i, 0] if gaps.ndim == 2 else gaps[i]
+
+
+@overload(gap_of, inline="always")
+def _gap_of(gaps, i):
+    # chosen by the array's type when the caller compiles: the driver passes its contact
+    # table itself, since a column view (G[:, 0]) made in the loop slowed the two-contact
+    # shared loop by 15-20 % (benchmarks/bench_moreau_jean.py)
+    if gaps.ndim == 2:
+        return lambda gaps, i: gaps[i, 0]
+    return lambda gaps, i: gaps[i]
+
+
 @njit(cache=True)
 def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap, nrec, t, q, v,
-                  reg, pN, pT, h, slip, gap, nc):
+                  reg, pN, pT, h, slip, gaps, nc):
     """Write sample ``nrec`` of a compiled loop and return ``nrec + 1``: time, state, and per
-    contact the regime, the forces (impulse / step), the slip velocity and the gap."""
+    contact the regime, the forces (impulse / step), the slip velocity and the gap
+    (:func:`gap_of` ``gaps``: a vector, or a contact table whose column 0 holds the gaps)."""
     rec_t[nrec] = t
     for j in range(q.shape[0]):
         rec_q[nrec, j] = q[j]
@@ -84,7 +107,7 @@ def record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_ga
         rec_fN[nrec, i] = pN[i] / h
         rec_fT[nrec, i] = pT[i] / h
         rec_slip[nrec, i] = slip[i]
-        rec_gap[nrec, i] = gap[i]
+        rec_gap[nrec, i] = gap_of(gaps, i)
     return nrec + 1
 
 
@@ -188,7 +211,7 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
             break
         if record_initial:
             nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0[:, 0], nc)
+                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0, nc)
             record_initial = False
         for i in range(nc):
             G0[i, 0] = Gq[i, 0]
@@ -201,7 +224,7 @@ def drive(par, mu, e, t0, h, t_bound, k0, nmax, q, v, opts, memo, save_every, re
             to_save = save_every
         if to_save == save_every or last:
             nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq[:, 0], nc)
+                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq, nc)
         if last:
             break
     for i in range(nc):

@@ -405,7 +405,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
             cnew[i] = pN[i] > 0.0
         if record_initial:
             nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0[:, 0], nc)
+                                 nrec, tk, q, v, reg, pN, pT, hk, slip, G0, nc)
             record_initial = False
         for i in range(nc):
             closed[i] = cnew[i]
@@ -415,7 +415,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
         k += 1
         if k % save_every == 0 or last:
             nrec = record_sample(rec_t, rec_q, rec_v, rec_reg, rec_fN, rec_fT, rec_slip, rec_gap,
-                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq[:, 0], nc)
+                                 nrec, t1, q, v, reg, pN, pT, hk, slip, Gq, nc)
         if last:
             break
     return status, k, nrec
