@@ -45,7 +45,6 @@ numpydoc_class_members_toctree = False
 autosummary_generate = False
 
 
-
 def _one_docstring_template():
     # numpydoc makes a new jinja2 environment, and so compiles its docstring template
     # again, for each of the ~1300 docstrings it renders (a quarter of the build's CPU

@@ -53,7 +53,8 @@ from numba.extending import overload
 
 from ._contact_step import CTL_IA, OK
 
-__all__ = ["drive", "grid_step", "record_sample", "gap_of", "loop_template", "spliced", "STEP_FUNCTIONS"]
+__all__ = ["drive", "grid_step", "record_sample", "gap_of", "loop_template", "spliced",
+           "STEP_FUNCTIONS"]
 
 #: the names under which a scheme module gives its step (see the module docstring)
 STEP_FUNCTIONS = ("step_workspace", "step_rule")
@@ -75,7 +76,8 @@ def gap_of(gaps, i):
 
     Examples
     --------
-    >>> float(gap_of(np.array([[0.5, 1.0], [0.25, 1.0]]), 1)), float(gap_of(np.array([0.5, 0.25]), 1))
+    >>> table, vector = np.array([[0.5, 1.0], [0.25, 1.0]]), np.array([0.5, 0.25])
+    >>> float(gap_of(table, 1)), float(gap_of(vector, 1))
     (0.25, 0.25)
     """
     return gaps[i, 0] if gaps.ndim == 2 else gaps[i]
@@ -84,8 +86,8 @@ def gap_of(gaps, i):
 @overload(gap_of, inline="always")
 def _gap_of(gaps, i):
     # chosen by the array's type when the caller compiles: the driver passes its contact
-    # table itself, since a column view (G[:, 0]) made in the loop slowed the two-contact
-    # shared loop by 15-20 % (benchmarks/bench_moreau_jean.py)
+    # table itself, since a column view (G[:, 0]) made in the loop went with the sliding
+    # box's shared loop 15-20 % slower (benchmarks/bench_moreau_jean.py)
     if gaps.ndim == 2:
         return lambda gaps, i: gaps[i, 0]
     return lambda gaps, i: gaps[i]

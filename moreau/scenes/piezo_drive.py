@@ -648,8 +648,7 @@ class PiezoDriveCase(DriveCase):
     scene_class = PiezoDrive
     default_frequency = 1400.0
     # Moreau-Jean theta = 1 at 1000 steps: 6.5 % off the reference at 1400 Hz (the stator's
-    # oscillation under first-order steps; with the 1 um depth preload of an earlier version:
-    # 7.1 %, 0.9 % at 4000 steps, theta = 1/2 at 8000: 0.04 %)
+    # oscillation under first-order steps)
     mj_tolerance = 0.1
 
     @staticmethod
