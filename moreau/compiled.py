@@ -33,6 +33,8 @@ leave the structural zeros alone):
 ``drift(par, q, v, t, Dr)``
     ``Dr`` (ncontacts, 2) = ``(wNbar_i, wTbar_i)``: the velocity-dependent
     parts of the contact accelerations (``d/dt (W v + w) = W a + wbar``).
+    ``None`` where they are zero: rows ``W`` and terms ``w`` that do not
+    change along the motion (a fixed flat obstacle in these coordinates).
 ``gaps(par, q, t, G)`` (optional)
     column 0 of ``G`` alone; without it the engine calls ``contacts`` with
     ``need_gap=True, need_T=False``.
@@ -62,13 +64,12 @@ A ball of radius ``par[0]`` above the floor, under gravity:
 ...     if need_gap:
 ...         G[0, 0] = q[0] - par[0]
 ...     G[0, 3] = 1.0
->>> @njit
-... def drift(par, q, v, t, Dr):
-...     Dr[0, 0] = 0.0
->>> model = CompiledModel(mass, forces, contacts, drift, par=[0.1], ndof=1, ncontacts=1,
+>>> model = CompiledModel(mass, forces, contacts, None, par=[0.1], ndof=1, ncontacts=1,
 ...                       const_mass=True, has_jacobians=False)
 >>> model.ndof, float(model.par[0])
 (1, 0.1)
+
+The floor's row is constant, so its drift terms are zero: ``drift=None``.
 """
 
 import dataclasses
@@ -82,11 +83,17 @@ from . import _jit_cache
 from .errors import InputError
 
 __all__ = ["CompiledModel", "evaluate_compiled", "check_compiled_model", "MODEL_FUNCTIONS",
-           "memo_sincos"]
+           "memo_sincos", "zero_drift"]
 
 #: the function fields of a :class:`CompiledModel`, required ones first
 MODEL_FUNCTIONS = ("mass", "forces", "contacts", "drift", "gaps")
-_REQUIRED = ("mass", "forces", "contacts", "drift")
+_REQUIRED = ("mass", "forces", "contacts")
+
+
+@njit(cache=True)
+def zero_drift(par, q, v, t, Dr):
+    """The drift of a model whose contact rows do not change: ``Dr = 0`` (``drift=None``)."""
+    Dr[:, :] = 0.0
 
 
 def _is_jitted(f):
@@ -101,9 +108,12 @@ class CompiledModel:
 
     Parameters
     ----------
-    mass, forces, contacts, drift : numba dispatchers
+    mass, forces, contacts : numba dispatchers
         The model functions (see the module docstring for their signatures
         and output layouts).
+    drift : numba dispatcher or None
+        The drift terms; ``None`` where they are zero (constant contact rows):
+        the model then takes :func:`zero_drift`.
     par : array_like of float
         Parameters passed to every function as a float64 vector.
     ndof, ncontacts : int
@@ -129,6 +139,8 @@ class CompiledModel:
     gaps: Optional[Any] = None
 
     def __post_init__(self):
+        if self.drift is None:
+            object.__setattr__(self, "drift", zero_drift)
         for name in MODEL_FUNCTIONS:
             f = getattr(self, name)
             if f is None and name not in _REQUIRED:

@@ -183,7 +183,7 @@ class BallChain(FromParams, SIUnits, CompiledScene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`); ``par = (mass ratio,)``."""
-        return CompiledModel(_mass, _forces, _contacts, _drift, [self.mass_ratio], self.ndof,
+        return CompiledModel(_mass, _forces, _contacts, None, [self.mass_ratio], self.ndof,
                              self.ndof - 1, True, False)
 
     def shapes(self, q, t=0.0):
@@ -481,11 +481,6 @@ def _contacts(par, q, t, G, need_gap, need_T):
         G[i, 3 + i] = -1.0
         G[i, 4 + i] = 1.0
 
-
-@njit(cache=True)
-def _drift(par, q, v, t, Dr):
-    for i in range(q.shape[0] - 1):
-        Dr[i, 0] = 0.0
 
 
 register_scene(SceneEntry(

@@ -105,7 +105,7 @@ class BouncingBall(FromParams, SIUnits, CompiledScene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
-        return CompiledModel(_mass, _forces, _contacts, _drift, [self.r], 1, 1, True, False)
+        return CompiledModel(_mass, _forces, _contacts, None, [self.r], 1, 1, True, False)
 
     def shapes(self, q, t=0.0):
         """The floor, the ball (centre height ``q[0]`` [m]) and its contact point."""
@@ -305,10 +305,6 @@ def _contacts(par, q, t, G, need_gap, need_T):
         G[0, 0] = q[0] - par[0]
     G[0, 3] = 1.0
 
-
-@njit(cache=True)
-def _drift(par, q, v, t, Dr):
-    Dr[0, 0] = 0.0
 
 
 register_scene(SceneEntry(

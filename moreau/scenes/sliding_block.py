@@ -104,7 +104,7 @@ class SlidingBlock(FromParams, SIUnits, CompiledScene):
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
         par = [math.sin(self.alpha), math.cos(self.alpha)]
-        return CompiledModel(block_mass, _forces, block_contacts, _drift, par, 2, 1, True, False)
+        return CompiledModel(block_mass, _forces, block_contacts, None, par, 2, 1, True, False)
 
     def shapes(self, q, t=0.0):
         """The plane (inclined by ``alpha``), the block (a point mass, drawn 0.2 length units wide) and its contact."""
@@ -263,11 +263,6 @@ def _forces(par, q, v, t, D, need_jac):
     D[0, 0] = par[0]
     D[1, 0] = -par[1]
 
-
-@njit(cache=True)
-def _drift(par, q, v, t, Dr):
-    Dr[0, 0] = 0.0
-    Dr[0, 1] = 0.0
 
 
 register_scene(SceneEntry(

@@ -195,7 +195,7 @@ class WoodpeckerToy(FromParams, SIUnits, CompiledScene):
 
     def compiled_model(self):
         """Compiled form of this model (:mod:`moreau.compiled`)."""
-        return CompiledModel(_mass, _forces, _contacts, _drift, self._par, 3, 3, True, True)
+        return CompiledModel(_mass, _forces, _contacts, None, self._par, 3, 3, True, True)
 
     def _qscale(self):
         return np.array([self.length, 1.0, 1.0])
@@ -427,12 +427,6 @@ def _contacts(par, q, t, G, need_gap, need_T):
         G[2, 7] = lM
         G[2, 8] = par[5] - par[10]
 
-
-@njit(cache=True)
-def _drift(par, q, v, t, Dr):
-    for i in range(3):
-        Dr[i, 0] = 0.0
-        Dr[i, 1] = 0.0
 
 
 register_scene(SceneEntry(

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 from numba import njit
 
-from moreau.compiled import CompiledModel, check_compiled_model
+from moreau.compiled import CompiledModel, check_compiled_model, zero_drift
 from moreau.errors import InputError
 from moreau.integrators import _loops, _sp_kernels, simulate
 from moreau.integrators.moreau_jean import MoreauJean
@@ -182,6 +182,23 @@ def test_bad_compiled_models_are_refused_by_name():
         CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [np.nan], 2, 1, True, True)
     with pytest.raises(InputError, match=r"`const_mass` must be True or False"):
         CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift, [1.0], 2, 1, "yes", True)
+
+
+def test_a_model_without_a_drift_function_has_zero_drift_terms():
+    class NoDrift(CompiledBeltBlock):
+        def compiled_model(self):
+            return CompiledModel(belt_mass, belt_forces, belt_contacts, None, [self.k, self.vb],
+                                 2, 1, True, True)
+
+    sc = NoDrift(k=3.0, vb=0.7, mu=0.4)
+    assert sc.compiled_model().drift is zero_drift
+    assert check_compiled_model(sc, np.array([0.3, 0.0]), np.array([-0.2, 0.1]), 0.5) < 1e-12
+    Dr = np.full((3, 2), np.nan)
+    zero_drift(np.zeros(1), np.zeros(2), np.zeros(2), 0.0, Dr)
+    np.testing.assert_array_equal(Dr, 0.0)
+    with pytest.raises(InputError, match=r"`drift` must be a numba.njit function"):
+        CompiledModel(belt_mass, belt_forces, belt_contacts, belt_drift.py_func, [1.0], 2, 1,
+                      True, True)
 
 
 def test_a_model_of_other_sizes_than_its_scene_is_refused():
