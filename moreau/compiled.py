@@ -92,7 +92,15 @@ _REQUIRED = ("mass", "forces", "contacts")
 
 @njit(cache=True)
 def zero_drift(par, q, v, t, Dr):
-    """The drift of a model whose contact rows do not change: ``Dr = 0`` (``drift=None``)."""
+    """The drift of a model whose contact rows do not change: ``Dr = 0`` (``drift=None``).
+
+    Examples
+    --------
+    >>> Dr = np.ones((2, 2))
+    >>> zero_drift(np.zeros(1), np.zeros(1), np.zeros(1), 0.0, Dr)
+    >>> Dr.tolist()
+    [[0.0, 0.0], [0.0, 0.0]]
+    """
     Dr[:, :] = 0.0
 
 
