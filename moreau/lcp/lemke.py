@@ -486,7 +486,7 @@ def eliminate(A, x, s, rtol, atol, pcol, sol, cols):
     return prow
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _resolve_basis(M, q, pos, n, z_out):
     # Re-solve the terminal complementary basis directly: with J the basic
     # z variables, M_JJ z_J = -q_J. Rounding accumulated over many pivots is
@@ -552,7 +552,7 @@ def _noise_scale(T, pos, M, d, n, i, entering):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     """Lemke's method on preallocated arrays (compiled; callable from ``@njit`` code).
 
@@ -883,7 +883,7 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
     return status, pivots, residual
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok, status,
               pivots, residual):
     # the rest of a path _core or _core_resume handed back (_NEED_SEEN: the
