@@ -1636,7 +1636,9 @@ def _fbuf_size(n):
     return (n + 3) * _padded(n) + n
 
 
-@njit(cache=True)
+# inlined (numba IR) into _exact_run: as a library of its own it had numba
+# optimise and compile all of _run_scaled once more for _exact_run
+@njit(cache=True, inline="always")
 def _resume_packed(M, q, d, out, start, max_iter, tol):
     # _solve_packed from a basis the exact path decided (start: see
     # _core_resume), on the data scaled as the run that handed over
