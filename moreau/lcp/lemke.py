@@ -1500,7 +1500,7 @@ def _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, scale_d, exact_ok):
                        residual)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_iter, tol, scale_d,
                 exact_ok, info, status, pivots, residual):
     # After _plain_stage (its outcome in status, pivots, residual; _NOT_PLAIN
@@ -1509,7 +1509,9 @@ def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_i
     # (_balance_rows_to_q), then with rows and columns equilibrated apart
     # (_balance_ruiz). On a hand-over to the exact path (exact_ok), info
     # (2 n + 3) receives the scaling of the data pivoted on (_handoff_info),
-    # for the exact step and the resume to use the same.
+    # for the exact step and the resume to use the same. Inlined (numba IR)
+    # into the entries (through _solve_buffers): as a library of its own it had
+    # numba optimise and compile _run_scaled and _core once more for each.
     n = q.shape[0]
     plain = status != _NOT_PLAIN
     if plain:
