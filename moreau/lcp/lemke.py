@@ -173,13 +173,15 @@ ROUND = 2.0**16 * np.finfo(float).eps
 # internal statuses: the compiled pivoting hands over to the exact path
 _HANDOFF_TIE = 100
 _HANDOFF_CYCLE = 101
-# internal statuses of the compiled path that allocates nothing (_core, _path): a
+# internal statuses of the compiled path that allocates nothing (_core): a
 # path that needs the hash set of visited bases, or a solution whose residual
 # check failed and whose basis must be re-solved, goes on in _continue
 _NEED_SEEN = 102
 _NEED_REPAIR = 103
 # _plain_stage: the data need scaling, nothing was pivoted
 _NOT_PLAIN = 104
+# _core: start the path from the data (_first_pivot)
+_FRESH = 105
 # the output buffer of _solve_packed: z, w, the ray (n + 1) and the scaling of a
 # hand-over (2 n + 3), _OUT n + 4 floats
 _OUT = 5
@@ -552,7 +554,7 @@ def _noise_scale(T, pos, M, d, n, i, entering):
     return acc
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     """Lemke's method on preallocated arrays (compiled; callable from ``@njit`` code).
 
@@ -596,8 +598,8 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     The arrays are not checked for shape beyond the workspace: ``M`` must
     be ``n x n`` and the output vectors at least ``n`` (``n + 1``) long.
     """
-    status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol,
-                                     np.bool_(False))
+    status, pivots, residual = _start(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol,
+                                      np.bool_(False))
     if status == _NEED_SEEN or status == _NEED_REPAIR:
         status, pivots, residual = _continue(M, q, d, z_out, w_out, ray_out, work, iwork,
                                              max_iter, tol, np.bool_(False), status, pivots,
@@ -605,102 +607,48 @@ def lemke_core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol):
     return status, pivots, residual
 
 
-# _core, _path and _core_resume allocate nothing and are compiled without numba's
+@njit(cache=True, inline="always")
+def _start(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
+    # _core from the data. np.int64, not the constants: literal arguments
+    # would type (and compile) a second _core
+    return _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok, iwork[:1],
+                 np.int64(0), np.int64(0), np.int64(_FRESH))
+
+
+# _core, _first_pivot and _core_resume allocate nothing and are compiled without numba's
 # reference counting (_nrt=False): on a small LCP the atomic increments and
 # decrements of the arrays passed and viewed cost more than the pivoting. A
 # function compiled so may only call functions that allocate nothing either;
 # what needs memory (the hash set of a long path, the re-solve of a basis)
 # returns _NEED_SEEN or _NEED_REPAIR to _continue, which its callers run
 @njit(cache=True, _nrt=False)
-def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok):
-    # lemke_core (the public entry documents it). With exact_ok, a tie that
-    # floating point cannot decide, or a repeated basis, returns _HANDOFF_TIE
-    # or _HANDOFF_CYCLE with the basis in ray_out[:n] and the entering
-    # variable in ray_out[n], for the exact path (_exact.exact_lemke) to go
-    # on from; without it (compiled callers) an undecidable entry counts as a
-    # tie and a repeated basis is BREAKDOWN, never a run to max_iter.
+def _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok, seen, pivots,
+          entering, status):
+    # lemke_core (the public entry documents it), as Lemke's path to its end.
+    # With status _FRESH, from the data (_start, _first_pivot); else from the
+    # tableau and basis in work and iwork (_views), `pivots` made, with
+    # `entering` to enter next, status MAX_ITER (another status: the path has
+    # ended already, only the terminal point is made; _core_resume's modes).
+    # One function for every start: numba optimises and compiles the code of a
+    # callee again in each caller up the chain, so the path is in one library.
+    # With exact_ok, a tie that floating point cannot decide, or a repeated
+    # basis, returns _HANDOFF_TIE or _HANDOFF_CYCLE with the basis in
+    # ray_out[:n] and the entering variable in ray_out[n], for the exact path
+    # (_exact.exact_lemke) to go on from; without it (compiled callers) an
+    # undecidable entry counts as a tie and a repeated basis is BREAKDOWN,
+    # never a run to max_iter. `seen` is the hash set of visited states
+    # (_SEEN_SIZE zeros), or of length 1 when none is allocated yet: the path
+    # then returns _NEED_SEEN, with `entering` in ray_out[n], when its watch begins
     n = q.shape[0]
-    for k in range(n + 1):
-        ray_out[k] = 0.0
-    # -- data scale and validity (NaN fails every comparison, so test with `not`)
-    mmax = 0.0
-    for i in range(n):
-        for j in range(n):
-            a = abs(M[i, j])
-            if not a < np.inf:
-                for k in range(n):
-                    z_out[k] = 0.0
-                    w_out[k] = 0.0
-                return INVALID_INPUT, 0, np.inf
-            if a > mmax:
-                mmax = a
-    qmax = 0.0
-    qsum = 0.0
-    qmin = np.inf
-    for i in range(n):
-        if not abs(q[i]) < np.inf or not (d[i] > 0.0 and d[i] < np.inf):
-            for k in range(n):
-                z_out[k] = 0.0
-                w_out[k] = 0.0
-            return INVALID_INPUT, 0, np.inf
-        qmax = max(qmax, abs(q[i]))
-        qsum += abs(q[i])
-        qmin = min(qmin, q[i])
-    if n == 0 or qmin >= 0.0:
-        for k in range(n):
-            z_out[k] = 0.0
-            w_out[k] = q[k]
-        return SOLVED, 0, 0.0
-
-    # pos[var] = row if basic, else -(slot + 1); variables: w_j -> j,
-    # z_j -> n + j, z0 -> 2n
+    if status == _FRESH:
+        status, entering, mmax, qmax, qsum = _first_pivot(M, q, d, z_out, w_out, ray_out, work,
+                                                          iwork)
+        if status != MAX_ITER:
+            return status, np.int64(0), np.inf if status == INVALID_INPUT else 0.0
+        pivots = np.int64(1)
+    else:
+        mmax, qmax, qsum = _scales(M, q, n)
     T, b, col, basis, pos = _views(work, iwork, n)
-    ncol = T.shape[1]
-    if ncol < n + 1 or T.shape[0] < n + 3 or iwork.shape[0] < 3 * n + 1:
-        for k in range(n):
-            z_out[k] = 0.0
-            w_out[k] = 0.0
-        return INVALID_INPUT, 0, np.inf
-    _start_tableau(M, q, d, T, b, basis, pos, n, ncol)
-    for i in range(n):
-        col[i] = -d[i]
-    z0 = 2 * n
-
-    # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i.
-    # With B^-1 = I, of two rows tied in q_i/d_i the one with the larger
-    # index is lexicographically smaller (its unit entry comes later), so a
-    # forward scan keeps the last of the tied rows.
-    r = np.int64(0)  # not a literal: it would type (and compile) _pivot a second time
-    rr = q[0] / d[0]
-    for i in range(1, n):
-        ri = q[i] / d[i]
-        if ri <= rr + TIE_TOL * max(abs(ri), abs(rr)):
-            r = i
-            rr = min(ri, rr)
-    _pivot(T, b, col, n, r, n)
-    leaving = basis[r]
-    basis[r] = z0
-    pos[z0] = r
-    pos[leaving] = -(n + 1)
-    pivots = 1
-    entering = leaving + n  # complement of w_r is z_r
-    # np.int64, not the constants: literal arguments would type (and compile) a
-    # second _path beside _core_resume's
-    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(pivots),
-                 entering, max_iter, tol, exact_ok, mmax, qmax, qsum, np.int64(MAX_ITER),
-                 iwork[:1])
-
-
-@njit(cache=True, _nrt=False)
-def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, entering,
-          max_iter, tol, exact_ok, mmax, qmax, qsum, status, seen):
-    # Lemke's path from the tableau (T, b) of the basis (basis, pos) with
-    # `entering` to enter next, to its end (status MAX_ITER; another status:
-    # the path has ended already, only the terminal point is made); _core
-    # after its first pivot, and _core_resume from a basis the exact path
-    # decided. `seen` is the hash set of visited states (_SEEN_SIZE zeros), or
-    # of length 1 when none is allocated yet: the path then returns
-    # _NEED_SEEN, with `entering` in ray_out[n], when its watch begins
     z0 = 2 * n
     # (basis, entering) identified by the XOR of its variables' keys: an exact
     # lexicographic path never repeats one, so a repeat is rounding having
@@ -883,7 +831,80 @@ def _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, pivots, ente
     return status, pivots, residual
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
+def _first_pivot(M, q, d, z_out, w_out, ray_out, work, iwork):
+    # _core's start from the data: checks them (INVALID_INPUT, z = w = 0),
+    # answers q >= 0 (SOLVED, z = 0, w = q), else makes the tableau and its
+    # first pivot, on z0 (MAX_ITER: the path goes on with `entering`); returns
+    # (status, entering, max|M|, max|q|, sum|q|)
+    n = q.shape[0]
+    for k in range(n + 1):
+        ray_out[k] = 0.0
+    # -- data scale and validity (NaN fails every comparison, so test with `not`)
+    mmax = 0.0
+    for i in range(n):
+        for j in range(n):
+            a = abs(M[i, j])
+            if not a < np.inf:
+                for k in range(n):
+                    z_out[k] = 0.0
+                    w_out[k] = 0.0
+                return INVALID_INPUT, 0, 0.0, 0.0, 0.0
+            if a > mmax:
+                mmax = a
+    qmax = 0.0
+    qsum = 0.0
+    qmin = np.inf
+    for i in range(n):
+        if not abs(q[i]) < np.inf or not (d[i] > 0.0 and d[i] < np.inf):
+            for k in range(n):
+                z_out[k] = 0.0
+                w_out[k] = 0.0
+            return INVALID_INPUT, 0, 0.0, 0.0, 0.0
+        qmax = max(qmax, abs(q[i]))
+        qsum += abs(q[i])
+        qmin = min(qmin, q[i])
+    if n == 0 or qmin >= 0.0:
+        for k in range(n):
+            z_out[k] = 0.0
+            w_out[k] = q[k]
+        return SOLVED, 0, 0.0, 0.0, 0.0
+
+    # pos[var] = row if basic, else -(slot + 1); variables: w_j -> j,
+    # z_j -> n + j, z0 -> 2n
+    T, b, col, basis, pos = _views(work, iwork, n)
+    ncol = T.shape[1]
+    if ncol < n + 1 or T.shape[0] < n + 3 or iwork.shape[0] < 3 * n + 1:
+        for k in range(n):
+            z_out[k] = 0.0
+            w_out[k] = 0.0
+        return INVALID_INPUT, 0, 0.0, 0.0, 0.0
+    _start_tableau(M, q, d, T, b, basis, pos, n, ncol)
+    for i in range(n):
+        col[i] = -d[i]
+    z0 = 2 * n
+
+    # -- first pivot: z0 enters at the lexicographic minimum of (q_i, e_i)/d_i.
+    # With B^-1 = I, of two rows tied in q_i/d_i the one with the larger
+    # index is lexicographically smaller (its unit entry comes later), so a
+    # forward scan keeps the last of the tied rows.
+    r = np.int64(0)  # not a literal: it would type (and compile) _pivot a second time
+    rr = q[0] / d[0]
+    for i in range(1, n):
+        ri = q[i] / d[i]
+        if ri <= rr + TIE_TOL * max(abs(ri), abs(rr)):
+            r = i
+            rr = min(ri, rr)
+    _pivot(T, b, col, n, r, n)
+    leaving = basis[r]
+    basis[r] = z0
+    pos[z0] = r
+    pos[leaving] = -(n + 1)
+    entering = leaving + n  # complement of w_r is z_r
+    return MAX_ITER, entering, mmax, qmax, qsum
+
+
+@njit(cache=True, inline="always")
 def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_ok, status,
               pivots, residual):
     # the rest of a path _core or _core_resume handed back (_NEED_SEEN: the
@@ -891,17 +912,17 @@ def _continue(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, exact_
     # solution's basis is re-solved from the data), with the tableau, basis
     # and outputs where they left them
     n = q.shape[0]
-    mmax, qmax, qsum = _scales(M, q, n)
-    T, b, col, basis, pos = _views(work, iwork, n)
     if status == _NEED_SEEN:
         seen = np.zeros(_SEEN_SIZE, dtype=np.int64)
         entering = np.int64(ray_out[n])
         # the ray stays zero unless the path ends on one
         ray_out[n] = 0.0
-        status, pivots, residual = _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos,
-                                         n, np.int64(pivots), entering, max_iter, tol, exact_ok,
-                                         mmax, qmax, qsum, np.int64(MAX_ITER), seen)
+        status, pivots, residual = _core(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter,
+                                         tol, exact_ok, seen, np.int64(pivots), entering,
+                                         np.int64(MAX_ITER))
     if status == _NEED_REPAIR:
+        mmax, qmax, _ = _scales(M, q, n)
+        pos = iwork[n:]
         status = SOLVED
         zsave = z_out.copy()
         wsave = w_out.copy()
@@ -931,23 +952,24 @@ _REBUILD_TOL = 1e-8
 
 
 @njit(cache=True, _nrt=False)
-def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, start):
-    # Lemke's path on (M, q, d) from a basis the exact path (moreau.lcp._exact.exact_step)
-    # has decided: start = (basis of each row (n), entering variable, mode,
-    # pivots made, the basis's right-hand side row by row (n), exactly rounded),
-    # all floats. The tableau of that basis is made afresh from the data, by
+def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, start):
+    # The start of Lemke's path on (M, q, d) from a basis the exact path
+    # (moreau.lcp._exact.exact_step) has decided: start = (basis of each row
+    # (n), entering variable, mode, pivots made, the basis's right-hand side
+    # row by row (n), exactly rounded), all floats. The tableau of that basis is made afresh from the data, by
     # pivoting its non-w variables in from the all-w basis (partial pivoting
     # among the rows whose w must leave), so that the rounding of the path
     # before the hand-over is gone, and takes the exact right-hand side (its
-    # zeros are the degenerate rows, its order that of the exact path); then,
-    # by mode, the path goes on
-    # (_RESUME_PATH), the basis's point is the answer (_RESUME_SOLVED), or the
-    # entering column gives the secondary ray (_RESUME_RAY). A basis too close
+    # zeros are the degenerate rows, its order that of the exact path).
+    # Returns (status, pivots, residual, entering) for _core to go on from, by
+    # mode: along the path (_RESUME_PATH: MAX_ITER), to the basis's point as the
+    # answer (_RESUME_SOLVED: SOLVED), or to the secondary ray of the entering
+    # column (_RESUME_RAY: SECONDARY_RAY, the ray written). A basis too close
     # to singular for floating point (a pivot below _REBUILD_TOL times its
-    # column) is handed back at once (_HANDOFF_TIE): the exact path decides
-    # its step too. The data are finite (the hand-over came from _core).
+    # column) is handed back at once (_HANDOFF_TIE, or BREAKDOWN outside
+    # _RESUME_PATH; final): the exact path decides its step too. The data are
+    # finite (the hand-over came from _core).
     n = q.shape[0]
-    mmax, qmax, qsum = _scales(M, q, n)
     for k in range(n + 1):
         ray_out[k] = 0.0
     T, b, col, basis, pos = _views(work, iwork, n)
@@ -967,7 +989,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
             continue
         s = -pos[v] - 1
         cmax = 0.0
-        r = np.int64(-1)  # not a literal (see _core's first pivot)
+        r = np.int64(-1)  # not a literal (see _first_pivot)
         best = 0.0
         for i in range(n):
             a = T[i, s]
@@ -985,7 +1007,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
                 z_out[i] = 0.0
                 w_out[i] = q[i]
             ray_out[n] = start[n]
-            return status, int(start[n + 2]), np.inf
+            return status, np.int64(start[n + 2]), np.inf, np.int64(0)
         _pivot(T, b, col, n, r, s)
         leaving = basis[r]
         basis[r] = v
@@ -1023,9 +1045,7 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, max_iter, tol, sta
             col[i] = T[i, s]
         _write_ray(col, pos, n, entering, ray_out)
         status = SECONDARY_RAY
-    return _path(M, q, d, z_out, w_out, ray_out, T, b, col, basis, pos, n, np.int64(start[n + 2]),
-                 np.int64(entering), max_iter, tol, np.bool_(True), mmax, qmax, qsum,
-                 np.int64(status), iwork[:1])
+    return np.int64(status), np.int64(start[n + 2]), np.inf, np.int64(entering)
 
 
 @njit(cache=True)
@@ -1270,12 +1290,16 @@ def _run_scaled(M, q, d, rexp, cexp, ka, kb, z_out, w_out, ray_out, work, iwork,
             for j in range(n):
                 Ms[i, j] = _times_pow2(M[i, j], rexp[i] + cexp[j] + ka)
     if start.shape[0] == 0:
-        status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
-                                         tol, exact_ok)
+        status, pivots, residual = _start(Ms, qs, ds, z_out, w_out, ray_out, work, iwork, max_iter,
+                                          tol, exact_ok)
     else:
         # from a basis the exact path decided (start: see _core_resume)
-        status, pivots, residual = _core_resume(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
-                                                max_iter, tol, start)
+        status, pivots, residual, entering = _core_resume(Ms, qs, ds, z_out, w_out, ray_out, work,
+                                                          iwork, start)
+        if status != _HANDOFF_TIE and status != BREAKDOWN:
+            status, pivots, residual = _core(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
+                                             max_iter, tol, np.bool_(True), iwork[:1], pivots,
+                                             entering, status)
     if status == _NEED_SEEN or status == _NEED_REPAIR:
         status, pivots, residual = _continue(Ms, qs, ds, z_out, w_out, ray_out, work, iwork,
                                              max_iter, tol, np.bool_(exact_ok or start.shape[0] > 0),
@@ -1442,8 +1466,8 @@ def _plain_stage(M, q, d, out, fbuf, ibuf, max_iter, tol, exact_ok):
     ok, ka, kb = balance(M, q, sexp)
     if not ok:
         # NaN or inf: _core refuses them
-        status, pivots, residual = _core(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1],
-                                         work, iwork, max_iter, tol, exact_ok)
+        status, pivots, residual = _start(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1],
+                                          work, iwork, max_iter, tol, exact_ok)
         return status, pivots, residual, ka, kb
     plain = -_PLAIN_RANGE <= ka <= _PLAIN_RANGE and -_PLAIN_RANGE <= kb <= _PLAIN_RANGE
     for i in range(n):
@@ -1453,8 +1477,8 @@ def _plain_stage(M, q, d, out, fbuf, ibuf, max_iter, tol, exact_ok):
     # data of one moderate scale: the pivoting's tests are all relative, so
     # pivoting on them as given is what the normalised copy would do (the
     # property tests scale by 2^k and compare), minus the copy
-    status, pivots, residual = _core(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1], work,
-                                     iwork, max_iter, tol, exact_ok)
+    status, pivots, residual = _start(M, q, d, out[:n], out[n:2 * n], out[2 * n:3 * n + 1], work,
+                                      iwork, max_iter, tol, exact_ok)
     return status, pivots, residual, ka, kb
 
 
@@ -1476,7 +1500,7 @@ def _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, scale_d, exact_ok):
                        residual)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_iter, tol, scale_d,
                 exact_ok, info, status, pivots, residual):
     # After _plain_stage (its outcome in status, pivots, residual; _NOT_PLAIN
@@ -1485,7 +1509,9 @@ def _lemke_rest(M, q, d, z_out, w_out, ray_out, work, iwork, sexp, ka, kb, max_i
     # (_balance_rows_to_q), then with rows and columns equilibrated apart
     # (_balance_ruiz). On a hand-over to the exact path (exact_ok), info
     # (2 n + 3) receives the scaling of the data pivoted on (_handoff_info),
-    # for the exact step and the resume to use the same.
+    # for the exact step and the resume to use the same. Inlined (numba IR)
+    # into the entries (through _solve_buffers): as a library of its own it had
+    # numba optimise and compile _run_scaled and _core once more for each.
     n = q.shape[0]
     plain = status != _NOT_PLAIN
     if plain:
@@ -1612,7 +1638,9 @@ def _fbuf_size(n):
     return (n + 3) * _padded(n) + n
 
 
-@njit(cache=True)
+# inlined (numba IR) into _exact_run: as a library of its own it had numba
+# optimise and compile all of _run_scaled once more for _exact_run
+@njit(cache=True, inline="always")
 def _resume_packed(M, q, d, out, start, max_iter, tol):
     # _solve_packed from a basis the exact path decided (start: see
     # _core_resume), on the data scaled as the run that handed over
