@@ -956,7 +956,8 @@ def _core_resume(M, q, d, z_out, w_out, ray_out, work, iwork, start):
     # The start of Lemke's path on (M, q, d) from a basis the exact path
     # (moreau.lcp._exact.exact_step) has decided: start = (basis of each row
     # (n), entering variable, mode, pivots made, the basis's right-hand side
-    # row by row (n), exactly rounded), all floats. The tableau of that basis is made afresh from the data, by
+    # row by row (n), exactly rounded), all floats. The tableau of that basis
+    # is made afresh from the data, by
     # pivoting its non-w variables in from the all-w basis (partial pivoting
     # among the rows whose w must leave), so that the rounding of the path
     # before the hand-over is gone, and takes the exact right-hand side (its
