@@ -10,7 +10,8 @@ kept from one call to the next in the contact problem's control array.
 A scheme's kernel module gives two functions under fixed names and builds its
 loop template with :func:`loop_template`:
 
-- ``step_workspace(n, nc, opts, lcp_ctl)``: its buffers, one tuple, allocated once a call;
+- ``step_workspace(n, nc, opts, lcp_ctl)``: its buffers, one tuple, allocated once a call
+  (a :func:`spliced` helper: its arrays go to the step rule's names with no tuple between);
 - ``step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS,
   CONST_MASS, HAS_JAC, HAS_GAPS, lcp_step, ws, par, mu, e, opts, memo,
   lcp_ctl, stats, k, k0, tk, t1, hk, hn, record_initial, q, v, out)``,
@@ -344,6 +345,7 @@ def _splice_template(name, namespace):
              if not (isinstance(arg, ast.Name) and arg.id == p)]
     loop.body[at:at + 1] = _one_exit(per_step)
     fdef.body[loop_at:loop_at] = binds + setup
+    _spliced_workspace(fdef.body, splicer)
     ast.fix_missing_locations(tree)
     source = ast.unparse(tree)
     code = compile(source, drive.__code__.co_filename, "exec")
@@ -606,6 +608,96 @@ def _one_exit(per_step):
     start, once, leave = tree.body
     once.body = per_step + ast.parse(f"{flag} = True\nbreak").body
     return [start, once, leave]
+
+
+def _spliced_workspace(body, splicer):
+    """Build the workspace in the loop's own code, straight into the names that use it.
+
+    A scheme's ``step_workspace`` returns a tuple of fifty and more arrays
+    (tuples in it, some), which the step rule unpacks: numba takes a
+    reference to each array for the tuple, for the copy the unpacking makes
+    and for each name, and drops them again, thousands of lines of
+    unoptimised code in every loop. Spliced (where ``step_workspace`` is a
+    :func:`spliced` helper) and forwarded (:func:`_forward_tuples`), the
+    same arrays are allocated in the same order, with no tuple between.
+    """
+    while True:
+        loop_at = next(i for i, st in enumerate(body) if isinstance(st, ast.While))
+        count = splicer.count
+        body[:loop_at] = splicer.stmts(body[:loop_at])
+        if not _forward_tuples(body) and splicer.count == count:
+            return
+
+
+def _names_in(stmts):
+    """Every name ``stmts`` (nodes) assign or read."""
+    return {node.id for st in stmts for node in ast.walk(st) if isinstance(node, ast.Name)}
+
+
+def _unpacked_later(body, i):
+    """Where ``body[i]`` is ``x = (a, b, ...)`` whose one use is ``p, q, ... = x`` of as many
+    names that the statements between neither assign nor read, nor ``a, b, ...`` read:
+    that statement's index, else None."""
+    st = body[i]
+    if not (isinstance(st, ast.Assign) and len(st.targets) == 1
+            and isinstance(st.targets[0], ast.Name) and isinstance(st.value, ast.Tuple)):
+        return None
+    x = st.targets[0].id
+    uses = [j for j in range(len(body)) if j != i and x in _names_in([body[j]])]
+    if len(uses) != 1 or uses[0] < i:
+        return None
+    j = uses[0]
+    un = body[j]
+    if not (isinstance(un, ast.Assign) and len(un.targets) == 1
+            and isinstance(un.targets[0], ast.Tuple) and isinstance(un.value, ast.Name)
+            and un.value.id == x and len(un.targets[0].elts) == len(st.value.elts)
+            and all(isinstance(t, ast.Name) for t in un.targets[0].elts)):
+        return None
+    names = {t.id for t in un.targets[0].elts}
+    if len(names) < len(un.targets[0].elts) \
+            or names & (_names_in(body[i + 1:j]) | _names_in(st.value.elts)):
+        return None
+    return j
+
+
+def _forward_tuples(body):
+    """Make ``x = (a, b)`` ... ``p, q = x`` into ``p = a; q = b`` where that is the same program
+    (:func:`_unpacked_later`); ``a`` a name assigned once before and read nowhere else is
+    renamed ``p`` instead of copied. Returns whether it changed ``body``."""
+    changed = False
+    i = 0
+    while i < len(body):
+        j = _unpacked_later(body, i)
+        if j is None:
+            i += 1
+            continue
+        changed = True
+        elts = body[i].value.elts
+        targets = [t.id for t in body[j].targets[0].elts]
+        del body[j]
+        new = []
+        for k, (t, e) in enumerate(zip(targets, elts)):
+            others = elts[:k] + elts[k + 1:]
+            if not (isinstance(e, ast.Name) and e.id not in _names_in(others)
+                    and _rename_once_assigned(body, i, e.id, t)):
+                new.append(ast.Assign(targets=[ast.Name(id=t, ctx=ast.Store())], value=e))
+        # the new assignments are looked at again: a tuple among them may be unpacked later
+        body[i:i + 1] = new
+    return changed
+
+
+def _rename_once_assigned(body, i, name, to):
+    """Rename ``name`` ``to`` in ``body[:i]`` where it is assigned once there and occurs
+    nowhere after ``body[i]``, and ``to`` occurs nowhere before; whether it did."""
+    before = body[:i]
+    stores = [node for st in before for node in ast.walk(st)
+              if isinstance(node, ast.Name) and node.id == name and isinstance(node.ctx, ast.Store)]
+    if len(stores) != 1 or name in _names_in(body[i + 1:]) or to in _names_in(before):
+        return False
+    renamer = _Rename({name: to})
+    for k in range(i):
+        body[k] = renamer.visit(body[k])
+    return True
 
 
 def _has_return(stmts):

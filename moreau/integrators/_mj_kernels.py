@@ -78,9 +78,10 @@ PROJECTION_MAXITER = 8
 LCP_REACHABLE = True
 PROJECTION_REACHABLE = True
 
-# inlined: allocated in the loop's own function, the buffers' shapes are known to LLVM
-# (a model's own loop of a two-contact scene ran 7-9 % slower with them from a call)
-@njit(inline="always")
+# spliced: allocated in the loop's own function, the buffers' shapes are known to LLVM
+# (a model's own loop of a two-contact scene ran 7-9 % slower with them from a call), and
+# given to the step rule's names with no tuple between (_driver._spliced_workspace)
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     ncm = max(nc, 1)

@@ -37,7 +37,8 @@ CONTACT_TOL = 1e-12
 POSITION_MAXITER = 8
 
 
-@njit(cache=True)
+# spliced, as Moreau–Jean's: allocated in the loop's own function
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     M = np.zeros((n, n))

@@ -27,15 +27,15 @@ from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_LCP,  # noqa:
                           S_PIVOTS, S_RES, SINGULAR, _lcp_size, _lcp_step, _lcp_step_unused,
                           lcp_buffers)
 from ._mj_kernels import SHARED_INDIRECT  # noqa: F401  (read by moreau.integrators._loops)
-from ._driver import loop_template
+from ._driver import loop_template, spliced
 from ._step_parts import (add_impulse, affine_rows, contact_block, gaps_at, gather_rows, index_set,
                           mass_inverse, record_contacts, rows_times, slip_rows, solve_one, times_ht)
 
 __all__ = ["sp_loop"]
 
 
-# inlined, as Moreau–Jean's: the buffers' shapes stay visible to LLVM
-@njit(inline="always")
+# spliced, as Moreau–Jean's: the buffers' shapes stay visible to LLVM
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     ncm = max(nc, 1)

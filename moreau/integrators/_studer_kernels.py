@@ -50,8 +50,8 @@ STUDER_COUNTERS = ("macro_steps", "base_steps", "rejected_steps", "smooth_steps"
 ADAPTIVE_STEPS = True
 
 
-# inlined: allocated in the loop's own function, the buffers' shapes are known to LLVM
-@njit(inline="always")
+# spliced, as Moreau–Jean's: allocated in the loop's own function
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     K = opts[1]

@@ -140,7 +140,8 @@ def _solve_small(S, x, m):
     return True
 
 
-@njit(cache=True)
+# spliced, as Moreau–Jean's: allocated in the loop's own function
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """The buffers of :func:`step_rule`, allocated once a call of the loop (one tuple)."""
     cs = opts[0]

@@ -51,7 +51,7 @@ from .base import register_integrator
 from ._contact_step import (LCP_HANDBACK, NUMERICAL, OK, S_PEN, S_PROJ,  # noqa: F401
                             SHARED_INDIRECT, _lcp_size, _lcp_step, _lcp_step_unused,
                             lcp_buffers)
-from ._driver import loop_template
+from ._driver import loop_template, spliced
 from ._step_parts import gap_block, gaps_at, mass_inverse, move_by
 from ._mj_kernels import step_rule as _mj_step
 from ._mj_kernels import step_workspace as _mj_workspace
@@ -70,7 +70,8 @@ PROJECTION_REACHABLE = False
 SPLICE_SWITCHES = ("PROJECTION_REACHABLE",)
 
 
-@njit(cache=True)
+# spliced, as Moreau–Jean's: allocated in the loop's own function
+@spliced
 def step_workspace(n, nc, opts, lcp_ctl):
     """Moreau–Jean's buffers and the projection's (one tuple)."""
     ncm = max(nc, 1)
