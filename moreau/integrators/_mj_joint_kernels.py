@@ -191,11 +191,22 @@ def _regular(A, k):
     return s[0] > 0.0 and s[k - 1] > RANK_RTOL * s[0]
 
 
+@njit(inline="always")
+def _solve_vector(A, b):
+    """``np.linalg.solve(A, b)`` of a contiguous vector ``b``, taken as a one-column matrix.
+
+    The same LAPACK call on the same numbers as the vector form, so the same
+    bits; numba then compiles one form of ``solve`` for the loop, not two
+    (the vector form's argument checks and messages alone cost 2-3 CPU s).
+    """
+    return np.ascontiguousarray(np.linalg.solve(A, b.reshape((b.shape[0], 1)))[:, 0])
+
+
 @njit(cache=True)
 def _refined(A, rhs):
     """``A^-1 rhs`` with one step of iterative refinement (moreau.lcp.mlcp.free_part)."""
-    u = np.linalg.solve(A, rhs)
-    return u + np.linalg.solve(A, rhs - A @ u)
+    u = _solve_vector(A, rhs)
+    return u + _solve_vector(A, rhs - A @ u)
 
 
 @njit(cache=True, error_model="numpy")
@@ -339,7 +350,7 @@ def mj_joint_loop(mass_fn, forces_fn, contacts_fn, joints_fn, n, nc, nj, has_jac
             Cc = np.ascontiguousarray(W[:nj, nj:])
             Dd = np.ascontiguousarray(W[nj:, :nj])
             AiC = np.linalg.solve(A, Cc)
-            Aia = np.linalg.solve(A, a)
+            Aia = _solve_vector(A, a)
             WS = W[nj:, nj:] - Dd @ AiC
             uS = Uf[nj:] - Dd @ Aia
             if fr:
