@@ -51,7 +51,28 @@ def test_the_step_rules_and_their_helpers_are_spliced_not_called():
                              "gather_rows", "contact_block", "solve_one", "record_contacts"}
         assert any(f.endswith("_step_parts.py") for f in loop.__moreau_sources__)
     src = moreau_jean_projected.mjp_loop.__moreau_source__
-    assert "_step_rule1_th, _step_rule1_projection = _step_rule1_opts" in src
+    # Moreau-Jean's options, a tuple built in the call, given to its renamed names directly
+    assert "_step_rule1_th = opts[0]" in src and "_step_rule1_projection = False" in src
+
+
+def test_a_tuple_unpacked_once_goes_to_its_names_directly():
+    body = ast.parse("c = n + 1\nws = (np.zeros(n), b, c)\nk = 1\nx, y, z = ws\n"
+                     "while k:\n    k = x[0] + y + z").body
+    assert _driver._forward_tuples(body)
+    out = ast.unparse(ast.fix_missing_locations(ast.Module(body, [])))
+    # the element named once before is renamed, not copied; the others are assigned
+    assert "ws" not in out and "x = np.zeros(n)" in out and "y = b" in out
+    assert "z = n + 1" in out and "c" not in out.split()
+    # a name the unpacking assigns is used between the two: the tuple stays
+    body = ast.parse("ws = (a, b)\nx = 3\nx, y = ws\nwhile k:\n    pass").body
+    assert not _driver._forward_tuples(body) and len(body) == 4
+
+
+def test_no_scheme_s_loop_unpacks_its_workspace_tuple():
+    for loop in (_sp_kernels.sp_loop, moreau_jean_projected.mjp_loop):
+        lines = [ln.strip() for ln in loop.__moreau_source__.splitlines()]
+        assert not [ln for ln in lines if ln.endswith(("= ws", "= mws", "= pws"))]
+        assert "ws = step_workspace(n, nc, opts, lcp_ctl)" not in lines
 
 
 def test_a_global_of_a_helper_that_the_namespace_binds_otherwise_is_renamed():
