@@ -2299,7 +2299,10 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             z = _exact.basis_point(M, q, J)
             if z is not None:
                 out[:n] = z
-                out[n:2 * n] = M @ out[:n] + q
+                # a point of huge entries may overflow here: its check then fails
+                # (residual inf or NaN) and the exact path goes on, without a warning
+                with np.errstate(over="ignore", invalid="ignore"):
+                    out[n:2 * n] = M @ out[:n] + q
                 residual = float(_violation(M, q, out[:n]))
                 if residual <= tol:
                     note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} "
@@ -2322,7 +2325,8 @@ def _exact_steps(M, q, covering, out, handoff, pivots, max_iter, tol, defer=Fals
             z = _exact.basis_point(M, q, J)
         if z is not None:
             out[:n] = z
-            out[n:2 * n] = M @ out[:n] + q
+            with np.errstate(over="ignore", invalid="ignore"):   # as above: the check decides
+                out[n:2 * n] = M @ out[:n] + q
             residual = float(_violation(M, q, out[:n]))
             status = SOLVED if residual <= tol else BREAKDOWN
     note = (f"Pivoting met {_why(first)}; {steps} step{'s' if steps > 1 else ''} of the path "
