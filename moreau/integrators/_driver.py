@@ -675,24 +675,27 @@ def _forward_tuples(body):
         elts = body[i].value.elts
         targets = [t.id for t in body[j].targets[0].elts]
         del body[j]
+        # the names after the tuple (the loop among them), walked once for all its elements:
+        # the renames below change only the statements before it
+        after = _names_in(body[i + 1:])
         new = []
         for k, (t, e) in enumerate(zip(targets, elts)):
             others = elts[:k] + elts[k + 1:]
             if not (isinstance(e, ast.Name) and e.id not in _names_in(others)
-                    and _rename_once_assigned(body, i, e.id, t)):
+                    and _rename_once_assigned(body, i, e.id, t, after)):
                 new.append(ast.Assign(targets=[ast.Name(id=t, ctx=ast.Store())], value=e))
         # the new assignments are looked at again: a tuple among them may be unpacked later
         body[i:i + 1] = new
     return changed
 
 
-def _rename_once_assigned(body, i, name, to):
-    """Rename ``name`` ``to`` in ``body[:i]`` where it is assigned once there and occurs
-    nowhere after ``body[i]``, and ``to`` occurs nowhere before; whether it did."""
+def _rename_once_assigned(body, i, name, to, after):
+    """Rename ``name`` ``to`` in ``body[:i]`` where it is assigned once there and is not among
+    ``after`` (the names of ``body[i + 1:]``), and ``to`` occurs nowhere before; whether it did."""
     before = body[:i]
     stores = [node for st in before for node in ast.walk(st)
               if isinstance(node, ast.Name) and node.id == name and isinstance(node.ctx, ast.Store)]
-    if len(stores) != 1 or name in _names_in(body[i + 1:]) or to in _names_in(before):
+    if len(stores) != 1 or name in after or to in _names_in(before):
         return False
     renamer = _Rename({name: to})
     for k in range(i):
