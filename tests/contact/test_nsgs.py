@@ -69,8 +69,15 @@ def test_chain_with_friction_keeps_the_block_result(name):
     assert np.max(np.abs(res.r - r_exact)) <= 1e-8
 
 
+#: the random problems' draws. With friction a problem may have several solutions (Coulomb's
+#: law is not monotone): in one draw of 9000 (seeds 0-299), a fast-slipping contact with
+#: q_N > 0 admits both r = 0 and a loaded slip, each to a residual of 1e-16, and NSGS and
+#: Lemke found one each. Fixed draws keep the comparison exact and the test repeatable
+SEED = 20261129
+
+
 def test_nsgs_matches_lemke_on_random_problems():
-    rng = np.random.default_rng()
+    rng = np.random.default_rng(SEED)
     for _ in range(30):
         nc = int(rng.integers(1, 7))
         W, q, mu = random_problem(nc, rng)
@@ -85,7 +92,7 @@ def test_nsgs_matches_lemke_on_random_problems():
 
 
 def test_apgd_matches_lemke_on_random_problems():
-    rng = np.random.default_rng()
+    rng = np.random.default_rng(SEED)
     done = 0
     for _ in range(30):
         nc = int(rng.integers(1, 7))

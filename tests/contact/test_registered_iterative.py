@@ -49,7 +49,9 @@ def _natural_map(problem, p):
 
 @pytest.mark.parametrize("method", ["nsgs", "apgd"])
 def test_iterative_methods_match_lemke_through_solve(method):
-    rng = np.random.default_rng()
+    # fixed draws: with friction a random problem may have several solutions, one found by
+    # each method (tests/contact/test_nsgs.py, SEED)
+    rng = np.random.default_rng(20261129)
     done = 0
     for _ in range(12):
         nc = int(rng.integers(2, 6))
