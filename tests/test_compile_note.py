@@ -162,10 +162,28 @@ def test_has_cached_code_sees_numba_disk_cache(tmp_path):
     assert _jit_cache.has_cached_code(second.f)
 
 
-def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monkeypatch, caplog):
-    # passed to the shared loop as an argument, the LCP step compiles on its own: one note
+class _FakeChild:
+    returncode = 0
+
+    def poll(self):
+        return 0
+
+    def wait(self):
+        return 0
+
+
+@pytest.mark.parametrize("spare", [0, 1])
+def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monkeypatch, caplog,
+                                                               spare):
+    # passed to the shared loop as an argument, the LCP step compiles on its own: one note,
+    # in this process (one CPU) or in a child beside the loop's compile (a spare CPU)
     from moreau.integrators import _mj_kernels as mk
     monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    monkeypatch.setattr(_loops, "_spare_cpus", lambda: spare)
+    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
+    children = []
+    monkeypatch.setattr(_loops.subprocess, "Popen",
+                        lambda cmd, **kw: children.append(cmd) or _FakeChild())
     compiled = []
     monkeypatch.setattr(mk._lcp_step, "compile", lambda sig: compiled.append(sig))
     monkeypatch.setattr(mk._lcp_step, "overloads", {})     # as in a fresh process
@@ -178,7 +196,14 @@ def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monk
         run = _loops.runner_for(scene.compiled_model(), scene=scene)
         run(*args)
         run(*args)
-    assert [r.getMessage() for r in caplog.records] == [
-        SHARED_NOTE, "compiling the contact problem's LCP step (Lemke; first use on this "
-        "machine, about 5-20 s)..."]
+    lemke_note = ("compiling the contact problem's LCP step (Lemke; first use on this machine, "
+                  "about 5-20 s)...") if not spare else (
+        "compiling the contact problem's LCP step (Lemke) alongside, in another process...")
+    # with a child, its note comes first: it starts before the loop's compile
+    expected = [lemke_note, SHARED_NOTE] if spare else [SHARED_NOTE, lemke_note]
+    assert [r.getMessage() for r in caplog.records] == expected
+    # the parent takes the step itself: compiled here, or loaded from the child's cache entry
     assert compiled == [mk.LCP_STEP_SIGNATURE]
+    assert len(children) == spare
+    if spare:
+        assert children[0][-1] == "moreau.integrators._mj_kernels"

@@ -40,6 +40,7 @@ import importlib
 import inspect
 import logging
 import os
+import subprocess
 import sys
 import textwrap
 import threading
@@ -381,10 +382,20 @@ class SharedRunner:
             return own(*args)
         lean = self._lean_for(args, stub)
         core = self._cores.get(lean)
+        aside = None
         if core is None:
-            core = self._bind(args, lean)
+            if not stub and not self._kernels_ready:
+                aside = self._kernels_aside(args, lean)
+            try:
+                core = self._bind(args, lean)
+            except BaseException:
+                _end_aside(aside)
+                raise
         if not stub and not self._kernels_ready:
-            self._compile_kernels()
+            try:
+                self._compile_kernels(announce=aside is None)
+            finally:
+                _end_aside(aside)
         t0 = _SHARED_CLOCK()
         out = core(*(self._stub_prefix if stub else self._prefix), *args)
         self.seconds[stub] += _SHARED_CLOCK() - t0
@@ -394,15 +405,52 @@ class SharedRunner:
             self._specialise(stub, args)
         return out
 
-    def _compile_kernels(self):
+    def _kernels_aside(self, args, lean):
+        """Start compiling the kernels passed as arguments in a child process; it, or None.
+
+        A several-contact run's first call compiles the shared loop and then Lemke's step
+        (about 13 and 9 CPU s), one after the other: numba compiles under one lock per
+        process. Where the loop is to be compiled, the kernels are not compiled yet, numba's
+        disk cache is writable and a second CPU is free, a child process compiles the kernels
+        into the cache under the compile lock while this one compiles the loop;
+        :meth:`_compile_kernels` then waits on that lock and loads them. The same machine
+        code either way; without the child, the same compiles in this process.
+        """
+        core = shared_core(self._lean if lean else self.template,
+                           tuple(numba.typeof(a) for a in args))
+        if _spare_cpus() < 1 or _jit_cache.has_cached_code(core):
+            return None
+        module = sys.modules[self.template.__module__]
+        for name, spec in _indirect(self.template).items():
+            fn = getattr(module, name)
+            if spec[0].args in fn.overloads or _jit_cache.has_cached_code(fn) \
+                    or not _writable_cache(fn):
+                return None
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+        env = dict(os.environ, PYTHONPATH=os.pathsep.join(
+            [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+        try:
+            child = subprocess.Popen(
+                [sys.executable, "-c", "import sys\nfrom moreau.integrators._loops import "
+                 "compile_indirect\ncompile_indirect(sys.argv[1])", self.template.__module__],
+                stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                env=env)
+        except OSError:
+            return None
+        note(log, "compiling the contact problem's LCP step (Lemke) alongside, in another "
+             "process...")
+        return child
+
+    def _compile_kernels(self, announce=True):
         # the kernels passed as arguments compile on their own, at their first use; under
-        # the lock, so that a sweep's (or pytest's) workers compile Lemke once, not each
+        # the lock, so that a sweep's (or pytest's) workers compile Lemke once, not each.
+        # Not announced where a child compiles them (_kernels_aside said so)
         module = sys.modules[self.template.__module__]
         for name, spec in _indirect(self.template).items():
             fn = getattr(module, name)
             if spec[0].args not in fn.overloads:
                 with _compile_lock(fn):
-                    if not _jit_cache.has_cached_code(fn):
+                    if announce and not _jit_cache.has_cached_code(fn):
                         note(log, "compiling the contact problem's LCP step (Lemke; first "
                              "use on this machine, about %s s)...", COMPILE_SECONDS)
                     fn.compile(spec[0])
@@ -514,6 +562,50 @@ def runner_for(model, template=None, scene=None, specialise=None, stub=False, an
         if not _jit_cache.has_cached_code(chosen):
             _note_compile(template, scene, shared=False)
     return chosen
+
+
+def compile_indirect(module_name):
+    """Compile the kernels that ``module_name``'s shared loops take as arguments, into the cache.
+
+    What the child process of :meth:`SharedRunner._kernels_aside` runs: each
+    kernel under the compile lock, so that the parent, which takes the same
+    lock before it compiles them, waits and then loads them.
+    """
+    module = importlib.import_module(module_name)
+    for name, spec in getattr(module, "SHARED_INDIRECT", {}).items():
+        fn = getattr(module, name)
+        with _compile_lock(fn):
+            fn.compile(spec[0])
+
+
+def _spare_cpus():
+    """CPUs this process may run on, beyond one."""
+    try:
+        return len(os.sched_getaffinity(0)) - 1
+    except AttributeError:  # not on Linux
+        return (os.cpu_count() or 1) - 1
+
+
+def _writable_cache(fn):
+    """Whether ``fn`` has a disk cache in a folder this process may write."""
+    cache = getattr(fn, "_cache", None)
+    folder = getattr(cache, "_cache_path", None)
+    return getattr(cache, "_cache_file", None) is not None and folder is not None \
+        and os.access(folder, os.W_OK)
+
+
+def _end_aside(child):
+    """Reap the child of :meth:`SharedRunner._kernels_aside` (kill it if still running)."""
+    if child is None:
+        return
+    if child.poll() is None:
+        try:
+            # the parent holds the compile lock once the child has released it: a child
+            # still running here is one this call no longer waits for (an interrupt)
+            child.kill()
+        except OSError:
+            pass
+    child.wait()
 
 
 def _note_compile(template, scene, shared):
