@@ -1615,21 +1615,26 @@ def _ray_is_farkas(M, q, y, tol):
 
 
 @njit(cache=True)
-def _solve_packed(M, q, d, out, max_iter, tol, scale_d=True):
+def _solve_packed(M, q, out, max_iter, tol, covering):
     # one compiled call per Python solve. The outputs live in one buffer
-    # (z | w | ray) allocated by the caller: returning arrays from compiled
-    # code costs more than the whole pivoting on a small LCP.
+    # (z | w | ray | hand-over) allocated by the caller: returning arrays from
+    # compiled code costs more than the whole pivoting on a small LCP. With
+    # `covering`, the covering vector follows them (out[_OUT n + 4:], n floats)
+    # and is balanced with the data; without, it is ones, made here (one array
+    # argument less to type on every call from Python). One entry for both: as
+    # two, numba optimised and compiled Lemke's whole path into each (4 CPU s)
     n = q.shape[0]
-    if M.shape[0] != n or M.shape[1] != n or d.shape[0] != n or out.shape[0] < _OUT * n + 4:
+    if M.shape[0] != n or M.shape[1] != n or (out.shape[0] != _OUT * n + 4 + n if covering
+                                               else out.shape[0] < _OUT * n + 4):
         # the unchecked path must never read out of bounds
         return INVALID_INPUT, 0, np.inf
     # the tableau and the covering vector in one allocation, the integer work in another
     fbuf = np.empty(_fbuf_size(n))
     ibuf = np.empty(4 * n + 1, dtype=np.int64)
-    dd = fbuf[_fbuf_size(n) - n:]
+    d = fbuf[_fbuf_size(n) - n:]
     for i in range(n):
-        dd[i] = d[i]
-    return _solve_buffers(M, q, dd, out, fbuf, ibuf, max_iter, tol, scale_d, np.bool_(True))
+        d[i] = out[_OUT * n + 4 + i] if covering else 1.0
+    return _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, covering, np.bool_(True))
 
 
 @njit(cache=True, _nrt=False)
@@ -1792,24 +1797,6 @@ def _handoff_info(info, rexp, cexp, ka, kb, scale_d, plain):
     info[2 * n] = 0.0 if plain else float(ka)
     info[2 * n + 1] = 0.0 if plain else float(kb)
     info[2 * n + 2] = 1.0 if scale_d and not plain else 0.0
-
-
-@njit(cache=True)
-def _solve_packed_ones(M, q, out, max_iter, tol):
-    # covering vector of ones made here: one array argument less to type on
-    # every call from Python. np.bool_, not the literal False: numba would compile
-    # _solve_buffers a second time for the literal
-    n = q.shape[0]
-    if M.shape[0] != n or M.shape[1] != n or out.shape[0] < _OUT * n + 4:
-        # the unchecked path must never read out of bounds
-        return INVALID_INPUT, 0, np.inf
-    fbuf = np.empty(_fbuf_size(n))
-    ibuf = np.empty(4 * n + 1, dtype=np.int64)
-    d = fbuf[_fbuf_size(n) - n:]
-    for i in range(n):
-        d[i] = 1.0
-    return _solve_buffers(M, q, d, out, fbuf, ibuf, max_iter, tol, np.bool_(False),
-                          np.bool_(True))
 
 
 class _LemkeResult(LCPResult):
@@ -2096,18 +2083,18 @@ def solve(M, q, *, max_iter=None, tol=None, check_input=True, friction=None, cov
     return _solve(M, q, max_iter, tol, check_input, covering)
 
 
-def _solve_ones_first(M, q, out, max_iter, tol):
+def _solve_packed_first(M, q, out, max_iter, tol, covering):
     # the first call compiles the solver (or loads it from the disk cache) under the
     # compile lock: processes that reach it together (pytest's or a sweep's workers)
     # compile it once, the others load the machine code (15 CPU s each otherwise)
-    global _solve_ones
-    with _jit_cache.compile_lock(_solve_packed_ones):
-        result = _solve_packed_ones(M, q, out, max_iter, tol)
-    _solve_ones = _solve_packed_ones
+    global _solve_entry
+    with _jit_cache.compile_lock(_solve_packed):
+        result = _solve_packed(M, q, out, max_iter, tol, covering)
+    _solve_entry = _solve_packed
     return result
 
 
-_solve_ones = _solve_ones_first
+_solve_entry = _solve_packed_first
 
 
 def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
@@ -2132,19 +2119,20 @@ def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
             if covering.shape != q.shape:
                 raise InputError(f"`covering` must have length {q.shape[0]}, got {covering.shape[0]}")
     n = q.shape[0]
-    out = np.empty(_OUT * n + 4)
     if max_iter is None:
         max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
     if covering is None:
-        status, pivots, residual = _solve_ones(
-            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol,
+        out = np.empty(_OUT * n + 4)
+        status, pivots, residual = _solve_entry(
+            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol, False,
         )
     else:
-        # scale_d given, not left to its default: an omitted argument is typed as its own
-        # specialisation, a second compile of the whole solver (6 CPU s on a cold cache)
-        # where the covering-of-ones path already compiled it for a boolean
-        status, pivots, residual = _solve_packed(
-            M, q, covering, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
+        # the covering vector rides behind the outputs (_solve_packed), so that both
+        # calls have one signature: one compile of the whole solver
+        out = np.empty(_OUT * n + 4 + covering.shape[0])
+        out[_OUT * n + 4:] = covering
+        status, pivots, residual = _solve_entry(
+            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
         )
     if status == SOLVED:
         return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)

@@ -393,5 +393,5 @@ def test_fortran_ordered_and_strided_matrices_reuse_the_c_ordered_compile():
         res = solve_lcp(other, q)
         assert res.success and ref.success
         np.testing.assert_array_equal(res.z, ref.z)
-    layouts = {sig[0].layout for sig in lemke._solve_packed_ones.signatures}
+    layouts = {sig[0].layout for sig in lemke._solve_packed.signatures}
     assert layouts == {"C"}, layouts
