@@ -54,7 +54,7 @@ except ImportError:
     NullCache = None
 
 __all__ = ["sources_digest", "bind_cache_to_sources", "has_cached_code", "dependency_files",
-           "compile_lock"]
+           "compile_lock", "try_lock"]
 
 
 def sources_digest(paths):
@@ -173,6 +173,38 @@ def compile_lock(dispatcher):
     finally:
         if fh is not None:
             fh.close()
+
+
+def try_lock(dispatcher, purpose):
+    """An exclusive lock file next to ``dispatcher``'s disk cache, or None if another holds it.
+
+    Does not wait: the caller that gets None leaves to the holder what the
+    lock is for (``purpose`` names the file, beside :func:`compile_lock`'s).
+    Release it by closing the returned file. None too where there is no lock
+    to be had (no writable cache folder, no ``fcntl``).
+
+    Examples
+    --------
+    >>> from moreau.scenes.bouncing_ball import _mass
+    >>> first = try_lock(_mass, "example")
+    >>> second = try_lock(_mass, "example")      # held by the first (or no lock to be had)
+    >>> second is None
+    True
+    >>> if first is not None:
+    ...     first.close()
+    """
+    fh = None
+    try:
+        folder = dispatcher._cache._cache_path
+        name = dispatcher.py_func.__qualname__
+        os.makedirs(folder, exist_ok=True)
+        fh = open(os.path.join(folder, f"{name}.moreau-{purpose}"), "a")
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        return fh
+    except Exception:
+        if fh is not None:
+            fh.close()
+        return None
 
 
 def dependency_files(functions):

@@ -414,18 +414,23 @@ class SharedRunner:
         disk cache is writable and a second CPU is free, a child process compiles the kernels
         into the cache under the compile lock while this one compiles the loop;
         :meth:`_compile_kernels` then waits on that lock and loads them. The same machine
-        code either way; without the child, the same compiles in this process.
+        code either way; without the child, the same compiles in this process. One child
+        at a time for a cache (:func:`moreau._jit_cache.try_lock`): a sweep's workers that
+        start together do not each start one; the others wait on the compile lock.
         """
         core = shared_core(self._lean if lean else self.template,
                            tuple(numba.typeof(a) for a in args))
         if _spare_cpus() < 1 or _jit_cache.has_cached_code(core):
             return None
         module = sys.modules[self.template.__module__]
-        for name, spec in _indirect(self.template).items():
-            fn = getattr(module, name)
+        kernels = [getattr(module, name) for name in _indirect(self.template)]
+        for fn, spec in zip(kernels, _indirect(self.template).values()):
             if spec[0].args in fn.overloads or _jit_cache.has_cached_code(fn) \
                     or not _writable_cache(fn):
                 return None
+        held = _jit_cache.try_lock(kernels[0], "aside") if kernels else None
+        if held is None:
+            return None
         root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
@@ -436,9 +441,12 @@ class SharedRunner:
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
                 env=env)
         except OSError:
+            held.close()
             return None
         note(log, "compiling the contact problem's LCP step (Lemke) alongside, in another "
              "process...")
+        # the lock goes with the child, released when it is reaped (_end_aside)
+        child.moreau_aside_lock = held
         return child
 
     def _compile_kernels(self, announce=True):
@@ -598,14 +606,20 @@ def _end_aside(child):
     """Reap the child of :meth:`SharedRunner._kernels_aside` (kill it if still running)."""
     if child is None:
         return
-    if child.poll() is None:
-        try:
-            # the parent holds the compile lock once the child has released it: a child
-            # still running here is one this call no longer waits for (an interrupt)
-            child.kill()
-        except OSError:
-            pass
-    child.wait()
+    try:
+        if child.poll() is None:
+            try:
+                # the parent holds the compile lock once the child has released it: a
+                # child still running here is one this call no longer waits for (an
+                # interrupt)
+                child.kill()
+            except OSError:
+                pass
+        child.wait()
+    finally:
+        held = getattr(child, "moreau_aside_lock", None)
+        if held is not None:
+            held.close()
 
 
 def _note_compile(template, scene, shared):

@@ -80,16 +80,37 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
     monkeypatch.setattr(_loops, "_writable_cache", lambda fn: False)
     assert runner._kernels_aside(args, False) is None
+    # another process's child compiles them already (a sweep's workers starting together):
+    # this one waits on the compile lock instead of starting a second child
+    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
+    monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: None)
+    assert runner._kernels_aside(args, False) is None
     assert started == []
 
 
-def test_a_child_still_running_is_killed_and_reaped():
+def test_a_child_still_running_is_killed_and_reaped_and_its_lock_released(tmp_path):
     child = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(120)"])
+    child.moreau_aside_lock = held = open(tmp_path / "lock", "a")
     t0 = time.monotonic()
     _loops._end_aside(child)
     assert child.returncode is not None and child.returncode < 0
     assert time.monotonic() - t0 < 30
+    assert held.closed
     _loops._end_aside(None)     # no child: nothing to do
+
+
+def test_the_aside_lock_is_had_by_one_holder_at_a_time():
+    from moreau.integrators._contact_step import _lcp_step
+    first = _loops._jit_cache.try_lock(_lcp_step, "aside-probe")
+    if first is None:
+        pytest.skip("no writable cache folder or no fcntl: no lock to be had")
+    try:
+        assert _loops._jit_cache.try_lock(_lcp_step, "aside-probe") is None
+    finally:
+        first.close()
+    again = _loops._jit_cache.try_lock(_lcp_step, "aside-probe")
+    assert again is not None
+    again.close()
 
 
 FIRST_CALL = textwrap.dedent("""
