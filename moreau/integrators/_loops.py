@@ -420,7 +420,8 @@ class SharedRunner:
         """
         core = shared_core(self._lean if lean else self.template,
                            tuple(numba.typeof(a) for a in args))
-        if _spare_cpus() < 1 or _jit_cache.has_cached_code(core):
+        # an embedded interpreter may have no executable to start a child with
+        if _spare_cpus() < 1 or not sys.executable or _jit_cache.has_cached_code(core):
             return None
         module = sys.modules[self.template.__module__]
         kernels = [getattr(module, name) for name in _indirect(self.template)]

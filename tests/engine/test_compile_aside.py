@@ -68,6 +68,12 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     # one CPU: the child would only take turns with this process
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 0)
     assert runner._kernels_aside(args, False) is None
+    # an embedded interpreter without an executable to start a child with
+    monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
+    monkeypatch.setattr(_loops.sys, "executable", "")
+    assert runner._kernels_aside(args, False) is None
+    monkeypatch.undo()
+    monkeypatch.setattr(_loops.subprocess, "Popen", lambda *a, **k: started.append(a))
     # the loop is compiled or on disk: no compile to overlap
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: True)
