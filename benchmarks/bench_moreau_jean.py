@@ -15,11 +15,12 @@ scene at >= 10x Siconos's bouncing-ball rate.
 
 Every rate is a median over ``--repeats`` runs after a warm-up run. The shared
 loop's rate differs from one process to the next by up to a fifth, and stays
-put within one (it calls the model's functions through pointers, and where
-their machine code lands decides how well the processor predicts those
-calls; the specialised loop, which inlines them, does not vary): its rate is
-the median over ``--processes`` fresh processes, with the slowest and the
-fastest beside it, and its ratio to Siconos is taken from that median. A scene
+put within one: it follows the address at which the loop's machine code is
+loaded (loaded again elsewhere in the same process, the loop changes speed;
+new copies of the model's functions or of the data do not change it), and the
+specialised loop does not vary so. The shared loop's rate is the median over
+``--processes`` fresh processes, with the slowest and the fastest beside it,
+and its ratio to Siconos is taken from that median. A scene
 whose model holds only for a while from its start (the Painlevé rod falls
 flat, :data:`SPANS`) is run at a finer step, so that every timed run stays
 inside its valid region. Then
