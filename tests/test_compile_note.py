@@ -172,18 +172,21 @@ class _FakeChild:
         return 0
 
 
-@pytest.mark.parametrize("spare", [0, 1])
+@pytest.mark.parametrize("spare, child_ok", [(0, None), (1, True), (1, False)])
 def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monkeypatch, caplog,
-                                                               spare):
+                                                               spare, child_ok):
     # passed to the shared loop as an argument, the LCP step compiles on its own: one note,
-    # in this process (one CPU) or in a child beside the loop's compile (a spare CPU)
+    # in this process (one CPU) or in a child beside the loop's compile (a spare CPU); a
+    # child that left nothing on disk (it failed) is followed by the compile here, announced
     from moreau.integrators import _mj_kernels as mk
-    monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: False)
+    children = []
+    # nothing on disk, but the LCP step once a child has compiled it
+    monkeypatch.setattr(_jit_cache, "has_cached_code",
+                        lambda disp: disp is mk._lcp_step and bool(children) and child_ok)
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: spare)
     monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
     # no other process's child at work (one may run in another test worker)
     monkeypatch.setattr(_jit_cache, "try_lock", lambda disp, purpose: io.StringIO())
-    children = []
     monkeypatch.setattr(_loops.subprocess, "Popen",
                         lambda cmd, **kw: children.append(cmd) or _FakeChild())
     compiled = []
@@ -198,11 +201,12 @@ def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monk
         run = _loops.runner_for(scene.compiled_model(), scene=scene)
         run(*args)
         run(*args)
-    lemke_note = ("compiling the contact problem's LCP step (Lemke; first use on this machine, "
-                  "about 5-20 s)...") if not spare else (
-        "compiling the contact problem's LCP step (Lemke) alongside, in another process...")
+    here = ("compiling the contact problem's LCP step (Lemke; first use on this machine, "
+            "about 5-20 s)...")
+    aside = "compiling the contact problem's LCP step (Lemke) alongside, in another process..."
     # with a child, its note comes first: it starts before the loop's compile
-    expected = [lemke_note, SHARED_NOTE] if spare else [SHARED_NOTE, lemke_note]
+    expected = {None: [SHARED_NOTE, here], True: [aside, SHARED_NOTE],
+                False: [aside, SHARED_NOTE, here]}[child_ok]
     assert [r.getMessage() for r in caplog.records] == expected
     # the parent takes the step itself: compiled here, or loaded from the child's cache entry
     assert compiled == [mk.LCP_STEP_SIGNATURE]

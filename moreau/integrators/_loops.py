@@ -393,7 +393,7 @@ class SharedRunner:
                 raise
         if not stub and not self._kernels_ready:
             try:
-                self._compile_kernels(announce=aside is None)
+                self._compile_kernels()
             finally:
                 _end_aside(aside)
         t0 = _SHARED_CLOCK()
@@ -450,16 +450,17 @@ class SharedRunner:
         child.moreau_aside_lock = held
         return child
 
-    def _compile_kernels(self, announce=True):
+    def _compile_kernels(self):
         # the kernels passed as arguments compile on their own, at their first use; under
         # the lock, so that a sweep's (or pytest's) workers compile Lemke once, not each.
-        # Not announced where a child compiles them (_kernels_aside said so)
+        # After a child of _kernels_aside they are on disk; if not (the child failed),
+        # they compile here, and say so
         module = sys.modules[self.template.__module__]
         for name, spec in _indirect(self.template).items():
             fn = getattr(module, name)
             if spec[0].args not in fn.overloads:
                 with _compile_lock(fn):
-                    if announce and not _jit_cache.has_cached_code(fn):
+                    if not _jit_cache.has_cached_code(fn):
                         note(log, "compiling the contact problem's LCP step (Lemke; first "
                              "use on this machine, about %s s)...", COMPILE_SECONDS)
                     fn.compile(spec[0])
