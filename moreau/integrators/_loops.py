@@ -435,6 +435,9 @@ class SharedRunner:
         root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
         env = dict(os.environ, PYTHONPATH=os.pathsep.join(
             [root] + [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]))
+        if getattr(numba.config, "CACHE_DIR", ""):
+            # the cache folder this process uses, also where it was set in code
+            env["NUMBA_CACHE_DIR"] = numba.config.CACHE_DIR
         try:
             child = subprocess.Popen(
                 [sys.executable, "-c", "import sys\nfrom moreau.integrators._loops import "
