@@ -11,6 +11,7 @@ first call through the child gives the arrays of a run in this process.
 """
 
 import inspect
+import io
 import json
 import os
 import subprocess
@@ -92,6 +93,25 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: None)
     assert runner._kernels_aside(args, False) is None
     assert started == []
+    # and with all of them as they should be, one child, holding the lock
+    lock = io.StringIO()
+    monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: lock)
+    child = _FakeChild()
+    monkeypatch.setattr(_loops.subprocess, "Popen",
+                        lambda cmd, **kw: started.append(cmd) or child)
+    assert runner._kernels_aside(args, False) is child
+    assert started[0][-1] == "moreau.integrators._mj_kernels"
+    assert child.moreau_aside_lock is lock
+    _loops._end_aside(child)
+    assert lock.closed
+
+
+class _FakeChild:
+    def poll(self):
+        return 0
+
+    def wait(self):
+        return 0
 
 
 def test_a_child_still_running_is_killed_and_reaped_and_its_lock_released(tmp_path):
