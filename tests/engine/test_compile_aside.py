@@ -59,6 +59,7 @@ def test_the_child_s_entry_leaves_machine_code_the_parent_loads(tmp_path, monkey
 
 
 def test_no_child_where_it_cannot_help(monkeypatch):
+    from moreau.integrators._contact_step import LCP_STEP_SIGNATURE, _lcp_step
     scene = make_scene("bidirectional-drive")
     runner = _loops.SharedRunner(scene.compiled_model(), _loops._mj_kernels.mj_loop)
     started = []
@@ -66,34 +67,42 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     names = list(inspect.signature(_loops._mj_kernels.mj_loop).parameters)
     args = [0.0] * len(names)
     args[names.index("lcp_ctl")] = _loops._mj_kernels.new_lcp_control(2)
+    # as in a fresh process, whatever the tests before compiled here; each case below
+    # departs from the favourable state in one condition only
+    monkeypatch.setattr(_lcp_step, "overloads", {})
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
+    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
+    monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
     # one CPU: the child would only take turns with this process
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 0)
     assert runner._kernels_aside(args, False) is None
-    # an embedded interpreter without an executable to start a child with
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
+    # an embedded interpreter without an executable to start a child with
+    executable = sys.executable
     monkeypatch.setattr(_loops.sys, "executable", "")
     assert runner._kernels_aside(args, False) is None
-    monkeypatch.undo()
-    monkeypatch.setattr(_loops.subprocess, "Popen", lambda *a, **k: started.append(a))
+    monkeypatch.setattr(_loops.sys, "executable", executable)
     # the loop is compiled or on disk: no compile to overlap
-    monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: True)
     assert runner._kernels_aside(args, False) is None
-    # the kernel is compiled in this process already
-    monkeypatch.setattr(_loops._jit_cache, "has_cached_code",
-                        lambda disp: disp is _loops._mj_kernels._lcp_step)
+    # the kernel is on disk
+    monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: disp is _lcp_step)
     assert runner._kernels_aside(args, False) is None
-    # no cache folder that the child could write to
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
+    # the kernel is compiled in this process already
+    monkeypatch.setattr(_lcp_step, "overloads", {LCP_STEP_SIGNATURE.args: None})
+    assert runner._kernels_aside(args, False) is None
+    monkeypatch.setattr(_lcp_step, "overloads", {})
+    # no cache folder that the child could write to
     monkeypatch.setattr(_loops, "_writable_cache", lambda fn: False)
     assert runner._kernels_aside(args, False) is None
+    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
     # another process's child compiles them already (a sweep's workers starting together):
     # this one waits on the compile lock instead of starting a second child
-    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
     monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: None)
     assert runner._kernels_aside(args, False) is None
     assert started == []
-    # and with all of them as they should be, one child, holding the lock
+    # and with every condition as it should be, one child, holding the lock
     lock = io.StringIO()
     monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: lock)
     child = _FakeChild()
