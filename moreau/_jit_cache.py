@@ -156,23 +156,31 @@ def compile_lock(dispatcher):
     --------
     See the module's docstring.
     """
-    fh = None
-    try:
-        folder = dispatcher._cache._cache_path
-        name = dispatcher.py_func.__qualname__
-        fh = open(os.path.join(folder, f"{name}.moreau-lock"), "a")
-        fcntl.flock(fh, fcntl.LOCK_EX)
-    except Exception:
-        # no lock to be had (read-only install, no fcntl, other numba internals,
-        # a function without a disk cache): compiling twice is slower, never wrong
-        if fh is not None:
-            fh.close()
-        fh = None
+    # no lock to be had (read-only install, no fcntl, other numba internals, a function
+    # without a disk cache): compiling twice is slower, never wrong
+    fh = _locked(dispatcher, "lock", fcntl.LOCK_EX if fcntl is not None else 0)
     try:
         yield
     finally:
         if fh is not None:
             fh.close()
+
+
+def _locked(dispatcher, purpose, mode):
+    """The lock file ``<function>.moreau-<purpose>`` beside ``dispatcher``'s disk cache, opened
+    and locked with ``fcntl.flock(mode)``; None where that fails (or would block, with
+    ``LOCK_NB``)."""
+    fh = None
+    try:
+        folder = dispatcher._cache._cache_path
+        name = dispatcher.py_func.__qualname__
+        fh = open(os.path.join(folder, f"{name}.moreau-{purpose}"), "a")
+        fcntl.flock(fh, mode)
+        return fh
+    except Exception:
+        if fh is not None:
+            fh.close()
+        return None
 
 
 def try_lock(dispatcher, purpose):
@@ -193,18 +201,8 @@ def try_lock(dispatcher, purpose):
     >>> if first is not None:
     ...     first.close()
     """
-    fh = None
-    try:
-        folder = dispatcher._cache._cache_path
-        name = dispatcher.py_func.__qualname__
-        os.makedirs(folder, exist_ok=True)
-        fh = open(os.path.join(folder, f"{name}.moreau-{purpose}"), "a")
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        return fh
-    except Exception:
-        if fh is not None:
-            fh.close()
-        return None
+    return _locked(dispatcher, purpose,
+                   fcntl.LOCK_EX | fcntl.LOCK_NB if fcntl is not None else 0)
 
 
 def dependency_files(functions):

@@ -184,7 +184,6 @@ def test_the_lcp_step_of_a_two_contact_scene_is_announced_once(fresh_loops, monk
     monkeypatch.setattr(_jit_cache, "has_cached_code",
                         lambda disp: disp is mk._lcp_step and bool(children) and child_ok)
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: spare)
-    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
     # no other process's child at work (one may run in another test worker)
     monkeypatch.setattr(_jit_cache, "try_lock", lambda disp, purpose: io.StringIO())
     monkeypatch.setattr(_loops.subprocess, "Popen",

@@ -426,9 +426,9 @@ class SharedRunner:
         module = sys.modules[self.template.__module__]
         kernels = [getattr(module, name) for name in _indirect(self.template)]
         for fn, spec in zip(kernels, _indirect(self.template).values()):
-            if spec[0].args in fn.overloads or _jit_cache.has_cached_code(fn) \
-                    or not _writable_cache(fn):
+            if spec[0].args in fn.overloads or _jit_cache.has_cached_code(fn):
                 return None
+        # None also where the cache folder cannot be written: the child would write nothing
         held = _jit_cache.try_lock(kernels[0], "aside") if kernels else None
         if held is None:
             return None
@@ -597,14 +597,6 @@ def _spare_cpus():
         return len(os.sched_getaffinity(0)) - 1
     except AttributeError:  # not on Linux
         return (os.cpu_count() or 1) - 1
-
-
-def _writable_cache(fn):
-    """Whether ``fn`` has a disk cache in a folder this process may write."""
-    cache = getattr(fn, "_cache", None)
-    folder = getattr(cache, "_cache_path", None)
-    return getattr(cache, "_cache_file", None) is not None and folder is not None \
-        and os.access(folder, os.W_OK)
 
 
 def _end_aside(child):

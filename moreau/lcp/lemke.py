@@ -2121,19 +2121,15 @@ def _solve(M, q, max_iter, tol, check_input, covering, defer=False):
     n = q.shape[0]
     if max_iter is None:
         max_iter = _MAX_ITER_TABLE[n] if n < 512 else default_max_iter(n)
+    # a covering vector rides behind the outputs (_solve_packed): one signature, one compile
     if covering is None:
         out = np.empty(_OUT * n + 4)
-        status, pivots, residual = _solve_entry(
-            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol, False,
-        )
     else:
-        # the covering vector rides behind the outputs (_solve_packed), so that both
-        # calls have one signature: one compile of the whole solver
         out = np.empty(_OUT * n + 4 + covering.shape[0])
         out[_OUT * n + 4:] = covering
-        status, pivots, residual = _solve_entry(
-            M, q, out, max_iter, DEFAULT_TOL if tol is None else tol, True,
-        )
+    status, pivots, residual = _solve_entry(
+        M, q, out, max_iter, DEFAULT_TOL if tol is None else tol, covering is not None,
+    )
     if status == SOLVED:
         return _LemkeResult(out[:n], out[n:2 * n], status, pivots, residual)
     if status == INVALID_INPUT:

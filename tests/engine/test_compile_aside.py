@@ -71,7 +71,6 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     # departs from the favourable state in one condition only
     monkeypatch.setattr(_lcp_step, "overloads", {})
     monkeypatch.setattr(_loops._jit_cache, "has_cached_code", lambda disp: False)
-    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 1)
     # one CPU: the child would only take turns with this process
     monkeypatch.setattr(_loops, "_spare_cpus", lambda: 0)
@@ -93,10 +92,12 @@ def test_no_child_where_it_cannot_help(monkeypatch):
     monkeypatch.setattr(_lcp_step, "overloads", {LCP_STEP_SIGNATURE.args: None})
     assert runner._kernels_aside(args, False) is None
     monkeypatch.setattr(_lcp_step, "overloads", {})
-    # no cache folder that the child could write to
-    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: False)
+    # no cache folder that the child could write to (numba's cache turned off): no lock
+    from numba.core.caching import NullCache
+    cache = _lcp_step._cache
+    monkeypatch.setattr(_lcp_step, "_cache", NullCache())
     assert runner._kernels_aside(args, False) is None
-    monkeypatch.setattr(_loops, "_writable_cache", lambda fn: True)
+    monkeypatch.setattr(_lcp_step, "_cache", cache)
     # another process's child compiles them already (a sweep's workers starting together):
     # this one waits on the compile lock instead of starting a second child
     monkeypatch.setattr(_loops._jit_cache, "try_lock", lambda disp, purpose: None)
