@@ -27,6 +27,7 @@ import math
 import numpy as np
 from numba import njit
 from numba.core import types as _nbt
+from numba.extending import intrinsic
 
 from .. import _jit_cache
 from ..contact import _one_contact as _one_contact_module
@@ -255,10 +256,35 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
     return res
 
 
+@intrinsic
+def borrowed(typingctx, arr):
+    """A view of the array ``arr`` that does not own its data (no memory-info pointer).
+
+    For arguments of a function inlined into a loop at numba's IR level
+    (:func:`_regime_solve`): numba takes a reference to each argument for the
+    callee's name and drops it at the end, an atomic increment and decrement
+    per array and call, which LLVM's pruning cannot pair across the callee's
+    loops. On a view without memory info both are a test of a null pointer.
+    The view must not outlive ``arr`` (the caller's buffers, alive for the
+    whole loop) and must not be returned to Python.
+    """
+    if not isinstance(arr, _nbt.Array):
+        return None
+
+    def codegen(context, builder, sig, args):
+        view = context.make_array(arr)(context, builder, value=args[0])
+        view.meminfo = context.get_constant_null(_nbt.MemInfoPointer(arr.dtype))
+        return view._getvalue()
+    return arr(arr), codegen
+
+
 # inlined into the loop (numba IR), unlike the other helpers: it runs on nearly every
 # step of a two-contact scene, and as a call with fifteen array arguments it cost the
 # bidirectional drive a fifth of its speed (2.1e6 -> 2.6e6 steps/s inlined, sliding box
-# 2.7e6 -> 3.7e6, same process); the loops that include it are compiled once each now
+# 2.7e6 -> 3.7e6, same process); the loops that include it are compiled once each now.
+# Its callers pass its arrays as borrowed() views: inlined, each argument's reference
+# count was an atomic increment and decrement per step that LLVM did not prune (a
+# quarter of the shared loop's time in the bidirectional drive)
 @njit(cache=True, inline="always")
 def _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, A, x, uidx, vel, pcol):
     """Solve the active contacts' problem in the regimes of the step before; the violation, or inf.

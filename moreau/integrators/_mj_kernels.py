@@ -55,7 +55,7 @@ from ..lcp.lemke import DEFAULT_TOL, eliminate
 from ._contact_step import (  # noqa: F401
     CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, LCP_STEP_SIGNATURE, NUMERICAL, OK, PAINLEVE,
     S_DIRECT, S_FALLBACKS, S_LCP, S_PEN, S_PIVOTS, S_PROJ, S_RES, S_WARM, SHARED_INDIRECT,
-    SINGULAR, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
+    SINGULAR, borrowed, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
     _lcp_step_unused, _one_contact, _one_contact_fr, _regime_solve, _residual, _residual_parts,
     _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
     new_stats, prev_regimes, set_painleve_stop)
@@ -227,8 +227,11 @@ def several_contacts(lcp_step, na, nfa, ia, mu, e, vN0, reg, Wd, Uf, p, pN, pT, 
     # the regimes of the step before (known from the second step of a call on)
     regimes = warm_on and k > k0
     if regimes:
-        res = _regime_solve(Wd, Uf, na, ia, trow, mu, reg, p, pN, pT, Ab, xb, idx, rvel,
-                            pcol)
+        # borrowed views: no reference counting per step (see _contact_step.borrowed)
+        res = _regime_solve(borrowed(Wd), borrowed(Uf), na, borrowed(ia), borrowed(trow),
+                            borrowed(mu), borrowed(reg), borrowed(p), borrowed(pN), borrowed(pT),
+                            borrowed(Ab), borrowed(xb), borrowed(idx), borrowed(rvel),
+                            borrowed(pcol))
     if 0.0 <= res <= DEFAULT_TOL:
         stats[S_LCP] += 1.0
         stats[S_WARM] += 1.0
