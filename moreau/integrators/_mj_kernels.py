@@ -55,10 +55,10 @@ from ..lcp.lemke import DEFAULT_TOL, eliminate
 from ._contact_step import (  # noqa: F401
     CTL_FORCE, CTL_IA, CTL_WARM, LCP_HANDBACK, LCP_STEP_SIGNATURE, NUMERICAL, OK, PAINLEVE,
     S_DIRECT, S_FALLBACKS, S_LCP, S_PEN, S_PIVOTS, S_PROJ, S_RES, S_WARM, SHARED_INDIRECT,
-    SINGULAR, borrowed, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
+    SINGULAR, SLIP_RTOL, SPECIALISED, STAT_NAMES, _classify, _jam, _lcp_size, _lcp_step,
     _lcp_step_unused, _one_contact, _one_contact_fr, _regime_solve, _residual, _residual_parts,
-    _residual_parts_fr, _slip_sign, _stop_at, lcp_buffers, lcp_needed, new_lcp_control,
-    new_stats, prev_regimes, set_painleve_stop)
+    _residual_parts_fr, _slip_sign, _stop_at, borrowed, lcp_buffers, lcp_needed,
+    new_lcp_control, new_stats, prev_regimes, set_painleve_stop)
 from . import _contact_step, _driver, _step_parts
 from ._driver import grid_step, loop_template, record_sample, spliced  # noqa: F401
 from ._step_parts import (COND_MAX, _invert_gj, _invert_small, add_impulse, all_finite,  # noqa: F401

@@ -16,7 +16,7 @@ from numba import njit
 
 from ._mj_kernels import (LCP_HANDBACK, NUMERICAL, OK, PAINLEVE, S_DIRECT, S_LCP,  # noqa: F401
                           S_PIVOTS, S_PROJ, S_RES, SINGULAR, _lcp_size, _lcp_step, _one_contact,
-                          _residual, _stop_at, grid_step, lcp_buffers, record_sample)
+                          _residual, _stop_at, borrowed, grid_step, lcp_buffers, record_sample)
 from ._driver import loop_template, spliced
 # read by moreau.integrators._loops
 from ._mj_kernels import SHARED_INDIRECT, _lcp_step_unused  # noqa: F401
@@ -27,7 +27,9 @@ __all__ = ["tdg_loop"]
 
 
 # inlined: a call would pass (and reference-count) its thirty arrays on every
-# solve, which cost about 1 us a call, 50 times the solve of one contact. Its loops are
+# solve, which cost about 1 us a call, 50 times the solve of one contact. Inlined, it
+# still took a reference on each per call (atomic, not pruned by LLVM): its callers pass
+# borrowed() views. Its loops are
 # written out: the parts of _step_parts inlined by numba inside it made a step of the
 # bouncing ball about 7 % slower
 @njit(inline="always")
@@ -172,8 +174,12 @@ def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, D
         ea[r] = e[ia[r]]
         ez[r] = vN0[ia[r]]
     times_ht(Mi0, H, Dirs[0], m, n)
-    st = _stage_problem(H, w, Dirs[0], v0, ea, ez, n, na, nfa, ia, mu, force_lemke, p,
-                        sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step)
+    # borrowed views: no reference counting per stage (see _contact_step.borrowed)
+    st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs[0]), borrowed(v0), borrowed(ea),
+                        borrowed(ez), n, na, nfa, borrowed(ia), borrowed(mu), force_lemke,
+                        borrowed(p), borrowed(sN), borrowed(sT), borrowed(U), borrowed(Wd),
+                        borrowed(Uf), borrowed(base), borrowed(trow), borrowed(lw),
+                        borrowed(lcp_ctl), borrowed(stats), lcp_step)
     if st != OK:
         return st
     for c in range(m):
@@ -307,9 +313,12 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             gather_rows(Gi, ia, fa, na, nfa, n, H, w)
             # the force of stage st_i - 1 is fixed by the constraint at stage st_i
             kc = hk * (b_st[st_i - 1] if fin else a_st[st_i, st_i - 1])
-            st = _stage_problem(H, w, Dirs[st_i - 1], vi, ea, ez, n, na, nfa, ia, mu,
-                                force_lemke, p, sN, sT, U, Wd, Uf, base, trow, lw, lcp_ctl,
-                                stats, lcp_step)
+            st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs[st_i - 1]), borrowed(vi),
+                                borrowed(ea), borrowed(ez), n, na, nfa, borrowed(ia),
+                                borrowed(mu), force_lemke, borrowed(p), borrowed(sN),
+                                borrowed(sT), borrowed(U), borrowed(Wd), borrowed(Uf),
+                                borrowed(base), borrowed(trow), borrowed(lw),
+                                borrowed(lcp_ctl), borrowed(stats), lcp_step)
             if st != OK:
                 return st
             for c in range(m):

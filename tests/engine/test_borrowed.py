@@ -65,3 +65,18 @@ def test_an_inlined_helper_on_borrowed_views_takes_fewer_references():
     # the loop function's own arguments, both have)
     owned, viewed = _refcount_calls(_owned), _refcount_calls(_viewed)
     assert viewed[0] < owned[0] and viewed[1] < owned[1], (owned, viewed)
+
+
+@njit
+def _write_through_tuple(group):
+    a, (b, c) = borrowed(group)
+    a[0] = 1.0
+    b[0] = 2.0
+    c[0] = 3
+    return a.shape[0] + b.shape[0] + c.shape[0]
+
+
+def test_a_tuple_of_arrays_gives_the_tuple_of_their_views():
+    a, b, c = np.zeros(2), np.zeros(3), np.zeros(4, dtype=np.int64)
+    assert _write_through_tuple((a, (b, c))) == 9
+    assert (a[0], b[0], c[0]) == (1.0, 2.0, 3)
