@@ -262,13 +262,14 @@ def borrowed(typingctx, arr):
 
     A tuple of arrays (and of such tuples) gives the tuple of their views.
 
-    For arguments of a function inlined into a loop at numba's IR level
-    (:func:`_regime_solve`): numba takes a reference to each argument for the
-    callee's name and drops it at the end, an atomic increment and decrement
-    per array and call, which LLVM's pruning cannot pair across the callee's
-    loops. On a view without memory info both are a test of a null pointer.
-    The view must not outlive ``arr`` (the caller's buffers, alive for the
-    whole loop) and must not be returned to Python.
+    For the arrays a compiled function hands to a function inlined at
+    numba's IR level (:func:`_regime_solve`, :func:`_lcp_step_body`): numba
+    takes a reference on each for the callee's names and drops it at each of
+    its exits, an atomic increment and decrement per array and call, which
+    LLVM's pruning does not pair across the callee's loops and branches. On a
+    view without memory info both are a test of a null pointer. The view must
+    not outlive ``arr`` (the caller's buffers, or its own arguments) and must
+    not be returned to Python.
     """
     if not _borrowable(arr):
         return None
@@ -424,9 +425,9 @@ def _lcp_step(Wd, Uf, na, ia, mu, p, pN, pT, L, base, trow, Ml, ql, dl, zl, wl, 
     """Assemble the friction LCP of the active contacts and solve it: :func:`_lcp_step_body`.
 
     Its arrays as :func:`borrowed` views: a reference taken on each of the
-    twenty-four and dropped at the end, through Lemke's branches, was forty
-    and more atomic operations per call that LLVM did not prune (a quarter of
-    the time of the schemes that solve an LCP at every step).
+    twenty-three and dropped at each exit, through Lemke's branches, was
+    dozens of atomic operations per call that LLVM did not prune (a fifth to
+    a third of the time of the schemes that solve an LCP at every step).
     """
     return _lcp_step_body(
         borrowed(Wd), borrowed(Uf), na, borrowed(ia), borrowed(mu), borrowed(p), borrowed(pN),

@@ -28,10 +28,10 @@ __all__ = ["tdg_loop"]
 
 # inlined: a call would pass (and reference-count) its thirty arrays on every
 # solve, which cost about 1 us a call, 50 times the solve of one contact. Inlined, it
-# still took a reference on each per call (atomic, not pruned by LLVM): its callers pass
-# borrowed() views. Its loops are
-# written out: the parts of _step_parts inlined by numba inside it made a step of the
-# bouncing ball about 7 % slower
+# still took an atomic reference on each, which LLVM did not prune: its callers pass
+# borrowed() views (see _contact_step.borrowed). Its loops are written out: the parts
+# of _step_parts inlined by numba inside it made a step of the bouncing ball about 7 %
+# slower
 @njit(inline="always")
 def _stage_problem(Hm, wm, Dir, vfree, e, vpre, n, na, nfa, ia, mu, force_lemke, p, pN, pT,
                    U, Wd, Uf, base, trow, lw, lcp_ctl, stats, lcp_step):
@@ -175,7 +175,7 @@ def impulse_at_start(G0, ia, fa, na, nfa, m, n, e, mu, vN0, ea, ez, Mi0, H, w, D
         ez[r] = vN0[ia[r]]
     times_ht(Mi0, H, Dirs[0], m, n)
     # borrowed views: no reference counting per stage (see _contact_step.borrowed)
-    st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs[0]), borrowed(v0), borrowed(ea),
+    st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs)[0], borrowed(v0), borrowed(ea),
                         borrowed(ez), n, na, nfa, borrowed(ia), borrowed(mu), force_lemke,
                         borrowed(p), borrowed(sN), borrowed(sT), borrowed(U), borrowed(Wd),
                         borrowed(Uf), borrowed(base), borrowed(trow), borrowed(lw),
@@ -313,7 +313,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
             gather_rows(Gi, ia, fa, na, nfa, n, H, w)
             # the force of stage st_i - 1 is fixed by the constraint at stage st_i
             kc = hk * (b_st[st_i - 1] if fin else a_st[st_i, st_i - 1])
-            st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs[st_i - 1]), borrowed(vi),
+            st = _stage_problem(borrowed(H), borrowed(w), borrowed(Dirs)[st_i - 1], borrowed(vi),
                                 borrowed(ea), borrowed(ez), n, na, nfa, borrowed(ia),
                                 borrowed(mu), force_lemke, borrowed(p), borrowed(sN),
                                 borrowed(sT), borrowed(U), borrowed(Wd), borrowed(Uf),
