@@ -260,7 +260,8 @@ def _warm_solve(Ml, qv, L, memo, off, A, x, idx, zl, wl, mmax, qmax, na, base, t
 def borrowed(typingctx, arr):
     """A view of the array ``arr`` that does not own its data (no memory-info pointer).
 
-    A tuple of arrays (and of such tuples) gives the tuple of their views.
+    A tuple of arrays (and of such tuples) gives the tuple of their views; a
+    number or a boolean is passed through.
 
     For the arrays a compiled function hands to a function inlined at
     numba's IR level (:func:`_regime_solve`, :func:`_lcp_step_body`): numba
@@ -273,15 +274,17 @@ def borrowed(typingctx, arr):
     """
     if not _borrowable(arr):
         return None
+    ty = _nbt.unliteral(arr)
 
     def codegen(context, builder, sig, args):
-        return _borrow_value(context, builder, arr, args[0])
-    return arr(arr), codegen
+        return _borrow_value(context, builder, ty, args[0])
+    return ty(arr), codegen
 
 
 def _borrowable(ty):
-    # an array, or a tuple of arrays and such tuples (a loop's buffer groups)
-    if isinstance(ty, _nbt.Array):
+    # an array, a number or a boolean (passed through: a model function's time and
+    # flags), or a tuple of them (a loop's buffer groups)
+    if isinstance(ty, (_nbt.Array, _nbt.Number, _nbt.Boolean)):
         return True
     return isinstance(ty, _nbt.BaseTuple) and all(_borrowable(t) for t in ty.types)
 
@@ -291,6 +294,8 @@ def _borrow_value(context, builder, ty, value):
         view = context.make_array(ty)(context, builder, value=value)
         view.meminfo = context.get_constant_null(_nbt.MemInfoPointer(ty.dtype))
         return view._getvalue()
+    if not isinstance(ty, _nbt.BaseTuple):
+        return value
     for k, t in enumerate(ty.types):
         value = builder.insert_value(
             value, _borrow_value(context, builder, t, builder.extract_value(value, k)), k)

@@ -52,7 +52,7 @@ import numpy as np
 from numba import njit
 from numba.extending import overload
 
-from ._contact_step import CTL_IA, OK
+from ._contact_step import CTL_IA, OK, borrowed
 
 __all__ = ["drive", "grid_step", "record_sample", "gap_of", "loop_template", "spliced",
            "STEP_FUNCTIONS"]
@@ -315,7 +315,7 @@ def loop_template(name, namespace):
 
 def _splice_template(name, namespace):
     # loop_template's work, done at the template's first use
-    for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample"):
+    for own in ("np", "OK", "CTL_IA", "grid_step", "record_sample", "borrowed"):
         namespace.setdefault(own, globals()[own])
     tree = ast.parse(_source(drive))
     fdef = tree.body[0]
@@ -346,6 +346,7 @@ def _splice_template(name, namespace):
     loop.body[at:at + 1] = _one_exit(per_step)
     fdef.body[loop_at:loop_at] = binds + setup
     _spliced_workspace(fdef.body, splicer)
+    _borrow_model_arguments(fdef)
     ast.fix_missing_locations(tree)
     source = ast.unparse(tree)
     code = compile(source, drive.__code__.co_filename, "exec")
@@ -358,6 +359,30 @@ def _splice_template(name, namespace):
     fn.__moreau_source__ = source
     fn.__moreau_sources__ = tuple(sorted(splicer.files))
     return fn
+
+
+#: the model's functions as a loop template names them (the shared loop's arguments)
+MODEL_FUNCTIONS = ("mass_fn", "forces_fn", "contacts_fn", "gaps_fn")
+
+
+def _borrow_model_arguments(fdef):
+    """Every call of a model's function in ``fdef`` takes its named arguments as borrowed views.
+
+    A model function with a branch (``if need_gap:``) kept numba's reference
+    counts on its array arguments, which LLVM did not prune: atomic operations
+    on every call, inlined into the model's own loop or called through a
+    pointer by the shared one (the bouncing ball's step spent most of its time
+    in them). On a view without memory info
+    (:func:`moreau.integrators._contact_step.borrowed`) each is a test of a
+    null pointer; numbers and booleans pass through, and constants are left as
+    they are. The loop owns the arrays for the whole call.
+    """
+    for node in ast.walk(fdef):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                and node.func.id in MODEL_FUNCTIONS:
+            node.args = [ast.Call(func=ast.Name(id="borrowed", ctx=ast.Load()), args=[a],
+                                  keywords=[]) if isinstance(a, (ast.Name, ast.Subscript)) else a
+                         for a in node.args]
 
 
 #: the helpers :func:`loop_template` splices in where a step rule calls them (their Python

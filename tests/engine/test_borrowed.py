@@ -80,3 +80,29 @@ def test_a_tuple_of_arrays_gives_the_tuple_of_their_views():
     a, b, c = np.zeros(2), np.zeros(3), np.zeros(4, dtype=np.int64)
     assert _write_through_tuple((a, (b, c))) == 9
     assert (a[0], b[0], c[0]) == (1.0, 2.0, 3)
+
+
+def test_every_model_call_of_every_driver_loop_takes_borrowed_arguments():
+    # a model function with a branch keeps numba's counts on its arrays: each call of one
+    # in a loop's source passes its named arguments through borrowed()
+    import ast
+    import importlib
+
+    from moreau.integrators._driver import MODEL_FUNCTIONS
+    checked = 0
+    for module, name in (("_mj_kernels", "mj_loop"), ("_sp_kernels", "sp_loop"),
+                         ("_nsga_kernels", "nsga_loop"), ("_tdg_kernels", "tdg_loop"),
+                         ("_studer_kernels", "studer_loop"),
+                         ("moreau_jean_projected", "mjp_loop")):
+        mod = importlib.import_module(f"moreau.integrators.{module}")
+        tree = ast.parse(getattr(mod, name).__moreau_source__)
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
+                    and node.func.id in MODEL_FUNCTIONS:
+                checked += 1
+                for arg in node.args:
+                    if isinstance(arg, (ast.Name, ast.Subscript)):
+                        raise AssertionError(f"{name}: {ast.unparse(node)}")
+                    if isinstance(arg, ast.Call):
+                        assert arg.func.id == "borrowed", ast.unparse(node)
+    assert checked >= 20
