@@ -264,7 +264,8 @@ def borrowed(typingctx, arr):
     number or a boolean is passed through.
 
     For the arrays a compiled function hands to a function inlined at
-    numba's IR level (:func:`_regime_solve`, :func:`_lcp_step_body`): numba
+    numba's IR level (:func:`_regime_solve`, :func:`_lcp_step_body`), or to a
+    model's function (``moreau.integrators._driver._borrow_model_arguments``): numba
     takes a reference on each for the callee's names and drops it at each of
     its exits, an atomic increment and decrement per array and call, which
     LLVM's pruning does not pair across the callee's loops and branches. On a
