@@ -366,7 +366,7 @@ MODEL_FUNCTIONS = ("mass_fn", "forces_fn", "contacts_fn", "gaps_fn")
 
 
 def _borrow_model_arguments(fdef):
-    """Every call of a model's function in ``fdef`` takes its named arguments as borrowed views.
+    """Every call of a model's function in ``fdef`` takes its lasting arrays as borrowed views.
 
     A model function with a branch (``if need_gap:``) kept numba's reference
     counts on its array arguments, which LLVM did not prune: atomic operations
@@ -374,14 +374,41 @@ def _borrow_model_arguments(fdef):
     pointer by the shared one (the bouncing ball's step spent most of its time
     in them). On a view without memory info
     (:func:`moreau.integrators._contact_step.borrowed`) each is a test of a
-    null pointer; numbers and booleans pass through, and constants are left as
-    they are. The loop owns the arrays for the whole call.
+    null pointer. A view owns nothing, so only a name that outlives the call is
+    borrowed: the loop's arguments and the buffers made before its ``while``
+    (and names that only alias them). A name the loop body assigns anew (an
+    array made during a step, whose last use may be this call: numba frees it
+    right after its last use, before the call would run) is passed as it is,
+    and so are constants and expressions.
     """
+    loop = next(st for st in fdef.body if isinstance(st, ast.While))
+    fresh, aliases = set(), []
+    for node in ast.walk(loop):
+        if isinstance(node, (ast.Assign, ast.AugAssign, ast.AnnAssign)):
+            targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+            for target in targets:
+                for name in ast.walk(target):
+                    if isinstance(name, ast.Name) and isinstance(name.ctx, ast.Store):
+                        if isinstance(node, ast.Assign) and isinstance(target, ast.Name) \
+                                and isinstance(node.value, ast.Name):
+                            aliases.append((name.id, node.value.id))
+                        else:
+                            fresh.add(name.id)
+        elif isinstance(node, (ast.For, ast.comprehension)):
+            fresh.update(n.id for n in ast.walk(node.target) if isinstance(n, ast.Name))
+    changed = True
+    while changed:       # an alias of a fresh name is fresh
+        changed = False
+        for name, source in aliases:
+            if source in fresh and name not in fresh:
+                fresh.add(name)
+                changed = True
     for node in ast.walk(fdef):
         if isinstance(node, ast.Call) and isinstance(node.func, ast.Name) \
                 and node.func.id in MODEL_FUNCTIONS:
             node.args = [ast.Call(func=ast.Name(id="borrowed", ctx=ast.Load()), args=[a],
-                                  keywords=[]) if isinstance(a, (ast.Name, ast.Subscript)) else a
+                                  keywords=[])
+                         if isinstance(a, ast.Name) and a.id not in fresh else a
                          for a in node.args]
 
 
