@@ -14,11 +14,11 @@ scene, whose ratios are to that measurement. The goal of issue 9 is every
 scene at >= 10x Siconos's bouncing-ball rate.
 
 Every rate is a median over ``--repeats`` runs after a warm-up run. The shared
-loop's rate differs from one process to the next by up to a fifth, and stays
+loop's rate differs from one process to the next by up to a third, and stays
 put within one: it follows the address at which the loop's machine code is
 loaded (loaded again elsewhere in the same process, the loop changes speed;
-new copies of the model's functions or of the data do not change it), and the
-specialised loop does not vary so. The shared loop's rate is the median over
+new copies of the model's functions or of the data do not change it); the
+specialised loop varies less. The shared loop's rate is the median over
 ``--processes`` fresh processes, with the slowest and the fastest beside it,
 and its ratio to Siconos is taken from that median. A scene
 whose model holds only for a while from its start (the Painlevé rod falls
