@@ -106,11 +106,54 @@ def test_no_dated_measurement_is_left_in_the_readme():
             assert "docs/benchmarks.md" in paragraph, paragraph
 
 
-def test_ci_runs_the_readme_test_command():
-    # .ci/run is the README's test command, with only pip's byte-compiling switched off
-    ci = (ROOT / ".ci" / "run").read_text().splitlines()
-    (run,) = [line for line in ci if "pytest" in line and not line.startswith("#")]
-    assert run.replace(" --no-compile", "") in [c for b in readme_blocks(README) for c in b]
+README_TEST = 'python -m venv .venv && . .venv/bin/activate && pip install -e ".[test]" && python -m pytest -q'
+
+
+def _ci_steps(pip_fails_on=None, uv_fails=False, tmp=None):
+    """Run .ci/run with stand-ins for python, pip and uv that log what they are asked."""
+    ci = tmp / ".ci"
+    ci.mkdir()
+    (ci / "run").write_text((ROOT / ".ci" / "run").read_text())
+    bin_ = tmp / "bin"
+    bin_.mkdir()
+    log = tmp / "log"
+    stub = {
+        # python -m venv makes the folder with an activate script; anything else is logged
+        "python": 'echo "python $*" >> LOG; if [ "$1 $2" = "-m venv" ]; then '
+                  'mkdir -p "$3/bin"; : > "$3/bin/activate"; fi',
+        "pip": f'echo "pip $*" >> LOG; [ "$*" != "{pip_fails_on}" ]',
+        "uv": f'echo "uv $*" >> LOG; {"false" if uv_fails else "true"}',
+    }
+    for name, body in stub.items():
+        (bin_ / name).write_text("#!/bin/sh\n" + body.replace("LOG", str(log)) + "\n")
+        (bin_ / name).chmod(0o755)
+    env = dict(os.environ, PATH=f"{bin_}:/usr/bin:/bin")
+    done = subprocess.run(["bash", str(ci / "run")], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return log.read_text().splitlines(), done.stderr
+
+
+def test_readme_test_command_is_the_one_ci_mirrors():
+    assert README_TEST in [c for b in readme_blocks(README) for c in b]
+
+
+@pytest.mark.parametrize("pip_fails_on, uv_fails", [(None, False), ("install -q uv", False),
+                                                     (None, True)])
+def test_ci_runs_the_readme_test_command(tmp_path, pip_fails_on, uv_fails):
+    # .ci/run makes the README's environment, installs the package with its test extras
+    # (through uv, or through pip as the README says when uv fails) and runs the README's
+    # pytest command, as it is
+    steps, stderr = _ci_steps(pip_fails_on, uv_fails, tmp_path)
+    venv, _, _, pytest_ = README_TEST.split(" && ")
+    assert steps[0] == venv
+    assert steps[-1] == pytest_
+    installs = [s for s in steps if '-e .[test]' in s]
+    if pip_fails_on is None and not uv_fails:
+        assert installs == ["uv pip install -q -e .[test]"] and stderr == ""
+    else:
+        # the README's install, with only the byte-compiling switched off
+        assert installs[-1] == "pip install --no-compile -e .[test]"
+        assert "installing with pip" in stderr
 
 
 def test_every_command_that_takes_force_is_documented_with_it():
