@@ -102,6 +102,35 @@ def test_the_shared_loop_is_announced_at_its_first_call_once(fresh_loops, monkey
     assert len(fake.compiled) == 1 and fake.calls == 3
 
 
+def _loop_templates():
+    # every scheme's loop template, found among the integrators' modules (none listed here)
+    import pkgutil
+
+    import moreau.integrators as pkg
+    from moreau.integrators._driver import _Template
+    found = {}
+    for info in pkgutil.iter_modules(pkg.__path__):
+        module = importlib.import_module(f"moreau.integrators.{info.name}")
+        found.update({id(v): v for v in vars(module).values() if isinstance(v, _Template)})
+    return list(found.values())
+
+
+def test_every_loop_template_names_its_scheme_in_the_note(caplog):
+    # the scheme's name comes with its template (loop_template's third argument), so a new
+    # scheme's module is the only file that names it
+    templates = _loop_templates()
+    assert {t.__name__ for t in templates} >= {"mj_loop", "tdg_loop", "mjp_loop", "sp_loop",
+                                                "nsga_loop", "studer_loop"}
+    with caplog.at_level(logging.INFO, logger="moreau"):
+        for t in templates:
+            _loops._note_compile(t, None, shared=True)
+    notes = [r.getMessage() for r in caplog.records]
+    assert notes == [f"compiling the {t.scheme} loop (first use on this machine, once for every "
+                     f"scene, about {_loops.COMPILE_SECONDS} s)..." for t in templates]
+    assert len({t.scheme for t in templates}) == len(templates)
+    assert "Moreau–Jean projected" in {t.scheme for t in templates}
+
+
 def test_a_cached_loop_is_not_announced(fresh_loops, monkeypatch, caplog):
     monkeypatch.setattr(_jit_cache, "has_cached_code", lambda disp: True)
     scene = BouncingBall()

@@ -250,8 +250,9 @@ class _Template:
     build the function once and are taken from it.
     """
 
-    def __init__(self, name, namespace):
+    def __init__(self, name, namespace, scheme):
         self.__name__ = self.__qualname__ = name
+        self.scheme = scheme
         self._namespace = namespace
         self._fn = None
 
@@ -288,7 +289,7 @@ class _Template:
         return f"<loop template {self.__module__}.{self.__name__}>"
 
 
-def loop_template(name, namespace):
+def loop_template(name, namespace, scheme):
     """The driver with the step rule of the scheme module whose globals are ``namespace`` spliced in.
 
     The module holds :data:`STEP_FUNCTIONS` and ``_lcp_step`` (a shared loop
@@ -308,9 +309,10 @@ def loop_template(name, namespace):
     names a function's disk-cache files after it); its source is kept in
     ``__moreau_source__`` for the shared loop's rewrite, and the files
     spliced into it in ``__moreau_sources__``. It is built on first use
-    (:class:`_Template`): an import splices nothing.
+    (:class:`_Template`): an import splices nothing. ``scheme`` is the
+    scheme's name in the notes of its compiles (``template.scheme``).
     """
-    return _Template(name, namespace)
+    return _Template(name, namespace, scheme)
 
 
 def _splice_template(name, namespace):

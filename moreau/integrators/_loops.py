@@ -63,12 +63,6 @@ _RUNNERS = {}
 _LOCK = threading.Lock()
 log = logging.getLogger(__name__)
 
-#: the schemes' names of the loop templates, for the compile note
-SCHEME_OF_TEMPLATE = {"mj_loop": "Moreau–Jean", "sp_loop": "Schatzman–Paoli",
-                      "nsga_loop": "nonsmooth generalized-alpha",
-                      "studer_loop": "Studer extrapolation",
-                      "tdg_loop": "time-discontinuous Galerkin",
-                      "mjp_loop": "Moreau–Jean projected"}
 #: seconds in a shared loop after which a model's own loop is compiled: with a compile
 #: of C ~ 10 s and the specialised loop taking r ~ 1/2 of the shared one's time, the
 #: compile pays for itself after C / (1 - r) more seconds of work; moving there bounds
@@ -620,7 +614,8 @@ def _end_aside(child):
 
 
 def _note_compile(template, scene, shared):
-    scheme = SCHEME_OF_TEMPLATE.get(template.__name__, template.__name__)
+    # a template of loop_template names its scheme; another (a test's) is named by itself
+    scheme = getattr(template, "scheme", template.__name__)
     if shared:
         note(log, "compiling the %s loop (first use on this machine, once for every scene, "
              "about %s s)...", scheme, COMPILE_SECONDS)

@@ -402,7 +402,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-mj_loop = loop_template("mj_loop", globals())
+mj_loop = loop_template("mj_loop", globals(), "Moreau–Jean")
 
 
 def lean_enough(nc, lcp_ctl, opts):

@@ -426,4 +426,4 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-nsga_loop = loop_template("nsga_loop", globals())
+nsga_loop = loop_template("nsga_loop", globals(), "nonsmooth generalized-alpha")

@@ -201,4 +201,4 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-sp_loop = loop_template("sp_loop", globals())
+sp_loop = loop_template("sp_loop", globals(), "Schatzman–Paoli")

@@ -456,4 +456,4 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-studer_loop = loop_template("studer_loop", globals())
+studer_loop = loop_template("studer_loop", globals(), "Studer extrapolation")

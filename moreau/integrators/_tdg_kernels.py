@@ -362,4 +362,4 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-tdg_loop = loop_template("tdg_loop", globals())
+tdg_loop = loop_template("tdg_loop", globals(), "time-discontinuous Galerkin")

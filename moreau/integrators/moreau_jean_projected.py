@@ -167,7 +167,7 @@ def step_rule(mass_fn, forces_fn, contacts_fn, gaps_fn, NDOF, NCONTACTS, CONST_M
     return OK
 
 
-mjp_loop = loop_template("mjp_loop", globals())
+mjp_loop = loop_template("mjp_loop", globals(), "Moreau–Jean projected")
 
 
 @register_integrator("moreau-jean-projected")
