@@ -56,6 +56,22 @@ def _array(name, value, ndim):
     return a
 
 
+def _support(name, value, n):
+    # distinct integer indices in [0, n), as an int64 array
+    try:
+        a = np.asarray(value)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.ndim != 1 or (a.size and not np.issubdtype(a.dtype, np.integer)):
+        raise InputError(f"`{name}` must be a 1-d sequence of integer indices, got {value!r}")
+    a = a.astype(np.int64)
+    if a.size and (a.min() < 0 or a.max() >= n or np.unique(a).size != a.size):
+        raise InputError(f"`{name}` must hold distinct indices in [0, {n}) (the friction LCP's "
+                         f"variables), got {a.tolist()}")
+    a.setflags(write=False)
+    return a
+
+
 @dataclass(frozen=True, eq=False)
 class ContactProblem:
     """The velocity-level contact problem of one step (rows: module docstring).
@@ -78,6 +94,14 @@ class ContactProblem:
         Number of leading equality (bilateral) rows.
     eq_target : array_like, shape (n_eq,), optional
         What the equality rows' velocities must equal; default zero.
+    warm : array_like of int, optional
+        A warm start without equality rows: the indices of the variables of
+        the friction LCP (:func:`moreau.lcp.friction.build_friction_lcp`'s
+        layout, ``nc + 3 nf`` of them) that were positive in the solution of
+        an earlier problem with the same rows, the step before's. ``"auto"``
+        tries that support's point where Lemke's path would be finished in
+        exact arithmetic (:func:`moreau.lcp.solve_lcp`), checked on the data
+        like any answer; other solvers ignore it.
 
     Raises
     ------
@@ -106,6 +130,7 @@ class ContactProblem:
     vN_pre: np.ndarray = None
     n_eq: int = 0
     eq_target: np.ndarray = None
+    warm: np.ndarray = None
 
     def __post_init__(self):
         n_eq = self.n_eq
@@ -147,19 +172,25 @@ class ContactProblem:
             if tgt.shape != (n_eq,):
                 raise InputError(f"`eq_target` must have one entry per equality row ({n_eq}), "
                                  f"got shape {tgt.shape}")
+        warm = None if self.warm is None else _support("warm", self.warm, nc + 3 * frictional.size)
+        if warm is not None and n_eq:
+            raise InputError(f"`warm` is a support of the friction LCP, which has no equality rows; "
+                             f"got n_eq = {n_eq}")
         self.__dict__.update(W=W, u_free=u, mu=mu, e=e, vN_pre=vN, n_eq=int(n_eq), eq_target=tgt,
-                             frictional=frictional)
+                             warm=warm, frictional=frictional)
 
     @classmethod
-    def trusted(cls, W, u_free, mu, e, vN_pre, n_eq=0, eq_target=None):
+    def trusted(cls, W, u_free, mu, e, vN_pre, n_eq=0, eq_target=None, warm=None):
         """A problem from float arrays already in the layout, taken as they are (no checks, no copies).
 
         For the schemes' per-step path, whose data are built in the layout;
-        ``mu``, ``e`` and ``vN_pre`` are float arrays over the contacts.
+        ``mu``, ``e`` and ``vN_pre`` are float arrays over the contacts,
+        ``warm`` None or an int64 array of distinct indices of the friction
+        LCP's variables.
         """
         self = object.__new__(cls)
         # (the instance dict directly: a frozen dataclass's fields, without its per-field calls)
-        self.__dict__.update(W=W, u_free=u_free, mu=mu, e=e, vN_pre=vN_pre, n_eq=n_eq,
+        self.__dict__.update(W=W, u_free=u_free, mu=mu, e=e, vN_pre=vN_pre, n_eq=n_eq, warm=warm,
                              eq_target=_NO_ROWS if eq_target is None and not n_eq
                              else np.zeros(n_eq) if eq_target is None else eq_target)
         return self

@@ -130,7 +130,8 @@ def _jam_check(W, U_free, mu, e, vN_pre, slip_before, painleve, c, t):
 
 
 def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counters=None,
-                          lemke_max_iter=None, t=None, slip_before=None, painleve="impulse"):
+                          lemke_max_iter=None, t=None, slip_before=None, painleve="impulse",
+                          warm=None, warm_key=None):
     """Impulses of the active contacts of one step.
 
     Parameters
@@ -167,6 +168,17 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
         every tangential impact, and also a stick whose slip of rounding size
         points the paradoxical way (the schemes' behaviour before the
         tangential impact was taken).
+    warm : dict, optional
+        The caller's memory from one step to the next, updated in place: it
+        keeps the support of the last friction LCP solved, under
+        ``warm_key`` (the active contacts, say). A problem of several
+        contacts with the same key gets that support as its warm start
+        (:class:`~moreau.contact.ContactProblem`'s ``warm``): where Lemke's
+        path would be finished in exact arithmetic, ``"auto"`` tries that
+        support's point first, checked on the data. A solve on it is counted
+        in ``counters["warm_starts"]``, not as a fallback.
+    warm_key : hashable, optional
+        The key of this problem in ``warm``.
 
     Returns
     -------
@@ -199,7 +211,11 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     vN_pre = np.asarray(vN_pre, dtype=float)
     _jam_check(W, U_free, mu, e, vN_pre, slip_before, painleve, c, t)
     c["lcp_solves"] += 1
-    problem = ContactProblem.trusted(W, U_free, mu, e, vN_pre)
+    support = None
+    if warm is not None:
+        support = warm.get(warm_key)
+        warm.clear()
+    problem = ContactProblem.trusted(W, U_free, mu, e, vN_pre, warm=support)
     if mu.size == 1 and lcp_method == "auto":
         # what "auto" does with one contact, without the registry's dispatch (4 us of 15)
         try:
@@ -218,8 +234,12 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
     else:
         if r.method == "lemke":
             c["pivots"] += int(r.pivots)
-        if r.fallback_used:
+        if r.path[-1:] == ("support",):
+            c["warm_starts"] = c.get("warm_starts", 0) + 1
+        elif r.fallback_used:
             c["fallbacks"] += 1
+        if warm is not None and r.success and r.z.size == mu.size + 3 * np.count_nonzero(mu > 0.0):
+            warm[warm_key] = np.flatnonzero(r.z > 0.0)
         if sol.method == "pieces":
             c["piece_enumerations"] = c.get("piece_enumerations", 0) + 1
     if not sol.success:

@@ -283,7 +283,12 @@ answer is kept only when it passes the check a Lemke solution must pass
 (:func:`moreau.lcp.lcp_violation` to Lemke's tolerance) with every
 inequality clear of its bound; otherwise Lemke runs, from scratch. While
 the contacts keep their regimes no pivot is needed
-(``lcp_warm_start=False`` turns it off; the generic step never uses it). A
+(``lcp_warm_start=False`` turns it off). The generic step solves with
+Lemke first and keeps the support of its last LCP on the same active
+contacts: where Lemke's path meets a tie it would finish in exact
+arithmetic, that support's point is tried before the QP, checked the same
+way (:func:`~moreau.integrators.contact_problem.solve_contact_problem`'s
+``warm``; the bidirectional drive's rods sticking at the cone's edge). A
 solution near a change of regime (a slip ending within the step, a contact
 about to lift off) is refused, so that the choice between two solutions
 within rounding of each other is Lemke's, as on the generic path. Where the
@@ -532,8 +537,10 @@ class MoreauJean(TimeStepping):
         :class:`~moreau.errors.LCPError`. Not with ``"qp"``.
     lcp_warm_start : bool
         On the compiled path with ``lcp_method="auto"``, try the previous
-        multi-contact LCP's support before Lemke (see the module docstring;
-        default True). False makes every such step pivot from scratch.
+        multi-contact LCP's support before Lemke, and on the generic step
+        where Lemke's path would be finished in exact arithmetic (see the
+        module docstring; default True). False makes every such step pivot
+        from scratch.
     save_every : int
         Record one sample every ``save_every`` steps (and the last one). The
         sample at ``t0`` is the initial state with the first step's regime and
@@ -668,8 +675,9 @@ class MoreauJean(TimeStepping):
         # the Python steps left after the compiled spatial loop handed back a first step,
         # and how many it takes the next time (see _space_block)
         self._python_steps_left, self._python_run = 0, 1
-        # the last polyhedral LCP's support, for the next Python step (_space_step.space_step);
-        # on box contacts the exact cone starts from the last step's impulses
+        # the last friction or polyhedral LCP's support, for the next Python step
+        # (solve_contact_problem's warm, _space_step.space_step); on box contacts the exact
+        # cone starts from the last step's impulses
         self._lcp_memo = {}
         self._warm_cone = (np.zeros((self.scene.ncontacts, 3))
                            if self._space and getattr(self.scene, "box_index", ()) else None)
@@ -1092,7 +1100,8 @@ class MoreauJean(TimeStepping):
         p, pN[ia], pT[ia] = solve_contact_problem(
             W, U_free, mu, e, vN_pre, lcp_method=self.lcp_method, counters=self.counters,
             lemke_max_iter=self.lemke_max_iter, t=self.t, slip_before=self._slip_before(ia),
-            painleve=self.painleve)
+            painleve=self.painleve, warm=self._lcp_memo if self._warm_start() else None,
+            warm_key=tuple(ia.tolist()))
         return p
 
     def _project(self, q, t, closed):

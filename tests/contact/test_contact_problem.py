@@ -87,6 +87,13 @@ BAD = [
     (dict(n_eq=True), "`n_eq` must be an integer >= 0"),
     (dict(eq_target=[1.0]), r"`eq_target` must have one entry per equality row \(0\)"),
     (dict(mu="a"), "`mu` must be an array of real numbers"),
+    # one frictional contact: the friction LCP has 4 variables (p_N, t+, t-, beta)
+    (dict(warm=[4]), r"`warm` must hold distinct indices in \[0, 4\)"),
+    (dict(warm=[0, 0]), r"`warm` must hold distinct indices in \[0, 4\)"),
+    (dict(warm=[0.5]), "`warm` must be a 1-d sequence of integer indices"),
+    (dict(warm=[[0]]), "`warm` must be a 1-d sequence of integer indices"),
+    (dict(W=np.eye(3), u_free=[0.0, -1.0, 1.0], n_eq=1, warm=[0]),
+     "`warm` is a support of the friction LCP, which has no equality rows"),
 ]
 
 
@@ -139,3 +146,65 @@ def test_an_empty_problem_is_solved_by_every_method():
     for method in ("auto", "closed-form", "lemke", "mlcp"):
         sol = solve(ContactProblem(np.zeros((0, 0)), np.zeros(0), np.zeros(0)), method)
         assert sol.success and sol.p.shape == (0,) and sol.method == "none"
+
+
+def test_a_warm_support_is_kept_under_its_key_and_only_the_last():
+    # two frictional contacts pressed: the friction LCP's support is remembered under the
+    # caller's key, and a problem under another key starts without it
+    W = np.array([[2.0, 0.5, 0.1, 0.0], [0.5, 2.0, 0.0, 0.1],
+                  [0.1, 0.0, 1.0, 0.2], [0.0, 0.1, 0.2, 1.0]])
+    U = np.array([-1.0, -1.0, 0.3, -0.2])
+    mu, e, vN = np.array([0.5, 0.5]), np.zeros(2), np.array([-1.0, -1.0])
+    warm, c = {}, new_contact_counters()
+    p, _, _ = solve_contact_problem(W, U, mu, e, vN, counters=c, warm=warm, warm_key=(0, 1))
+    M, q, _ = build_friction_lcp(W, U, mu, e, vN)
+    (key, support), = warm.items()
+    assert key == (0, 1)
+    z = np.zeros(M.shape[0])
+    z[support] = np.linalg.solve(M[np.ix_(support, support)], -q[support])
+    assert lcp_violation(M, q, z) <= 1e-12
+    solve_contact_problem(W[:2, :2], U[:2], np.zeros(2), e, vN, counters=c, warm=warm,
+                          warm_key=(5,))
+    assert list(warm) == [(5,)]
+
+
+def _h(values):
+    return np.array([float.fromhex(v) for v in values])
+
+
+#: a step of the bidirectional drive's generic Moreau–Jean run (h = 2 pi / 1000, from the
+#: scene's initial state, about its 50th step): both rods stick, each at the friction
+#: cone's edge (p_T = mu p_N), a tie on which Lemke's path would be finished in exact
+#: arithmetic
+TIED = dict(
+    W=np.array([_h(r) for r in (
+        ["0x1.77d289444922fp+0", "0x0.0p+0", "-0x1.77c380c1d4952p+0", "0x0.0p+0"],
+        ["0x0.0p+0", "0x1.77d289444922fp+0", "0x0.0p+0", "0x1.77c380c1d4952p+0"],
+        ["-0x1.77c380c1d4952p+0", "0x0.0p+0", "0x1.7a43d502476dfp+0", "0x1.47ae147ae147bp-7"],
+        ["0x0.0p+0", "0x1.77c380c1d4952p+0", "0x1.47ae147ae147bp-7", "0x1.7a43d502476dfp+0"])]),
+    U=_h(["-0x1.a70f715c37f7cp-13", "-0x1.a70f715c38028p-13", "-0x1.1c6655315f3f3p-12",
+          "0x1.1c6655315f39bp-12"]),
+    mu=np.full(2, 0.1), e=np.zeros(2), vN=_h(["0x1.033bf9f520000p-29", "0x1.033bf9ea20000p-29"]))
+
+
+def test_a_warm_support_solves_where_lemke_would_go_exact():
+    # with the support of the step before, "auto" takes that support's point (no pivot, no
+    # QP) and counts a warm start; without, the QP's answer (a fallback). Both are checked
+    # on the data
+    from moreau.lcp import lemke
+    W, U, mu, e, vN = TIED["W"], TIED["U"], TIED["mu"], TIED["e"], TIED["vN"]
+    M, q, _ = build_friction_lcp(W, U, mu, e, vN)
+    assert lemke._solve(M, q, None, None, True, None, True) is None     # the hand-over
+    c = new_contact_counters()
+    warm = {(0, 1): np.array([0, 1, 3, 4, 6, 7])}
+    p, pN, pT = solve_contact_problem(W, U, mu, e, vN, counters=c, warm=warm, warm_key=(0, 1))
+    assert c["warm_starts"] == 1 and c["fallbacks"] == 0 and c["pivots"] == 0
+    np.testing.assert_allclose(np.abs(pT), mu * pN, rtol=1e-14)     # at the cone's edge
+    sol = solve(ContactProblem(W, U, mu, e, vN, warm=[0, 1, 3, 4, 6, 7]), "auto")
+    assert sol.lcp.path == ("lemke", "support") and sol.lcp.pivots == 0
+    assert lcp_violation(M, q, sol.lcp.z) <= lemke.DEFAULT_TOL
+    np.testing.assert_array_equal(sol.p, p)
+    c0 = new_contact_counters()
+    p0, _, _ = solve_contact_problem(W, U, mu, e, vN, counters=c0)
+    assert c0["fallbacks"] == 1 and c0.get("warm_starts", 0) == 0
+    np.testing.assert_allclose(p0, p, rtol=0, atol=1e-9 * np.abs(p).max())

@@ -241,3 +241,18 @@ def test_regime_solve_where_regimes_change(name):
         ratio = np.abs(ref.force_T) / np.maximum(sc.mu[0] * ref.force_N, 1e-300)
         differ = ref.regime != warm.regime
         assert not np.any(differ & (np.abs(ratio - 1.0) > 1e-6))
+
+
+def test_the_generic_step_warm_starts_the_ties_lemke_would_finish_exactly():
+    # the bidirectional drive from its initial state: both rods stick at the cone's edge, a
+    # tie that Lemke's path would finish in exact arithmetic, so the generic step took the
+    # QP on such steps (78 of the first 500). With the support of the step before it takes
+    # that point, checked on the data, and follows the compiled loop as closely as before
+    sc, h, n = BidirectionalDrive(), TWO_PI / 1000, 400
+    slow = _run(sc, h, n, fast=False, save_every=n)
+    fast = _run(sc, h, n, save_every=n)
+    assert slow.stats["fallbacks"] == 0
+    assert slow.stats["warm_starts"] >= 1
+    assert slow.stats["lcp_solves"] == n
+    np.testing.assert_allclose(slow.q[-1], fast.q[-1], rtol=0, atol=1e-14)
+    np.testing.assert_allclose(slow.v[-1], fast.v[-1], rtol=0, atol=1e-14)

@@ -23,7 +23,9 @@ def solve_friction_lcp(problem, lcp_method, max_iter, tol):
     W, U, mu, e, vN = problem.W, problem.u_free, problem.mu, problem.e, problem.vN_pre
     na = mu.size
     Ml, ql, layout = build_friction_lcp(W, U, mu, e, vN)
-    r = solve_lcp(Ml, ql, method=lcp_method, friction=layout, max_iter=max_iter, tol=tol)
+    # the warm start (a support) is "auto"'s: Lemke and the QP alone take none
+    warm = {"support": problem.warm} if lcp_method == "auto" and problem.warm is not None else {}
+    r = solve_lcp(Ml, ql, method=lcp_method, friction=layout, max_iter=max_iter, tol=tol, **warm)
     z = r.z if r.success else None
     path, method = r.path, r.method
     # (a pivot limit the caller set is kept: its failure is the answer)
