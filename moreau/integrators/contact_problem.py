@@ -67,7 +67,7 @@ def slip_signs(regimes):
 
 def new_contact_counters():
     """The statistics :func:`solve_contact_problem` updates, all zero."""
-    return {"lcp_solves": 0, "direct_solves": 0, "pivots": 0, "fallbacks": 0,
+    return {"lcp_solves": 0, "direct_solves": 0, "pivots": 0, "fallbacks": 0, "warm_starts": 0,
             "max_residual": 0.0, "tangential_impacts": 0, "tangential_impact_times": []}
 
 
@@ -235,7 +235,7 @@ def solve_contact_problem(W, U_free, mu, e, vN_pre, *, lcp_method="auto", counte
         if r.method == "lemke":
             c["pivots"] += int(r.pivots)
         if r.path[-1:] == ("support",):
-            c["warm_starts"] = c.get("warm_starts", 0) + 1
+            c["warm_starts"] += 1
         elif r.fallback_used:
             c["fallbacks"] += 1
         if warm is not None and r.success and r.z.size == mu.size + 3 * np.count_nonzero(mu > 0.0):

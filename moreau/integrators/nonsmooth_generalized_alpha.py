@@ -255,7 +255,9 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
                                                     counters=self.counters, t=self.t,
                                                     painleve=self.painleve,
                                                     slip_before=(slip_signs(self._prev_reg[ib])
-                                                                 if stop else None))
+                                                                 if stop else None),
+                                                    warm=self._lcp_warm("newton"),
+                                                    warm_key=tuple(ib.tolist()))
                 dx = dx + JiHT @ lam
                 lamN[ib], lamT[ib] = ln, lt
                 slip[fb] = (U_free + W @ lam)[ib.size:]
@@ -328,7 +330,9 @@ class NonsmoothGeneralizedAlpha(TimeStepping):
                                                   lcp_method=self.lcp_method,
                                                   counters=self.counters, t=t0,
                                                   slip_before=slip_signs(self._prev_reg[ia]),
-                                                  painleve=self.painleve)
+                                                  painleve=self.painleve,
+                                                  warm=self._lcp_warm("impulse"),
+                                                  warm_key=tuple(ia.tolist()))
                 pN[ia], pT[ia] = pn, pt
                 v1 = vs + MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]

@@ -227,7 +227,8 @@ class SchatzmanPaoli(TimeStepping):
                     lemke_max_iter=self.lemke_max_iter, t=t,
                     # a node solved again must not record its tangential impact twice
                     slip_before=slip_signs(self._prev_reg[ia]) if count else None,
-                    painleve=self.painleve)
+                    painleve=self.painleve, warm=self._lcp_warm("impulse"),
+                    warm_key=tuple(ia.tolist()))
                 pN[ia], pT[ia] = pn, pt
                 dv_contact = MinvHT @ p
                 slip[fa] = (U_free + W @ p)[ia.size:]

@@ -306,7 +306,8 @@ class StuderExtrapolation(TimeStepping):
                     p, pn, pt = solve_contact_problem(
                         W, U_free, self.mu_c[ia], e, vN_pre, lcp_method=self.lcp_method,
                         counters=self.counters, t=t, painleve=self.painleve,
-                        slip_before=slip_signs(self._prev_reg[ia]) if stop else None)
+                        slip_before=slip_signs(self._prev_reg[ia]) if stop else None,
+                        warm=self._lcp_warm("base step"), warm_key=tuple(ia.tolist()))
                     pN[ia], pT[ia] = pn, pt
                     v1 = v_free + MinvHT @ p
                     U = U_free + W @ p

@@ -207,7 +207,8 @@ class TimeDiscontinuousGalerkin(TimeStepping):
                                         lcp_method=self.lcp_method, counters=self.counters,
                                         lemke_max_iter=self.lemke_max_iter, t=t,
                                         slip_before=slip_signs(self._prev_reg[ia]) if stop else None,
-                                        painleve=self.painleve)
+                                        painleve=self.painleve, warm=self._lcp_warm("stage"),
+                                        warm_key=tuple(ia.tolist()))
         return p, U_free + W @ p
 
     def _step_impl(self):

@@ -330,6 +330,9 @@ class TimeStepping(CompiledRecording, Integrator):
         self._trow[scene.frictional_index] = np.arange(len(scene.frictional_index))
         self._closed = np.zeros(nc, dtype=bool)
         self.counters = self._new_counters()
+        # the generic step's memory of its last LCP's support, one per place a step solves
+        # one (solve_contact_problem's warm): see _lcp_warm
+        self._lcp_memos = {}
         self._pending_initial = True
         self._setup_scheme()
         self._prev_reg = sliding_regimes(scene, self.q, self.v, self.t0)
@@ -363,6 +366,18 @@ class TimeStepping(CompiledRecording, Integrator):
     def _warm_start(self):
         """Whether the compiled path warm-starts its contact problems."""
         return False
+
+    def _lcp_warm(self, site):
+        """The generic step's warm-start memory for the contact problems solved at ``site``.
+
+        Given to :func:`~moreau.integrators.contact_problem.solve_contact_problem`
+        (``warm``, with the active contacts as ``warm_key``): where Lemke's path
+        meets a tie it would finish in exact arithmetic, the support of the last
+        problem solved there on the same contacts is tried before the QP,
+        checked on the data. One memory per site, since a step may solve
+        problems of several kinds (stages, iterates) whose supports differ.
+        """
+        return self._lcp_memos.setdefault(site, {})
 
     def _end_gaps(self, q1, t1, nc):
         """The ``nc`` gaps at the step's end ``(q1, t1)``, the deepest penetration counted."""
