@@ -11,9 +11,12 @@ ROOT = pathlib.Path(__file__).parents[1]
 DOCS = ROOT / "docs"
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(importlib.util.find_spec("sphinx") is None,
                     reason='sphinx is not installed: pip install -e ".[docs]"')
 def test_the_reference_builds_without_warnings(tmp_path):
+    # slow: the whole reference read by Sphinx, 10 CPU s (the default run's largest check
+    # of its own; tests/test_readme.py holds the guide's pages to the program meanwhile)
     # the dummy builder reads and resolves every page (autodoc, numpydoc, the README, the
     # notebooks) like the html one, without writing pages: a warning is an error (-W)
     done = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-b", "dummy",

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
 
+import pytest
 
 import moreau
 
@@ -82,8 +83,11 @@ def _import_alone(module):
     return module, run.returncode, run.stderr.strip().splitlines()[-1:] if run.returncode else []
 
 
+@pytest.mark.slow
 def test_every_module_imports_alone_in_a_fresh_interpreter():
-    # import-order bugs (circles) hide inside one test process
+    # import-order bugs (circles) hide inside one test process. slow: a fork per module,
+    # 8 CPU s; tests/test_layers.py reads every import statement for circles in the default
+    # run
     assert len(MODULES) > 40
     if hasattr(os, "fork"):
         run = subprocess.run([sys.executable, "-c", _FORK_IMPORTS, json.dumps(MODULES)],
