@@ -109,7 +109,7 @@ def test_no_dated_measurement_is_left_in_the_readme():
 README_TEST = 'python -m venv .venv && . .venv/bin/activate && pip install -e ".[test]" && python -m pytest -q'
 
 
-def _ci_steps(pip_fails_on=None, uv_fails=False, tmp=None):
+def _ci_steps(tmp, pip_fails_on=None, uv_fails=False):
     """Run .ci/run with stand-ins for python, pip and uv that log what they are asked."""
     ci = tmp / ".ci"
     ci.mkdir()
@@ -143,7 +143,7 @@ def test_ci_runs_the_readme_test_command(tmp_path, pip_fails_on, uv_fails):
     # .ci/run makes the README's environment, installs the package with its test extras
     # (through uv, or through pip as the README says when uv fails) and runs the README's
     # pytest command, as it is
-    steps, stderr = _ci_steps(pip_fails_on, uv_fails, tmp_path)
+    steps, stderr = _ci_steps(tmp_path, pip_fails_on, uv_fails)
     venv, _, _, pytest_ = README_TEST.split(" && ")
     assert steps[0] == venv
     assert steps[-1] == pytest_

@@ -675,9 +675,8 @@ class MoreauJean(TimeStepping):
         # the Python steps left after the compiled spatial loop handed back a first step,
         # and how many it takes the next time (see _space_block)
         self._python_steps_left, self._python_run = 0, 1
-        # the last friction or polyhedral LCP's support, for the next Python step
-        # (solve_contact_problem's warm, _space_step.space_step); on box contacts the exact
-        # cone starts from the last step's impulses
+        # the last polyhedral LCP's support, for the next Python step (_space_step.space_step);
+        # on box contacts the exact cone starts from the last step's impulses
         self._lcp_memo = {}
         self._warm_cone = (np.zeros((self.scene.ncontacts, 3))
                            if self._space and getattr(self.scene, "box_index", ()) else None)
@@ -1100,7 +1099,8 @@ class MoreauJean(TimeStepping):
         p, pN[ia], pT[ia] = solve_contact_problem(
             W, U_free, mu, e, vN_pre, lcp_method=self.lcp_method, counters=self.counters,
             lemke_max_iter=self.lemke_max_iter, t=self.t, slip_before=self._slip_before(ia),
-            painleve=self.painleve, warm=self._lcp_memo if self._warm_start() else None,
+            painleve=self.painleve,
+            warm=self._lcp_warm("impulse") if self._warm_start() else None,
             warm_key=tuple(ia.tolist()))
         return p
 
